@@ -1,0 +1,22 @@
+"""BEM plant of a reference wind turbine: data, aerodynamics, nonlinear plant and trim.
+
+This package never imports ``mpc_wt`` or ``lidar``.
+"""
+from .bem import AeroOptions, element_loads
+from .plant import (DOF_NAMES, INPUT_NAMES, INPUT_UNITS, MADSEN_OUTPUTS, OUTPUT_NAMES,
+                    OUTPUT_UNITS, STATE_NAMES, STATE_UNITS, GridWind, PlantConfig, PlantParams,
+                    SimulationDivergedError, SimulationResult, SteadyWind, element_wind,
+                    plant_outputs, plant_params, plant_rhs, rk4_simulate, structural_frequencies)
+from .steady import optimal_tsr, rotor_average, steady_coefficients
+from .trim import OperatingPoint, TrimError, operating_schedule, rated_wind_speed, trim
+from .turbine import Turbine, TurbineFileError, available_turbines, load_turbine
+
+__all__ = [
+    "AeroOptions", "element_loads", "DOF_NAMES", "INPUT_NAMES", "INPUT_UNITS", "MADSEN_OUTPUTS",
+    "OUTPUT_NAMES", "OUTPUT_UNITS", "STATE_NAMES", "STATE_UNITS", "GridWind", "PlantConfig",
+    "PlantParams", "SimulationDivergedError", "SimulationResult", "SteadyWind", "element_wind",
+    "plant_outputs", "plant_params", "plant_rhs", "rk4_simulate", "structural_frequencies",
+    "optimal_tsr", "rotor_average", "steady_coefficients", "OperatingPoint", "TrimError",
+    "operating_schedule", "rated_wind_speed", "trim", "Turbine", "TurbineFileError", "available_turbines",
+    "load_turbine",
+]

@@ -1,0 +1,349 @@
+"""Steady operating points against mean wind speed (trim).
+
+Schedule (Madsen et al. 2012, sec. II-D: "maximizing the power output at low wind speeds ...
+limiting the power to the rated level"; Jonkman et al. 2009, sec. 7):
+
+* region 1.5: rotor speed held at its minimum, fine pitch;
+* region 2: maximum C_P tracking, omega = lambda_opt V / R, fine pitch;
+* region 2.5: rotor speed held at rated, fine pitch, power still below the cap;
+* region 3: power held at the cap (rated, or a power reference below rated) by pitching to
+  feather at the scheduled rotor speed.
+
+The structural equilibrium (tower deflections, shaft torsion, blade flap) follows exactly from
+the rotor loads, so that the trim point is an equilibrium of :func:`linearize.plant_rhs` (with
+tilt, gravity or shear on, of its azimuth average).
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+from scipy.optimize import brentq
+
+from ._typing import FloatArray
+from ._validate import check_finite_scalar
+from .plant import STATE_NAMES, PlantConfig, PlantParams, n_x, plant_params
+from .steady import optimal_tsr, rotor_average
+from .turbine import Turbine
+
+__all__ = ["TrimError", "OperatingPoint", "trim", "operating_schedule", "rated_wind_speed"]
+
+
+class TrimError(RuntimeError):
+    """The requested operating point cannot be reached."""
+
+
+@dataclass(frozen=True)
+class OperatingPoint:
+    """A trimmed steady operating point.
+
+    Parameters
+    ----------
+    wind_speed : float
+        Hub-height mean wind speed [m/s].
+    region : str
+        "1.5", "2", "2.5" or "3".
+    pitch_rad : float
+        Collective pitch [rad].
+    rotor_speed_rad_s, gen_speed_rad_s : float
+        [rad/s].
+    gen_torque : float
+        Generator torque (high-speed shaft) [N m].
+    power : float
+        Electrical power [W].
+    aero_power : float
+        Rotor aerodynamic power, torque times rotor speed [W].
+    aero_torque : float
+        [N m].
+    thrust : float
+        Rotor thrust along the shaft [N].
+    tsr : float
+        Tip-speed ratio on the projected radius [-].
+    cp, ct : float
+        Power and thrust coefficients [-].
+    x : (n_x,) ndarray
+        Equilibrium state (:data:`linearize.STATE_NAMES`).
+    u : (n_u,) ndarray
+        Equilibrium inputs (:data:`linearize.INPUT_NAMES`).
+    power_reference : float or None
+        The power cap the point was trimmed to, if a reference below rated was asked [W].
+    shear_exponent : float
+        Shear of the steady wind the point was trimmed in [-].
+    """
+
+    wind_speed: float
+    region: str
+    pitch_rad: float
+    rotor_speed_rad_s: float
+    gen_speed_rad_s: float
+    gen_torque: float
+    power: float
+    aero_power: float
+    aero_torque: float
+    thrust: float
+    tsr: float
+    cp: float
+    ct: float
+    x: FloatArray = field(repr=False)
+    u: FloatArray = field(repr=False)
+    power_reference: float | None = None
+    shear_exponent: float = 0.0
+
+    def __post_init__(self) -> None:
+        for name in ("x", "u"):
+            a = np.array(getattr(self, name), dtype=float)
+            a.flags.writeable = False
+            object.__setattr__(self, name, a)
+
+    @property
+    def pitch_deg(self) -> float:
+        """Collective pitch [deg] (I/O convenience)."""
+        return math.degrees(self.pitch_rad)
+
+    @property
+    def rotor_speed_rpm(self) -> float:
+        """Rotor speed [rpm] (I/O convenience)."""
+        return self.rotor_speed_rad_s * 30.0 / math.pi
+
+    def state(self, name: str) -> float:
+        """One equilibrium state by name."""
+        return float(self.x[STATE_NAMES.index(name)])
+
+    def as_dict(self) -> dict[str, Any]:
+        """Plain dict with unit-suffixed keys, for JSON and tables."""
+        return {
+            "wind_mps": self.wind_speed, "region": self.region, "pitch_deg": self.pitch_deg,
+            "rotor_speed_rpm": self.rotor_speed_rpm,
+            "gen_speed_rpm": self.gen_speed_rad_s * 30.0 / math.pi,
+            "gen_torque_Nm": self.gen_torque, "power_W": self.power,
+            "aero_power_W": self.aero_power, "aero_torque_Nm": self.aero_torque,
+            "thrust_N": self.thrust, "tsr": self.tsr, "cp": self.cp, "ct": self.ct,
+            "tower_fa_deflection_m": self.state("tower_fa_displacement"),
+            "tower_ss_deflection_m": self.state("tower_ss_displacement"),
+            "shaft_torsion_rad": self.state("shaft_torsion"),
+            "flap_deflection_m": self.state("flap_1"),
+        }
+
+
+_TSR_CACHE: dict[tuple[int, PlantConfig, float], tuple[Turbine, float]] = {}
+
+
+def _tsr_opt(params: PlantParams, shear: float) -> float:
+    t = params.turbine
+    key = (id(t), params.config, shear)
+    hit = _TSR_CACHE.get(key)
+    if hit is not None and hit[0] is t:
+        return hit[1]
+    lam, _ = optimal_tsr(t, math.degrees(t.operation.fine_pitch_rad), params.config.aero,
+                         shear_exponent=shear, integration=params.config.integration)
+    _TSR_CACHE[key] = (t, lam)
+    return lam
+
+
+def _state(params: PlantParams, omega: float, pitch: float) -> FloatArray:
+    x = np.zeros(n_x)
+    x[2] = omega
+    x[3] = omega * params.turbine.drivetrain.gearbox_ratio
+    x[5:8] = pitch
+    return x
+
+
+def _aero(params: PlantParams, v: float, omega: float, pitch: float,
+          shear: float) -> tuple[float, float]:
+    """Azimuth-averaged aerodynamic torque [N m] and thrust [N]."""
+    x = _state(params, omega, pitch)
+    u = np.array([pitch, pitch, pitch, 0.0])
+    _, z = rotor_average(params, x, u, v, shear)
+    return float(z[22]), float(z[23])
+
+
+def trim(turbine: Turbine, wind_mps: float, power_W: float | None = None, *,
+         config: PlantConfig | None = None, shear_exponent: float = 0.0,
+         params: PlantParams | None = None) -> OperatingPoint:
+    """Trim the plant at a mean wind speed.
+
+    Parameters
+    ----------
+    turbine : Turbine
+    wind_mps : float
+        Hub-height wind speed [m/s], within cut-in..cut-out.
+    power_W : float, optional
+        Electrical power reference below rated [W] (down-regulation, active power control).
+        ``None`` trims to the normal schedule with rated power as the cap.
+    config : PlantConfig, optional
+        Degrees of freedom and aerodynamic options (default: all on).
+    shear_exponent : float
+        Power-law shear of the steady wind [-] (default 0: uniform).
+    params : PlantParams, optional
+        Prebuilt parameters (skips :func:`plant_params`); must match ``turbine``.
+
+    Returns
+    -------
+    OperatingPoint
+
+    Raises
+    ------
+    TrimError
+        If the wind is outside cut-in..cut-out, the power reference is above rated or above the
+        power available in this wind, or the generator torque would exceed its limit.
+    ValueError
+        If an argument is not finite.
+    """
+    v = check_finite_scalar("wind_mps", wind_mps)
+    op = turbine.operation
+    if not op.cut_in_wind <= v <= op.cut_out_wind:
+        raise TrimError(f"wind_mps = {v:g} m/s is outside the operating range cut-in.."
+                        f"cut-out = {op.cut_in_wind:g}..{op.cut_out_wind:g} m/s")
+    if power_W is not None:
+        pref = check_finite_scalar("power_W", power_W)
+        if not 0.0 < pref <= op.rated_power * (1 + 1e-12):
+            raise TrimError(f"power_W = {pref:g} W must be in (0, rated power "
+                            f"{op.rated_power:g} W]")
+    else:
+        pref = None
+    cap = op.rated_power if pref is None else pref
+    p = params if params is not None else plant_params(turbine, config)
+    shear = float(shear_exponent)
+    dt = turbine.drivetrain
+    ngear = dt.gearbox_ratio
+    eta = dt.generator_efficiency * dt.gearbox_efficiency
+    cone = turbine.geometry.precone_rad if p.config.aero.cone else 0.0
+    rproj = turbine.geometry.tip_radius * math.cos(cone)
+    fine = op.fine_pitch_rad
+
+    lam = _tsr_opt(p, shear)
+    w_opt = lam * v / rproj
+    omega = min(max(w_opt, op.min_rotor_speed_rad_s), op.rated_rotor_speed_rad_s)
+    q_fine, _ = _aero(p, v, omega, fine, shear)
+    p_fine = eta * q_fine * omega
+    if p_fine <= cap * (1 + 1e-12):
+        if pref is not None and p_fine < pref * (1 - 1e-9):
+            raise TrimError(f"power_W = {pref:g} W is above the power available at "
+                            f"{v:g} m/s ({p_fine:g} W)")
+        pitch = fine
+        if omega <= op.min_rotor_speed_rad_s * (1 + 1e-12) and w_opt < omega:
+            region = "1.5"
+        elif omega >= op.rated_rotor_speed_rad_s * (1 - 1e-12) and w_opt > omega:
+            region = "2.5"
+        else:
+            region = "2"
+        q_target = q_fine
+    else:
+        region = "3"
+        q_target = cap / (eta * omega)
+
+        def resid(b: float) -> float:
+            return _aero(p, v, omega, b, shear)[0] - q_target
+
+        hi = turbine.pitch_actuator.max_pitch_rad
+        if resid(hi) > 0:
+            raise TrimError(f"cannot shed enough power at {v:g} m/s even at maximum pitch")
+        pitch = brentq(resid, fine, hi, xtol=1e-14, rtol=4 * np.finfo(float).eps, maxiter=200)
+    tg = q_target / ngear
+    if tg > turbine.generator.max_torque * (1 + 1e-9):
+        raise TrimError(f"trim at {v:g} m/s needs generator torque {tg:g} N m, above the "
+                        f"limit {turbine.generator.max_torque:g} N m")
+    x, u, z = _equilibrium(p, v, omega, pitch, tg, shear)
+    q, thrust = float(z[22]), float(z[23])
+    area = math.pi * rproj**2
+    return OperatingPoint(
+        wind_speed=v, region=region, pitch_rad=float(pitch), rotor_speed_rad_s=omega,
+        gen_speed_rad_s=omega * ngear, gen_torque=tg, power=eta * tg * omega * ngear,
+        aero_power=q * omega, aero_torque=q, thrust=thrust, tsr=omega * rproj / v if v > 0 else 0,
+        cp=q * omega / (0.5 * turbine.environment.air_density * area * v**3),
+        ct=thrust / (0.5 * turbine.environment.air_density * area * v**2),
+        x=x, u=u, power_reference=pref, shear_exponent=shear)
+
+
+def _equilibrium(p: PlantParams, v: float, omega: float, pitch: float, tg: float,
+                 shear: float) -> tuple[FloatArray, FloatArray, FloatArray]:
+    """Structural displacements that null the (azimuth-averaged) accelerations.
+
+    The loads do not depend on displacements, so the accelerations are affine in them and
+    one solve of K delta = M a0 is exact.
+    """
+    pk = p.pack
+    x = _state(p, omega, pitch)
+    u = np.array([pitch, pitch, pitch, tg])
+    # shaft torsion: K theta = Q_aero (with the rigid-shaft torque as the reference)
+    if p.dof("drivetrain"):
+        q, _ = _aero(p, v, omega, pitch, shear)
+        x[4] = q / pk.k_shaft
+    dx0, _ = rotor_average(p, x, u, v, shear)
+    if p.dof("tower_fa") or p.dof("blade_flap"):
+        kq = pk.k_b + omega**2 * pk.k_cf
+        m = np.array([[pk.m_fa, pk.m_c, pk.m_c, pk.m_c],
+                      [pk.m_c, pk.m_b, 0.0, 0.0],
+                      [pk.m_c, 0.0, pk.m_b, 0.0],
+                      [pk.m_c, 0.0, 0.0, pk.m_b]])
+        k = np.diag([pk.k_fa, kq, kq, kq])
+        a0 = np.array([dx0[1], dx0[13], dx0[14], dx0[15]])
+        on = np.array([p.dof("tower_fa")] + [p.dof("blade_flap")] * 3)
+        idx = np.flatnonzero(on)
+        delta = np.zeros(4)
+        delta[idx] = np.linalg.solve(k[np.ix_(idx, idx)], m[np.ix_(idx, idx)] @ a0[idx])
+        x[0] = delta[0]
+        x[10:13] = delta[1:]
+    if p.dof("tower_ss"):
+        x[8] = pk.m_ss * dx0[9] / pk.k_ss
+    dx, z = rotor_average(p, x, u, v, shear)
+    scale = np.array([1.0, 1e-2, 1e-3, 1e-1, 1e-3, 1e-3, 1e-3, 1e-3, 1.0, 1e-2, 1.0, 1.0, 1.0,
+                      1e-2, 1e-2, 1e-2, 1.0])
+    resid = np.abs(dx[:16]) / scale[:16]
+    resid[[0, 8, 10, 11, 12]] = 0.0   # displacement rates are velocities (zero by construction)
+    if not np.all(np.isfinite(dx)) or resid.max() > 1e-6:
+        k = int(np.argmax(resid))
+        raise TrimError(f"trim did not reach equilibrium: d({STATE_NAMES[k]})/dt = {dx[k]!r}")
+    return x, u, z
+
+
+def operating_schedule(turbine: Turbine, wind_speeds: FloatArray, power_W: float | None = None,
+                       *, config: PlantConfig | None = None,
+                       shear_exponent: float = 0.0) -> list[OperatingPoint]:
+    """Trim at each wind speed; with ``power_W``, cap the power at min(available, power_W).
+
+    Unlike :func:`trim`, a power reference above what the wind offers is not an error here:
+    those points follow the normal schedule (the derated turbine's partial-load region).
+    """
+    p = plant_params(turbine, config)
+    out = []
+    for v in np.asarray(wind_speeds, dtype=float).ravel():
+        if power_W is None:
+            out.append(trim(turbine, float(v), params=p, shear_exponent=shear_exponent))
+            continue
+        try:
+            out.append(trim(turbine, float(v), power_W, params=p, shear_exponent=shear_exponent))
+        except TrimError as err:
+            if "above the power available" not in str(err):
+                raise
+            out.append(trim(turbine, float(v), params=p, shear_exponent=shear_exponent))
+    return out
+
+
+def rated_wind_speed(turbine: Turbine, *, config: PlantConfig | None = None,
+                     shear_exponent: float = 0.0) -> float:
+    """Lowest wind speed at which rated power is reached at fine pitch [m/s].
+
+    Raises
+    ------
+    TrimError
+        If rated power is not reached below cut-out.
+    """
+    p = plant_params(turbine, config)
+    op = turbine.operation
+    dt = turbine.drivetrain
+    eta = dt.generator_efficiency * dt.gearbox_efficiency
+    cone = turbine.geometry.precone_rad if p.config.aero.cone else 0.0
+    rproj = turbine.geometry.tip_radius * math.cos(cone)
+    lam = _tsr_opt(p, float(shear_exponent))
+
+    def surplus(v: float) -> float:
+        w = min(max(lam * v / rproj, op.min_rotor_speed_rad_s), op.rated_rotor_speed_rad_s)
+        q, _ = _aero(p, v, w, op.fine_pitch_rad, float(shear_exponent))
+        return eta * q * w - op.rated_power
+
+    if surplus(op.cut_out_wind) < 0:
+        raise TrimError("rated power is not reached below cut-out")
+    return float(brentq(surplus, op.cut_in_wind, op.cut_out_wind, xtol=1e-10))

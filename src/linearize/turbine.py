@@ -1,0 +1,725 @@
+"""Reference-turbine data: typed, frozen, validated on loading.
+
+A turbine is a YAML file of scalar parameters plus CSV tables (blade aerodynamics, airfoil polars,
+distributed blade and tower structure, mode shapes). The format is documented in
+``docs/turbine-format.md``; :func:`load_turbine` reads it and names the file, field and allowed
+range on any error. Everything held by :class:`Turbine` is SI (angles in rad).
+"""
+from __future__ import annotations
+
+import csv
+import math
+from dataclasses import dataclass, field, fields
+from importlib import resources
+from pathlib import Path
+from typing import Any, Callable
+
+import numpy as np
+import yaml
+
+from ._typing import FloatArray, IntArray
+from ._validate import frozen_array
+
+__all__ = [
+    "TurbineFileError", "Geometry", "Operation", "Environment", "RotorMass", "Nacelle",
+    "Drivetrain", "Generator", "PitchActuator", "Damping", "BladeAero", "Polar",
+    "BladeStructure", "TowerStructure", "ModeShapes", "Turbine", "load_turbine",
+    "available_turbines",
+]
+
+SCHEMA_VERSION = 1
+_DEG = math.pi / 180.0
+_RPM = math.pi / 30.0
+
+
+class TurbineFileError(ValueError):
+    """A turbine file is missing, malformed or holds a value out of range."""
+
+
+def _pos(v: float) -> bool:
+    return v > 0.0
+
+
+# --------------------------------------------------------------------------------------------
+# Scalar sections. Each field's metadata: yaml key, unit factor to SI, allowed closed range.
+# --------------------------------------------------------------------------------------------
+def _f(key: str, lo: float, hi: float, scale: float = 1.0, *, lo_open: bool = False) -> Any:
+    return field(metadata={"key": key, "lo": lo, "hi": hi, "scale": scale, "lo_open": lo_open})
+
+
+def _check_section(obj: Any) -> None:
+    for f in fields(obj):
+        meta = f.metadata
+        if "key" not in meta:
+            continue
+        v = getattr(obj, f.name)
+        lo, hi = meta["lo"] * meta["scale"], meta["hi"] * meta["scale"]
+        bad_lo = v <= lo if meta["lo_open"] else v < lo
+        if not math.isfinite(v) or bad_lo or v > hi:
+            lb = "(" if meta["lo_open"] else "["
+            raise ValueError(
+                f"{type(obj).__name__}.{f.name} ({meta['key']}) must be in "
+                f"{lb}{meta['lo']:g}, {meta['hi']:g}], got {v / meta['scale']!r}")
+
+
+@dataclass(frozen=True)
+class Geometry:
+    """Rotor and nacelle geometry.
+
+    Parameters
+    ----------
+    number_of_blades : int
+        Blade count [-] (the plant supports 3).
+    tip_radius : float
+        Rotor apex to blade tip along the blade [m].
+    hub_radius : float
+        Rotor apex to blade root [m].
+    hub_height : float
+        Hub centre above ground [m].
+    tower_height : float
+        Tower top (yaw bearing) above ground [m].
+    twr2shft : float
+        Tower top to shaft axis, vertical [m].
+    overhang : float
+        Yaw axis to rotor apex, positive upwind [m].
+    precone_rad : float
+        Blade cone angle, positive coned upwind [rad].
+    shaft_tilt_rad : float
+        Shaft tilt, positive nose up [rad].
+    nacelle_cm_downwind, nacelle_cm_vertical : float
+        Nacelle centre of mass from the tower top [m].
+    """
+
+    number_of_blades: int = _f("number_of_blades", 3, 3)
+    tip_radius: float = _f("tip_radius_m", 0.0, 300.0, lo_open=True)
+    hub_radius: float = _f("hub_radius_m", 0.0, 50.0)
+    hub_height: float = _f("hub_height_m", 0.0, 400.0, lo_open=True)
+    tower_height: float = _f("tower_height_m", 0.0, 400.0, lo_open=True)
+    twr2shft: float = _f("twr2shft_m", -20.0, 20.0)
+    overhang: float = _f("overhang_m", -30.0, 30.0)
+    precone_rad: float = _f("precone_deg", -20.0, 20.0, _DEG)
+    shaft_tilt_rad: float = _f("shaft_tilt_deg", -20.0, 20.0, _DEG)
+    nacelle_cm_downwind: float = _f("nacelle_cm_downwind_m", -30.0, 30.0)
+    nacelle_cm_vertical: float = _f("nacelle_cm_vertical_m", -30.0, 30.0)
+
+    def __post_init__(self) -> None:
+        _check_section(self)
+        if not self.hub_radius < self.tip_radius:
+            raise ValueError(f"Geometry.hub_radius ({self.hub_radius} m) must be smaller than "
+                             f"tip_radius ({self.tip_radius} m)")
+        if self.tip_radius >= self.hub_height:
+            raise ValueError(f"Geometry.tip_radius ({self.tip_radius} m) must be smaller than "
+                             f"hub_height ({self.hub_height} m): the blade would hit the ground")
+
+
+@dataclass(frozen=True)
+class Operation:
+    """Operating envelope.
+
+    Parameters
+    ----------
+    rated_power : float
+        Rated electrical power [W].
+    cut_in_wind, cut_out_wind : float
+        Wind-speed envelope [m/s].
+    min_rotor_speed_rad_s, rated_rotor_speed_rad_s : float
+        Rotor-speed envelope [rad/s].
+    fine_pitch_rad : float
+        Fine (minimum operating) pitch [rad].
+    """
+
+    rated_power: float = _f("rated_power_W", 0.0, 1e9, lo_open=True)
+    cut_in_wind: float = _f("cut_in_wind_mps", 0.0, 15.0, lo_open=True)
+    cut_out_wind: float = _f("cut_out_wind_mps", 5.0, 60.0)
+    min_rotor_speed_rad_s: float = _f("min_rotor_speed_rpm", 0.0, 100.0, _RPM)
+    rated_rotor_speed_rad_s: float = _f("rated_rotor_speed_rpm", 0.0, 100.0, _RPM, lo_open=True)
+    fine_pitch_rad: float = _f("fine_pitch_deg", -10.0, 30.0, _DEG)
+
+    def __post_init__(self) -> None:
+        _check_section(self)
+        if not self.cut_in_wind < self.cut_out_wind:
+            raise ValueError(f"Operation.cut_in_wind ({self.cut_in_wind}) must be below "
+                             f"cut_out_wind ({self.cut_out_wind}) m/s")
+        if not self.min_rotor_speed_rad_s < self.rated_rotor_speed_rad_s:
+            raise ValueError("Operation.min_rotor_speed_rpm must be below rated_rotor_speed_rpm")
+
+
+@dataclass(frozen=True)
+class Environment:
+    """Air and gravity: ``air_density`` [kg/m^3], ``gravity`` [m/s^2]."""
+
+    air_density: float = _f("air_density_kgpm3", 0.5, 1.6)
+    gravity: float = _f("gravity_mps2", 0.0, 20.0)
+
+    def __post_init__(self) -> None:
+        _check_section(self)
+
+
+@dataclass(frozen=True)
+class RotorMass:
+    """Hub mass [kg], hub inertia about the shaft [kg m^2], blade mass scale factor [-]."""
+
+    hub_mass: float = _f("hub_mass_kg", 0.0, 1e7, lo_open=True)
+    hub_inertia: float = _f("hub_inertia_kgm2", 0.0, 1e10, lo_open=True)
+    blade_mass_scale: float = _f("blade_mass_scale", 0.5, 2.0)
+
+    def __post_init__(self) -> None:
+        _check_section(self)
+
+
+@dataclass(frozen=True)
+class Nacelle:
+    """Nacelle mass [kg] and yaw inertia [kg m^2]."""
+
+    mass: float = _f("mass_kg", 0.0, 1e8, lo_open=True)
+    yaw_inertia: float = _f("yaw_inertia_kgm2", 0.0, 1e10, lo_open=True)
+
+    def __post_init__(self) -> None:
+        _check_section(self)
+
+
+@dataclass(frozen=True)
+class Drivetrain:
+    """Two-mass drivetrain (Madsen et al. 2012, eq 11).
+
+    Parameters
+    ----------
+    gearbox_ratio : float
+        High-speed over low-speed shaft speed [-].
+    gearbox_efficiency, generator_efficiency : float
+        [-], in (0, 1].
+    generator_inertia : float
+        Generator inertia about the high-speed shaft [kg m^2].
+    shaft_stiffness : float
+        Equivalent low-speed-shaft torsional stiffness [N m/rad].
+    shaft_damping : float
+        Equivalent low-speed-shaft torsional damping [N m s/rad].
+    """
+
+    gearbox_ratio: float = _f("gearbox_ratio", 1.0, 1000.0)
+    gearbox_efficiency: float = _f("gearbox_efficiency", 0.0, 1.0, lo_open=True)
+    generator_efficiency: float = _f("generator_efficiency", 0.0, 1.0, lo_open=True)
+    generator_inertia: float = _f("generator_inertia_kgm2", 0.0, 1e9, lo_open=True)
+    shaft_stiffness: float = _f("shaft_stiffness_Nm_per_rad", 0.0, 1e13, lo_open=True)
+    shaft_damping: float = _f("shaft_damping_Nms_per_rad", 0.0, 1e12)
+
+    def __post_init__(self) -> None:
+        _check_section(self)
+
+
+@dataclass(frozen=True)
+class Generator:
+    """Generator torque limits on the high-speed shaft [N m] and rate limit [N m/s]."""
+
+    min_torque: float = _f("min_torque_Nm", -1e8, 1e8)
+    max_torque: float = _f("max_torque_Nm", 0.0, 1e8, lo_open=True)
+    max_torque_rate: float = _f("max_torque_rate_Nmps", 0.0, 1e9, lo_open=True)
+
+    def __post_init__(self) -> None:
+        _check_section(self)
+        if not self.min_torque < self.max_torque:
+            raise ValueError("Generator.min_torque_Nm must be below max_torque_Nm")
+
+
+@dataclass(frozen=True)
+class PitchActuator:
+    """First-order pitch servo with limits (Madsen et al. 2012, eqs 14-15).
+
+    Parameters
+    ----------
+    min_pitch_rad, max_pitch_rad : float
+        Position limits [rad].
+    max_rate_rad_s : float
+        Rate limit [rad/s].
+    time_constant : float
+        Servo time constant tau_beta [s].
+    """
+
+    min_pitch_rad: float = _f("min_pitch_deg", -30.0, 30.0, _DEG)
+    max_pitch_rad: float = _f("max_pitch_deg", 0.0, 95.0, _DEG)
+    max_rate_rad_s: float = _f("max_rate_degps", 0.0, 50.0, _DEG, lo_open=True)
+    time_constant: float = _f("time_constant_s", 0.0, 5.0, lo_open=True)
+
+    def __post_init__(self) -> None:
+        _check_section(self)
+        if not self.min_pitch_rad < self.max_pitch_rad:
+            raise ValueError("PitchActuator.min_pitch_deg must be below max_pitch_deg")
+
+
+@dataclass(frozen=True)
+class Damping:
+    """Structural damping ratios of the first modes [-]."""
+
+    blade: float = _f("blade_damping_ratio", 0.0, 0.5)
+    tower_fa: float = _f("tower_fa_damping_ratio", 0.0, 0.5)
+    tower_ss: float = _f("tower_ss_damping_ratio", 0.0, 0.5)
+
+    def __post_init__(self) -> None:
+        _check_section(self)
+
+
+# --------------------------------------------------------------------------------------------
+# Tables
+# --------------------------------------------------------------------------------------------
+def _freeze(obj: Any, names: tuple[str, ...]) -> None:
+    for n in names:
+        object.__setattr__(obj, n, frozen_array(getattr(obj, n)))
+
+
+@dataclass(frozen=True)
+class BladeAero:
+    """Blade elements for BEM.
+
+    Parameters
+    ----------
+    r : (n_r,) ndarray
+        Element centre from the rotor apex, along the blade [m].
+    dr : (n_r,) ndarray
+        Element length [m].
+    chord : (n_r,) ndarray
+        [m].
+    twist_rad : (n_r,) ndarray
+        Aerodynamic twist, positive toward feather [rad].
+    airfoil : (n_r,) ndarray of int
+        Index into :attr:`Turbine.polars`.
+    """
+
+    r: FloatArray
+    dr: FloatArray
+    chord: FloatArray
+    twist_rad: FloatArray
+    airfoil: IntArray
+
+    def __post_init__(self) -> None:
+        _freeze(self, ("r", "dr", "chord", "twist_rad"))
+        a = np.array(self.airfoil, dtype=np.int64)
+        a.flags.writeable = False
+        object.__setattr__(self, "airfoil", a)
+        n = self.r.shape
+        for name in ("dr", "chord", "twist_rad", "airfoil"):
+            if getattr(self, name).shape != n:
+                raise ValueError(f"BladeAero.{name} has shape {getattr(self, name).shape}; "
+                                 f"expected (n_r,) = {n}")
+        if self.r.size < 2 or np.any(np.diff(self.r) <= 0):
+            raise ValueError("BladeAero.r (element radius) must be strictly increasing")
+        if np.any(self.dr <= 0) or np.any(self.chord <= 0):
+            raise ValueError("BladeAero.dr and chord must be > 0")
+
+
+@dataclass(frozen=True)
+class Polar:
+    """Static airfoil polar covering -180..180 deg.
+
+    Parameters
+    ----------
+    name : str
+    alpha_rad : (n_alpha,) ndarray
+        Angle of attack, strictly increasing, from -pi to pi [rad].
+    cl, cd : (n_alpha,) ndarray
+        Lift and drag coefficients [-].
+    """
+
+    name: str
+    alpha_rad: FloatArray
+    cl: FloatArray
+    cd: FloatArray
+
+    def __post_init__(self) -> None:
+        _freeze(self, ("alpha_rad", "cl", "cd"))
+        a = self.alpha_rad
+        if a.ndim != 1 or a.size < 2 or self.cl.shape != a.shape or self.cd.shape != a.shape:
+            raise ValueError(f"Polar {self.name}: alpha, cl, cd must be 1-D of equal length")
+        if np.any(np.diff(a) <= 0):
+            raise ValueError(f"Polar {self.name}: alpha must be strictly increasing")
+        if a[0] > -math.pi + 1e-9 or a[-1] < math.pi - 1e-9:
+            raise ValueError(f"Polar {self.name}: alpha must cover -180..180 deg, got "
+                             f"{math.degrees(a[0]):.2f}..{math.degrees(a[-1]):.2f} deg")
+        if not (np.all(np.isfinite(self.cl)) and np.all(np.isfinite(self.cd))):
+            raise ValueError(f"Polar {self.name}: cl and cd must be finite")
+
+
+@dataclass(frozen=True)
+class BladeStructure:
+    """Distributed blade properties at span fractions 0..1 from the root.
+
+    ``mass_per_length`` [kg/m] (already scaled), ``flap_stiffness``, ``edge_stiffness`` [N m^2].
+    """
+
+    span_fraction: FloatArray
+    mass_per_length: FloatArray
+    flap_stiffness: FloatArray
+    edge_stiffness: FloatArray
+
+    def __post_init__(self) -> None:
+        _freeze(self, ("span_fraction", "mass_per_length", "flap_stiffness", "edge_stiffness"))
+        _check_stations("BladeStructure", self.span_fraction)
+
+
+@dataclass(frozen=True)
+class TowerStructure:
+    """Distributed tower properties at height fractions 0..1 of the flexible tower.
+
+    ``mass_per_length`` [kg/m], ``fa_stiffness``, ``ss_stiffness`` [N m^2].
+    """
+
+    height_fraction: FloatArray
+    mass_per_length: FloatArray
+    fa_stiffness: FloatArray
+    ss_stiffness: FloatArray
+
+    def __post_init__(self) -> None:
+        _freeze(self, ("height_fraction", "mass_per_length", "fa_stiffness", "ss_stiffness"))
+        _check_stations("TowerStructure", self.height_fraction)
+
+
+def _check_stations(owner: str, x: FloatArray) -> None:
+    if x.ndim != 1 or x.size < 2 or np.any(np.diff(x) <= 0):
+        raise ValueError(f"{owner}: station fractions must be strictly increasing")
+    if abs(x[0]) > 1e-9 or abs(x[-1] - 1.0) > 1e-9:
+        raise ValueError(f"{owner}: station fractions must run from 0 to 1, got "
+                         f"{x[0]:g}..{x[-1]:g}")
+
+
+@dataclass(frozen=True)
+class ModeShapes:
+    """Polynomial mode shapes phi(x) = sum_k c_k x^k, k = 2..6, with phi(1) = 1.
+
+    Each field is a (5,) ndarray of coefficients for x^2..x^6 (x = fraction of height/span).
+    """
+
+    tower_fa1: FloatArray
+    tower_ss1: FloatArray
+    blade_flap1: FloatArray
+
+    def __post_init__(self) -> None:
+        _freeze(self, ("tower_fa1", "tower_ss1", "blade_flap1"))
+        for f in fields(self):
+            c = getattr(self, f.name)
+            if c.shape != (5,):
+                raise ValueError(f"ModeShapes.{f.name} has shape {c.shape}; expected (5,)")
+            if abs(c.sum() - 1.0) > 2e-3:
+                raise ValueError(f"ModeShapes.{f.name}: phi(1) = {c.sum():.4f}; must be 1")
+
+
+def mode_shape(coeffs: FloatArray, x: FloatArray, derivative: int = 0) -> FloatArray:
+    """Evaluate a polynomial mode shape or its first/second derivative w.r.t. ``x`` [-]."""
+    x = np.asarray(x, dtype=float)
+    out = np.zeros_like(x)
+    for i, c in enumerate(coeffs):
+        k = i + 2
+        if derivative == 0:
+            out = out + c * x**k
+        elif derivative == 1:
+            out = out + c * k * x ** (k - 1)
+        elif derivative == 2:
+            out = out + c * k * (k - 1) * x ** (k - 2)
+        else:
+            raise ValueError(f"derivative must be 0, 1 or 2, got {derivative!r}")
+    return out
+
+
+@dataclass(frozen=True)
+class Turbine:
+    """A reference turbine as the BEM plant sees it. All quantities SI, angles in rad."""
+
+    name: str
+    source: str
+    geometry: Geometry
+    operation: Operation
+    environment: Environment
+    rotor: RotorMass
+    nacelle: Nacelle
+    drivetrain: Drivetrain
+    generator: Generator
+    pitch_actuator: PitchActuator
+    damping: Damping
+    blade: BladeAero
+    polars: tuple[Polar, ...]
+    blade_structure: BladeStructure
+    tower_structure: TowerStructure
+    mode_shapes: ModeShapes
+
+    def __post_init__(self) -> None:
+        g = self.geometry
+        b = self.blade
+        lo = b.r - 0.5 * b.dr
+        hi = b.r + 0.5 * b.dr
+        if lo[0] < g.hub_radius - 1e-3 or hi[-1] > g.tip_radius + 1e-3:
+            raise ValueError(
+                f"blade elements span {lo[0]:.4g}..{hi[-1]:.4g} m; they must lie within "
+                f"hub_radius..tip_radius = {g.hub_radius:g}..{g.tip_radius:g} m")
+        if np.any(b.chord > 0.5 * g.tip_radius):
+            raise ValueError(f"blade chord must be below half the tip radius "
+                             f"({0.5 * g.tip_radius:g} m), got max {b.chord.max():g} m")
+        if b.airfoil.min() < 0 or b.airfoil.max() >= len(self.polars):
+            raise ValueError(f"blade airfoil index out of range 0..{len(self.polars) - 1}")
+
+    @property
+    def rated_generator_speed_rad_s(self) -> float:
+        """Rated generator speed [rad/s]."""
+        return self.operation.rated_rotor_speed_rad_s * self.drivetrain.gearbox_ratio
+
+    @property
+    def rated_mechanical_power(self) -> float:
+        """Rated rotor (mechanical) power: rated electrical power over the efficiencies [W]."""
+        d = self.drivetrain
+        return self.operation.rated_power / (d.generator_efficiency * d.gearbox_efficiency)
+
+    @property
+    def rated_generator_torque(self) -> float:
+        """Generator torque at rated power and rated speed [N m]."""
+        return self.operation.rated_power / (
+            self.drivetrain.generator_efficiency * self.rated_generator_speed_rad_s)
+
+
+# --------------------------------------------------------------------------------------------
+# Loading
+# --------------------------------------------------------------------------------------------
+_SECTIONS: dict[str, type] = {
+    "geometry": Geometry, "operation": Operation, "environment": Environment,
+    "rotor": RotorMass, "nacelle": Nacelle, "drivetrain": Drivetrain, "generator": Generator,
+    "pitch_actuator": PitchActuator, "structure": Damping,
+}
+_TOP_KEYS = {"schema_version", "name", "files", *_SECTIONS}
+_FILE_KEYS = {"blade_aero", "airfoil_index", "blade_structure", "tower_structure", "mode_shapes"}
+
+
+def available_turbines() -> list[str]:
+    """Names of the turbines shipped as package data."""
+    root = resources.files("linearize") / "data"
+    return sorted(p.name for p in root.iterdir() if (p / "turbine.yaml").is_file())
+
+
+def load_turbine(name_or_path: str | Path = "nrel5mw") -> Turbine:
+    """Load a turbine shipped with mpc-wt (by name) or a user's turbine file (by path).
+
+    Parameters
+    ----------
+    name_or_path : str or Path
+        A packaged name (see :func:`available_turbines`, default ``"nrel5mw"``), a path to a
+        ``turbine.yaml`` file, or a directory holding one.
+
+    Returns
+    -------
+    Turbine
+
+    Raises
+    ------
+    TurbineFileError
+        Naming the file, the field and the allowed range: unknown or missing keys, values out of
+        range, non-monotonic span, polars not covering -180..180 deg, non-positive masses or
+        stiffnesses, elements outside the rotor.
+    FileNotFoundError
+        If neither a packaged name nor an existing path.
+    """
+    text = str(name_or_path)
+    if isinstance(name_or_path, str) and text in available_turbines():
+        ref = resources.files("linearize") / "data" / text / "turbine.yaml"
+        with resources.as_file(ref) as p:
+            return _load_path(Path(p))
+    path = Path(name_or_path)
+    if path.is_dir():
+        path = path / "turbine.yaml"
+    if not path.is_file():
+        raise FileNotFoundError(
+            f"turbine {text!r} is neither a packaged turbine {available_turbines()} "
+            f"nor an existing turbine file")
+    return _load_path(path)
+
+
+def _load_path(path: Path) -> Turbine:
+    try:
+        raw = yaml.safe_load(path.read_text())
+    except yaml.YAMLError as err:
+        raise TurbineFileError(f"{path}: not valid YAML: {err}") from err
+    if not isinstance(raw, dict):
+        raise TurbineFileError(f"{path}: top level must be a mapping, got {type(raw).__name__}")
+    _check_keys(path, "top level", raw, _TOP_KEYS)
+    if raw["schema_version"] != SCHEMA_VERSION:
+        raise TurbineFileError(f"{path}: schema_version must be {SCHEMA_VERSION}, got "
+                               f"{raw['schema_version']!r}")
+    sections = {}
+    for sec, cls in _SECTIONS.items():
+        sections[sec] = _build_section(path, sec, raw[sec], cls)
+    files = raw["files"]
+    _check_keys(path, "files", files, _FILE_KEYS)
+    base = path.parent
+    scale = sections["rotor"].blade_mass_scale
+    try:
+        polars, index_of = _read_polars(base / str(files["airfoil_index"]), base)
+        blade = _read_blade_aero(base / str(files["blade_aero"]), index_of)
+        bstruct = _read_blade_structure(base / str(files["blade_structure"]), scale)
+        tstruct = _read_tower_structure(base / str(files["tower_structure"]))
+        modes = _read_mode_shapes(base / str(files["mode_shapes"]))
+        return Turbine(name=str(raw["name"]), source=str(path), blade=blade, polars=polars,
+                       blade_structure=bstruct, tower_structure=tstruct, mode_shapes=modes,
+                       geometry=sections["geometry"], operation=sections["operation"],
+                       environment=sections["environment"], rotor=sections["rotor"],
+                       nacelle=sections["nacelle"], drivetrain=sections["drivetrain"],
+                       generator=sections["generator"],
+                       pitch_actuator=sections["pitch_actuator"], damping=sections["structure"])
+    except TurbineFileError:
+        raise
+    except ValueError as err:
+        raise TurbineFileError(f"{path}: {err}") from err
+
+
+def _check_keys(path: Path, where: str, d: Any, allowed: set[str]) -> None:
+    if not isinstance(d, dict):
+        raise TurbineFileError(f"{path}: section {where!r} must be a mapping")
+    unknown = sorted(set(d) - allowed)
+    missing = sorted(allowed - set(d))
+    msg = []
+    if unknown:
+        msg.append(f"unknown keys {unknown}")
+    if missing:
+        msg.append(f"missing keys {missing}")
+    if msg:
+        raise TurbineFileError(f"{path}: section {where!r}: " + "; ".join(msg))
+
+
+def _build_section(path: Path, sec: str, d: Any, cls: type) -> Any:
+    meta = {f.metadata["key"]: f for f in fields(cls)}
+    _check_keys(path, sec, d, set(meta))
+    kwargs = {}
+    for key, f in meta.items():
+        v = d[key]
+        if isinstance(v, bool) or not isinstance(v, (int, float)):
+            raise TurbineFileError(f"{path}: {sec}.{key} must be a number, got {v!r}")
+        kwargs[f.name] = int(v) if f.name == "number_of_blades" else float(v) * f.metadata["scale"]
+    try:
+        return cls(**kwargs)
+    except ValueError as err:
+        raise TurbineFileError(f"{path}: {sec}: {err}") from err
+
+
+def _read_csv(path: Path, required: tuple[str, ...],
+              text_cols: tuple[str, ...] = ()) -> dict[str, Any]:
+    if not path.is_file():
+        raise TurbineFileError(f"{path}: file not found")
+    with path.open(newline="") as fh:
+        rows = [r for r in csv.reader(fh) if r and any(c.strip() for c in r)]
+    if not rows:
+        raise TurbineFileError(f"{path}: empty file")
+    header = [h.strip() for h in rows[0]]
+    missing = [c for c in required if c not in header]
+    if missing:
+        raise TurbineFileError(f"{path}: missing columns {missing}; has {header}")
+    out: dict[str, Any] = {}
+    for col in required:
+        j = header.index(col)
+        vals = []
+        for i, row in enumerate(rows[1:], start=2):
+            if j >= len(row):
+                raise TurbineFileError(f"{path}: line {i} has no column {col!r}")
+            cell = row[j].strip()
+            if col in text_cols:
+                vals.append(cell)
+                continue
+            try:
+                v = float(cell)
+            except ValueError:
+                raise TurbineFileError(f"{path}: line {i}, column {col!r}: {cell!r} "
+                                       f"is not a number") from None
+            if not math.isfinite(v):
+                raise TurbineFileError(f"{path}: line {i}, column {col!r}: {cell!r} "
+                                       f"is not finite")
+            vals.append(v)
+        out[col] = vals if col in text_cols else np.array(vals)
+    return out
+
+
+def _require(path: Path, col: str, values: FloatArray, ok: Callable[[FloatArray], Any],
+             allowed: str) -> None:
+    bad = ~np.asarray(ok(values), dtype=bool)
+    if np.any(bad):
+        i = int(np.argmax(bad))
+        raise TurbineFileError(f"{path}: column {col!r}, data row {i + 1}: {values[i]!r}; "
+                               f"allowed {allowed}")
+
+
+def _read_polars(index_path: Path, base: Path) -> tuple[tuple[Polar, ...], dict[int, int]]:
+    """Read the airfoil index; its ``file`` column is relative to the turbine directory."""
+    idx = _read_csv(index_path, ("af_id", "name", "file"), text_cols=("name", "file"))
+    polars = []
+    index_of: dict[int, int] = {}
+    for k, (af_id, name, file) in enumerate(zip(idx["af_id"], idx["name"], idx["file"])):
+        p = base / file
+        tab = _read_csv(p, ("alpha_deg", "cl", "cd"))
+        try:
+            polars.append(Polar(name=name, alpha_rad=np.radians(tab["alpha_deg"]),
+                                cl=tab["cl"], cd=tab["cd"]))
+        except ValueError as err:
+            raise TurbineFileError(f"{p}: {err}") from err
+        index_of[int(af_id)] = k
+    return tuple(polars), index_of
+
+
+def _read_blade_aero(path: Path, index_of: dict[int, int]) -> BladeAero:
+    t = _read_csv(path, ("RNodes_m_from_apex", "DRNodes_m", "AeroTwst_deg", "Chord_m", "af_id"))
+    r = t["RNodes_m_from_apex"]
+    _require(path, "RNodes_m_from_apex", r, lambda v: v > 0, "> 0 m")
+    if np.any(np.diff(r) <= 0):
+        i = int(np.argmax(np.diff(r) <= 0)) + 1
+        raise TurbineFileError(f"{path}: column 'RNodes_m_from_apex' must be strictly increasing "
+                               f"(non-monotonic span at data row {i + 1}: {r[i]!r} after "
+                               f"{r[i - 1]!r})")
+    _require(path, "DRNodes_m", t["DRNodes_m"], lambda v: v > 0, "> 0 m")
+    _require(path, "Chord_m", t["Chord_m"], lambda v: v > 0, "> 0 m")
+    _require(path, "AeroTwst_deg", t["AeroTwst_deg"], lambda v: np.abs(v) <= 90, "-90..90 deg")
+    ids = t["af_id"].astype(int)
+    _require(path, "af_id", t["af_id"], lambda v: np.isin(v.astype(int), list(index_of)),
+             f"one of the airfoil index ids {sorted(index_of)}")
+    return BladeAero(r=r, dr=t["DRNodes_m"], chord=t["Chord_m"],
+                     twist_rad=np.radians(t["AeroTwst_deg"]),
+                     airfoil=np.array([index_of[i] for i in ids]))
+
+
+def _stations(path: Path, col: str, x: FloatArray) -> None:
+    _require(path, col, x, lambda v: (v >= 0) & (v <= 1), "0..1")
+    if np.any(np.diff(x) <= 0) or abs(x[0]) > 1e-9 or abs(x[-1] - 1) > 1e-9:
+        raise TurbineFileError(f"{path}: column {col!r} must increase strictly from 0 to 1")
+
+
+def _read_blade_structure(path: Path, scale: float) -> BladeStructure:
+    cols = ("BlFract", "BMassDen_kg_per_m", "FlpStff_Nm2", "EdgStff_Nm2")
+    t = _read_csv(path, cols)
+    _stations(path, "BlFract", t["BlFract"])
+    for c in cols[1:]:
+        _require(path, c, t[c], lambda v: v > 0, "> 0")
+    return BladeStructure(span_fraction=t["BlFract"], mass_per_length=t["BMassDen_kg_per_m"] * scale,
+                          flap_stiffness=t["FlpStff_Nm2"], edge_stiffness=t["EdgStff_Nm2"])
+
+
+def _read_tower_structure(path: Path) -> TowerStructure:
+    cols = ("HtFract", "TMassDen_kg_per_m", "TwFAStif_Nm2", "TwSSStif_Nm2")
+    t = _read_csv(path, cols)
+    _stations(path, "HtFract", t["HtFract"])
+    for c in cols[1:]:
+        _require(path, c, t[c], lambda v: v > 0, "> 0")
+    return TowerStructure(height_fraction=t["HtFract"], mass_per_length=t["TMassDen_kg_per_m"],
+                          fa_stiffness=t["TwFAStif_Nm2"], ss_stiffness=t["TwSSStif_Nm2"])
+
+
+def _read_mode_shapes(path: Path) -> ModeShapes:
+    if not path.is_file():
+        raise TurbineFileError(f"{path}: file not found")
+    with path.open(newline="") as fh:
+        rows = list(csv.DictReader(fh))
+    by_name = {r["mode"].strip(): r for r in rows if r.get("mode")}
+    need = {"tower_fa1": "tower_fore_aft_1", "tower_ss1": "tower_side_side_1",
+            "blade_flap1": "blade_flap_1"}
+    missing = [m for m in need.values() if m not in by_name]
+    if missing:
+        raise TurbineFileError(f"{path}: missing modes {missing}")
+    kwargs = {}
+    for fname, mode in need.items():
+        try:
+            kwargs[fname] = np.array([float(by_name[mode][f"c_x{k}"]) for k in range(2, 7)])
+        except (KeyError, ValueError, TypeError) as err:
+            raise TurbineFileError(f"{path}: mode {mode}: coefficients c_x2..c_x6 must be "
+                                   f"numbers ({err})") from err
+    try:
+        return ModeShapes(**kwargs)
+    except ValueError as err:
+        raise TurbineFileError(f"{path}: {err}") from err

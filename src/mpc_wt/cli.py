@@ -1,0 +1,234 @@
+"""The ``mpcwt`` command line.
+
+Subcommands
+-----------
+run        the main job on a turbine: steady operating table, C_P surface and plots
+trim       steady operating points against wind speed (table or ``--json``)
+aero       rotor aerodynamics: ``aero cp-surface --out FILE.csv [--plot FILE.png]``
+
+Errors in the arguments or the turbine file print one line naming the parameter and the value
+to stderr and exit with status 2.
+"""
+from __future__ import annotations
+
+import argparse
+import csv
+import json
+import logging
+import math
+import sys
+from pathlib import Path
+from typing import Sequence
+
+import numpy as np
+
+import linearize
+from linearize import OperatingPoint, TrimError, TurbineFileError
+
+__all__ = ["main", "parse_range"]
+
+log = logging.getLogger(__name__)
+
+
+class UsageError(ValueError):
+    """A command-line value that is not allowed."""
+
+
+def parse_range(text: str, name: str) -> np.ndarray:
+    """Parse ``START:STOP:STEP`` (STOP included), ``START:STOP`` (step 1) or ``A,B,C``.
+
+    Raises
+    ------
+    UsageError
+        Naming the option and the value if it is not a finite, increasing range.
+    """
+    try:
+        if ":" in text:
+            parts = [float(p) for p in text.split(":")]
+            if len(parts) == 2:
+                parts.append(1.0)
+            if len(parts) != 3:
+                raise ValueError
+            a, b, s = parts
+            if not all(math.isfinite(v) for v in parts) or s <= 0 or b < a:
+                raise ValueError
+            n = int(math.floor((b - a) / s + 1e-9)) + 1
+            vals = a + s * np.arange(n)
+        else:
+            vals = np.array([float(p) for p in text.split(",")])
+    except ValueError:
+        raise UsageError(f"{name} must be START:STOP:STEP with STEP > 0 and STOP >= START, "
+                         f"or a comma list of numbers; got {text!r}") from None
+    if vals.size == 0 or not np.all(np.isfinite(vals)):
+        raise UsageError(f"{name} must hold finite numbers; got {text!r}")
+    return vals
+
+
+def _schedule(turbine: linearize.Turbine, winds: np.ndarray, power_W: float | None,
+              progress: bool) -> list[OperatingPoint]:
+    from tqdm import tqdm
+
+    params = linearize.plant_params(turbine)
+    out = []
+    for v in tqdm(winds, desc="trim", unit="pt", disable=not progress, file=sys.stderr):
+        out.append(linearize.trim(turbine, float(v), power_W, params=params))
+    return out
+
+
+_TABLE_COLS = (("wind_mps", "wind [m/s]", "{:8.2f}"), ("region", "region", "{:>6s}"),
+               ("pitch_deg", "pitch [deg]", "{:11.3f}"),
+               ("rotor_speed_rpm", "rotor [rpm]", "{:11.3f}"),
+               ("gen_torque_Nm", "gen torque [N m]", "{:16.1f}"),
+               ("power_W", "power [kW]", "{:10.1f}"), ("thrust_N", "thrust [kN]", "{:11.1f}"),
+               ("cp", "C_P", "{:6.3f}"), ("tower_fa_deflection_m", "tower FA [m]", "{:12.4f}"))
+
+
+def _format_table(points: Sequence[OperatingPoint]) -> str:
+    head = " ".join(f"{h:>{len(fmt.format(0.0 if 's' not in fmt else ''))}s}"
+                    for _, h, fmt in _TABLE_COLS)
+    lines = [head]
+    for p in points:
+        d = p.as_dict()
+        cells = []
+        for key, _, fmt in _TABLE_COLS:
+            val = d[key]
+            if key == "power_W" or key == "thrust_N":
+                val = val / 1e3
+            cells.append(fmt.format(val))
+        lines.append(" ".join(cells))
+    return "\n".join(lines)
+
+
+def _write_points_csv(points: Sequence[OperatingPoint], path: Path) -> None:
+    rows = [p.as_dict() for p in points]
+    with path.open("w", newline="") as fh:
+        w = csv.DictWriter(fh, fieldnames=list(rows[0]))
+        w.writeheader()
+        w.writerows(rows)
+
+
+def _cp_surface(turbine: linearize.Turbine, tsr: np.ndarray,
+                pitch: np.ndarray) -> np.ndarray:
+    lam, pit = np.meshgrid(tsr, pitch)
+    cp, _ = linearize.steady_coefficients(turbine, lam, pit)
+    return cp
+
+
+def _write_surface_csv(tsr: np.ndarray, pitch: np.ndarray, cp: np.ndarray, path: Path) -> None:
+    with path.open("w", newline="") as fh:
+        w = csv.writer(fh)
+        w.writerow(["pitch_deg \\ tsr"] + [f"{v:g}" for v in tsr])
+        for b, row in zip(pitch, cp):
+            w.writerow([f"{b:g}"] + [f"{c:.6f}" for c in row])
+
+
+def _cmd_trim(args: argparse.Namespace) -> int:
+    turbine = linearize.load_turbine(args.turbine)
+    winds = parse_range(args.wind, "--wind")
+    points = _schedule(turbine, winds, args.power_W, progress=not args.json)
+    if args.json:
+        print(json.dumps([p.as_dict() for p in points], indent=1))
+    else:
+        print(f"# {turbine.name}")
+        print(_format_table(points))
+    return 0
+
+
+def _cmd_cp_surface(args: argparse.Namespace) -> int:
+    turbine = linearize.load_turbine(args.turbine)
+    tsr = parse_range(args.tsr, "--tsr")
+    pitch = parse_range(args.pitch, "--pitch")
+    if np.any(tsr < 0):
+        raise UsageError(f"--tsr must be >= 0, got {args.tsr!r}")
+    cp = _cp_surface(turbine, tsr, pitch)
+    if args.out:
+        _write_surface_csv(tsr, pitch, cp, Path(args.out))
+        print(f"wrote {args.out}")
+    if args.plot:
+        from .plotting import plot_cp_surface
+
+        plot_cp_surface(tsr, pitch, cp, args.plot, title=f"{turbine.name}: C_P")
+        print(f"wrote {args.plot}")
+    i, j = np.unravel_index(int(np.argmax(cp)), cp.shape)
+    print(f"C_P max {cp[i, j]:.4f} at tip-speed ratio {tsr[j]:.3f}, pitch {pitch[i]:.2f} deg")
+    return 0
+
+
+def _cmd_run(args: argparse.Namespace) -> int:
+    from .plotting import plot_cp_surface, plot_operating_schedule
+
+    turbine = linearize.load_turbine(args.turbine)
+    out = Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    op = turbine.operation
+    winds = np.arange(op.cut_in_wind, op.cut_out_wind + 1e-9, 1.0)
+    points = _schedule(turbine, winds, None, progress=True)
+    v_rated = linearize.rated_wind_speed(turbine)
+    lam_opt, cp_max = linearize.optimal_tsr(turbine, math.degrees(op.fine_pitch_rad))
+    print(f"# {turbine.name}: steady operating table, cut-in to cut-out")
+    print(_format_table(points))
+    print(f"# rated wind speed {v_rated:.3f} m/s; C_P max {cp_max:.4f} at tip-speed ratio "
+          f"{lam_opt:.3f} (fine pitch)")
+    _write_points_csv(points, out / "operating_points.csv")
+    (out / "operating_points.json").write_text(json.dumps([p.as_dict() for p in points],
+                                                          indent=1))
+    tsr = np.arange(2.0, 16.0 + 1e-9, 0.25)
+    pitch = np.arange(-2.0, 24.0 + 1e-9, 0.5)
+    cp = _cp_surface(turbine, tsr, pitch)
+    _write_surface_csv(tsr, pitch, cp, out / "cp_surface.csv")
+    plot_cp_surface(tsr, pitch, cp, out / "cp_surface.png", title=f"{turbine.name}: C_P")
+    plot_operating_schedule(points, out / "operating_schedule.png",
+                            title=f"{turbine.name}: steady operating schedule")
+    print(f"# wrote {out}/operating_points.csv, operating_points.json, cp_surface.csv, "
+          f"cp_surface.png, operating_schedule.png")
+    return 0
+
+
+def _parser() -> argparse.ArgumentParser:
+    ap = argparse.ArgumentParser(prog="mpcwt", description=__doc__.split("\n")[0])
+    sub = ap.add_subparsers(dest="command", required=True)
+    turb = dict(default="nrel5mw", help="packaged turbine name or path to a turbine.yaml "
+                                         "(default nrel5mw)")
+
+    p = sub.add_parser("run", help="main job: operating table, C_P surface, plots")
+    p.add_argument("--turbine", **turb)
+    p.add_argument("--out", default="mpcwt-out", help="output directory (default mpcwt-out)")
+    p.set_defaults(func=_cmd_run)
+
+    p = sub.add_parser("trim", help="steady operating points")
+    p.add_argument("--turbine", **turb)
+    p.add_argument("--wind", default="4:25:1", help="START:STOP:STEP in m/s (default 4:25:1)")
+    p.add_argument("--power-W", dest="power_W", type=float, default=None,
+                   help="power reference below rated [W]")
+    p.add_argument("--json", action="store_true", help="print a JSON list")
+    p.set_defaults(func=_cmd_trim)
+
+    p = sub.add_parser("aero", help="rotor aerodynamics")
+    aero = p.add_subparsers(dest="aero_command", required=True)
+    q = aero.add_parser("cp-surface", help="C_P(lambda, pitch) table and plot")
+    q.add_argument("--turbine", **turb)
+    q.add_argument("--out", help="CSV file (rows pitch, columns tip-speed ratio)")
+    q.add_argument("--plot", help="PNG file")
+    q.add_argument("--tsr", default="2:16:0.25", help="START:STOP:STEP (default 2:16:0.25)")
+    q.add_argument("--pitch", default="-2:24:0.5", help="START:STOP:STEP in deg")
+    q.set_defaults(func=_cmd_cp_surface)
+    return ap
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Entry point of ``mpcwt``; returns the exit status."""
+    logging.basicConfig(level=logging.WARNING, format="%(levelname)s %(name)s: %(message)s")
+    args = _parser().parse_args(argv)
+    if getattr(args, "command", None) == "aero" and not (args.out or args.plot):
+        print("mpcwt aero cp-surface: give --out FILE.csv and/or --plot FILE.png",
+              file=sys.stderr)
+        return 2
+    try:
+        return int(args.func(args))
+    except (UsageError, TurbineFileError, TrimError, FileNotFoundError, ValueError) as err:
+        print(f"mpcwt {args.command}: error: {err}", file=sys.stderr)
+        return 2
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(main())

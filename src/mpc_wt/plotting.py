@@ -1,0 +1,92 @@
+"""Plots (PNG). matplotlib is imported here only, with the non-interactive Agg backend."""
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Sequence
+
+import numpy as np
+
+from linearize import OperatingPoint
+
+__all__ = ["plot_cp_surface", "plot_operating_schedule"]
+
+
+def _plt():  # type: ignore[no-untyped-def]
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    return plt
+
+
+def plot_cp_surface(tsr: np.ndarray, pitch_deg: np.ndarray, cp: np.ndarray, path: str | Path,
+                    title: str = "") -> Path:
+    """Contour plot of C_P(lambda, beta) with its maximum marked; returns the PNG path.
+
+    Parameters
+    ----------
+    tsr : (n_tsr,) ndarray
+        Tip-speed ratios [-].
+    pitch_deg : (n_pitch,) ndarray
+        Pitch angles [deg].
+    cp : (n_pitch, n_tsr) ndarray
+        Power coefficient [-].
+    """
+    plt = _plt()
+    fig, ax = plt.subplots(figsize=(7.5, 5.0), dpi=120)
+    shown = np.clip(cp, 0.0, None)
+    levels = np.linspace(0.0, max(float(shown.max()), 1e-3), 25)
+    cs = ax.contourf(tsr, pitch_deg, shown, levels=levels, cmap="viridis")
+    ax.contour(tsr, pitch_deg, shown, levels=[0.1, 0.2, 0.3, 0.4, 0.45], colors="w",
+               linewidths=0.6)
+    i, j = np.unravel_index(int(np.argmax(cp)), cp.shape)
+    ax.plot(tsr[j], pitch_deg[i], "r*", ms=12,
+            label=f"C_P max {cp[i, j]:.3f} at lambda {tsr[j]:.2f}, pitch {pitch_deg[i]:.1f} deg")
+    fig.colorbar(cs, ax=ax, label="C_P [-]")
+    ax.set_xlabel("tip-speed ratio lambda [-]")
+    ax.set_ylabel("collective pitch [deg]")
+    ax.set_title(title or "Power coefficient C_P(lambda, pitch)")
+    ax.legend(loc="upper right", fontsize=8)
+    fig.tight_layout()
+    out = Path(path)
+    fig.savefig(out)
+    plt.close(fig)
+    return out
+
+
+def plot_operating_schedule(points: Sequence[OperatingPoint], path: str | Path,
+                            title: str = "") -> Path:
+    """Four panels against wind speed: power, rotor speed, pitch, thrust and generator torque."""
+    plt = _plt()
+    v = np.array([p.wind_speed for p in points])
+    fig, axs = plt.subplots(2, 2, figsize=(9.0, 6.5), dpi=120, sharex=True)
+    axs[0, 0].plot(v, [p.power / 1e6 for p in points], "o-", ms=3, label="electrical")
+    axs[0, 0].plot(v, [p.aero_power / 1e6 for p in points], "s--", ms=3, label="aerodynamic")
+    axs[0, 0].set_ylabel("power [MW]")
+    axs[0, 0].legend(fontsize=8)
+    axs[0, 1].plot(v, [p.rotor_speed_rpm for p in points], "o-", ms=3)
+    axs[0, 1].set_ylabel("rotor speed [rpm]")
+    axs[1, 0].plot(v, [p.pitch_deg for p in points], "o-", ms=3)
+    axs[1, 0].set_ylabel("pitch [deg]")
+    ax2 = axs[1, 1]
+    ax2.plot(v, [p.thrust / 1e3 for p in points], "o-", ms=3, color="C0")
+    ax2.set_ylabel("rotor thrust [kN]", color="C0")
+    ax3 = ax2.twinx()
+    ax3.plot(v, [p.gen_torque / 1e3 for p in points], "s--", ms=3, color="C3")
+    ax3.set_ylabel("generator torque [kN m]", color="C3")
+    for ax in axs[1]:
+        ax.set_xlabel("hub-height wind speed [m/s]")
+    for ax in axs.flat:
+        ax.grid(alpha=0.3)
+    for p in points:
+        if p.region == "3":
+            for ax in axs.flat:
+                ax.axvline(p.wind_speed, color="0.6", lw=0.8, ls=":")
+            break
+    fig.suptitle(title or "Steady operating schedule")
+    fig.tight_layout()
+    out = Path(path)
+    fig.savefig(out)
+    plt.close(fig)
+    return out
