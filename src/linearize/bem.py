@@ -53,8 +53,6 @@ class AeroOptions:
     ----------
     tip_loss, hub_loss : bool
         Prandtl tip and hub loss factors.
-    high_induction : bool
-        Buhl's high-induction correction above a = 0.4 (else pure momentum).
     tangential_induction : bool
         Solve for a' (else a' = 0).
     tilt, cone : bool
@@ -65,7 +63,6 @@ class AeroOptions:
 
     tip_loss: bool = True
     hub_loss: bool = True
-    high_induction: bool = True
     tangential_induction: bool = True
     tilt: bool = True
     cone: bool = True
@@ -178,7 +175,9 @@ def _induction(phi, vx, vy, r, chord, theta, k_af, table, alpha0, dalpha, nb_, r
                flags):  # pragma: no cover - compiled
     """Residual R(phi) * V_y and the factors (1 - a), (1 + a'), cn, ct at phi.
 
-    ``flags`` = (tip_loss, hub_loss, high_induction, tangential_induction) as int64.
+    ``flags`` = (tip_loss, hub_loss, tangential_induction) as int64. Buhl's high-induction
+    relation is always applied above a = 0.4 (k > 2/3): Ning's proof that the first bracket
+    holds a root needs it (with pure momentum theory a -> 1 as phi -> 0 and R(0+) > 0).
     """
     s = math.sin(phi)
     c = math.cos(phi)
@@ -194,9 +193,9 @@ def _induction(phi, vx, vy, r, chord, theta, k_af, table, alpha0, dalpha, nb_, r
     sc = s * c
     if abs(sc) < 1e-24:
         sc = 1e-24 if sc >= 0.0 else -1e-24
-    kp = sig * ct / (4.0 * F * sc) if flags[3] != 0 else 0.0
+    kp = sig * ct / (4.0 * F * sc) if flags[2] != 0 else 0.0
     if phi > 0.0:
-        if k <= 2.0 / 3.0 or flags[2] == 0:
+        if k <= 2.0 / 3.0:
             # a = k/(1+k): 1 - a = 1/(1+k); written without the division
             res = vy * s * (1.0 + k) - vx * c * (1.0 - kp)
             den = 1.0 + k
@@ -383,9 +382,9 @@ def _element(vx, vy, r, chord, theta, k_af, table, alpha0, dalpha, nb_, rtip, rh
 # Public entry points
 # --------------------------------------------------------------------------------------------
 def aero_flags(options: AeroOptions) -> np.ndarray:
-    """Kernel flag vector (tip_loss, hub_loss, high_induction, tangential_induction)."""
-    return np.array([options.tip_loss, options.hub_loss, options.high_induction,
-                     options.tangential_induction], dtype=np.int64)
+    """Kernel flag vector (tip_loss, hub_loss, tangential_induction)."""
+    return np.array([options.tip_loss, options.hub_loss, options.tangential_induction],
+                    dtype=np.int64)
 
 
 _TABLE_CACHE: dict[int, tuple[Turbine, PolarTable]] = {}

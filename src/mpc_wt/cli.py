@@ -210,7 +210,8 @@ def _parser() -> argparse.ArgumentParser:
     q.add_argument("--out", help="CSV file (rows pitch, columns tip-speed ratio)")
     q.add_argument("--plot", help="PNG file")
     q.add_argument("--tsr", default="2:16:0.25", help="START:STOP:STEP (default 2:16:0.25)")
-    q.add_argument("--pitch", default="-2:24:0.5", help="START:STOP:STEP in deg")
+    q.add_argument("--pitch", default="-2:24:0.5",
+                   help="START:STOP:STEP in deg; write --pitch=-2:24:0.5 for a negative start")
     q.set_defaults(func=_cmd_cp_surface)
     return ap
 

@@ -1,0 +1,252 @@
+"""Nonlinear plant: structure against published frequencies, consistency with trim, DOF
+switches, wind inputs, divergence and bad input."""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from numpy.testing import assert_allclose
+
+import linearize
+from linearize import (OUTPUT_NAMES, STATE_NAMES, GridWind, PlantConfig, SimulationDivergedError,
+                       SteadyWind, plant_outputs, plant_rhs, rk4_simulate, structural_frequencies,
+                       trim)
+
+# published: Jonkman et al. (2009) Table 9-1, FAST full-system natural frequencies
+# (report values, not re-read): 1st tower fore-aft 0.3240 Hz, 1st tower side-to-side 0.3120 Hz,
+# 1st blade collective flap 0.6993 Hz, 1st blade asymmetric flap (yaw / pitch) 0.6664 / 0.6675 Hz.
+PUBLISHED_HZ = {"tower_fa": 0.3240, "tower_ss": 0.3120, "flap_collective": 0.6993,
+                "flap_asymmetric": 0.5 * (0.6664 + 0.6675)}
+
+
+@pytest.mark.parametrize("mode, rtol", [
+    # tower: one assumed mode, rotor-nacelle as rigid bodies above the top; side-side lacks the
+    # drivetrain-tower coupling FAST has, hence 5 % (issue 2 floor)
+    ("tower_fa", 0.05), ("tower_ss", 0.05),
+    # flap: one assumed mode per blade, no edge/torsion coupling: 3 %
+    ("flap_collective", 0.03), ("flap_asymmetric", 0.03)])
+def test_first_mode_frequencies_match_fast(params: linearize.PlantParams, mode: str,
+                                           rtol: float) -> None:
+    f = structural_frequencies(params, 0.0)
+    assert_allclose(f[mode], PUBLISHED_HZ[mode], rtol=rtol, atol=0)
+
+
+def test_flap_mode_stiffens_with_rotor_speed(params: linearize.PlantParams) -> None:
+    f0 = structural_frequencies(params, 0.0)["flap_asymmetric"]
+    f1 = structural_frequencies(params, 1.2671)["flap_asymmetric"]
+    # analytic: K = K0 + Omega^2 Kc  =>  f1^2 - f0^2 = Omega^2 Kc / (4 pi^2 m)
+    pk = params.pack
+    assert_allclose(f1**2 - f0**2, 1.2671**2 * pk.k_cf / pk.m_b / (4 * math.pi**2), rtol=1e-9,
+                    atol=0)
+
+
+def _rel_drift(res: linearize.SimulationResult, x0: np.ndarray) -> float:
+    scale = np.maximum(np.abs(x0[:16]), [1e-2, 1e-2, 1, 1, 1e-3, 1e-2, 1e-2, 1e-2, 1e-2, 1e-2,
+                                         1e-1, 1e-1, 1e-1, 1e-1, 1e-1, 1e-1])
+    return float(np.max(np.abs(res.x[:, :16] - x0[:16]) / scale))
+
+
+@pytest.mark.parametrize("wind", [8.0, 18.0])
+def test_600s_at_trim_stays_at_trim(turbine: linearize.Turbine,
+                                    params_axisym: linearize.PlantParams, wind: float) -> None:
+    # issue 2: uniform constant wind, trim inputs, azimuth-dependent effects off ->
+    # relative drift < 1e-6 over 600 s at 80 Hz
+    op = trim(turbine, wind, config=params_axisym.config)
+    res = rk4_simulate(params_axisym, op.x, op.u, SteadyWind(wind), 600.0)
+    assert res.t[-1] == pytest.approx(600.0)
+    assert _rel_drift(res, op.x) < 1e-6
+
+
+def test_with_azimuth_effects_settles_to_1p_periodic_motion(turbine: linearize.Turbine,
+                                                            params: linearize.PlantParams) -> None:
+    # issue 2: with tilt, cone, gravity and shear on, the states settle to a 1P-periodic motion
+    # about the trim point. Check: over the last rotor revolution every state repeats the one
+    # before to 1e-3 of its oscillation amplitude, and the mean is the trimmed (azimuth-averaged)
+    # equilibrium to 1 % (the nonlinear mean of a periodic response differs from the
+    # equilibrium of the averaged loads at second order in the 1P amplitude).
+    op = trim(turbine, 18.0, shear_exponent=0.2)
+    res = rk4_simulate(params, op.x, op.u, SteadyWind(18.0, 0.2), 600.0)
+    late = res.t > 450.0
+    w = res.state("rotor_speed")[late].mean()
+    period = 2 * math.pi / w
+    last = res.t > res.t[-1] - period
+    for k, name in enumerate(STATE_NAMES[:16]):
+        x = res.x[:, k]
+        amp = max(float(np.ptp(x[late])), 1e-9)
+        prev = np.interp(res.t[last] - period, res.t, x)
+        assert np.max(np.abs(x[last] - prev)) <= 1e-3 * amp, name
+    for name in ("rotor_speed", "tower_fa_displacement", "shaft_torsion"):
+        assert_allclose(res.state(name)[late].mean(), op.state(name), rtol=0.01, atol=0)
+    amp_flap = np.ptp(res.output("flap_moment_1")[late])
+    assert amp_flap > 1e5   # the 1P motion exists: shear, tilt and gravity act
+
+
+def test_coleman_moments_of_equal_blades_vanish(params_axisym: linearize.PlantParams,
+                                                turbine: linearize.Turbine) -> None:
+    # analytic (Madsen eqs 8-9): three equal blade moments give zero tilt and yaw moments
+    op = trim(turbine, 14.0, config=params_axisym.config)
+    for psi in (0.0, 0.7, 2.1):
+        x = op.x.copy()
+        x[16] = psi
+        z = plant_outputs(0.0, x, op.u, np.full(3, 14.0), params_axisym)
+        flap = z[OUTPUT_NAMES.index("flap_moment_1")]
+        assert abs(z[OUTPUT_NAMES.index("tilt_moment")]) <= 1e-9 * abs(flap)
+        assert abs(z[OUTPUT_NAMES.index("yaw_moment")]) <= 1e-9 * abs(flap)
+        assert_allclose(z[10:13], flap, rtol=1e-12, atol=0)
+
+
+def test_coleman_tilt_of_one_loaded_blade(params: linearize.PlantParams) -> None:
+    # analytic: with only the blade at azimuth 0 (up) carrying load, M_tilt = 2/3 M_b and
+    # M_yaw = 0 (Madsen eq 9). Shear makes the top blade see more wind, so tilt > 0 there.
+    x = np.zeros(17)
+    x[2], x[3] = 1.0, 97.0
+    d = np.zeros((3, 17))
+    d[0] = 10.0
+    z = plant_outputs(0.0, x, np.zeros(4), d, params)
+    m1 = z[OUTPUT_NAMES.index("flap_moment_1")]
+    m2, m3 = z[OUTPUT_NAMES.index("flap_moment_2")], z[OUTPUT_NAMES.index("flap_moment_3")]
+    expected = 2 / 3 * (m1 + m2 * math.cos(2 * math.pi / 3) + m3 * math.cos(4 * math.pi / 3))
+    assert_allclose(z[OUTPUT_NAMES.index("tilt_moment")], expected, rtol=1e-12, atol=1e-6)
+
+
+@pytest.mark.parametrize("cfg, active", [
+    (PlantConfig.madsen(), 8), (PlantConfig.clemens(), 7), (PlantConfig.do(), 14)])
+def test_dof_switches_freeze_states(turbine: linearize.Turbine, cfg: PlantConfig,
+                                    active: int) -> None:
+    # Madsen's 8 states, Clemens's 7, Do's with blade flap: the others have zero derivative
+    assert len(cfg.active_states()) == active
+    p = linearize.plant_params(turbine, cfg)
+    op = trim(turbine, 16.0, config=cfg)
+    x = op.x + 0.01
+    dx = plant_rhs(0.0, x, op.u, np.full(3, 16.0), p)
+    frozen = [i for i, n in enumerate(STATE_NAMES[:16]) if n not in cfg.active_states()]
+    assert np.all(dx[frozen] == 0.0)
+    moving = [STATE_NAMES.index(n) for n in cfg.active_states()]
+    assert np.all(dx[moving] != 0.0)
+
+
+def test_madsen_state_order_first() -> None:
+    assert STATE_NAMES[:8] == ("tower_fa_displacement", "tower_fa_velocity", "rotor_speed",
+                               "gen_speed", "shaft_torsion", "pitch_1", "pitch_2", "pitch_3")
+    assert linearize.MADSEN_OUTPUTS == (
+        "gen_power", "pitch_1", "pitch_2", "pitch_3", "pitch_rate_1", "pitch_rate_2",
+        "pitch_rate_3", "tower_fa_velocity", "rotor_speed", "shaft_torsion",
+        "flap_moment_1", "flap_moment_2", "flap_moment_3")
+
+
+def test_pitch_actuator_limits(params: linearize.PlantParams, turbine: linearize.Turbine) -> None:
+    op = trim(turbine, 18.0)
+    u = op.u.copy()
+    u[:3] = math.radians(120.0)   # beyond the 90 deg limit
+    res = rk4_simulate(params, op.x, u, SteadyWind(18.0), 3.0)
+    rate = np.diff(res.state("pitch_1")) / np.diff(res.t)
+    # eq 15: rate limit 8 deg/s, position limit 90 deg (RK4 keeps the clipped rate exact)
+    assert rate.max() <= math.radians(8.0) * (1 + 1e-9)
+    assert res.state("pitch_1").max() <= math.radians(90.0)
+
+
+def test_generator_torque_rate_limit(params: linearize.PlantParams,
+                                     turbine: linearize.Turbine) -> None:
+    op = trim(turbine, 18.0)
+    u = op.u.copy()
+    u[3] = 0.0
+    res = rk4_simulate(params, op.x, u, SteadyWind(18.0), 1.0)
+    tq = res.u[:, 3]
+    assert np.max(np.abs(np.diff(tq))) <= 15000.0 / 80.0 * (1 + 1e-12)
+    assert_allclose(res.output("gen_torque"), tq, rtol=0, atol=1e-9)
+
+
+def test_uniform_grid_wind_equals_steady_wind(params: linearize.PlantParams,
+                                              turbine: linearize.Turbine) -> None:
+    op = trim(turbine, 12.0)
+    y = np.linspace(-70, 70, 15)
+    z = np.linspace(20, 160, 15)
+    t = np.array([0.0, 100.0])
+    zz = np.broadcast_to(z, (2, 15, 15))
+    grid = GridWind(t=t, y=y, z=z, u=12.0 * (zz / 90.0) ** 0.0)
+    a = rk4_simulate(params, op.x, op.u, grid, 5.0)
+    b = rk4_simulate(params, op.x, op.u, SteadyWind(12.0), 5.0)
+    # tolerance from the solver: warm BEM solves stop at a Newton correction of 1e-9 rad, so
+    # rounding differences in the wind (bilinear weights sum to 1 within 1e-16) can stop them
+    # at a different iterate; the loads then differ at 1e-8 relative at most
+    assert_allclose(a.x, b.x, rtol=1e-7, atol=1e-9)
+
+
+def test_grid_wind_must_cover_rotor_and_time(params: linearize.PlantParams) -> None:
+    y = np.linspace(-40, 40, 5)
+    z = np.linspace(20, 160, 5)
+    g = GridWind(t=np.array([0.0, 10.0]), y=y, z=z, u=np.full((2, 5, 5), 10.0))
+    with pytest.raises(ValueError, match=r"does not cover the rotor"):
+        rk4_simulate(params, np.zeros(17), np.zeros(4), g, 1.0)
+    g = GridWind(t=np.array([0.0, 10.0]), y=np.linspace(-70, 70, 5), z=z,
+                 u=np.full((2, 5, 5), 10.0))
+    with pytest.raises(ValueError, match=r"ends at t = 10 s, before the simulation end t = 20 s"):
+        rk4_simulate(params, np.zeros(17), np.zeros(4), g, 20.0)
+
+
+def test_grid_wind_rejects_nan_and_shape() -> None:
+    y = np.linspace(-70, 70, 4)
+    u = np.full((2, 4, 4), 10.0)
+    u[1, 2, 2] = np.nan
+    with pytest.raises(ValueError, match=r"GridWind.u must be finite; entry \(1, 2, 2\)"):
+        GridWind(t=np.array([0.0, 1.0]), y=y, z=y + 90, u=u)
+    with pytest.raises(ValueError, match=r"GridWind.u has shape \(2, 4\); expected"):
+        GridWind(t=np.array([0.0, 1.0]), y=y, z=y + 90, u=np.ones((2, 4)))
+    with pytest.raises(ValueError, match=r"GridWind.u must be >= 0"):
+        GridWind(t=np.array([0.0, 1.0]), y=y, z=y + 90, u=-np.ones((2, 4, 4)))
+
+
+@pytest.mark.parametrize("speed, shear, match", [
+    (float("nan"), 0.0, "wind speed must be finite and >= 0"),
+    (-3.0, 0.0, "wind speed must be finite and >= 0 m/s, got -3.0"),
+    (10.0, 3.0, "shear_exponent must be in"),
+])
+def test_steady_wind_bad_values(speed: float, shear: float, match: str) -> None:
+    with pytest.raises(ValueError, match=match):
+        SteadyWind(speed, shear)
+
+
+@pytest.mark.parametrize("x, u, d, match", [
+    (np.zeros(16), np.zeros(4), np.full(3, 10.0), r"x has shape \(16,\); expected \(n_x,\)"),
+    (np.zeros(17), np.zeros(3), np.full(3, 10.0), r"u has shape \(3,\); expected \(n_u,\)"),
+    (np.zeros(17), np.zeros(4), np.full((3, 5), 10.0), r"d \(wind\) has shape \(3, 5\)"),
+    (np.zeros(17), np.zeros(4), np.array([10.0, np.nan, 10.0]), r"d \(wind\) must be finite"),
+    (np.zeros(17), np.zeros(4), np.array([10.0, -1.0, 10.0]), r"d \(wind\) must be >= 0 m/s"),
+    (np.full(17, np.nan), np.zeros(4), np.full(3, 10.0), r"x must be finite"),
+])
+def test_rhs_bad_input(params: linearize.PlantParams, x, u, d, match: str) -> None:
+    with pytest.raises(ValueError, match=match):
+        plant_rhs(0.0, x, u, d, params)
+
+
+def test_diverging_run_names_time_and_state_and_keeps_data(
+        params: linearize.PlantParams, turbine: linearize.Turbine) -> None:
+    # no generator torque at fine pitch in 25 m/s: the rotor runs away
+    op = trim(turbine, 25.0)
+    u = np.array([0.0, 0.0, 0.0, 0.0])
+    x0 = op.x.copy()
+    x0[5:8] = 0.0
+    with pytest.raises(SimulationDivergedError,
+                       match=r"diverged at t = [0-9.]+ s: state 'rotor_speed'") as exc:
+        rk4_simulate(params, x0, u, SteadyWind(25.0), 300.0)
+    part = exc.value.partial
+    assert part.t.size > 100 and np.all(np.isfinite(part.x))
+    assert part.x.shape == (part.t.size, 17) and part.z.shape == (part.t.size, 31)
+
+
+@pytest.mark.parametrize("kwargs, match", [
+    (dict(duration=0.0), "duration must be > 0"),
+    (dict(duration=1.0, dt=-0.1), "dt must be > 0"),
+    (dict(duration=0.001), r"must be at least one step"),
+])
+def test_simulate_bad_arguments(params: linearize.PlantParams, kwargs, match: str) -> None:
+    with pytest.raises(ValueError, match=match):
+        rk4_simulate(params, np.zeros(17), np.zeros(4), SteadyWind(10.0), **kwargs)
+
+
+def test_plant_config_rejects_unknown_dof() -> None:
+    with pytest.raises(ValueError, match=r"dofs has unknown names \['tower_torsion'\]"):
+        PlantConfig(frozenset({"tower_torsion"}))
+    with pytest.raises(ValueError, match=r"integration must be"):
+        PlantConfig(integration="simpson")

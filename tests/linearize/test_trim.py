@@ -1,0 +1,104 @@
+"""Trim: the published NREL 5-MW operating schedule, equilibrium, power references, errors."""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from numpy.testing import assert_allclose
+
+import linearize
+from linearize import TrimError, operating_schedule, rated_wind_speed, trim
+
+
+def test_rated_wind_speed(turbine: linearize.Turbine) -> None:
+    # published: Jonkman et al. (2009) Table 1-1: rated wind speed 11.4 m/s; issue 2: +-0.3
+    assert abs(rated_wind_speed(turbine) - 11.4) <= 0.3
+
+
+# published: Jonkman et al. (2009) Table 7-2, steady region-3 pitch of the baseline controller
+# (FAST, frozen wake): 14 m/s 8.70 deg, 18 m/s 14.92 deg, 25 m/s 23.47 deg (report values as
+# recalled, not re-read). Issue 2: within +-1 deg.
+@pytest.mark.parametrize("wind, pitch_deg", [(14.0, 8.70), (18.0, 14.92), (25.0, 23.47)])
+def test_region3_pitch_schedule(turbine: linearize.Turbine, wind: float, pitch_deg: float) -> None:
+    op = trim(turbine, wind)
+    assert op.region == "3"
+    assert abs(op.pitch_deg - pitch_deg) <= 1.0
+    assert_allclose(op.power, 5e6, rtol=1e-9, atol=0)
+    assert_allclose(op.rotor_speed_rpm, 12.1, rtol=1e-12, atol=0)
+
+
+def test_thrust_at_rated(turbine: linearize.Turbine) -> None:
+    # published: NREL/turbine-models Offshore/NREL_5MW_126_RWT.csv (@be1ca72): 805.112 kN at
+    # 11.4 m/s (rated). That column is OpenFAST's low-speed-shaft axial force, which carries the
+    # rotor weight along the 5 deg tilted shaft: 109,389.842 kg (ED.sum) * 9.80665 * sin 5 deg
+    # = 93.5 kN (check: at 3 m/s the table's 171.7 kN minus 93.5 kN is 78.2 kN; ours 76.6 kN).
+    # Issue 2: within 5 %.
+    published = 805.112e3 - 109389.842 * 9.80665 * math.sin(math.radians(5.0))
+    op = trim(turbine, rated_wind_speed(turbine))
+    assert_allclose(op.thrust, published, rtol=0.05, atol=0)
+
+
+def test_trim_is_an_equilibrium(turbine: linearize.Turbine,
+                                params_axisym: linearize.PlantParams) -> None:
+    for v in (5.0, 9.0, 11.0, 13.0, 22.0):
+        op = trim(turbine, v, config=params_axisym.config)
+        dx = linearize.plant_rhs(0.0, op.x, op.u, np.full(3, v), params_axisym)
+        # tolerance from the solvers: brentq on pitch to 1e-14 rad, BEM to 1e-13 rad
+        assert np.max(np.abs(dx[:16])) < 1e-8, (v, dx)
+
+
+def test_power_reference_below_rated(turbine: linearize.Turbine) -> None:
+    full = trim(turbine, 15.0)
+    der = trim(turbine, 15.0, power_W=4.0e6)
+    assert der.region == "3"
+    assert_allclose(der.power, 4.0e6, rtol=1e-9, atol=0)
+    assert der.pitch_rad > full.pitch_rad        # more pitch sheds the extra power
+    assert der.thrust < full.thrust
+    assert der.power_reference == 4.0e6
+
+
+@pytest.mark.parametrize("wind, power, match", [
+    (2.0, None, r"wind_mps = 2 m/s is outside the operating range cut-in..cut-out = 3..25"),
+    (26.0, None, r"outside the operating range"),
+    (8.0, 4.0e6, r"power_W = 4e\+06 W is above the power available at 8 m/s"),
+    (15.0, 6.0e6, r"power_W = 6e\+06 W must be in \(0, rated power 5e\+06 W\]"),
+    (15.0, -1.0, r"must be in \(0, rated power"),
+])
+def test_unreachable_trim_says_why(turbine: linearize.Turbine, wind: float, power,
+                                   match: str) -> None:
+    with pytest.raises(TrimError, match=match):
+        trim(turbine, wind, power)
+
+
+@pytest.mark.parametrize("wind", [float("nan"), "12"])
+def test_trim_bad_types(turbine: linearize.Turbine, wind) -> None:
+    with pytest.raises((ValueError, TypeError), match="wind_mps must be"):
+        trim(turbine, wind)
+
+
+def test_schedule_caps_power_reference_at_availability(turbine: linearize.Turbine) -> None:
+    pts = operating_schedule(turbine, [6.0, 10.0, 14.0], power_W=3.0e6)
+    assert pts[0].power < 3.0e6 and pts[0].power_reference is None
+    assert_allclose([pts[1].power, pts[2].power], 3.0e6, rtol=1e-9, atol=0)
+
+
+@settings(max_examples=25, deadline=None)
+@given(v=st.floats(3.0, 25.0))
+def test_schedule_invariants(turbine: linearize.Turbine, v: float) -> None:
+    op = trim(turbine, v)
+    o = turbine.operation
+    assert op.power <= o.rated_power * (1 + 1e-9)
+    assert o.min_rotor_speed_rad_s * (1 - 1e-12) <= op.rotor_speed_rad_s \
+        <= o.rated_rotor_speed_rad_s * (1 + 1e-12)
+    assert op.pitch_rad >= o.fine_pitch_rad - 1e-12
+    # analytic: electrical power = efficiency * torque * speed
+    assert_allclose(op.power, 0.944 * op.gen_torque * op.gen_speed_rad_s, rtol=1e-12, atol=0)
+    assert op.gen_torque <= turbine.generator.max_torque
+
+
+def test_region3_pitch_increases_with_wind(turbine: linearize.Turbine) -> None:
+    pts = operating_schedule(turbine, np.arange(12.0, 25.5, 1.0))
+    assert np.all(np.diff([p.pitch_rad for p in pts]) > 0)

@@ -1,0 +1,79 @@
+"""The mpcwt command line: output formats, files written, errors on bad arguments."""
+from __future__ import annotations
+
+import csv
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from mpc_wt.cli import UsageError, main, parse_range
+
+
+def test_trim_json_keys(capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(["trim", "--wind", "10:12:1", "--json"]) == 0
+    rows = json.loads(capsys.readouterr().out)
+    assert [r["wind_mps"] for r in rows] == [10.0, 11.0, 12.0]
+    for key in ("wind_mps", "pitch_deg", "rotor_speed_rpm", "gen_torque_Nm", "power_W",
+                "thrust_N"):
+        assert all(isinstance(r[key], float) for r in rows), key
+    assert rows[2]["power_W"] == pytest.approx(5e6, rel=1e-9)
+
+
+def test_trim_table_and_power_reference(capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(["trim", "--wind", "16", "--power-W", "4e6", "--json"]) == 0
+    rows = json.loads(capsys.readouterr().out)
+    assert rows[0]["power_W"] == pytest.approx(4e6, rel=1e-9)
+    assert main(["trim", "--wind", "8,16"]) == 0
+    out = capsys.readouterr().out
+    assert "pitch [deg]" in out and len(out.strip().splitlines()) == 4
+
+
+def test_cp_surface_csv_and_plot(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    csv_path, png = tmp_path / "cp.csv", tmp_path / "cp.png"
+    assert main(["aero", "cp-surface", "--tsr", "6:9:0.5", "--pitch=-1:2:1", "--out",
+                 str(csv_path), "--plot", str(png)]) == 0
+    rows = list(csv.reader(csv_path.open()))
+    assert len(rows) == 1 + 4 and len(rows[0]) == 1 + 7
+    cp = np.array([[float(c) for c in r[1:]] for r in rows[1:]])
+    assert 0.45 < cp.max() < 0.5
+    assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    assert "C_P max" in capsys.readouterr().out
+
+
+def test_run_writes_table_and_plots(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(["run", "--out", str(tmp_path)]) == 0
+    out = capsys.readouterr().out
+    assert "rated wind speed" in out and out.count("\n") > 20
+    for name in ("operating_points.csv", "operating_points.json", "cp_surface.csv",
+                 "cp_surface.png", "operating_schedule.png"):
+        assert (tmp_path / name).stat().st_size > 100, name
+    pts = json.loads((tmp_path / "operating_points.json").read_text())
+    assert pts[0]["wind_mps"] == 3.0 and pts[-1]["wind_mps"] == 25.0
+
+
+@pytest.mark.parametrize("argv, match", [
+    (["trim", "--wind", "12:4:1"], "--wind must be START:STOP:STEP"),
+    (["trim", "--wind", "1:4:1"], "wind_mps = 1 m/s is outside the operating range"),
+    (["trim", "--wind", "abc"], "--wind must be"),
+    (["trim", "--turbine", "/no/such/turbine.yaml"], "neither a packaged turbine"),
+    (["trim", "--wind", "8", "--power-W", "9e6"], "power_W = 9e\\+06 W must be in"),
+    (["aero", "cp-surface", "--tsr", "6:9:1"], "give --out FILE.csv and/or --plot"),
+])
+def test_errors_exit_2_with_a_message(argv: list[str], match: str,
+                                      capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(argv) == 2
+    import re
+
+    assert re.search(match, capsys.readouterr().err)
+
+
+def test_parse_range() -> None:
+    np.testing.assert_allclose(parse_range("4:25:1", "--wind"), np.arange(4.0, 26.0))
+    np.testing.assert_allclose(parse_range("0.1:0.3:0.1", "x"), [0.1, 0.2, 0.3])
+    np.testing.assert_allclose(parse_range("3,5", "x"), [3.0, 5.0])
+    with pytest.raises(UsageError, match="STEP > 0"):
+        parse_range("1:2:0", "x")
+    with pytest.raises(UsageError, match="finite"):
+        parse_range("nan", "x")
