@@ -125,17 +125,22 @@ _JIT = dict(cache=True, error_model="numpy", fastmath=False)
 
 
 @nb.njit(**_JIT)
-def _polar_lookup(table, k, alpha, alpha0, dalpha):  # pragma: no cover - compiled
-    """cl, cd of airfoil k at alpha [rad], alpha wrapped into [-pi, pi)."""
-    a = alpha - 2.0 * _PI * math.floor((alpha + _PI) / (2.0 * _PI))
-    x = (a - alpha0) / dalpha
-    n = table.shape[2]
+def _locate_cell(x, n):  # pragma: no cover - compiled
+    """Cell of a uniform grid with n nodes holding the fractional index x: (i, x - i), i in
+    [0, n - 2] (clamped, so points outside extrapolate the end cells)."""
     i = int(math.floor(x))
     if i < 0:
         i = 0
     elif i > n - 2:
         i = n - 2
-    t = x - i
+    return i, x - i
+
+
+@nb.njit(**_JIT)
+def _polar_lookup(table, k, alpha, alpha0, dalpha):  # pragma: no cover - compiled
+    """cl, cd of airfoil k at alpha [rad], alpha wrapped into [-pi, pi)."""
+    a = alpha - 2.0 * _PI * math.floor((alpha + _PI) / (2.0 * _PI))
+    i, t = _locate_cell((a - alpha0) / dalpha, table.shape[2])
     t2 = t * t
     t3 = t2 * t
     h00 = 2.0 * t3 - 3.0 * t2 + 1.0

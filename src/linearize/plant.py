@@ -58,7 +58,7 @@ import numpy as np
 
 from ._typing import FloatArray
 from ._validate import check_array, check_positive
-from .bem import AeroOptions, _element, aero_flags, polar_table_of
+from .bem import AeroOptions, _element, _locate_cell, aero_flags, polar_table_of
 from .turbine import Turbine, mode_shape
 
 __all__ = [
@@ -583,24 +583,14 @@ def _sample_wind(t, psi, p, kind, wpar, grid):  # pragma: no cover - compiled
         return out
     t0, dt, y0, dy, z0, dz = wpar[0], wpar[1], wpar[2], wpar[3], wpar[4], wpar[5]
     nt, ny, nz = grid.shape
-    ft = (t - t0) / dt
-    it = int(math.floor(ft))
-    if it < 0:
-        it = 0
-    if it > nt - 2:
-        it = nt - 2
-    at = ft - it
     if nt == 1:
-        it = 0
-        at = 0.0
+        it, at = 0, 0.0
+    else:
+        it, at = _locate_cell((t - t0) / dt, nt)
     for i in range(3):
         for j in range(nr):
-            fy = (ys[i, j] - y0) / dy
-            fz = (zs[i, j] - z0) / dz
-            iy = min(max(int(math.floor(fy)), 0), ny - 2)
-            iz = min(max(int(math.floor(fz)), 0), nz - 2)
-            ay = fy - iy
-            az = fz - iz
+            iy, ay = _locate_cell((ys[i, j] - y0) / dy, ny)
+            iz, az = _locate_cell((zs[i, j] - z0) / dz, nz)
             acc = 0.0
             for kt in range(2):
                 if nt == 1 and kt == 1:

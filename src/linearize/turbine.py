@@ -62,8 +62,15 @@ def _check_section(obj: Any) -> None:
                 f"{lb}{meta['lo']:g}, {meta['hi']:g}], got {v / meta['scale']!r}")
 
 
+class _Section:
+    """Base of the scalar sections: each field is checked against its allowed range."""
+
+    def __post_init__(self) -> None:
+        _check_section(self)
+
+
 @dataclass(frozen=True)
-class Geometry:
+class Geometry(_Section):
     """Rotor and nacelle geometry.
 
     Parameters
@@ -103,7 +110,7 @@ class Geometry:
     nacelle_cm_vertical: float = _f("nacelle_cm_vertical_m", -30.0, 30.0)
 
     def __post_init__(self) -> None:
-        _check_section(self)
+        super().__post_init__()
         if not self.hub_radius < self.tip_radius:
             raise ValueError(f"Geometry.hub_radius ({self.hub_radius} m) must be smaller than "
                              f"tip_radius ({self.tip_radius} m)")
@@ -113,7 +120,7 @@ class Geometry:
 
 
 @dataclass(frozen=True)
-class Operation:
+class Operation(_Section):
     """Operating envelope.
 
     Parameters
@@ -136,7 +143,7 @@ class Operation:
     fine_pitch_rad: float = _f("fine_pitch_deg", -10.0, 30.0, _DEG)
 
     def __post_init__(self) -> None:
-        _check_section(self)
+        super().__post_init__()
         if not self.cut_in_wind < self.cut_out_wind:
             raise ValueError(f"Operation.cut_in_wind ({self.cut_in_wind}) must be below "
                              f"cut_out_wind ({self.cut_out_wind}) m/s")
@@ -145,41 +152,32 @@ class Operation:
 
 
 @dataclass(frozen=True)
-class Environment:
+class Environment(_Section):
     """Air and gravity: ``air_density`` [kg/m^3], ``gravity`` [m/s^2]."""
 
     air_density: float = _f("air_density_kgpm3", 0.5, 1.6)
     gravity: float = _f("gravity_mps2", 0.0, 20.0)
 
-    def __post_init__(self) -> None:
-        _check_section(self)
-
 
 @dataclass(frozen=True)
-class RotorMass:
+class RotorMass(_Section):
     """Hub mass [kg], hub inertia about the shaft [kg m^2], blade mass scale factor [-]."""
 
     hub_mass: float = _f("hub_mass_kg", 0.0, 1e7, lo_open=True)
     hub_inertia: float = _f("hub_inertia_kgm2", 0.0, 1e10, lo_open=True)
     blade_mass_scale: float = _f("blade_mass_scale", 0.5, 2.0)
 
-    def __post_init__(self) -> None:
-        _check_section(self)
-
 
 @dataclass(frozen=True)
-class Nacelle:
+class Nacelle(_Section):
     """Nacelle mass [kg] and yaw inertia [kg m^2]."""
 
     mass: float = _f("mass_kg", 0.0, 1e8, lo_open=True)
     yaw_inertia: float = _f("yaw_inertia_kgm2", 0.0, 1e10, lo_open=True)
 
-    def __post_init__(self) -> None:
-        _check_section(self)
-
 
 @dataclass(frozen=True)
-class Drivetrain:
+class Drivetrain(_Section):
     """Two-mass drivetrain (Madsen et al. 2012, eq 11).
 
     Parameters
@@ -203,12 +201,9 @@ class Drivetrain:
     shaft_stiffness: float = _f("shaft_stiffness_Nm_per_rad", 0.0, 1e13, lo_open=True)
     shaft_damping: float = _f("shaft_damping_Nms_per_rad", 0.0, 1e12)
 
-    def __post_init__(self) -> None:
-        _check_section(self)
-
 
 @dataclass(frozen=True)
-class Generator:
+class Generator(_Section):
     """Generator torque limits on the high-speed shaft [N m] and rate limit [N m/s]."""
 
     min_torque: float = _f("min_torque_Nm", -1e8, 1e8)
@@ -216,13 +211,13 @@ class Generator:
     max_torque_rate: float = _f("max_torque_rate_Nmps", 0.0, 1e9, lo_open=True)
 
     def __post_init__(self) -> None:
-        _check_section(self)
+        super().__post_init__()
         if not self.min_torque < self.max_torque:
             raise ValueError("Generator.min_torque_Nm must be below max_torque_Nm")
 
 
 @dataclass(frozen=True)
-class PitchActuator:
+class PitchActuator(_Section):
     """First-order pitch servo with limits (Madsen et al. 2012, eqs 14-15).
 
     Parameters
@@ -241,21 +236,18 @@ class PitchActuator:
     time_constant: float = _f("time_constant_s", 0.0, 5.0, lo_open=True)
 
     def __post_init__(self) -> None:
-        _check_section(self)
+        super().__post_init__()
         if not self.min_pitch_rad < self.max_pitch_rad:
             raise ValueError("PitchActuator.min_pitch_deg must be below max_pitch_deg")
 
 
 @dataclass(frozen=True)
-class Damping:
+class Damping(_Section):
     """Structural damping ratios of the first modes [-]."""
 
     blade: float = _f("blade_damping_ratio", 0.0, 0.5)
     tower_fa: float = _f("tower_fa_damping_ratio", 0.0, 0.5)
     tower_ss: float = _f("tower_ss_damping_ratio", 0.0, 0.5)
-
-    def __post_init__(self) -> None:
-        _check_section(self)
 
 
 # --------------------------------------------------------------------------------------------
