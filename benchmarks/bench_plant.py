@@ -37,7 +37,7 @@ from linearize.steady import _avg_eval
 def _loop_rhs(x, u, w, pk, hint, n):  # pragma: no cover - compiled
     acc = 0.0
     for _ in range(n):
-        dx, z, ph = _eval(x, u, w, pk, hint)
+        dx, z, ph = _eval(x, u, w, pk, hint, 0)
         hint = ph
         acc += dx[2]
     return acc
@@ -139,7 +139,7 @@ def main() -> int:
     t = min(_timeit(lambda: [linearize.plant_rhs(0.0, op.x, op.u, d, params) for _ in range(n)],
                     args.repeat))
     res["rhs_python_us"] = t / n * 1e6
-    hint = np.full((2, 3, 17), np.nan)
+    hint = np.full((4, 3, 17), np.nan)
     _loop_rhs(op.x, op.u, d, params.pack, hint, 2)
     n = 20000
     t = min(_timeit(lambda: _loop_rhs(op.x, op.u, d, params.pack, hint, n), args.repeat))

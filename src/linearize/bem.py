@@ -123,12 +123,21 @@ def build_polar_table(polars: tuple[Polar, ...], n_alpha: int = _N_ALPHA) -> Pol
 # --------------------------------------------------------------------------------------------
 _JIT = dict(cache=True, error_model="numpy", fastmath=False)
 
+# Mode bits of _element (and of the plant kernel that passes them on).
+MODE_FROZEN = 1    # frozen wake: induction factors given, no solve
+MODE_CS = 2        # complex step: implicit-function step around a tight real root
+MODE_TIGHT = 4     # warm-started solves run to _XTOL instead of _XTOL_WARM
+MODE_NOLIMITS = 8  # plant: no actuator position/rate clipping (linearization)
+
+# The kernels below are generic over float64 and complex128 (for complex-step derivatives):
+# branches test the real part, and abs() of a signed quantity is written as a sign flip.
+
 
 @nb.njit(**_JIT)
 def _locate_cell(x, n):  # pragma: no cover - compiled
     """Cell of a uniform grid with n nodes holding the fractional index x: (i, x - i), i in
     [0, n - 2] (clamped, so points outside extrapolate the end cells)."""
-    i = int(math.floor(x))
+    i = int(math.floor(x.real))
     if i < 0:
         i = 0
     elif i > n - 2:
@@ -137,9 +146,20 @@ def _locate_cell(x, n):  # pragma: no cover - compiled
 
 
 @nb.njit(**_JIT)
+def _atan2(y, x):  # pragma: no cover - compiled
+    """atan2 that also differentiates under complex step (quadrant from the real parts)."""
+    if x.real == 0.0:
+        return 0.5 * _PI if y.real >= 0.0 else -0.5 * _PI
+    a = np.arctan(y / x)
+    if x.real < 0.0:
+        a = a + _PI if y.real >= 0.0 else a - _PI
+    return a
+
+
+@nb.njit(**_JIT)
 def _polar_lookup(table, k, alpha, alpha0, dalpha):  # pragma: no cover - compiled
     """cl, cd of airfoil k at alpha [rad], alpha wrapped into [-pi, pi)."""
-    a = alpha - 2.0 * _PI * math.floor((alpha + _PI) / (2.0 * _PI))
+    a = alpha - 2.0 * _PI * math.floor((alpha.real + _PI) / (2.0 * _PI))
     i, t = _locate_cell((a - alpha0) / dalpha, table.shape[2])
     t2 = t * t
     t3 = t2 * t
@@ -158,20 +178,26 @@ def _prandtl(r, rtip, rhub, nb_, sphi, tip, hub):  # pragma: no cover - compiled
 
     Where the exponent exceeds 40, exp(-f) < 5e-18 and F = 1 to rounding: the acos is skipped.
     """
-    F = 1.0
-    s = abs(sphi)
-    if s < 1e-12:
-        s = 1e-12
+    F = 1.0 + 0.0 * sphi
+    s = sphi if sphi.real >= 0.0 else -sphi
+    if s.real < 1e-12:
+        s = 1e-12 + 0.0 * sphi
     if tip:
         f = 0.5 * nb_ * (rtip - r) / (r * s)
-        if f < 40.0:
-            F *= 2.0 / _PI * math.acos(min(1.0, math.exp(-f)))
+        if f.real < 40.0:
+            e = np.exp(-f)
+            if e.real > 1.0:
+                e = 1.0 + 0.0 * e
+            F = F * (2.0 / _PI * np.arccos(e))
     if hub and rhub > 0.0:
         f = 0.5 * nb_ * (r - rhub) / (rhub * s)
-        if f < 40.0:
-            F *= 2.0 / _PI * math.acos(min(1.0, math.exp(-f)))
-    if F < 1e-10:
-        F = 1e-10
+        if f.real < 40.0:
+            e = np.exp(-f)
+            if e.real > 1.0:
+                e = 1.0 + 0.0 * e
+            F = F * (2.0 / _PI * np.arccos(e))
+    if F.real < 1e-10:
+        F = 1e-10 + 0.0 * F
     return F
 
 
@@ -184,46 +210,47 @@ def _induction(phi, vx, vy, r, chord, theta, k_af, table, alpha0, dalpha, nb_, r
     relation is always applied above a = 0.4 (k > 2/3): Ning's proof that the first bracket
     holds a root needs it (with pure momentum theory a -> 1 as phi -> 0 and R(0+) > 0).
     """
-    s = math.sin(phi)
-    c = math.cos(phi)
+    s = np.sin(phi)
+    c = np.cos(phi)
     cl, cd = _polar_lookup(table, k_af, phi - theta, alpha0, dalpha)
     cn = cl * c + cd * s
     ct = cl * s - cd * c
     F = _prandtl(r, rtip, rhub, nb_, s, flags[0] != 0, flags[1] != 0)
     sig = nb_ * chord / (2.0 * _PI * r)
     ss = s * s
-    if ss < 1e-24:
-        ss = 1e-24
+    if ss.real < 1e-24:
+        ss = 1e-24 + 0.0 * ss
     k = sig * cn / (4.0 * F * ss)
     sc = s * c
-    if abs(sc) < 1e-24:
-        sc = 1e-24 if sc >= 0.0 else -1e-24
-    kp = sig * ct / (4.0 * F * sc) if flags[2] != 0 else 0.0
-    if phi > 0.0:
-        if k <= 2.0 / 3.0:
+    if abs(sc.real) < 1e-24:
+        sc = (1e-24 if sc.real >= 0.0 else -1e-24) + 0.0 * sc
+    kp = sig * ct / (4.0 * F * sc) if flags[2] != 0 else 0.0 * ct
+    if phi.real > 0.0:
+        if k.real <= 2.0 / 3.0:
             # a = k/(1+k): 1 - a = 1/(1+k); written without the division
             res = vy * s * (1.0 + k) - vx * c * (1.0 - kp)
             den = 1.0 + k
-            one_m_a = 1.0 / den if abs(den) > 1e-9 else 1e9
+            one_m_a = 1.0 / den if abs(den.real) > 1e-9 else 1e9 + 0.0 * den
         else:
             g1 = 2.0 * F * k - (10.0 / 9.0 - F)
             g2 = 2.0 * F * k - F * (4.0 / 3.0 - F)
             g3 = 2.0 * F * k - (25.0 / 9.0 - 2.0 * F)
-            g2 = max(g2, 1e-12)
-            if abs(g3) < 1e-6:
-                a = 1.0 - 1.0 / (2.0 * math.sqrt(g2))
+            if g2.real < 1e-12:
+                g2 = 1e-12 + 0.0 * g2
+            if abs(g3.real) < 1e-6:
+                a = 1.0 - 1.0 / (2.0 * np.sqrt(g2))
             else:
-                a = (g1 - math.sqrt(g2)) / g3
+                a = (g1 - np.sqrt(g2)) / g3
             one_m_a = 1.0 - a
-            if abs(one_m_a) < 1e-9:
-                one_m_a = 1e-9
+            if abs(one_m_a.real) < 1e-9:
+                one_m_a = 1e-9 + 0.0 * one_m_a
             res = vy * s / one_m_a - vx * c * (1.0 - kp)
     else:
         # propeller-brake region (Ning 2014, sec. 3)
         res = vy * s * (1.0 - k) - vx * c * (1.0 - kp)
-        one_m_a = 1.0 / (1.0 - k) if k > 1.0 else 1.0
+        one_m_a = 1.0 / (1.0 - k) if k.real > 1.0 else 1.0 + 0.0 * k
     den = 1.0 - kp
-    one_p_ap = 1.0 / den if abs(den) > 1e-9 else 1e9
+    one_p_ap = 1.0 / den if abs(den.real) > 1e-9 else 1e9 + 0.0 * den
     return res, one_m_a, one_p_ap, cn, ct
 
 
@@ -236,7 +263,7 @@ def _res(phi, vx, vy, r, chord, theta, k_af, table, alpha0, dalpha, nb_, rtip, r
 @nb.njit(**_JIT)
 def _brent(a, b, fa, fb, vx, vy, r, chord, theta, k_af, table, alpha0, dalpha, nb_, rtip, rhub,
            flags):  # pragma: no cover - compiled
-    """Brent's root finder on [a, b] with fa * fb < 0 (Brent 1973, zeroin)."""
+    """Brent's root finder on [a, b] with fa * fb < 0 (Brent 1973, zeroin). Real only."""
     c = a
     fc = fa
     d = b - a
@@ -293,15 +320,15 @@ def _brent(a, b, fa, fb, vx, vy, r, chord, theta, k_af, table, alpha0, dalpha, n
 
 @nb.njit(**_JIT)
 def _solve_phi(vx, vy, r, chord, theta, k_af, table, alpha0, dalpha, nb_, rtip, rhub, flags,
-               hint, hint_slope):  # pragma: no cover - compiled
-    """Solve one element: (phi, dR/dphi, 1 - a, 1 + a', cn, ct) for V_x > 0, V_y > 0.
+               hint, hint_slope, tol):  # pragma: no cover - compiled
+    """Solve one element (real): (phi, dR/dphi, 1 - a, 1 + a', cn, ct) for V_x, V_y > 0.
 
     Without a hint (NaN) the root is found in Ning's (2014) global brackets by Brent's method
-    to ``_XTOL`` (1e-13 rad); this always converges and is what trim and linearization use.
-    With a hint (an earlier solution nearby, as in time stepping) a secant iteration starts
-    from it with the slope cached at that solve, confined to the hint's Ning region, and stops
-    at the evaluated point whose Newton correction is below ``_XTOL_WARM`` (1e-9 rad); if it
-    does not get there in 8 steps it falls back to the global brackets.
+    to ``_XTOL`` (1e-13 rad); this always converges and is what trim uses. With a hint (an
+    earlier solution nearby, as in time stepping) a secant iteration starts from it with the
+    slope cached at that solve, confined to the hint's Ning region, and stops at the evaluated
+    point whose Newton correction is below ``tol``; if it does not get there in 8 steps it falls
+    back to the global brackets.
     """
     args = (vx, vy, r, chord, theta, k_af, table, alpha0, dalpha, nb_, rtip, rhub, flags)
     if hint == hint:  # not NaN
@@ -320,7 +347,7 @@ def _solve_phi(vx, vy, r, chord, theta, k_af, table, alpha0, dalpha, nb_, rtip, 
                 if slope == 0.0 or not (slope == slope):
                     break
                 step = f0 / slope
-                if abs(step) <= _XTOL_WARM:
+                if abs(step) <= tol:
                     return x0, slope, oma, opa, cn, ct
                 x1 = x0 - step
                 if x1 <= lo_b or x1 >= hi_b:
@@ -354,33 +381,84 @@ def _solve_phi(vx, vy, r, chord, theta, k_af, table, alpha0, dalpha, nb_, rtip, 
 
 
 @nb.njit(**_JIT)
+def _loads_at(phi, vx, vy, one_m_a, one_p_ap, chord, theta, k_af, table, alpha0, dalpha,
+              rho):  # pragma: no cover - compiled
+    """N', T' from the inflow angle and induction: W^2 = (V_x (1-a))^2 + (V_y (1+a'))^2."""
+    cl, cd = _polar_lookup(table, k_af, phi - theta, alpha0, dalpha)
+    s = np.sin(phi)
+    c = np.cos(phi)
+    ua = vx * one_m_a
+    ut = vy * one_p_ap
+    q = 0.5 * rho * (ua * ua + ut * ut) * chord
+    return q * (cl * c + cd * s), q * (cl * s - cd * c)
+
+
+@nb.njit(**_JIT)
+def _element_frozen(vx, vy, chord, theta, k_af, table, alpha0, dalpha, rho, one_m_a,
+                    one_p_ap):  # pragma: no cover - compiled
+    """Frozen wake: induction held, tan(phi) = V_x (1 - a) / (V_y (1 + a')); no solve."""
+    phi = _atan2(vx * one_m_a, vy * one_p_ap)
+    npr, tpr = _loads_at(phi, vx, vy, one_m_a, one_p_ap, chord, theta, k_af, table, alpha0,
+                         dalpha, rho)
+    return npr, tpr, phi, math.nan, one_m_a + 0.0 * phi, one_p_ap + 0.0 * phi
+
+
+@nb.njit(**_JIT)
+def _element_cs(vx, vy, r, chord, theta, k_af, table, alpha0, dalpha, nb_, rtip, rhub, flags,
+                rho):  # pragma: no cover - compiled
+    """Complex-step sensitivity of the implicit solve (inputs complex).
+
+    The real root phi_r is solved tightly; then phi = phi_r - R(phi_r; complex inputs) /
+    R'(phi_r), whose imaginary part is the exact first-order sensitivity (implicit function
+    theorem), with R'(phi_r) itself taken by a complex step in phi.
+    """
+    vxr, vyr, thr = vx.real, vy.real, theta.real
+    phr = _solve_phi(vxr, vyr, r, chord, thr, k_af, table, alpha0, dalpha, nb_, rtip, rhub,
+                     flags, math.nan, math.nan, _XTOL)[0]
+    h = 1e-30
+    dres = _res(phr + 1j * h, vxr, vyr, r, chord, thr, k_af, table, alpha0, dalpha, nb_, rtip,
+                rhub, flags).imag / h
+    f0 = _res(phr + 0.0 * vx, vx, vy, r, chord, theta, k_af, table, alpha0, dalpha, nb_, rtip,
+              rhub, flags)
+    phi = phr - f0 / dres
+    _, oma, opa, _, _ = _induction(phi, vx, vy, r, chord, theta, k_af, table, alpha0, dalpha,
+                                   nb_, rtip, rhub, flags)
+    npr, tpr = _loads_at(phi, vx, vy, oma, opa, chord, theta, k_af, table, alpha0, dalpha, rho)
+    return npr, tpr, phi, math.nan, oma, opa
+
+
+@nb.njit(**_JIT)
 def _element(vx, vy, r, chord, theta, k_af, table, alpha0, dalpha, nb_, rtip, rhub, flags, rho,
-             hint, hint_slope):  # pragma: no cover - compiled
-    """Loads per unit length on one element: (N', T', phi, dR/dphi).
+             hint, hint_slope, frozen_oma, frozen_opa, mode):  # pragma: no cover - compiled
+    """Loads per unit length on one element: (N', T', phi, dR/dphi, 1 - a, 1 + a').
 
     N' is normal to the rotor plane (positive downwind) and T' in the plane (positive driving
-    the rotor) [N/m]; the relative speed is W^2 = (V_x (1 - a))^2 + (V_y (1 + a'))^2.
-    Reversed or stalled kinematics (V_x <= 0 or V_y <= 0, where momentum theory has no
-    meaning) use the geometric inflow without induction.
+    the rotor) [N/m]. Reversed or stalled kinematics (V_x <= 0 or V_y <= 0, where momentum
+    theory has no meaning) use the geometric inflow without induction.
+
+    ``mode`` bits: MODE_FROZEN holds the induction at (frozen_oma, frozen_opa) (frozen wake,
+    :func:`_element_frozen`); MODE_CS differentiates the implicit solve by complex step
+    (:func:`_element_cs`); MODE_TIGHT makes warm solves converge to 1e-13 rad.
     """
-    slope = math.nan
-    if vx > 1e-9 and vy > 1e-9 * max(1.0, vx):
+    if mode & MODE_FROZEN:
+        return _element_frozen(vx, vy, chord, theta, k_af, table, alpha0, dalpha, rho,
+                               frozen_oma, frozen_opa)
+    if vx.real > 1e-9 and vy.real > 1e-9 * max(1.0, vx.real):
+        if mode & MODE_CS:
+            return _element_cs(vx, vy, r, chord, theta, k_af, table, alpha0, dalpha, nb_, rtip,
+                               rhub, flags, rho)
+        tol = _XTOL if mode & MODE_TIGHT else _XTOL_WARM
         phi, slope, one_m_a, one_p_ap, cn, ct = _solve_phi(
             vx, vy, r, chord, theta, k_af, table, alpha0, dalpha, nb_, rtip, rhub, flags, hint,
-            hint_slope)
+            hint_slope, tol)
         ua = vx * one_m_a
         ut = vy * one_p_ap
-        w2 = ua * ua + ut * ut
-    else:
-        phi = math.atan2(vx, vy)
-        cl, cd = _polar_lookup(table, k_af, phi - theta, alpha0, dalpha)
-        s = math.sin(phi)
-        c = math.cos(phi)
-        cn = cl * c + cd * s
-        ct = cl * s - cd * c
-        w2 = vx * vx + vy * vy
-    q = 0.5 * rho * w2 * chord
-    return q * cn, q * ct, phi, slope
+        q = 0.5 * rho * (ua * ua + ut * ut) * chord
+        return q * cn, q * ct, phi, slope, one_m_a, one_p_ap
+    phi = _atan2(vx, vy)
+    one = 1.0 + 0.0 * phi
+    npr, tpr = _loads_at(phi, vx, vy, one, one, chord, theta, k_af, table, alpha0, dalpha, rho)
+    return npr, tpr, phi, math.nan, one, one
 
 
 # --------------------------------------------------------------------------------------------
@@ -436,10 +514,10 @@ def element_loads(turbine: Turbine, vx: FloatArray, vy: FloatArray, pitch_rad: f
     b = turbine.blade
     g = turbine.geometry
     flags = aero_flags(opts)
-    out = np.empty((4, n))
+    out = np.empty((6, n))
     for j in range(n):
         out[:, j] = _element(vx[j], vy[j], b.r[j], b.chord[j], b.twist_rad[j] + pitch_rad,
                              b.airfoil[j], tab.table, tab.alpha0, tab.dalpha,
                              float(g.number_of_blades), g.tip_radius, g.hub_radius, flags,
-                             turbine.environment.air_density, math.nan, math.nan)
+                             turbine.environment.air_density, math.nan, math.nan, 1.0, 1.0, 0)
     return out[0], out[1], out[2]

@@ -58,7 +58,8 @@ import numpy as np
 
 from ._typing import FloatArray
 from ._validate import check_array, check_positive
-from .bem import AeroOptions, _element, _locate_cell, aero_flags, polar_table_of
+from .bem import (MODE_NOLIMITS, AeroOptions, _element, _locate_cell, aero_flags,
+                  polar_table_of)
 from .turbine import Turbine, mode_shape
 
 __all__ = [
@@ -361,22 +362,24 @@ _TWO_PI_3 = 2.0 * math.pi / 3.0
 
 @nb.njit(**_JIT)
 def _clip(v, lo, hi):  # pragma: no cover - compiled
-    return lo if v < lo else (hi if v > hi else v)
+    return lo + 0.0 * v if v.real < lo else (hi + 0.0 * v if v.real > hi else v)
 
 
 @nb.njit(**_JIT)
-def _eval(x, u, wind, p, hint):  # pragma: no cover - compiled
-    """Derivatives, outputs and BEM state at one instant.
+def _eval(x, u, wind, p, hint, mode):  # pragma: no cover - compiled
+    """Derivatives, outputs and BEM state at one instant (generic over float and complex).
 
-    ``wind``: (3, n_r) [m/s]. ``hint``: (2, 3, n_r) inflow angles and residual slopes of a
-    nearby earlier solve (NaN: none); the same layout is returned for the next call.
+    ``wind``: (3, n_r) [m/s]. ``hint``: (4, 3, n_r) BEM state of a nearby earlier solve --
+    inflow angle, residual slope, 1 - a, 1 + a' (NaN: none); the same layout is returned.
+    ``mode``: bits of :mod:`linearize.bem` (frozen wake, complex step, tight, no limits).
     """
     dof_fa, dof_ss, dof_dt, dof_gen, dof_flap, dof_pitch = (p.dof[0], p.dof[1], p.dof[2],
                                                             p.dof[3], p.dof[4], p.dof[5])
+    limits = (mode & MODE_NOLIMITS) == 0
     nr = p.r.size
-    dx = np.zeros(17)
-    z = np.zeros(31)
-    phis = np.empty((2, 3, nr))
+    dx = np.zeros(17, dtype=x.dtype)
+    z = np.zeros(31, dtype=x.dtype)
+    bem = np.empty((4, 3, nr), dtype=x.dtype)
     xd = x[1]
     wr = x[2]
     wg = x[3]
@@ -384,52 +387,56 @@ def _eval(x, u, wind, p, hint):  # pragma: no cover - compiled
     yd = x[9]
     psi = x[16]
     # pitch actually applied and its rate
-    pitch = np.empty(3)
-    prate = np.zeros(3)
+    pitch = np.empty(3, dtype=x.dtype)
+    prate = np.zeros(3, dtype=x.dtype)
     for i in range(3):
-        ref = _clip(u[i], p.min_p, p.max_p)
+        ref = _clip(u[i], p.min_p, p.max_p) if limits else u[i]
         if dof_pitch:
             pitch[i] = x[5 + i]
-            prate[i] = _clip((ref - x[5 + i]) / p.tau_p, -p.rate_p, p.rate_p)
+            rate = (ref - x[5 + i]) / p.tau_p
+            prate[i] = _clip(rate, -p.rate_p, p.rate_p) if limits else rate
         else:
             pitch[i] = ref
-    tq = _clip(u[3], p.min_tq, p.max_tq)
+    tq = _clip(u[3], p.min_tq, p.max_tq) if limits else u[3]
     cc = math.cos(p.cone)
     sc = math.sin(p.cone)
     ct = math.cos(p.tilt)
     st = math.sin(p.tilt)
-    vhub_x = p.hub_fa * xd if dof_fa else 0.0
-    vhub_y = p.hub_ss * yd if dof_ss else 0.0
-    nod = p.slope_fa * xd if dof_fa else 0.0         # tower-top pitch rate
-    roll = -p.slope_ss * yd if dof_ss else 0.0       # tower-top roll rate about +x
-    torque = 0.0
-    thrust = 0.0
-    fy = 0.0
-    mtilt = 0.0
-    myaw = 0.0
-    mflap_aero = np.zeros(3)
-    medge_aero = np.zeros(3)
-    gq = np.zeros(3)
+    vhub_x = p.hub_fa * xd if dof_fa else 0.0 * xd
+    vhub_y = p.hub_ss * yd if dof_ss else 0.0 * yd
+    nod = p.slope_fa * xd if dof_fa else 0.0 * xd       # tower-top pitch rate
+    roll = -p.slope_ss * yd if dof_ss else 0.0 * yd     # tower-top roll rate about +x
+    torque = 0.0 * wr
+    thrust = 0.0 * wr
+    fy = 0.0 * wr
+    mtilt = 0.0 * wr
+    myaw = 0.0 * wr
+    mflap_aero = np.zeros(3, dtype=x.dtype)
+    medge_aero = np.zeros(3, dtype=x.dtype)
+    gq = np.zeros(3, dtype=x.dtype)
     for i in range(3):
         psi_i = psi + i * _TWO_PI_3
-        sp = math.sin(psi_i)
-        cp = math.cos(psi_i)
-        qd = x[13 + i] if dof_flap else 0.0
-        tor_i = 0.0
-        thr_i = 0.0
-        mf = 0.0
-        me = 0.0
-        gqi = 0.0
+        sp = np.sin(psi_i)
+        cp = np.cos(psi_i)
+        qd = x[13 + i] if dof_flap else 0.0 * x[13 + i]
+        tor_i = 0.0 * wr
+        thr_i = 0.0 * wr
+        mf = 0.0 * wr
+        me = 0.0 * wr
+        gqi = 0.0 * wr
         for j in range(nr):
             rj = p.r[j]
             vrel = wind[i, j] - vhub_x - nod * rj * cc * cp
             vx = vrel * (ct * cc + st * sc * cp) - qd * p.phi_flap[j]
             vy = (wr + roll) * rj * cc + vrel * st * sp - vhub_y * cp
-            npr, tpr, ph, sl = _element(vx, vy, rj, p.chord[j], p.twist[j] + pitch[i], p.af[j],
-                                        p.table, p.alpha0, p.dalpha, p.nb, p.rtip, p.rhub,
-                                        p.flags, p.rho, hint[0, i, j], hint[1, i, j])
-            phis[0, i, j] = ph
-            phis[1, i, j] = sl
+            npr, tpr, ph, sl, oma, opa = _element(
+                vx, vy, rj, p.chord[j], p.twist[j] + pitch[i], p.af[j], p.table, p.alpha0,
+                p.dalpha, p.nb, p.rtip, p.rhub, p.flags, p.rho, hint[0, i, j].real,
+                hint[1, i, j].real, hint[2, i, j].real, hint[3, i, j].real, mode)
+            bem[0, i, j] = ph
+            bem[1, i, j] = sl
+            bem[2, i, j] = oma
+            bem[3, i, j] = opa
             wj = p.w[j]
             tor_i += tpr * rj * cc * wj
             thr_i += npr * cc * wj
@@ -455,23 +462,23 @@ def _eval(x, u, wind, p, hint):  # pragma: no cover - compiled
             jt = p.j_rot + p.ngear * p.ngear * p.j_gen
             dwr = (torque - p.ngear * tq) / jt
             dwg = p.ngear * dwr
-            dth = 0.0
+            dth = 0.0 * dwr
             qs = torque - p.j_rot * dwr
     else:
-        dwr = 0.0
-        dwg = 0.0
-        dth = 0.0
+        dwr = 0.0 * wr
+        dwg = 0.0 * wr
+        dth = 0.0 * wr
         qs = p.k_shaft * th if dof_dt else p.ngear * tq
     # reaction torque on the nacelle about +x (rotor and generator spin the same way)
     m_react = tq + (1.0 - 1.0 / p.ngear) * qs
     # tower fore-aft + blade flap (inertially coupled)
     omega2 = wr * wr
     kq = p.k_b + omega2 * p.k_cf
-    fq = np.zeros(3)
+    fq = np.zeros(3, dtype=x.dtype)
     for i in range(3):
         if dof_flap:
             fq[i] = gq[i] - p.c_b * x[13 + i] - kq * x[10 + i]
-    xdd = 0.0
+    xdd = 0.0 * wr
     if dof_fa:
         ft = (thrust * ct * p.hub_fa + mtilt * p.slope_fa - p.c_fa * xd - p.k_fa * x[0])
         if dof_flap:
@@ -479,11 +486,11 @@ def _eval(x, u, wind, p, hint):  # pragma: no cover - compiled
             xdd = (ft - ratio * (fq[0] + fq[1] + fq[2])) / (p.m_fa - 3.0 * p.m_c * ratio)
         else:
             xdd = ft / p.m_fa
-    qdd = np.zeros(3)
+    qdd = np.zeros(3, dtype=x.dtype)
     if dof_flap:
         for i in range(3):
             qdd[i] = (fq[i] - p.m_c * xdd) / p.m_b
-    ydd = 0.0
+    ydd = 0.0 * wr
     if dof_ss:
         fss = fy * p.hub_ss - m_react * p.slope_ss - p.c_ss * yd - p.k_ss * x[8]
         ydd = fss / p.m_ss
@@ -516,27 +523,27 @@ def _eval(x, u, wind, p, hint):  # pragma: no cover - compiled
     z[9] = th
     for i in range(3):
         psi_i = psi + i * _TWO_PI_3
-        q = x[10 + i] if dof_flap else 0.0
+        q = x[10 + i] if dof_flap else 0.0 * x[10 + i]
         mf = (mflap_aero[i] - p.hub_fa * xdd * p.s1 - qdd[i] * p.s_phi_s
               - omega2 * q * p.s_phi_r)
         me = medge_aero[i] - dwr * p.i_edge
         if p.opt[0]:
-            me += p.grav * p.s1 * math.sin(psi_i) * ct
+            me += p.grav * p.s1 * np.sin(psi_i) * ct
         z[10 + i] = mf
         z[13 + i] = me
     z[16] = (thrust * ct * p.zhub + mtilt + p.fa_static + p.fa_pdelta * x[0]
              - p.fa_inertia * xdd)
     z[17] = m_react - fy * p.zhub - p.ss_pdelta * x[8] + p.ss_inertia * ydd
     z[18] = qs
-    tl = 0.0
-    yw = 0.0
+    tl = 0.0 * wr
+    yw = 0.0 * wr
     for i in range(3):
         psi_i = psi + i * _TWO_PI_3
-        tl += math.cos(psi_i) * z[10 + i]
-        yw += math.sin(psi_i) * z[10 + i]
+        tl += np.cos(psi_i) * z[10 + i]
+        yw += np.sin(psi_i) * z[10 + i]
     z[19] = 2.0 / 3.0 * tl
     z[20] = 2.0 / 3.0 * yw
-    z[21] = psi - 2.0 * math.pi * math.floor(psi / (2.0 * math.pi))
+    z[21] = psi - 2.0 * math.pi * math.floor(psi.real / (2.0 * math.pi))
     z[22] = torque
     z[23] = thrust
     z[24] = torque * wr
@@ -546,7 +553,7 @@ def _eval(x, u, wind, p, hint):  # pragma: no cover - compiled
     z[28] = ydd
     z[29] = x[0]
     z[30] = x[8]
-    return dx, z, phis
+    return dx, z, bem
 
 
 # wind kinds: 0 = steady power law (speed, exponent), 1 = grid (t, y, z) trilinear
@@ -613,17 +620,18 @@ def _rk4(t, x, u, h, p, kind, wpar, grid, hint, dphi):  # pragma: no cover - com
     Returns the new state, the outputs at t, the stage-4 BEM state and the new ``dphi``.
     """
     w1 = _sample_wind(t, x[16], p, kind, wpar, grid)
-    k1, z, ph1 = _eval(x, u, w1, p, hint)
+    k1, z, ph1 = _eval(x, u, w1, p, hint, 0)
     x2 = x + 0.5 * h * k1
     hint2 = ph1.copy()
     hint2[0] += 0.5 * dphi
-    k2, _, ph2 = _eval(x2, u, _sample_wind(t + 0.5 * h, x2[16], p, kind, wpar, grid), p, hint2)
+    k2, _, ph2 = _eval(x2, u, _sample_wind(t + 0.5 * h, x2[16], p, kind, wpar, grid), p, hint2,
+                       0)
     x3 = x + 0.5 * h * k2
-    k3, _, ph3 = _eval(x3, u, _sample_wind(t + 0.5 * h, x3[16], p, kind, wpar, grid), p, ph2)
+    k3, _, ph3 = _eval(x3, u, _sample_wind(t + 0.5 * h, x3[16], p, kind, wpar, grid), p, ph2, 0)
     x4 = x + h * k3
     hint4 = ph3.copy()
     hint4[0] += 0.5 * dphi
-    k4, _, ph4 = _eval(x4, u, _sample_wind(t + h, x4[16], p, kind, wpar, grid), p, hint4)
+    k4, _, ph4 = _eval(x4, u, _sample_wind(t + h, x4[16], p, kind, wpar, grid), p, hint4, 0)
     xn = x + h / 6.0 * (k1 + 2.0 * k2 + 2.0 * k3 + k4)
     new_dphi = ph4[0] - ph1[0]
     for i in range(new_dphi.shape[0]):
@@ -648,7 +656,7 @@ def _simulate(x0, u_seq, t0, h, n_steps, p, kind, wpar, grid, lim, rate_tq):  # 
     zs = np.empty((n_steps + 1, 31))
     us = np.empty((n_steps + 1, 4))
     x = x0.copy()
-    hint = np.full((2, 3, p.r.size), np.nan)
+    hint = np.full((4, 3, p.r.size), np.nan)
     dphi = np.zeros((3, p.r.size))
     u = u_seq[0].copy()
     tq = u[3]
@@ -664,7 +672,7 @@ def _simulate(x0, u_seq, t0, h, n_steps, p, kind, wpar, grid, lim, rate_tq):  # 
         t = t0 + k * h
         if k == n_steps:
             w = _sample_wind(t, x[16], p, kind, wpar, grid)
-            _, z, _ = _eval(x, u, w, p, hint)
+            _, z, _ = _eval(x, u, w, p, hint, 0)
             zs[k] = z
             break
         xn, z, hint, dphi = _rk4(t, x, u, h, p, kind, wpar, grid, hint, dphi)
@@ -717,8 +725,8 @@ def plant_rhs(t: float, x: FloatArray, u: FloatArray, d: FloatArray,
         On a wrong shape, a non-finite entry or a negative wind speed.
     """
     x, u, d = _check_xud(x, u, d, params.pack.r.size)
-    hint = np.full((2, _N_BLADE, params.pack.r.size), np.nan)
-    dx, _, _ = _eval(x, u, d, params.pack, hint)
+    hint = np.full((4, _N_BLADE, params.pack.r.size), np.nan)
+    dx, _, _ = _eval(x, u, d, params.pack, hint, 0)
     return dx
 
 
@@ -726,8 +734,8 @@ def plant_outputs(t: float, x: FloatArray, u: FloatArray, d: FloatArray,
                   params: PlantParams) -> FloatArray:
     """Performance outputs z (Madsen eq 17 first, then :data:`OUTPUT_NAMES`), (n_z,) ndarray."""
     x, u, d = _check_xud(x, u, d, params.pack.r.size)
-    hint = np.full((2, _N_BLADE, params.pack.r.size), np.nan)
-    _, z, _ = _eval(x, u, d, params.pack, hint)
+    hint = np.full((4, _N_BLADE, params.pack.r.size), np.nan)
+    _, z, _ = _eval(x, u, d, params.pack, hint, 0)
     return z
 
 

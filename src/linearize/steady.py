@@ -26,14 +26,14 @@ def _avg_eval(x, u, speed, shear, p, n_az):  # pragma: no cover - compiled
     """Derivatives and outputs averaged over ``n_az`` azimuths in [0, 2 pi / 3)."""
     dx_avg = np.zeros(17)
     z_avg = np.zeros(31)
-    hint = np.full((2, 3, p.r.size), np.nan)
+    hint = np.full((4, 3, p.r.size), np.nan)
     wpar = np.array([speed, shear])
     dummy = np.zeros((1, 1, 1))
     xx = x.copy()
     for k in range(n_az):
         xx[16] = k * _TWO_PI_3 / n_az
         w = _sample_wind(0.0, xx[16], p, 0, wpar, dummy)
-        dx, z, phis = _eval(xx, u, w, p, hint)
+        dx, z, phis = _eval(xx, u, w, p, hint, 0)
         hint = phis
         dx_avg += dx
         z_avg += z
