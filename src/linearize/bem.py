@@ -448,13 +448,14 @@ def _element(vx, vy, r, chord, theta, k_af, table, alpha0, dalpha, nb_, rtip, rh
             return _element_cs(vx, vy, r, chord, theta, k_af, table, alpha0, dalpha, nb_, rtip,
                                rhub, flags, rho)
         tol = _XTOL if mode & MODE_TIGHT else _XTOL_WARM
+        # real inputs here (complex ones take the MODE_CS branch); .real keeps typing real
         phi, slope, one_m_a, one_p_ap, cn, ct = _solve_phi(
-            vx, vy, r, chord, theta, k_af, table, alpha0, dalpha, nb_, rtip, rhub, flags, hint,
-            hint_slope, tol)
+            vx.real, vy.real, r, chord, theta.real, k_af, table, alpha0, dalpha, nb_, rtip,
+            rhub, flags, hint, hint_slope, tol)
         ua = vx * one_m_a
         ut = vy * one_p_ap
         q = 0.5 * rho * (ua * ua + ut * ut) * chord
-        return q * cn, q * ct, phi, slope, one_m_a, one_p_ap
+        return q * cn, q * ct, phi + 0.0 * vx, slope, one_m_a + 0.0 * vx, one_p_ap + 0.0 * vx
     phi = _atan2(vx, vy)
     one = 1.0 + 0.0 * phi
     npr, tpr = _loads_at(phi, vx, vy, one, one, chord, theta, k_af, table, alpha0, dalpha, rho)

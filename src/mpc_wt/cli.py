@@ -4,6 +4,7 @@ Subcommands
 -----------
 run        the main job on a turbine: steady operating table, C_P surface and plots
 trim       steady operating points against wind speed (table or ``--json``)
+linearize  linear models over mean wind, saved as .mat/.npz/.json (``--json`` summary)
 aero       rotor aerodynamics: ``aero cp-surface --out FILE.csv [--plot FILE.png]``
 
 Errors in the arguments or the turbine file print one line naming the parameter and the value
@@ -154,6 +155,38 @@ def _cmd_cp_surface(args: argparse.Namespace) -> int:
     return 0
 
 
+def _cmd_linearize(args: argparse.Namespace) -> int:
+    turbine = linearize.load_turbine(args.turbine)
+    winds = parse_range(args.wind, "--wind")
+    fam = linearize.linearize_family(
+        turbine, winds, wake="frozen" if args.frozen_wake else "quasi-steady",
+        disturbance=args.disturbance, coordinates="mbc" if args.mbc else "blade",
+        progress=not args.json)
+    if args.out:
+        fam.save(args.out)
+        if not args.json:
+            print(f"wrote {args.out}: {len(fam.models)} models, {fam.models[0].n_x} states, "
+                  f"inputs {list(fam.models[0].inputs)}")
+    rows = []
+    for m in fam.models:
+        row = {"wind_mps": m.wind_speed, "pitch_deg": m.info["pitch_deg"],
+               "rotor_speed_rpm": m.info["rotor_speed_rpm"], **linearize.sensitivities(m),
+               "modes": m.modes()}
+        rows.append(row)
+    if args.json:
+        print(json.dumps(rows, indent=1))
+    else:
+        print(f"{'wind [m/s]':>10s} {'pitch [deg]':>11s} {'dP/dpitch [MW/rad]':>18s} "
+              f"{'dQ/domega [kNms]':>16s} {'dT/dV [kN s/m]':>14s}  modes [Hz, damping]")
+        for r in rows:
+            modes = ", ".join(f"{md['name']} {md['frequency_Hz']:.3f} {md['damping_ratio']:.3f}"
+                              for md in r["modes"])
+            print(f"{r['wind_mps']:10.2f} {r['pitch_deg']:11.3f} "
+                  f"{r['dP_dpitch_W_per_rad'] / 1e6:18.3f} {r['dQ_domega'] / 1e3:16.1f} "
+                  f"{r['dT_dV'] / 1e3:14.2f}  {modes}")
+    return 0
+
+
 def _cmd_run(args: argparse.Namespace) -> int:
     from .plotting import plot_cp_surface, plot_operating_schedule
 
@@ -203,6 +236,18 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument("--json", action="store_true", help="print a JSON list")
     p.set_defaults(func=_cmd_trim)
 
+    p = sub.add_parser("linearize", help="linear models over mean wind")
+    p.add_argument("--turbine", **turb)
+    p.add_argument("--wind", default="4:25:1", help="START:STOP:STEP in m/s (default 4:25:1)")
+    p.add_argument("--frozen-wake", action="store_true",
+                   help="hold the induction at trim (as FAST/OpenFAST linearize)")
+    p.add_argument("--disturbance", choices=("blade", "rotor"), default="blade",
+                   help="one wind per blade (default) or one rotor-effective wind")
+    p.add_argument("--mbc", action="store_true", help="multi-blade (Coleman) coordinates")
+    p.add_argument("--out", help="models file: .mat (MATLAB), .npz or .json")
+    p.add_argument("--json", action="store_true", help="print sensitivities and modes as JSON")
+    p.set_defaults(func=_cmd_linearize)
+
     p = sub.add_parser("aero", help="rotor aerodynamics")
     aero = p.add_subparsers(dest="aero_command", required=True)
     q = aero.add_parser("cp-surface", help="C_P(lambda, pitch) table and plot")
@@ -226,7 +271,8 @@ def main(argv: Sequence[str] | None = None) -> int:
         return 2
     try:
         return int(args.func(args))
-    except (UsageError, TurbineFileError, TrimError, FileNotFoundError, ValueError) as err:
+    except (UsageError, TurbineFileError, TrimError, FileNotFoundError, ValueError,
+            linearize.LinearizationError) as err:
         print(f"mpcwt {args.command}: error: {err}", file=sys.stderr)
         return 2
 

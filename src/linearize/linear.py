@@ -1,0 +1,927 @@
+"""Numerical linearization of the plant at trim points, parameterized by mean wind.
+
+``linearize(turbine, wind_mps)`` returns the continuous model of Madsen et al. (2012) eqs 18-19,
+
+    dx/dt = A x + B_u u + B_d d,      z = C_z x + D_u u + D_d d,
+
+in perturbations from the trim point, with named states, inputs, disturbances and outputs.
+
+Derivatives are central differences of :func:`linearize.plant_rhs` with a step per variable
+scaled to that variable; warm-started BEM solves run to 1e-13 rad so the differences are not
+noise. ``jacobian_check`` computes the same Jacobians by complex step through the same kernels
+(the implicit BEM solve is differentiated by the implicit-function theorem), an independent
+derivative used by the tests.
+
+Wake assumption (``wake``):
+
+* ``"quasi-steady"`` re-solves the induction at every perturbation, as Madsen's numerical
+  linearization does. Use it for controllers whose time scale is long compared with the wake's
+  (the steady power and thrust surfaces are its limit): baseline PI tuning, MPC at 10 Hz in a
+  quasi-steady BEM plant like ours.
+* ``"frozen"`` holds the axial and tangential induction at their trim values, as FAST/OpenFAST
+  linearize and as the NREL 5-MW report's pitch sensitivities were computed. Use it to compare
+  with OpenFAST models and for fast pitch action (IPC, load control), where the wake has no time
+  to respond within a control period; it predicts a stronger immediate pitch sensitivity.
+
+With tilt, cone, gravity or shear on, the plant is periodic in azimuth; the models are averaged
+over azimuth in blade coordinates (Madsen's azimuth-independent models), or in multi-blade
+coordinates (``coordinates="mbc"``: collective, cosine (tilt-like) and sine (yaw-like)
+components, Bir 2008), which OpenFAST's MBC3 users know.
+
+References
+----------
+Madsen, Filsoe, Soltani (2012), IEEE CCA, doi:10.1109/CCA.2012.6402671, sec. II-D.
+Bir (2008), Multi-blade coordinate transformation and its application to wind turbine analysis,
+AIAA 2008-1300. Do et al. (2020), Wind Energy, eq 6 (actuator augmentation).
+Jonkman et al. (2009), NREL/TP-500-38060, sec. 7.4 (pitch sensitivity).
+"""
+from __future__ import annotations
+
+import json
+import math
+from dataclasses import dataclass, field, replace
+from pathlib import Path
+from typing import Any, Sequence
+
+import numba as nb
+import numpy as np
+import scipy.linalg
+
+from ._typing import FloatArray
+from ._validate import check_finite_scalar, check_positive
+from .bem import MODE_CS, MODE_FROZEN, MODE_NOLIMITS, MODE_TIGHT
+from .plant import (INPUT_NAMES, INPUT_UNITS, OUTPUT_NAMES, OUTPUT_UNITS, STATE_NAMES,
+                    STATE_UNITS, PlantConfig, PlantParams, _eval, _sample_wind, plant_params)
+from .trim import OperatingPoint, trim
+from .turbine import Turbine
+
+__all__ = ["LinearModel", "LinearModelFamily", "LinearizationError", "linearize",
+           "linearize_family", "jacobian_check", "augment_actuator", "with_power_input",
+           "sensitivities"]
+
+SCHEMA_VERSION = 1
+_OUT_IDX = [i for i, n in enumerate(OUTPUT_NAMES) if n != "azimuth"]
+#: variables scales for the finite-difference steps (state, input, disturbance)
+_X_SCALE = np.array([0.1, 0.1, 0.1, 10.0, 1e-3, 0.01, 0.01, 0.01, 0.1, 0.1, 0.1, 0.1, 0.1,
+                     0.1, 0.1, 0.1, 1.0])
+_U_SCALE = np.array([0.01, 0.01, 0.01, 1000.0])
+_D_SCALE = np.array([1.0, 1.0, 1.0])
+_REL_STEP = 2e-5
+_BLADE_GROUPS_X = (("pitch_1", "pitch_2", "pitch_3"), ("flap_1", "flap_2", "flap_3"),
+                   ("flap_rate_1", "flap_rate_2", "flap_rate_3"))
+_BLADE_GROUPS_Z = (("pitch_1", "pitch_2", "pitch_3"),
+                   ("pitch_rate_1", "pitch_rate_2", "pitch_rate_3"),
+                   ("flap_moment_1", "flap_moment_2", "flap_moment_3"),
+                   ("edge_moment_1", "edge_moment_2", "edge_moment_3"))
+
+
+class LinearizationError(RuntimeError):
+    """The plant could not be linearized (e.g. a Jacobian entry is not finite)."""
+
+
+# --------------------------------------------------------------------------------------------
+# Jacobian kernels
+# --------------------------------------------------------------------------------------------
+@nb.njit(cache=True, error_model="numpy")
+def _jac_fd(x0, u0, w0, p, bem0, mode, hx, hu, hd):  # pragma: no cover - compiled
+    """Central-difference Jacobians of (dx/dt, z) w.r.t. x, u and per-blade wind."""
+    nx, nu, nd = 17, 4, 3
+    jx = np.zeros((nx, nx))
+    ju = np.zeros((nx, nu))
+    jd = np.zeros((nx, nd))
+    hxm = np.zeros((31, nx))
+    hum = np.zeros((31, nu))
+    hdm = np.zeros((31, nd))
+    for j in range(nx):
+        xp = x0.copy()
+        xm = x0.copy()
+        xp[j] += hx[j]
+        xm[j] -= hx[j]
+        fp, zp, _ = _eval(xp, u0, w0, p, bem0, mode)
+        fm, zm, _ = _eval(xm, u0, w0, p, bem0, mode)
+        jx[:, j] = (fp - fm) / (2 * hx[j])
+        hxm[:, j] = (zp - zm) / (2 * hx[j])
+    for j in range(nu):
+        up = u0.copy()
+        um = u0.copy()
+        up[j] += hu[j]
+        um[j] -= hu[j]
+        fp, zp, _ = _eval(x0, up, w0, p, bem0, mode)
+        fm, zm, _ = _eval(x0, um, w0, p, bem0, mode)
+        ju[:, j] = (fp - fm) / (2 * hu[j])
+        hum[:, j] = (zp - zm) / (2 * hu[j])
+    for j in range(nd):
+        wp = w0.copy()
+        wm = w0.copy()
+        wp[j] += hd[j]
+        wm[j] -= hd[j]
+        fp, zp, _ = _eval(x0, u0, wp, p, bem0, mode)
+        fm, zm, _ = _eval(x0, u0, wm, p, bem0, mode)
+        jd[:, j] = (fp - fm) / (2 * hd[j])
+        hdm[:, j] = (zp - zm) / (2 * hd[j])
+    return jx, ju, jd, hxm, hum, hdm
+
+
+@nb.njit(cache=True, error_model="numpy")
+def _jac_cs(x0, u0, w0, p, bem0, mode):  # pragma: no cover - compiled
+    """Complex-step Jacobians (step 1e-30 i): exact to rounding, no subtraction error."""
+    h = 1e-30
+    nx, nu, nd = 17, 4, 3
+    xc = x0 + 0j
+    uc = u0 + 0j
+    wc = w0 + 0j
+    jx = np.zeros((nx, nx))
+    ju = np.zeros((nx, nu))
+    jd = np.zeros((nx, nd))
+    hxm = np.zeros((31, nx))
+    hum = np.zeros((31, nu))
+    hdm = np.zeros((31, nd))
+    for j in range(nx):
+        xp = xc.copy()
+        xp[j] += 1j * h
+        f, z, _ = _eval(xp, uc, wc, p, bem0, mode)
+        jx[:, j] = f.imag / h
+        hxm[:, j] = z.imag / h
+    for j in range(nu):
+        up = uc.copy()
+        up[j] += 1j * h
+        f, z, _ = _eval(xc, up, wc, p, bem0, mode)
+        ju[:, j] = f.imag / h
+        hum[:, j] = z.imag / h
+    for j in range(nd):
+        wp = wc.copy()
+        wp[j] += 1j * h
+        f, z, _ = _eval(xc, uc, wp, p, bem0, mode)
+        jd[:, j] = f.imag / h
+        hdm[:, j] = z.imag / h
+    return jx, ju, jd, hxm, hum, hdm
+
+
+def _azimuths(params: PlantParams, shear: float, n_azimuth: int | None) -> FloatArray:
+    a = params.config.aero
+    if n_azimuth is None:
+        periodic = (a.tilt or a.gravity or shear != 0.0 or params.dof("tower_fa")
+                    or params.dof("tower_ss"))
+        n_azimuth = 8 if periodic else 1
+    if n_azimuth < 1:
+        raise ValueError(f"n_azimuth must be >= 1, got {n_azimuth!r}")
+    return 2 * math.pi * np.arange(n_azimuth) / n_azimuth
+
+
+def _raw_jacobians(params: PlantParams, op: OperatingPoint, wake: str, shear: float,
+                   psi: float, method: str = "fd") -> tuple[FloatArray, ...]:
+    """Full (17-state, 4-input, 3-blade-wind, 31-output) Jacobians at one azimuth."""
+    pk = params.pack
+    x0 = op.x.copy()
+    x0[16] = psi
+    u0 = op.u.copy()
+    w0 = _sample_wind(0.0, psi, pk, 0, np.array([op.wind_speed, shear]), np.zeros((1, 1, 1)))
+    bem0 = _eval(x0, u0, w0, pk, np.full((4, 3, pk.r.size), np.nan), MODE_NOLIMITS)[2]
+    mode = MODE_NOLIMITS | (MODE_FROZEN if wake == "frozen" else 0)
+    if method == "cs":
+        mode |= 0 if wake == "frozen" else MODE_CS
+        return _jac_cs(x0, u0, w0, pk, bem0, mode)
+    mode |= MODE_TIGHT
+    hx = _REL_STEP * np.maximum(np.abs(x0), _X_SCALE)
+    hu = _REL_STEP * np.maximum(np.abs(u0), _U_SCALE)
+    hd = _REL_STEP * np.maximum(np.abs(w0.mean(axis=1)), _D_SCALE)
+    return _jac_fd(x0, u0, w0, pk, bem0, mode, hx, hu, hd)
+
+
+# --------------------------------------------------------------------------------------------
+# The model
+# --------------------------------------------------------------------------------------------
+def _frozen(a: Any) -> FloatArray:
+    arr = np.array(a, dtype=float)
+    arr.flags.writeable = False
+    return arr
+
+
+@dataclass(frozen=True)
+class LinearModel:
+    """A linear model about an operating point (Madsen et al. 2012, eqs 18-19).
+
+    Parameters
+    ----------
+    A : (n_x, n_x) ndarray
+    B_u : (n_x, n_u) ndarray
+    B_d : (n_x, n_d) ndarray
+    C_z : (n_z, n_x) ndarray
+    D_u : (n_z, n_u) ndarray
+    D_d : (n_z, n_d) ndarray
+    states, inputs, disturbances, outputs : tuple of str
+        Names (see docs/nomenclature.md; MBC models use ``_coll``, ``_cos``, ``_sin``).
+    state_units, input_units, disturbance_units, output_units : tuple of str
+    x0, u0, d0, z0 : ndarray
+        Operating-point values of the states, inputs, disturbances and outputs; the model's
+        variables are perturbations from them.
+    wind_speed : float
+        Mean (hub-height) wind speed of the operating point [m/s].
+    wake : str
+        "quasi-steady" or "frozen".
+    coordinates : str
+        "blade" or "mbc".
+    dt : float or None
+        Sample time of a discrete model [s]; None for continuous.
+    info : dict
+        Operating-point summary (pitch, rotor speed, power, region, config).
+    """
+
+    A: FloatArray
+    B_u: FloatArray
+    B_d: FloatArray
+    C_z: FloatArray
+    D_u: FloatArray
+    D_d: FloatArray
+    states: tuple[str, ...]
+    inputs: tuple[str, ...]
+    disturbances: tuple[str, ...]
+    outputs: tuple[str, ...]
+    state_units: tuple[str, ...]
+    input_units: tuple[str, ...]
+    disturbance_units: tuple[str, ...]
+    output_units: tuple[str, ...]
+    x0: FloatArray
+    u0: FloatArray
+    d0: FloatArray
+    z0: FloatArray
+    wind_speed: float
+    wake: str = "quasi-steady"
+    coordinates: str = "blade"
+    dt: float | None = None
+    info: dict[str, Any] = field(default_factory=dict, compare=False)
+
+    def __post_init__(self) -> None:
+        for name in ("A", "B_u", "B_d", "C_z", "D_u", "D_d", "x0", "u0", "d0", "z0"):
+            object.__setattr__(self, name, _frozen(getattr(self, name)))
+        nx, nu, nd, nz = len(self.states), len(self.inputs), len(self.disturbances), \
+            len(self.outputs)
+        shapes = {"A": (nx, nx), "B_u": (nx, nu), "B_d": (nx, nd), "C_z": (nz, nx),
+                  "D_u": (nz, nu), "D_d": (nz, nd), "x0": (nx,), "u0": (nu,), "d0": (nd,),
+                  "z0": (nz,)}
+        for name, shp in shapes.items():
+            got = getattr(self, name).shape
+            if got != shp:
+                raise ValueError(f"LinearModel.{name} has shape {got}; expected {shp} "
+                                 f"(n_x, n_u, n_d, n_z = {nx}, {nu}, {nd}, {nz})")
+        for name in ("A", "B_u", "B_d", "C_z", "D_u", "D_d"):
+            m = getattr(self, name)
+            if not np.all(np.isfinite(m)):
+                i = np.argwhere(~np.isfinite(m))[0]
+                raise LinearizationError(f"LinearModel.{name}[{i[0]}, {i[1]}] is {m[tuple(i)]}")
+
+    # -- sizes and lookup
+    @property
+    def n_x(self) -> int:
+        """Number of states."""
+        return len(self.states)
+
+    def index(self, kind: str, name: str) -> int:
+        """Index of a named state, input, disturbance or output (``kind`` e.g. "output")."""
+        names = {"state": self.states, "input": self.inputs, "disturbance": self.disturbances,
+                 "output": self.outputs}[kind]
+        if name not in names:
+            raise KeyError(f"no {kind} {name!r}; {kind}s are {list(names)}")
+        return names.index(name)
+
+    # -- transformations
+    def discretize(self, dt: float) -> "LinearModel":
+        """Zero-order hold on inputs and disturbances at sample time ``dt`` [s].
+
+        Raises
+        ------
+        ValueError
+            If ``dt`` is not finite and > 0 or the model is already discrete.
+        """
+        check_positive("dt", dt)
+        if self.dt is not None:
+            raise ValueError(f"model is already discrete (dt = {self.dt} s)")
+        nx, nu = self.n_x, len(self.inputs)
+        b = np.hstack([self.B_u, self.B_d])
+        m = np.zeros((nx + b.shape[1], nx + b.shape[1]))
+        m[:nx, :nx] = self.A
+        m[:nx, nx:] = b
+        e = scipy.linalg.expm(m * dt)
+        return replace(self, A=e[:nx, :nx], B_u=e[:nx, nx:nx + nu], B_d=e[:nx, nx + nu:],
+                       dt=float(dt))
+
+    def to_statespace(self) -> Any:
+        """python-control ``StateSpace`` with inputs [u, d] and the model's names."""
+        import control
+
+        return control.ss(self.A, np.hstack([self.B_u, self.B_d]), self.C_z,
+                          np.hstack([self.D_u, self.D_d]), 0 if self.dt is None else self.dt,
+                          states=list(self.states),
+                          inputs=list(self.inputs) + list(self.disturbances),
+                          outputs=list(self.outputs))
+
+    def select(self, inputs: Sequence[str] | None = None,
+               disturbances: Sequence[str] | None = None,
+               outputs: Sequence[str] | None = None) -> "LinearModel":
+        """The same dynamics with a subset of inputs, disturbances and outputs (names)."""
+        iu = [self.index("input", n) for n in (inputs or self.inputs)]
+        idd = [self.index("disturbance", n) for n in (disturbances or self.disturbances)]
+        iz = [self.index("output", n) for n in (outputs or self.outputs)]
+        return replace(
+            self, B_u=self.B_u[:, iu], B_d=self.B_d[:, idd], C_z=self.C_z[iz],
+            D_u=self.D_u[np.ix_(iz, iu)], D_d=self.D_d[np.ix_(iz, idd)],
+            inputs=tuple(self.inputs[i] for i in iu),
+            input_units=tuple(self.input_units[i] for i in iu),
+            disturbances=tuple(self.disturbances[i] for i in idd),
+            disturbance_units=tuple(self.disturbance_units[i] for i in idd),
+            outputs=tuple(self.outputs[i] for i in iz),
+            output_units=tuple(self.output_units[i] for i in iz),
+            u0=self.u0[iu], d0=self.d0[idd], z0=self.z0[iz])
+
+    def modes(self) -> list[dict[str, Any]]:
+        """Oscillatory modes: frequency [Hz], damping ratio [-] and a name from participation.
+
+        The name is the state group with the largest participation factor |phi_k psi_k|
+        (right and left eigenvectors): tower fore-aft, tower side-side, drivetrain torsion,
+        blade flap (collective or asymmetric), rotor, pitch actuator.
+        """
+        a = self.A
+        if self.dt is not None:
+            a = scipy.linalg.logm(self.A).real / self.dt
+        lam, vr = scipy.linalg.eig(a)
+        vl = np.linalg.inv(vr)
+        part = np.abs(vr * vl.T)
+        out = []
+        for k in np.argsort(np.abs(lam)):
+            if lam[k].imag <= 1e-9:
+                continue
+            wn = abs(lam[k])
+            name = self._mode_name(part[:, k], vr[:, k])
+            out.append({"frequency_Hz": float(wn / (2 * math.pi)),
+                        "damped_frequency_Hz": float(lam[k].imag / (2 * math.pi)),
+                        "damping_ratio": float(-lam[k].real / wn), "name": name})
+        return out
+
+    def _mode_name(self, part: FloatArray, vec: np.ndarray) -> str:
+        groups = {"tower fore-aft": ("tower_fa_",), "tower side-side": ("tower_ss_",),
+                  "drivetrain torsion": ("shaft_torsion", "gen_speed"),
+                  "rotor": ("rotor_speed",), "blade flap": ("flap",), "pitch actuator": ("pitch",)}
+        score = {}
+        for g, prefixes in groups.items():
+            idx = [i for i, n in enumerate(self.states) if n.startswith(prefixes)]
+            score[g] = float(part[idx].sum()) if idx else 0.0
+        best = max(score, key=score.get)
+        if best == "blade flap":
+            idx = [i for i, n in enumerate(self.states) if n.startswith("flap_") and "rate" not in n]
+            if self.coordinates == "mbc":
+                coll = [i for i in idx if self.states[i].endswith("_coll")]
+                share = part[coll].sum() / max(part[idx].sum(), 1e-300)
+            else:
+                v = vec[idx]
+                share = abs(v.sum()) / max(np.abs(v).sum(), 1e-300)
+            best += " (collective)" if share > 0.5 else " (asymmetric)"
+        return best
+
+    # -- I/O
+    def to_dict(self) -> dict[str, Any]:
+        """Plain dict (lists, floats, strings) for JSON."""
+        d = {k: getattr(self, k) for k in ("states", "inputs", "disturbances", "outputs",
+                                            "state_units", "input_units", "disturbance_units",
+                                            "output_units", "wind_speed", "wake",
+                                            "coordinates", "dt", "info")}
+        for k in ("A", "B_u", "B_d", "C_z", "D_u", "D_d", "x0", "u0", "d0", "z0"):
+            d[k] = getattr(self, k).tolist()
+        d = {k: (list(v) if isinstance(v, tuple) else v) for k, v in d.items()}
+        d["schema_version"] = SCHEMA_VERSION
+        return d
+
+    @classmethod
+    def from_dict(cls, d: dict[str, Any]) -> "LinearModel":
+        """Inverse of :meth:`to_dict`; rejects another schema version."""
+        if d.get("schema_version") != SCHEMA_VERSION:
+            raise ValueError(f"schema_version must be {SCHEMA_VERSION}, got "
+                             f"{d.get('schema_version')!r}")
+        kw = {k: v for k, v in d.items() if k != "schema_version"}
+        for k in ("states", "inputs", "disturbances", "outputs", "state_units", "input_units",
+                  "disturbance_units", "output_units"):
+            kw[k] = tuple(kw[k])
+        return cls(**kw)
+
+
+# --------------------------------------------------------------------------------------------
+# Linearization
+# --------------------------------------------------------------------------------------------
+_WAKES = ("quasi-steady", "frozen")
+
+
+def _check_options(wake: str, disturbance: str, coordinates: str) -> None:
+    if wake not in _WAKES:
+        raise ValueError(f"wake must be one of {_WAKES}, got {wake!r}")
+    if disturbance not in ("blade", "rotor"):
+        raise ValueError(f"disturbance must be 'blade' or 'rotor', got {disturbance!r}")
+    if coordinates not in ("blade", "mbc"):
+        raise ValueError(f"coordinates must be 'blade' or 'mbc', got {coordinates!r}")
+
+
+def _mbc_matrices(psi: float, omega: float) -> tuple[FloatArray, FloatArray, FloatArray,
+                                                      FloatArray]:
+    """T(psi) with rows [1, cos psi_i, sin psi_i], its inverse, dT/dpsi, d2T/dpsi2."""
+    ang = psi + 2 * math.pi * np.arange(3) / 3
+    t = np.column_stack([np.ones(3), np.cos(ang), np.sin(ang)])
+    dt = np.column_stack([np.zeros(3), -np.sin(ang), np.cos(ang)])
+    ddt = np.column_stack([np.zeros(3), -np.cos(ang), -np.sin(ang)])
+    tinv = np.vstack([np.ones(3) / 3, 2 / 3 * np.cos(ang), 2 / 3 * np.sin(ang)])
+    return t, tinv, dt * omega, ddt * omega**2
+
+
+def _assemble(jx: FloatArray, ju: FloatArray, jd: FloatArray, hx: FloatArray, hu: FloatArray,
+              hd: FloatArray, si: list[int], psi: float, omega: float,
+              coordinates: str) -> tuple[FloatArray, ...]:
+    """Select active states, then (MBC) transform to non-rotating coordinates at psi."""
+    a = jx[np.ix_(si, si)]
+    b = ju[si]
+    bd = jd[si]
+    c = hx[np.ix_(_OUT_IDX, si)]
+    du = hu[_OUT_IDX]
+    dd = hd[_OUT_IDX]
+    if coordinates == "blade":
+        return a, b, bd, c, du, dd
+    t, tinv, tdot, tddot = _mbc_matrices(psi, omega)
+    names = [STATE_NAMES[i] for i in si]
+    n = len(si)
+    tx = np.eye(n)          # x_blade = tx x_nr
+    txdot = np.zeros((n, n))
+    for grp in _BLADE_GROUPS_X:
+        if grp[0] not in names:
+            continue
+        ix = [names.index(g) for g in grp]
+        tx[np.ix_(ix, ix)] = t
+        txdot[np.ix_(ix, ix)] = tdot
+    if "flap_1" in names:   # velocity states of a second-order group
+        ip = [names.index(g) for g in _BLADE_GROUPS_X[1]]
+        iv = [names.index(g) for g in _BLADE_GROUPS_X[2]]
+        tx[np.ix_(iv, ip)] = tdot
+        txdot[np.ix_(iv, ip)] = tddot
+        txdot[np.ix_(iv, iv)] = tdot
+    tx_inv = np.linalg.inv(tx)
+    tu = np.eye(4)
+    tu[:3, :3] = t
+    tz_inv = np.eye(len(_OUT_IDX))
+    onames = [OUTPUT_NAMES[i] for i in _OUT_IDX]
+    for grp in _BLADE_GROUPS_Z:
+        iz = [onames.index(g) for g in grp]
+        tz_inv[np.ix_(iz, iz)] = tinv
+    a_nr = tx_inv @ (a @ tx - txdot)
+    return (a_nr, tx_inv @ b @ tu, tx_inv @ bd @ t, tz_inv @ c @ tx, tz_inv @ du @ tu,
+            tz_inv @ dd @ t)
+
+
+def _mbc_name(name: str, k: int) -> str:
+    stem = name.rsplit("_", 1)[0]
+    return f"{stem}_{('coll', 'cos', 'sin')[k]}"
+
+
+def _rename(names: Sequence[str], groups: Sequence[Sequence[str]]) -> tuple[str, ...]:
+    out = list(names)
+    for grp in groups:
+        if grp[0] in out:
+            for k, g in enumerate(grp):
+                out[out.index(g)] = _mbc_name(g, k)
+    return tuple(out)
+
+
+def linearize(turbine: Turbine, wind_mps: float, *, config: PlantConfig | None = None,
+              wake: str = "quasi-steady", disturbance: str = "blade",
+              coordinates: str = "blade", power_W: float | None = None,
+              shear_exponent: float = 0.0, n_azimuth: int | None = None,
+              params: PlantParams | None = None,
+              operating_point: OperatingPoint | None = None) -> LinearModel:
+    """Linearize the plant at the trim point of a mean wind speed.
+
+    Parameters
+    ----------
+    turbine : Turbine
+    wind_mps : float
+        Mean hub-height wind speed [m/s], within cut-in..cut-out.
+    config : PlantConfig, optional
+        Degrees of freedom and aerodynamic options; the states of the model are the active
+        states of this configuration (``PlantConfig.madsen()`` gives Madsen's 8 states).
+    wake : {"quasi-steady", "frozen"}
+        Induction re-solved at each perturbation, or held at trim (see the module docstring).
+    disturbance : {"blade", "rotor"}
+        One wind speed per blade, uniform along it (Madsen's V_1..V_3), or one rotor-effective
+        wind speed for all elements (the Takagi-Sugeno model and wind observer).
+    coordinates : {"blade", "mbc"}
+        Blade coordinates, or multi-blade (collective, cosine, sine) coordinates.
+    power_W : float, optional
+        Linearize at the trim point for a power reference below rated.
+    shear_exponent : float
+        Shear of the steady wind at the operating point [-].
+    n_azimuth : int, optional
+        Azimuth samples averaged over a revolution. Default 8 whenever the plant is periodic
+        in azimuth: with tilt, gravity or shear, and also with a tower DOF on, since tower
+        nodding and side-side motion reach each blade weighted by cos(psi_i); else 1.
+    params, operating_point : optional
+        Prebuilt plant parameters and trim point (must match turbine, config and wind).
+
+    Returns
+    -------
+    LinearModel
+
+    Raises
+    ------
+    TrimError
+        If the wind is outside cut-in..cut-out or the power reference is unreachable.
+    LinearizationError
+        If a Jacobian entry is not finite (the plant failed at the perturbed point); the
+        message names the entry.
+    """
+    v = check_finite_scalar("wind_mps", wind_mps)
+    _check_options(wake, disturbance, coordinates)
+    p = params if params is not None else plant_params(turbine, config)
+    op = operating_point if operating_point is not None else trim(
+        turbine, v, power_W, params=p, shear_exponent=shear_exponent)
+    jac = _averaged(p, op, wake, shear_exponent, n_azimuth, coordinates, "fd")
+    return _model(p, op, jac, wake, disturbance, coordinates, shear_exponent)
+
+
+def _averaged(p: PlantParams, op: OperatingPoint, wake: str, shear: float,
+              n_azimuth: int | None, coordinates: str, method: str) -> tuple[FloatArray, ...]:
+    si = [STATE_NAMES.index(n) for n in p.config.active_states()]
+    acc: list[FloatArray] | None = None
+    psis = _azimuths(p, shear, n_azimuth)
+    for psi in psis:
+        raw = _raw_jacobians(p, op, wake, shear, float(psi), method)
+        for name, m in zip(("A", "B_u", "B_d", "C", "D_u", "D_d"), raw):
+            if not np.all(np.isfinite(m)):
+                i = np.argwhere(~np.isfinite(m))[0]
+                raise LinearizationError(
+                    f"Jacobian {name}[{i[0]}, {i[1]}] is not finite at {op.wind_speed:g} m/s, "
+                    f"azimuth {math.degrees(psi):.0f} deg: the plant failed at a perturbed point")
+        mats = _assemble(*raw, si, float(psi), op.rotor_speed_rad_s, coordinates)
+        acc = list(mats) if acc is None else [a + m for a, m in zip(acc, mats)]
+    assert acc is not None
+    return tuple(m / len(psis) for m in acc)
+
+
+def _model(p: PlantParams, op: OperatingPoint, jac: tuple[FloatArray, ...], wake: str,
+           disturbance: str, coordinates: str, shear: float) -> LinearModel:
+    a, b, bd, c, du, dd = jac
+    si = [STATE_NAMES.index(n) for n in p.config.active_states()]
+    states = tuple(STATE_NAMES[i] for i in si)
+    outputs = tuple(OUTPUT_NAMES[i] for i in _OUT_IDX)
+    inputs = INPUT_NAMES
+    dists = ("wind_1", "wind_2", "wind_3")
+    x0 = op.x[si]
+    u0 = op.u.copy()
+    d0 = np.full(3, op.wind_speed)
+    w = np.full((3, p.pack.r.size), op.wind_speed)
+    z_full = _eval(op.x, op.u, w, p.pack, np.full((4, 3, p.pack.r.size), np.nan), 0)[1]
+    z0 = z_full[_OUT_IDX]
+    if coordinates == "mbc":
+        states = _rename(states, _BLADE_GROUPS_X)
+        outputs = _rename(outputs, _BLADE_GROUPS_Z)
+        inputs = _rename(inputs, (INPUT_NAMES[:3],))
+        dists = _rename(dists, (dists,))
+        t, tinv, _, _ = _mbc_matrices(0.0, 0.0)
+        x0 = _to_mbc_values(states, x0)
+        u0 = np.concatenate([tinv @ u0[:3], u0[3:]])
+        d0 = tinv @ d0
+        z0 = _to_mbc_values(outputs, z0)
+    if disturbance == "rotor":
+        bd = bd.sum(axis=1, keepdims=True) if coordinates == "blade" else bd[:, :1]
+        dd = dd.sum(axis=1, keepdims=True) if coordinates == "blade" else dd[:, :1]
+        dists = ("wind",)
+        d0 = np.array([op.wind_speed])
+    unit = dict(zip(STATE_NAMES, STATE_UNITS))
+    ounit = dict(zip(OUTPUT_NAMES, OUTPUT_UNITS))
+    iunit = dict(zip(INPUT_NAMES, INPUT_UNITS))
+    return LinearModel(
+        A=a, B_u=b, B_d=bd, C_z=c, D_u=du, D_d=dd, states=states, inputs=inputs,
+        disturbances=dists, outputs=outputs,
+        state_units=tuple(unit[STATE_NAMES[i]] for i in si),
+        input_units=tuple(iunit[n] for n in INPUT_NAMES),
+        disturbance_units=tuple("m/s" for _ in dists),
+        output_units=tuple(ounit[OUTPUT_NAMES[i]] for i in _OUT_IDX),
+        x0=x0, u0=u0, d0=d0, z0=z0, wind_speed=op.wind_speed, wake=wake,
+        coordinates=coordinates,
+        info={"region": op.region, "pitch_deg": op.pitch_deg,
+              "rotor_speed_rpm": op.rotor_speed_rpm, "gen_torque_Nm": op.gen_torque,
+              "power_W": op.power, "thrust_N": op.thrust, "shear_exponent": shear,
+              "power_reference_W": op.power_reference,
+              "dofs": sorted(p.config.dofs), "turbine": p.turbine.name})
+
+
+def _to_mbc_values(names: Sequence[str], vals: FloatArray) -> FloatArray:
+    """Operating-point values in MBC: equal blade values -> collective = value, cos = sin = 0."""
+    out = np.array(vals, dtype=float)
+    for k, n in enumerate(names):
+        if n.endswith(("_cos", "_sin")):
+            out[k] = 0.0
+    return out
+
+
+def jacobian_check(turbine: Turbine, wind_mps: float, *, config: PlantConfig | None = None,
+                   wake: str = "quasi-steady", shear_exponent: float = 0.0,
+                   params: PlantParams | None = None) -> tuple[tuple[FloatArray, ...],
+                                                                tuple[FloatArray, ...]]:
+    """Full Jacobians at azimuth 0 by central differences and by complex step.
+
+    Returns
+    -------
+    fd, cs : tuple of 6 ndarray
+        (df/dx, df/du, df/dd, dz/dx, dz/du, dz/dd) on all 17 states, 4 inputs, 3 blade winds
+        and 31 outputs, from each method.
+    """
+    p = params if params is not None else plant_params(turbine, config)
+    op = trim(turbine, wind_mps, params=p, shear_exponent=shear_exponent)
+    return (_raw_jacobians(p, op, wake, shear_exponent, 0.0, "fd"),
+            _raw_jacobians(p, op, wake, shear_exponent, 0.0, "cs"))
+
+
+# --------------------------------------------------------------------------------------------
+# Forms
+# --------------------------------------------------------------------------------------------
+def augment_actuator(model: LinearModel, time_constant: float,
+                     inputs: Sequence[str] = ("pitch_ref_1", "pitch_ref_2", "pitch_ref_3")
+                     ) -> LinearModel:
+    """Append first-order actuator states to a model whose inputs act directly (Do et al.
+    2020, eq 6): d/dt [x; beta] = [[A, B], [0, -I/tau]] [x; beta] + [0; I/tau] u.
+
+    The new states are named after the inputs with ``_ref`` dropped (``pitch_1`` ...).
+
+    Raises
+    ------
+    ValueError
+        If the time constant is not > 0, an input is unknown, or the state exists already.
+    """
+    tau = check_positive("time_constant", time_constant)
+    idx = [model.index("input", n) for n in inputs]
+    new = tuple(n.replace("_ref", "") for n in inputs)
+    clash = [n for n in new if n in model.states]
+    if clash:
+        raise ValueError(f"model already has states {clash}: it already includes the actuator")
+    nx, k = model.n_x, len(idx)
+    a = np.zeros((nx + k, nx + k))
+    a[:nx, :nx] = model.A
+    a[:nx, nx:] = model.B_u[:, idx]
+    a[nx:, nx:] = -np.eye(k) / tau
+    b = np.vstack([model.B_u, np.zeros((k, model.B_u.shape[1]))])
+    b[:nx, idx] = 0.0
+    b[nx + np.arange(k), idx] = 1.0 / tau
+    bd = np.vstack([model.B_d, np.zeros((k, model.B_d.shape[1]))])
+    c = np.hstack([model.C_z, model.D_u[:, idx]])
+    du = model.D_u.copy()
+    du[:, idx] = 0.0
+    return replace(model, A=a, B_u=b, B_d=bd, C_z=c, D_u=du, states=model.states + new,
+                   state_units=model.state_units + tuple(model.input_units[i] for i in idx),
+                   x0=np.concatenate([model.x0, model.u0[idx]]))
+
+
+def with_power_input(model: LinearModel, generator_efficiency: float) -> LinearModel:
+    """Replace the generator-torque input by an electrical power reference.
+
+    The converter sets T_g = P_ref / (eta omega_g), so
+    dT_g = dP_ref / (eta omega_g0) - P_0 / (eta omega_g0^2) d omega_g: the torque input column
+    becomes the power input (scaled) and feeds back on generator speed. This is the model of a
+    turbine following a power reference (down-regulation, active power control; Clemens et al.
+    eq 11).
+
+    Raises
+    ------
+    ValueError
+        If the model has no ``gen_torque_ref`` input or no ``gen_speed`` state.
+    """
+    eta = check_positive("generator_efficiency", generator_efficiency)
+    it = model.index("input", "gen_torque_ref")
+    iw = model.index("state", "gen_speed")
+    wg0 = model.x0[iw]
+    tg0 = model.u0[it]
+    p0 = eta * tg0 * wg0
+    k_w = -p0 / (eta * wg0**2)
+    a = model.A + np.outer(model.B_u[:, it], np.eye(model.n_x)[iw]) * k_w
+    c = model.C_z + np.outer(model.D_u[:, it], np.eye(model.n_x)[iw]) * k_w
+    b = model.B_u.copy()
+    d = model.D_u.copy()
+    b[:, it] /= eta * wg0
+    d[:, it] /= eta * wg0
+    inputs = list(model.inputs)
+    units = list(model.input_units)
+    inputs[it], units[it] = "power_ref", "W"
+    u0 = model.u0.copy()
+    u0[it] = p0
+    return replace(model, A=a, B_u=b, C_z=c, D_u=d, inputs=tuple(inputs),
+                   input_units=tuple(units), u0=u0)
+
+
+# --------------------------------------------------------------------------------------------
+# Family over mean wind
+# --------------------------------------------------------------------------------------------
+@dataclass(frozen=True)
+class LinearModelFamily:
+    """Linear models on a grid of mean wind speeds, interpolated linearly between them.
+
+    Parameters
+    ----------
+    wind_speeds : (n_op,) ndarray
+        Strictly increasing [m/s].
+    models : tuple of LinearModel
+        One per wind speed, with identical names.
+    """
+
+    wind_speeds: FloatArray
+    models: tuple[LinearModel, ...]
+
+    def __post_init__(self) -> None:
+        v = _frozen(self.wind_speeds)
+        object.__setattr__(self, "wind_speeds", v)
+        _check_grid(v)
+        if len(self.models) != v.size:
+            raise ValueError(f"{len(self.models)} models for {v.size} wind speeds")
+        ref = self.models[0]
+        for m in self.models[1:]:
+            if (m.states, m.inputs, m.disturbances, m.outputs) != (ref.states, ref.inputs,
+                                                                  ref.disturbances, ref.outputs):
+                raise ValueError("models of a family must have the same names")
+
+    def stacked(self, name: str) -> FloatArray:
+        """Matrices or operating-point vectors stacked over wind: (n_op, ...)."""
+        return np.stack([getattr(m, name) for m in self.models])
+
+    def at(self, wind_mps: float) -> LinearModel:
+        """The model at a mean wind speed, interpolated linearly in every matrix and in the
+        operating point between the two neighbouring grid points.
+
+        Raises
+        ------
+        ValueError
+            If the wind speed is outside the family's range.
+        """
+        v = check_finite_scalar("wind_mps", wind_mps)
+        lo, hi = float(self.wind_speeds[0]), float(self.wind_speeds[-1])
+        if not lo <= v <= hi:
+            raise ValueError(f"wind_mps = {v:g} m/s is outside the family's range "
+                             f"{lo:g}..{hi:g} m/s")
+        k = int(np.clip(np.searchsorted(self.wind_speeds, v) - 1, 0, self.wind_speeds.size - 2))
+        w = (v - self.wind_speeds[k]) / (self.wind_speeds[k + 1] - self.wind_speeds[k])
+        m0, m1 = self.models[k], self.models[k + 1]
+        mix = {n: (1 - w) * getattr(m0, n) + w * getattr(m1, n)
+               for n in ("A", "B_u", "B_d", "C_z", "D_u", "D_d", "x0", "u0", "d0", "z0")}
+        return replace(m0, wind_speed=v, info={"interpolated_between": [m0.wind_speed,
+                                                                       m1.wind_speed]}, **mix)
+
+    # -- I/O
+    def save(self, path: str | Path) -> Path:
+        """Write ``.mat`` (MATLAB), ``.npz`` or ``.json`` by the file suffix."""
+        path = Path(path)
+        suffix = path.suffix.lower()
+        ref = self.models[0]
+        names = {"state_names": list(ref.states), "input_names": list(ref.inputs),
+                 "disturbance_names": list(ref.disturbances), "output_names": list(ref.outputs),
+                 "state_units": list(ref.state_units), "input_units": list(ref.input_units),
+                 "disturbance_units": list(ref.disturbance_units),
+                 "output_units": list(ref.output_units)}
+        meta = {"schema_version": SCHEMA_VERSION, "wake": ref.wake,
+                "coordinates": ref.coordinates, "info": [m.info for m in self.models]}
+        mats = {k: self.stacked(k) for k in ("A", "B_u", "B_d", "C_z", "D_u", "D_d", "x0", "u0",
+                                              "d0", "z0")}
+        if suffix == ".mat":
+            import scipy.io
+
+            out: dict[str, Any] = {"wind_speed": self.wind_speeds.reshape(-1, 1)}
+            matlab = {"A": "A", "B_u": "Bu", "B_d": "Bd", "C_z": "Cz", "D_u": "Du", "D_d": "Dd"}
+            for k, mk in matlab.items():
+                out[mk] = np.moveaxis(mats[k], 0, -1)   # A(:, :, k) is the k-th wind speed
+            for k, mk in (("x0", "x_op"), ("u0", "u_op"), ("d0", "d_op"), ("z0", "z_op")):
+                out[mk] = mats[k].T
+            for k, v in names.items():
+                out[k] = np.array(v, dtype=object).reshape(-1, 1)
+            out["meta_json"] = json.dumps(meta)
+            scipy.io.savemat(path, out, do_compression=True)
+        elif suffix == ".npz":
+            np.savez_compressed(path, wind_speed=self.wind_speeds, **mats,
+                                names_json=json.dumps(names), meta_json=json.dumps(meta))
+        elif suffix == ".json":
+            path.write_text(json.dumps({"wind_speed": self.wind_speeds.tolist(), **meta,
+                                        **names,
+                                        "models": [m.to_dict() for m in self.models]}))
+        else:
+            raise ValueError(f"file suffix must be .mat, .npz or .json, got {path.suffix!r}")
+        return path
+
+    @classmethod
+    def load(cls, path: str | Path) -> "LinearModelFamily":
+        """Read a family written by :meth:`save` (any of the three formats).
+
+        Raises
+        ------
+        ValueError
+            If the file is of another schema version or misses a field.
+        """
+        path = Path(path)
+        suffix = path.suffix.lower()
+        if suffix == ".json":
+            d = json.loads(path.read_text())
+            _check_schema(d.get("schema_version"), path)
+            return cls(np.array(d["wind_speed"]),
+                       tuple(LinearModel.from_dict(m) for m in d["models"]))
+        if suffix == ".mat":
+            import scipy.io
+
+            raw = scipy.io.loadmat(path)
+            meta = json.loads(str(raw["meta_json"][0]))
+            _check_schema(meta.get("schema_version"), path)
+            v = raw["wind_speed"].ravel()
+            mats = {k: np.moveaxis(raw[mk], -1, 0) for k, mk in
+                    (("A", "A"), ("B_u", "Bu"), ("B_d", "Bd"), ("C_z", "Cz"), ("D_u", "Du"),
+                     ("D_d", "Dd"))}
+            for k, mk in (("x0", "x_op"), ("u0", "u_op"), ("d0", "d_op"), ("z0", "z_op")):
+                mats[k] = raw[mk].T
+            names = {k: tuple(str(s[0]) for s in raw[k].ravel()) for k in
+                     ("state_names", "input_names", "disturbance_names", "output_names",
+                      "state_units", "input_units", "disturbance_units", "output_units")}
+        elif suffix == ".npz":
+            with np.load(path, allow_pickle=False) as raw:
+                meta = json.loads(str(raw["meta_json"]))
+                _check_schema(meta.get("schema_version"), path)
+                v = raw["wind_speed"]
+                mats = {k: raw[k] for k in ("A", "B_u", "B_d", "C_z", "D_u", "D_d", "x0", "u0",
+                                             "d0", "z0")}
+                names = {k: tuple(val) for k, val in json.loads(str(raw["names_json"])).items()}
+        else:
+            raise ValueError(f"file suffix must be .mat, .npz or .json, got {path.suffix!r}")
+        models = []
+        for k, vk in enumerate(v):
+            models.append(LinearModel(
+                **{n: mats[n][k] for n in mats}, states=names["state_names"],
+                inputs=names["input_names"], disturbances=names["disturbance_names"],
+                outputs=names["output_names"], state_units=names["state_units"],
+                input_units=names["input_units"], disturbance_units=names["disturbance_units"],
+                output_units=names["output_units"], wind_speed=float(vk), wake=meta["wake"],
+                coordinates=meta["coordinates"], info=meta["info"][k]))
+        return cls(np.asarray(v, dtype=float), tuple(models))
+
+
+def _check_schema(version: Any, path: Path) -> None:
+    if version != SCHEMA_VERSION:
+        raise ValueError(f"{path}: schema_version must be {SCHEMA_VERSION}, got {version!r}")
+
+
+def _check_grid(v: FloatArray) -> None:
+    if v.ndim != 1 or v.size < 1 or not np.all(np.isfinite(v)):
+        raise ValueError(f"wind_speeds must be a finite 1-D array, got {v!r}")
+    if np.any(np.diff(v) <= 0):
+        i = int(np.argmax(np.diff(v) <= 0))
+        raise ValueError(f"wind_speeds must be strictly increasing; {v[i + 1]:g} follows "
+                         f"{v[i]:g} m/s")
+
+
+def linearize_family(turbine: Turbine, wind_speeds: Sequence[float] | FloatArray | None = None,
+                     *, progress: bool = False, **kwargs: Any) -> LinearModelFamily:
+    """Linear models over a grid of mean wind speeds (default 4..25 m/s, step 1).
+
+    ``kwargs`` are those of :func:`linearize` (config, wake, disturbance, coordinates,
+    power_W, shear_exponent, n_azimuth).
+
+    Raises
+    ------
+    ValueError
+        If the grid is not strictly increasing and finite.
+    TrimError
+        If a wind speed is outside cut-in..cut-out (the message names it).
+    """
+    v = np.asarray(np.arange(4.0, 25.5, 1.0) if wind_speeds is None else wind_speeds,
+                   dtype=float)
+    _check_grid(v)
+    p = kwargs.pop("params", None) or plant_params(turbine, kwargs.pop("config", None))
+    from tqdm import tqdm
+
+    models = tuple(linearize(turbine, float(w), params=p, **kwargs)
+                   for w in tqdm(v, desc="linearize", unit="op", disable=not progress))
+    return LinearModelFamily(v, models)
+
+
+def sensitivities(model: LinearModel) -> dict[str, float]:
+    """Aerodynamic sensitivities of a blade-coordinate or MBC model.
+
+    Returns
+    -------
+    dict
+        ``dP_dpitch_W_per_rad``: aerodynamic power per collective pitch (all blades together)
+        [W/rad]; ``dQ_domega``: aerodynamic torque per rotor speed [N m s/rad];
+        ``dT_dV``: thrust per uniform wind speed [N s/m].
+    """
+    io_p = model.index("output", "aero_power")
+    io_q = model.index("output", "aero_torque")
+    io_t = model.index("output", "thrust")
+    blade = [n for n in model.states if n.startswith("pitch_")]
+    if model.coordinates == "mbc":
+        if "pitch_coll" in model.states:
+            dp = model.C_z[io_p, model.index("state", "pitch_coll")]
+        else:
+            dp = model.D_u[io_p, model.index("input", "pitch_ref_coll")]
+        dt = model.D_d[io_t, 0]
+    else:
+        if blade:
+            dp = sum(model.C_z[io_p, model.index("state", n)] for n in blade)
+        else:
+            dp = sum(model.D_u[io_p, model.index("input", f"pitch_ref_{i}")] for i in (1, 2, 3))
+        dt = model.D_d[io_t].sum()
+    return {"dP_dpitch_W_per_rad": float(dp),
+            "dQ_domega": float(model.C_z[io_q, model.index("state", "rotor_speed")]),
+            "dT_dV": float(dt)}
