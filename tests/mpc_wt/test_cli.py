@@ -77,3 +77,28 @@ def test_parse_range() -> None:
         parse_range("1:2:0", "x")
     with pytest.raises(UsageError, match="finite"):
         parse_range("nan", "x")
+
+
+def test_linearize_json_and_mat(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    out = tmp_path / "models.mat"
+    assert main(["linearize", "--wind", "12:13:1", "--frozen-wake", "--out", str(out),
+                 "--json"]) == 0
+    rows = json.loads(capsys.readouterr().out)
+    assert [r["wind_mps"] for r in rows] == [12.0, 13.0]
+    for key in ("wind_mps", "pitch_deg", "dP_dpitch_W_per_rad", "dQ_domega", "dT_dV", "modes"):
+        assert key in rows[0], key
+    names = {m["name"] for m in rows[0]["modes"]}
+    assert {"tower fore-aft", "drivetrain torsion"} <= names
+    assert all({"frequency_Hz", "damping_ratio"} <= set(m) for m in rows[0]["modes"])
+    assert rows[0]["dP_dpitch_W_per_rad"] < 0 and rows[0]["dT_dV"] > 0
+    import linearize
+
+    fam = linearize.LinearModelFamily.load(out)
+    assert fam.models[0].wake == "frozen" and fam.wind_speeds.tolist() == [12.0, 13.0]
+
+
+def test_linearize_bad_grid(capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(["linearize", "--wind", "12,11"]) == 2
+    assert "strictly increasing" in capsys.readouterr().err
+    assert main(["linearize", "--wind", "26"]) == 2
+    assert "outside the operating range" in capsys.readouterr().err
