@@ -1,5 +1,15 @@
-"""Turbulent wind fields and a hub-mounted continuous-wave LIDAR (issue 4).
+"""Turbulent wind fields and a hub-mounted continuous-wave LIDAR with per-blade preview.
 
-This package imports neither ``linearize`` nor ``mpc_wt``.
+This package imports neither ``linearize`` nor ``mpc_wt``; turbine geometry arrives as numbers.
 """
-__all__: list[str] = []
+from .cw import CWLidar, LidarMeasurement
+from .field import FieldFileError, WindField
+from .preview import (Preview, blade_effective_wind, coherence, coherence_bandwidth, peak_lag,
+                      preview, preview_series, rms_preview_error, rotor_effective_wind)
+from .turbulence import (TurbulenceSpec, evolve_field, generate_field, iec_coherence, iec_sigma,
+                         kaimal_spectrum)
+
+__all__ = ["CWLidar", "LidarMeasurement", "FieldFileError", "WindField", "Preview",
+           "blade_effective_wind", "coherence", "coherence_bandwidth", "peak_lag", "preview",
+           "preview_series", "rms_preview_error", "rotor_effective_wind", "TurbulenceSpec",
+           "evolve_field", "generate_field", "iec_coherence", "iec_sigma", "kaimal_spectrum"]

@@ -1,0 +1,155 @@
+"""Per-blade wind preview from LIDAR measurements, the true blade and rotor winds, and the
+metrics that judge a preview (coherence bandwidth, preview error, preview lag).
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+from scipy import signal
+
+from ._typing import FloatArray
+from .cw import LidarMeasurement
+from .field import WindField
+
+__all__ = ["Preview", "preview", "preview_series", "blade_effective_wind",
+           "rotor_effective_wind", "coherence", "coherence_bandwidth", "rms_preview_error",
+           "peak_lag"]
+
+
+@dataclass(frozen=True)
+class Preview:
+    """Wind each blade will meet over the next controller steps.
+
+    Parameters
+    ----------
+    t : (n_h,) ndarray
+        Times of the steps [s] (t_k + j dt, j = 1..n_h).
+    blade : (n_h, 3) ndarray
+        Per-blade wind at 75 % span [m/s].
+    rotor : (n_h,) ndarray
+        Rotor-effective estimate (mean of the three beams) [m/s].
+    measured : (n_h,) ndarray of bool
+        False where the step lies beyond the preview time and the last measurement is held.
+    """
+
+    t: FloatArray
+    blade: FloatArray
+    rotor: FloatArray
+    measured: np.ndarray
+
+
+def preview(meas: LidarMeasurement, t_now: float, horizon: int = 15,
+            dt: float = 0.1) -> Preview:
+    """The preview at controller time ``t_now``: measurement taken at t - T_p for each step t.
+
+    Raises
+    ------
+    ValueError
+        If ``horizon`` < 1, ``dt`` <= 0, or ``t_now`` lies outside the measured times.
+    """
+    if not isinstance(horizon, (int, np.integer)) or horizon < 1:
+        raise ValueError(f"horizon must be an integer >= 1, got {horizon!r}")
+    if not (math.isfinite(dt) and dt > 0):
+        raise ValueError(f"dt must be > 0 s, got {dt!r}")
+    if not meas.t[0] <= t_now <= meas.t[-1] + 1e-9:
+        raise ValueError(f"t_now = {t_now:g} s is outside the measurements "
+                         f"{meas.t[0]:g}..{meas.t[-1]:g} s")
+    steps = t_now + dt * np.arange(1, horizon + 1)
+    tm = steps - meas.preview_time
+    measured = tm <= t_now + 1e-9
+    tm = np.clip(np.minimum(tm, t_now), meas.t[0], meas.t[-1])
+    blade = np.column_stack([np.interp(tm, meas.t, meas.u_hat[:, i]) for i in range(3)])
+    return Preview(t=steps, blade=blade, rotor=blade.mean(axis=1), measured=measured)
+
+
+def preview_series(meas: LidarMeasurement, t_ctrl: FloatArray, horizon: int = 15,
+                   dt: float = 0.1) -> FloatArray:
+    """Previews for a sequence of controller times, (n_k, horizon, 3) [m/s] (vectorized)."""
+    t_ctrl = np.asarray(t_ctrl, float)
+    steps = t_ctrl[:, None] + dt * np.arange(1, horizon + 1)[None, :]
+    tm = np.clip(np.minimum(steps - meas.preview_time, t_ctrl[:, None]), meas.t[0], meas.t[-1])
+    return np.stack([np.interp(tm, meas.t, meas.u_hat[:, i]) for i in range(3)], axis=-1)
+
+
+def blade_effective_wind(field: WindField, t: FloatArray, blade_azimuth_rad: FloatArray,
+                         radius: float) -> FloatArray:
+    """Longitudinal wind at each blade's point at ``radius`` (75 % span), (n_t, 3) [m/s]."""
+    t = np.asarray(t, float)
+    ang = np.asarray(blade_azimuth_rad, float)[:, None] + 2 * math.pi * np.arange(3) / 3
+    y = -radius * np.sin(ang)
+    z = field.hub_height + radius * np.cos(ang)
+    return field.sample(np.broadcast_to(t[:, None], y.shape), y, z, "u")
+
+
+def rotor_effective_wind(field: WindField, rotor_radius: float, method: str = "mean"
+                         ) -> FloatArray:
+    """Rotor-effective wind speed over the field's times, (n_t,) [m/s].
+
+    ``"mean"``: the disc average of u (grid points inside the rotor disc); ``"cube"``: the
+    cube root of the disc average of u^3 (the power-equivalent speed of IEC 61400-12-1).
+    """
+    yy, zz = np.meshgrid(field.y, field.z - field.hub_height, indexing="ij")
+    inside = yy**2 + zz**2 <= rotor_radius**2
+    if not inside.any():
+        raise ValueError(f"no field point lies within rotor_radius = {rotor_radius:g} m")
+    u = field.u[:, inside]
+    if method == "mean":
+        return u.mean(axis=1)
+    if method == "cube":
+        return np.cbrt((u**3).mean(axis=1))
+    raise ValueError(f"method must be 'mean' or 'cube', got {method!r}")
+
+
+def coherence(estimate: FloatArray, truth: FloatArray, fs: float,
+              nperseg: int = 256) -> tuple[FloatArray, FloatArray]:
+    """Magnitude-squared coherence (Welch) between an estimate and the truth.
+
+    Returns
+    -------
+    f : (n_f,) ndarray
+        [Hz]
+    gamma2 : (n_f,) ndarray
+        [-]
+    """
+    f, g = signal.coherence(estimate, truth, fs=fs, nperseg=min(nperseg, len(estimate)))
+    return f, g
+
+
+def coherence_bandwidth(f: FloatArray, gamma2: FloatArray, level: float = 0.5) -> float:
+    """Lowest frequency above 0 where the coherence falls below ``level`` [Hz] (interpolated;
+    the last frequency if it never does)."""
+    idx = np.flatnonzero((gamma2 < level) & (f > 0))
+    if idx.size == 0:
+        return float(f[-1])
+    k = int(idx[0])
+    if k == 0:
+        return float(f[0])
+    f0, f1, g0, g1 = f[k - 1], f[k], gamma2[k - 1], gamma2[k]
+    return float(f0 + (g0 - level) * (f1 - f0) / (g0 - g1))
+
+
+def rms_preview_error(previews: FloatArray, truth: FloatArray) -> float:
+    """RMS of preview minus truth over all steps and blades [m/s]."""
+    d = np.asarray(previews, float) - np.asarray(truth, float)
+    return float(np.sqrt(np.mean(d**2)))
+
+
+def peak_lag(estimate: FloatArray, later: FloatArray, dt: float, max_lag: float) -> float:
+    """Lag [s] that maximizes the cross-correlation of ``later`` against ``estimate``
+    (positive: ``later`` follows ``estimate``), refined by a parabola through the peak."""
+    a = np.asarray(estimate, float) - np.mean(estimate)
+    b = np.asarray(later, float) - np.mean(later)
+    n = len(a)
+    m = int(round(max_lag / dt))
+    lags = np.arange(-m, m + 1)
+    cc = np.array([np.dot(a[max(0, -k):n - max(0, k)], b[max(0, k):n - max(0, -k)])
+                   / (n - abs(k)) for k in lags])
+    i = int(np.argmax(cc))
+    shift = 0.0
+    if 0 < i < len(cc) - 1:
+        den = cc[i - 1] - 2 * cc[i] + cc[i + 1]
+        shift = 0.5 * (cc[i - 1] - cc[i + 1]) / den if den != 0 else 0.0
+    return float((lags[i] + shift) * dt)
