@@ -118,16 +118,36 @@ def coherence(estimate: FloatArray, truth: FloatArray, fs: float,
     return f, g
 
 
-def coherence_bandwidth(f: FloatArray, gamma2: FloatArray, level: float = 0.5) -> float:
-    """Lowest frequency above 0 where the coherence falls below ``level`` [Hz] (interpolated;
-    the last frequency if it never does)."""
-    idx = np.flatnonzero((gamma2 < level) & (f > 0))
+def coherence_bandwidth(f: FloatArray, gamma2: FloatArray, level: float = 0.5,
+                        bands_per_decade: int = 12) -> float:
+    """Frequency where the coherence first falls below ``level`` [Hz].
+
+    The Welch estimate scatters from bin to bin (dips of a single bin would decide a
+    first-crossing on the raw curve), so the coherence is first averaged in logarithmic bands
+    (``bands_per_decade``; 0 uses the raw bins). Returns the interpolated crossing, or the
+    highest frequency if the coherence never falls below the level.
+    """
+    f = np.asarray(f, float)
+    g = np.asarray(gamma2, float)
+    keep = f > 0
+    f, g = f[keep], g[keep]
+    if bands_per_decade > 0 and f.size > 2:
+        edges = 10 ** np.arange(np.log10(f[0]), np.log10(f[-1]) + 1e-9, 1.0 / bands_per_decade)
+        edges = np.append(edges, f[-1] * 1.0001)
+        fc, gc = [], []
+        for a, b in zip(edges[:-1], edges[1:]):
+            m = (f >= a) & (f < b)
+            if m.any():
+                fc.append(f[m].mean())
+                gc.append(g[m].mean())
+        f, g = np.array(fc), np.array(gc)
+    idx = np.flatnonzero(g < level)
     if idx.size == 0:
         return float(f[-1])
     k = int(idx[0])
     if k == 0:
         return float(f[0])
-    f0, f1, g0, g1 = f[k - 1], f[k], gamma2[k - 1], gamma2[k]
+    f0, f1, g0, g1 = f[k - 1], f[k], g[k - 1], g[k]
     return float(f0 + (g0 - level) * (f1 - f0) / (g0 - g1))
 
 

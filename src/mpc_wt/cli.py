@@ -6,6 +6,8 @@ run        the main job on a turbine: steady operating table, C_P surface and pl
 trim       steady operating points against wind speed (table or ``--json``)
 linearize  linear models over mean wind, saved as .mat/.npz/.json (``--json`` summary)
 aero       rotor aerodynamics: ``aero cp-surface --out FILE.csv [--plot FILE.png]``
+wind       turbulent wind fields: ``wind generate --mean 18 --class A --out FIELD.bts``
+lidar      CW LIDAR preview: ``lidar evaluate --field FIELD [--focus 54] [--json]``
 
 Errors in the arguments or the turbine file print one line naming the parameter and the value
 to stderr and exit with status 2.
@@ -187,6 +189,41 @@ def _cmd_linearize(args: argparse.Namespace) -> int:
     return 0
 
 
+def _cmd_wind_generate(args: argparse.Namespace) -> int:
+    import lidar
+
+    turb: str | float = args.turbulence_class
+    if args.ti is not None:
+        turb = args.ti
+    spec = lidar.TurbulenceSpec(args.mean, turb, hub_height=args.hub_height, width=args.width,
+                                height=args.width, n_y=args.n, n_z=args.n,
+                                duration=args.duration, dt=args.dt, shear_exponent=args.shear)
+    field = lidar.generate_field(spec, args.seed)
+    out = field.save(args.out)
+    u = field.u
+    print(f"wrote {out}: {u.shape[0]} steps x {u.shape[1]} x {u.shape[2]} points, "
+          f"hub TI {u[:, u.shape[1] // 2, u.shape[2] // 2].std() / args.mean:.3f}")
+    return 0
+
+
+def _cmd_lidar_evaluate(args: argparse.Namespace) -> int:
+    import lidar
+
+    from .lidar_eval import evaluate_lidar
+
+    field = lidar.WindField.load(args.field)
+    turbine = linearize.load_turbine(args.turbine)
+    res = evaluate_lidar(field, turbine, focus_distance=args.focus, plots=args.plots,
+                         range_weighting=not args.point, los_error=not args.no_los_error,
+                         noise_std=args.noise)
+    if args.json:
+        print(json.dumps(res, indent=1))
+    else:
+        for k, v in res.items():
+            print(f"{k:32s} {v:.4g}" if isinstance(v, float) else f"{k:32s} {v}")
+    return 0
+
+
 def _cmd_run(args: argparse.Namespace) -> int:
     from .plotting import plot_cp_surface, plot_operating_schedule
 
@@ -247,6 +284,35 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument("--out", help="models file: .mat (MATLAB), .npz or .json")
     p.add_argument("--json", action="store_true", help="print sensitivities and modes as JSON")
     p.set_defaults(func=_cmd_linearize)
+
+    p = sub.add_parser("wind", help="turbulent wind fields")
+    wind = p.add_subparsers(dest="wind_command", required=True)
+    q = wind.add_parser("generate", help="IEC 61400-1 Kaimal field (TurbSim IECKAI model)")
+    q.add_argument("--mean", type=float, required=True, help="hub-height mean speed [m/s]")
+    q.add_argument("--class", dest="turbulence_class", choices=("A", "B", "C"), default="A")
+    q.add_argument("--ti", type=float, default=None, help="turbulence intensity instead of a class")
+    q.add_argument("--seed", type=int, default=1)
+    q.add_argument("--duration", type=float, default=600.0, help="[s]")
+    q.add_argument("--dt", type=float, default=0.05, help="[s] (default 0.05: 20 Hz)")
+    q.add_argument("--n", type=int, default=32, help="grid points per side (default 32)")
+    q.add_argument("--width", type=float, default=150.0, help="grid side [m]")
+    q.add_argument("--hub-height", type=float, default=90.0, help="[m]")
+    q.add_argument("--shear", type=float, default=0.2, help="power-law exponent")
+    q.add_argument("--out", required=True, help=".bts (TurbSim) or .npz (native)")
+    q.set_defaults(func=_cmd_wind_generate)
+
+    p = sub.add_parser("lidar", help="CW LIDAR preview")
+    lid = p.add_subparsers(dest="lidar_command", required=True)
+    q = lid.add_parser("evaluate", help="coherence bandwidth and preview error on a field")
+    q.add_argument("--field", required=True, help=".bts or .npz wind field")
+    q.add_argument("--turbine", **turb)
+    q.add_argument("--focus", type=float, default=54.0, help="axial focus distance [m]")
+    q.add_argument("--point", action="store_true", help="point measurement (no range weighting)")
+    q.add_argument("--no-los-error", action="store_true", help="measure u directly")
+    q.add_argument("--noise", type=float, default=0.0, help="LOS noise std [m/s]")
+    q.add_argument("--json", action="store_true")
+    q.add_argument("--plots", help="directory for lidar_coherence.png and lidar_scan.png")
+    q.set_defaults(func=_cmd_lidar_evaluate)
 
     p = sub.add_parser("aero", help="rotor aerodynamics")
     aero = p.add_subparsers(dest="aero_command", required=True)

@@ -8,7 +8,14 @@ import numpy as np
 
 from linearize import OperatingPoint
 
-__all__ = ["plot_cp_surface", "plot_operating_schedule"]
+__all__ = ["plot_cp_surface", "plot_operating_schedule", "plot_lidar_coherence", "plot_scan_pattern"]
+
+
+def _save(fig, path: str | Path) -> Path:  # type: ignore[no-untyped-def]
+    """Lay out, write the PNG and release the figure."""
+    import matplotlib.pyplot as plt
+
+    return _save(fig, path)
 
 
 def _plt():  # type: ignore[no-untyped-def]
@@ -48,11 +55,7 @@ def plot_cp_surface(tsr: np.ndarray, pitch_deg: np.ndarray, cp: np.ndarray, path
     ax.set_ylabel("collective pitch [deg]")
     ax.set_title(title or "Power coefficient C_P(lambda, pitch)")
     ax.legend(loc="upper right", fontsize=8)
-    fig.tight_layout()
-    out = Path(path)
-    fig.savefig(out)
-    plt.close(fig)
-    return out
+    return _save(fig, path)
 
 
 def plot_operating_schedule(points: Sequence[OperatingPoint], path: str | Path,
@@ -85,8 +88,66 @@ def plot_operating_schedule(points: Sequence[OperatingPoint], path: str | Path,
                 ax.axvline(p.wind_speed, color="0.6", lw=0.8, ls=":")
             break
     fig.suptitle(title or "Steady operating schedule")
-    fig.tight_layout()
-    out = Path(path)
-    fig.savefig(out)
-    plt.close(fig)
-    return out
+    return _save(fig, path)
+
+
+def plot_lidar_coherence(f: np.ndarray, gamma2: np.ndarray, bandwidth_hz: float,
+                         mean_speed: float, path: str | Path) -> Path:
+    """Magnitude-squared coherence of the LIDAR estimate with the later blade wind, per blade.
+
+    Parameters
+    ----------
+    f : (n_f,) ndarray
+        [Hz]
+    gamma2 : (n_f, 3) ndarray
+        [-]
+    """
+    plt = _plt()
+    fig, ax = plt.subplots(figsize=(7.0, 4.2), dpi=120)
+    for i in range(gamma2.shape[1]):
+        ax.semilogx(f[1:], gamma2[1:, i], lw=1.0, label=f"blade {i + 1}")
+    ax.axhline(0.5, color="0.4", ls=":", lw=0.8)
+    ax.axvline(bandwidth_hz, color="C3", ls="--", lw=1.0,
+               label=f"bandwidth {bandwidth_hz:.2f} Hz (k = "
+                     f"{2 * np.pi * bandwidth_hz / mean_speed:.3f} rad/m)")
+    ax.set_xlabel("frequency [Hz]")
+    ax.set_ylabel("coherence gamma^2 [-]")
+    ax.set_ylim(0, 1.02)
+    ax.set_title("LIDAR preview vs wind at the blade (75 % span)")
+    ax.legend(fontsize=8)
+    ax.grid(alpha=0.3, which="both")
+    return _save(fig, path)
+
+
+def plot_scan_pattern(beam_azimuth_rad: np.ndarray, blade_azimuth_rad: np.ndarray,
+                      radius: float, rotor_radius: float, path: str | Path) -> Path:
+    """Measurement points and blade positions in the rotor plane seen from upwind.
+
+    Parameters
+    ----------
+    beam_azimuth_rad : (n_t, 3) ndarray
+        Azimuth of each beam's focus [rad] (0 = up, clockwise seen from upwind).
+    blade_azimuth_rad : (n_t,) ndarray
+        Azimuth of blade 1 [rad].
+    """
+    plt = _plt()
+    fig, ax = plt.subplots(figsize=(5.5, 5.5), dpi=120)
+    th = np.linspace(0, 2 * np.pi, 200)
+    ax.plot(rotor_radius * np.sin(th), rotor_radius * np.cos(th), color="0.6", lw=0.8)
+    # seen from upwind, +y (left looking downwind) is on the right: plot -y as x
+    for i in range(beam_azimuth_rad.shape[1]):
+        a = beam_azimuth_rad[:, i]
+        ax.plot(radius * np.sin(a), radius * np.cos(a), ".", ms=2, alpha=0.4,
+                label=f"beam {i + 1}")
+    a0 = blade_azimuth_rad[0] + 2 * np.pi * np.arange(3) / 3
+    for i, a in enumerate(a0):
+        ax.plot([0, rotor_radius * np.sin(a)], [0, rotor_radius * np.cos(a)], lw=2,
+                color=f"C{i}")
+        b = beam_azimuth_rad[0, i]
+        ax.plot(radius * np.sin(b), radius * np.cos(b), "o", ms=8, mfc="none", color=f"C{i}")
+    ax.set_aspect("equal")
+    ax.set_xlabel("lateral, seen from upwind [m]")
+    ax.set_ylabel("vertical from hub [m]")
+    ax.set_title("CW LIDAR scan: foci lead their blades by omega T_p")
+    ax.legend(fontsize=8, loc="lower right")
+    return _save(fig, path)

@@ -102,3 +102,31 @@ def test_linearize_bad_grid(capsys: pytest.CaptureFixture[str]) -> None:
     assert "strictly increasing" in capsys.readouterr().err
     assert main(["linearize", "--wind", "26"]) == 2
     assert "outside the operating range" in capsys.readouterr().err
+
+
+def test_wind_generate_and_lidar_evaluate(tmp_path: Path,
+                                          capsys: pytest.CaptureFixture[str]) -> None:
+    field = tmp_path / "f.bts"
+    assert main(["wind", "generate", "--mean", "18", "--class", "A", "--seed", "1",
+                 "--duration", "120", "--n", "16", "--out", str(field)]) == 0
+    assert "wrote" in capsys.readouterr().out
+    assert main(["lidar", "evaluate", "--field", str(field), "--json", "--plots",
+                 str(tmp_path / "plots")]) == 0
+    res = json.loads(capsys.readouterr().out)
+    for key in ("coherence_bandwidth_Hz", "rms_preview_error_mps", "focus_m", "preview_time_s"):
+        assert isinstance(res[key], float), key
+    assert res["focus_m"] == 54.0 and res["preview_time_s"] == pytest.approx(3.0)
+    assert res["lead_angle_deg"] == pytest.approx(217.8, abs=0.1)
+    for png in ("lidar_coherence.png", "lidar_scan.png"):
+        assert (tmp_path / "plots" / png).read_bytes()[:4] == b"\x89PNG"
+    # idealized: the preview is the later blade wind
+    assert main(["lidar", "evaluate", "--field", str(field), "--json", "--point",
+                 "--no-los-error"]) == 0
+    assert json.loads(capsys.readouterr().out)["rms_preview_error_mps"] < 1e-6
+
+
+def test_lidar_evaluate_bad_field(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    bad = tmp_path / "f.bts"
+    bad.write_bytes(b"\x07\x00" + b"\x00" * 10)
+    assert main(["lidar", "evaluate", "--field", str(bad)]) == 2
+    assert "truncated .bts header" in capsys.readouterr().err

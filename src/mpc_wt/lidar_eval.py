@@ -1,0 +1,77 @@
+"""Evaluate a CW LIDAR's per-blade preview on a wind field for a turbine (``mpcwt lidar``)."""
+from __future__ import annotations
+
+import math
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+import lidar
+import linearize
+
+__all__ = ["evaluate_lidar"]
+
+
+def evaluate_lidar(field: lidar.WindField, turbine: linearize.Turbine, *,
+                   focus_distance: float = 54.0, sample_rate: float = 10.0, horizon: int = 15,
+                   dt_ctrl: float = 0.1, plots: str | Path | None = None,
+                   **lidar_options: Any) -> dict[str, Any]:
+    """Run the LIDAR over the field with the rotor at its trimmed speed and judge the preview.
+
+    The rotor turns at the trimmed speed of the field's mean wind (constant); measurements run
+    from the field's start to its end less the preview time. Returns the coherence bandwidth
+    (gamma^2 = 0.5, mean of the blades) and wavenumber, the RMS preview error over the horizon
+    against the wind each blade meets at 75 % span, the preview time and the lead angle.
+
+    Raises
+    ------
+    ValueError
+        If the field is too short or too narrow for the LIDAR (the message says which).
+    """
+    op = linearize.trim(turbine, float(np.clip(field.mean_speed, turbine.operation.cut_in_wind,
+                                               turbine.operation.cut_out_wind)))
+    omega = op.rotor_speed_rad_s
+    lid = lidar.CWLidar(turbine.geometry.tip_radius, focus_distance=focus_distance,
+                        sample_rate=sample_rate, **lidar_options)
+    tp = lid.preview_time(field.mean_speed)
+    t_end = field.t[-1] - tp - horizon * dt_ctrl - 1.0
+    if t_end <= field.t[0] + 10.0:
+        raise ValueError(f"the field ({field.duration:g} s) is too short for a preview of "
+                         f"{tp:.2f} s plus a {horizon * dt_ctrl:g} s horizon")
+    t = np.arange(field.t[0], t_end, 1.0 / sample_rate)
+    psi = omega * t
+    meas = lid.measure(field, t, psi, omega)
+    later = lidar.blade_effective_wind(field, t + tp, psi + omega * tp, lid.radius)
+    fs = sample_rate
+    g_all = []
+    f = np.zeros(1)
+    for i in range(3):
+        f, g = lidar.coherence(meas.u_hat[:, i], later[:, i], fs, nperseg=256)
+        g_all.append(g)
+    gamma2 = np.column_stack(g_all)
+    bw = lidar.coherence_bandwidth(f, gamma2.mean(axis=1))
+    k_ctrl = t[(t >= t[0] + tp) & (t <= t[-1] - horizon * dt_ctrl)][::max(1, int(round(
+        dt_ctrl * sample_rate)))]
+    prev = lidar.preview_series(meas, k_ctrl, horizon, dt_ctrl)
+    steps = k_ctrl[:, None] + dt_ctrl * np.arange(1, horizon + 1)[None, :]
+    truth = np.stack([lidar.blade_effective_wind(field, steps[:, j], omega * steps[:, j],
+                                                 lid.radius) for j in range(horizon)], axis=1)
+    res = {"focus_m": focus_distance, "preview_time_s": tp,
+           "lead_angle_deg": math.degrees(omega * tp) % 360.0,
+           "rotor_speed_rpm": omega * 30 / math.pi, "coherence_bandwidth_Hz": bw,
+           "coherence_bandwidth_rad_per_m": 2 * math.pi * bw / field.mean_speed,
+           "rms_preview_error_mps": lidar.rms_preview_error(prev, truth),
+           "half_width_m": lid.half_width, "cone_angle_deg": math.degrees(lid.cone_angle_rad),
+           "mean_speed_mps": field.mean_speed}
+    if plots:
+        from .plotting import plot_lidar_coherence, plot_scan_pattern
+
+        d = Path(plots)
+        d.mkdir(parents=True, exist_ok=True)
+        plot_lidar_coherence(f, gamma2, bw, field.mean_speed, d / "lidar_coherence.png")
+        n_rev = int(round(2 * math.pi / omega * sample_rate))
+        plot_scan_pattern(meas.beam_azimuth_rad[:n_rev], psi[:n_rev], lid.radius,
+                          turbine.geometry.tip_radius, d / "lidar_scan.png")
+        res["plots"] = [str(d / "lidar_coherence.png"), str(d / "lidar_scan.png")]
+    return res
