@@ -15,7 +15,11 @@ def _save(fig, path: str | Path) -> Path:  # type: ignore[no-untyped-def]
     """Lay out, write the PNG and release the figure."""
     import matplotlib.pyplot as plt
 
-    return _save(fig, path)
+    fig.tight_layout()
+    out = Path(path)
+    fig.savefig(out)
+    plt.close(fig)
+    return out
 
 
 def _plt():  # type: ignore[no-untyped-def]
