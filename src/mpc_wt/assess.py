@@ -1,0 +1,370 @@
+"""Load and performance assessment: rainflow, damage-equivalent loads, lifetime damage and
+extension, covariance-ellipse measures CS1-CS5, spectra at rotor harmonics, pitch duty, energy.
+
+Pure functions on arrays (the run-level wrappers come with the simulation harness).
+
+References
+----------
+ASTM E1049-85 (2017), Standard practices for cycle counting in fatigue analysis, sec. 5.4.4.
+Do et al. (2020), Wind Energy, eqs 19-26 (Miner, DEL, CS1-CS5).
+Clemens et al., DEL assessment of active power control, eqs 12-18 (lifetime DEL).
+Pettas and Cheng (2018), eq 1 (lifetime extension).
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any
+
+import numba as nb
+import numpy as np
+from scipy import signal
+from scipy import stats
+
+__all__ = ["rainflow", "damage_equivalent_load", "lifetime_del", "wind_bin_probabilities",
+           "miner_damage", "lifetime_extension", "CSMeasures", "cs_measures", "psd",
+           "harmonic_psd", "pitch_duty", "energy_Wh", "aep_Wh"]
+
+FloatArray = np.ndarray
+
+
+def _check_series(name: str, x: Any) -> FloatArray:
+    arr = np.asarray(x, dtype=float)
+    if arr.ndim != 1:
+        raise ValueError(f"{name} must be 1-D, got shape {arr.shape}")
+    if not np.all(np.isfinite(arr)):
+        i = int(np.argmax(~np.isfinite(arr)))
+        raise ValueError(f"{name} must be finite; sample {i} is {float(arr[i])!r}")
+    return arr
+
+
+@nb.njit(cache=True)
+def _reversals(x):  # pragma: no cover - compiled
+    """Peaks and valleys (ASTM: reversals), endpoints included, plateaus collapsed."""
+    n = x.size
+    out = np.empty(n)
+    k = 0
+    if n == 0:
+        return out[:0]
+    out[0] = x[0]
+    k = 1
+    direction = 0
+    for i in range(1, n):
+        d = x[i] - out[k - 1]
+        if d == 0.0:
+            continue
+        s = 1 if d > 0 else -1
+        if direction == 0 or s == direction:
+            if direction == 0:
+                out[k] = x[i]
+                k += 1
+            else:
+                out[k - 1] = x[i]          # extend the current excursion
+            direction = s
+        else:
+            out[k] = x[i]
+            k += 1
+            direction = s
+    return out[:k]
+
+
+@nb.njit(cache=True)
+def _count(rev, start_half=True):  # pragma: no cover - compiled
+    """ASTM E1049-85 5.4.4 three-point rainflow: (range, mean, count) rows; residue 0.5.
+
+    With ``start_half=False`` a range containing the starting point is not counted as a half
+    cycle (the four-point rule): the starting point stays in the residue, which is returned
+    last, as repeated-residue counting needs.
+    """
+    n = rev.size
+    ranges = np.empty(n)
+    means = np.empty(n)
+    counts = np.empty(n)
+    m = 0
+    stack = np.empty(n)
+    top = 0
+    for i in range(n):
+        stack[top] = rev[i]
+        top += 1
+        while top >= 3:
+            x = abs(stack[top - 1] - stack[top - 2])
+            y = abs(stack[top - 2] - stack[top - 3])
+            if x < y:
+                break
+            if top == 3:
+                if not start_half:
+                    break
+                # Y contains the starting point: count Y as a half cycle, drop its first point
+                ranges[m] = y
+                means[m] = 0.5 * (stack[0] + stack[1])
+                counts[m] = 0.5
+                m += 1
+                stack[0] = stack[1]
+                stack[1] = stack[2]
+                top = 2
+            else:
+                ranges[m] = y
+                means[m] = 0.5 * (stack[top - 2] + stack[top - 3])
+                counts[m] = 1.0
+                m += 1
+                stack[top - 3] = stack[top - 1]
+                top -= 2
+    for j in range(top - 1):
+        ranges[m] = abs(stack[j + 1] - stack[j])
+        means[m] = 0.5 * (stack[j + 1] + stack[j])
+        counts[m] = 0.5
+        m += 1
+    return ranges[:m], means[:m], counts[:m], stack[:top].copy()
+
+
+def rainflow(x: Any, *, repeated_residue: bool = False) -> tuple[FloatArray, FloatArray,
+                                                                   FloatArray]:
+    """Rainflow cycles of a load series (ASTM E1049-85, sec. 5.4.4).
+
+    Parameters
+    ----------
+    x : (n_t,) array_like
+        Load series (any unit).
+    repeated_residue : bool
+        False (ASTM): the residue's reversals count as half cycles of weight 0.5. True: the
+        residue is counted once more after itself and only full cycles are kept, as fatpack
+        and pCrunch do (the residue's cycles then close).
+
+    Returns
+    -------
+    ranges, means, counts : (n_c,) ndarray
+        Cycle ranges (peak to valley), means [unit of x] and counts (1 or 0.5) [-].
+    """
+    arr = _check_series("x", x)
+    rev = _reversals(arr)
+    if not repeated_residue:
+        r, mu, c, _ = _count(rev, True)
+        return r, mu, c
+    r, mu, c, residue = _count(rev, False)
+    full = c == 1.0
+    # the residue followed by itself closes its cycles (fatpack's "concatenate residue")
+    r2, mu2, c2, _ = _count(_reversals(np.concatenate([residue, residue])), False)
+    f2 = c2 == 1.0
+    return (np.concatenate([r[full], r2[f2]]), np.concatenate([mu[full], mu2[f2]]),
+            np.ones(int(full.sum() + f2.sum())))
+
+
+def damage_equivalent_load(x: Any, m: float, *, n_eq: float | None = None,
+                           duration: float | None = None, f_eq: float = 1.0,
+                           method: str = "astm", bins: int = 100) -> float:
+    """Short-term damage-equivalent load as a range (Do et al. eq 20; Clemens eq 17).
+
+    DEL = (sum_i n_i S_i^m / N_eq)^(1/m) with S_i the rainflow ranges, n_i their counts and
+    N_eq = f_eq * duration (default 1 Hz times the record's duration).
+
+    Parameters
+    ----------
+    x : (n_t,) array_like
+        Load series.
+    m : float
+        Woehler exponent (4 steel, 10 composite), > 0.
+    n_eq : float, optional
+        Equivalent cycle count; else ``f_eq * duration``.
+    duration : float, optional
+        Record length [s] (required unless ``n_eq`` is given).
+    f_eq : float
+        Equivalent-load frequency [Hz] (default 1).
+    method : {"astm", "pcrunch"}
+        ASTM counting with half-cycle residue, or pCrunch-style: repeated residue and ranges
+        binned into ``bins`` equal bins at their centres.
+
+    Raises
+    ------
+    ValueError
+        On a non-positive m, duration or n_eq, a non-finite series or an unknown method.
+    """
+    if not (math.isfinite(m) and m > 0):
+        raise ValueError(f"m (Woehler exponent) must be > 0, got {m!r}")
+    if n_eq is None:
+        if duration is None or not (math.isfinite(duration) and duration > 0):
+            raise ValueError(f"duration must be > 0 s when n_eq is not given, got {duration!r}")
+        n_eq = f_eq * duration
+    if not (math.isfinite(n_eq) and n_eq > 0):
+        raise ValueError(f"n_eq must be > 0, got {n_eq!r}")
+    if method == "astm":
+        r, _, c = rainflow(x)
+    elif method == "pcrunch":
+        r, _, c = rainflow(x, repeated_residue=True)
+        if r.size:
+            edges = np.linspace(0.0, r.max(), bins + 1)
+            idx = np.clip(np.searchsorted(edges, r, side="right") - 1, 0, bins - 1)
+            r = 0.5 * (edges[idx] + edges[idx + 1])
+    else:
+        raise ValueError(f"method must be 'astm' or 'pcrunch', got {method!r}")
+    if r.size == 0:
+        return 0.0
+    scale = r.max()
+    if scale == 0.0:
+        return 0.0
+    return float(scale * (np.sum(c * (r / scale) ** m) / n_eq) ** (1.0 / m))
+
+
+def wind_bin_probabilities(v: Any, kind: str = "rayleigh", *, mean: float | None = None,
+                           shape: float = 2.0, scale: float | None = None) -> FloatArray:
+    """Probability of each wind bin centred at ``v`` (edges midway between centres).
+
+    ``kind="rayleigh"`` with ``mean`` (IEC: 0.2 v_ref, e.g. 10 m/s for class I), or
+    ``"weibull"`` with ``shape`` k and ``scale`` A [m/s].
+    """
+    v = np.asarray(v, dtype=float)
+    if v.ndim != 1 or v.size < 1 or np.any(np.diff(v) <= 0):
+        raise ValueError("v must be a strictly increasing 1-D array of bin centres")
+    if kind == "rayleigh":
+        if mean is None or not mean > 0:
+            raise ValueError(f"mean must be > 0 m/s for a Rayleigh distribution, got {mean!r}")
+        k, a = 2.0, 2.0 * mean / math.sqrt(math.pi)
+    elif kind == "weibull":
+        if scale is None or not scale > 0 or not shape > 0:
+            raise ValueError(f"weibull needs shape > 0 and scale > 0, got {shape!r}, {scale!r}")
+        k, a = shape, scale
+    else:
+        raise ValueError(f"kind must be 'rayleigh' or 'weibull', got {kind!r}")
+    mid = 0.5 * (v[1:] + v[:-1])
+    half = (v[1] - v[0]) / 2 if v.size > 1 else 0.5
+    edges = np.concatenate([[v[0] - half], mid, [v[-1] + (v[-1] - v[-2]) / 2 if v.size > 1
+                                                  else v[0] + 0.5]])
+    cdf = stats.weibull_min.cdf(np.maximum(edges, 0.0), k, scale=a)
+    return np.diff(cdf)
+
+
+def lifetime_del(dels: Any, m: float, probabilities: Any, n_eq: Any | None = None) -> float:
+    """Lifetime DEL over mean-wind bins (Clemens eq 18): the m-power mean weighted by the wind
+    distribution and the bins' cycle counts, never the arithmetic mean of the DELs.
+
+    DEL_life = (sum_j p_j n_j DEL_j^m / sum_j p_j n_j)^(1/m), n_j the equivalent cycle count
+    of bin j (equal by default); the lifetime factor L_F cancels.
+    """
+    d = np.asarray(dels, float)
+    p = np.asarray(probabilities, float)
+    n = np.ones_like(d) if n_eq is None else np.asarray(n_eq, float)
+    if not (d.shape == p.shape == n.shape and d.ndim == 1):
+        raise ValueError(f"dels, probabilities and n_eq must be 1-D of equal length, got "
+                         f"{d.shape}, {p.shape}, {n.shape}")
+    if np.any(p < 0) or p.sum() <= 0 or np.any(d < 0) or np.any(n <= 0):
+        raise ValueError("probabilities must be >= 0 with a positive sum, dels >= 0, n_eq > 0")
+    w = p * n
+    return float((np.sum(w * d**m) / np.sum(w)) ** (1.0 / m))
+
+
+def miner_damage(ranges: Any, counts: Any, m: float, s_ref: float, n_ref: float) -> float:
+    """Palmgren-Miner damage sum n_i / N_i with N(S) = n_ref (s_ref / S)^m (Clemens eqs 13-16)."""
+    r = np.asarray(ranges, float)
+    c = np.asarray(counts, float)
+    if not (s_ref > 0 and n_ref > 0 and m > 0):
+        raise ValueError("s_ref, n_ref and m must be > 0")
+    return float(np.sum(c * (r / s_ref) ** m) / n_ref)
+
+
+def lifetime_extension(del_base: float, del_upd: float, m: float, *, t_base: float = 15.0,
+                       t_upd: float = 5.0, t_lifetime: float = 20.0) -> dict[str, float]:
+    """Combined damage and lifetime extension of a controller retrofit (Pettas and Cheng eq 1).
+
+    D_comb = T_base / T_life + T_upd / T_life (DEL_upd / DEL_base)^m, with the baseline damage
+    over the design life taken as 1. The reserve 1 - D_comb, used at the updated controller's
+    damage rate (DEL_upd / DEL_base)^m / T_life per year, gives the extension in years.
+    """
+    for name, val in (("del_base", del_base), ("m", m), ("t_lifetime", t_lifetime)):
+        if not val > 0:
+            raise ValueError(f"{name} must be > 0, got {val!r}")
+    ratio = (del_upd / del_base) ** m
+    d_comb = t_base / t_lifetime + t_upd / t_lifetime * ratio
+    rate = ratio / t_lifetime
+    ext = (1.0 - d_comb) / rate if rate > 0 else math.inf
+    return {"damage": d_comb, "extension_years": ext, "damage_rate_ratio": ratio}
+
+
+@dataclass(frozen=True)
+class CSMeasures:
+    """Covariance-ellipse measures of Do et al. (2020), eqs 21-26.
+
+    cs1, cs2 : standard deviations along the ellipse axes nearest the load and power axes;
+    cs3, cs4 : means of load and power; cs5 : min(alpha, 90 - alpha) [deg]; alpha : angle of the
+    major axis to the load axis [deg]; ``s`` the chi-square scale (5.99: 95 %).
+    """
+
+    cs1: float
+    cs2: float
+    cs3: float
+    cs4: float
+    cs5: float
+    alpha_deg: float
+    covariance: FloatArray
+    s: float = 5.99
+
+    def ellipse(self, n: int = 200) -> tuple[FloatArray, FloatArray]:
+        """Points of the s-scaled ellipse (x = load, y = power)."""
+        lam, vec = np.linalg.eigh(self.covariance)
+        th = np.linspace(0, 2 * np.pi, n)
+        pts = vec @ (np.sqrt(self.s * np.maximum(lam, 0))[:, None]
+                     * np.vstack([np.cos(th), np.sin(th)]))
+        return self.cs3 + pts[0], self.cs4 + pts[1]
+
+
+def cs_measures(load: Any, power: Any, s: float = 5.99) -> CSMeasures:
+    """CS1-CS5 from load and power samples (Do et al. eqs 21-26)."""
+    x = _check_series("load", load)
+    y = _check_series("power", power)
+    if x.shape != y.shape or x.size < 3:
+        raise ValueError(f"load and power must have equal length >= 3, got {x.size}, {y.size}")
+    c = np.cov(np.vstack([x, y]))                 # eqs 22-23 (1 / (N - 1))
+    lam, vec = np.linalg.eigh(c)
+    i_load = int(np.argmax(np.abs(vec[0])))       # eigenvector nearest the load (x) axis
+    i_pow = 1 - i_load
+    vmax = vec[:, int(np.argmax(lam))]
+    alpha = math.degrees(math.atan(abs(vmax[1]) / abs(vmax[0]))) if vmax[0] != 0 else 90.0
+    return CSMeasures(cs1=float(np.sqrt(lam[i_load])), cs2=float(np.sqrt(lam[i_pow])),
+                      cs3=float(x.mean()), cs4=float(y.mean()), cs5=min(alpha, 90.0 - alpha),
+                      alpha_deg=alpha, covariance=c, s=s)
+
+
+def psd(x: Any, fs: float, nperseg: int = 4096) -> tuple[FloatArray, FloatArray]:
+    """One-sided power spectral density (Welch, Hann, 50 % overlap): f [Hz], S [unit^2/Hz]."""
+    arr = _check_series("x", x)
+    return signal.welch(arr - arr.mean(), fs=fs, nperseg=min(nperseg, arr.size))
+
+
+def harmonic_psd(x: Any, fs: float, rotor_hz: float, harmonics: tuple[int, ...] = (1, 3, 6),
+                 nperseg: int = 4096, half_width: float = 0.1) -> dict[int, float]:
+    """Spectral amplitude at n P: the PSD integrated over n f_rotor (1 +- half_width)
+    [unit^2], i.e. the variance the nP peak carries (Madsen et al. 2012, sec. IV)."""
+    f, p = psd(x, fs, nperseg)
+    out = {}
+    df = f[1] - f[0]
+    for n in harmonics:
+        lo, hi = n * rotor_hz * (1 - half_width), n * rotor_hz * (1 + half_width)
+        m = (f >= lo) & (f <= hi)
+        out[n] = float(p[m].sum() * df)
+    return out
+
+
+def pitch_duty(pitch_rad: Any, dt: float) -> dict[str, float]:
+    """Pitch activity (Pettas and Cheng sec. 4): total travel [deg] summed over blades, std of
+    pitch rate [deg/s] and of pitch acceleration [deg/s^2] (mean over blades)."""
+    p = np.asarray(pitch_rad, float)
+    if p.ndim == 1:
+        p = p[:, None]
+    rate = np.diff(p, axis=0) / dt
+    acc = np.diff(rate, axis=0) / dt
+    return {"pitch_travel_deg": float(np.degrees(np.abs(np.diff(p, axis=0)).sum())),
+            "pitch_rate_std_degps": float(np.degrees(rate.std(axis=0)).mean()),
+            "pitch_acc_std_degps2": float(np.degrees(acc.std(axis=0)).mean())}
+
+
+def energy_Wh(power_W: Any, dt: float) -> float:
+    """Energy of a power series (trapezoid) [Wh]."""
+    p = _check_series("power_W", power_W)
+    return float(np.trapezoid(p, dx=dt) / 3600.0)
+
+
+def aep_Wh(mean_power_W: Any, probabilities: Any, availability: float = 1.0) -> float:
+    """Annual energy from the mean power per wind bin and the bins' probabilities [Wh/yr]."""
+    p = np.asarray(mean_power_W, float)
+    w = np.asarray(probabilities, float)
+    if p.shape != w.shape:
+        raise ValueError(f"mean_power_W {p.shape} and probabilities {w.shape} differ in shape")
+    return float(availability * 8766.0 * np.sum(p * w))
