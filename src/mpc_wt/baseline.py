@@ -1,0 +1,214 @@
+"""The baseline controller: NREL 5-MW style variable-speed, variable-pitch control, tuned by
+mpc-wt from its own linear models.
+
+* Generator torque (Jonkman et al. 2009, sec. 7.3): region 1 (no torque), 1.5 (linear from
+  cut-in speed), 2 (K omega_g^2 with K from the optimal C_P), 2.5 (straight line to rated
+  torque at rated speed with a slip), 3 (constant power, or constant torque), on the filtered
+  generator speed; torque rate limited.
+* Collective pitch: PI on the filtered generator-speed error, gain-scheduled
+  GK(theta) = 1 / (1 + theta / theta_K), with anti-windup (the integral is held so that the
+  command stays within the pitch limits), rate-limited command.
+* Tuning (report sec. 7.4; Do et al. 2020 eq 8, the method of Wright and Fingersh): the rotor as
+  one rigid inertia J (rotor plus generator on the low-speed shaft) with the aerodynamic power
+  sensitivity dP/dtheta, linear in pitch: dP/dtheta = (dP/dtheta)_0 (1 + theta / theta_K).
+  Placing the closed-loop poles at omega_n, zeta (aerodynamic damping neglected, as the report
+  does) gives KP = 2 J Omega_0 zeta omega_n / (N (-dP/dtheta)_0) and
+  KI = J Omega_0 omega_n^2 / (N (-dP/dtheta)_0), on the generator speed.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+import linearize
+
+__all__ = ["BaselineGains", "tune_baseline", "BaselineController"]
+
+
+@dataclass(frozen=True)
+class BaselineGains:
+    """Gains and set points of the baseline controller (high-speed-shaft quantities).
+
+    Parameters
+    ----------
+    kp : float
+        Proportional gain at zero pitch [rad pitch / (rad/s generator speed)] (= [s]).
+    ki : float
+        Integral gain at zero pitch [rad pitch / rad generator-speed integral] (= [-]).
+    theta_k_rad : float
+        Pitch at which the pitch sensitivity doubles (gain-schedule corner) [rad].
+    k_opt : float
+        Region-2 torque gain [N m / (rad/s)^2].
+    rated_gen_speed_rad_s, rated_torque, rated_power : float
+        Set points [rad/s, N m, W (electrical)].
+    dpdtheta_0 : float
+        Aerodynamic power sensitivity extrapolated to zero pitch [W/rad].
+    omega_n_rad_s, zeta : float
+        Design natural frequency [rad/s] and damping ratio [-].
+    """
+
+    kp: float
+    ki: float
+    theta_k_rad: float
+    k_opt: float
+    rated_gen_speed_rad_s: float
+    rated_torque: float
+    rated_power: float
+    dpdtheta_0: float
+    omega_n_rad_s: float = 0.6
+    zeta: float = 0.7
+    info: dict[str, Any] = field(default_factory=dict, compare=False)
+
+
+def tune_baseline(turbine: linearize.Turbine, *, omega_n_rad_s: float = 0.6, zeta: float = 0.7,
+                  wake: str = "frozen", winds: Any = None,
+                  inertia: float | None = None) -> BaselineGains:
+    """Tune the baseline from the turbine's own linear models.
+
+    Parameters
+    ----------
+    omega_n_rad_s, zeta : float
+        Closed-loop natural frequency [rad/s] and damping ratio (report: 0.6 rad/s, 0.7).
+    wake : {"frozen", "quasi-steady"}
+        Wake assumption of the pitch sensitivities (the report's are frozen-wake).
+    winds : array_like, optional
+        Wind speeds for the linear fit of dP/dtheta against pitch; default rated (zero pitch),
+        then 12-25 m/s, the range of the report's fit (its Table 7-2 starts at 11.4 m/s).
+    inertia : float, optional
+        Drivetrain inertia on the low-speed shaft [kg m^2]; default rotor (from the blade data)
+        plus N^2 times the generator inertia.
+    """
+    if not (omega_n_rad_s > 0 and zeta > 0):
+        raise ValueError(f"omega_n_rad_s and zeta must be > 0, got {omega_n_rad_s!r}, {zeta!r}")
+    if winds is None:
+        v_rated = linearize.rated_wind_speed(turbine)
+        v = np.r_[v_rated + 1e-6, np.arange(12.0, 25.5, 1.0)]
+    else:
+        v = np.asarray(winds, float)
+    params = linearize.plant_params(turbine)
+    fam = linearize.linearize_family(turbine, v, wake=wake, params=params)
+    theta = np.array([m.info["pitch_deg"] for m in fam.models]) * math.pi / 180
+    dpdt = np.array([linearize.sensitivities(m)["dP_dpitch_W_per_rad"] for m in fam.models])
+    slope, intercept = np.polyfit(theta, dpdt, 1)
+    theta_k = intercept / slope
+    n = turbine.drivetrain.gearbox_ratio
+    j = (params.rotor_inertia + n**2 * turbine.drivetrain.generator_inertia
+         if inertia is None else float(inertia))
+    om0 = turbine.operation.rated_rotor_speed_rad_s
+    kp = 2 * j * om0 * zeta * omega_n_rad_s / (n * -intercept)
+    ki = j * om0 * omega_n_rad_s**2 / (n * -intercept)
+    lam, cp = linearize.optimal_tsr(turbine, math.degrees(turbine.operation.fine_pitch_rad))
+    r = turbine.geometry.tip_radius * math.cos(turbine.geometry.precone_rad)
+    rho = turbine.environment.air_density
+    k_opt = 0.5 * rho * math.pi * r**5 * cp / lam**3 / n**3
+    return BaselineGains(kp=kp, ki=ki, theta_k_rad=theta_k, k_opt=k_opt,
+                         rated_gen_speed_rad_s=turbine.rated_generator_speed_rad_s,
+                         rated_torque=turbine.rated_generator_torque,
+                         rated_power=turbine.operation.rated_power, dpdtheta_0=intercept,
+                         omega_n_rad_s=omega_n_rad_s, zeta=zeta,
+                         info={"wake": wake, "inertia_lss": j, "tsr_opt": lam, "cp_max": cp,
+                               "fit_winds": v.tolist()})
+
+
+class BaselineController:
+    """NREL 5-MW style baseline (torque law + gain-scheduled PI pitch) as a harness controller.
+
+    ``step(t, meas)`` takes a measurement dict with at least ``gen_speed`` [rad/s] and
+    ``pitch`` (3,) [rad] and returns (pitch_ref (3,), gen_torque_ref) and stores its internal
+    signals in ``.signals``. Call at the plant rate (``dt``).
+    """
+
+    def __init__(self, turbine: linearize.Turbine, gains: BaselineGains | None = None, *,
+                 dt: float = 1.0 / 80.0, region3: str = "constant_power",
+                 filter_hz: float = 0.25, slip_pct: float = 10.0) -> None:
+        if region3 not in ("constant_power", "constant_torque"):
+            raise ValueError(f"region3 must be 'constant_power' or 'constant_torque', got "
+                             f"{region3!r}")
+        if not dt > 0:
+            raise ValueError(f"dt must be > 0 s, got {dt!r}")
+        self.turbine = turbine
+        self.gains = gains or tune_baseline(turbine)
+        self.dt = float(dt)
+        self.region3 = region3
+        g = self.gains
+        n = turbine.drivetrain.gearbox_ratio
+        self.wc = 2 * math.pi * filter_hz
+        self.pitch_min = turbine.operation.fine_pitch_rad
+        self.pitch_max = turbine.pitch_actuator.max_pitch_rad
+        self.rate = turbine.pitch_actuator.max_rate_rad_s
+        self.tq_rate = turbine.generator.max_torque_rate
+        self.tq_max = turbine.generator.max_torque
+        # torque-law breakpoints (report sec. 7.3, DISCON): rated speed 99 % of the set point
+        # region 1.5 runs from the minimum rotor speed to 30 % above it on the generator (the
+        # NREL 5-MW's 670 and 871 rpm)
+        self.w_cutin = turbine.operation.min_rotor_speed_rad_s * n
+        self.w_rgn2 = 1.3 * self.w_cutin
+        self.w_rated = 0.99 * g.rated_gen_speed_rad_s
+        self.w_sync = self.w_rated / (1.0 + 0.01 * slip_pct)
+        self.slope25 = g.rated_power / turbine.drivetrain.generator_efficiency / self.w_rated \
+            / (self.w_rated - self.w_sync)
+        self.slope15 = g.k_opt * self.w_rgn2**2 / (self.w_rgn2 - self.w_cutin)
+        if g.k_opt * self.w_rated**2 > self.slope25 * (self.w_rated - self.w_sync):
+            self.w_sync = self.w_rated - g.rated_power / turbine.drivetrain.generator_efficiency \
+                / self.w_rated / (g.k_opt * self.w_rated)
+        self.reset()
+
+    def reset(self) -> None:
+        """Forget the filter, integral and last commands."""
+        self.w_filt: float | None = None
+        self.integral = 0.0
+        self.last_pitch: float | None = None
+        self.last_torque: float | None = None
+        self.signals: dict[str, float] = {}
+
+    def torque(self, w: float, pitch: float) -> float:
+        """Generator torque demand for a filtered generator speed and the collective pitch."""
+        g = self.gains
+        eta = self.turbine.drivetrain.generator_efficiency
+        if w >= self.w_rated or pitch >= math.radians(1.0):
+            if self.region3 == "constant_power":
+                return g.rated_power / eta / max(w, 1e-6)
+            return g.rated_torque
+        if w <= self.w_cutin:
+            return 0.0
+        if w < self.w_rgn2:
+            return self.slope15 * (w - self.w_cutin)
+        if w < self.w_sync:
+            return g.k_opt * w * w
+        return self.slope25 * (w - self.w_sync)
+
+    def step(self, t: float, meas: dict[str, Any]) -> tuple[np.ndarray, float]:
+        """One control step; returns (pitch_ref (3,) [rad], gen_torque_ref [N m])."""
+        w = float(meas["gen_speed"])
+        if not math.isfinite(w):
+            raise ValueError(f"measurement gen_speed is not finite at t = {t:g} s: {w!r}")
+        pitch_meas = float(np.mean(meas["pitch"]))
+        if self.w_filt is None:
+            self.w_filt = w
+            self.last_pitch = pitch_meas
+        a = math.exp(-self.wc * self.dt)
+        self.w_filt = a * self.w_filt + (1 - a) * w
+        g = self.gains
+        gk = 1.0 / (1.0 + self.last_pitch / g.theta_k_rad)
+        err = self.w_filt - g.rated_gen_speed_rad_s
+        self.integral += err * self.dt
+        # anti-windup: keep the integral term within the pitch limits
+        lo, hi = self.pitch_min / (gk * g.ki), self.pitch_max / (gk * g.ki)
+        self.integral = min(max(self.integral, lo), hi)
+        cmd = gk * (g.kp * err + g.ki * self.integral)
+        cmd = min(max(cmd, self.pitch_min), self.pitch_max)
+        step = self.rate * self.dt
+        cmd = min(max(cmd, self.last_pitch - step), self.last_pitch + step)
+        self.last_pitch = cmd
+        tq = min(self.torque(self.w_filt, cmd), self.tq_max)
+        if self.last_torque is not None:
+            d = self.tq_rate * self.dt
+            tq = min(max(tq, self.last_torque - d), self.last_torque + d)
+        self.last_torque = tq
+        self.signals = {"gen_speed_filtered": self.w_filt, "speed_error": err,
+                        "pitch_integral": self.integral, "gain_schedule": gk,
+                        "pitch_command": cmd, "torque_command": tq}
+        return np.full(3, cmd), tq

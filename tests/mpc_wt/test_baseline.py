@@ -1,0 +1,166 @@
+"""Baseline controller: tuning against the published gains, closed-loop behaviour on the plant,
+the harness's results and its errors."""
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+from numpy.testing import assert_allclose
+
+import lidar
+import linearize
+from mpc_wt.baseline import BaselineController, tune_baseline
+from mpc_wt.simulate import (ClosedLoopResult, ResultFileError, SimulationDivergedError,
+                             simulate_closed_loop)
+
+
+@pytest.fixture(scope="module")
+def gains(turbine: linearize.Turbine):
+    return tune_baseline(turbine)
+
+
+def test_gains_match_the_published_baseline(gains) -> None:
+    # published: DISCON.F90 (Jonkman's baseline, report sec. 7.4): PC_KP = 0.01882681 s,
+    # PC_KI = 0.008068634, PC_KK = 0.1099965 rad (6.302336 deg), dP/dtheta at zero pitch
+    # -25.52e6 W/rad, VS_Rgn2K = 2.332287 N m/(rad/s)^2. Issue 5: within 20 %. Differences:
+    # our frozen-wake sensitivities (within 8.3 % of the report's), the fit's points, and the
+    # rotor inertia from the blade table (0.6 % below the report's).
+    assert_allclose(gains.kp, 0.01882681, rtol=0.20)
+    assert_allclose(gains.ki, 0.008068634, rtol=0.20)
+    assert_allclose(gains.theta_k_rad, math.radians(6.302336), rtol=0.20)
+    assert_allclose(gains.dpdtheta_0, -25.52e6, rtol=0.20)
+    assert_allclose(gains.k_opt, 2.332287, rtol=0.05)
+
+
+def test_pole_placement_formula(gains, turbine: linearize.Turbine) -> None:
+    # analytic: with the report's own numbers (J = 43,784,725 kg m^2, dP/dtheta = -25.52e6,
+    # Omega = 12.1 rpm, N = 97, 0.6 rad/s, 0.7) the formulas give DISCON's KP and KI
+    j, om = 43784725.0, 12.1 * math.pi / 30
+    kp = 2 * j * om * 0.7 * 0.6 / (97 * 25.52e6)
+    ki = j * om * 0.36 / (97 * 25.52e6)
+    assert_allclose([kp, ki], [0.01882681, 0.008068634], rtol=2e-4)
+    # and ours are the same formulas with our inertia and sensitivity
+    assert_allclose(gains.kp, 2 * gains.info["inertia_lss"] * om * 0.7 * 0.6
+                    / (97 * -gains.dpdtheta_0), rtol=1e-12)
+
+
+def _field(v: float, turb, seed: int) -> tuple[linearize.GridWind, lidar.WindField]:
+    f = lidar.generate_field(lidar.TurbulenceSpec(v, turb, duration=610.0), seed)
+    return linearize.GridWind(t=f.t, y=f.y, z=f.z, u=np.maximum(f.u, 0.0)), f
+
+
+@pytest.fixture(scope="module")
+def run18(turbine: linearize.Turbine, params: linearize.PlantParams, gains):
+    gw, _ = _field(18.0, "A", 1)
+    op = linearize.trim(turbine, 18.0)
+    return simulate_closed_loop(params, BaselineController(turbine, gains), gw, 600.0,
+                                x0=op.x, u0=op.u)
+
+
+def test_region3_closed_loop(run18: ClosedLoopResult) -> None:
+    # issue 5: 18 m/s, turbulent (class A): rated power held (mean within 1 %), generator
+    # speed std below 5 % of rated (first 60 s of start-up transient left out)
+    late = run18.t > 60.0
+    assert_allclose(run18.channel("gen_power")[late].mean(), 5e6, rtol=0.01)
+    assert run18.channel("gen_speed")[late].std() < 0.05 * 122.9096
+
+
+def test_no_actuator_limit_violated(run18: ClosedLoopResult, turbine: linearize.Turbine) -> None:
+    pitch = run18.x[:, 5:8]
+    dt = run18.t[1] - run18.t[0]
+    pa = turbine.pitch_actuator
+    assert pitch.min() >= pa.min_pitch_rad - 1e-9 and pitch.max() <= pa.max_pitch_rad + 1e-9
+    assert np.abs(np.diff(pitch, axis=0)).max() / dt <= pa.max_rate_rad_s * (1 + 1e-6)
+    tq = run18.channel("gen_torque")
+    g = turbine.generator
+    assert tq.max() <= g.max_torque + 1e-6 and tq.min() >= g.min_torque - 1e-6
+    assert np.abs(np.diff(tq)).max() / dt <= g.max_torque_rate * (1 + 1e-9)
+
+
+def test_region2_tracks_optimal_tsr(turbine: linearize.Turbine, params: linearize.PlantParams,
+                                    gains) -> None:
+    # issue 5: at 8 m/s the turbine tracks the optimal tip-speed ratio (mean within 3 %),
+    # here in Do et al.'s region-II turbulence (12 %); the tip-speed ratio uses the rotor-
+    # averaged wind. (In class A, 23 % at 8 m/s, the mean is 10 % above optimal: lulls hold the
+    # rotor at its minimum speed and gusts are not followed.)
+    gw, f = _field(8.0, 0.12, 3)
+    op = linearize.trim(turbine, 8.0)
+    r = simulate_closed_loop(params, BaselineController(turbine, gains), gw, 600.0,
+                             x0=op.x, u0=op.u)
+    late = r.t > 60.0
+    rews = np.interp(r.t[late], f.t, lidar.rotor_effective_wind(f, 63.0))
+    tsr = r.channel("rotor_speed")[late].mean() * 63.0 * math.cos(math.radians(2.5)) / rews.mean()
+    assert_allclose(tsr, gains.info["tsr_opt"], rtol=0.03)
+
+
+def test_result_round_trip(run18: ClosedLoopResult, tmp_path: Path) -> None:
+    p = run18.save(tmp_path / "run.nc")
+    back = ClosedLoopResult.load(p)
+    assert_allclose(back.z, run18.z, rtol=0, atol=0)
+    assert_allclose(back.channel("pitch_integral"), run18.channel("pitch_integral"), rtol=0)
+    assert back.meta["software_version"] == run18.meta["software_version"]
+    import xarray as xr     # self-describing: readable without mpc-wt
+
+    with xr.open_dataset(p, engine="scipy") as ds:
+        assert ds["gen_power"].attrs["units"] == "W" and ds["time"].attrs["units"] == "s"
+
+
+def test_broken_result_files(run18: ClosedLoopResult, tmp_path: Path) -> None:
+    p = run18.save(tmp_path / "run.nc")
+    raw = p.read_bytes()
+    (tmp_path / "cut.nc").write_bytes(raw[: len(raw) // 3])
+    with pytest.raises(ResultFileError, match="not a readable result file"):
+        ClosedLoopResult.load(tmp_path / "cut.nc")
+    with pytest.raises(ResultFileError, match="file not found"):
+        ClosedLoopResult.load(tmp_path / "none.nc")
+    with pytest.raises(KeyError, match=r"no channel 'gen_powr'"):
+        run18.channel("gen_powr")
+
+
+class _NaNController:
+    signals: dict = {}
+
+    def reset(self) -> None:
+        pass
+
+    def step(self, t, meas):
+        return (np.array([0.1, 0.1, np.nan]), 40000.0) if t > 0.5 else (np.zeros(3), 40000.0)
+
+
+def test_controller_returning_nan(turbine: linearize.Turbine,
+                                  params: linearize.PlantParams) -> None:
+    op = linearize.trim(turbine, 12.0)
+    with pytest.raises(ValueError, match=r"controller returned pitch .* at t = 0.5125 s"):
+        simulate_closed_loop(params, _NaNController(), linearize.SteadyWind(12.0), 2.0,
+                             x0=op.x, u0=op.u)
+
+
+class _NoTorque:
+    signals: dict = {}
+
+    def reset(self) -> None:
+        pass
+
+    def step(self, t, meas):
+        return np.zeros(3), 0.0
+
+
+def test_diverging_closed_loop_keeps_the_partial_result(turbine: linearize.Turbine,
+                                                        params: linearize.PlantParams) -> None:
+    op = linearize.trim(turbine, 25.0)
+    x0 = op.x.copy()
+    x0[5:8] = 0.0
+    with pytest.raises(SimulationDivergedError, match=r"state '(rotor|gen)_speed'") as exc:
+        simulate_closed_loop(params, _NoTorque(), linearize.SteadyWind(25.0), 300.0,
+                             x0=x0, u0=op.u)
+    assert exc.value.partial.t.size > 100 and np.all(np.isfinite(exc.value.partial.z))
+
+
+def test_controller_period_must_divide(turbine: linearize.Turbine,
+                                      params: linearize.PlantParams) -> None:
+    op = linearize.trim(turbine, 12.0)
+    with pytest.raises(ValueError, match="whole multiple of dt"):
+        simulate_closed_loop(params, _NoTorque(), linearize.SteadyWind(12.0), 1.0, x0=op.x,
+                             u0=op.u, controller_dt=0.03)
