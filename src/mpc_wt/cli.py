@@ -6,6 +6,8 @@ run        the main job on a turbine: steady operating table, C_P surface and pl
 trim       steady operating points against wind speed (table or ``--json``)
 linearize  linear models over mean wind, saved as .mat/.npz/.json (``--json`` summary)
 aero       rotor aerodynamics: ``aero cp-surface --out FILE.csv [--plot FILE.png]``
+simulate   closed loop on the plant: ``simulate --controller baseline --wind 18 --out RUN``
+assess     DELs, CS1-CS5, pitch duty, energy of runs or CSV time series
 wind       turbulent wind fields: ``wind generate --mean 18 --class A --out FIELD.bts``
 lidar      CW LIDAR preview: ``lidar evaluate --field FIELD [--focus 54] [--json]``
 
@@ -224,6 +226,60 @@ def _cmd_lidar_evaluate(args: argparse.Namespace) -> int:
     return 0
 
 
+def _cmd_simulate(args: argparse.Namespace) -> int:
+    from .runs import run_baseline
+
+    if args.controller != "baseline":
+        raise UsageError(f"--controller must be one of ['baseline'] (more come with the MPC "
+                         f"and synthesis issues), got {args.controller!r}")
+    turbine = linearize.load_turbine(args.turbine)
+    res = run_baseline(turbine, args.wind, args.turbulence, args.seed, args.duration,
+                       progress=True)
+    out = Path(args.out)
+    if out.suffix == "":
+        out = out.with_suffix(".nc")
+    res.save(out)
+    p = res.channel("gen_power")
+    print(f"wrote {out}: {res.t.size} samples; mean power {p.mean() / 1e6:.3f} MW, "
+          f"gen speed std {res.channel('gen_speed').std():.3f} rad/s")
+    return 0
+
+
+def _cmd_assess(args: argparse.Namespace) -> int:
+    from .runs import DEFAULT_CHANNELS, assess_plots, assess_series, load_series
+
+    chans = None
+    if args.channels:
+        chans = {c: DEFAULT_CHANNELS.get(c, 4.0) for c in args.channels.split(",")}
+    rows, runs = [], []
+    for path in args.runs:
+        t, cols = load_series(path, args.time_column)
+        keep = t >= args.t_start
+        if keep.sum() < 3:
+            raise UsageError(f"--t-start = {args.t_start:g} s leaves fewer than 3 samples of "
+                             f"{path} (it ends at {t[-1]:g} s)")
+        t, cols = t[keep], {k: v[keep] for k, v in cols.items()}
+        res = assess_series(t, cols, chans, args.m)
+        rows.append({"run": str(path), **res})
+        runs.append((Path(path).stem, t, cols))
+    if args.plots:
+        made = assess_plots(runs, args.plots)
+        for r in rows:
+            r["plots"] = made
+    if args.json:
+        print(json.dumps(rows, indent=1))
+    else:
+        for r in rows:
+            print(f"# {r['run']} ({r['duration_s']:.0f} s)")
+            for name, d in r["channels"].items():
+                print(f"  DEL {name:24s} {d['del']:14.4g}  (m = {d['m']:g})")
+            for k in ("cs1", "cs2", "cs3", "cs4", "cs5", "power_std_W", "energy_Wh",
+                      "pitch_travel_deg"):
+                if k in r:
+                    print(f"  {k:28s} {r[k]:14.6g}")
+    return 0
+
+
 def _cmd_run(args: argparse.Namespace) -> int:
     from .plotting import plot_cp_surface, plot_operating_schedule
 
@@ -251,6 +307,30 @@ def _cmd_run(args: argparse.Namespace) -> int:
                             title=f"{turbine.name}: steady operating schedule")
     print(f"# wrote {out}/operating_points.csv, operating_points.json, cp_surface.csv, "
           f"cp_surface.png, operating_schedule.png")
+    if args.duration > 0:
+        from .baseline import tune_baseline
+        from .runs import assess_plots, assess_series, run_baseline
+
+        g = tune_baseline(turbine)
+        print(f"# baseline tuned from the linear models: KP {g.kp:.5f} s, KI {g.ki:.5f}, "
+              f"theta_K {math.degrees(g.theta_k_rad):.2f} deg, K_opt {g.k_opt:.4f} "
+              f"N m/(rad/s)^2 (published 0.01883, 0.00807, 6.30 deg, 2.3323)")
+        res = run_baseline(turbine, args.wind, args.turbulence, args.seed, args.duration,
+                           progress=True)
+        res.save(out / "baseline_run.nc")
+        keep = res.t >= min(60.0, 0.1 * args.duration)
+        cols = {n: res.channel(n)[keep] for n in res.channels()}
+        a = assess_series(res.t[keep], cols)
+        (out / "baseline_assessment.json").write_text(json.dumps(a, indent=1))
+        assess_plots([("baseline", res.t[keep], cols)], out)
+        print(f"# {args.duration:g} s at {args.wind:g} m/s, turbulence {args.turbulence}, "
+              f"seed {args.seed}: mean power {a['power_mean_W'] / 1e6:.3f} MW, power std "
+              f"{a['power_std_W'] / 1e3:.1f} kW, gen speed std {a['gen_speed_std_rad_s']:.2f} "
+              f"rad/s, pitch travel {a['pitch_travel_deg']:.0f} deg")
+        for name, d in a["channels"].items():
+            print(f"#   DEL {name:22s} {d['del']:12.4g} N m (m = {d['m']:g})")
+        print(f"# wrote {out}/baseline_run.nc, baseline_assessment.json, cs_ellipses.png, "
+              f"psd_flap_moment_1.png")
     return 0
 
 
@@ -260,9 +340,15 @@ def _parser() -> argparse.ArgumentParser:
     turb = dict(default="nrel5mw", help="packaged turbine name or path to a turbine.yaml "
                                          "(default nrel5mw)")
 
-    p = sub.add_parser("run", help="main job: operating table, C_P surface, plots")
+    p = sub.add_parser("run", help="main job: operating table, C_P surface, baseline run, "
+                                   "assessment, plots")
     p.add_argument("--turbine", **turb)
     p.add_argument("--out", default="mpcwt-out", help="output directory (default mpcwt-out)")
+    p.add_argument("--wind", type=float, default=18.0, help="wind of the baseline run [m/s]")
+    p.add_argument("--turbulence", choices=("A", "B", "C", "steady"), default="A")
+    p.add_argument("--seed", type=int, default=1)
+    p.add_argument("--duration", type=float, default=600.0,
+                   help="baseline run length [s] (0 skips the run)")
     p.set_defaults(func=_cmd_run)
 
     p = sub.add_parser("trim", help="steady operating points")
@@ -284,6 +370,27 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument("--out", help="models file: .mat (MATLAB), .npz or .json")
     p.add_argument("--json", action="store_true", help="print sensitivities and modes as JSON")
     p.set_defaults(func=_cmd_linearize)
+
+    p = sub.add_parser("simulate", help="closed-loop simulation on the plant")
+    p.add_argument("--turbine", **turb)
+    p.add_argument("--controller", default="baseline", help="controller (baseline)")
+    p.add_argument("--wind", type=float, required=True, help="mean hub-height wind [m/s]")
+    p.add_argument("--turbulence", choices=("A", "B", "C", "steady"), default="A")
+    p.add_argument("--seed", type=int, default=1)
+    p.add_argument("--duration", type=float, default=600.0, help="[s]")
+    p.add_argument("--out", required=True, help="result file (netCDF, .nc)")
+    p.set_defaults(func=_cmd_simulate)
+
+    p = sub.add_parser("assess", help="loads and performance of runs or CSV time series")
+    p.add_argument("runs", nargs="+", help="result files (.nc) or CSV with a time column")
+    p.add_argument("--channels", help="comma list of channels (default: blade, tower, shaft)")
+    p.add_argument("--m", type=float, default=None, help="Woehler exponent for all channels")
+    p.add_argument("--time-column", default="time", help="CSV time column (default time)")
+    p.add_argument("--t-start", type=float, default=0.0,
+                   help="discard samples before this time, e.g. the start-up transient [s]")
+    p.add_argument("--json", action="store_true")
+    p.add_argument("--plots", help="directory for cs_ellipses.png and psd_flap_moment_1.png")
+    p.set_defaults(func=_cmd_assess)
 
     p = sub.add_parser("wind", help="turbulent wind fields")
     wind = p.add_subparsers(dest="wind_command", required=True)
@@ -337,7 +444,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         return 2
     try:
         return int(args.func(args))
-    except (UsageError, TurbineFileError, TrimError, FileNotFoundError, ValueError,
+    except (UsageError, TurbineFileError, TrimError, FileNotFoundError, ValueError, KeyError,
             linearize.LinearizationError) as err:
         print(f"mpcwt {args.command}: error: {err}", file=sys.stderr)
         return 2

@@ -2,13 +2,14 @@
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Sequence
+from typing import Any, Sequence
 
 import numpy as np
 
 from linearize import OperatingPoint
 
-__all__ = ["plot_cp_surface", "plot_operating_schedule", "plot_lidar_coherence", "plot_scan_pattern"]
+__all__ = ["plot_cp_surface", "plot_operating_schedule", "plot_lidar_coherence", "plot_scan_pattern",
+           "plot_cs_ellipses", "plot_psd_comparison"]
 
 
 def _save(fig, path: str | Path) -> Path:  # type: ignore[no-untyped-def]
@@ -154,4 +155,46 @@ def plot_scan_pattern(beam_azimuth_rad: np.ndarray, blade_azimuth_rad: np.ndarra
     ax.set_ylabel("vertical from hub [m]")
     ax.set_title("CW LIDAR scan: foci lead their blades by omega T_p")
     ax.legend(fontsize=8, loc="lower right")
+    return _save(fig, path)
+
+
+def plot_cs_ellipses(items: list[tuple[str, Any, np.ndarray, np.ndarray]], path: str | Path,
+                     load_label: str = "tower-base fore-aft moment [MN m]") -> Path:
+    """Do et al. (2020) fig. 4: load-power samples and their 95 % ellipses for several runs.
+
+    ``items``: (label, CSMeasures, load samples, power samples) per run.
+    """
+    plt = _plt()
+    fig, ax = plt.subplots(figsize=(7.0, 5.0), dpi=120)
+    for k, (label, cs, x, y) in enumerate(items):
+        step = max(1, len(x) // 3000)
+        ax.plot(np.asarray(x)[::step] / 1e6, np.asarray(y)[::step] / 1e6, ".", ms=1.5,
+                alpha=0.25, color=f"C{k}")
+        ex, ey = cs.ellipse()
+        ax.plot(ex / 1e6, ey / 1e6, color=f"C{k}", lw=1.6,
+                label=f"{label}: CS1 {cs.cs1 / 1e6:.2f}, CS2 {cs.cs2 / 1e6:.3f}, "
+                      f"CS5 {cs.cs5:.1f} deg")
+        ax.plot(cs.cs3 / 1e6, cs.cs4 / 1e6, "+", color=f"C{k}", ms=10)
+    ax.set_xlabel(load_label)
+    ax.set_ylabel("generator power [MW]")
+    ax.set_title("Covariance ellipses (95 %, s = 5.99), Do et al. 2020")
+    ax.legend(fontsize=7)
+    ax.grid(alpha=0.3)
+    return _save(fig, path)
+
+
+def plot_psd_comparison(items: list[tuple[str, np.ndarray, np.ndarray]], rotor_hz: float,
+                        path: str | Path, ylabel: str) -> Path:
+    """PSDs of one channel for several runs, with 1P, 3P, 6P marked."""
+    plt = _plt()
+    fig, ax = plt.subplots(figsize=(7.0, 4.2), dpi=120)
+    for label, f, p in items:
+        ax.loglog(f[1:], p[1:], lw=1.0, label=label)
+    for n in (1, 3, 6):
+        ax.axvline(n * rotor_hz, color="0.5", ls=":", lw=0.8)
+        ax.text(n * rotor_hz, ax.get_ylim()[1], f"{n}P", fontsize=7, va="top")
+    ax.set_xlabel("frequency [Hz]")
+    ax.set_ylabel(ylabel)
+    ax.legend(fontsize=8)
+    ax.grid(alpha=0.3, which="both")
     return _save(fig, path)

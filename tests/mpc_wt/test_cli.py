@@ -43,11 +43,12 @@ def test_cp_surface_csv_and_plot(tmp_path: Path, capsys: pytest.CaptureFixture[s
 
 
 def test_run_writes_table_and_plots(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
-    assert main(["run", "--out", str(tmp_path)]) == 0
+    assert main(["run", "--out", str(tmp_path), "--duration", "30"]) == 0
     out = capsys.readouterr().out
     assert "rated wind speed" in out and out.count("\n") > 20
     for name in ("operating_points.csv", "operating_points.json", "cp_surface.csv",
-                 "cp_surface.png", "operating_schedule.png"):
+                 "cp_surface.png", "operating_schedule.png", "baseline_run.nc",
+                 "baseline_assessment.json", "cs_ellipses.png", "psd_flap_moment_1.png"):
         assert (tmp_path / name).stat().st_size > 100, name
     pts = json.loads((tmp_path / "operating_points.json").read_text())
     assert pts[0]["wind_mps"] == 3.0 and pts[-1]["wind_mps"] == 25.0
@@ -130,3 +131,51 @@ def test_lidar_evaluate_bad_field(tmp_path: Path, capsys: pytest.CaptureFixture[
     bad.write_bytes(b"\x07\x00" + b"\x00" * 10)
     assert main(["lidar", "evaluate", "--field", str(bad)]) == 2
     assert "truncated .bts header" in capsys.readouterr().err
+
+
+def test_simulate_and_assess(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    run = tmp_path / "run"
+    assert main(["simulate", "--controller", "baseline", "--wind", "16", "--turbulence", "B",
+                 "--duration", "60", "--out", str(run)]) == 0
+    assert "mean power" in capsys.readouterr().out
+    assert (tmp_path / "run.nc").is_file()
+    assert main(["assess", str(tmp_path / "run.nc"), "--json", "--t-start", "10",
+                 "--plots", str(tmp_path / "p")]) == 0
+    rows = json.loads(capsys.readouterr().out)
+    r = rows[0]
+    for key in ("cs1", "cs2", "cs3", "cs4", "cs5", "pitch_travel_deg", "power_std_W",
+                "energy_Wh"):
+        assert isinstance(r[key], float), key
+    assert r["channels"]["flap_moment_1"]["m"] == 10.0
+    assert r["channels"]["tower_base_fa_moment"]["m"] == 4.0
+    assert r["channels"]["tower_base_fa_moment"]["del"] > 0
+    assert (tmp_path / "p" / "cs_ellipses.png").read_bytes()[:4] == b"\x89PNG"
+
+
+def test_assess_csv_from_another_tool(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    t = np.arange(0, 100, 0.05)
+    x = 1e6 * np.sin(2 * np.pi * 0.5 * t)
+    p = tmp_path / "field.csv"
+    p.write_text("Time,RootMyc1\n" + "\n".join(f"{a},{b}" for a, b in zip(t, x)))
+    assert main(["assess", str(p), "--time-column", "Time", "--channels", "RootMyc1",
+                 "--m", "4", "--json"]) == 0
+    d = json.loads(capsys.readouterr().out)[0]["channels"]["RootMyc1"]
+    # analytic: 50 cycles of range 2e6 over 100 s, N_eq = 100: DEL = 2e6 (0.5)^(1/4)
+    assert d["del"] == pytest.approx(2e6 * 0.5 ** 0.25, rel=0.01)
+
+
+@pytest.mark.parametrize("argv, match", [
+    (["assess", "/no/run.nc"], "file not found"),
+    (["simulate", "--controller", "mpc", "--wind", "18", "--out", "x"],
+     "--controller must be one of"),
+])
+def test_simulate_assess_errors(argv, match: str, capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(argv) == 2
+    assert match in capsys.readouterr().err
+
+
+def test_assess_unknown_channel(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    p = tmp_path / "a.csv"
+    p.write_text("time,x\n0,1\n1,2\n2,1\n3,2\n")
+    assert main(["assess", str(p), "--channels", "y"]) == 2
+    assert "no channel 'y'" in capsys.readouterr().err

@@ -1,0 +1,143 @@
+"""Run-level helpers behind ``mpcwt simulate`` and ``mpcwt assess``."""
+from __future__ import annotations
+
+import csv
+import math
+from pathlib import Path
+from typing import Any, Sequence
+
+import numpy as np
+
+import lidar
+import linearize
+
+from .assess import cs_measures, damage_equivalent_load, energy_Wh, harmonic_psd, pitch_duty, psd
+from .baseline import BaselineController, tune_baseline
+from .simulate import ClosedLoopResult, ResultFileError, simulate_closed_loop
+
+__all__ = ["DEFAULT_CHANNELS", "run_baseline", "load_series", "assess_series"]
+
+#: Load channels and their default Woehler exponents (10 composite blades, 4 steel elsewhere).
+DEFAULT_CHANNELS = {"flap_moment_1": 10.0, "flap_moment_2": 10.0, "flap_moment_3": 10.0,
+                    "edge_moment_1": 10.0, "edge_moment_2": 10.0, "edge_moment_3": 10.0,
+                    "tower_base_fa_moment": 4.0, "tower_base_ss_moment": 4.0,
+                    "lss_torque": 4.0, "tilt_moment": 4.0, "yaw_moment": 4.0}
+
+
+def run_baseline(turbine: linearize.Turbine, wind_mps: float, turbulence: str = "A",
+                 seed: int = 1, duration: float = 600.0, progress: bool = False,
+                 shear_exponent: float = 0.2) -> ClosedLoopResult:
+    """Trim, tune the baseline, generate the wind and simulate (the main job's run)."""
+    params = linearize.plant_params(turbine)
+    gains = tune_baseline(turbine)
+    if turbulence == "steady":
+        wind: Any = linearize.SteadyWind(wind_mps, shear_exponent)
+    else:
+        spec = lidar.TurbulenceSpec(wind_mps, turbulence, hub_height=turbine.geometry.hub_height,
+                                    duration=duration + 10.0, shear_exponent=shear_exponent)
+        f = lidar.generate_field(spec, seed)
+        wind = linearize.GridWind(t=f.t, y=f.y, z=f.z, u=np.maximum(f.u, 0.0))
+    op = linearize.trim(turbine, wind_mps)
+    meta = {"controller": "baseline", "wind_mps": wind_mps, "turbulence": turbulence,
+            "seed": seed, "duration_s": duration, "shear_exponent": shear_exponent,
+            "turbine": turbine.name, "gains": {"kp": gains.kp, "ki": gains.ki,
+                                               "theta_k_rad": gains.theta_k_rad,
+                                               "k_opt": gains.k_opt}}
+    return simulate_closed_loop(params, BaselineController(turbine, gains), wind, duration,
+                                x0=op.x, u0=op.u, progress=progress, meta=meta)
+
+
+def load_series(path: str | Path, time_column: str = "time") -> tuple[np.ndarray,
+                                                                       dict[str, np.ndarray]]:
+    """Time and channels of a run: our netCDF result, or any CSV with a time column.
+
+    Raises
+    ------
+    ResultFileError
+        If the file cannot be read, has no time column or non-numeric cells.
+    """
+    path = Path(path)
+    if path.suffix.lower() == ".csv":
+        if not path.is_file():
+            raise ResultFileError(f"{path}: file not found")
+        with path.open(newline="") as fh:
+            rows = list(csv.reader(fh))
+        if not rows:
+            raise ResultFileError(f"{path}: empty file")
+        head = [h.strip() for h in rows[0]]
+        if time_column not in head:
+            raise ResultFileError(f"{path}: no time column {time_column!r}; columns {head}")
+        try:
+            data = np.array([[float(c) for c in r] for r in rows[1:] if r], dtype=float)
+        except ValueError as err:
+            raise ResultFileError(f"{path}: non-numeric cell ({err})") from err
+        if data.ndim != 2 or data.shape[1] != len(head):
+            raise ResultFileError(f"{path}: ragged rows")
+        cols = {h: data[:, i] for i, h in enumerate(head)}
+        return cols.pop(time_column), cols
+    res = ClosedLoopResult.load(path)
+    return res.t, {n: res.channel(n) for n in res.channels()}
+
+
+def assess_series(t: np.ndarray, cols: dict[str, np.ndarray],
+                  channels: dict[str, float] | None = None,
+                  m_override: float | None = None) -> dict[str, Any]:
+    """DEL per channel, CS1-CS5 (tower-base fore-aft moment vs power), pitch duty, power std,
+    energy and the 1P/3P/6P content of the blade-1 flap moment, for one run."""
+    chans = dict(channels or {k: v for k, v in DEFAULT_CHANNELS.items() if k in cols})
+    missing = [c for c in chans if c not in cols]
+    if missing:
+        raise KeyError(f"no channel {missing[0]!r}; channels are {sorted(cols)}")
+    dt = float(np.median(np.diff(t)))
+    duration = float(t[-1] - t[0])
+    out: dict[str, Any] = {"duration_s": duration, "channels": {}}
+    for name, m in chans.items():
+        mm = m_override if m_override is not None else m
+        out["channels"][name] = {"del": damage_equivalent_load(cols[name], mm,
+                                                               duration=duration), "m": mm}
+    if "gen_power" in cols:
+        p = cols["gen_power"]
+        out["power_mean_W"] = float(p.mean())
+        out["power_std_W"] = float(p.std())
+        out["energy_Wh"] = energy_Wh(p, dt)
+        if "tower_base_fa_moment" in cols:
+            cs = cs_measures(cols["tower_base_fa_moment"], p)
+            out.update({f"cs{i}": getattr(cs, f"cs{i}") for i in range(1, 6)})
+    pitch = [cols[f"pitch_{i}"] for i in (1, 2, 3) if f"pitch_{i}" in cols]
+    if pitch:
+        out.update(pitch_duty(np.column_stack(pitch), dt))
+    if "gen_speed" in cols:
+        out["gen_speed_std_rad_s"] = float(cols["gen_speed"].std())
+    if "rotor_speed" in cols and "flap_moment_1" in cols:
+        frot = float(cols["rotor_speed"].mean()) / (2 * math.pi)
+        out["flap_1_harmonics"] = {f"{n}P": v for n, v in
+                                   harmonic_psd(cols["flap_moment_1"], 1 / dt, frot).items()}
+    return out
+
+
+def assess_plots(runs: Sequence[tuple[str, np.ndarray, dict[str, np.ndarray]]],
+                 out_dir: str | Path) -> list[str]:
+    """CS ellipses (Do et al. fig. 4) and flap-moment PSDs of several runs, as PNG."""
+    from .plotting import plot_cs_ellipses, plot_psd_comparison
+
+    d = Path(out_dir)
+    d.mkdir(parents=True, exist_ok=True)
+    made = []
+    items = [(name, cs_measures(c["tower_base_fa_moment"], c["gen_power"]),
+              c["tower_base_fa_moment"], c["gen_power"]) for name, _, c in runs
+             if "tower_base_fa_moment" in c and "gen_power" in c]
+    if items:
+        made.append(str(plot_cs_ellipses(items, d / "cs_ellipses.png")))
+    spectra = []
+    frot = 0.2
+    for name, t, c in runs:
+        if "flap_moment_1" in c:
+            dt = float(np.median(np.diff(t)))
+            f, p = psd(c["flap_moment_1"], 1 / dt)
+            spectra.append((name, f, p))
+            if "rotor_speed" in c:
+                frot = float(c["rotor_speed"].mean()) / (2 * math.pi)
+    if spectra:
+        made.append(str(plot_psd_comparison(spectra, frot, d / "psd_flap_moment_1.png",
+                                             "flap moment PSD [(N m)^2/Hz]")))
+    return made
