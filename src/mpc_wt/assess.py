@@ -117,18 +117,14 @@ def _count(rev, start_half=True):  # pragma: no cover - compiled
     return ranges[:m], means[:m], counts[:m], stack[:top].copy()
 
 
-def rainflow(x: Any, *, repeated_residue: bool = False) -> tuple[FloatArray, FloatArray,
-                                                                   FloatArray]:
-    """Rainflow cycles of a load series (ASTM E1049-85, sec. 5.4.4).
+def rainflow(x: Any) -> tuple[FloatArray, FloatArray, FloatArray]:
+    """Rainflow cycles of a load series (ASTM E1049-85, sec. 5.4.4): the residue's reversals
+    count as half cycles of weight 0.5.
 
     Parameters
     ----------
     x : (n_t,) array_like
         Load series (any unit).
-    repeated_residue : bool
-        False (ASTM): the residue's reversals count as half cycles of weight 0.5. True: the
-        residue is counted once more after itself and only full cycles are kept, as fatpack
-        and pCrunch do (the residue's cycles then close).
 
     Returns
     -------
@@ -136,17 +132,8 @@ def rainflow(x: Any, *, repeated_residue: bool = False) -> tuple[FloatArray, Flo
         Cycle ranges (peak to valley), means [unit of x] and counts (1 or 0.5) [-].
     """
     arr = _check_series("x", x)
-    rev = _reversals(arr)
-    if not repeated_residue:
-        r, mu, c, _ = _count(rev, True)
-        return r, mu, c
-    r, mu, c, residue = _count(rev, False)
-    full = c == 1.0
-    # the residue followed by itself closes its cycles (fatpack's "concatenate residue")
-    r2, mu2, c2, _ = _count(_reversals(np.concatenate([residue, residue])), False)
-    f2 = c2 == 1.0
-    return (np.concatenate([r[full], r2[f2]]), np.concatenate([mu[full], mu2[f2]]),
-            np.ones(int(full.sum() + f2.sum())))
+    r, mu, c, _ = _count(_reversals(arr), True)
+    return r, mu, c
 
 
 def damage_equivalent_load(x: Any, m: float, *, n_eq: float | None = None,
@@ -170,8 +157,10 @@ def damage_equivalent_load(x: Any, m: float, *, n_eq: float | None = None,
     f_eq : float
         Equivalent-load frequency [Hz] (default 1).
     method : {"astm", "pcrunch"}
-        ASTM counting with half-cycle residue, or pCrunch-style: repeated residue and ranges
-        binned into ``bins`` equal bins at their centres.
+        ASTM counting with half-cycle residue (our kernel); or exactly what pCrunch does
+        (``FatigueParams.compute_del``): fatpack's rainflow on reversals quantized to 256
+        levels with the residue repeated, ranges histogrammed into ``bins`` bins at their
+        centres. ``"pcrunch"`` needs the optional fatpack (``pip install 'mpc-wt[pcrunch]'``).
 
     Raises
     ------
@@ -189,13 +178,20 @@ def damage_equivalent_load(x: Any, m: float, *, n_eq: float | None = None,
     if method == "astm":
         r, _, c = rainflow(x)
     elif method == "pcrunch":
-        r, _, c = rainflow(x, repeated_residue=True)
-        if r.size:
-            edges = np.linspace(0.0, r.max(), bins + 1)
-            idx = np.clip(np.searchsorted(edges, r, side="right") - 1, 0, bins - 1)
-            r = 0.5 * (edges[idx] + edges[idx + 1])
+        try:
+            import fatpack
+        except ImportError as err:
+            raise ImportError("method='pcrunch' needs fatpack: pip install 'mpc-wt[pcrunch]'") \
+                from err
+        arr = _check_series("x", x)
+        ranges = fatpack.find_rainflow_ranges(arr, k=256)
+        if ranges.size == 0:
+            return 0.0
+        c, r = fatpack.find_range_count(ranges, bins)
     else:
         raise ValueError(f"method must be 'astm' or 'pcrunch', got {method!r}")
+    r = np.asarray(r, float)
+    c = np.asarray(c, float)
     if r.size == 0:
         return 0.0
     scale = r.max()

@@ -21,7 +21,8 @@ __all__ = ["DEFAULT_CHANNELS", "run_baseline", "load_series", "assess_series"]
 DEFAULT_CHANNELS = {"flap_moment_1": 10.0, "flap_moment_2": 10.0, "flap_moment_3": 10.0,
                     "edge_moment_1": 10.0, "edge_moment_2": 10.0, "edge_moment_3": 10.0,
                     "tower_base_fa_moment": 4.0, "tower_base_ss_moment": 4.0,
-                    "lss_torque": 4.0, "tilt_moment": 4.0, "yaw_moment": 4.0}
+                    "lss_torque": 4.0, "tilt_moment": 4.0, "yaw_moment": 4.0,
+                    "shaft_bending_blade1": 4.0}
 
 
 def run_baseline(turbine: linearize.Turbine, wind_mps: float, turbulence: str = "A",

@@ -74,7 +74,13 @@ class ClosedLoopResult:
     meta: dict[str, Any] = field(default_factory=dict)
 
     def channel(self, name: str) -> np.ndarray:
-        """A time series by name: output, state, input or controller signal."""
+        """A time series by name: output, state, input, controller signal, or the derived
+        ``shaft_bending_blade1``: the rotating low-speed-shaft bending moment in the direction
+        of blade 1 from the blades' flap moments, M_1 - (M_2 + M_3) / 2 [N m] (rotor weight
+        and hub inertia left out)."""
+        if name == "shaft_bending_blade1":
+            f = self.z[:, _Z["flap_moment_1"]:_Z["flap_moment_3"] + 1]
+            return f[:, 0] - 0.5 * (f[:, 1] + f[:, 2])
         if name in _Z:
             return self.z[:, _Z[name]]
         if name in linearize.STATE_NAMES:
@@ -89,7 +95,8 @@ class ClosedLoopResult:
         """All channel names."""
         return (list(linearize.OUTPUT_NAMES) + [n for n in linearize.STATE_NAMES
                                                 if n not in _Z]
-                + list(linearize.INPUT_NAMES) + list(self.controller))
+                + list(linearize.INPUT_NAMES) + ["shaft_bending_blade1"]
+                + list(self.controller))
 
     def save(self, path: str | Path) -> Path:
         """Write a self-describing netCDF file (xarray; openable without mpc-wt) with units,
@@ -220,6 +227,7 @@ def simulate_closed_loop(params: linearize.PlantParams, controller: Any,
     dphi = np.zeros((3, pk.r.size))
     rate = params.turbine.generator.max_torque_rate * dt
     applied_tq = u[3]
+    clipped = 0
     k_done = 0
     bar = tqdm(total=n, desc="simulate", unit="step", disable=not progress, mininterval=0.5)
     try:
@@ -240,6 +248,16 @@ def simulate_closed_loop(params: linearize.PlantParams, controller: Any,
                     raise ValueError(f"controller returned pitch {pitch!r}, torque {tq!r} at "
                                      f"t = {t:g} s: need 3 finite pitch angles [rad] and a "
                                      f"finite torque [N m]")
+                pa = params.turbine.pitch_actuator
+                gen = params.turbine.generator
+                if (pitch.min() < pa.min_pitch_rad - 1e-9 or pitch.max() > pa.max_pitch_rad + 1e-9
+                        or not gen.min_torque - 1e-6 <= tq <= gen.max_torque + 1e-6):
+                    if clipped == 0:
+                        log.warning("controller command out of the actuator range at t = %g s "
+                                    "(pitch %s rad, torque %g N m): the plant clips it; the "
+                                    "count is in result.meta['commands_clipped']", t,
+                                    np.round(pitch, 4), tq)
+                    clipped += 1
                 u[:3] = pitch
                 u_tq = float(tq)
             for name, val in getattr(controller, "signals", {}).items():
@@ -271,6 +289,7 @@ def simulate_closed_loop(params: linearize.PlantParams, controller: Any,
     ctrl = {k: np.array(v[:n + 1]) for k, v in sig.items()}
     return ClosedLoopResult(t=dt * np.arange(n + 1), x=xs, u=us, z=zs, controller=ctrl,
                             meta={**(meta or {}), "dt": dt, "controller_dt": cdt,
+                                  "commands_clipped": clipped,
                                   "software_version": __version__})
 
 

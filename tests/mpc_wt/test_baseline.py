@@ -164,3 +164,31 @@ def test_controller_period_must_divide(turbine: linearize.Turbine,
     with pytest.raises(ValueError, match="whole multiple of dt"):
         simulate_closed_loop(params, _NoTorque(), linearize.SteadyWind(12.0), 1.0, x0=op.x,
                              u0=op.u, controller_dt=0.03)
+
+
+class _Overpitch:
+    signals: dict = {}
+
+    def reset(self) -> None:
+        pass
+
+    def step(self, t, meas):
+        return np.full(3, math.radians(120.0)), 40000.0
+
+
+def test_out_of_range_commands_are_recorded(turbine: linearize.Turbine,
+                                            params: linearize.PlantParams,
+                                            caplog: pytest.LogCaptureFixture) -> None:
+    op = linearize.trim(turbine, 14.0)
+    with caplog.at_level("WARNING"):
+        r = simulate_closed_loop(params, _Overpitch(), linearize.SteadyWind(14.0), 1.0,
+                                 x0=op.x, u0=op.u)
+    assert r.meta["commands_clipped"] == 80
+    assert "out of the actuator range" in caplog.text
+    assert r.x[:, 5].max() <= math.radians(90.0) + 1e-9
+
+
+def test_shaft_bending_channel(run18: ClosedLoopResult) -> None:
+    f = run18.z[:, 10:13]
+    assert_allclose(run18.channel("shaft_bending_blade1"), f[:, 0] - 0.5 * (f[:, 1] + f[:, 2]),
+                    rtol=0, atol=0)
