@@ -246,7 +246,7 @@ def _cmd_simulate(args: argparse.Namespace) -> int:
 
 
 def _cmd_assess(args: argparse.Namespace) -> int:
-    from .runs import DEFAULT_CHANNELS, assess_plots, assess_series, load_series
+    from .runs import DEFAULT_CHANNELS, assess_plots, assess_series, load_series, reductions
 
     chans = None
     if args.channels:
@@ -260,7 +260,10 @@ def _cmd_assess(args: argparse.Namespace) -> int:
                              f"{path} (it ends at {t[-1]:g} s)")
         t, cols = t[keep], {k: v[keep] for k, v in cols.items()}
         res = assess_series(t, cols, chans, args.m)
-        rows.append({"run": str(path), **res})
+        row = {"run": str(path), **res}
+        if rows:
+            row["relative_to_first"] = reductions(rows[0], res)
+        rows.append(row)
         runs.append((Path(path).stem, t, cols))
     if args.plots:
         made = assess_plots(runs, args.plots)

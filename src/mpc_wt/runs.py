@@ -15,7 +15,7 @@ from .assess import cs_measures, damage_equivalent_load, energy_Wh, harmonic_psd
 from .baseline import BaselineController, tune_baseline
 from .simulate import ClosedLoopResult, ResultFileError, simulate_closed_loop
 
-__all__ = ["DEFAULT_CHANNELS", "run_baseline", "load_series", "assess_series"]
+__all__ = ["DEFAULT_CHANNELS", "run_baseline", "load_series", "assess_series", "reductions"]
 
 #: Load channels and their default Woehler exponents (10 composite blades, 4 steel elsewhere).
 DEFAULT_CHANNELS = {"flap_moment_1": 10.0, "flap_moment_2": 10.0, "flap_moment_3": 10.0,
@@ -109,10 +109,31 @@ def assess_series(t: np.ndarray, cols: dict[str, np.ndarray],
         out.update(pitch_duty(np.column_stack(pitch), dt))
     if "gen_speed" in cols:
         out["gen_speed_std_rad_s"] = float(cols["gen_speed"].std())
+    if "gen_torque" in cols:
+        out["gen_torque_std_Nm"] = float(cols["gen_torque"].std())
     if "rotor_speed" in cols and "flap_moment_1" in cols:
         frot = float(cols["rotor_speed"].mean()) / (2 * math.pi)
         out["flap_1_harmonics"] = {f"{n}P": v for n, v in
                                    harmonic_psd(cols["flap_moment_1"], 1 / dt, frot).items()}
+    return out
+
+
+def reductions(base: dict[str, Any], other: dict[str, Any]) -> dict[str, Any]:
+    """Change of ``other`` against ``base`` (two :func:`assess_series` results), in percent:
+    DEL per channel, the 1P/3P/6P content of the blade-1 flap moment (Madsen sec. IV), power
+    and generator-speed std, pitch travel."""
+    def pct(a: float, b: float) -> float:
+        return 100.0 * (b / a - 1.0) if a else float("nan")
+
+    out: dict[str, Any] = {"del_change_pct": {c: pct(base["channels"][c]["del"], d["del"])
+                                               for c, d in other["channels"].items()
+                                               if c in base["channels"]}}
+    if "flap_1_harmonics" in base and "flap_1_harmonics" in other:
+        out["flap_1_harmonic_change_pct"] = {k: pct(base["flap_1_harmonics"][k], v)
+                                             for k, v in other["flap_1_harmonics"].items()}
+    for k in ("power_std_W", "gen_speed_std_rad_s", "pitch_travel_deg", "cs1", "cs2"):
+        if k in base and k in other:
+            out[f"{k}_change_pct"] = pct(base[k], other[k])
     return out
 
 

@@ -27,7 +27,8 @@ from linearize.plant import _bad_state, _rk4, _state_limits
 
 from . import __version__
 
-__all__ = ["Controller", "ClosedLoopResult", "ResultFileError", "simulate_closed_loop"]
+__all__ = ["Controller", "ClosedLoopResult", "ResultFileError", "LidarPreview",
+           "simulate_closed_loop"]
 
 log = logging.getLogger(__name__)
 SCHEMA_VERSION = 1
@@ -142,6 +143,8 @@ class ClosedLoopResult:
         except Exception as err:  # noqa: BLE001 - any reader failure means a broken file
             raise ResultFileError(f"{path}: not a readable result file ({err})") from err
         ver = ds.attrs.get("schema_version")
+        if isinstance(ver, (np.integer, int)):
+            ver = int(ver)
         if ver != SCHEMA_VERSION:
             raise ResultFileError(f"{path}: schema_version must be {SCHEMA_VERSION}, got {ver!r} "
                                   f"(written by {ds.attrs.get('software_version', '?')})")
@@ -155,6 +158,50 @@ class ClosedLoopResult:
                 if ds[n].attrs.get("source") == "controller"}
         return cls(t=ds["time"].values, x=x, u=u, z=z, controller=ctrl,
                    meta=json.loads(ds.attrs.get("meta_json", "{}")))
+
+
+class LidarPreview:
+    """A simulated LIDAR in the loop: measures the wind field at the rotor's current azimuth
+    and speed at every controller step and serves the per-blade preview of the next
+    ``horizon`` steps from the measurements taken T_p earlier (:func:`lidar.preview`).
+
+    Parameters
+    ----------
+    lidar_model : lidar.CWLidar
+    field : lidar.WindField
+        The same field the plant meets (as its GridWind).
+    horizon : int
+        Preview steps H_p (default 15).
+    dt : float
+        Controller step [s] (default 0.1).
+    """
+
+    def __init__(self, lidar_model: Any, field: Any, horizon: int = 15, dt: float = 0.1) -> None:
+        self.lidar = lidar_model
+        self.field = field
+        self.horizon = int(horizon)
+        self.dt = float(dt)
+        self.reset()
+
+    def reset(self) -> None:
+        """Forget the measurement history."""
+        self._t: list[float] = []
+        self._u: list[np.ndarray] = []
+        self._az: list[np.ndarray] = []
+
+    def __call__(self, t: float, azimuth_rad: float, rotor_speed_rad_s: float) -> Any:
+        import lidar
+
+        m = self.lidar.measure(self.field, np.array([t]), np.array([azimuth_rad]),
+                               rotor_speed_rad_s)
+        self._t.append(t)
+        self._u.append(m.u_hat[0])
+        self._az.append(m.beam_azimuth_rad[0])
+        hist = lidar.LidarMeasurement(t=np.array(self._t), los=np.array(self._u) * 0.0,
+                                      u_hat=np.array(self._u),
+                                      beam_azimuth_rad=np.array(self._az),
+                                      preview_time=m.preview_time, radius=m.radius)
+        return lidar.preview(hist, t, self.horizon, self.dt)
 
 
 class SimulationDivergedError(RuntimeError):
@@ -178,6 +225,7 @@ def simulate_closed_loop(params: linearize.PlantParams, controller: Any,
                          wind: linearize.SteadyWind | linearize.GridWind, duration: float, *,
                          x0: np.ndarray, u0: np.ndarray, dt: float = 1.0 / 80.0,
                          controller_dt: float | None = None, progress: bool = False,
+                         preview: LidarPreview | None = None,
                          meta: dict[str, Any] | None = None) -> ClosedLoopResult:
     """Run plant, wind and controller together.
 
@@ -196,6 +244,9 @@ def simulate_closed_loop(params: linearize.PlantParams, controller: Any,
         Controller period [s], a multiple of ``dt`` (default ``dt``).
     progress : bool
         Show a progress bar.
+    preview : LidarPreview, optional
+        A simulated LIDAR; its preview is passed to the controller as ``meas["preview"]``
+        (a :class:`lidar.Preview`).
 
     Raises
     ------
@@ -217,6 +268,8 @@ def simulate_closed_loop(params: linearize.PlantParams, controller: Any,
     pk = params.pack
     lim = _state_limits(params)
     controller.reset()
+    if preview is not None:
+        preview.reset()
     xs = np.empty((n + 1, 17))
     us = np.empty((n + 1, 4))
     zs = np.empty((n + 1, 31))
@@ -242,7 +295,10 @@ def simulate_closed_loop(params: linearize.PlantParams, controller: Any,
                 xn, z, hint, dphi = _rk4(t, x, u, dt, pk, kind, wpar, grid, hint, dphi)
             xs[k], us[k], zs[k] = x, u, z
             if k % ratio == 0 and k < n:
-                pitch, tq = controller.step(t, _measurements(t, x, z))
+                meas = _measurements(t, x, z)
+                if preview is not None:
+                    meas["preview"] = preview(t, float(x[16]), float(x[2]))
+                pitch, tq = controller.step(t, meas)
                 pitch = np.asarray(pitch, float)
                 if pitch.shape != (3,) or not np.all(np.isfinite(pitch)) or not math.isfinite(tq):
                     raise ValueError(f"controller returned pitch {pitch!r}, torque {tq!r} at "
