@@ -83,78 +83,54 @@ class LinearizationError(RuntimeError):
 # Jacobian kernels
 # --------------------------------------------------------------------------------------------
 @nb.njit(cache=True, error_model="numpy")
-def _jac_fd(x0, u0, w0, p, bem0, mode, hx, hu, hd):  # pragma: no cover - compiled
-    """Central-difference Jacobians of (dx/dt, z) w.r.t. x, u and per-blade wind."""
-    nx, nu, nd = 17, 4, 3
-    jx = np.zeros((nx, nx))
-    ju = np.zeros((nx, nu))
-    jd = np.zeros((nx, nd))
-    hxm = np.zeros((31, nx))
-    hum = np.zeros((31, nu))
-    hdm = np.zeros((31, nd))
-    for j in range(nx):
-        xp = x0.copy()
-        xm = x0.copy()
-        xp[j] += hx[j]
-        xm[j] -= hx[j]
-        fp, zp, _ = _eval(xp, u0, w0, p, bem0, mode)
-        fm, zm, _ = _eval(xm, u0, w0, p, bem0, mode)
-        jx[:, j] = (fp - fm) / (2 * hx[j])
-        hxm[:, j] = (zp - zm) / (2 * hx[j])
-    for j in range(nu):
-        up = u0.copy()
-        um = u0.copy()
-        up[j] += hu[j]
-        um[j] -= hu[j]
-        fp, zp, _ = _eval(x0, up, w0, p, bem0, mode)
-        fm, zm, _ = _eval(x0, um, w0, p, bem0, mode)
-        ju[:, j] = (fp - fm) / (2 * hu[j])
-        hum[:, j] = (zp - zm) / (2 * hu[j])
-    for j in range(nd):
-        wp = w0.copy()
-        wm = w0.copy()
-        wp[j] += hd[j]
-        wm[j] -= hd[j]
-        fp, zp, _ = _eval(x0, u0, wp, p, bem0, mode)
-        fm, zm, _ = _eval(x0, u0, wm, p, bem0, mode)
-        jd[:, j] = (fp - fm) / (2 * hd[j])
-        hdm[:, j] = (zp - zm) / (2 * hd[j])
-    return jx, ju, jd, hxm, hum, hdm
+def _perturbed(x0, u0, w0, j, delta):  # pragma: no cover - compiled
+    """(x, u, wind) with variable j of the combined vector [x (17), u (4), blade winds (3)]
+    moved by delta (a blade wind moves every element of that blade)."""
+    x = x0.copy()
+    u = u0.copy()
+    w = w0.copy()
+    if j < 17:
+        x[j] += delta
+    elif j < 21:
+        u[j - 17] += delta
+    else:
+        w[j - 21] += delta
+    return x, u, w
+
+
+@nb.njit(cache=True, error_model="numpy")
+def _jac_fd(x0, u0, w0, p, bem0, mode, h):  # pragma: no cover - compiled
+    """Central-difference Jacobians of (dx/dt, z) w.r.t. the combined vector [x, u, blade
+    winds], with step h[j] per variable: (17, 24) and (31, 24)."""
+    jf = np.zeros((17, 24))
+    jz = np.zeros((31, 24))
+    for j in range(24):
+        xp, up, wp = _perturbed(x0, u0, w0, j, h[j])
+        xm, um, wm = _perturbed(x0, u0, w0, j, -h[j])
+        fp, zp, _ = _eval(xp, up, wp, p, bem0, mode)
+        fm, zm, _ = _eval(xm, um, wm, p, bem0, mode)
+        jf[:, j] = (fp - fm) / (2 * h[j])
+        jz[:, j] = (zp - zm) / (2 * h[j])
+    return jf, jz
 
 
 @nb.njit(cache=True, error_model="numpy")
 def _jac_cs(x0, u0, w0, p, bem0, mode):  # pragma: no cover - compiled
     """Complex-step Jacobians (step 1e-30 i): exact to rounding, no subtraction error."""
     h = 1e-30
-    nx, nu, nd = 17, 4, 3
-    xc = x0 + 0j
-    uc = u0 + 0j
-    wc = w0 + 0j
-    jx = np.zeros((nx, nx))
-    ju = np.zeros((nx, nu))
-    jd = np.zeros((nx, nd))
-    hxm = np.zeros((31, nx))
-    hum = np.zeros((31, nu))
-    hdm = np.zeros((31, nd))
-    for j in range(nx):
-        xp = xc.copy()
-        xp[j] += 1j * h
-        f, z, _ = _eval(xp, uc, wc, p, bem0, mode)
-        jx[:, j] = f.imag / h
-        hxm[:, j] = z.imag / h
-    for j in range(nu):
-        up = uc.copy()
-        up[j] += 1j * h
-        f, z, _ = _eval(xc, up, wc, p, bem0, mode)
-        ju[:, j] = f.imag / h
-        hum[:, j] = z.imag / h
-    for j in range(nd):
-        wp = wc.copy()
-        wp[j] += 1j * h
-        f, z, _ = _eval(xc, uc, wp, p, bem0, mode)
-        jd[:, j] = f.imag / h
-        hdm[:, j] = z.imag / h
-    return jx, ju, jd, hxm, hum, hdm
+    jf = np.zeros((17, 24))
+    jz = np.zeros((31, 24))
+    for j in range(24):
+        x, u, w = _perturbed(x0 + 0j, u0 + 0j, w0 + 0j, j, 1j * h)
+        f, z, _ = _eval(x, u, w, p, bem0, mode)
+        jf[:, j] = f.imag / h
+        jz[:, j] = z.imag / h
+    return jf, jz
+
+
+def _split(jf: FloatArray, jz: FloatArray) -> tuple[FloatArray, ...]:
+    """(df/dx, df/du, df/dd, dz/dx, dz/du, dz/dd) from the combined Jacobians."""
+    return (jf[:, :17], jf[:, 17:21], jf[:, 21:], jz[:, :17], jz[:, 17:21], jz[:, 21:])
 
 
 def _azimuths(params: PlantParams, shear: float, n_azimuth: int | None) -> FloatArray:
@@ -180,12 +156,12 @@ def _raw_jacobians(params: PlantParams, op: OperatingPoint, wake: str, shear: fl
     mode = MODE_NOLIMITS | (MODE_FROZEN if wake == "frozen" else 0)
     if method == "cs":
         mode |= 0 if wake == "frozen" else MODE_CS
-        return _jac_cs(x0, u0, w0, pk, bem0, mode)
+        return _split(*_jac_cs(x0, u0, w0, pk, bem0, mode))
     mode |= MODE_TIGHT
-    hx = _REL_STEP * np.maximum(np.abs(x0), _X_SCALE)
-    hu = _REL_STEP * np.maximum(np.abs(u0), _U_SCALE)
-    hd = _REL_STEP * np.maximum(np.abs(w0.mean(axis=1)), _D_SCALE)
-    return _jac_fd(x0, u0, w0, pk, bem0, mode, hx, hu, hd)
+    h = _REL_STEP * np.concatenate([np.maximum(np.abs(x0), _X_SCALE),
+                                    np.maximum(np.abs(u0), _U_SCALE),
+                                    np.maximum(np.abs(w0.mean(axis=1)), _D_SCALE)])
+    return _split(*_jac_fd(x0, u0, w0, pk, bem0, mode, h))
 
 
 # --------------------------------------------------------------------------------------------
