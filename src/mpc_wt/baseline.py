@@ -151,9 +151,11 @@ class BaselineController:
         self.slope25 = g.rated_power / turbine.drivetrain.generator_efficiency / self.w_rated \
             / (self.w_rated - self.w_sync)
         self.slope15 = g.k_opt * self.w_rgn2**2 / (self.w_rgn2 - self.w_cutin)
-        if g.k_opt * self.w_rated**2 > self.slope25 * (self.w_rated - self.w_sync):
-            self.w_sync = self.w_rated - g.rated_power / turbine.drivetrain.generator_efficiency \
-                / self.w_rated / (g.k_opt * self.w_rated)
+        # region 2 -> 2.5 where K w^2 meets the 2.5 line (DISCON's VS_TrGnSp), so the torque is
+        # continuous; without an intersection the line starts at the synchronous speed
+        disc = self.slope25**2 - 4.0 * g.k_opt * self.slope25 * self.w_sync
+        self.w_trans = ((self.slope25 - math.sqrt(disc)) / (2.0 * g.k_opt) if disc >= 0
+                        else self.w_sync)
         self.reset()
 
     def reset(self) -> None:
@@ -176,7 +178,7 @@ class BaselineController:
             return 0.0
         if w < self.w_rgn2:
             return self.slope15 * (w - self.w_cutin)
-        if w < self.w_sync:
+        if w < self.w_trans:
             return g.k_opt * w * w
         return self.slope25 * (w - self.w_sync)
 

@@ -246,3 +246,16 @@ def test_lidar_preview_in_the_loop(turbine: linearize.Turbine,
     # speed drifts over T_p, so the preview is only as good as that prediction (here < 2 m/s)
     truth = lidar.blade_effective_wind(f, p.t, np.interp(p.t, r.t, r.x[:, 16]), lid.radius)
     assert np.abs(p.blade - truth).max() < 2.5
+
+
+def test_torque_law_is_continuous_and_monotone(turbine: linearize.Turbine, gains) -> None:
+    # regions 1.5 -> 2 -> 2.5 -> 3 meet without jumps below rated (the 2 -> 2.5 switch is where
+    # K w^2 meets the 2.5 line, as DISCON's VS_TrGnSp), and the torque rises with speed
+    c = BaselineController(turbine, gains)
+    w = np.linspace(60.0, c.w_rated - 1e-6, 20001)
+    tq = np.array([c.torque(x, 0.0) for x in w])
+    assert np.all(np.diff(tq) >= -1e-9)
+    # no jump: every step is bounded by the steepest segment's slope (region 2.5) times the step
+    steep = max(c.slope25, c.slope15, 2 * gains.k_opt * c.w_rated)
+    assert np.max(np.abs(np.diff(tq))) <= steep * (w[1] - w[0]) * (1 + 1e-9)
+    assert_allclose(c.torque(c.w_trans, 0.0), gains.k_opt * c.w_trans**2, rtol=1e-9)
