@@ -7,8 +7,9 @@ gen_torque_ref)``; it may expose a dict ``signals`` of internal signals, recorde
 
 Measurements given to the controller: ``t``, ``gen_speed``, ``rotor_speed``, ``pitch`` (3,),
 ``flap_moment`` (3,), ``edge_moment`` (3,), ``tower_fa_acceleration``,
-``tower_ss_acceleration``, ``azimuth``, ``gen_power``, and ``preview`` when a LIDAR preview is
-attached.
+``tower_ss_acceleration``, ``azimuth``, ``gen_power``; ``state``, the full plant state
+(:data:`linearize.STATE_NAMES`), for full-state-information designs (Madsen's MPC); and
+``preview`` when a LIDAR preview is attached.
 """
 from __future__ import annotations
 
@@ -218,7 +219,7 @@ def _measurements(t: float, x: np.ndarray, z: np.ndarray) -> dict[str, Any]:
             "edge_moment": z[13:16].copy(),
             "tower_fa_acceleration": z[_Z["tower_fa_acceleration"]],
             "tower_ss_acceleration": z[_Z["tower_ss_acceleration"]],
-            "azimuth": z[_Z["azimuth"]], "gen_power": z[_Z["gen_power"]]}
+            "azimuth": z[_Z["azimuth"]], "gen_power": z[_Z["gen_power"]], "state": x.copy()}
 
 
 def simulate_closed_loop(params: linearize.PlantParams, controller: Any,

@@ -1,0 +1,324 @@
+"""Coleman-weighted individual-pitch MPC with actuator constraints (Madsen et al. 2012, sec. III).
+
+Formulation (eqs 20-23): the discrete linear model (zero-order hold, 10 Hz by default) predicts
+the performance outputs z over H_p steps from the inputs over H_u steps (held after H_u) and the
+disturbance preview; the cost is sum ||z||_Q^2 + sum ||u||_R^2 (+ an optional input-rate
+penalty), with Q = blockdiag(I, T) Q_w where T = T_c^T T_c turns the three flap moments into
+M_tilt^2 + M_yaw^2 for every azimuth (eqs 8, 9, 21). Constraints (eqs 12, 15): pitch angle
+and rate per blade (the rate through the model's pitch-rate outputs), generator torque and its
+rate, all on absolute values about the operating point.
+
+The QP is condensed in the inputs and solved by OSQP. Its matrix is built and factorized once
+per operating point; each step only updates the linear term and the bounds, warm-started.
+The status is checked every step: on failure the previous plan shifted by one step is applied,
+else the previous command is held; the fallback used is recorded in ``signals``.
+"""
+from __future__ import annotations
+
+import logging
+import math
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+import scipy.sparse as sp
+
+import linearize
+
+__all__ = ["coleman_weight", "MPCWeights", "MPC"]
+
+log = logging.getLogger(__name__)
+
+
+def coleman_weight() -> np.ndarray:
+    """The constant matrix T with M^T T M = M_tilt^2 + M_yaw^2 for every azimuth.
+
+    With T_c of Madsen et al. (2012) eq 9 (the 2/3 Coleman factor),
+    T_c^T T_c [i, j] = (4/9) cos(psi_i - psi_j): 4/9 on the diagonal and -2/9 off it, so
+    T = (2^2 / 3^2) [[1, -1/2, -1/2], [-1/2, 1, -1/2], [-1/2, -1/2, 1]]. Eq 22 prints the
+    constant as 2^2 / 3^3, which does not satisfy the identity (eq 21); 2^2 / 3^2 does (test).
+    """
+    return 4.0 / 9.0 * np.array([[1.0, -0.5, -0.5], [-0.5, 1.0, -0.5], [-0.5, -0.5, 1.0]])
+
+
+@dataclass(frozen=True)
+class MPCWeights:
+    """Weights of the MPC cost, on signals scaled by their typical magnitudes.
+
+    Parameters
+    ----------
+    outputs : dict of str to float
+        Weight per performance output (Madsen's z); the three flap moments share the weight
+        ``flap_moment`` and enter through the Coleman matrix.
+    inputs : dict of str to float
+        Weight per input (``pitch_ref``, ``gen_torque_ref``).
+    rate : dict of str to float
+        Weight on the input change per step (0: none).
+    scales : dict of str to float
+        Typical magnitudes by which signals are divided before weighting [their units].
+    """
+
+    outputs: dict[str, float] = field(default_factory=lambda: {
+        "gen_power": 1.0, "pitch": 0.0, "pitch_rate": 0.01, "tower_fa_velocity": 0.1,
+        "rotor_speed": 1.0, "shaft_torsion": 0.01, "flap_moment": 0.3})
+    inputs: dict[str, float] = field(default_factory=lambda: {"pitch_ref": 0.01,
+                                                              "gen_torque_ref": 0.01})
+    rate: dict[str, float] = field(default_factory=lambda: {"pitch_ref": 0.0,
+                                                            "gen_torque_ref": 0.0})
+    scales: dict[str, float] = field(default_factory=lambda: {
+        "gen_power": 5e5, "pitch": math.radians(1.0), "pitch_rate": math.radians(1.0),
+        "tower_fa_velocity": 0.1, "rotor_speed": 0.05, "shaft_torsion": 1e-3,
+        "flap_moment": 1e6, "pitch_ref": math.radians(1.0), "gen_torque_ref": 4e3})
+
+    def __post_init__(self) -> None:
+        for group in (self.outputs, self.inputs, self.rate):
+            for k, v in group.items():
+                if not (math.isfinite(v) and v >= 0):
+                    raise ValueError(f"weight {k!r} must be finite and >= 0 (the QP must be "
+                                     f"convex), got {v!r}")
+        for k, v in self.scales.items():
+            if not (math.isfinite(v) and v > 0):
+                raise ValueError(f"scale {k!r} must be > 0, got {v!r}")
+
+
+def _group(name: str) -> str:
+    for g in ("pitch_rate", "pitch", "flap_moment"):
+        if name.startswith(g + "_"):
+            return g
+    return name
+
+
+class MPC:
+    """Condensed linear MPC on a discretized :class:`linearize.LinearModel`.
+
+    Parameters
+    ----------
+    model : LinearModel
+        Continuous or discrete; with Madsen's 13 outputs among its outputs.
+    turbine : Turbine
+        For the actuator limits.
+    dt : float
+        Controller period [s] (default 0.1).
+    horizon, control_horizon : int
+        H_p and H_u (defaults 15, 15), >= 1, H_u <= H_p.
+    weights : MPCWeights
+    collective : bool
+        One collective pitch input instead of three (Madsen's comparison controller).
+    solver_options : dict
+        Passed to OSQP (defaults: eps_abs = eps_rel = 1e-6, polish off, warm start).
+    """
+
+    def __init__(self, model: linearize.LinearModel, turbine: linearize.Turbine, *,
+                 dt: float = 0.1, horizon: int = 15, control_horizon: int | None = None,
+                 weights: MPCWeights | None = None, collective: bool = False,
+                 solver_options: dict[str, Any] | None = None) -> None:
+        hu = horizon if control_horizon is None else control_horizon
+        for name, v in (("horizon", horizon), ("control_horizon", hu)):
+            if not isinstance(v, (int, np.integer)) or v < 1:
+                raise ValueError(f"{name} must be an integer >= 1, got {v!r}")
+        if hu > horizon:
+            raise ValueError(f"control_horizon ({hu}) must not exceed horizon ({horizon})")
+        if not (math.isfinite(dt) and dt > 0):
+            raise ValueError(f"dt must be > 0 s, got {dt!r}")
+        self.turbine = turbine
+        self.dt = float(dt)
+        self.hp, self.hu = int(horizon), int(hu)
+        self.w = weights or MPCWeights()
+        self.collective = collective
+        m = model if model.dt is not None else model.discretize(dt)
+        if abs((m.dt or dt) - dt) > 1e-12:
+            raise ValueError(f"model dt {m.dt} s differs from the controller dt {dt} s")
+        zsel = list(linearize.MADSEN_OUTPUTS)
+        missing = [n for n in zsel if n not in m.outputs]
+        if missing:
+            raise ValueError(f"model lacks Madsen outputs {missing}")
+        self.model = m.select(outputs=zsel)
+        self.x_names = m.states
+        self._build(solver_options or {})
+        self.reset()
+
+    # ------------------------------------------------------------------------------------
+    def _weights(self) -> tuple[np.ndarray, np.ndarray]:
+        m, w = self.model, self.w
+        q = np.zeros((len(m.outputs), len(m.outputs)))
+        flap = [i for i, n in enumerate(m.outputs) if n.startswith("flap_moment_")]
+        for i, n in enumerate(m.outputs):
+            g = _group(n)
+            if g != "flap_moment":
+                q[i, i] = w.outputs.get(g, 0.0) / w.scales[g] ** 2
+        q[np.ix_(flap, flap)] = (w.outputs["flap_moment"] / w.scales["flap_moment"] ** 2
+                                 * coleman_weight())
+        r = np.diag([w.inputs[_group(n).replace("_1", "").replace("_2", "").replace("_3", "")
+                             if not n.startswith("pitch_ref") else "pitch_ref"]
+                     / w.scales["pitch_ref" if n.startswith("pitch_ref") else n] ** 2
+                     for n in m.inputs])
+        return q, r
+
+    def _build(self, solver_options: dict[str, Any]) -> None:
+        import osqp
+
+        m = self.model
+        a, b, bd, c, du, dd = m.A, m.B_u, m.B_d, m.C_z, m.D_u, m.D_d
+        if self.collective:          # one pitch input drives all three blades
+            tmat = np.zeros((b.shape[1], 2))
+            tmat[:3, 0] = 1.0
+            tmat[3, 1] = 1.0
+            b, du = b @ tmat, du @ tmat
+        nx, nu, nd, nz = a.shape[0], b.shape[1], bd.shape[1], c.shape[0]
+        hp, hu = self.hp, self.hu
+        q1, r_full = self._weights()
+        r1 = (np.diag([r_full[0, 0], r_full[3, 3]]) * np.array([3.0, 1.0])
+              if self.collective else r_full)
+        # prediction z_i = C x_i + D u_i (+ Dd d_i), x_{i+1} = A x_i + B u_i + Bd d_i,
+        # i = 0..hp-1, u_i = u_{min(i, hu-1)}
+        apow = [np.eye(nx)]
+        for _ in range(hp):
+            apow.append(a @ apow[-1])
+        psi = np.vstack([c @ apow[i] for i in range(hp)])                    # (hp nz, nx)
+        theta = np.zeros((hp * nz, hu * nu))
+        phi = np.zeros((hp * nz, hp * nd))
+        for i in range(hp):
+            for j in range(i):                                                # x_i from u_j
+                col = min(j, hu - 1)
+                theta[i * nz:(i + 1) * nz, col * nu:(col + 1) * nu] += c @ apow[i - 1 - j] @ b
+                phi[i * nz:(i + 1) * nz, j * nd:(j + 1) * nd] += c @ apow[i - 1 - j] @ bd
+            col = min(i, hu - 1)
+            theta[i * nz:(i + 1) * nz, col * nu:(col + 1) * nu] += du
+            phi[i * nz:(i + 1) * nz, i * nd:(i + 1) * nd] += dd
+        qbar = np.kron(np.eye(hp), q1)
+        rbar = np.kron(np.eye(hu), r1)
+        # input-rate penalty on u_j - u_{j-1} (u_{-1} = previous command: linear term)
+        dmat = np.eye(hu * nu) - np.eye(hu * nu, k=-nu)
+        wr = np.diag(np.tile([self.w.rate["pitch_ref"] / self.w.scales["pitch_ref"] ** 2]
+                             * (nu - 1) + [self.w.rate["gen_torque_ref"]
+                                           / self.w.scales["gen_torque_ref"] ** 2], hu))
+        h = theta.T @ qbar @ theta + rbar + dmat.T @ wr @ dmat
+        h = 0.5 * (h + h.T)
+        lam_min = float(np.linalg.eigvalsh(h).min())
+        if lam_min < -1e-9 * max(1.0, abs(np.linalg.eigvalsh(h).max())):
+            raise ValueError(f"the weights make the QP non-convex (smallest Hessian eigenvalue "
+                             f"{lam_min:g})")
+        self._psi, self._theta, self._phi = psi, theta, phi
+        self._qbar, self._wr, self._dmat = qbar, wr, dmat
+        self._nx, self._nu, self._nd, self._nz = nx, nu, nd, nz
+        # constraints: absolute input bounds (all hu moves), torque rate, pitch rate via the
+        # pitch-rate outputs over the horizon
+        pa, gen = self.turbine.pitch_actuator, self.turbine.generator
+        rows = [np.eye(hu * nu)]
+        rows.append(dmat[np.arange(hu * nu) % nu == nu - 1])                  # torque moves
+        prate = [k for k, n in enumerate(m.outputs) if n.startswith("pitch_rate_")]
+        self._prate_rows = np.array([i * nz + k for i in range(hp) for k in prate])
+        rows.append(theta[self._prate_rows])
+        acon = np.vstack(rows)
+        # scaling (OSQP converges far faster on well-scaled problems): decision variables in
+        # units of the input scales, constraint rows divided by their limits
+        su = np.tile([self.w.scales["pitch_ref"]] * (nu - 1) + [self.w.scales["gen_torque_ref"]],
+                     hu)
+        row_s = np.concatenate([su, np.full(hu, gen.max_torque_rate * self.dt),
+                                np.full(len(self._prate_rows), pa.max_rate_rad_s)])
+        self._su, self._row_s = su, row_s
+        acon_s = (acon * su[None, :]) / row_s[:, None]
+        h_s = h * np.outer(su, su)
+        self._acon = acon
+        self._n_box = hu * nu
+        self._n_trate = hu
+        self._limits = dict(pmin=pa.min_pitch_rad, pmax=pa.max_pitch_rad,
+                            rate=pa.max_rate_rad_s, tmin=gen.min_torque, tmax=gen.max_torque,
+                            trate=gen.max_torque_rate * self.dt)
+        opts = dict(eps_abs=1e-6, eps_rel=1e-6, polishing=False, warm_starting=True,
+                    verbose=False, max_iter=4000)
+        opts.update(solver_options)
+        self._solver = osqp.OSQP()
+        self._solver.setup(P=sp.triu(sp.csc_matrix(h_s)).tocsc(), q=np.zeros(hu * nu),
+                           A=sp.csc_matrix(acon_s), l=-np.inf * np.ones(acon.shape[0]),
+                           u=np.inf * np.ones(acon.shape[0]), **opts)
+        self._h = h
+
+    # ------------------------------------------------------------------------------------
+    def reset(self) -> None:
+        """Forget the previous plan and command."""
+        self._plan: np.ndarray | None = None
+        self._u_prev: np.ndarray | None = None
+        self.signals: dict[str, float] = {}
+
+    def _u_abs(self, du: np.ndarray) -> np.ndarray:
+        u0 = self.model.u0
+        if self.collective:
+            return np.array([u0[0] + du[0]] * 3 + [u0[3] + du[1]])
+        return u0 + du
+
+    def solve(self, x: np.ndarray, d_preview: np.ndarray | None = None,
+              u_prev: np.ndarray | None = None) -> tuple[np.ndarray, str]:
+        """One QP: state deviation ``x`` (n_x,), disturbance preview deviations (H_p, n_d) or
+        None (held at zero), previous command deviation (n_u,). Returns the planned inputs
+        (H_u, n_u) and the solver status."""
+        nx, nu, nd, hp, hu = self._nx, self._nu, self._nd, self.hp, self.hu
+        x = np.asarray(x, float)
+        if x.shape != (nx,):
+            raise ValueError(f"x has shape {x.shape}; expected (n_x,) = ({nx},)")
+        if d_preview is None:
+            dvec = np.zeros(hp * nd)
+        else:
+            dp = np.asarray(d_preview, float)
+            if dp.shape != (hp, nd):
+                raise ValueError(f"d_preview has shape {dp.shape}; expected (H_p, n_d) = "
+                                 f"({hp}, {nd})")
+            dvec = dp.ravel()
+        up = np.zeros(nu) if u_prev is None else np.asarray(u_prev, float)
+        free = self._psi @ x + self._phi @ dvec
+        e0 = np.zeros(hu * nu)
+        e0[:nu] = up                                   # D u - e0 = moves, first from u_prev
+        q = self._theta.T @ self._qbar @ free - self._dmat.T @ self._wr @ e0
+        u0 = self.model.u0
+        lim = self._limits
+        if self.collective:
+            lo_u = np.tile([lim["pmin"] - u0[0], lim["tmin"] - u0[3]], hu)
+            hi_u = np.tile([lim["pmax"] - u0[0], lim["tmax"] - u0[3]], hu)
+        else:
+            lo_u = np.tile(np.r_[np.full(3, lim["pmin"]) - u0[:3], lim["tmin"] - u0[3]], hu)
+            hi_u = np.tile(np.r_[np.full(3, lim["pmax"]) - u0[:3], lim["tmax"] - u0[3]], hu)
+        tr = np.full(hu, lim["trate"])
+        tr_off = np.zeros(hu)
+        tr_off[0] = up[-1]
+        pr_free = free[self._prate_rows]
+        lo = np.concatenate([lo_u, -tr + tr_off, -lim["rate"] - pr_free])
+        hi = np.concatenate([hi_u, tr + tr_off, lim["rate"] - pr_free])
+        rs = self._row_s
+        self._solver.update(q=q * self._su, l=lo / rs, u=hi / rs)
+        res = self._solver.solve(raise_error=False)
+        status = res.info.status
+        ok = res.x is not None and np.all(np.isfinite(res.x))
+        plan = (res.x * self._su).reshape(hu, nu) if ok else None
+        return plan, status
+
+    def step(self, t: float, meas: dict[str, Any]) -> tuple[np.ndarray, float]:
+        """Harness step with full-state information (``meas["state"]``) and, optionally, a
+        LIDAR preview (``meas["preview"]``, per-blade winds) as the disturbance."""
+        if "state" not in meas:
+            raise ValueError("the MPC needs full-state information: meas['state']")
+        xfull = np.asarray(meas["state"], float)
+        idx = [linearize.STATE_NAMES.index(n) for n in self.x_names]
+        x = xfull[idx] - self.model.x0
+        dprev = None
+        if "preview" in meas and meas["preview"] is not None:
+            blade = np.asarray(meas["preview"].blade, float)[: self.hp]
+            if blade.shape[0] < self.hp:
+                blade = np.vstack([blade, np.repeat(blade[-1:], self.hp - blade.shape[0], 0)])
+            dprev = blade - self.model.d0 if self._nd == 3 else \
+                blade.mean(axis=1, keepdims=True) - self.model.d0
+        plan, status = self.solve(x, dprev, self._u_prev)
+        fallback = 0.0
+        if plan is None or status not in ("solved", "solved inaccurate"):
+            if self._plan is not None and self._plan.shape[0] > 1:
+                plan = np.vstack([self._plan[1:], self._plan[-1:]])
+                fallback = 1.0
+            else:
+                plan = np.zeros((self.hu, self._nu)) if self._u_prev is None \
+                    else np.tile(self._u_prev, (self.hu, 1))
+                fallback = 2.0
+            log.warning("MPC QP %s at t = %g s: fallback %d", status, t, int(fallback))
+        self._plan = plan
+        self._u_prev = plan[0].copy()
+        u = self._u_abs(plan[0])
+        self.signals = {"qp_fallback": fallback, "pitch_ref_1": u[0], "torque_ref": u[3]}
+        return u[:3], float(u[3])

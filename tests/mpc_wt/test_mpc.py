@@ -1,0 +1,136 @@
+"""MPC (issue 6, first part): Coleman weighting, LQR limit, constraints, bad input."""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from numpy.testing import assert_allclose
+
+import linearize
+from mpc_wt.mpc import MPC, MPCWeights, coleman_weight
+
+
+@settings(max_examples=100, deadline=None)
+@given(psi=st.floats(0, 2 * math.pi), m=st.lists(st.floats(-1e7, 1e7), min_size=3, max_size=3))
+def test_coleman_weight_gives_tilt_and_yaw_squared(psi: float, m: list[float]) -> None:
+    # analytic (Madsen eqs 8, 9, 21): M^T T M = M_t^2 + M_y^2 for every azimuth, with
+    # T = (2^2 / 3^2) [[1, -1/2, -1/2], ...]; the printed 2^2 / 3^3 (eq 22) does not hold
+    ang = psi + 2 * math.pi * np.arange(3) / 3
+    tc = 2 / 3 * np.vstack([np.cos(ang), np.sin(ang)])
+    mv = np.array(m)
+    mt, my = tc @ mv
+    assert_allclose(mv @ coleman_weight() @ mv, mt**2 + my**2, rtol=1e-9,
+                    atol=1e-9 * (mv @ mv + 1.0))
+
+
+def test_printed_constant_fails_the_identity() -> None:
+    mv = np.array([1.0, 0.0, 0.0])
+    tc = 2 / 3 * np.vstack([np.cos(2 * math.pi * np.arange(3) / 3),
+                            np.sin(2 * math.pi * np.arange(3) / 3)])
+    printed = (4 / 27) / (4 / 9) * coleman_weight()
+    assert abs(mv @ printed @ mv - np.sum((tc @ mv) ** 2)) > 0.2
+
+
+@pytest.fixture(scope="module")
+def model(turbine: linearize.Turbine) -> linearize.LinearModel:
+    return linearize.linearize(turbine, 18.0, config=linearize.PlantConfig.madsen())
+
+
+def test_long_horizon_converges_to_discrete_lqr(model, turbine: linearize.Turbine) -> None:
+    # issue 6: the unconstrained MPC with a long horizon converges to the discrete LQR gain
+    # with the same weights: cost z'Qz + u'Ru with z = C x + D u gives state weight C'QC,
+    # cross term C'QD, input weight R + D'QD (python-control dlqr)
+    import control
+
+    ctl = MPC(model, turbine, horizon=200, control_horizon=200)
+    q, r = ctl._weights()
+    m = ctl.model
+    qx = m.C_z.T @ q @ m.C_z
+    ru = r + m.D_u.T @ q @ m.D_u
+    k_lqr, _, _ = control.dlqr(m.A, m.B_u, 0.5 * (qx + qx.T), 0.5 * (ru + ru.T),
+                               m.C_z.T @ q @ m.D_u)
+    # first move of the unconstrained QP: u_0 = -[H^-1 Theta' Qbar Psi]_(0) x
+    k_mpc = np.linalg.solve(ctl._h, ctl._theta.T @ ctl._qbar @ ctl._psi)[:4]
+    assert_allclose(k_mpc, k_lqr, rtol=1e-4, atol=1e-6 * np.abs(k_lqr).max())
+
+
+def test_qp_solution_equals_the_unconstrained_one_when_nothing_binds(model, turbine) -> None:
+    ctl = MPC(model, turbine)
+    x = np.zeros(8)
+    x[2] = 0.005                                     # small rotor overspeed [rad/s]
+    plan, status = ctl.solve(x)
+    assert status == "solved"
+    exact = -np.linalg.solve(ctl._h, ctl._theta.T @ ctl._qbar @ ctl._psi @ x)
+    # tolerance from OSQP's eps_abs = eps_rel = 1e-6 on a scaled problem
+    assert_allclose(plan.ravel(), exact, rtol=1e-3, atol=1e-3 * np.abs(exact).max())
+    assert plan[0, 0] > 0                            # overspeed: pitch toward feather
+
+
+def test_constraints_hold_when_they_bind(model, turbine: linearize.Turbine) -> None:
+    ctl = MPC(model, turbine)
+    x = np.zeros(8)
+    x[2] = 0.3                                       # large overspeed: the pitch rate binds
+    plan, status = ctl.solve(x)
+    assert status == "solved"
+    pa = turbine.pitch_actuator
+    u = model.u0 + plan
+    tol = 1e-4
+    assert u[:, :3].min() >= pa.min_pitch_rad - tol and u[:, :3].max() <= pa.max_pitch_rad + tol
+    # predicted pitch rates within +-8 deg/s (to the solver tolerance)
+    z = ctl._psi @ x + ctl._theta @ plan.ravel()
+    rates = z[ctl._prate_rows]
+    assert np.abs(rates).max() <= pa.max_rate_rad_s * (1 + 1e-3)
+    assert np.abs(rates).max() >= pa.max_rate_rad_s * 0.99   # it does bind here
+    tq = u[:, 3]
+    assert np.abs(np.diff(np.r_[model.u0[3], tq])).max() <= 15000.0 * 0.1 * (1 + 1e-3)
+
+
+def test_collective_variant(model, turbine: linearize.Turbine) -> None:
+    ctl = MPC(model, turbine, collective=True)
+    x = np.zeros(8)
+    x[2] = 0.01
+    pitch, tq = ctl.step(0.0, {"state": np.r_[model.x0 + x, np.zeros(9)]})
+    assert np.allclose(pitch, pitch[0]) and pitch[0] > model.u0[0]
+
+
+@pytest.mark.parametrize("kwargs, match", [
+    (dict(horizon=0), "horizon must be an integer >= 1"),
+    (dict(horizon=5, control_horizon=8), "must not exceed horizon"),
+    (dict(weights=None, dt=-0.1), "dt must be > 0"),
+])
+def test_bad_arguments(model, turbine, kwargs, match: str) -> None:
+    with pytest.raises(ValueError, match=match):
+        MPC(model, turbine, **kwargs)
+
+
+def test_negative_weight_is_rejected() -> None:
+    with pytest.raises(ValueError, match=r"weight 'rotor_speed' must be finite and >= 0 "
+                                         r"\(the QP must be convex\)"):
+        MPCWeights(outputs={"rotor_speed": -1.0})
+
+
+def test_preview_of_wrong_shape(model, turbine) -> None:
+    ctl = MPC(model, turbine)
+    with pytest.raises(ValueError, match=r"d_preview has shape \(10, 3\); expected \(H_p, n_d\)"):
+        ctl.solve(np.zeros(8), np.zeros((10, 3)))
+    with pytest.raises(ValueError, match=r"x has shape \(7,\)"):
+        ctl.solve(np.zeros(7))
+
+
+def test_mpc_in_the_loop_respects_limits(turbine: linearize.Turbine,
+                                         params: linearize.PlantParams, model) -> None:
+    from mpc_wt.simulate import simulate_closed_loop
+
+    op = linearize.trim(turbine, 18.0)
+    ctl = MPC(model, turbine)
+    r = simulate_closed_loop(params, ctl, linearize.SteadyWind(18.0, 0.2), 30.0, x0=op.x,
+                             u0=op.u, controller_dt=0.1)
+    late = r.t > 5
+    assert abs(r.channel("gen_power")[late].mean() / 5e6 - 1) < 0.02
+    assert np.all(r.controller["qp_fallback"] == 0)
+    pa = turbine.pitch_actuator
+    assert r.x[:, 5:8].min() >= pa.min_pitch_rad - 1e-9
+    assert np.abs(np.diff(r.x[:, 5:8], axis=0)).max() / r.t[1] <= pa.max_rate_rad_s * (1 + 1e-6)
