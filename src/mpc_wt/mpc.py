@@ -106,12 +106,16 @@ class MPC:
         One collective pitch input instead of three (Madsen's comparison controller).
     solver_options : dict
         Passed to OSQP (defaults: eps_abs = eps_rel = 1e-6, polish off, warm start).
+    backend : {"osqp", "daqp"}
+        OSQP (operator splitting, the default) or DAQP (dual active set, exact to its
+        tolerances on these small dense QPs; ``pip install 'mpc-wt[daqp]'``).
     """
 
     def __init__(self, model: linearize.LinearModel, turbine: linearize.Turbine, *,
                  dt: float = 0.1, horizon: int = 15, control_horizon: int | None = None,
                  weights: MPCWeights | None = None, collective: bool = False,
-                 solver_options: dict[str, Any] | None = None) -> None:
+                 solver_options: dict[str, Any] | None = None,
+                 backend: str = "osqp") -> None:
         hu = horizon if control_horizon is None else control_horizon
         for name, v in (("horizon", horizon), ("control_horizon", hu)):
             if not isinstance(v, (int, np.integer)) or v < 1:
@@ -120,6 +124,15 @@ class MPC:
             raise ValueError(f"control_horizon ({hu}) must not exceed horizon ({horizon})")
         if not (math.isfinite(dt) and dt > 0):
             raise ValueError(f"dt must be > 0 s, got {dt!r}")
+        if backend not in ("osqp", "daqp"):
+            raise ValueError(f"backend must be 'osqp' or 'daqp', got {backend!r}")
+        if backend == "daqp":
+            try:
+                import daqp  # noqa: F401
+            except ImportError as err:
+                raise ImportError("backend='daqp' needs daqp: pip install 'mpc-wt[daqp]'") \
+                    from err
+        self.backend = backend
         self.turbine = turbine
         self.dt = float(dt)
         self.hp, self.hu = int(horizon), int(hu)
@@ -200,6 +213,10 @@ class MPC:
                              f"{lam_min:g})")
         self._psi, self._theta, self._phi = psi, theta, phi
         self._qbar, self._wr, self._dmat = qbar, wr, dmat
+        # per-step work reduces to small products with these (precomputed per operating point)
+        g = theta.T @ qbar
+        self._g_x, self._g_d = g @ psi, g @ phi
+        self._dwr = dmat.T @ wr
         self._nx, self._nu, self._nd, self._nz = nx, nu, nd, nz
         # constraints: absolute input bounds (all hu moves), torque rate, pitch rate via the
         # pitch-rate outputs over the horizon
@@ -209,6 +226,7 @@ class MPC:
         prate = [k for k, n in enumerate(m.outputs) if n.startswith("pitch_rate_")]
         self._prate_rows = np.array([i * nz + k for i in range(hp) for k in prate])
         rows.append(theta[self._prate_rows])
+        self._pr_x, self._pr_d = psi[self._prate_rows], phi[self._prate_rows]
         acon = np.vstack(rows)
         # scaling (OSQP converges far faster on well-scaled problems): decision variables in
         # units of the input scales, constraint rows divided by their limits
@@ -228,6 +246,8 @@ class MPC:
         opts = dict(eps_abs=1e-6, eps_rel=1e-6, polishing=False, warm_starting=True,
                     verbose=False, max_iter=4000)
         opts.update(solver_options)
+        self._h_s = np.ascontiguousarray(h_s)
+        self._a_gen_s = np.ascontiguousarray(acon_s[hu * nu:])   # rows after the box bounds
         self._solver = osqp.OSQP()
         self._solver.setup(P=sp.triu(sp.csc_matrix(h_s)).tocsc(), q=np.zeros(hu * nu),
                            A=sp.csc_matrix(acon_s), l=-np.inf * np.ones(acon.shape[0]),
@@ -265,10 +285,8 @@ class MPC:
                                  f"({hp}, {nd})")
             dvec = dp.ravel()
         up = np.zeros(nu) if u_prev is None else np.asarray(u_prev, float)
-        free = self._psi @ x + self._phi @ dvec
-        e0 = np.zeros(hu * nu)
-        e0[:nu] = up                                   # D u - e0 = moves, first from u_prev
-        q = self._theta.T @ self._qbar @ free - self._dmat.T @ self._wr @ e0
+        # q = Theta' Qbar (Psi x + Phi d) - D' W e0, with D u - e0 the moves from u_prev
+        q = self._g_x @ x + self._g_d @ dvec - self._dwr[:, :nu] @ up
         u0 = self.model.u0
         lim = self._limits
         if self.collective:
@@ -280,10 +298,18 @@ class MPC:
         tr = np.full(hu, lim["trate"])
         tr_off = np.zeros(hu)
         tr_off[0] = up[-1]
-        pr_free = free[self._prate_rows]
+        pr_free = self._pr_x @ x + self._pr_d @ dvec
         lo = np.concatenate([lo_u, -tr + tr_off, -lim["rate"] - pr_free])
         hi = np.concatenate([hi_u, tr + tr_off, lim["rate"] - pr_free])
         rs = self._row_s
+        if self.backend == "daqp":
+            import daqp
+
+            xs, _, flag, _ = daqp.solve(self._h_s, q * self._su, self._a_gen_s, hi / rs,
+                                        lo / rs)
+            status = "solved" if flag == 1 else f"daqp exitflag {flag}"
+            ok = flag == 1 and np.all(np.isfinite(xs))
+            return ((np.asarray(xs) * self._su).reshape(hu, nu) if ok else None), status
         self._solver.update(q=q * self._su, l=lo / rs, u=hi / rs)
         res = self._solver.solve(raise_error=False)
         status = res.info.status

@@ -134,3 +134,21 @@ def test_mpc_in_the_loop_respects_limits(turbine: linearize.Turbine,
     pa = turbine.pitch_actuator
     assert r.x[:, 5:8].min() >= pa.min_pitch_rad - 1e-9
     assert np.abs(np.diff(r.x[:, 5:8], axis=0)).max() / r.t[1] <= pa.max_rate_rad_s * (1 + 1e-6)
+
+
+@pytest.mark.parametrize("overspeed", [0.005, 0.3])
+def test_daqp_backend_agrees_with_osqp(model, turbine, overspeed: float) -> None:
+    pytest.importorskip("daqp")
+    x = np.zeros(8)
+    x[2] = overspeed
+    a, sa = MPC(model, turbine).solve(x)
+    b, sb = MPC(model, turbine, backend="daqp").solve(x)
+    assert sa == sb == "solved"
+    # issue 6: first moves agree within 0.01 deg pitch and 0.1 % of rated torque
+    assert np.abs(a[0, :3] - b[0, :3]).max() < math.radians(0.01)
+    assert abs(a[0, 3] - b[0, 3]) < 0.001 * 43093.55
+
+
+def test_unknown_backend(model, turbine) -> None:
+    with pytest.raises(ValueError, match="backend must be 'osqp' or 'daqp'"):
+        MPC(model, turbine, backend="qpoases")
