@@ -240,14 +240,32 @@ class MPC:
         self._acon = acon
         self._n_box = hu * nu
         self._n_trate = hu
-        self._limits = dict(pmin=pa.min_pitch_rad, pmax=pa.max_pitch_rad,
-                            rate=pa.max_rate_rad_s, tmin=gen.min_torque, tmax=gen.max_torque,
-                            trate=gen.max_torque_rate * self.dt)
         opts = dict(eps_abs=1e-6, eps_rel=1e-6, polishing=False, warm_starting=True,
                     verbose=False, max_iter=4000)
         opts.update(solver_options)
+        u0 = self.model.u0
+        if self.collective:
+            lo_u = np.tile([pa.min_pitch_rad - u0[0], gen.min_torque - u0[3]], hu)
+            hi_u = np.tile([pa.max_pitch_rad - u0[0], gen.max_torque - u0[3]], hu)
+        else:
+            lo_u = np.tile(np.r_[np.full(3, pa.min_pitch_rad) - u0[:3], gen.min_torque - u0[3]],
+                           hu)
+            hi_u = np.tile(np.r_[np.full(3, pa.max_pitch_rad) - u0[:3], gen.max_torque - u0[3]],
+                           hu)
+        trate = np.full(hu, gen.max_torque_rate * self.dt)
+        prate_lim = np.full(len(self._prate_rows), pa.max_rate_rad_s)
+        self._inv_rs = 1.0 / row_s
+        self._lo_s = np.concatenate([lo_u, -trate, -prate_lim]) * self._inv_rs
+        self._hi_s = np.concatenate([hi_u, trate, prate_lim]) * self._inv_rs
         self._h_s = np.ascontiguousarray(h_s)
         self._a_gen_s = np.ascontiguousarray(acon_s[hu * nu:])   # rows after the box bounds
+        self._daqp = None
+        if self.backend == "daqp":
+            import daqp
+
+            big = np.full(acon.shape[0], 1e30)
+            self._daqp = daqp.Model()
+            self._daqp.setup(self._h_s, np.zeros(hu * nu), self._a_gen_s, big, -big)
         self._solver = osqp.OSQP()
         self._solver.setup(P=sp.triu(sp.csc_matrix(h_s)).tocsc(), q=np.zeros(hu * nu),
                            A=sp.csc_matrix(acon_s), l=-np.inf * np.ones(acon.shape[0]),
@@ -276,9 +294,7 @@ class MPC:
         x = np.asarray(x, float)
         if x.shape != (nx,):
             raise ValueError(f"x has shape {x.shape}; expected (n_x,) = ({nx},)")
-        if d_preview is None:
-            dvec = np.zeros(hp * nd)
-        else:
+        if d_preview is not None:
             dp = np.asarray(d_preview, float)
             if dp.shape != (hp, nd):
                 raise ValueError(f"d_preview has shape {dp.shape}; expected (H_p, n_d) = "
@@ -286,31 +302,27 @@ class MPC:
             dvec = dp.ravel()
         up = np.zeros(nu) if u_prev is None else np.asarray(u_prev, float)
         # q = Theta' Qbar (Psi x + Phi d) - D' W e0, with D u - e0 the moves from u_prev
-        q = self._g_x @ x + self._g_d @ dvec - self._dwr[:, :nu] @ up
-        u0 = self.model.u0
-        lim = self._limits
-        if self.collective:
-            lo_u = np.tile([lim["pmin"] - u0[0], lim["tmin"] - u0[3]], hu)
-            hi_u = np.tile([lim["pmax"] - u0[0], lim["tmax"] - u0[3]], hu)
-        else:
-            lo_u = np.tile(np.r_[np.full(3, lim["pmin"]) - u0[:3], lim["tmin"] - u0[3]], hu)
-            hi_u = np.tile(np.r_[np.full(3, lim["pmax"]) - u0[:3], lim["tmax"] - u0[3]], hu)
-        tr = np.full(hu, lim["trate"])
-        tr_off = np.zeros(hu)
-        tr_off[0] = up[-1]
-        pr_free = self._pr_x @ x + self._pr_d @ dvec
-        lo = np.concatenate([lo_u, -tr + tr_off, -lim["rate"] - pr_free])
-        hi = np.concatenate([hi_u, tr + tr_off, lim["rate"] - pr_free])
-        rs = self._row_s
-        if self.backend == "daqp":
-            import daqp
-
-            xs, _, flag, _ = daqp.solve(self._h_s, q * self._su, self._a_gen_s, hi / rs,
-                                        lo / rs)
+        q = self._g_x @ x - self._dwr[:, :nu] @ up
+        pr = self._pr_x @ x
+        if d_preview is not None:
+            q += self._g_d @ dvec
+            pr += self._pr_d @ dvec
+        # bounds (scaled): constant parts precomputed; the first torque move is relative to
+        # u_prev and the pitch-rate rows to the free response
+        lo, hi = self._lo_s.copy(), self._hi_s.copy()
+        k0, k1 = self._n_box, self._n_box + self._n_trate
+        lo[k0] += up[-1] * self._inv_rs[k0]
+        hi[k0] += up[-1] * self._inv_rs[k0]
+        lo[k1:] -= pr * self._inv_rs[k1:]
+        hi[k1:] -= pr * self._inv_rs[k1:]
+        qs = q * self._su
+        if self._daqp is not None:
+            self._daqp.update(f=qs, bupper=hi, blower=lo)
+            xs, _, flag, _ = self._daqp.solve()
             status = "solved" if flag == 1 else f"daqp exitflag {flag}"
             ok = flag == 1 and np.all(np.isfinite(xs))
             return ((np.asarray(xs) * self._su).reshape(hu, nu) if ok else None), status
-        self._solver.update(q=q * self._su, l=lo / rs, u=hi / rs)
+        self._solver.update(q=qs, l=lo, u=hi)
         res = self._solver.solve(raise_error=False)
         status = res.info.status
         ok = res.x is not None and np.all(np.isfinite(res.x))
