@@ -30,7 +30,7 @@ import numba as nb
 import numpy as np
 
 import linearize
-from linearize.plant import _eval, _sample_wind
+from linearize.plant import _eval
 from linearize.steady import _avg_eval
 
 

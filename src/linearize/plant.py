@@ -250,7 +250,6 @@ def plant_params(turbine: Turbine, config: PlantConfig | None = None) -> PlantPa
     nblade = g.number_of_blades
     cone = g.precone_rad if cfg.aero.cone else 0.0
     tilt = g.shaft_tilt_rad if cfg.aero.tilt else 0.0
-    cc = math.cos(cone)
 
     # --- blade distributed properties on a fine grid
     lb = g.tip_radius - g.hub_radius
