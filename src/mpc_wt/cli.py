@@ -227,14 +227,14 @@ def _cmd_lidar_evaluate(args: argparse.Namespace) -> int:
 
 
 def _cmd_simulate(args: argparse.Namespace) -> int:
-    from .runs import run_baseline
+    from .runs import CONTROLLERS, run_controller
 
-    if args.controller != "baseline":
-        raise UsageError(f"--controller must be one of ['baseline'] (more come with the MPC "
-                         f"and synthesis issues), got {args.controller!r}")
+    if args.controller not in CONTROLLERS:
+        raise UsageError(f"--controller must be one of {list(CONTROLLERS)}, got "
+                         f"{args.controller!r}")
     turbine = linearize.load_turbine(args.turbine)
-    res = run_baseline(turbine, args.wind, args.turbulence, args.seed, args.duration,
-                       progress=True)
+    res = run_controller(turbine, args.controller, args.wind, args.turbulence, args.seed,
+                         args.duration, progress=True)
     out = Path(args.out)
     if out.suffix == "":
         out = out.with_suffix(".nc")
@@ -376,7 +376,8 @@ def _parser() -> argparse.ArgumentParser:
 
     p = sub.add_parser("simulate", help="closed-loop simulation on the plant")
     p.add_argument("--turbine", **turb)
-    p.add_argument("--controller", default="baseline", help="controller (baseline)")
+    p.add_argument("--controller", default="baseline",
+                   help="baseline | mpc | mpc-lidar | mpc-collective")
     p.add_argument("--wind", type=float, required=True, help="mean hub-height wind [m/s]")
     p.add_argument("--turbulence", choices=("A", "B", "C", "steady"), default="A")
     p.add_argument("--seed", type=int, default=1)

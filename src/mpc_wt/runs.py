@@ -15,7 +15,8 @@ from .assess import cs_measures, damage_equivalent_load, energy_Wh, harmonic_psd
 from .baseline import BaselineController, tune_baseline
 from .simulate import ClosedLoopResult, ResultFileError, simulate_closed_loop
 
-__all__ = ["DEFAULT_CHANNELS", "run_baseline", "load_series", "assess_series", "reductions"]
+__all__ = ["DEFAULT_CHANNELS", "CONTROLLERS", "run_controller", "run_baseline", "load_series",
+           "assess_series", "reductions"]
 
 #: Load channels and their default Woehler exponents (10 composite blades, 4 steel elsewhere).
 DEFAULT_CHANNELS = {"flap_moment_1": 10.0, "flap_moment_2": 10.0, "flap_moment_3": 10.0,
@@ -25,27 +26,81 @@ DEFAULT_CHANNELS = {"flap_moment_1": 10.0, "flap_moment_2": 10.0, "flap_moment_3
                     "shaft_bending_blade1": 4.0}
 
 
+CONTROLLERS = ("baseline", "mpc", "mpc-lidar", "mpc-collective")
+
+
+def _wind(turbine: linearize.Turbine, wind_mps: float, turbulence: str, seed: int,
+          duration: float, shear_exponent: float) -> tuple[Any, lidar.WindField]:
+    """The plant's wind and the same field as a lidar.WindField (for a LIDAR in the loop)."""
+    hub = turbine.geometry.hub_height
+    if turbulence == "steady":
+        spec = lidar.TurbulenceSpec(wind_mps, 0.01, hub_height=hub, duration=duration + 20.0,
+                                    dt=1.0, n_y=8, n_z=8, shear_exponent=shear_exponent)
+        t, y, z = spec.grid()
+        u = np.broadcast_to(wind_mps * (z / hub) ** shear_exponent, (t.size, y.size, z.size))
+        zero = np.zeros(u.shape)
+        f = lidar.WindField(t=t, y=y, z=z, u=u, v=zero, w=zero, mean_speed=wind_mps,
+                            hub_height=hub, meta={"model": "steady power law"})
+        return linearize.SteadyWind(wind_mps, shear_exponent), f
+    spec = lidar.TurbulenceSpec(wind_mps, turbulence, hub_height=hub, duration=duration + 20.0,
+                                shear_exponent=shear_exponent)
+    f = lidar.generate_field(spec, seed)
+    return linearize.GridWind(t=f.t, y=f.y, z=f.z, u=np.maximum(f.u, 0.0)), f
+
+
+def run_controller(turbine: linearize.Turbine, controller: str, wind_mps: float,
+                   turbulence: str = "A", seed: int = 1, duration: float = 600.0,
+                   progress: bool = False, shear_exponent: float = 0.2) -> ClosedLoopResult:
+    """Trim, design the controller, generate the wind and simulate.
+
+    ``controller``: "baseline" (tuned PI and torque law, 80 Hz), "mpc" (Madsen's 8-state
+    individual-pitch MPC at 10 Hz, disturbance held at the mean), "mpc-collective" (the same with
+    one pitch input), "mpc-lidar" (individual pitch with the preview of a CW LIDAR -- range
+    weighting and LOS error on -- measuring the field the plant meets).
+    """
+    if controller not in CONTROLLERS:
+        raise ValueError(f"controller must be one of {list(CONTROLLERS)}, got {controller!r}")
+    params = linearize.plant_params(turbine)
+    wind, field = _wind(turbine, wind_mps, turbulence, seed, duration, shear_exponent)
+    op = linearize.trim(turbine, wind_mps)
+    meta: dict[str, Any] = {"controller": controller, "wind_mps": wind_mps,
+                            "turbulence": turbulence, "seed": seed, "duration_s": duration,
+                            "shear_exponent": shear_exponent, "turbine": turbine.name}
+    preview = None
+    cdt = None
+    if controller == "baseline":
+        gains = tune_baseline(turbine)
+        ctl: Any = BaselineController(turbine, gains)
+        meta["gains"] = {"kp": gains.kp, "ki": gains.ki, "theta_k_rad": gains.theta_k_rad,
+                         "k_opt": gains.k_opt}
+    else:
+        from .mpc import MPC
+
+        try:
+            import daqp  # noqa: F401
+            backend = "daqp"
+        except ImportError:
+            backend = "osqp"
+        model = linearize.linearize(turbine, wind_mps, config=linearize.PlantConfig.madsen(),
+                                    params=None)
+        ctl = MPC(model, turbine, collective=controller == "mpc-collective", backend=backend)
+        cdt = ctl.dt
+        meta["mpc"] = {"horizon": ctl.hp, "backend": backend, "dt": ctl.dt}
+        if controller == "mpc-lidar":
+            from .simulate import LidarPreview
+
+            preview = LidarPreview(lidar.CWLidar(turbine.geometry.tip_radius), field, ctl.hp,
+                                   ctl.dt)
+    return simulate_closed_loop(params, ctl, wind, duration, x0=op.x, u0=op.u,
+                                controller_dt=cdt, preview=preview, progress=progress, meta=meta)
+
+
 def run_baseline(turbine: linearize.Turbine, wind_mps: float, turbulence: str = "A",
                  seed: int = 1, duration: float = 600.0, progress: bool = False,
                  shear_exponent: float = 0.2) -> ClosedLoopResult:
     """Trim, tune the baseline, generate the wind and simulate (the main job's run)."""
-    params = linearize.plant_params(turbine)
-    gains = tune_baseline(turbine)
-    if turbulence == "steady":
-        wind: Any = linearize.SteadyWind(wind_mps, shear_exponent)
-    else:
-        spec = lidar.TurbulenceSpec(wind_mps, turbulence, hub_height=turbine.geometry.hub_height,
-                                    duration=duration + 10.0, shear_exponent=shear_exponent)
-        f = lidar.generate_field(spec, seed)
-        wind = linearize.GridWind(t=f.t, y=f.y, z=f.z, u=np.maximum(f.u, 0.0))
-    op = linearize.trim(turbine, wind_mps)
-    meta = {"controller": "baseline", "wind_mps": wind_mps, "turbulence": turbulence,
-            "seed": seed, "duration_s": duration, "shear_exponent": shear_exponent,
-            "turbine": turbine.name, "gains": {"kp": gains.kp, "ki": gains.ki,
-                                               "theta_k_rad": gains.theta_k_rad,
-                                               "k_opt": gains.k_opt}}
-    return simulate_closed_loop(params, BaselineController(turbine, gains), wind, duration,
-                                x0=op.x, u0=op.u, progress=progress, meta=meta)
+    return run_controller(turbine, "baseline", wind_mps, turbulence, seed, duration, progress,
+                          shear_exponent)
 
 
 def load_series(path: str | Path, time_column: str = "time") -> tuple[np.ndarray,

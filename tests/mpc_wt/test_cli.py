@@ -166,7 +166,7 @@ def test_assess_csv_from_another_tool(tmp_path: Path, capsys: pytest.CaptureFixt
 
 @pytest.mark.parametrize("argv, match", [
     (["assess", "/no/run.nc"], "file not found"),
-    (["simulate", "--controller", "mpc", "--wind", "18", "--out", "x"],
+    (["simulate", "--controller", "lqr", "--wind", "18", "--out", "x"],
      "--controller must be one of"),
 ])
 def test_simulate_assess_errors(argv, match: str, capsys: pytest.CaptureFixture[str]) -> None:
@@ -179,3 +179,19 @@ def test_assess_unknown_channel(tmp_path: Path, capsys: pytest.CaptureFixture[st
     p.write_text("time,x\n0,1\n1,2\n2,1\n3,2\n")
     assert main(["assess", str(p), "--channels", "y"]) == 2
     assert "no channel 'y'" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("controller", ["mpc", "mpc-lidar", "mpc-collective"])
+def test_simulate_mpc_controllers(controller: str, tmp_path: Path,
+                                  capsys: pytest.CaptureFixture[str]) -> None:
+    out = tmp_path / f"{controller}.nc"
+    assert main(["simulate", "--controller", controller, "--wind", "18", "--turbulence", "B",
+                 "--duration", "20", "--out", str(out)]) == 0
+    assert "mean power" in capsys.readouterr().out
+    from mpc_wt.simulate import ClosedLoopResult
+
+    r = ClosedLoopResult.load(out)
+    assert r.meta["controller"] == controller and r.meta["mpc"]["horizon"] == 15
+    assert np.all(r.controller["qp_fallback"] == 0)
+    if controller == "mpc-collective":
+        assert np.allclose(r.u[:, 0], r.u[:, 2])
