@@ -337,6 +337,16 @@ def _cmd_run(args: argparse.Namespace) -> int:
     return 0
 
 
+def _cmd_bench_mpc(args: argparse.Namespace) -> int:
+    from .bench import format_table, plot_solver_times, run_solver_benchmark
+
+    res = run_solver_benchmark(args.steps, progress=not args.json)
+    print(json.dumps(res, indent=1) if args.json else format_table(res))
+    if args.plot:
+        plot_solver_times(res, args.plot)
+    return 0
+
+
 def _parser() -> argparse.ArgumentParser:
     ap = argparse.ArgumentParser(prog="mpcwt", description=__doc__.split("\n")[0])
     sub = ap.add_subparsers(dest="command", required=True)
@@ -424,6 +434,14 @@ def _parser() -> argparse.ArgumentParser:
     q.add_argument("--json", action="store_true")
     q.add_argument("--plots", help="directory for lidar_coherence.png and lidar_scan.png")
     q.set_defaults(func=_cmd_lidar_evaluate)
+
+    p = sub.add_parser("bench", help="benchmarks")
+    bench = p.add_subparsers(dest="bench_command", required=True)
+    q = bench.add_parser("mpc", help="MPC QP solver comparison on a closed-loop run (18 m/s)")
+    q.add_argument("--steps", type=int, default=3000, help="closed-loop steps (default 3000)")
+    q.add_argument("--json", action="store_true")
+    q.add_argument("--plot", help="PNG of the solve times")
+    q.set_defaults(func=_cmd_bench_mpc)
 
     p = sub.add_parser("aero", help="rotor aerodynamics")
     aero = p.add_subparsers(dest="aero_command", required=True)

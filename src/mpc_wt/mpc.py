@@ -147,6 +147,7 @@ class MPC:
             raise ValueError(f"model lacks Madsen outputs {missing}")
         self.model = m.select(outputs=zsel)
         self.x_names = m.states
+        self._x_idx = np.array([linearize.STATE_NAMES.index(n) for n in m.states])
         self._build(solver_options or {})
         self.reset()
 
@@ -257,6 +258,21 @@ class MPC:
         self._inv_rs = 1.0 / row_s
         self._lo_s = np.concatenate([lo_u, -trate, -prate_lim]) * self._inv_rs
         self._hi_s = np.concatenate([hi_u, trate, prate_lim]) * self._inv_rs
+        # every step's QP vectors [q_s; lo; hi] are affine in (x, d, u_prev): precompute the
+        # maps so that a step costs three matrix-vector products
+        ncon = len(row_s)
+        k0, k1 = hu * nu, hu * nu + hu
+        lx = np.zeros((ncon, nx))
+        lx[k1:] = -self._pr_x * self._inv_rs[k1:, None]
+        ld = np.zeros((ncon, phi.shape[1]))
+        ld[k1:] = -self._pr_d * self._inv_rs[k1:, None]
+        lu = np.zeros((ncon, nu))
+        lu[k0, nu - 1] = self._inv_rs[k0]
+        self._w0 = np.concatenate([np.zeros(hu * nu), self._lo_s, self._hi_s])
+        self._wx = np.ascontiguousarray(np.vstack([su[:, None] * self._g_x, lx, lx]))
+        self._wd = np.ascontiguousarray(np.vstack([su[:, None] * self._g_d, ld, ld]))
+        self._wu = np.ascontiguousarray(np.vstack([-su[:, None] * self._dwr[:, :nu], lu, lu]))
+        self._nv, self._ncon = hu * nu, ncon
         self._h_s = np.ascontiguousarray(h_s)
         self._a_gen_s = np.ascontiguousarray(acon_s[hu * nu:])   # rows after the box bounds
         self._daqp = None
@@ -301,26 +317,19 @@ class MPC:
                                  f"({hp}, {nd})")
             dvec = dp.ravel()
         up = np.zeros(nu) if u_prev is None else np.asarray(u_prev, float)
-        # q = Theta' Qbar (Psi x + Phi d) - D' W e0, with D u - e0 the moves from u_prev
-        q = self._g_x @ x - self._dwr[:, :nu] @ up
-        pr = self._pr_x @ x
+        # q = Theta' Qbar (Psi x + Phi d) - D' W e0 (D u - e0: the moves from u_prev); the first
+        # torque-move bound is relative to u_prev, the pitch-rate rows to the free response
+        w = self._w0 + self._wx @ x + self._wu @ up
         if d_preview is not None:
-            q += self._g_d @ dvec
-            pr += self._pr_d @ dvec
-        # bounds (scaled): constant parts precomputed; the first torque move is relative to
-        # u_prev and the pitch-rate rows to the free response
-        lo, hi = self._lo_s.copy(), self._hi_s.copy()
-        k0, k1 = self._n_box, self._n_box + self._n_trate
-        lo[k0] += up[-1] * self._inv_rs[k0]
-        hi[k0] += up[-1] * self._inv_rs[k0]
-        lo[k1:] -= pr * self._inv_rs[k1:]
-        hi[k1:] -= pr * self._inv_rs[k1:]
-        qs = q * self._su
+            w += self._wd @ dvec
+        nv, nc = self._nv, self._ncon
+        qs, lo, hi = w[:nv], w[nv:nv + nc], w[nv + nc:]
+        self._last_qp = (qs, lo, hi)
         if self._daqp is not None:
             self._daqp.update(f=qs, bupper=hi, blower=lo)
             xs, _, flag, _ = self._daqp.solve()
             status = "solved" if flag == 1 else f"daqp exitflag {flag}"
-            ok = flag == 1 and np.all(np.isfinite(xs))
+            ok = flag == 1 and math.isfinite(xs.sum())
             return ((np.asarray(xs) * self._su).reshape(hu, nu) if ok else None), status
         self._solver.update(q=qs, l=lo, u=hi)
         res = self._solver.solve(raise_error=False)
@@ -329,14 +338,25 @@ class MPC:
         plan = (res.x * self._su).reshape(hu, nu) if ok else None
         return plan, status
 
+    def qp(self) -> dict[str, np.ndarray]:
+        """The scaled QP of the last :meth:`solve`, for other solvers and checks:
+        minimise 0.5 v'Hv + q'v over v with lo_box <= v <= hi_box and lo <= A v <= hi; the
+        inputs are ``v * scale`` (H_u n_u, input deviations stacked by step)."""
+        if getattr(self, "_last_qp", None) is None:
+            raise RuntimeError("no QP yet: call solve() first")
+        qs, lo, hi = self._last_qp
+        nb = self._n_box
+        return {"H": self._h_s, "q": qs.copy(), "A": self._a_gen_s, "lo": lo[nb:].copy(),
+                "hi": hi[nb:].copy(), "lo_box": lo[:nb].copy(), "hi_box": hi[:nb].copy(),
+                "scale": self._su.copy()}
+
     def step(self, t: float, meas: dict[str, Any]) -> tuple[np.ndarray, float]:
         """Harness step with full-state information (``meas["state"]``) and, optionally, a
         LIDAR preview (``meas["preview"]``, per-blade winds) as the disturbance."""
         if "state" not in meas:
             raise ValueError("the MPC needs full-state information: meas['state']")
         xfull = np.asarray(meas["state"], float)
-        idx = [linearize.STATE_NAMES.index(n) for n in self.x_names]
-        x = xfull[idx] - self.model.x0
+        x = xfull[self._x_idx] - self.model.x0
         dprev = None
         if "preview" in meas and meas["preview"] is not None:
             blade = np.asarray(meas["preview"].blade, float)[: self.hp]
