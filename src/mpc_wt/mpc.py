@@ -147,9 +147,41 @@ class MPC:
             raise ValueError(f"model lacks Madsen outputs {missing}")
         self.model = m.select(outputs=zsel)
         self.x_names = m.states
+        # "auto": use meas["preview"] when the harness gives one; from_turbine sets None/"lidar"
+        self.preview: str | None = "auto"
         self._x_idx = np.array([linearize.STATE_NAMES.index(n) for n in m.states])
         self._build(solver_options or {})
         self.reset()
+
+    @classmethod
+    def from_turbine(cls, turbine: linearize.Turbine, wind_mps: float, *,
+                     horizon: int = 15, preview: str | None = None,
+                     family: linearize.LinearModelFamily | None = None,
+                     **kwargs: Any) -> "MPC":
+        """Madsen's MPC for ``turbine`` at the mean wind ``wind_mps`` in a few words.
+
+        The model is the 8-state linearization of Madsen et al. (section II, eqs 1-19) at
+        ``wind_mps`` -- taken from ``family`` (interpolated; the wind must lie in its range) or
+        linearized now with :meth:`linearize.PlantConfig.madsen`. ``preview="lidar"`` makes the
+        controller require a preview (``meas["preview"]``) every step; ``None`` holds the
+        disturbance at the operating point and ignores any preview. Other keywords go to
+        :class:`MPC` (``control_horizon``, ``weights``, ``collective``, ``backend``, ...).
+        """
+        if preview not in (None, "lidar"):
+            raise ValueError(f"preview must be None or 'lidar', got {preview!r}")
+        if family is not None:
+            model = family.at(wind_mps)
+        else:
+            v = float(wind_mps) if isinstance(wind_mps, (int, float, np.floating)) else math.nan
+            op = turbine.operation
+            if not (math.isfinite(v) and op.cut_in_wind <= v <= op.cut_out_wind):
+                raise ValueError(f"wind_mps must be a finite mean wind within the turbine's "
+                                 f"operating range {op.cut_in_wind:g}..{op.cut_out_wind:g} m/s, "
+                                 f"got {wind_mps!r}")
+            model = linearize.linearize(turbine, v, config=linearize.PlantConfig.madsen())
+        ctl = cls(model, turbine, horizon=horizon, **kwargs)
+        ctl.preview = preview
+        return ctl
 
     # ------------------------------------------------------------------------------------
     def _weights(self) -> tuple[np.ndarray, np.ndarray]:
@@ -358,7 +390,10 @@ class MPC:
         xfull = np.asarray(meas["state"], float)
         x = xfull[self._x_idx] - self.model.x0
         dprev = None
-        if "preview" in meas and meas["preview"] is not None:
+        if self.preview == "lidar" and meas.get("preview") is None:
+            raise ValueError("this MPC was built with preview='lidar' but the harness gives no "
+                             "preview: pass simulate_closed_loop(..., preview=LidarPreview(...))")
+        if self.preview is not None and meas.get("preview") is not None:
             blade = np.asarray(meas["preview"].blade, float)[: self.hp]
             if blade.shape[0] < self.hp:
                 blade = np.vstack([blade, np.repeat(blade[-1:], self.hp - blade.shape[0], 0)])

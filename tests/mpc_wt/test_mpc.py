@@ -180,3 +180,41 @@ def test_lidar_preview_reduces_asymmetric_loads(turbine: linearize.Turbine,
         assert r.controller["qp_fallback"].sum() == 0
     for k in range(3):
         assert out["lidar"][k] < 0.8 * out["none"][k], (k, out)
+
+
+def test_from_turbine_matches_the_explicit_model(model, turbine) -> None:
+    ctl = MPC.from_turbine(turbine, 18.0, horizon=15)
+    ref = MPC(model, turbine)
+    x = np.zeros(8)
+    x[2] = 0.05
+    assert_allclose(ctl.solve(x)[0], ref.solve(x)[0], atol=1e-9)
+
+
+@pytest.mark.parametrize("wind", [math.nan, -3.0, 40.0, "18"])
+def test_from_turbine_rejects_wind_outside_the_operating_range(turbine, wind) -> None:
+    with pytest.raises(ValueError, match=r"wind_mps must be a finite mean wind within the "
+                                         r"turbine's operating range 3\.\.25 m/s, got"):
+        MPC.from_turbine(turbine, wind)
+
+
+def test_from_turbine_rejects_wind_outside_the_family(turbine) -> None:
+    fam = linearize.linearize_family(turbine, [16.0, 18.0],
+                                     config=linearize.PlantConfig.madsen())
+    ctl = MPC.from_turbine(turbine, 17.0, family=fam)
+    assert ctl.model.A.shape == (8, 8)
+    with pytest.raises(ValueError, match=r"wind_mps = 20 m/s is outside the family's range "
+                                         r"16\.\.18 m/s"):
+        MPC.from_turbine(turbine, 20.0, family=fam)
+
+
+def test_from_turbine_preview_modes(turbine, params: linearize.PlantParams) -> None:
+    from mpc_wt.simulate import simulate_closed_loop
+
+    with pytest.raises(ValueError, match="preview must be None or 'lidar', got 'radar'"):
+        MPC.from_turbine(turbine, 18.0, preview="radar")
+    ctl = MPC.from_turbine(turbine, 18.0, preview="lidar")
+    op = linearize.trim(turbine, 18.0)
+    with pytest.raises(ValueError, match="built with preview='lidar' but the harness gives no "
+                                         "preview"):
+        simulate_closed_loop(params, ctl, linearize.SteadyWind(18.0, 0.2), 1.0, x0=op.x,
+                             u0=op.u, controller_dt=0.1)
