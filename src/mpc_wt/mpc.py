@@ -109,13 +109,23 @@ class MPC:
     backend : {"osqp", "daqp"}
         OSQP (operator splitting, the default) or DAQP (dual active set, exact to its
         tolerances on these small dense QPs; ``pip install 'mpc-wt[daqp]'``).
+    max_rotor_speed : float or None
+        Soft output constraint [rad/s]: the predicted rotor speed stays below it unless a slack
+        variable s_i >= 0 pays for the excess (one slack per predicted step, cost
+        ``slack_weight * (s_i/scale)^2 + slack_linear * s_i/scale`` with the rotor-speed scale;
+        the largest is reported as the ``rotor_speed_slack`` signal). With
+        the linear term large enough the penalty is exact: the slack is zero whenever the hard
+        constraint is feasible, and the QP is always feasible. None (default): no constraint.
+    slack_weight, slack_linear : float
+        Quadratic and linear slack penalties (defaults 1e4 and 1e3), > 0.
     """
 
     def __init__(self, model: linearize.LinearModel, turbine: linearize.Turbine, *,
                  dt: float = 0.1, horizon: int = 15, control_horizon: int | None = None,
                  weights: MPCWeights | None = None, collective: bool = False,
                  solver_options: dict[str, Any] | None = None,
-                 backend: str = "osqp") -> None:
+                 backend: str = "osqp", max_rotor_speed: float | None = None,
+                 slack_weight: float = 1e4, slack_linear: float = 1e3) -> None:
         hu = horizon if control_horizon is None else control_horizon
         for name, v in (("horizon", horizon), ("control_horizon", hu)):
             if not isinstance(v, (int, np.integer)) or v < 1:
@@ -132,6 +142,16 @@ class MPC:
             except ImportError as err:
                 raise ImportError("backend='daqp' needs daqp: pip install 'mpc-wt[daqp]'") \
                     from err
+        if max_rotor_speed is not None and not (isinstance(max_rotor_speed, (int, float))
+                                                and math.isfinite(max_rotor_speed)
+                                                and max_rotor_speed > 0):
+            raise ValueError(f"max_rotor_speed must be a finite speed > 0 rad/s or None, got "
+                             f"{max_rotor_speed!r}")
+        for name, v in (("slack_weight", slack_weight), ("slack_linear", slack_linear)):
+            if not (math.isfinite(v) and v > 0):
+                raise ValueError(f"{name} must be finite and > 0, got {v!r}")
+        self.max_rotor_speed = None if max_rotor_speed is None else float(max_rotor_speed)
+        self.slack_weight, self.slack_linear = float(slack_weight), float(slack_linear)
         self.backend = backend
         self.turbine = turbine
         self.dt = float(dt)
@@ -260,18 +280,36 @@ class MPC:
         self._prate_rows = np.array([i * nz + k for i in range(hp) for k in prate])
         rows.append(theta[self._prate_rows])
         self._pr_x, self._pr_d = psi[self._prate_rows], phi[self._prate_rows]
+        soft = self.max_rotor_speed is not None
+        ns = hp if soft else 0                         # one slack per predicted step
+        if soft:                                       # rotor-speed rows, minus the slack
+            ks = m.outputs.index("rotor_speed")
+            self._speed_rows = np.array([i * nz + ks for i in range(hp)])
+            rows.append(theta[self._speed_rows])
         acon = np.vstack(rows)
         # scaling (OSQP converges far faster on well-scaled problems): decision variables in
         # units of the input scales, constraint rows divided by their limits
         su = np.tile([self.w.scales["pitch_ref"]] * (nu - 1) + [self.w.scales["gen_torque_ref"]],
                      hu)
+        sw = self.w.scales["rotor_speed"]
         row_s = np.concatenate([su, np.full(hu, gen.max_torque_rate * self.dt),
-                                np.full(len(self._prate_rows), pa.max_rate_rad_s)])
+                                np.full(len(self._prate_rows), pa.max_rate_rad_s),
+                                np.full(hp if soft else 0, sw)])
         self._su, self._row_s = su, row_s
         acon_s = (acon * su[None, :]) / row_s[:, None]
         h_s = h * np.outer(su, su)
+        if soft:   # the slack: last variable (scaled by the rotor-speed scale), its own box row
+            acon_s = np.hstack([acon_s, np.zeros((acon_s.shape[0], ns))])
+            acon_s[-hp:, -ns:] = -np.eye(ns)
+            acon_s = np.vstack([acon_s[:hu * nu], np.eye(ns, hu * nu + ns, hu * nu),
+                                acon_s[hu * nu:]])
+            h_s = np.pad(h_s, ((0, ns), (0, ns)))
+            h_s[-ns:, -ns:] = 2.0 * self.slack_weight * np.eye(ns)
+            row_s = np.concatenate([row_s[:hu * nu], np.full(ns, sw), row_s[hu * nu:]])
+            su = np.append(su, np.full(ns, sw))
+            self._su, self._row_s = su, row_s
         self._acon = acon
-        self._n_box = hu * nu
+        self._n_box = hu * nu + ns
         self._n_trate = hu
         opts = dict(eps_abs=1e-6, eps_rel=1e-6, polishing=False, warm_starting=True,
                     verbose=False, max_iter=4000)
@@ -287,37 +325,56 @@ class MPC:
                            hu)
         trate = np.full(hu, gen.max_torque_rate * self.dt)
         prate_lim = np.full(len(self._prate_rows), pa.max_rate_rad_s)
+        big = 1e20
+        if soft:
+            lim = self.max_rotor_speed - self.model.z0[m.outputs.index("rotor_speed")]
+            lo_u, hi_u = np.append(lo_u, np.zeros(ns)), np.append(hi_u, np.full(ns, big * sw))
+            spd_lo, spd_hi = np.full(hp, -big * sw), np.full(hp, lim)
+        else:
+            spd_lo = spd_hi = np.zeros(0)
         self._inv_rs = 1.0 / row_s
-        self._lo_s = np.concatenate([lo_u, -trate, -prate_lim]) * self._inv_rs
-        self._hi_s = np.concatenate([hi_u, trate, prate_lim]) * self._inv_rs
+        self._lo_s = np.concatenate([lo_u, -trate, -prate_lim, spd_lo]) * self._inv_rs
+        self._hi_s = np.concatenate([hi_u, trate, prate_lim, spd_hi]) * self._inv_rs
         # every step's QP vectors [q_s; lo; hi] are affine in (x, d, u_prev): precompute the
         # maps so that a step costs three matrix-vector products
         ncon = len(row_s)
-        k0, k1 = hu * nu, hu * nu + hu
+        nvu = hu * nu
+        k0, k1 = nvu + ns, nvu + ns + hu        # first torque-move row, first pitch-rate row
+        free_x, free_d = self._pr_x, self._pr_d
+        if soft:
+            free_x = np.vstack([free_x, psi[self._speed_rows]])
+            free_d = np.vstack([free_d, phi[self._speed_rows]])
         lx = np.zeros((ncon, nx))
-        lx[k1:] = -self._pr_x * self._inv_rs[k1:, None]
+        lx[k1:] = -free_x * self._inv_rs[k1:, None]
         ld = np.zeros((ncon, phi.shape[1]))
-        ld[k1:] = -self._pr_d * self._inv_rs[k1:, None]
+        ld[k1:] = -free_d * self._inv_rs[k1:, None]
         lu = np.zeros((ncon, nu))
         lu[k0, nu - 1] = self._inv_rs[k0]
-        self._w0 = np.concatenate([np.zeros(hu * nu), self._lo_s, self._hi_s])
-        self._wx = np.ascontiguousarray(np.vstack([su[:, None] * self._g_x, lx, lx]))
-        self._wd = np.ascontiguousarray(np.vstack([su[:, None] * self._g_d, ld, ld]))
-        self._wu = np.ascontiguousarray(np.vstack([-su[:, None] * self._dwr[:, :nu], lu, lu]))
-        self._nv, self._ncon = hu * nu, ncon
+        gx, gd = np.zeros((nvu + ns, nx)), np.zeros((nvu + ns, phi.shape[1]))
+        gu = np.zeros((nvu + ns, nu))
+        gx[:nvu], gd[:nvu] = su[:nvu, None] * self._g_x, su[:nvu, None] * self._g_d
+        gu[:nvu] = -su[:nvu, None] * self._dwr[:, :nu]
+        q0 = np.zeros(nvu + ns)
+        if soft:
+            q0[-ns:] = self.slack_linear
+        self._w0 = np.concatenate([q0, self._lo_s, self._hi_s])
+        self._wx = np.ascontiguousarray(np.vstack([gx, lx, lx]))
+        self._wd = np.ascontiguousarray(np.vstack([gd, ld, ld]))
+        self._wu = np.ascontiguousarray(np.vstack([gu, lu, lu]))
+        self._nv, self._ncon, self._nvu = nvu + ns, ncon, nvu
         self._h_s = np.ascontiguousarray(h_s)
-        self._a_gen_s = np.ascontiguousarray(acon_s[hu * nu:])   # rows after the box bounds
+        self._a_gen_s = np.ascontiguousarray(acon_s[nvu + ns:])  # rows after the box bounds
         self._daqp = None
         if self.backend == "daqp":
             import daqp
 
-            big = np.full(acon.shape[0], 1e30)
+            big = np.full(acon_s.shape[0], 1e30)
             self._daqp = daqp.Model()
-            self._daqp.setup(self._h_s, np.zeros(hu * nu), self._a_gen_s, big, -big)
+            self._daqp.setup(self._h_s, np.zeros(nvu + ns), self._a_gen_s, big, -big)
         self._solver = osqp.OSQP()
-        self._solver.setup(P=sp.triu(sp.csc_matrix(h_s)).tocsc(), q=np.zeros(hu * nu),
-                           A=sp.csc_matrix(acon_s), l=-np.inf * np.ones(acon.shape[0]),
-                           u=np.inf * np.ones(acon.shape[0]), **opts)
+        self._solver.setup(P=sp.triu(sp.csc_matrix(h_s)).tocsc(), q=np.zeros(nvu + ns),
+                           A=sp.csc_matrix(acon_s), l=-np.inf * np.ones(acon_s.shape[0]),
+                           u=np.inf * np.ones(acon_s.shape[0]), **opts)
         self._h = h
 
     # ------------------------------------------------------------------------------------
@@ -325,6 +382,7 @@ class MPC:
         """Forget the previous plan and command."""
         self._plan: np.ndarray | None = None
         self._u_prev: np.ndarray | None = None
+        self._last_slack = 0.0
         self.signals: dict[str, float] = {}
 
     def _u_abs(self, du: np.ndarray) -> np.ndarray:
@@ -362,12 +420,17 @@ class MPC:
             xs, _, flag, _ = self._daqp.solve()
             status = "solved" if flag == 1 else f"daqp exitflag {flag}"
             ok = flag == 1 and math.isfinite(xs.sum())
-            return ((np.asarray(xs) * self._su).reshape(hu, nu) if ok else None), status
+            self._last_slack = float(xs[self._nvu:].max() * self._su[-1]) \
+                if ok and self._nv > self._nvu else 0.0
+            return ((xs[:self._nvu] * self._su[:self._nvu]).reshape(hu, nu) if ok else None), \
+                status
         self._solver.update(q=qs, l=lo, u=hi)
         res = self._solver.solve(raise_error=False)
         status = res.info.status
         ok = res.x is not None and np.all(np.isfinite(res.x))
-        plan = (res.x * self._su).reshape(hu, nu) if ok else None
+        plan = (res.x[:self._nvu] * self._su[:self._nvu]).reshape(hu, nu) if ok else None
+        self._last_slack = float(res.x[self._nvu:].max() * self._su[-1]) \
+            if ok and self._nv > self._nvu else 0.0
         return plan, status
 
     def qp(self) -> dict[str, np.ndarray]:
@@ -413,5 +476,6 @@ class MPC:
         self._plan = plan
         self._u_prev = plan[0].copy()
         u = self._u_abs(plan[0])
-        self.signals = {"qp_fallback": fallback, "pitch_ref_1": u[0], "torque_ref": u[3]}
+        self.signals = {"qp_fallback": fallback, "pitch_ref_1": u[0], "torque_ref": u[3],
+                        "rotor_speed_slack": self._last_slack}
         return u[:3], float(u[3])

@@ -218,3 +218,56 @@ def test_from_turbine_preview_modes(turbine, params: linearize.PlantParams) -> N
                                          "preview"):
         simulate_closed_loop(params, ctl, linearize.SteadyWind(18.0, 0.2), 1.0, x0=op.x,
                              u0=op.u, controller_dt=0.1)
+
+
+def _speeds(ctl: MPC, x: np.ndarray, plan: np.ndarray) -> np.ndarray:
+    """Predicted rotor-speed deviations over the horizon for a plan."""
+    k = ctl.model.outputs.index("rotor_speed")
+    z = ctl._psi @ x + ctl._theta @ plan.ravel()
+    return z[k::len(ctl.model.outputs)]
+
+
+@pytest.fixture(params=["osqp", "daqp"])
+def backend(request: pytest.FixtureRequest) -> str:
+    if request.param == "daqp":
+        pytest.importorskip("daqp")
+    return str(request.param)
+
+
+def test_soft_speed_limit_far_away_changes_nothing(model, turbine, backend: str) -> None:
+    w0 = model.z0[model.outputs.index("rotor_speed")]
+    x = np.zeros(8)
+    x[2], x[0] = 0.01, 0.02
+    a, sa = MPC(model, turbine, backend=backend, max_rotor_speed=w0 + 1.0).solve(x)
+    b, _ = MPC(model, turbine, backend=backend).solve(x)
+    assert sa == "solved"
+    assert np.abs(a[:, :3] - b[:, :3]).max() < math.radians(0.01)
+    assert np.abs(a[:, 3] - b[:, 3]).max() < 0.001 * turbine.rated_generator_torque
+
+
+def test_soft_speed_limit_keeps_the_qp_feasible(model, turbine, backend: str) -> None:
+    # the rotor already runs 0.03 rad/s fast, 0.01 above the limit: no input can change the
+    # first predicted speed, so a hard limit would be infeasible; the slack takes the excess
+    w0 = model.z0[model.outputs.index("rotor_speed")]
+    x = np.zeros(8)
+    x[2], x[3] = 0.03, 0.03 * turbine.drivetrain.gearbox_ratio
+    soft = MPC(model, turbine, backend=backend, max_rotor_speed=w0 + 0.02)
+    plan, status = soft.solve(x)
+    assert status == "solved"
+    assert soft._last_slack == pytest.approx(0.01, abs=1e-5)
+    free, _ = MPC(model, turbine, backend=backend).solve(x)
+    s_soft, s_free = _speeds(soft, x, plan), _speeds(soft, x, free)
+    assert np.all(s_soft <= s_free + 1e-6)
+    assert (s_free - s_soft).max() > 1e-3       # the limit acts: the rotor is slowed faster
+
+
+@pytest.mark.parametrize("kwargs, match", [
+    (dict(max_rotor_speed=-1.0), "max_rotor_speed must be a finite speed > 0 rad/s or None, "
+                                 "got -1.0"),
+    (dict(max_rotor_speed=math.nan), "max_rotor_speed must be a finite speed"),
+    (dict(max_rotor_speed=1.5, slack_weight=0.0), "slack_weight must be finite and > 0, got 0.0"),
+    (dict(max_rotor_speed=1.5, slack_linear=math.inf), "slack_linear must be finite and > 0"),
+])
+def test_soft_constraint_bad_arguments(model, turbine, kwargs, match: str) -> None:
+    with pytest.raises(ValueError, match=match):
+        MPC(model, turbine, **kwargs)
