@@ -118,6 +118,11 @@ class MPC:
         constraint is feasible, and the QP is always feasible. None (default): no constraint.
     slack_weight, slack_linear : float
         Quadratic and linear slack penalties (defaults 1e4 and 1e3), > 0.
+    estimator : None, "kalman" or KalmanEstimator
+        None (default): full-state information from the harness (``meas["state"]``), as in the
+        paper. "kalman": a :class:`~mpc_wt.estimator.KalmanEstimator` on the same model estimates
+        the states and the blade-effective winds from measured signals; without a preview the
+        disturbance over the horizon is held at the wind estimate.
     """
 
     def __init__(self, model: linearize.LinearModel, turbine: linearize.Turbine, *,
@@ -125,7 +130,8 @@ class MPC:
                  weights: MPCWeights | None = None, collective: bool = False,
                  solver_options: dict[str, Any] | None = None,
                  backend: str = "osqp", max_rotor_speed: float | None = None,
-                 slack_weight: float = 1e4, slack_linear: float = 1e3) -> None:
+                 slack_weight: float = 1e4, slack_linear: float = 1e3,
+                 estimator: Any = None) -> None:
         hu = horizon if control_horizon is None else control_horizon
         for name, v in (("horizon", horizon), ("control_horizon", hu)):
             if not isinstance(v, (int, np.integer)) or v < 1:
@@ -166,6 +172,14 @@ class MPC:
         if missing:
             raise ValueError(f"model lacks Madsen outputs {missing}")
         self.model = m.select(outputs=zsel)
+        if isinstance(estimator, str):
+            if estimator != "kalman":
+                raise ValueError(f"estimator must be None, 'kalman' or a KalmanEstimator, got "
+                                 f"{estimator!r}")
+            from .estimator import KalmanEstimator
+
+            estimator = KalmanEstimator(m)
+        self.estimator = estimator
         self.x_names = m.states
         # "auto": use meas["preview"] when the harness gives one; from_turbine sets None/"lidar"
         self.preview: str | None = "auto"
@@ -383,6 +397,8 @@ class MPC:
         self._plan: np.ndarray | None = None
         self._u_prev: np.ndarray | None = None
         self._last_slack = 0.0
+        if getattr(self, "estimator", None) is not None:
+            self.estimator.reset()
         self.signals: dict[str, float] = {}
 
     def _u_abs(self, du: np.ndarray) -> np.ndarray:
@@ -448,11 +464,19 @@ class MPC:
     def step(self, t: float, meas: dict[str, Any]) -> tuple[np.ndarray, float]:
         """Harness step with full-state information (``meas["state"]``) and, optionally, a
         LIDAR preview (``meas["preview"]``, per-blade winds) as the disturbance."""
-        if "state" not in meas:
-            raise ValueError("the MPC needs full-state information: meas['state']")
-        xfull = np.asarray(meas["state"], float)
-        x = xfull[self._x_idx] - self.model.x0
         dprev = None
+        if self.estimator is not None:
+            u_dev = (np.zeros(len(self.model.u0)) if self._u_prev is None
+                     else self._u_abs(self._u_prev) - self.model.u0)
+            x, dhat = self.estimator.update(self.estimator.measurement(meas), u_dev)
+            dprev = np.tile(dhat, (self.hp, 1))
+            self.signals_est = {f"wind_est_{i + 1}": float(v + self.model.d0[i])
+                                for i, v in enumerate(dhat)}
+        else:
+            if "state" not in meas:
+                raise ValueError("the MPC needs full-state information: meas['state'] (or "
+                                 "estimator='kalman')")
+            x = np.asarray(meas["state"], float)[self._x_idx] - self.model.x0
         if self.preview == "lidar" and meas.get("preview") is None:
             raise ValueError("this MPC was built with preview='lidar' but the harness gives no "
                              "preview: pass simulate_closed_loop(..., preview=LidarPreview(...))")
@@ -478,4 +502,6 @@ class MPC:
         u = self._u_abs(plan[0])
         self.signals = {"qp_fallback": fallback, "pitch_ref_1": u[0], "torque_ref": u[3],
                         "rotor_speed_slack": self._last_slack}
+        if self.estimator is not None:
+            self.signals.update(self.signals_est)
         return u[:3], float(u[3])

@@ -1,0 +1,126 @@
+"""State and wind estimation for controllers that run on measured signals (issue 6, item 4).
+
+A steady-state Kalman filter on the discrete linear model augmented with the blade-effective
+winds as random walks (an unknown-input formulation in the spirit of the PI observer of Do et al.
+and the wind observer of Clemens et al.):
+
+    [x; d]_{k+1} = [[A, B_d], [0, I]] [x; d]_k + [B_u; 0] u_k + w_k,
+    y_k          = [C_y, D_yd] [x; d]_k + D_yu u_k + v_k,
+
+with y the measured signals (rotor and generator speed, the three pitch angles, the three flap
+moments, tower-top fore-aft acceleration). The gain comes from the discrete algebraic Riccati
+equation (scipy), once per operating point.
+"""
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+import scipy.linalg
+
+import linearize
+
+__all__ = ["KalmanEstimator", "MEASURED_SIGNALS"]
+
+#: Model outputs the estimator uses and their default measurement noise std [output units].
+MEASURED_SIGNALS: dict[str, float] = {
+    "rotor_speed": 1e-3, "gen_speed": 0.1, "pitch_1": 1e-4, "pitch_2": 1e-4, "pitch_3": 1e-4,
+    "flap_moment_1": 2e4, "flap_moment_2": 2e4, "flap_moment_3": 2e4,
+    "tower_fa_acceleration": 0.02}
+
+#: Default process-noise std per state and per step [state units].
+_STATE_NOISE = {"tower_fa_displacement": 1e-3, "tower_fa_velocity": 2e-3, "rotor_speed": 1e-4,
+                "gen_speed": 1e-2, "shaft_torsion": 1e-5, "pitch_1": 1e-5, "pitch_2": 1e-5,
+                "pitch_3": 1e-5}
+
+
+class KalmanEstimator:
+    """Steady-state Kalman filter for the states and the blade-effective winds.
+
+    Parameters
+    ----------
+    model : LinearModel
+        Discrete model (any ``dt``) with the outputs of :data:`MEASURED_SIGNALS` among its
+        outputs (the full output set of :func:`linearize.linearize`).
+    wind_std_per_step : float
+        Random-walk std of each blade-effective wind per step [m/s] (default 0.2 at 10 Hz): larger
+        follows gusts faster and passes more measurement noise.
+    measurement_std : dict, optional
+        Overrides of the noise std per measured signal.
+    """
+
+    def __init__(self, model: linearize.LinearModel, *, wind_std_per_step: float = 0.2,
+                 measurement_std: dict[str, float] | None = None) -> None:
+        if model.dt is None:
+            raise ValueError("model must be discrete: call model.discretize(dt) first")
+        if not (math.isfinite(wind_std_per_step) and wind_std_per_step > 0):
+            raise ValueError(f"wind_std_per_step must be finite and > 0 m/s, got "
+                             f"{wind_std_per_step!r}")
+        std = dict(MEASURED_SIGNALS)
+        for k, v in (measurement_std or {}).items():
+            if k not in std:
+                raise ValueError(f"measurement_std: unknown signal {k!r}; signals are "
+                                 f"{sorted(std)}")
+            if not (math.isfinite(v) and v > 0):
+                raise ValueError(f"measurement_std[{k!r}] must be finite and > 0, got {v!r}")
+            std[k] = float(v)
+        missing = [n for n in std if n not in model.outputs]
+        if missing:
+            raise ValueError(f"model lacks the measured outputs {missing}")
+        unknown = [n for n in model.states if n not in _STATE_NOISE]
+        if unknown:
+            raise ValueError(f"no process-noise default for states {unknown}")
+        self.signals = tuple(std)
+        iy = [model.outputs.index(n) for n in self.signals]
+        nx, nd = model.A.shape[0], model.B_d.shape[1]
+        self.nx, self.nd = nx, nd
+        self.a = np.block([[model.A, model.B_d], [np.zeros((nd, nx)), np.eye(nd)]])
+        self.b = np.vstack([model.B_u, np.zeros((nd, model.B_u.shape[1]))])
+        self.c = np.hstack([model.C_z[iy], model.D_d[iy]])
+        self.d = model.D_u[iy]
+        self.y0 = model.z0[iy]
+        q = np.diag([_STATE_NOISE[n] ** 2 for n in model.states] + [wind_std_per_step ** 2] * nd)
+        r = np.diag([std[n] ** 2 for n in self.signals])
+        # scale the outputs for the Riccati solve (flap moments ~1e6, pitch ~1e-2)
+        sy = np.sqrt(np.diag(r))
+        cs, rs = self.c / sy[:, None], r / np.outer(sy, sy)
+        p = scipy.linalg.solve_discrete_are(self.a.T, cs.T, q, rs)
+        # filter ("current estimator") gain on the scaled innovation, unscaled afterwards
+        self.gain = p @ cs.T @ np.linalg.inv(cs @ p @ cs.T + rs) / sy[None, :]
+        eig = np.abs(np.linalg.eigvals((np.eye(nx + nd) - self.gain @ self.c) @ self.a))
+        if eig.max() >= 1.0:
+            raise ValueError(f"the estimator is unstable (spectral radius {eig.max():.4f})")
+        self.spectral_radius = float(eig.max())
+        self.reset()
+
+    def reset(self, x_dev: np.ndarray | None = None, d_dev: np.ndarray | None = None) -> None:
+        """Start from deviations (default: the operating point)."""
+        self.xa = np.concatenate([np.zeros(self.nx) if x_dev is None else x_dev,
+                                  np.zeros(self.nd) if d_dev is None else d_dev])
+        self._started = False
+
+    def measurement(self, meas: dict[str, Any]) -> np.ndarray:
+        """The measured-signal vector from a harness measurement dict."""
+        y = []
+        for n in self.signals:
+            if n[-2] == "_" and n[-1] in "123":
+                y.append(float(meas[n[:-2]][int(n[-1]) - 1]))
+            else:
+                y.append(float(meas[n]))
+        return np.array(y)
+
+    def update(self, y: np.ndarray, u_dev: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """One step: predict with the input applied over the last step, correct with the
+        measurement ``y`` (absolute values, :attr:`signals` order). Returns the state and wind
+        deviations from the operating point."""
+        y = np.asarray(y, float)
+        if y.shape != (len(self.signals),) or not np.all(np.isfinite(y)):
+            raise ValueError(f"y must be {len(self.signals)} finite measurements "
+                             f"{self.signals}, got {y!r}")
+        if self._started:
+            self.xa = self.a @ self.xa + self.b @ u_dev
+        self._started = True
+        innov = (y - self.y0) - self.c @ self.xa - self.d @ u_dev
+        self.xa = self.xa + self.gain @ innov
+        return self.xa[:self.nx].copy(), self.xa[self.nx:].copy()
