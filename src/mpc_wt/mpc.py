@@ -25,7 +25,7 @@ import scipy.sparse as sp
 
 import linearize
 
-__all__ = ["coleman_weight", "MPCWeights", "MPC"]
+__all__ = ["coleman_weight", "MPCWeights", "MPC", "ScheduledMPC"]
 
 log = logging.getLogger(__name__)
 
@@ -505,3 +505,97 @@ class MPC:
         if self.estimator is not None:
             self.signals.update(self.signals_est)
         return u[:3], float(u[3])
+
+
+class ScheduledMPC:
+    """MPC scheduled over a :class:`linearize.LinearModelFamily` by mean wind (issue 6, item 3).
+
+    One :class:`MPC` per grid wind of the family, built on first use and kept, so that the QP
+    matrices, the OSQP factorization and the DAQP workspace of an operating point are set up
+    once and reused whenever the schedule returns to it. Each step the active controller is
+    the one whose grid wind is nearest to a low-passed mean-wind signal (first-order filter with
+    ``time_constant``), with ``hysteresis`` [m/s] beyond the midpoint between grid winds against
+    chattering. On a switch the previous command and the estimator state are handed over in
+    absolute units.
+
+    The wind signal is the mean of the Kalman estimator's blade-wind estimates
+    (``wind_source="estimator"``, which turns on ``estimator="kalman"``) or the rotor mean of the
+    LIDAR preview's first step (``wind_source="preview"``).
+    """
+
+    def __init__(self, family: linearize.LinearModelFamily, turbine: linearize.Turbine, *,
+                 wind_source: str = "estimator", time_constant: float = 30.0,
+                 hysteresis: float = 0.25, initial_wind_mps: float | None = None,
+                 **mpc_kwargs: Any) -> None:
+        if wind_source not in ("estimator", "preview"):
+            raise ValueError(f"wind_source must be 'estimator' or 'preview', got {wind_source!r}")
+        for name, v in (("time_constant", time_constant), ("hysteresis", hysteresis)):
+            if not (math.isfinite(v) and v >= 0):
+                raise ValueError(f"{name} must be finite and >= 0, got {v!r}")
+        if wind_source == "estimator":
+            mpc_kwargs.setdefault("estimator", "kalman")
+            if mpc_kwargs["estimator"] is None:
+                raise ValueError("wind_source='estimator' needs estimator='kalman'")
+        self.family, self.turbine = family, turbine
+        self.wind_source, self.tau, self.hyst = wind_source, float(time_constant), \
+            float(hysteresis)
+        self._kw = mpc_kwargs
+        self._ctl: dict[int, MPC] = {}
+        grid = family.wind_speeds
+        w0 = float(grid[len(grid) // 2]) if initial_wind_mps is None else initial_wind_mps
+        if not (math.isfinite(w0) and grid[0] <= w0 <= grid[-1]):
+            raise ValueError(f"initial_wind_mps must lie in the family's range {grid[0]:g}.."
+                             f"{grid[-1]:g} m/s, got {initial_wind_mps!r}")
+        self._w_init = w0
+        self.reset()
+
+    def controller(self, k: int) -> MPC:
+        """The MPC of grid point ``k`` (built on first use)."""
+        if k not in self._ctl:
+            self._ctl[k] = MPC(self.family.models[k], self.turbine, **self._kw)
+        return self._ctl[k]
+
+    def reset(self) -> None:
+        self._w = self._w_init
+        self.active = int(np.argmin(np.abs(self.family.wind_speeds - self._w)))
+        for c in self._ctl.values():
+            c.reset()
+        self.switches = 0
+        self.signals: dict[str, float] = {}
+
+    def _switch(self, k: int) -> None:
+        old, new = self.controller(self.active), self.controller(k)
+        new.reset()
+        if old._u_prev is not None:
+            u_abs = old._u_abs(old._u_prev)
+            du = u_abs - new.model.u0
+            new._u_prev = np.array([du[0], du[3]]) if new.collective else du
+        if old.estimator is not None and new.estimator is not None:
+            xa_abs = old.estimator.xa + np.concatenate([old.model.x0, old.model.d0])
+            new.estimator.xa = xa_abs - np.concatenate([new.model.x0, new.model.d0])
+            new.estimator._started = old.estimator._started
+        self.active = k
+        self.switches += 1
+
+    def step(self, t: float, meas: dict[str, Any]) -> tuple[np.ndarray, float]:
+        ctl = self.controller(self.active)
+        if self.wind_source == "preview" and meas.get("preview") is not None:
+            wsig: float | None = float(np.mean(np.asarray(meas["preview"].blade)[0]))
+        elif self.wind_source == "estimator" and "wind_est_1" in ctl.signals:
+            wsig = float(np.mean([ctl.signals[f"wind_est_{i}"] for i in (1, 2, 3)]))
+        else:
+            wsig = None
+        if wsig is not None:
+            a = 1.0 if self.tau == 0 else min(1.0, ctl.dt / self.tau)
+            self._w += a * (wsig - self._w)
+        grid = self.family.wind_speeds
+        k = int(np.argmin(np.abs(grid - self._w)))
+        if k != self.active:
+            mid = 0.5 * (grid[k] + grid[self.active])
+            if abs(self._w - mid) > self.hyst:
+                self._switch(k)
+                ctl = self.controller(k)
+        u = ctl.step(t, meas)
+        self.signals = dict(ctl.signals, schedule_wind=self._w,
+                            schedule_grid_wind=float(grid[self.active]))
+        return u

@@ -71,3 +71,39 @@ def test_estimator_bad_input(model, turbine) -> None:
     y = np.full(len(est.signals), math.nan)
     with pytest.raises(ValueError, match="y must be 9 finite measurements"):
         est.update(y, np.zeros(4))
+
+
+def test_scheduled_mpc_switches_to_the_wind_it_meets(turbine: linearize.Turbine,
+                                                     params: linearize.PlantParams) -> None:
+    from mpc_wt.mpc import ScheduledMPC
+
+    fam = linearize.linearize_family(turbine, [16.0, 18.0, 20.0, 22.0],
+                                     config=linearize.PlantConfig.madsen())
+    ctl = ScheduledMPC(fam, turbine, time_constant=5.0, initial_wind_mps=18.0)
+    op = linearize.trim(turbine, 18.0)
+    r = simulate_closed_loop(params, ctl, linearize.SteadyWind(20.0, 0.0), 40.0, x0=op.x,
+                             u0=op.u, controller_dt=0.1)
+    late = r.t > 30
+    assert ctl.switches == 1
+    assert r.controller["schedule_grid_wind"][-1] == 20.0
+    assert sorted(ctl._ctl) == [1, 2]                      # only the models it used were built
+    assert np.all(r.controller["qp_fallback"] == 0)
+    assert r.channel("gen_power")[late].mean() == pytest.approx(5e6, rel=0.01)
+    # returning to a grid point reuses its controller (set up once per operating point)
+    c2 = ctl.controller(2)
+    assert ctl.controller(2) is c2
+
+
+def test_scheduled_mpc_bad_input(turbine: linearize.Turbine) -> None:
+    from mpc_wt.mpc import ScheduledMPC
+
+    fam = linearize.linearize_family(turbine, [16.0, 18.0],
+                                     config=linearize.PlantConfig.madsen())
+    with pytest.raises(ValueError, match="wind_source must be 'estimator' or 'preview', got "
+                                         "'mast'"):
+        ScheduledMPC(fam, turbine, wind_source="mast")
+    with pytest.raises(ValueError, match=r"initial_wind_mps must lie in the family's range "
+                                         r"16\.\.18 m/s, got 25"):
+        ScheduledMPC(fam, turbine, initial_wind_mps=25.0)
+    with pytest.raises(ValueError, match="time_constant must be finite and >= 0, got -1"):
+        ScheduledMPC(fam, turbine, time_constant=-1.0)
