@@ -279,7 +279,7 @@ class MPC:
             raise ValueError(f"the weights make the QP non-convex (smallest Hessian eigenvalue "
                              f"{lam_min:g})")
         self._psi, self._theta, self._phi = psi, theta, phi
-        self._qbar, self._wr, self._dmat = qbar, wr, dmat
+        self._qbar = qbar
         # per-step work reduces to small products with these (precomputed per operating point)
         g = theta.T @ qbar
         self._g_x, self._g_d = g @ psi, g @ phi
@@ -309,7 +309,6 @@ class MPC:
         row_s = np.concatenate([su, np.full(hu, gen.max_torque_rate * self.dt),
                                 np.full(len(self._prate_rows), pa.max_rate_rad_s),
                                 np.full(hp if soft else 0, sw)])
-        self._su, self._row_s = su, row_s
         acon_s = (acon * su[None, :]) / row_s[:, None]
         h_s = h * np.outer(su, su)
         if soft:   # the slack: last variable (scaled by the rotor-speed scale), its own box row
@@ -321,10 +320,8 @@ class MPC:
             h_s[-ns:, -ns:] = 2.0 * self.slack_weight * np.eye(ns)
             row_s = np.concatenate([row_s[:hu * nu], np.full(ns, sw), row_s[hu * nu:]])
             su = np.append(su, np.full(ns, sw))
-            self._su, self._row_s = su, row_s
-        self._acon = acon
+        self._su = su
         self._n_box = hu * nu + ns
-        self._n_trate = hu
         opts = dict(eps_abs=1e-6, eps_rel=1e-6, polishing=False, warm_starting=True,
                     verbose=False, max_iter=4000)
         opts.update(solver_options)
