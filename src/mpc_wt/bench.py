@@ -133,9 +133,9 @@ def run_solver_benchmark(steps: int = 3000, progress: bool = True) -> dict[str, 
     n = len(rec)
 
     # 2. the QP sequence and its reference solution
+    ctl.solve = solve0  # type: ignore[method-assign]
     qps = []
     for x, d, up in rec:
-        ctl.solve = solve0  # type: ignore[method-assign]
         solve0(x, d, up)
         qps.append(ctl.qp())
     nu = ctl._nu

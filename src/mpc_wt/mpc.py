@@ -274,17 +274,13 @@ class MPC:
                                            / self.w.scales["gen_torque_ref"] ** 2], hu))
         h = theta.T @ qbar @ theta + rbar + dmat.T @ wr @ dmat
         h = 0.5 * (h + h.T)
-        lam_min = float(np.linalg.eigvalsh(h).min())
-        if lam_min < -1e-9 * max(1.0, abs(np.linalg.eigvalsh(h).max())):
+        lam = np.linalg.eigvalsh(h)
+        lam_min = float(lam[0])
+        if lam_min < -1e-9 * max(1.0, abs(float(lam[-1]))):
             raise ValueError(f"the weights make the QP non-convex (smallest Hessian eigenvalue "
                              f"{lam_min:g})")
-        self._psi, self._theta, self._phi = psi, theta, phi
-        self._qbar = qbar
-        # per-step work reduces to small products with these (precomputed per operating point)
-        g = theta.T @ qbar
-        self._g_x, self._g_d = g @ psi, g @ phi
-        self._dwr = dmat.T @ wr
-        self._nx, self._nu, self._nd, self._nz = nx, nu, nd, nz
+        self._psi, self._theta, self._qbar, self._h = psi, theta, qbar, h
+        self._nx, self._nu, self._nd = nx, nu, nd
         # constraints: absolute input bounds (all hu moves), torque rate, pitch rate via the
         # pitch-rate outputs over the horizon
         pa, gen = self.turbine.pitch_actuator, self.turbine.generator
@@ -293,13 +289,12 @@ class MPC:
         prate = [k for k, n in enumerate(m.outputs) if n.startswith("pitch_rate_")]
         self._prate_rows = np.array([i * nz + k for i in range(hp) for k in prate])
         rows.append(theta[self._prate_rows])
-        self._pr_x, self._pr_d = psi[self._prate_rows], phi[self._prate_rows]
         soft = self.max_rotor_speed is not None
         ns = hp if soft else 0                         # one slack per predicted step
         if soft:                                       # rotor-speed rows, minus the slack
             ks = m.outputs.index("rotor_speed")
-            self._speed_rows = np.array([i * nz + ks for i in range(hp)])
-            rows.append(theta[self._speed_rows])
+            speed_rows = np.array([i * nz + ks for i in range(hp)])
+            rows.append(theta[speed_rows])
         acon = np.vstack(rows)
         # scaling (OSQP converges far faster on well-scaled problems): decision variables in
         # units of the input scales, constraint rows divided by their limits
@@ -336,39 +331,39 @@ class MPC:
                            hu)
         trate = np.full(hu, gen.max_torque_rate * self.dt)
         prate_lim = np.full(len(self._prate_rows), pa.max_rate_rad_s)
-        big = 1e20
+        big = 1e20                                     # "no bound" on slacks and speed rows
         if soft:
             lim = self.max_rotor_speed - self.model.z0[m.outputs.index("rotor_speed")]
             lo_u, hi_u = np.append(lo_u, np.zeros(ns)), np.append(hi_u, np.full(ns, big * sw))
             spd_lo, spd_hi = np.full(hp, -big * sw), np.full(hp, lim)
         else:
             spd_lo = spd_hi = np.zeros(0)
-        self._inv_rs = 1.0 / row_s
-        self._lo_s = np.concatenate([lo_u, -trate, -prate_lim, spd_lo]) * self._inv_rs
-        self._hi_s = np.concatenate([hi_u, trate, prate_lim, spd_hi]) * self._inv_rs
+        inv_rs = 1.0 / row_s
+        lo_s = np.concatenate([lo_u, -trate, -prate_lim, spd_lo]) * inv_rs
+        hi_s = np.concatenate([hi_u, trate, prate_lim, spd_hi]) * inv_rs
         # every step's QP vectors [q_s; lo; hi] are affine in (x, d, u_prev): precompute the
         # maps so that a step costs three matrix-vector products
         ncon = len(row_s)
         nvu = hu * nu
         k0, k1 = nvu + ns, nvu + ns + hu        # first torque-move row, first pitch-rate row
-        free_x, free_d = self._pr_x, self._pr_d
-        if soft:
-            free_x = np.vstack([free_x, psi[self._speed_rows]])
-            free_d = np.vstack([free_d, phi[self._speed_rows]])
+        # the output rows' free response (pitch rate, then rotor speed)
+        out_rows = np.concatenate([self._prate_rows, speed_rows]) if soft else self._prate_rows
         lx = np.zeros((ncon, nx))
-        lx[k1:] = -free_x * self._inv_rs[k1:, None]
+        lx[k1:] = -psi[out_rows] * inv_rs[k1:, None]
         ld = np.zeros((ncon, phi.shape[1]))
-        ld[k1:] = -free_d * self._inv_rs[k1:, None]
+        ld[k1:] = -phi[out_rows] * inv_rs[k1:, None]
         lu = np.zeros((ncon, nu))
-        lu[k0, nu - 1] = self._inv_rs[k0]
+        lu[k0, nu - 1] = inv_rs[k0]
+        # q = Theta' Qbar (Psi x + Phi d) - D' W e0 (D u - e0: the moves from u_prev)
+        g = theta.T @ qbar
         gx, gd = np.zeros((nvu + ns, nx)), np.zeros((nvu + ns, phi.shape[1]))
         gu = np.zeros((nvu + ns, nu))
-        gx[:nvu], gd[:nvu] = su[:nvu, None] * self._g_x, su[:nvu, None] * self._g_d
-        gu[:nvu] = -su[:nvu, None] * self._dwr[:, :nu]
+        gx[:nvu], gd[:nvu] = su[:nvu, None] * (g @ psi), su[:nvu, None] * (g @ phi)
+        gu[:nvu] = -su[:nvu, None] * (dmat.T @ wr)[:, :nu]
         q0 = np.zeros(nvu + ns)
         if soft:
             q0[-ns:] = self.slack_linear
-        self._w0 = np.concatenate([q0, self._lo_s, self._hi_s])
+        self._w0 = np.concatenate([q0, lo_s, hi_s])
         self._wx = np.ascontiguousarray(np.vstack([gx, lx, lx]))
         self._wd = np.ascontiguousarray(np.vstack([gd, ld, ld]))
         self._wu = np.ascontiguousarray(np.vstack([gu, lu, lu]))
@@ -379,14 +374,13 @@ class MPC:
         if self.backend == "daqp":
             import daqp
 
-            big = np.full(acon_s.shape[0], 1e30)
+            free = np.full(acon_s.shape[0], 1e30)        # bounds are set every step
             self._daqp = daqp.Model()
-            self._daqp.setup(self._h_s, np.zeros(nvu + ns), self._a_gen_s, big, -big)
+            self._daqp.setup(self._h_s, np.zeros(nvu + ns), self._a_gen_s, free, -free)
         self._solver = osqp.OSQP()
         self._solver.setup(P=sp.triu(sp.csc_matrix(h_s)).tocsc(), q=np.zeros(nvu + ns),
                            A=sp.csc_matrix(acon_s), l=-np.inf * np.ones(acon_s.shape[0]),
                            u=np.inf * np.ones(acon_s.shape[0]), **opts)
-        self._h = h
 
     # ------------------------------------------------------------------------------------
     def reset(self) -> None:
