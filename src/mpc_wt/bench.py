@@ -96,8 +96,8 @@ def run_solver_benchmark(steps: int = 3000, progress: bool = True) -> dict[str, 
                            "wind_mps": wind_mps, "turbulence": "A", "horizon": 15,
                            "solvers": []}
 
-    # 1. the closed loop (DAQP backend if installed), recording each QP's data and the whole
-    # controller step's time
+    # 1. the closed loop (DAQP backend if installed), recording each step's measurements and
+    # QP data and timing the whole controller step in the loop
     backends = ["osqp"]
     try:
         import daqp  # noqa: F401
@@ -106,14 +106,8 @@ def run_solver_benchmark(steps: int = 3000, progress: bool = True) -> dict[str, 
         res["daqp"] = "not installed (pip install 'mpc-wt[daqp]')"
     res["closed_loop_backend"] = backends[-1]
     ctl = MPC(model, t, backend=backends[-1])
-    rec: list[tuple[np.ndarray, Any, Any]] = []
-    solve0 = ctl.solve
-
-    def recording(x: np.ndarray, d: Any = None, up: Any = None) -> Any:
-        rec.append((np.array(x), None if d is None else np.array(d),
-                    None if up is None else np.array(up)))
-        return solve0(x, d, up)
-    ctl.solve = recording  # type: ignore[method-assign]
+    rec_z: list[tuple[np.ndarray, bool]] = []
+    rec_meas: list[tuple[float, dict[str, Any]]] = []
     step_times: list[float] = []
     step0 = ctl.step
 
@@ -121,6 +115,8 @@ def run_solver_benchmark(steps: int = 3000, progress: bool = True) -> dict[str, 
         t0 = time.perf_counter()
         out = step0(tt, meas)
         step_times.append(time.perf_counter() - t0)
+        rec_z.append((ctl._z.copy(), ctl._has_preview))
+        rec_meas.append((tt, {"state": np.array(meas["state"])}))
         return out
     ctl.step = timed_step  # type: ignore[method-assign]
     wind, _ = runs._wind(t, wind_mps, "A", 1, duration, 0.2)
@@ -130,13 +126,13 @@ def run_solver_benchmark(steps: int = 3000, progress: bool = True) -> dict[str, 
                          controller_dt=dt, progress=progress)
     res["closed_loop_s"] = time.perf_counter() - t0
     res["whole_step_closed_loop"] = _stats(step_times)
-    n = len(rec)
+    n = len(rec_z)
 
     # 2. the QP sequence and its reference solution
-    ctl.solve = solve0  # type: ignore[method-assign]
     qps = []
-    for x, d, up in rec:
-        solve0(x, d, up)
+    for zz, has_preview in rec_z:
+        ctl._z[:] = zz
+        ctl._has_preview = has_preview
         qps.append(ctl.qp())
     nu = ctl._nu
     su = qps[0]["scale"]
@@ -159,26 +155,31 @@ def run_solver_benchmark(steps: int = 3000, progress: bool = True) -> dict[str, 
         return {"max_move_error_pitch_deg": pitch, "max_move_error_torque_pct": torque,
                 "max_move_error": max(pitch / 0.01, torque / 0.1)}
 
-    # 3. our backends, replayed in order (warm starts as in the loop)
-    for backend in backends:
-        c = MPC(model, t, backend=backend)
-        if backend == "osqp":
-            c._solver = _Timed(c._solver, "solve")
-            timer = c._solver
-        else:
-            c._daqp = _Timed(c._daqp, "solve")
-            timer = c._daqp
-        whole, first, iters = [], [], []
-        for x, d, up in rec:
+    # 3. our backends: the whole controller step replayed on the recorded measurements (the
+    # controller's own warm starts and previous commands, as in the loop, without the plant
+    # between the steps); then the recorded QPs solved in order for the move error
+    for backend, form in [("osqp", "condensed"), ("osqp", "sparse")] + \
+            [("daqp", "condensed")] * ("daqp" in backends):
+        c = MPC(model, t, backend=backend, formulation=form)
+        attr = "_osqp_ext" if backend == "osqp" else "_daqp"
+        timer = _Timed(getattr(c, attr), "solve")
+        setattr(c, attr, timer)
+        whole, iters = [], []
+        for tt, meas in rec_meas:
             t0 = time.perf_counter()
-            plan, _ = c.solve(x, d, up)
+            c.step(tt, meas)
             whole.append(time.perf_counter() - t0)
-            first.append(plan[0] if plan is not None else np.full(nu, np.nan))
-            last = timer.last
-            iters.append(last.info.iter if backend == "osqp" else last[3]["iterations"])
-        entry = {"solver": f"{backend}-condensed", **_stats(timer.times),
+            iters.append(c._info.iter if backend == "osqp" else c._info["iterations"])
+        solve_times = list(timer.times)
+        c.reset()
+        first = []
+        for zz, has_preview in rec_z:
+            c._z[:] = zz
+            v, _ = c._solve_z(has_preview)
+            first.append(v[:nu] * su[:nu] if v is not None else np.full(nu, np.nan))
+        entry = {"solver": f"{backend}-{form}", **_stats(solve_times),
                  "iter_median": float(np.median(iters)), "iter_max": int(np.max(iters)),
-                 "whole_solve": _stats(whole), **move_error(np.array(first))}
+                 "whole_step": _stats(whole), **move_error(np.array(first))}
         res["solvers"].append(entry)
 
     # 4. cvxpy with parameters (OSQP underneath), re-solved each step
@@ -248,9 +249,9 @@ def format_table(res: dict[str, Any]) -> str:
              f"whole controller step in the loop ({res['closed_loop_backend']}): median "
              f"{w['median_us']:.1f} us, p99 {w['p99_us']:.1f} us, max {w['max_us']:.1f} us",
              f"{'solver':22s} {'median':>8s} {'p95':>8s} {'p99':>8s} {'max':>8s} {'iter':>5s} "
-             f"{'pitch err deg':>13s} {'torque err %':>12s}  whole solve median/p99 [us]"]
+             f"{'pitch err deg':>13s} {'torque err %':>12s}  whole step median/p99 [us]"]
     for e in res["solvers"]:
-        ws = e.get("whole_solve")
+        ws = e.get("whole_step")
         extra = f"{ws['median_us']:.1f} / {ws['p99_us']:.1f}" if ws else ""
         it = e.get("iter_median")
         its = f"{it:5.0f}" if it is not None else "    -"

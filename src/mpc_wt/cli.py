@@ -23,7 +23,7 @@ import logging
 import math
 import sys
 from pathlib import Path
-from typing import Sequence
+from typing import Any, Sequence
 
 import numpy as np
 
@@ -233,8 +233,17 @@ def _cmd_simulate(args: argparse.Namespace) -> int:
         raise UsageError(f"--controller must be one of {list(CONTROLLERS)}, got "
                          f"{args.controller!r}")
     turbine = linearize.load_turbine(args.turbine)
+    mpc_opts: dict[str, Any] = {}
+    if args.controller != "baseline":
+        mpc_opts = {"backend": args.backend, "formulation": args.formulation,
+                    "horizon": args.horizon, "scheduled": args.scheduled,
+                    "estimator": None if args.estimator == "none" else args.estimator}
+    elif (args.backend, args.formulation, args.estimator, args.scheduled) != \
+            (None, "condensed", "none", False) or args.horizon != 15:
+        raise UsageError("--backend/--formulation/--horizon/--estimator/--scheduled apply to the "
+                         "MPC controllers only, not to --controller baseline")
     res = run_controller(turbine, args.controller, args.wind, args.turbulence, args.seed,
-                         args.duration, progress=True)
+                         args.duration, progress=True, mpc_options=mpc_opts)
     out = Path(args.out)
     if out.suffix == "":
         out = out.with_suffix(".nc")
@@ -393,6 +402,17 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument("--seed", type=int, default=1)
     p.add_argument("--duration", type=float, default=600.0, help="[s]")
     p.add_argument("--out", required=True, help="result file (netCDF, .nc)")
+    p.add_argument("--backend", choices=("osqp", "daqp"),
+                   help="MPC QP solver (default DAQP when installed, else OSQP)")
+    p.add_argument("--formulation", choices=("condensed", "sparse"), default="condensed",
+                   help="MPC QP formulation (sparse: OSQP only)")
+    p.add_argument("--horizon", type=int, default=15, help="MPC H_p = H_u (default 15)")
+    p.add_argument("--estimator", choices=("none", "kalman"), default="none",
+                   help="kalman: MPC on measured signals (state and blade-wind Kalman filter); "
+                        "none: full-state information (default)")
+    p.add_argument("--scheduled", action="store_true",
+                   help="MPC scheduled over a model family 12-25 m/s on the estimated wind "
+                        "(or the preview with mpc-lidar)")
     p.set_defaults(func=_cmd_simulate)
 
     p = sub.add_parser("assess", help="loads and performance of runs or CSV time series")

@@ -50,13 +50,21 @@ def _wind(turbine: linearize.Turbine, wind_mps: float, turbulence: str, seed: in
 
 def run_controller(turbine: linearize.Turbine, controller: str, wind_mps: float,
                    turbulence: str = "A", seed: int = 1, duration: float = 600.0,
-                   progress: bool = False, shear_exponent: float = 0.2) -> ClosedLoopResult:
+                   progress: bool = False, shear_exponent: float = 0.2,
+                   mpc_options: dict[str, Any] | None = None) -> ClosedLoopResult:
     """Trim, design the controller, generate the wind and simulate.
 
     ``controller``: "baseline" (tuned PI and torque law, 80 Hz), "mpc" (Madsen's 8-state
     individual-pitch MPC at 10 Hz, disturbance held at the mean), "mpc-collective" (the same with
     one pitch input), "mpc-lidar" (individual pitch with the preview of a CW LIDAR -- range
     weighting and LOS error on -- measuring the field the plant meets).
+
+    ``mpc_options`` (MPC controllers only): ``backend`` ("osqp" or "daqp"; default DAQP when
+    installed), ``formulation`` ("condensed" or "sparse", OSQP), ``horizon`` (H_p = H_u),
+    ``estimator`` (None or "kalman": states and blade winds estimated from measured signals),
+    ``scheduled`` (True: a :class:`~mpc_wt.mpc.ScheduledMPC` over a model family from the
+    first whole m/s above rated to 25 m/s in 1 m/s steps, scheduled on the estimated wind, or
+    on the preview with "mpc-lidar").
     """
     if controller not in CONTROLLERS:
         raise ValueError(f"controller must be one of {list(CONTROLLERS)}, got {controller!r}")
@@ -74,23 +82,49 @@ def run_controller(turbine: linearize.Turbine, controller: str, wind_mps: float,
         meta["gains"] = {"kp": gains.kp, "ki": gains.ki, "theta_k_rad": gains.theta_k_rad,
                          "k_opt": gains.k_opt}
     else:
-        from .mpc import MPC
+        from .mpc import MPC, ScheduledMPC
 
-        try:
-            import daqp  # noqa: F401
-            backend = "daqp"
-        except ImportError:
-            backend = "osqp"
-        model = linearize.linearize(turbine, wind_mps, config=linearize.PlantConfig.madsen(),
-                                    params=None)
-        ctl = MPC(model, turbine, collective=controller == "mpc-collective", backend=backend)
-        cdt = ctl.dt
-        meta["mpc"] = {"horizon": ctl.hp, "backend": backend, "dt": ctl.dt}
+        opts = dict(mpc_options or {})
+        unknown = set(opts) - {"backend", "formulation", "horizon", "estimator", "scheduled"}
+        if unknown:
+            raise ValueError(f"mpc_options has unknown keys {sorted(unknown)}; allowed: backend, "
+                             f"formulation, horizon, estimator, scheduled")
+        backend = opts.get("backend")
+        if backend is None:
+            try:
+                import daqp  # noqa: F401
+                backend = "osqp" if opts.get("formulation") == "sparse" else "daqp"
+            except ImportError:
+                backend = "osqp"
+        kw = dict(collective=controller == "mpc-collective", backend=backend,
+                  formulation=opts.get("formulation", "condensed"),
+                  horizon=int(opts.get("horizon", 15)), estimator=opts.get("estimator"))
+        if opts.get("scheduled"):
+            lo = float(np.floor(linearize.rated_wind_speed(turbine))) + 1.0
+            winds = np.arange(lo, min(25.0, turbine.operation.cut_out_wind) + 0.5, 1.0)
+            if not winds[0] <= wind_mps <= winds[-1]:
+                raise ValueError(f"scheduled MPC covers {winds[0]:g}..{winds[-1]:g} m/s; the "
+                                 f"wind {wind_mps:g} m/s is outside")
+            fam = linearize.linearize_family(turbine, winds,
+                                             config=linearize.PlantConfig.madsen())
+            src = "preview" if controller == "mpc-lidar" else "estimator"
+            if src == "estimator" and kw["estimator"] is None:
+                kw["estimator"] = "kalman"
+            ctl = ScheduledMPC(fam, turbine, wind_source=src, initial_wind_mps=wind_mps, **kw)
+            cdt = ctl.controller(ctl.active).dt
+            hp = kw["horizon"]
+        else:
+            model = linearize.linearize(turbine, wind_mps,
+                                        config=linearize.PlantConfig.madsen(), params=None)
+            ctl = MPC(model, turbine, **kw)
+            cdt, hp = ctl.dt, ctl.hp
+        meta["mpc"] = {"horizon": hp, "backend": backend, "dt": cdt,
+                       "formulation": kw["formulation"], "estimator": str(kw["estimator"]),
+                       "scheduled": bool(opts.get("scheduled"))}
         if controller == "mpc-lidar":
             from .simulate import LidarPreview
 
-            preview = LidarPreview(lidar.CWLidar(turbine.geometry.tip_radius), field, ctl.hp,
-                                   ctl.dt)
+            preview = LidarPreview(lidar.CWLidar(turbine.geometry.tip_radius), field, hp, cdt)
     return simulate_closed_loop(params, ctl, wind, duration, x0=op.x, u0=op.u,
                                 controller_dt=cdt, preview=preview, progress=progress, meta=meta)
 

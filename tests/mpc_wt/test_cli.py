@@ -168,6 +168,12 @@ def test_assess_csv_from_another_tool(tmp_path: Path, capsys: pytest.CaptureFixt
     (["assess", "/no/run.nc"], "file not found"),
     (["simulate", "--controller", "lqr", "--wind", "18", "--out", "x"],
      "--controller must be one of"),
+    (["simulate", "--controller", "baseline", "--estimator", "kalman", "--wind", "18", "--out",
+      "x"], "apply to the MPC controllers only"),
+    (["simulate", "--controller", "mpc", "--formulation", "sparse", "--backend", "daqp",
+      "--wind", "18", "--duration", "1", "--out", "x"], "formulation='sparse' needs backend"),
+    (["simulate", "--controller", "mpc", "--scheduled", "--wind", "8", "--duration", "1",
+      "--out", "x"], "wind 8 m/s is outside"),
 ])
 def test_simulate_assess_errors(argv, match: str, capsys: pytest.CaptureFixture[str]) -> None:
     assert main(argv) == 2
@@ -195,3 +201,24 @@ def test_simulate_mpc_controllers(controller: str, tmp_path: Path,
     assert np.all(r.controller["qp_fallback"] == 0)
     if controller == "mpc-collective":
         assert np.allclose(r.u[:, 0], r.u[:, 2])
+
+
+@pytest.mark.parametrize("extra, meta", [
+    (["--formulation", "sparse", "--backend", "osqp"], {"formulation": "sparse",
+                                                         "backend": "osqp"}),
+    (["--scheduled", "--estimator", "kalman", "--horizon", "10"],
+     {"scheduled": True, "estimator": "kalman", "horizon": 10}),
+])
+def test_simulate_mpc_options(extra: list[str], meta: dict, tmp_path: Path,
+                              capsys: pytest.CaptureFixture[str]) -> None:
+    out = tmp_path / "run.nc"
+    assert main(["simulate", "--controller", "mpc", "--wind", "17", "--turbulence", "B",
+                 "--duration", "20", "--out", str(out), *extra]) == 0
+    from mpc_wt.simulate import ClosedLoopResult
+
+    r = ClosedLoopResult.load(out)
+    for k, v in meta.items():
+        assert r.meta["mpc"][k] == v, k
+    assert np.all(r.controller["qp_fallback"] == 0)
+    # the controller holds the rotor near rated speed (1.267 rad/s) through the gusts
+    assert abs(r.x[r.t > 10, 2].mean() - 1.267) < 0.05
