@@ -642,8 +642,9 @@ def _rk4(t, x, u, h, p, kind, wpar, grid, hint, dphi):  # pragma: no cover - com
 
 @nb.njit(**_JIT)
 def _bad_state(x, lim):  # pragma: no cover - compiled
+    # lim: (2, n_x) lower and upper bounds
     for k in range(x.size):
-        if not (abs(x[k]) <= lim[k]):   # also catches NaN
+        if not (lim[0, k] <= x[k] <= lim[1, k]):   # also catches NaN
             return k
     return -1
 
@@ -878,7 +879,9 @@ class SimulationResult:
 
 
 def _state_limits(params: PlantParams) -> FloatArray:
-    """Physical envelope; leaving it means the simulation diverged."""
+    """Physical envelope (2, n_x): lower and upper bounds; leaving it means the simulation
+    diverged. Symmetric except for the rotor and generator speeds, which may not run backwards
+    by more than 10 % of rated (the aerodynamics are not valid for a reversed rotor)."""
     t = params.turbine
     wr = t.operation.rated_rotor_speed_rad_s
     lim = np.full(n_x, np.inf)
@@ -891,7 +894,9 @@ def _state_limits(params: PlantParams) -> FloatArray:
     lim[10:13] = 0.5 * (t.geometry.tip_radius - t.geometry.hub_radius)
     lim[13:16] = 200.0
     lim[16] = 1e12
-    return lim
+    lo = -lim
+    lo[2], lo[3] = -0.1 * wr, -0.1 * wr * t.drivetrain.gearbox_ratio
+    return np.vstack([lo, lim])
 
 
 def rk4_simulate(params: PlantParams, x0: FloatArray, u: FloatArray,
@@ -951,7 +956,7 @@ def rk4_simulate(params: PlantParams, x0: FloatArray, u: FloatArray,
     if bad >= 0:
         raise SimulationDivergedError(
             f"simulation diverged at t = {t0 + n * dt:.4f} s: state {STATE_NAMES[bad]!r} = "
-            f"{val!r} {STATE_UNITS[bad]} left its envelope +-{_state_limits(params)[bad]:g}; "
+            f"{val!r} {STATE_UNITS[bad]} left its envelope {_state_limits(params)[0, bad]:g}..{_state_limits(params)[1, bad]:g}; "
             f"the {n} samples before are kept in .partial", res)
     return res
 

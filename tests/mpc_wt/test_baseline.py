@@ -259,3 +259,26 @@ def test_torque_law_is_continuous_and_monotone(turbine: linearize.Turbine, gains
     steep = max(c.slope25, c.slope15, 2 * gains.k_opt * c.w_rated)
     assert np.max(np.abs(np.diff(tq))) <= steep * (w[1] - w[0]) * (1 + 1e-9)
     assert_allclose(c.torque(c.w_trans, 0.0), gains.k_opt * c.w_trans**2, rtol=1e-9)
+
+
+class _Feather:
+    signals: dict = {}
+
+    def reset(self) -> None:
+        pass
+
+    def step(self, t, meas):
+        return np.full(3, np.radians(90.0)), 43093.55
+
+
+def test_a_rotor_driven_backwards_is_reported_as_divergence(turbine: linearize.Turbine,
+                                                            params: linearize.PlantParams) -> None:
+    # feathered blades and full generator torque stop the rotor and drive it backwards: the
+    # envelope allows at most -10 % of rated speed (found when an unstable observer loop ran at
+    # -0.26 rad/s unreported)
+    op = linearize.trim(turbine, 12.0)
+    with pytest.raises(SimulationDivergedError,
+                       match=r"state '(rotor|gen)_speed' = -\d") as exc:
+        simulate_closed_loop(params, _Feather(), linearize.SteadyWind(12.0), 120.0, x0=op.x,
+                             u0=op.u)
+    assert exc.value.partial.x[:, 2].min() > -0.2
