@@ -947,16 +947,16 @@ def rk4_simulate(params: PlantParams, x0: FloatArray, u: FloatArray,
         raise TypeError(f"wind must be SteadyWind or GridWind, got {type(wind).__name__}")
     wind.check_covers(params, t0 + n_steps * dt)
     kind, wpar, grid = wind._kernel_args()
+    lim = _state_limits(params)
     xs, zs, us, n, bad, val = _simulate(x0, np.ascontiguousarray(u), float(t0), float(dt),
-                                        n_steps, params.pack, kind, wpar, grid,
-                                        _state_limits(params),
+                                        n_steps, params.pack, kind, wpar, grid, lim,
                                         params.turbine.generator.max_torque_rate)
     t = t0 + dt * np.arange(n)
     res = SimulationResult(t=t, x=xs, u=us, z=zs)
     if bad >= 0:
         raise SimulationDivergedError(
             f"simulation diverged at t = {t0 + n * dt:.4f} s: state {STATE_NAMES[bad]!r} = "
-            f"{val!r} {STATE_UNITS[bad]} left its envelope {_state_limits(params)[0, bad]:g}..{_state_limits(params)[1, bad]:g}; "
+            f"{val!r} {STATE_UNITS[bad]} left its envelope {lim[0, bad]:g}..{lim[1, bad]:g}; "
             f"the {n} samples before are kept in .partial", res)
     return res
 

@@ -21,7 +21,7 @@ import scipy.linalg
 
 import linearize
 
-__all__ = ["KalmanEstimator", "MEASURED_SIGNALS"]
+__all__ = ["KalmanEstimator", "MEASURED_SIGNALS", "read_signals"]
 
 #: Model outputs the estimator uses and their default measurement noise std [output units].
 MEASURED_SIGNALS: dict[str, float] = {
@@ -33,6 +33,23 @@ MEASURED_SIGNALS: dict[str, float] = {
 _STATE_NOISE = {"tower_fa_displacement": 1e-3, "tower_fa_velocity": 2e-3, "rotor_speed": 1e-4,
                 "gen_speed": 1e-2, "shaft_torsion": 1e-5, "pitch_1": 1e-5, "pitch_2": 1e-5,
                 "pitch_3": 1e-5}
+
+
+def read_signals(meas: dict[str, Any], names: tuple[str, ...] | list[str]) -> np.ndarray:
+    """Named signals from a harness measurement dict: a key of ``meas`` itself, a blade signal
+    ``<key>_<1|2|3>`` of a per-blade array, or else a plant state from ``meas["state"]``."""
+    y = np.empty(len(names))
+    for i, n in enumerate(names):
+        if n in meas:
+            y[i] = meas[n]
+        elif n[-2:] in ("_1", "_2", "_3") and n[:-2] in meas:
+            y[i] = meas[n[:-2]][int(n[-1]) - 1]
+        elif n in linearize.STATE_NAMES and "state" in meas:
+            y[i] = meas["state"][linearize.STATE_NAMES.index(n)]
+        else:
+            raise KeyError(f"signal {n!r} is neither in the measurements {sorted(meas)} nor a "
+                           f"plant state")
+    return y
 
 
 class KalmanEstimator:
@@ -102,13 +119,7 @@ class KalmanEstimator:
 
     def measurement(self, meas: dict[str, Any]) -> np.ndarray:
         """The measured-signal vector from a harness measurement dict."""
-        y = []
-        for n in self.signals:
-            if n[-2] == "_" and n[-1] in "123":
-                y.append(float(meas[n[:-2]][int(n[-1]) - 1]))
-            else:
-                y.append(float(meas[n]))
-        return np.array(y)
+        return read_signals(meas, self.signals)
 
     def update(self, y: np.ndarray, u_dev: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """One step: predict with the input applied over the last step, correct with the

@@ -33,6 +33,8 @@ import scipy.linalg
 
 import linearize
 
+from .estimator import read_signals
+
 __all__ = ["LQRDesign", "PIObserver", "design_lqr", "design_lqr_family", "design_pi_observer",
            "LQRPIOController", "SynthesisError"]
 
@@ -136,7 +138,6 @@ def design_lqr(model: linearize.LinearModel, *,
     for k, v in scales.items():
         if not (isinstance(v, (int, float, np.floating)) and math.isfinite(v) and v > 0):
             raise ValueError(f"scale {k!r} must be finite and > 0, got {v!r}")
-    names = _names(model)
     sw = dict(state_weights or {})
     ow = dict(output_weights or {})
     if not sw and not ow:
@@ -150,7 +151,8 @@ def design_lqr(model: linearize.LinearModel, *,
                 raise ValueError(f"{kind}_weights: unknown {kind} {n!r}; the model's {kind}s are "
                                  f"{list(pool)}")
             w = _check_weight(n, w) / scales.get(n, 1.0) ** 2
-            row = names[n][0] if kind == "output" else np.eye(nx)[model.states.index(n)]
+            row = (model.C_z[model.outputs.index(n)] if kind == "output"
+                   else np.eye(nx)[model.states.index(n)])
             q += w * np.outer(row, row)
     q = 0.5 * (q + q.T)
     inputs = tuple(inputs)
@@ -307,19 +309,6 @@ def design_pi_observer(model: linearize.LinearModel, *,
                       gain_ratio=ratio, measured=tuple(measured), y0=y0, q=float(q))
 
 
-def _measure(meas: dict[str, Any], names: Sequence[str], state_idx: dict[str, int]) -> np.ndarray:
-    """Measured signals from a harness dict: states from ``meas['state']``, others by name."""
-    y = np.empty(len(names))
-    for i, n in enumerate(names):
-        if n in state_idx:
-            y[i] = meas["state"][state_idx[n]]
-        elif n[-2] == "_" and n[-1] in "123" and n[:-2] in meas:
-            y[i] = meas[n[:-2]][int(n[-1]) - 1]
-        else:
-            y[i] = meas[n]
-    return y
-
-
 class LQRPIOController:
     """LQR state feedback on PI-observer estimates (Do et al. Fig. 2) for the harness.
 
@@ -384,8 +373,6 @@ class LQRPIOController:
             ainv = np.linalg.solve(acl, np.eye(nx))
             kf = np.linalg.lstsq(ainv[sel] @ bsel, ainv[sel] @ nmat, rcond=None)[0]
         self.K_f = kf
-        self._state_idx = {nm: linearize.STATE_NAMES.index(nm) for nm in observer.measured
-                           if nm in linearize.STATE_NAMES}
         self.reset()
 
     def reset(self) -> None:
@@ -394,7 +381,7 @@ class LQRPIOController:
         self.signals: dict[str, float] = {}
 
     def step(self, t: float, meas: dict[str, Any]) -> tuple[np.ndarray, float]:
-        y = _measure(meas, self.obs.measured, self._state_idx) - self.obs.y0
+        y = read_signals(meas, self.obs.measured) - self.obs.y0
         if not np.all(np.isfinite(y)):
             raise ValueError(f"non-finite measurement at t = {t:g} s: "
                              f"{dict(zip(self.obs.measured, y))}")

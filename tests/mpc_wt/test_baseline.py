@@ -137,14 +137,19 @@ def test_controller_returning_nan(turbine: linearize.Turbine,
                              x0=op.x, u0=op.u)
 
 
-class _NoTorque:
+class _Fixed:
+    """A controller that always commands the same pitch [rad] and generator torque [N m]."""
+
     signals: dict = {}
+
+    def __init__(self, pitch: float = 0.0, torque: float = 0.0) -> None:
+        self.pitch, self.torque = pitch, torque
 
     def reset(self) -> None:
         pass
 
     def step(self, t, meas):
-        return np.zeros(3), 0.0
+        return np.full(3, self.pitch), self.torque
 
 
 def test_diverging_closed_loop_keeps_the_partial_result(turbine: linearize.Turbine,
@@ -153,7 +158,7 @@ def test_diverging_closed_loop_keeps_the_partial_result(turbine: linearize.Turbi
     x0 = op.x.copy()
     x0[5:8] = 0.0
     with pytest.raises(SimulationDivergedError, match=r"state '(rotor|gen)_speed'") as exc:
-        simulate_closed_loop(params, _NoTorque(), linearize.SteadyWind(25.0), 300.0,
+        simulate_closed_loop(params, _Fixed(), linearize.SteadyWind(25.0), 300.0,
                              x0=x0, u0=op.u)
     assert exc.value.partial.t.size > 100 and np.all(np.isfinite(exc.value.partial.z))
 
@@ -162,18 +167,8 @@ def test_controller_period_must_divide(turbine: linearize.Turbine,
                                       params: linearize.PlantParams) -> None:
     op = linearize.trim(turbine, 12.0)
     with pytest.raises(ValueError, match="whole multiple of dt"):
-        simulate_closed_loop(params, _NoTorque(), linearize.SteadyWind(12.0), 1.0, x0=op.x,
+        simulate_closed_loop(params, _Fixed(), linearize.SteadyWind(12.0), 1.0, x0=op.x,
                              u0=op.u, controller_dt=0.03)
-
-
-class _Overpitch:
-    signals: dict = {}
-
-    def reset(self) -> None:
-        pass
-
-    def step(self, t, meas):
-        return np.full(3, math.radians(120.0)), 40000.0
 
 
 def test_out_of_range_commands_are_recorded(turbine: linearize.Turbine,
@@ -181,8 +176,8 @@ def test_out_of_range_commands_are_recorded(turbine: linearize.Turbine,
                                             caplog: pytest.LogCaptureFixture) -> None:
     op = linearize.trim(turbine, 14.0)
     with caplog.at_level("WARNING"):
-        r = simulate_closed_loop(params, _Overpitch(), linearize.SteadyWind(14.0), 1.0,
-                                 x0=op.x, u0=op.u)
+        r = simulate_closed_loop(params, _Fixed(math.radians(120.0), 40000.0),
+                                 linearize.SteadyWind(14.0), 1.0, x0=op.x, u0=op.u)
     assert r.meta["commands_clipped"] == 80
     assert "out of the actuator range" in caplog.text
     assert r.x[:, 5].max() <= math.radians(90.0) + 1e-9
@@ -261,16 +256,6 @@ def test_torque_law_is_continuous_and_monotone(turbine: linearize.Turbine, gains
     assert_allclose(c.torque(c.w_trans, 0.0), gains.k_opt * c.w_trans**2, rtol=1e-9)
 
 
-class _Feather:
-    signals: dict = {}
-
-    def reset(self) -> None:
-        pass
-
-    def step(self, t, meas):
-        return np.full(3, np.radians(90.0)), 43093.55
-
-
 def test_a_rotor_driven_backwards_is_reported_as_divergence(turbine: linearize.Turbine,
                                                             params: linearize.PlantParams) -> None:
     # feathered blades and full generator torque stop the rotor and drive it backwards: the
@@ -279,6 +264,6 @@ def test_a_rotor_driven_backwards_is_reported_as_divergence(turbine: linearize.T
     op = linearize.trim(turbine, 12.0)
     with pytest.raises(SimulationDivergedError,
                        match=r"state '(rotor|gen)_speed' = -\d") as exc:
-        simulate_closed_loop(params, _Feather(), linearize.SteadyWind(12.0), 120.0, x0=op.x,
-                             u0=op.u)
+        simulate_closed_loop(params, _Fixed(math.radians(90.0), 43093.55),
+                             linearize.SteadyWind(12.0), 120.0, x0=op.x, u0=op.u)
     assert exc.value.partial.x[:, 2].min() > -0.2

@@ -102,7 +102,7 @@ def test_pi_observer_recovers_a_constant_unknown_input(do_model) -> None:
     ob = design_pi_observer(do_model, q=1e5)
     nx, nf = do_model.A.shape[0], 3
     f = np.array([1.0, -0.5, 0.25])
-    # true steady state under the step with the LQR off: unstable modes? use a stabilized plant
+    # the plant's steady state under the step, stabilized by an LQR (the open loop drifts)
     lq = design_lqr(do_model)
     acl = do_model.A - do_model.B_u[:, :3] @ lq.K
     x_ss = -np.linalg.solve(acl, do_model.B_d @ f)
