@@ -369,27 +369,29 @@ def _check_rate(name: str, v: Any, allow_none: bool = False) -> float | None:
     return float(v)
 
 
-def _solve(prob: Any, solver: str | None) -> str:
+def _solve(prob: Any, solver: str | None) -> tuple[str, str]:
+    """Solve with ``solver`` or the first installed of MOSEK, Clarabel, SCS that returns a
+    status; a solver that fails numerically is logged and the next one tried. Returns the
+    solver's name and the status, "solver_error" when none gave one (treated as infeasible by
+    the callers, who then say what to relax)."""
     import cvxpy as cp
 
-    names = [solver] if solver else (["MOSEK"] if "MOSEK" in cp.installed_solvers() else []) \
-        + ["CLARABEL", "SCS"]
-    last: Exception | None = None
+    installed = cp.installed_solvers()
+    if solver and solver not in installed:
+        raise ValueError(f"solver {solver!r} is not installed; installed: {installed}")
+    names = [solver] if solver else [s for s in ("MOSEK", "CLARABEL", "SCS") if s in installed]
     for s in names:
-        if s not in cp.installed_solvers():
-            if solver:
-                raise ValueError(f"solver {solver!r} is not installed; installed: "
-                                 f"{cp.installed_solvers()}")
-            continue
         try:
             prob.solve(solver=s)
-            if prob.status in ("optimal", "optimal_inaccurate", "infeasible",
-                               "infeasible_inaccurate"):
-                return s
-        except Exception as err:  # cvxpy.SolverError
-            last = err
+        except (KeyboardInterrupt, SystemExit):
+            raise
+        except BaseException as err:  # cvxpy.SolverError; Clarabel's Rust panics are
             log.warning("SDP solver %s failed (%s); trying the next", s, err)
-    raise SynthesisError(f"no SDP solver could solve the LMIs (last error: {last})")
+            continue
+        if prob.status in ("optimal", "optimal_inaccurate", "infeasible",
+                           "infeasible_inaccurate"):
+            return s, prob.status
+    return (names[-1] if names else "none"), "solver_error"
 
 
 def _sym(m: Any) -> Any:
@@ -451,7 +453,8 @@ def _controller_problem(a: np.ndarray, b: np.ndarray, cells: list[tuple[int, ...
                 row = y[i][j:j + 1, :]
                 cons.append(_sym(cp.bmat([[x, row.T], [row, cp.reshape(t[j], (1, 1), order="C")]])) >> 0)
         if mu is not None:
-            cons.append(t <= mu ** 2)
+            for j in np.nonzero(np.isfinite(mu))[0]:
+                cons.append(t[j] <= mu[j] ** 2)
     obj = cp.Minimize(cp.sum(t)) if use_bound else cp.Minimize(cp.trace(x))
     return cp.Problem(obj, cons), x, y, t
 
@@ -510,14 +513,13 @@ def design_ts_controller(ts: TSModel, *, decay_rate: float = 0.2,
         mu = np.array([float(input_bounds.get(n, np.inf)) for n in ts.inputs]) / su
         if np.any(~(mu > 0)):
             raise ValueError(f"input_bounds must be > 0, got {dict(input_bounds)}")
-        mu = np.where(np.isfinite(mu), mu, 1e12)
     a, b = _controller_mats(ts, integral_of, sx, su)
     cells = ts.cells()
     t0 = time.perf_counter()
     prob, xv, yv, tv = _controller_problem(a, b, cells, alpha, radius, mu, margin)
-    used = _solve(prob, solver)
+    used, status = _solve(prob, solver)
     dt = time.perf_counter() - t0
-    if prob.status not in ("optimal", "optimal_inaccurate"):
+    if status not in ("optimal", "optimal_inaccurate"):
         raise SynthesisError(_diagnose_controller(a, b, cells, alpha, radius, mu, margin, used))
     xs = 0.5 * (xv.value + xv.value.T)
     ks = np.array([y.value @ np.linalg.inv(xs) for y in yv])
@@ -526,7 +528,7 @@ def design_ts_controller(ts: TSModel, *, decay_rate: float = 0.2,
     cert = verify_controller(ts, k, p, sx, su, alpha, radius, margin=0.5 * margin,
                              grid_points=grid_points, integral_of=integral_of)
     if not cert.ok:
-        raise SynthesisError(f"the solver ({used}, status {prob.status}) returned gains whose "
+        raise SynthesisError(f"the solver ({used}, status {status}) returned gains whose "
                              f"certificate fails: {'; '.join(cert.failures[:3])}; tighten the "
                              f"solver tolerance or scale the model")
     bounds = np.sqrt(np.maximum(tv.value, 0)) * su if tv.value is not None else \
@@ -542,23 +544,20 @@ def _diagnose_controller(a, b, cells, alpha, radius, mu, margin, solver) -> str:
     what = []
     if mu is not None:
         p, *_ = _controller_problem(a, b, cells, alpha, radius, None, margin)
-        _solve(p, solver)
-        if p.status in ("optimal", "optimal_inaccurate"):
+        if _solve(p, solver)[1] in ("optimal", "optimal_inaccurate"):
             return ("the controller LMIs are infeasible with the input bounds given: relax "
                     "input_bounds (feasible without them)")
         what.append("input_bounds")
     if radius is not None:
         p, *_ = _controller_problem(a, b, cells, alpha, None, None, margin, use_bound=False)
-        _solve(p, solver)
-        if p.status in ("optimal", "optimal_inaccurate"):
+        if _solve(p, solver)[1] in ("optimal", "optimal_inaccurate"):
             return (f"the controller LMIs are infeasible with disk_radius = {radius:g} 1/s: "
                     f"relax (increase) disk_radius")
     lo, hi = 0.0, alpha
-    for _ in range(12):
+    for _ in range(8):
         mid = 0.5 * (lo + hi)
         p, *_ = _controller_problem(a, b, cells, mid, None, None, margin, use_bound=False)
-        _solve(p, solver)
-        if p.status in ("optimal", "optimal_inaccurate"):
+        if _solve(p, solver)[1] in ("optimal", "optimal_inaccurate"):
             lo = mid
         else:
             hi = mid
@@ -689,13 +688,15 @@ def design_ts_observer(ts: TSModel, *, tau_v: float = 4.0, decay_rate: float = 1
     a = np.array([np.diag(1 / sxi) @ ai @ np.diag(sxi) for ai in aa])
     c = np.diag(1 / sy) @ cc @ np.diag(sxi)
     for i, ai in enumerate(a):
-        modes = _uncontrollable_modes(ai.T, c.T, discrete=False)
+        # modes slower than the required decay must be observable (PBH on A~ + alpha I)
+        modes = _uncontrollable_modes(ai.T + alpha * np.eye(ai.shape[0]), c.T, discrete=False)
         if modes:
             raise SynthesisError(
-                f"(A~, C~) is not detectable at vertex {i} (v = {ts.vertices[i, 0]:g} m/s, "
-                f"dP = {ts.vertices[i, 1]:g}) from {list(ts.measured)}: unobservable modes "
-                f"{', '.join(f'{m.real:.4g}{m.imag:+.4g}j' for m in modes)}; measure more "
-                f"signals")
+                f"(A~, C~) is not detectable with decay rate {alpha:g} 1/s at vertex {i} "
+                f"(v = {ts.vertices[i, 0]:g} m/s, dP = {ts.vertices[i, 1]:g}) from "
+                f"{list(ts.measured)}: the modes "
+                f"{', '.join(f'{m.real - alpha:.4g}{m.imag:+.4g}j' for m in modes)} are not "
+                f"seen; measure more signals or lower decay_rate")
     nv, n = a.shape[:2]
     ny = c.shape[0]
     pv = cp.Variable((n, n), symmetric=True)
@@ -712,9 +713,9 @@ def design_ts_observer(ts: TSModel, *, tau_v: float = 4.0, decay_rate: float = 1
         cons.append(_sym(cp.bmat([[t * np.eye(n), nvar[i]], [nvar[i].T, t * np.eye(ny)]])) >> 0)
     prob = cp.Problem(cp.Minimize(t), cons)
     t0 = time.perf_counter()
-    used = _solve(prob, solver)
+    used, status = _solve(prob, solver)
     dt = time.perf_counter() - t0
-    if prob.status not in ("optimal", "optimal_inaccurate"):
+    if status not in ("optimal", "optimal_inaccurate"):
         hint = ("relax (increase) disk_radius or lower decay_rate" if radius is not None
                 else "lower decay_rate")
         raise SynthesisError(f"the observer LMIs are infeasible at decay_rate = {alpha:g} 1/s"
