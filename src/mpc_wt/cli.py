@@ -10,6 +10,8 @@ simulate   closed loop on the plant: ``simulate --controller baseline --wind 18 
 assess     DELs, CS1-CS5, pitch duty, energy of runs or CSV time series
 wind       turbulent wind fields: ``wind generate --mean 18 --class A --out FIELD.bts``
 lidar      CW LIDAR preview: ``lidar evaluate --field FIELD [--focus 54] [--json]``
+design     gain synthesis: ``design baseline|lqr|ts [...] --out DIR`` (DIR/design.json + plot)
+export     gain tables: ``export DIR --format csv|json|mat|rosco``
 
 Errors in the arguments or the turbine file print one line naming the parameter and the value
 to stderr and exit with status 2.
@@ -356,6 +358,122 @@ def _cmd_bench_mpc(args: argparse.Namespace) -> int:
     return 0
 
 
+def _pairs(items: Sequence[str] | None, name: str) -> dict[str, float]:
+    """NAME=VALUE options to a dict of floats."""
+    out: dict[str, float] = {}
+    for it in items or []:
+        key, sep, val = it.partition("=")
+        try:
+            out[key.strip()] = float(val)
+        except ValueError:
+            sep = ""
+        if not sep or not key.strip():
+            raise UsageError(f"{name} takes NAME=VALUE with a number, got {it!r}")
+    return out
+
+
+def _floats(text: str, name: str) -> list[float]:
+    try:
+        vals = [float(v) for v in text.split(",") if v.strip()]
+    except ValueError:
+        raise UsageError(f"{name} takes a comma list of numbers, got {text!r}") from None
+    if not vals or not all(math.isfinite(v) for v in vals):
+        raise UsageError(f"{name} takes a comma list of finite numbers, got {text!r}")
+    return vals
+
+
+def _plot_design(doc: dict[str, Any], path: Path) -> None:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    s = doc["schedule"]
+    rows = np.asarray(s["rows"], dtype=float)
+    x = rows[:, 0]
+    fig, ax = plt.subplots(figsize=(7, 4))
+    if doc["kind"] == "baseline":
+        for c in ("kp", "ki"):
+            ax.plot(x, rows[:, s["columns"].index(c)], "o-", label=c)
+        ax.set_ylabel("PI gain on generator speed [s], [-]")
+    else:
+        k = np.asarray(doc["matrices"]["K"]["data"])
+        m = doc["matrices"]["K"]
+        flat = k.reshape(k.shape[0], -1)
+        big = np.argsort(-np.abs(flat).max(axis=0))[:6]
+        for j in big:
+            lab = f"K[{m['rows'][j // len(m['cols'])]}, {m['cols'][j % len(m['cols'])]}]"
+            v = flat[:, j] / max(np.abs(flat[:, j]).max(), 1e-300)
+            ax.plot(np.arange(len(x)) if doc["kind"] == "ts" else x, v, "o-", label=lab)
+        ax.set_ylabel("gain / its largest magnitude [-]")
+    ax.set_xlabel("vertex index (wind outer, power reduction inner)" if doc["kind"] == "ts"
+                  else "wind speed [m/s]")
+    ax.set_title(f"{doc['kind']} gains, {doc['turbine']}")
+    ax.grid(True, alpha=0.3)
+    ax.legend(fontsize=7)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
+def _cmd_design(args: argparse.Namespace) -> int:
+    from .export import baseline_table, lqr_table, save_design, ts_table
+
+    turbine = linearize.load_turbine(args.turbine)
+    if args.kind == "baseline":
+        from .baseline import tune_baseline
+
+        doc = baseline_table(turbine, tune_baseline(turbine, omega_n_rad_s=args.omega_n,
+                                                    zeta=args.zeta))
+        note = f"kp {doc['settings']['kp']:.4g} s, ki {doc['settings']['ki']:.4g}"
+    elif args.kind == "lqr":
+        from .synthesis import design_lqr_family, design_pi_observer
+
+        winds = parse_range(args.wind or "12:25:1", "--wind")
+        fam = linearize.linearize_family(turbine, winds, config=linearize.PlantConfig.do(),
+                                         progress=True)
+        weights = _pairs(args.weight, "--weight") or {"rotor_speed": 5.0,
+                                                       "tower_fa_velocity": 1.0}
+        scales = {"rotor_speed": 0.05, "tower_fa_velocity": 0.1,
+                  **{f"pitch_ref_{k}": math.radians(1.0) for k in (1, 2, 3)}}
+        scales.update(_pairs(args.scale, "--scale"))
+        sw = {k: v for k, v in weights.items() if k in fam.models[0].states}
+        ow = {k: v for k, v in weights.items() if k not in sw}
+        designs = design_lqr_family(fam, state_weights=sw, output_weights=ow, scales=scales)
+        obs = [design_pi_observer(m, q=args.observer_q) for m in fam.models] \
+            if args.observer_q > 0 else None
+        doc = lqr_table(turbine, designs, obs)
+        note = f"{len(designs)} operating points"
+        if obs:
+            note += f", PIO ||L2||/||L1|| {min(o.gain_ratio for o in obs):.3g}.." \
+                    f"{max(o.gain_ratio for o in obs):.3g}"
+    else:
+        from .ts import build_ts_model, design_ts_controller, design_ts_observer
+
+        ts = build_ts_model(turbine, _floats(args.wind or "12,14,16,19,22,25", "--wind"),
+                            _floats(args.reductions, "--reductions"), progress=True)
+        ctl = design_ts_controller(ts, decay_rate=args.decay_rate)
+        obs = design_ts_observer(ts, decay_rate=args.observer_decay_rate)
+        doc = ts_table(turbine, ts, ctl, obs)
+        note = (f"{ts.n_vertices} vertices, {ctl.solver} {ctl.solve_time_s:.1f} s + "
+                f"{obs.solve_time_s:.1f} s, certificates ok")
+    p = save_design(doc, args.out)
+    _plot_design(doc, Path(args.out) / "gains.png")
+    print(f"wrote {p} and {Path(args.out) / 'gains.png'} ({args.kind}: {note})")
+    return 0
+
+
+def _cmd_export(args: argparse.Namespace) -> int:
+    from .export import GainTableError, export
+
+    try:
+        files = export(args.design, args.format, args.to)
+    except GainTableError as err:
+        raise UsageError(str(err)) from None
+    print("wrote " + ", ".join(str(f) for f in files))
+    return 0
+
+
 def _parser() -> argparse.ArgumentParser:
     ap = argparse.ArgumentParser(prog="mpcwt", description=__doc__.split("\n")[0])
     sub = ap.add_subparsers(dest="command", required=True)
@@ -414,6 +532,34 @@ def _parser() -> argparse.ArgumentParser:
                    help="MPC scheduled over a model family 12-25 m/s on the estimated wind "
                         "(or the preview with mpc-lidar)")
     p.set_defaults(func=_cmd_simulate)
+
+    p = sub.add_parser("design", help="gain synthesis: baseline PI, LQR family, TS by LMIs")
+    p.add_argument("kind", choices=("baseline", "lqr", "ts"))
+    p.add_argument("--turbine", **turb)
+    p.add_argument("--out", required=True, help="design directory (design.json, gains.png)")
+    p.add_argument("--wind", help="lqr: START:STOP:STEP (default 12:25:1); ts: comma list of "
+                                  "vertex winds (default 12,14,16,19,22,25) [m/s]")
+    p.add_argument("--reductions", default="0,0.4,0.8",
+                   help="ts: comma list of vertex power reductions (default 0,0.4,0.8)")
+    p.add_argument("--decay-rate", type=float, default=0.2, help="ts: controller decay [1/s]")
+    p.add_argument("--observer-decay-rate", type=float, default=1.0,
+                   help="ts: observer decay [1/s]")
+    p.add_argument("--weight", action="append",
+                   help="lqr: NAME=VALUE weight on a state or output (repeatable; default "
+                        "rotor_speed=5, tower_fa_velocity=1)")
+    p.add_argument("--scale", action="append",
+                   help="lqr: NAME=VALUE typical magnitude dividing a weight (repeatable)")
+    p.add_argument("--observer-q", type=float, default=1e3,
+                   help="lqr: PI observer q of Q_obs = diag(I, q I) (0: no observer)")
+    p.add_argument("--omega-n", type=float, default=0.6, help="baseline: PI design [rad/s]")
+    p.add_argument("--zeta", type=float, default=0.7, help="baseline: PI damping [-]")
+    p.set_defaults(func=_cmd_design)
+
+    p = sub.add_parser("export", help="export a design's gain table")
+    p.add_argument("design", help="design directory (from `mpcwt design`) or gain-table JSON")
+    p.add_argument("--format", required=True, choices=("csv", "json", "mat", "rosco"))
+    p.add_argument("--to", help="output directory (default: the design directory)")
+    p.set_defaults(func=_cmd_export)
 
     p = sub.add_parser("assess", help="loads and performance of runs or CSV time series")
     p.add_argument("runs", nargs="+", help="result files (.nc) or CSV with a time column")

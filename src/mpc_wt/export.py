@@ -1,0 +1,396 @@
+"""Gain tables: one document per designed controller, exported to CSV, JSON, MATLAB and ROSCO.
+
+A gain table is a JSON-able dict (``design.json`` in a design directory):
+
+    {"schema": "mpc-wt gain table", "schema_version": 1, "kind": "baseline" | "lqr" | "ts",
+     "turbine": ..., "software": {"mpc_wt": version}, "settings": {...},
+     "schedule": {"columns": [...], "units": [...], "rows": [[...], ...]},
+     "matrices": {name: {"unit": ..., "rows": [...], "cols": [...], "data": [[[...]]] }}}
+
+``schedule`` has one row per operating point (wind speed for the LQR family, premise vertex
+for TS with its membership breakpoints ``wind_grid`` / ``reduction_grid`` in ``settings``,
+pitch angle for the PI baseline); ``matrices`` stacks gain matrices over those points with
+row/column names and one unit string per matrix.
+
+Formats (:func:`export`):
+
+* ``json``: the document itself (``gains.json``);
+* ``csv``: ``gains_schedule.csv`` (wide: one row per point, headers ``name [unit]``) and
+  ``gains_matrices.csv`` (long: matrix, point, row, col, value, unit); a first ``#`` line gives
+  schema and kind (``pandas.read_csv(..., comment="#")``);
+* ``mat``: ``gains.mat`` (scipy.io.savemat) with the schedule columns as vectors and every
+  matrix as an (n_points, n_rows, n_cols) array, names and units as cell strings;
+* ``rosco``: ``DISCON_gains.IN``, the PI schedule and set points as ROSCO ``DISCON.IN`` lines
+  (PC_GS_n/angles/KP/KI/KD/TF, PC_RefSpd, PC_MaxPit/MinPit/MaxRat/MinRat, VS_Rgn2K, VS_RtTq,
+  VS_RefSpd, VS_RtPwr, VS_MaxTq, VS_MinTq, VS_MaxRat, VS_MinOMSpd); ROSCO's pitch gains act on
+  the speed error (reference minus measured), so they carry the opposite sign of ours.
+"""
+from __future__ import annotations
+
+import csv
+import json
+import math
+from pathlib import Path
+from typing import Any, Sequence
+
+import numpy as np
+
+import linearize
+
+from . import __version__
+
+__all__ = ["SCHEMA_VERSION", "GainTableError", "baseline_table", "lqr_table", "ts_table",
+           "save_design", "load_design", "export", "read_rosco", "FORMATS"]
+
+SCHEMA_VERSION = 1
+SCHEMA = "mpc-wt gain table"
+FORMATS = ("csv", "json", "mat", "rosco")
+
+
+class GainTableError(ValueError):
+    """A gain table that is missing, of another schema, or inconsistent."""
+
+
+def _unit_ratio(num: str, den: str) -> str:
+    if den in ("-", ""):
+        return num
+    if num == den:
+        return "-"
+    return f"{num}/({den})" if " " in den or "/" in den else f"{num}/{den}"
+
+
+def _doc(kind: str, turbine: linearize.Turbine, settings: dict[str, Any], columns: list[str],
+         units: list[str], rows: list[list[float]],
+         matrices: dict[str, dict[str, Any]]) -> dict[str, Any]:
+    return {"schema": SCHEMA, "schema_version": SCHEMA_VERSION, "kind": kind,
+            "turbine": turbine.name, "software": {"mpc_wt": __version__},
+            "settings": settings,
+            "schedule": {"columns": columns, "units": units,
+                         "rows": [[float(v) for v in r] for r in rows]},
+            "matrices": matrices}
+
+
+def _matrix(stack: np.ndarray, rows: Sequence[str], cols: Sequence[str], unit: str,
+            units: Sequence[str] | None = None) -> dict[str, Any]:
+    d = {"unit": unit, "rows": list(rows), "cols": list(cols),
+         "data": np.asarray(stack, dtype=float).tolist()}
+    if units is not None:
+        d["units"] = list(units)
+    return d
+
+
+def baseline_table(turbine: linearize.Turbine, gains: Any,
+                   winds: Sequence[float] | None = None) -> dict[str, Any]:
+    """The PI baseline (:class:`~mpc_wt.baseline.BaselineGains`) as a gain table: the pitch
+    gain schedule kp GK(theta), ki GK(theta), GK = 1 / (1 + theta / theta_K), at the trim pitch
+    of each wind speed from rated to cut-out (default 1 m/s steps), with the set points."""
+    op = turbine.operation
+    if winds is None:
+        lo = math.ceil(linearize.rated_wind_speed(turbine))
+        winds = np.arange(lo, op.cut_out_wind + 0.5, 1.0)
+    rows = []
+    for v in winds:
+        p = linearize.trim(turbine, float(v))
+        gk = 1.0 / (1.0 + p.pitch_rad / gains.theta_k_rad)
+        rows.append([float(v), p.pitch_rad, gains.kp * gk, gains.ki * gk, p.gen_torque,
+                     p.gen_speed_rad_s, p.power])
+    settings = {"kp": gains.kp, "ki": gains.ki, "theta_k_rad": gains.theta_k_rad,
+                "k_opt": gains.k_opt, "rated_gen_speed_rad_s": gains.rated_gen_speed_rad_s,
+                "rated_torque": gains.rated_torque, "rated_power": gains.rated_power,
+                "omega_n_rad_s": gains.omega_n_rad_s, "zeta": gains.zeta,
+                "min_pitch_rad": op.fine_pitch_rad,
+                "max_pitch_rad": turbine.pitch_actuator.max_pitch_rad,
+                "max_pitch_rate_rad_s": turbine.pitch_actuator.max_rate_rad_s,
+                "max_torque": turbine.generator.max_torque,
+                "min_torque": turbine.generator.min_torque,
+                "max_torque_rate": turbine.generator.max_torque_rate,
+                "min_gen_speed_rad_s": op.min_rotor_speed_rad_s
+                * turbine.drivetrain.gearbox_ratio,
+                "units": {"kp": "s", "ki": "-", "theta_k_rad": "rad",
+                          "k_opt": "N m/(rad/s)^2", "rated_torque": "N m", "rated_power": "W"}}
+    return _doc("baseline", turbine, settings,
+                ["wind_speed", "pitch", "kp", "ki", "gen_torque", "gen_speed", "power"],
+                ["m/s", "rad", "s", "-", "N m", "rad/s", "W"], rows, {})
+
+
+def lqr_table(turbine: linearize.Turbine, designs: Sequence[Any],
+              observers: Sequence[Any] | None = None,
+              state_units: Sequence[str] | None = None) -> dict[str, Any]:
+    """An LQR family (:func:`~mpc_wt.synthesis.design_lqr_family`) as a gain table: operating
+    points per wind speed, the gains K (u - u0 = -K (x - x0)) and, when given, the PI observer
+    gains L1, L2 (Do et al. eqs 13-16)."""
+    if not designs:
+        raise GainTableError("no LQR designs to tabulate")
+    d0 = designs[0]
+    su = list(state_units or [dict(zip(linearize.STATE_NAMES, linearize.STATE_UNITS)).get(
+        n, "-") for n in d0.states])
+    iu = dict(zip(linearize.INPUT_NAMES, linearize.INPUT_UNITS))
+    cols = ["wind_speed"] + [f"x0_{n}" for n in d0.states] + [f"u0_{n}" for n in d0.inputs]
+    units = ["m/s"] + su + [iu.get(n, "-") for n in d0.inputs]
+    rows = [[d.wind_speed, *d.x0, *d.u0] for d in designs]
+    mats = {"K": _matrix(np.array([d.K for d in designs]), d0.inputs, d0.states,
+                         "input unit / state unit",
+                         [_unit_ratio(iu.get(i, "-"), s) for i in d0.inputs for s in su])}
+    if observers:
+        o = observers[0]
+        nf = o.L2.shape[0]
+        mats["L1"] = _matrix(np.array([ob.L1 for ob in observers]), d0.states, o.measured,
+                             "state unit / measurement unit")
+        mats["L2"] = _matrix(np.array([ob.L2 for ob in observers]),
+                             [f"unknown_input_{k + 1}" for k in range(nf)], o.measured,
+                             "unknown-input unit / measurement unit")
+    settings = {"dt": d0.dt, "weights": d0.weights,
+                "gain_ratio_L2_L1": [ob.gain_ratio for ob in observers] if observers else None,
+                "convention": "u = u0 - K (x - x0); observer per Do et al. eqs 13-16"}
+    return _doc("lqr", turbine, settings, cols, units, rows, mats)
+
+
+def ts_table(turbine: linearize.Turbine, ts: Any, controller: Any,
+             observer: Any | None = None) -> dict[str, Any]:
+    """A TS design (:mod:`mpc_wt.ts`) as a gain table: one row per premise vertex (wind,
+    power reduction, equilibrium x0, u0), the PDC gains K_i and observer gains L_i, with the
+    membership breakpoints and the LMI settings and certificate."""
+    su = dict(zip(linearize.STATE_NAMES, linearize.STATE_UNITS))
+    st_units = [su.get(n, "-") for n in ts.states]
+    in_units = ["rad", "N m"]
+    vt = ts.vertices
+    cols = ["wind_speed", "power_reduction"] + [f"x0_{n}" for n in ts.states] + \
+        [f"u0_{n}" for n in ts.inputs]
+    units = ["m/s", "-"] + st_units + in_units
+    rows = [[vt[i, 0], vt[i, 1], *ts.x0[i], *ts.u0[i]] for i in range(ts.n_vertices)]
+    kcols = list(ts.states) + ([f"integral_{controller.integral_of}"]
+                               if controller.integral_of else [])
+    kunits = st_units + ([su.get(controller.integral_of, "-") + " s"]
+                         if controller.integral_of else [])
+    mats = {"K": _matrix(controller.K, ts.inputs, kcols, "input unit / state unit",
+                         [_unit_ratio(i, s) for i in in_units for s in kunits])}
+    settings = {"wind_grid": ts.wind_grid.tolist(), "reduction_grid": ts.reduction_grid.tolist(),
+                "membership": "product of piecewise-linear hats on wind_grid x reduction_grid",
+                "rated_power": ts.rated_power, "measured": list(ts.measured),
+                "decay_rate": controller.decay_rate, "disk_radius": controller.disk_radius,
+                "input_bounds": controller.input_bounds.tolist(), "solver": controller.solver,
+                "certificate_ok": controller.certificate.ok,
+                "convention": "u = sum_i h_i (u0_i - K_i (x_hat - x0_i)) (Clemens eq 7)"}
+    if observer is not None:
+        yunits = [su.get(n, "-") for n in ts.measured]
+        mats["L"] = _matrix(observer.L, list(ts.states) + ["wind"], list(ts.measured),
+                            "xi unit / measurement unit",
+                            [_unit_ratio(s, y) for s in st_units + ["m/s"] for y in yunits])
+        settings.update({"tau_v": observer.tau_v, "observer_decay_rate": observer.decay_rate,
+                         "observer_disk_radius": observer.disk_radius,
+                         "observer_certificate_ok": observer.certificate.ok})
+    return _doc("ts", turbine, settings, cols, units, rows, mats)
+
+
+def _check(doc: Any, where: str) -> dict[str, Any]:
+    if not isinstance(doc, dict) or doc.get("schema") != SCHEMA:
+        raise GainTableError(f"{where} is not an mpc-wt gain table (no schema {SCHEMA!r})")
+    if doc.get("schema_version") != SCHEMA_VERSION:
+        raise GainTableError(f"{where} has schema_version {doc.get('schema_version')!r}; this "
+                             f"mpc-wt reads version {SCHEMA_VERSION}")
+    missing = [k for k in ("kind", "schedule", "matrices", "settings") if k not in doc]
+    if missing:
+        raise GainTableError(f"{where} misses the keys {missing}")
+    s = doc["schedule"]
+    if not all(len(r) == len(s["columns"]) for r in s["rows"]) or \
+            len(s["units"]) != len(s["columns"]):
+        raise GainTableError(f"{where}: schedule rows, columns and units differ in length")
+    return doc
+
+
+def save_design(doc: dict[str, Any], out_dir: str | Path) -> Path:
+    """Write ``design.json`` into ``out_dir`` (created)."""
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    p = out / "design.json"
+    p.write_text(json.dumps(_check(doc, "the design"), indent=1))
+    return p
+
+
+def load_design(path: str | Path) -> dict[str, Any]:
+    """Read a design directory's ``design.json`` (or a gain-table JSON file).
+
+    Raises
+    ------
+    GainTableError
+        Missing, not JSON, another schema or version, inconsistent lengths.
+    """
+    p = Path(path)
+    if p.is_dir():
+        p = p / "design.json"
+    if not p.exists():
+        raise GainTableError(f"{p} does not exist (run `mpcwt design ... --out DIR` first)")
+    try:
+        doc = json.loads(p.read_text())
+    except json.JSONDecodeError as err:
+        raise GainTableError(f"{p} is not valid JSON: {err}") from err
+    return _check(doc, str(p))
+
+
+def _write_csv(doc: dict[str, Any], out: Path) -> list[Path]:
+    s = doc["schedule"]
+    head = f"# {SCHEMA}, schema_version {SCHEMA_VERSION}, kind {doc['kind']}, " \
+           f"turbine {doc['turbine']}"
+    p1 = out / "gains_schedule.csv"
+    with p1.open("w", newline="") as fh:
+        fh.write(head + "\n")
+        w = csv.writer(fh)
+        w.writerow([f"{c} [{u}]" for c, u in zip(s["columns"], s["units"])])
+        w.writerows([[repr(float(v)) for v in r] for r in s["rows"]])
+    p2 = out / "gains_matrices.csv"
+    with p2.open("w", newline="") as fh:
+        fh.write(head + "\n")
+        w = csv.writer(fh)
+        w.writerow(["matrix", "point", "row", "col", "value", "unit"])
+        for name, m in doc["matrices"].items():
+            data = np.asarray(m["data"], dtype=float)
+            ncol = len(m["cols"])
+            for k in range(data.shape[0]):
+                for i, rn in enumerate(m["rows"]):
+                    for j, cn in enumerate(m["cols"]):
+                        unit = m["units"][i * ncol + j] if "units" in m else m["unit"]
+                        w.writerow([name, k, rn, cn, repr(float(data[k, i, j])), unit])
+    return [p1, p2]
+
+
+def _write_mat(doc: dict[str, Any], out: Path) -> list[Path]:
+    import scipy.io
+
+    s = doc["schedule"]
+    rows = np.asarray(s["rows"], dtype=float).reshape(-1, len(s["columns"]))
+    d: dict[str, Any] = {"schema_version": SCHEMA_VERSION, "kind": doc["kind"],
+                         "turbine": doc["turbine"],
+                         "schedule_columns": np.array(s["columns"], dtype=object),
+                         "schedule_units": np.array(s["units"], dtype=object),
+                         "schedule": rows}
+    for c, col in zip(s["columns"], rows.T):
+        d[f"s_{c}"[:63]] = col
+    for name, m in doc["matrices"].items():
+        d[name] = np.asarray(m["data"], dtype=float)
+        d[f"{name}_rows"] = np.array(m["rows"], dtype=object)
+        d[f"{name}_cols"] = np.array(m["cols"], dtype=object)
+        d[f"{name}_unit"] = m["unit"]
+    p = out / "gains.mat"
+    scipy.io.savemat(p, d, long_field_names=True, do_compression=True)
+    return [p]
+
+
+#: ROSCO DISCON.IN names written by the rosco export, with their units.
+ROSCO_KEYS = ("PC_GS_n", "PC_GS_angles", "PC_GS_KP", "PC_GS_KI", "PC_GS_KD", "PC_GS_TF",
+              "PC_MaxPit", "PC_MinPit", "PC_MaxRat", "PC_MinRat", "PC_RefSpd", "VS_GenEff",
+              "VS_ArSatTq", "VS_MaxRat", "VS_MaxTq", "VS_MinTq", "VS_MinOMSpd", "VS_Rgn2K",
+              "VS_RtPwr", "VS_RtTq", "VS_RefSpd")
+
+
+def _write_rosco(doc: dict[str, Any], out: Path, turbine_eff: float | None = None) -> list[Path]:
+    if doc["kind"] != "baseline":
+        raise GainTableError(f"the rosco format holds a PI pitch schedule and torque set points; "
+                             f"a {doc['kind']!r} design has none: export the baseline design "
+                             f"(`mpcwt design baseline`) for ROSCO, or use csv/json/mat")
+    s, st = doc["schedule"], doc["settings"]
+    cols = s["columns"]
+    rows = np.asarray(s["rows"], dtype=float)
+    ang, kp, ki = (rows[:, cols.index(c)] for c in ("pitch", "kp", "ki"))
+    order = np.argsort(ang)
+    eff_pct = 100.0 * (turbine_eff if turbine_eff is not None else
+                       st["rated_power"] / (st["rated_torque"] * st["rated_gen_speed_rad_s"]))
+
+    def vec(a: np.ndarray) -> str:
+        return "  ".join(f"{float(v):.8g}" for v in a)
+
+    lines = [
+        f"! DISCON.IN lines from mpc-wt {__version__} (gain table schema {SCHEMA_VERSION}), "
+        f"turbine {doc['turbine']}; paste into the matching sections of ROSCO's DISCON.IN",
+        "!------- BLADE PITCH CONTROL ----------------------------------------------",
+        f"{len(ang):<20d} ! PC_GS_n       - Amount of gain-scheduling table entries",
+        f"{vec(ang[order])} ! PC_GS_angles  - Gain-schedule table: pitch angles [rad].",
+        f"{vec(-kp[order])} ! PC_GS_KP      - Gain-schedule table: pitch controller kp gains [s].",
+        f"{vec(-ki[order])} ! PC_GS_KI      - Gain-schedule table: pitch controller ki gains [-].",
+        f"{vec(np.zeros(len(ang)))} ! PC_GS_KD      - Gain-schedule table: pitch controller kd "
+        f"gains",
+        f"{vec(np.zeros(len(ang)))} ! PC_GS_TF      - Gain-schedule table: pitch controller tf "
+        f"gains (derivative filter)",
+        f"{st['max_pitch_rad']:<20.8g} ! PC_MaxPit     - Maximum physical pitch limit, [rad].",
+        f"{st['min_pitch_rad']:<20.8g} ! PC_MinPit     - Minimum physical pitch limit, [rad].",
+        f"{st['max_pitch_rate_rad_s']:<20.8g} ! PC_MaxRat     - Maximum pitch rate (in absolute "
+        f"value) in pitch controller, [rad/s].",
+        f"{-st['max_pitch_rate_rad_s']:<20.8g} ! PC_MinRat     - Minimum pitch rate (in absolute "
+        f"value) in pitch controller, [rad/s].",
+        f"{st['rated_gen_speed_rad_s']:<20.8g} ! PC_RefSpd     - Desired (reference) HSS speed "
+        f"for pitch controller, [rad/s].",
+        "!------- VS TORQUE CONTROL ------------------------------------------------",
+        f"{eff_pct:<20.8g} ! VS_GenEff     - Generator efficiency mechanical power -> electrical "
+        f"power, [should match the efficiency defined in the generator properties!], [%]",
+        f"{st['rated_torque']:<20.8g} ! VS_ArSatTq    - Above rated generator torque PI control "
+        f"saturation, [Nm]",
+        f"{st['max_torque_rate']:<20.8g} ! VS_MaxRat     - Maximum torque rate (in absolute "
+        f"value) in torque controller, [Nm/s].",
+        f"{st['max_torque']:<20.8g} ! VS_MaxTq      - Maximum generator torque in Region 3 "
+        f"(HSS side), [Nm].",
+        f"{st['min_torque']:<20.8g} ! VS_MinTq      - Minimum generator (HSS side), [Nm].",
+        f"{st['min_gen_speed_rad_s']:<20.8g} ! VS_MinOMSpd   - Minimum generator speed [rad/s]",
+        f"{st['k_opt']:<20.8g} ! VS_Rgn2K      - Generator torque constant in Region 2 (HSS "
+        f"side), [Nm/(rad/s)^2]",
+        f"{st['rated_power']:<20.8g} ! VS_RtPwr      - Wind turbine rated power [W]",
+        f"{st['rated_torque']:<20.8g} ! VS_RtTq       - Rated torque, [Nm].",
+        f"{st['rated_gen_speed_rad_s']:<20.8g} ! VS_RefSpd     - Rated generator speed [rad/s]",
+    ]
+    p = out / "DISCON_gains.IN"
+    p.write_text("\n".join(lines) + "\n")
+    return [p]
+
+
+def read_rosco(path: str | Path) -> dict[str, Any]:
+    """Parse ``NAME`` values from DISCON.IN-style lines (``values ! NAME - text``): a float,
+    or a list of floats when the line holds several. Lines without ``!`` are skipped."""
+    out: dict[str, Any] = {}
+    for line in Path(path).read_text().splitlines():
+        if "!" not in line or line.lstrip().startswith("!"):
+            continue
+        vals, comment = line.split("!", 1)
+        name = comment.split()[0] if comment.split() else ""
+        try:
+            nums = [float(v) for v in vals.split()]
+        except ValueError:
+            continue
+        if name and nums:
+            out[name] = nums if len(nums) > 1 or name in ("PC_GS_angles", "PC_GS_KP",
+                                                          "PC_GS_KI", "PC_GS_KD",
+                                                          "PC_GS_TF") else nums[0]
+    return out
+
+
+def export(doc_or_dir: dict[str, Any] | str | Path, fmt: str,
+           out_dir: str | Path | None = None) -> list[Path]:
+    """Export a gain table (a document, or a design directory) to ``fmt`` in ``out_dir``
+    (default the design directory). Returns the files written.
+
+    Raises
+    ------
+    ValueError
+        An unknown format.
+    GainTableError
+        A broken table, or ``rosco`` for a design that is not the PI baseline.
+    """
+    if fmt not in FORMATS:
+        raise ValueError(f"format must be one of {list(FORMATS)}, got {fmt!r}")
+    if isinstance(doc_or_dir, dict):
+        doc = _check(doc_or_dir, "the design")
+        if out_dir is None:
+            raise ValueError("out_dir is needed when exporting a document")
+    else:
+        doc = load_design(doc_or_dir)
+        if out_dir is None:
+            p = Path(doc_or_dir)
+            out_dir = p if p.is_dir() else p.parent
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    if fmt == "json":
+        p = out / "gains.json"
+        p.write_text(json.dumps(doc, indent=1))
+        return [p]
+    if fmt == "csv":
+        return _write_csv(doc, out)
+    if fmt == "mat":
+        return _write_mat(doc, out)
+    return _write_rosco(doc, out)
