@@ -12,12 +12,10 @@ Run:  python benchmarks/study_madsen.py [--duration 600] [--out study-madsen]
 """
 from __future__ import annotations
 
-import argparse
 import json
 import math
 import sys
 import time
-from pathlib import Path
 
 import numpy as np
 
@@ -25,6 +23,8 @@ import linearize
 from mpc_wt.assess import damage_equivalent_load, harmonic_psd, psd
 from mpc_wt.plotting import plot_psd_comparison
 from mpc_wt.runs import run_controller
+
+from _study import study_args
 
 PAPER = {"power_std_pct_lidar": 0.29, "power_std_pct_no_lidar": 0.36,
          "flap_1P_reduction_pct": 60.0, "shaft_1P_reduction_pct": 85.0,
@@ -35,14 +35,8 @@ CHANNELS = {"flap": ("flap_moment_1", 10.0), "shaft": ("shaft_bending_blade1", 4
 
 
 def main() -> int:
-    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    ap.add_argument("--duration", type=float, default=600.0, help="assessed length [s]")
-    ap.add_argument("--transient", type=float, default=60.0, help="discarded start [s]")
-    ap.add_argument("--seed", type=int, default=1)
-    ap.add_argument("--out", default="study-madsen")
-    args = ap.parse_args()
-    out = Path(args.out)
-    out.mkdir(parents=True, exist_ok=True)
+    args, out = study_args(__doc__, "study-madsen",
+                           lambda ap: ap.add_argument("--seed", type=int, default=1))
     t = linearize.load_turbine()
     figs: dict = {"date": time.strftime("%Y-%m-%d"), "wind_mps": 18.0, "turbulence": "A",
                   "seed": args.seed, "duration_s": args.duration, "paper": PAPER}

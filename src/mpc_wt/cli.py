@@ -236,16 +236,19 @@ def _cmd_simulate(args: argparse.Namespace) -> int:
                          f"{args.controller!r}")
     turbine = linearize.load_turbine(args.turbine)
     mpc_opts: dict[str, Any] = {}
-    if args.controller != "baseline":
+    if args.controller.startswith("mpc"):
         mpc_opts = {"backend": args.backend, "formulation": args.formulation,
                     "horizon": args.horizon, "scheduled": args.scheduled,
                     "estimator": None if args.estimator == "none" else args.estimator}
     elif (args.backend, args.formulation, args.estimator, args.scheduled) != \
             (None, "condensed", "none", False) or args.horizon != 15:
-        raise UsageError("--backend/--formulation/--horizon/--estimator/--scheduled apply to the "
-                         "MPC controllers only, not to --controller baseline")
+        raise UsageError(f"--backend/--formulation/--horizon/--estimator/--scheduled apply to "
+                         f"the MPC controllers only, not to --controller {args.controller}")
+    if args.apc_frequency is not None and args.controller != "ts":
+        raise UsageError("--apc-frequency applies to --controller ts only")
     res = run_controller(turbine, args.controller, args.wind, args.turbulence, args.seed,
-                         args.duration, progress=True, mpc_options=mpc_opts)
+                         args.duration, progress=True, mpc_options=mpc_opts,
+                         apc_frequency=args.apc_frequency)
     out = Path(args.out)
     if out.suffix == "":
         out = out.with_suffix(".nc")
@@ -514,7 +517,7 @@ def _parser() -> argparse.ArgumentParser:
     p = sub.add_parser("simulate", help="closed-loop simulation on the plant")
     p.add_argument("--turbine", **turb)
     p.add_argument("--controller", default="baseline",
-                   help="baseline | mpc | mpc-lidar | mpc-collective")
+                   help="baseline | mpc | mpc-lidar | mpc-collective | lqr-pio | ts")
     p.add_argument("--wind", type=float, required=True, help="mean hub-height wind [m/s]")
     p.add_argument("--turbulence", choices=("A", "B", "C", "steady"), default="A")
     p.add_argument("--seed", type=int, default=1)
@@ -531,6 +534,8 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument("--scheduled", action="store_true",
                    help="MPC scheduled over a model family 12-25 m/s on the estimated wind "
                         "(or the preview with mpc-lidar)")
+    p.add_argument("--apc-frequency", type=float, default=None,
+                   help="ts: sinusoidal power reduction of Clemens eq 11 at this f_r [Hz]")
     p.set_defaults(func=_cmd_simulate)
 
     p = sub.add_parser("design", help="gain synthesis: baseline PI, LQR family, TS by LMIs")

@@ -26,7 +26,7 @@ DEFAULT_CHANNELS = {"flap_moment_1": 10.0, "flap_moment_2": 10.0, "flap_moment_3
                     "shaft_bending_blade1": 4.0}
 
 
-CONTROLLERS = ("baseline", "mpc", "mpc-lidar", "mpc-collective")
+CONTROLLERS = ("baseline", "mpc", "mpc-lidar", "mpc-collective", "lqr-pio", "ts")
 
 
 def _wind(turbine: linearize.Turbine, wind_mps: float, turbulence: str, seed: int,
@@ -51,7 +51,8 @@ def _wind(turbine: linearize.Turbine, wind_mps: float, turbulence: str, seed: in
 def run_controller(turbine: linearize.Turbine, controller: str, wind_mps: float,
                    turbulence: str = "A", seed: int = 1, duration: float = 600.0,
                    progress: bool = False, shear_exponent: float = 0.2,
-                   mpc_options: dict[str, Any] | None = None) -> ClosedLoopResult:
+                   mpc_options: dict[str, Any] | None = None,
+                   apc_frequency: float | None = None) -> ClosedLoopResult:
     """Trim, design the controller, generate the wind and simulate.
 
     ``controller``: "baseline" (tuned PI and torque law, 80 Hz), "mpc" (Madsen's 8-state
@@ -65,6 +66,11 @@ def run_controller(turbine: linearize.Turbine, controller: str, wind_mps: float,
     ``scheduled`` (True: a :class:`~mpc_wt.mpc.ScheduledMPC` over a model family from the
     first whole m/s above rated to 25 m/s in 1 m/s steps, scheduled on the estimated wind, or
     on the preview with "mpc-lidar").
+
+    "lqr-pio": Do et al.'s LQR on PI-observer estimates at the mean wind (region III, constant
+    torque; :mod:`mpc_wt.synthesis`). "ts": Clemens et al.'s TS controller and wind observer,
+    LMI-designed on the default vertex grid (:mod:`mpc_wt.ts`); ``apc_frequency`` [Hz] adds
+    the sinusoidal power reduction of eq 11 (:func:`mpc_wt.ts.apc_reference`).
     """
     if controller not in CONTROLLERS:
         raise ValueError(f"controller must be one of {list(CONTROLLERS)}, got {controller!r}")
@@ -76,7 +82,29 @@ def run_controller(turbine: linearize.Turbine, controller: str, wind_mps: float,
                             "shear_exponent": shear_exponent, "turbine": turbine.name}
     preview = None
     cdt = None
-    if controller == "baseline":
+    if apc_frequency is not None and controller != "ts":
+        raise ValueError("apc_frequency applies to the 'ts' controller only")
+    if controller == "lqr-pio":
+        from .synthesis import LQRPIOController, design_lqr, design_pi_observer
+
+        model = linearize.linearize(turbine, wind_mps, config=linearize.PlantConfig.do())
+        lq = design_lqr(model, state_weights={"rotor_speed": 5.0, "tower_fa_velocity": 1.0},
+                        scales={"rotor_speed": 0.05, "tower_fa_velocity": 0.1,
+                                **{f"pitch_ref_{i}": math.radians(1.0) for i in (1, 2, 3)}})
+        ctl = LQRPIOController(model, turbine, lq, design_pi_observer(model, q=1e3))
+        meta["lqr"] = {"weights": lq.weights, "observer_q": 1e3}
+    elif controller == "ts":
+        from .ts import (TSController, apc_reference, build_ts_model, design_ts_controller,
+                         design_ts_observer)
+
+        ts = build_ts_model(turbine)
+        c, o = design_ts_controller(ts), design_ts_observer(ts)
+        ctl = TSController(ts, c, o, turbine, initial_wind=float(np.clip(
+            wind_mps, ts.wind_grid[0], ts.wind_grid[-1])),
+            power_reduction=None if apc_frequency is None else apc_reference(apc_frequency))
+        meta["ts"] = {"vertices": ts.n_vertices, "decay_rate": c.decay_rate,
+                      "observer_decay_rate": o.decay_rate, "apc_frequency_Hz": apc_frequency}
+    elif controller == "baseline":
         gains = tune_baseline(turbine)
         ctl: Any = BaselineController(turbine, gains)
         meta["gains"] = {"kp": gains.kp, "ki": gains.ki, "theta_k_rad": gains.theta_k_rad,

@@ -40,6 +40,7 @@ import itertools
 import logging
 import math
 import time
+import warnings
 from dataclasses import dataclass, field
 from typing import Any, Callable, Mapping, Sequence
 
@@ -382,7 +383,10 @@ def _solve(prob: Any, solver: str | None) -> tuple[str, str]:
     names = [solver] if solver else [s for s in ("MOSEK", "CLARABEL", "SCS") if s in installed]
     for s in names:
         try:
-            prob.solve(solver=s)
+            with warnings.catch_warnings():
+                # "optimal_inaccurate" is kept: the numpy certificate decides, not the status
+                warnings.filterwarnings("ignore", message="Solution may be inaccurate")
+                prob.solve(solver=s)
         except (KeyboardInterrupt, SystemExit):
             raise
         except BaseException as err:  # cvxpy.SolverError; Clarabel's Rust panics are
@@ -451,7 +455,8 @@ def _controller_problem(a: np.ndarray, b: np.ndarray, cells: list[tuple[int, ...
         for i in range(nv):
             for j in range(nu):
                 row = y[i][j:j + 1, :]
-                cons.append(_sym(cp.bmat([[x, row.T], [row, cp.reshape(t[j], (1, 1), order="C")]])) >> 0)
+                tj = cp.reshape(t[j], (1, 1), order="C")
+                cons.append(_sym(cp.bmat([[x, row.T], [row, tj]])) >> 0)
         if mu is not None:
             for j in np.nonzero(np.isfinite(mu))[0]:
                 cons.append(t[j] <= mu[j] ** 2)
@@ -492,7 +497,6 @@ def design_ts_controller(ts: TSModel, *, decay_rate: float = 0.2,
         LMIs infeasible: the message says which constraint to relax (the input bound, the
         disk, or the decay rate, with the largest feasible decay rate found).
     """
-    import cvxpy as cp
 
     alpha = _check_rate("decay_rate", decay_rate)
     radius = _check_rate("disk_radius", disk_radius, allow_none=True)
@@ -597,7 +601,6 @@ def verify_controller(ts: TSModel, K: np.ndarray, P: np.ndarray, scale_x: np.nda
     nrm = np.linalg.norm(x, 2)
     alpha = float(decay_rate)
     worst = -np.inf
-    nx = p.shape[0]
 
     def g(i: int, j: int) -> np.ndarray:
         return a[i] @ x - b[i] @ (k[j] @ x)

@@ -174,6 +174,10 @@ def test_assess_csv_from_another_tool(tmp_path: Path, capsys: pytest.CaptureFixt
       "--wind", "18", "--duration", "1", "--out", "x"], "formulation='sparse' needs backend"),
     (["simulate", "--controller", "mpc", "--scheduled", "--wind", "8", "--duration", "1",
       "--out", "x"], "wind 8 m/s is outside"),
+    (["simulate", "--controller", "lqr-pio", "--apc-frequency", "0.1", "--wind", "18",
+      "--out", "x"], "--apc-frequency applies to --controller ts only"),
+    (["simulate", "--controller", "ts", "--horizon", "5", "--wind", "18", "--out", "x"],
+     "not to --controller ts"),
 ])
 def test_simulate_assess_errors(argv, match: str, capsys: pytest.CaptureFixture[str]) -> None:
     assert main(argv) == 2
@@ -222,3 +226,21 @@ def test_simulate_mpc_options(extra: list[str], meta: dict, tmp_path: Path,
     assert np.all(r.controller["qp_fallback"] == 0)
     # the controller holds the rotor near rated speed (1.267 rad/s) through the gusts
     assert abs(r.x[r.t > 10, 2].mean() - 1.267) < 0.05
+
+
+@pytest.mark.parametrize("controller, extra", [("lqr-pio", []),
+                                               ("ts", ["--apc-frequency", "0.1"])])
+def test_simulate_gain_controllers(controller: str, extra: list[str], tmp_path: Path,
+                                   capsys: pytest.CaptureFixture[str]) -> None:
+    out = tmp_path / f"{controller}.nc"
+    assert main(["simulate", "--controller", controller, "--wind", "16", "--turbulence", "B",
+                 "--duration", "20", "--out", str(out), *extra]) == 0
+    from mpc_wt.simulate import ClosedLoopResult
+
+    r = ClosedLoopResult.load(out)
+    assert r.meta["controller"] == controller
+    w = r.channel("rotor_speed")
+    assert abs(w.mean() / 1.2671 - 1) < 0.03
+    if controller == "ts":
+        assert r.meta["ts"]["apc_frequency_Hz"] == 0.1
+        assert r.channel("power_ref").min() < 0.4 * r.channel("power_ref").max()

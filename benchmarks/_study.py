@@ -1,0 +1,22 @@
+"""Shared command line of the paper studies: run length, discarded transient, output folder."""
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+from typing import Callable
+
+
+def study_args(doc: str, default_out: str,
+               extra: Callable[[argparse.ArgumentParser], None] | None = None
+               ) -> tuple[argparse.Namespace, Path]:
+    """Parse --duration, --transient, --out (created) and the study's own options."""
+    ap = argparse.ArgumentParser(description=doc.split("\n")[0])
+    ap.add_argument("--duration", type=float, default=600.0, help="assessed length [s]")
+    ap.add_argument("--transient", type=float, default=60.0, help="discarded start [s]")
+    ap.add_argument("--out", default=default_out)
+    if extra is not None:
+        extra(ap)
+    args = ap.parse_args()
+    out = Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    return args, out
