@@ -10,6 +10,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+import lidar
 import linearize
 from mpc_wt.runs import _wind
 from mpc_wt.simulate import simulate_closed_loop
@@ -147,9 +148,8 @@ def test_ts_controller_regulates_and_tracks_power(turbine, params, ts, designs) 
     rated = turbine.operation.rated_rotor_speed_rad_s
     assert abs(w.mean() / rated - 1) < 0.01 and w.std() / rated < 0.04
     # wind estimate against the rotor-disk mean of the field
-    yy, zz = np.meshgrid(field.y, field.z - turbine.geometry.hub_height, indexing="ij")
-    veff = field.u[:, yy**2 + zz**2 <= turbine.geometry.tip_radius**2].mean(axis=1)
-    truth = np.interp(r.t, field.t, veff)
+    truth = np.interp(r.t, field.t,
+                      lidar.rotor_effective_wind(field, turbine.geometry.tip_radius))
     err = (r.channel("wind_est") - truth)[r.t > 20]
     assert np.sqrt(np.mean(err**2)) < 0.5 * truth[r.t > 20].std() + 0.3
     # active power control: the sinusoidal reduction of eq 11 at 0.1 Hz
