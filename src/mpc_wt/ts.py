@@ -880,12 +880,10 @@ class TSController:
         h = self.ts.membership(v, dp)
         act = np.nonzero(h)[0]
         xh = self.xi[:-1]
-        m = self.ts.blend(h)
         q_prev = self._q
         if self._ki is not None:
             src = self._int_src
-            err = (y[src] if isinstance(src, (int, np.integer)) else xh[self._ki]) \
-                - m["x0"][self._ki]
+            err = (y[src] if src is not None else xh[self._ki]) - h @ self.ts.x0[:, self._ki]
             self._q = q_prev + err * self.dt
         u = sum(h[i] * (self.ts.u0[i] - self.ctl.K[i] @ (
             np.append(xh - self.ts.x0[i], self._q) if self._ki is not None
