@@ -13,7 +13,6 @@ Run:  python benchmarks/study_do.py [--duration 600] [--seeds 1,2,3] [--out stud
 from __future__ import annotations
 
 import json
-import math
 import time
 
 import numpy as np
@@ -23,13 +22,14 @@ from mpc_wt.assess import cs_measures, damage_equivalent_load
 from mpc_wt.baseline import BaselineController, tune_baseline
 from mpc_wt.runs import _wind
 from mpc_wt.simulate import SimulationDivergedError, simulate_closed_loop
-from mpc_wt.synthesis import LQRPIOController, design_lqr, design_pi_observer
+from mpc_wt.synthesis import (REGION3_SCALES, REGION3_WEIGHTS, LQRPIOController, design_lqr,
+                              design_pi_observer)
 
 from _study import study_args
 
 PAPER = {"cs1_change_pct": -27.0, "cs2_change_pct": -79.0, "tower_del_change_pct": -29.0,
          "table4": {"5-10": [0.144, 149.9], "5-15": [0.122, 102.8], "5-20": [0.134, 102.7]}}
-PITCH_SCALES = {f"pitch_ref_{i}": math.radians(1.0) for i in (1, 2, 3)}
+PITCH_SCALES = {k: v for k, v in REGION3_SCALES.items() if k.startswith("pitch_ref")}
 
 
 def _fsf(model: linearize.LinearModel, turbine: linearize.Turbine,
@@ -62,8 +62,7 @@ def main() -> int:
     gains = tune_baseline(tb)
     dur = args.duration + args.transient
     cases = {"PI": None,
-             "FSF": ({"rotor_speed": 5.0, "tower_fa_velocity": 1.0},
-                     {"rotor_speed": 0.05, "tower_fa_velocity": 0.1})}
+             "FSF": (REGION3_WEIGHTS, REGION3_SCALES)}
     for w in (10.0, 15.0, 20.0):
         cases[f"5-{w:g}"] = ({"rotor_speed": 5.0, **{f"flap_{i}": w for i in (1, 2, 3)}},
                              {"rotor_speed": 0.05, **{f"flap_{i}": 2.0 for i in (1, 2, 3)}})

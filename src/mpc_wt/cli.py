@@ -430,16 +430,14 @@ def _cmd_design(args: argparse.Namespace) -> int:
                                                     zeta=args.zeta))
         note = f"kp {doc['settings']['kp']:.4g} s, ki {doc['settings']['ki']:.4g}"
     elif args.kind == "lqr":
-        from .synthesis import design_lqr_family, design_pi_observer
+        from .synthesis import (REGION3_SCALES, REGION3_WEIGHTS, design_lqr_family,
+                                design_pi_observer)
 
         winds = parse_range(args.wind or "12:25:1", "--wind")
         fam = linearize.linearize_family(turbine, winds, config=linearize.PlantConfig.do(),
                                          progress=True)
-        weights = _pairs(args.weight, "--weight") or {"rotor_speed": 5.0,
-                                                       "tower_fa_velocity": 1.0}
-        scales = {"rotor_speed": 0.05, "tower_fa_velocity": 0.1,
-                  **{f"pitch_ref_{k}": math.radians(1.0) for k in (1, 2, 3)}}
-        scales.update(_pairs(args.scale, "--scale"))
+        weights = _pairs(args.weight, "--weight") or dict(REGION3_WEIGHTS)
+        scales = {**REGION3_SCALES, **_pairs(args.scale, "--scale")}
         sw = {k: v for k, v in weights.items() if k in fam.models[0].states}
         ow = {k: v for k, v in weights.items() if k not in sw}
         designs = design_lqr_family(fam, state_weights=sw, output_weights=ow, scales=scales)

@@ -85,12 +85,11 @@ def run_controller(turbine: linearize.Turbine, controller: str, wind_mps: float,
     if apc_frequency is not None and controller != "ts":
         raise ValueError("apc_frequency applies to the 'ts' controller only")
     if controller == "lqr-pio":
-        from .synthesis import LQRPIOController, design_lqr, design_pi_observer
+        from .synthesis import (REGION3_SCALES, REGION3_WEIGHTS, LQRPIOController, design_lqr,
+                                design_pi_observer)
 
         model = linearize.linearize(turbine, wind_mps, config=linearize.PlantConfig.do())
-        lq = design_lqr(model, state_weights={"rotor_speed": 5.0, "tower_fa_velocity": 1.0},
-                        scales={"rotor_speed": 0.05, "tower_fa_velocity": 0.1,
-                                **{f"pitch_ref_{i}": math.radians(1.0) for i in (1, 2, 3)}})
+        lq = design_lqr(model, state_weights=REGION3_WEIGHTS, scales=REGION3_SCALES)
         ctl = LQRPIOController(model, turbine, lq, design_pi_observer(model, q=1e3))
         meta["lqr"] = {"weights": lq.weights, "observer_q": 1e3}
     elif controller == "ts":

@@ -36,7 +36,14 @@ import linearize
 from .estimator import read_signals
 
 __all__ = ["LQRDesign", "PIObserver", "design_lqr", "design_lqr_family", "design_pi_observer",
-           "LQRPIOController", "SynthesisError"]
+           "LQRPIOController", "SynthesisError", "REGION3_WEIGHTS", "REGION3_SCALES"]
+
+#: Region-III LQR weights that hold the loop stable with the PI observer (q = 1e3) on the
+#: nonlinear plant: rotor-speed regulation and tower fore-aft damping (``state_weights``).
+REGION3_WEIGHTS = {"rotor_speed": 5.0, "tower_fa_velocity": 1.0}
+#: Their typical magnitudes (``scales``): 0.05 rad/s, 0.1 m/s, 1 deg of pitch per blade.
+REGION3_SCALES = {"rotor_speed": 0.05, "tower_fa_velocity": 0.1,
+                  **{f"pitch_ref_{i}": math.radians(1.0) for i in (1, 2, 3)}}
 
 
 class SynthesisError(ValueError):

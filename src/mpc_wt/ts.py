@@ -654,6 +654,14 @@ def _augmented(ts: TSModel, tau_v: float) -> tuple[np.ndarray, np.ndarray, np.nd
     return aa, bb, cc
 
 
+def _observer_mats(ts: TSModel, tau_v: float, sxi: np.ndarray, sy: np.ndarray
+                   ) -> tuple[np.ndarray, np.ndarray]:
+    """Scaled A~_i and C~ of the observer design (states and wind by ``sxi``, outputs by ``sy``)."""
+    aa, _, cc = _augmented(ts, tau_v)
+    return (np.array([np.diag(1 / sxi) @ ai @ np.diag(sxi) for ai in aa]),
+            np.diag(1 / sy) @ cc @ np.diag(sxi))
+
+
 def design_ts_observer(ts: TSModel, *, tau_v: float = 4.0, decay_rate: float = 1.0,
                        disk_radius: float | None = 60.0,
                        scales: Mapping[str, float] | None = None, margin: float = 1e-4,
@@ -688,8 +696,7 @@ def design_ts_observer(ts: TSModel, *, tau_v: float = 4.0, decay_rate: float = 1
     aa, bb, cc = _augmented(ts, float(tau_v))
     sxi = _scales(ts.states + ("wind",), scales)
     sy = _scales(ts.measured, scales)
-    a = np.array([np.diag(1 / sxi) @ ai @ np.diag(sxi) for ai in aa])
-    c = np.diag(1 / sy) @ cc @ np.diag(sxi)
+    a, c = _observer_mats(ts, float(tau_v), sxi, sy)
     for i, ai in enumerate(a):
         # modes slower than the required decay must be observable (PBH on A~ + alpha I)
         modes = _uncontrollable_modes(ai.T + alpha * np.eye(ai.shape[0]), c.T, discrete=False)
@@ -743,10 +750,8 @@ def verify_observer(ts: TSModel, L: np.ndarray, P: np.ndarray, scale_xi: np.ndar
                     grid_points: int = 6) -> Certificate:
     """Check TS observer gains with numpy: vertex LMIs at P with ``margin`` and, on a premise
     grid, sum_i h_i (A~_i - L_i C~) Hurwitz with the decay rate and decreasing e' P e."""
-    aa, _, cc = _augmented(ts, tau_v)
     sxi, sy = np.asarray(scale_xi, float), np.asarray(scale_y, float)
-    a = np.array([np.diag(1 / sxi) @ ai @ np.diag(sxi) for ai in aa])
-    c = np.diag(1 / sy) @ cc @ np.diag(sxi)
+    a, c = _observer_mats(ts, tau_v, sxi, sy)
     ls = np.array([np.diag(1 / sxi) @ li @ np.diag(sy) for li in np.asarray(L, float)])
     p = 0.5 * (np.asarray(P, float) + np.asarray(P, float).T)
     fails: list[str] = []
