@@ -15,25 +15,19 @@ from __future__ import annotations
 
 import argparse
 import json
-import math
 import time
 
 import numpy as np
 
 import lidar
 import linearize
+from mpc_wt.assess import tracking_response
 from mpc_wt.runs import _wind, run_baseline
 from mpc_wt.simulate import simulate_closed_loop
-from mpc_wt.ts import (TSController, apc_reference, build_ts_model, design_ts_controller,
-                       design_ts_observer)
+from mpc_wt.retrofit import apc_reference
+from mpc_wt.ts import TSController, build_ts_model, design_ts_controller, design_ts_observer
 
 from _study import study_args
-
-
-def _sine_fit(t: np.ndarray, x: np.ndarray, f: float) -> complex:
-    basis = np.c_[np.sin(2 * np.pi * f * t), np.cos(2 * np.pi * f * t), np.ones_like(t)]
-    c = np.linalg.lstsq(basis, x, rcond=None)[0]
-    return complex(c[0], c[1])
 
 
 def main() -> int:
@@ -98,10 +92,10 @@ def main() -> int:
         c = TSController(ts, ctl, obs, tb, initial_wind=v, power_reduction=apc_reference(fr))
         r = simulate_closed_loop(params, c, wind, dur, x0=op.x, u0=op.u, progress=True)
         k = r.t >= args.transient
-        g = _sine_fit(r.t[k], r.channel("gen_power")[k], fr) / \
-            _sine_fit(r.t[k], r.channel("power_ref")[k], fr)
+        amp, ph = tracking_response(r.t[k], r.channel("power_ref")[k],
+                                    r.channel("gen_power")[k], fr)
         err = r.channel("gen_power")[k] - r.channel("power_ref")[k]
-        row = {"f_r_Hz": fr, "amplitude_ratio": abs(g), "phase_deg": math.degrees(np.angle(g)),
+        row = {"f_r_Hz": fr, "amplitude_ratio": amp, "phase_deg": ph,
                "tracking_rms_kW": float(np.sqrt(np.mean(err**2)) / 1e3),
                "rotor_std_pct": float(100 * r.channel("rotor_speed")[k].std() / rated)}
         figs["apc"].append(row)

@@ -23,7 +23,7 @@ from scipy import stats
 
 __all__ = ["rainflow", "damage_equivalent_load", "lifetime_del", "wind_bin_probabilities",
            "miner_damage", "lifetime_extension", "CSMeasures", "cs_measures", "psd",
-           "harmonic_psd", "pitch_duty", "energy_Wh", "aep_Wh"]
+           "harmonic_psd", "pitch_duty", "energy_Wh", "aep_Wh", "tracking_response"]
 
 FloatArray = np.ndarray
 
@@ -364,3 +364,33 @@ def aep_Wh(mean_power_W: Any, probabilities: Any, availability: float = 1.0) -> 
     if p.shape != w.shape:
         raise ValueError(f"mean_power_W {p.shape} and probabilities {w.shape} differ in shape")
     return float(availability * 8766.0 * np.sum(p * w))
+
+
+def tracking_response(t: Any, reference: Any, output: Any, frequency_hz: float
+                      ) -> tuple[float, float]:
+    """Amplitude ratio [-] and phase [deg] (negative: lag) of ``output`` against ``reference``
+    at one frequency, from least-squares fits of a sine, a cosine and an offset to each
+    (power tracking, Clemens et al. fig. 3).
+
+    Raises
+    ------
+    ValueError
+        If the series differ in length, are not finite, or the frequency is not positive, or
+        the reference carries no component at that frequency.
+    """
+    tt = _check_series("t", t)
+    r = _check_series("reference", reference)
+    y = _check_series("output", output)
+    if not (tt.shape == r.shape == y.shape):
+        raise ValueError(f"t {tt.shape}, reference {r.shape} and output {y.shape} must match")
+    f = float(frequency_hz)
+    if not (math.isfinite(f) and f > 0):
+        raise ValueError(f"frequency_hz must be > 0, got {frequency_hz!r}")
+    basis = np.c_[np.sin(2 * np.pi * f * tt), np.cos(2 * np.pi * f * tt), np.ones_like(tt)]
+    cr = np.linalg.lstsq(basis, r, rcond=None)[0]
+    cy = np.linalg.lstsq(basis, y, rcond=None)[0]
+    zr, zy = complex(cr[0], cr[1]), complex(cy[0], cy[1])
+    if abs(zr) <= 1e-12 * max(1.0, float(np.abs(r).max())):
+        raise ValueError(f"reference has no component at {f:g} Hz")
+    g = zy / zr
+    return float(abs(g)), float(math.degrees(np.angle(g)))

@@ -14,18 +14,33 @@ mpc-wt from its own linear models.
   Placing the closed-loop poles at omega_n, zeta (aerodynamic damping neglected, as the report
   does) gives KP = 2 J Omega_0 zeta omega_n / (N (-dP/dtheta)_0) and
   KI = J Omega_0 omega_n^2 / (N (-dP/dtheta)_0), on the generator speed.
+* Down-regulation (Pettas and Cheng 2018, sec. 3.2): ``power_fraction`` f < 1 lowers the rated
+  power to f P_r by the generator torque (rated torque f T_r at the same rated speed) and
+  re-tunes the PI on the derated operating points (trim to the power reference).
+* Active power control (Clemens et al. sec. 3.2, eq 11): a power reference P_ref(t) replaces
+  rated power in the constant-power torque law, and the PI gains are interpolated between
+  designs at several power fractions (the pitch loop scheduled on the power reference).
 """
 from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from typing import Any
+from typing import Any, Callable, Sequence
 
 import numpy as np
 
 import linearize
 
-__all__ = ["BaselineGains", "tune_baseline", "BaselineController"]
+__all__ = ["BaselineGains", "tune_baseline", "tune_baseline_schedule", "BaselineController",
+           "check_power_fraction"]
+
+
+def check_power_fraction(value: Any, name: str = "power_fraction") -> float:
+    """A derating fraction of rated power: finite and in (0, 1]."""
+    f = float(value)
+    if not (math.isfinite(f) and 0.0 < f <= 1.0):
+        raise ValueError(f"{name} must be in (0, 1] (a fraction of rated power), got {value!r}")
+    return f
 
 
 @dataclass(frozen=True)
@@ -48,6 +63,9 @@ class BaselineGains:
         Aerodynamic power sensitivity extrapolated to zero pitch [W/rad].
     omega_n_rad_s, zeta : float
         Design natural frequency [rad/s] and damping ratio [-].
+    power_fraction : float
+        Fraction of the turbine's rated power this design was tuned for (1: normal operation;
+        < 1: derated, ``rated_power`` and ``rated_torque`` already lowered) [-].
     """
 
     kp: float
@@ -60,13 +78,18 @@ class BaselineGains:
     dpdtheta_0: float
     omega_n_rad_s: float = 0.6
     zeta: float = 0.7
+    power_fraction: float = 1.0
     info: dict[str, Any] = field(default_factory=dict, compare=False)
 
 
 def tune_baseline(turbine: linearize.Turbine, *, omega_n_rad_s: float = 0.6, zeta: float = 0.7,
                   wake: str = "frozen", winds: Any = None,
-                  inertia: float | None = None) -> BaselineGains:
+                  inertia: float | None = None, power_fraction: float = 1.0) -> BaselineGains:
     """Tune the baseline from the turbine's own linear models.
+
+    With ``power_fraction`` f < 1 (down-regulation, Pettas and Cheng sec. 3.2) the pitch
+    sensitivities come from the operating points trimmed to f P_r at rated rotor speed, and the
+    set points become f P_r and f T_r (the same rated speed, so the same tip-speed ratio).
 
     Parameters
     ----------
@@ -80,7 +103,15 @@ def tune_baseline(turbine: linearize.Turbine, *, omega_n_rad_s: float = 0.6, zet
     inertia : float, optional
         Drivetrain inertia on the low-speed shaft [kg m^2]; default rotor (from the blade data)
         plus N^2 times the generator inertia.
+    power_fraction : float
+        Derating fraction in (0, 1] [-].
+
+    Raises
+    ------
+    ValueError
+        If ``power_fraction`` is outside (0, 1] or a gain parameter is not positive.
     """
+    frac = check_power_fraction(power_fraction)
     if not (omega_n_rad_s > 0 and zeta > 0):
         raise ValueError(f"omega_n_rad_s and zeta must be > 0, got {omega_n_rad_s!r}, {zeta!r}")
     if winds is None:
@@ -89,7 +120,8 @@ def tune_baseline(turbine: linearize.Turbine, *, omega_n_rad_s: float = 0.6, zet
     else:
         v = np.asarray(winds, float)
     params = linearize.plant_params(turbine)
-    fam = linearize.linearize_family(turbine, v, wake=wake, params=params)
+    p_w = None if frac == 1.0 else frac * turbine.operation.rated_power
+    fam = linearize.linearize_family(turbine, v, wake=wake, params=params, power_W=p_w)
     theta = np.array([m.info["pitch_deg"] for m in fam.models]) * math.pi / 180
     dpdt = np.array([linearize.sensitivities(m)["dP_dpitch_W_per_rad"] for m in fam.models])
     slope, intercept = np.polyfit(theta, dpdt, 1)
@@ -106,11 +138,22 @@ def tune_baseline(turbine: linearize.Turbine, *, omega_n_rad_s: float = 0.6, zet
     k_opt = 0.5 * rho * math.pi * r**5 * cp / lam**3 / n**3
     return BaselineGains(kp=kp, ki=ki, theta_k_rad=theta_k, k_opt=k_opt,
                          rated_gen_speed_rad_s=turbine.rated_generator_speed_rad_s,
-                         rated_torque=turbine.rated_generator_torque,
-                         rated_power=turbine.operation.rated_power, dpdtheta_0=intercept,
-                         omega_n_rad_s=omega_n_rad_s, zeta=zeta,
+                         rated_torque=frac * turbine.rated_generator_torque,
+                         rated_power=frac * turbine.operation.rated_power, dpdtheta_0=intercept,
+                         omega_n_rad_s=omega_n_rad_s, zeta=zeta, power_fraction=frac,
                          info={"wake": wake, "inertia_lss": j, "tsr_opt": lam, "cp_max": cp,
                                "fit_winds": v.tolist()})
+
+
+def tune_baseline_schedule(turbine: linearize.Turbine,
+                           fractions: Sequence[float] = (1.0, 0.75, 0.5, 0.25),
+                           **kwargs: Any) -> tuple[BaselineGains, ...]:
+    """PI designs at several power fractions, for a pitch loop scheduled on the power reference
+    (active power control). ``kwargs`` go to :func:`tune_baseline`; sorted by fraction."""
+    fr = sorted({check_power_fraction(f, "fractions") for f in fractions})
+    if len(fr) < 1:
+        raise ValueError("fractions must hold at least one power fraction")
+    return tuple(tune_baseline(turbine, power_fraction=f, **kwargs) for f in fr)
 
 
 class BaselineController:
@@ -119,17 +162,50 @@ class BaselineController:
     ``step(t, meas)`` takes a measurement dict with at least ``gen_speed`` [rad/s] and
     ``pitch`` (3,) [rad] and returns (pitch_ref (3,), gen_torque_ref) and stores its internal
     signals in ``.signals``. Call at the plant rate (``dt``).
+
+    Derated gains (``gains.power_fraction`` < 1) cap the torque law at the derated rated torque
+    at rated speed. Region 2.5 is the NREL line from the synchronous speed to (rated speed,
+    rated torque); when K omega^2 meets no such line below rated speed (deep derating), the
+    region-2 torque is capped at the rated torque instead (a constant-torque region 2.5 in which
+    the rotor speeds up to rated, as in Pettas and Cheng fig. 5).
+
+    Active power control: ``power_reference(t)`` [W] replaces rated power in region 3, and with
+    ``gain_schedule`` (designs at several power fractions, :func:`tune_baseline_schedule`) the
+    effective gains KP GK(theta), KI GK(theta) of the designs are interpolated on P_ref / P_r
+    (integral kept in pitch units, so a gain change moves no command), and with ``feedforward``
+    each change of the reference moves the pitch by dP_ref / (eta dP/dtheta), dP/dtheta from the
+    same designs at the present pitch (the pitch loop then only corrects). A reference outside
+    (0, rated power] raises ``ValueError``; while the rotor is below rated speed at fine pitch
+    the wind cannot give the reference (signal ``apc_saturated`` = 1).
     """
 
     def __init__(self, turbine: linearize.Turbine, gains: BaselineGains | None = None, *,
                  dt: float = 1.0 / 80.0, region3: str = "constant_power",
-                 filter_hz: float = 0.25, slip_pct: float = 10.0) -> None:
+                 filter_hz: float = 0.25, slip_pct: float = 10.0,
+                 power_reference: Callable[[float], float] | None = None,
+                 gain_schedule: Sequence[BaselineGains] | None = None,
+                 feedforward: bool = True) -> None:
         if region3 not in ("constant_power", "constant_torque"):
             raise ValueError(f"region3 must be 'constant_power' or 'constant_torque', got "
                              f"{region3!r}")
         if not dt > 0:
             raise ValueError(f"dt must be > 0 s, got {dt!r}")
+        if not 0 < filter_hz < 0.5 / dt:
+            raise ValueError(f"filter_hz must be in (0, Nyquist = {0.5 / dt:g} Hz) at dt = "
+                             f"{dt:g} s, got {filter_hz!r}")
         self.turbine = turbine
+        self.power_reference = power_reference
+        self.feedforward = bool(feedforward)
+        if gain_schedule is not None:
+            sched = sorted(gain_schedule, key=lambda g: g.power_fraction)
+            if not sched:
+                raise ValueError("gain_schedule must hold at least one BaselineGains")
+            self._sched_f: np.ndarray | None = np.array([g.power_fraction for g in sched])
+            self._sched = np.array([[g.kp, g.ki, g.theta_k_rad, g.dpdtheta_0] for g in sched])
+            if gains is None:
+                gains = sched[-1]
+        else:
+            self._sched_f = None
         self.gains = gains or tune_baseline(turbine)
         self.dt = float(dt)
         self.region3 = region3
@@ -155,7 +231,11 @@ class BaselineController:
         # continuous; without an intersection the line starts at the synchronous speed
         disc = self.slope25**2 - 4.0 * g.k_opt * self.slope25 * self.w_sync
         self.w_trans = ((self.slope25 - math.sqrt(disc)) / (2.0 * g.k_opt) if disc >= 0
-                        else self.w_sync)
+                        else math.inf)
+        # no crossing below rated speed: region 2 runs up to rated, capped at rated torque
+        self.tq_cap = g.rated_power / turbine.drivetrain.generator_efficiency / self.w_rated
+        if self.w_trans > self.w_rated:
+            self.w_trans = self.w_rated
         self.reset()
 
     def reset(self) -> None:
@@ -166,21 +246,34 @@ class BaselineController:
         self.last_torque: float | None = None
         self.signals: dict[str, float] = {}
 
-    def torque(self, w: float, pitch: float) -> float:
-        """Generator torque demand for a filtered generator speed and the collective pitch."""
+    def torque(self, w: float, pitch: float, power: float | None = None) -> float:
+        """Generator torque demand for a filtered generator speed and the collective pitch;
+        ``power`` replaces rated power in region 3 (active power control) [W]."""
         g = self.gains
         eta = self.turbine.drivetrain.generator_efficiency
+        p3 = g.rated_power if power is None else power
         if w >= self.w_rated or pitch >= math.radians(1.0):
             if self.region3 == "constant_power":
-                return g.rated_power / eta / max(w, 1e-6)
-            return g.rated_torque
+                return p3 / eta / max(w, 1e-6)
+            return g.rated_torque * p3 / g.rated_power
         if w <= self.w_cutin:
             return 0.0
         if w < self.w_rgn2:
-            return self.slope15 * (w - self.w_cutin)
-        if w < self.w_trans:
-            return g.k_opt * w * w
-        return self.slope25 * (w - self.w_sync)
+            tq = self.slope15 * (w - self.w_cutin)
+        elif w < self.w_trans:
+            tq = g.k_opt * w * w
+        else:
+            tq = self.slope25 * (w - self.w_sync)
+        return min(tq, self.tq_cap, p3 / eta / max(w, 1e-6))
+
+    def _reference(self, t: float) -> float | None:
+        if self.power_reference is None:
+            return None
+        p = float(self.power_reference(t))
+        if not (math.isfinite(p) and 0.0 < p <= self.gains.rated_power * (1 + 1e-9)):
+            raise ValueError(f"power_reference({t:g} s) = {p!r} W must be in (0, rated power "
+                             f"{self.gains.rated_power:g} W]")
+        return p
 
     def step(self, t: float, meas: dict[str, Any]) -> tuple[np.ndarray, float]:
         """One control step; returns (pitch_ref (3,) [rad], gen_torque_ref [N m])."""
@@ -188,24 +281,53 @@ class BaselineController:
         if not math.isfinite(w):
             raise ValueError(f"measurement gen_speed is not finite at t = {t:g} s: {w!r}")
         pitch_meas = float(np.mean(meas["pitch"]))
-        if self.w_filt is None:
+        first = self.w_filt is None
+        if first:
             self.w_filt = w
             self.last_pitch = pitch_meas
         a = math.exp(-self.wc * self.dt)
         self.w_filt = a * self.w_filt + (1 - a) * w
         g = self.gains
-        gk = 1.0 / (1.0 + self.last_pitch / g.theta_k_rad)
+        p_ref = self._reference(t)
         err = self.w_filt - g.rated_gen_speed_rad_s
-        self.integral += err * self.dt
-        # anti-windup: keep the integral term within the pitch limits
-        lo, hi = self.pitch_min / (gk * g.ki), self.pitch_max / (gk * g.ki)
-        self.integral = min(max(self.integral, lo), hi)
-        cmd = gk * (g.kp * err + g.ki * self.integral)
+        if self._sched_f is None:
+            # DISCON form: the integral of the speed error, scaled by GK with the P part
+            gk = 1.0 / (1.0 + self.last_pitch / g.theta_k_rad)
+            if first:                       # bumpless start at the measured pitch
+                self.integral = (pitch_meas / gk - g.kp * err) / g.ki
+            self.integral += err * self.dt
+            # anti-windup: keep the integral term within the pitch limits
+            lo, hi = self.pitch_min / (gk * g.ki), self.pitch_max / (gk * g.ki)
+            self.integral = min(max(self.integral, lo), hi)
+            cmd = gk * (g.kp * err + g.ki * self.integral)
+        else:
+            # scheduled on P_ref / P_r and pitch: the integral is kept in pitch units (ROSCO
+            # form) so that a gain change moves no command
+            frac = p_ref / (g.rated_power / g.power_fraction) if p_ref is not None \
+                else g.power_fraction
+            gks = 1.0 / (1.0 + self.last_pitch / self._sched[:, 2])
+            kp = float(np.interp(frac, self._sched_f, self._sched[:, 0] * gks))
+            ki = float(np.interp(frac, self._sched_f, self._sched[:, 1] * gks))
+            gk = kp / g.kp
+            if first:
+                self.integral = pitch_meas - kp * err
+                self._p_ref_last = p_ref
+            ff = 0.0
+            if self.feedforward and p_ref is not None:
+                # pitch that sheds the reference change at this operating point:
+                # d theta = d P_aero / (dP/dtheta), dP/dtheta = (dP/dtheta)_0 / GK
+                dpdt = float(np.interp(frac, self._sched_f, self._sched[:, 3] / gks))
+                eta = self.turbine.drivetrain.generator_efficiency
+                ff = (p_ref - self._p_ref_last) / eta / dpdt
+                self._p_ref_last = p_ref
+            self.integral = min(max(self.integral + ki * err * self.dt + ff, self.pitch_min),
+                                self.pitch_max)
+            cmd = kp * err + self.integral
         cmd = min(max(cmd, self.pitch_min), self.pitch_max)
         step = self.rate * self.dt
         cmd = min(max(cmd, self.last_pitch - step), self.last_pitch + step)
         self.last_pitch = cmd
-        tq = min(self.torque(self.w_filt, cmd), self.tq_max)
+        tq = min(self.torque(self.w_filt, cmd, p_ref), self.tq_max)
         if self.last_torque is not None:
             d = self.tq_rate * self.dt
             tq = min(max(tq, self.last_torque - d), self.last_torque + d)
@@ -213,4 +335,8 @@ class BaselineController:
         self.signals = {"gen_speed_filtered": self.w_filt, "speed_error": err,
                         "pitch_integral": self.integral, "gain_schedule": gk,
                         "pitch_command": cmd, "torque_command": tq}
+        if p_ref is not None:
+            self.signals["power_reference"] = p_ref
+            self.signals["apc_saturated"] = float(cmd <= self.pitch_min + 1e-9
+                                                  and err < 0.0)
         return np.full(3, cmd), tq

@@ -8,8 +8,8 @@ import numpy as np
 
 from linearize import OperatingPoint
 
-__all__ = ["plot_cp_surface", "plot_operating_schedule", "plot_lidar_coherence", "plot_scan_pattern",
-           "plot_cs_ellipses", "plot_psd_comparison"]
+__all__ = ["plot_cp_surface", "plot_operating_schedule", "plot_lidar_coherence",
+           "plot_scan_pattern", "plot_cs_ellipses", "plot_psd_comparison"]
 
 
 def _save(fig, path: str | Path) -> Path:  # type: ignore[no-untyped-def]

@@ -3,6 +3,7 @@ from __future__ import annotations
 
 import csv
 import math
+import re
 from pathlib import Path
 from typing import Any, Sequence
 
@@ -26,7 +27,36 @@ DEFAULT_CHANNELS = {"flap_moment_1": 10.0, "flap_moment_2": 10.0, "flap_moment_3
                     "shaft_bending_blade1": 4.0}
 
 
-CONTROLLERS = ("baseline", "mpc", "mpc-lidar", "mpc-collective", "lqr-pio", "ts")
+CONTROLLERS = ("baseline", "mpc", "mpc-lidar", "mpc-collective", "lqr-pio", "ts", "ibc",
+               "coleman-ipc", "derate90", "derate80", "derate90+ibc", "derate80+ibc", "apc")
+_DERATE = re.compile(r"^derate(\d+(?:\.\d+)?)(\+ibc|\+coleman-ipc)?$")
+
+
+def parse_controller(name: str) -> tuple[str, float, str | None]:
+    """Split a controller name into (collective kind, power fraction, add-on).
+
+    ``"derateNN"`` is the baseline derated to NN % of rated power (any NN in (0, 100]), with
+    ``+ibc`` or ``+coleman-ipc`` on top; ``"ibc"`` and ``"coleman-ipc"`` sit on the normal
+    baseline. Other names return (name, 1.0, None).
+
+    Raises
+    ------
+    ValueError
+        If the name is unknown or the derating is outside (0, 100] %.
+    """
+    mt = _DERATE.match(name)
+    if mt:
+        pct = float(mt.group(1))
+        if not 0.0 < pct <= 100.0:
+            raise ValueError(f"derating in {name!r} is {pct:g} % of rated power; allowed: "
+                             f"(0, 100] %")
+        return "baseline", pct / 100.0, (mt.group(2) or "")[1:] or None
+    if name in ("ibc", "coleman-ipc"):
+        return "baseline", 1.0, name
+    if name not in CONTROLLERS:
+        raise ValueError(f"controller must be one of {list(CONTROLLERS)} or derateNN[+ibc|"
+                         f"+coleman-ipc], got {name!r}")
+    return name, 1.0, None
 
 
 def _wind(turbine: linearize.Turbine, wind_mps: float, turbulence: str, seed: int,
@@ -52,7 +82,9 @@ def run_controller(turbine: linearize.Turbine, controller: str, wind_mps: float,
                    turbulence: str = "A", seed: int = 1, duration: float = 600.0,
                    progress: bool = False, shear_exponent: float = 0.2,
                    mpc_options: dict[str, Any] | None = None,
-                   apc_frequency: float | None = None) -> ClosedLoopResult:
+                   apc_frequency: float | None = None, apc_amplitude: float = 0.375,
+                   apc_offset: float = 0.375,
+                   retrofit_options: dict[str, Any] | None = None) -> ClosedLoopResult:
     """Trim, design the controller, generate the wind and simulate.
 
     ``controller``: "baseline" (tuned PI and torque law, 80 Hz), "mpc" (Madsen's 8-state
@@ -70,21 +102,51 @@ def run_controller(turbine: linearize.Turbine, controller: str, wind_mps: float,
     "lqr-pio": Do et al.'s LQR on PI-observer estimates at the mean wind (region III, constant
     torque; :mod:`mpc_wt.synthesis`). "ts": Clemens et al.'s TS controller and wind observer,
     LMI-designed on the default vertex grid (:mod:`mpc_wt.ts`); ``apc_frequency`` [Hz] adds
-    the sinusoidal power reduction of eq 11 (:func:`mpc_wt.ts.apc_reference`).
+    the sinusoidal power reduction of eq 11 (:func:`mpc_wt.retrofit.apc_reference`, with
+    ``apc_amplitude`` and ``apc_offset``).
+
+    Retrofit strategies (Pettas and Cheng; :mod:`mpc_wt.retrofit`): "ibc" (individual blade
+    control on the baseline), "coleman-ipc" (tilt/yaw integral IPC), "derateNN" (baseline
+    derated to NN % of rated power, PI re-tuned), "derateNN+ibc" / "derateNN+coleman-ipc"
+    (both, IBC tuned on the derated points), "apc" (baseline following P_r (1 - Delta P(t)),
+    ``apc_frequency`` required, pitch PI scheduled on the reference). ``retrofit_options``
+    go to :func:`~mpc_wt.retrofit.tune_ibc` / :func:`~mpc_wt.retrofit.tune_coleman_ipc`.
     """
-    if controller not in CONTROLLERS:
-        raise ValueError(f"controller must be one of {list(CONTROLLERS)}, got {controller!r}")
+    kind, frac, addon = parse_controller(controller)
     params = linearize.plant_params(turbine)
     wind, field = _wind(turbine, wind_mps, turbulence, seed, duration, shear_exponent)
-    op = linearize.trim(turbine, wind_mps)
+    p_init = None if frac == 1.0 else frac * turbine.operation.rated_power
+    if kind == "apc":
+        from .retrofit import apc_reference
+
+        if apc_frequency is None:
+            raise ValueError("controller 'apc' needs apc_frequency [Hz] (0 for a constant "
+                             "reduction at the offset)")
+        dp = apc_reference(apc_frequency, amplitude=apc_amplitude, offset=apc_offset)
+        p_init = turbine.operation.rated_power * (1.0 - dp(0.0))
+        # the reference peaks at P_r (1 - offset + amplitude): the mean wind must give it
+        p_peak = turbine.operation.rated_power * (1.0 - apc_offset + apc_amplitude)
+        try:
+            linearize.trim(turbine, wind_mps, min(p_peak, turbine.operation.rated_power))
+        except linearize.TrimError as err:
+            raise ValueError(f"apc: the power reference peaks at {p_peak:g} W, above the power "
+                             f"available at the mean wind {wind_mps:g} m/s ({err})") from err
+    try:
+        op = linearize.trim(turbine, wind_mps, p_init)
+    except linearize.TrimError:
+        if p_init is None or kind == "apc":
+            raise
+        op = linearize.trim(turbine, wind_mps)    # derated turbine below its rated power
     meta: dict[str, Any] = {"controller": controller, "wind_mps": wind_mps,
                             "turbulence": turbulence, "seed": seed, "duration_s": duration,
                             "shear_exponent": shear_exponent, "turbine": turbine.name}
     preview = None
     cdt = None
-    if apc_frequency is not None and controller != "ts":
-        raise ValueError("apc_frequency applies to the 'ts' controller only")
-    if controller == "lqr-pio":
+    if apc_frequency is not None and kind not in ("ts", "apc"):
+        raise ValueError("apc_frequency applies to the 'ts' and 'apc' controllers only")
+    if retrofit_options and addon is None:
+        raise ValueError("retrofit_options apply to the ibc and coleman-ipc controllers only")
+    if kind == "lqr-pio":
         from .synthesis import (REGION3_SCALES, REGION3_WEIGHTS, LQRPIOController, design_lqr,
                                 design_pi_observer)
 
@@ -92,22 +154,50 @@ def run_controller(turbine: linearize.Turbine, controller: str, wind_mps: float,
         lq = design_lqr(model, state_weights=REGION3_WEIGHTS, scales=REGION3_SCALES)
         ctl = LQRPIOController(model, turbine, lq, design_pi_observer(model, q=1e3))
         meta["lqr"] = {"weights": lq.weights, "observer_q": 1e3}
-    elif controller == "ts":
-        from .ts import (TSController, apc_reference, build_ts_model, design_ts_controller,
-                         design_ts_observer)
+    elif kind == "ts":
+        from .retrofit import apc_reference
+        from .ts import TSController, build_ts_model, design_ts_controller, design_ts_observer
 
         ts = build_ts_model(turbine)
         c, o = design_ts_controller(ts), design_ts_observer(ts)
         ctl = TSController(ts, c, o, turbine, initial_wind=float(np.clip(
             wind_mps, ts.wind_grid[0], ts.wind_grid[-1])),
-            power_reduction=None if apc_frequency is None else apc_reference(apc_frequency))
+            power_reduction=None if apc_frequency is None else apc_reference(
+                apc_frequency, amplitude=apc_amplitude, offset=apc_offset))
         meta["ts"] = {"vertices": ts.n_vertices, "decay_rate": c.decay_rate,
                       "observer_decay_rate": o.decay_rate, "apc_frequency_Hz": apc_frequency}
-    elif controller == "baseline":
-        gains = tune_baseline(turbine)
+    elif kind == "apc":
+        from .baseline import tune_baseline_schedule
+
+        sched = tune_baseline_schedule(turbine)
+        ctl = BaselineController(turbine, gain_schedule=sched, power_reference=lambda t: (
+            turbine.operation.rated_power * (1.0 - dp(t))))
+        meta["apc"] = {"frequency_Hz": apc_frequency, "amplitude": apc_amplitude,
+                       "offset": apc_offset,
+                       "schedule_fractions": [g.power_fraction for g in sched]}
+    elif kind == "baseline":
+        gains = tune_baseline(turbine, power_fraction=frac)
         ctl: Any = BaselineController(turbine, gains)
         meta["gains"] = {"kp": gains.kp, "ki": gains.ki, "theta_k_rad": gains.theta_k_rad,
-                         "k_opt": gains.k_opt}
+                         "k_opt": gains.k_opt, "power_fraction": frac}
+        if addon is not None:
+            from . import retrofit
+
+            opts = dict(retrofit_options or {})
+            if addon == "ibc":
+                rc = bool(opts.pop("remove_collective", False))
+                ig = retrofit.tune_ibc(turbine, power_fraction=frac, dt=ctl.dt, **opts)
+                ctl = retrofit.IBCController(ctl, ig, remove_collective=rc)
+                opts["remove_collective"] = rc
+                meta["ibc"] = {"gain": ig.gain.tolist(), "pitch_rad": ig.pitch_rad.tolist(),
+                               "highpass_hz": ig.highpass_hz,
+                               "notch_harmonics": list(ig.notch_harmonics), **opts}
+            else:
+                cg = retrofit.tune_coleman_ipc(turbine, power_fraction=frac, **opts)
+                ctl = retrofit.ColemanIPCController(ctl, cg)
+                meta["coleman_ipc"] = {"ki": cg.ki.tolist(), "pitch_rad": cg.pitch_rad.tolist(),
+                                       "azimuth_offset_rad": cg.azimuth_offset_rad.tolist(),
+                                       **opts}
     else:
         from .mpc import MPC, ScheduledMPC
 
@@ -123,7 +213,7 @@ def run_controller(turbine: linearize.Turbine, controller: str, wind_mps: float,
                 backend = "osqp" if opts.get("formulation") == "sparse" else "daqp"
             except ImportError:
                 backend = "osqp"
-        kw = dict(collective=controller == "mpc-collective", backend=backend,
+        kw = dict(collective=kind == "mpc-collective", backend=backend,
                   formulation=opts.get("formulation", "condensed"),
                   horizon=int(opts.get("horizon", 15)), estimator=opts.get("estimator"))
         if opts.get("scheduled"):
@@ -134,7 +224,7 @@ def run_controller(turbine: linearize.Turbine, controller: str, wind_mps: float,
                                  f"wind {wind_mps:g} m/s is outside")
             fam = linearize.linearize_family(turbine, winds,
                                              config=linearize.PlantConfig.madsen())
-            src = "preview" if controller == "mpc-lidar" else "estimator"
+            src = "preview" if kind == "mpc-lidar" else "estimator"
             if src == "estimator" and kw["estimator"] is None:
                 kw["estimator"] = "kalman"
             ctl = ScheduledMPC(fam, turbine, wind_source=src, initial_wind_mps=wind_mps, **kw)
@@ -148,7 +238,7 @@ def run_controller(turbine: linearize.Turbine, controller: str, wind_mps: float,
         meta["mpc"] = {"horizon": hp, "backend": backend, "dt": cdt,
                        "formulation": kw["formulation"], "estimator": str(kw["estimator"]),
                        "scheduled": bool(opts.get("scheduled"))}
-        if controller == "mpc-lidar":
+        if kind == "mpc-lidar":
             from .simulate import LidarPreview
 
             preview = LidarPreview(lidar.CWLidar(turbine.geometry.tip_radius), field, hp, cdt)

@@ -50,6 +50,7 @@ import scipy.linalg
 import linearize
 
 from .estimator import read_signals
+from .retrofit import apc_reference  # noqa: F401 - re-exported (eq 11 lives with the APC)
 from .synthesis import SynthesisError
 
 __all__ = ["TSModel", "build_ts_model", "TSControllerDesign", "TSObserverDesign",
@@ -252,22 +253,6 @@ def build_ts_model(turbine: linearize.Turbine,
                    measured=tuple(measured), C=c, rated_power=float(rated),
                    info={"turbine": turbine.name, "config": "clemens"},
                    **{k: np.array(v) for k, v in mats.items()})
-
-
-def apc_reference(frequency_hz: float, *, amplitude: float = 0.375, offset: float = 0.375
-                  ) -> Callable[[float], float]:
-    """Power reduction Delta P(t) = offset + amplitude sin(2 pi f_r t) (Clemens eq 11).
-
-    Eq 11 as printed, Delta P = 3/4 sin(2 pi f_r t), asks for up to 175 % of the rotor power
-    when the sine is negative, which no generator at rated can give; the default keeps the
-    printed peak reduction 3/4 and shifts the sine into [0, 3/4]. Set ``offset=0,
-    amplitude=0.75`` for the printed form (it is clipped at Delta P = 0 by the controller's
-    premise grid).
-    """
-    f = float(frequency_hz)
-    if not (math.isfinite(f) and f >= 0):
-        raise ValueError(f"frequency_hz must be finite and >= 0, got {frequency_hz!r}")
-    return lambda t: offset + amplitude * math.sin(2.0 * math.pi * f * t)
 
 
 # --------------------------------------------------------------------------------------------

@@ -1,0 +1,824 @@
+"""Retrofit control strategies: individual blade control, Coleman-frame IPC, down-regulation,
+active power control, and the metrics that judge them (issue 8).
+
+Individual blade control (Pettas and Cheng 2018, sec. 3.1, fig. 3): three decoupled
+proportional loops, one per blade, on the blade-root flap moment M_i. A high-pass filter on the
+input keeps the loops out of the collective pitch controller's band, band-stop (notch) filters
+on the output keep them out of 3P (and any further harmonics given), and the gain is scheduled
+on the mean pitch. The IBC pitch is weighted by a factor rising linearly from 0 to 1 with the
+electrical power between two fractions of rated (partial to full load):
+
+    theta_i = theta_CPC + w(P) BS(K(theta_mean) HP(M_i)),     i = 1, 2, 3.
+
+The paper tunes K on identified blade models; here K comes from our linear models: at each
+region-III wind, the single-blade loop L = K F(z) (-G(z)) (G: pitch_ref_1 -> flap_moment_1 of
+the blade-coordinate model discretized at the controller rate, F: the filters) gets the loop
+gain ``loop_gain_1p`` at 1P, lowered if needed so that the gain margin is at least
+``min_gain_margin`` (python-control's stability margins), and the closed loop is checked
+stable.
+
+Coleman-frame IPC (Bossanyi 2003, the scheme ROSCO's IPC implements): the tilt and yaw
+components M_cs = 2/3 sum_i M_i [cos psi_i, sin psi_i] are driven to zero by integral control,
+theta_cs = -K_I R(-phi) int M_cs dt, and returned to the blades by the inverse transform. K_I
+and the azimuth offset phi come from the static gain of the MBC linear model (the 2x2 map
+pitch_ref_cos/sin -> flap_moment_cos/sin is close to a gain times a rotation R(phi)): K_I sets
+the crossover ``crossover_rad_s`` and phi cancels the rotation.
+
+Down-regulation (Pettas and Cheng sec. 3.2) is :func:`mpc_wt.baseline.tune_baseline` with
+``power_fraction``; :func:`steady_power_curve` and :func:`aep_change` give the steady power
+curve of a torque law and the Weibull/Rayleigh-weighted AEP loss.
+
+Active power control (Clemens et al. sec. 3.2, eq 11): :func:`apc_reference` is the test
+signal; :class:`mpc_wt.baseline.BaselineController` follows it with ``power_reference`` and a
+pitch loop scheduled on the reference.
+
+Metrics (Pettas and Cheng sec. 4, eq 1): :func:`lifetime_comparison`.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Any, Callable, Mapping, Sequence
+
+import numpy as np
+from scipy import signal
+
+import linearize
+
+from .assess import aep_Wh, lifetime_del, lifetime_extension
+from .baseline import BaselineController, BaselineGains, check_power_fraction
+
+__all__ = ["apc_reference", "check_corner", "filter_sos", "SOSFilterBank", "IBCGains",
+           "tune_ibc", "IBCController", "ColemanIPCGains", "tune_coleman_ipc",
+           "ColemanIPCController", "steady_power_curve", "aep_change", "lifetime_comparison",
+           "power_weight"]
+
+
+# --------------------------------------------------------------------------------------------
+# Active power control reference
+# --------------------------------------------------------------------------------------------
+def apc_reference(frequency_hz: float, *, amplitude: float = 0.375, offset: float = 0.375
+                  ) -> Callable[[float], float]:
+    """Power reduction Delta P(t) = offset + amplitude sin(2 pi f_r t) (Clemens eq 11); the
+    power reference is P_r (1 - Delta P).
+
+    Eq 11 as printed, Delta P = 3/4 sin(2 pi f_r t), asks for up to 175 % of rated power when
+    the sine is negative, which no generator at rated can give; the default keeps the printed
+    peak reduction 3/4 and shifts the sine into [0, 3/4].
+
+    Raises
+    ------
+    ValueError
+        If the frequency is negative or not finite, or Delta P leaves [0, 1): a reduction below
+        0 asks for more than rated power, one of 1 or more for no power at all.
+    """
+    f = float(frequency_hz)
+    if not (math.isfinite(f) and f >= 0):
+        raise ValueError(f"frequency_hz must be finite and >= 0, got {frequency_hz!r}")
+    a, o = float(amplitude), float(offset)
+    if not (math.isfinite(a) and math.isfinite(o) and a >= 0):
+        raise ValueError(f"amplitude must be finite and >= 0 and offset finite, got {amplitude!r}"
+                         f", {offset!r}")
+    if o - a < -1e-12:
+        raise ValueError(f"offset - amplitude = {o - a:g}: the power reference would rise to "
+                         f"{100 * (1 - o + a):.0f} % of rated, above the power available at rated; "
+                         f"need offset >= amplitude")
+    if o + a >= 1.0:
+        raise ValueError(f"offset + amplitude = {o + a:g}: the power reference would fall to "
+                         f"{100 * (1 - o - a):.0f} % of rated; need offset + amplitude < 1")
+    return lambda t: o + a * math.sin(2.0 * math.pi * f * t)
+
+
+# --------------------------------------------------------------------------------------------
+# Filters
+# --------------------------------------------------------------------------------------------
+def check_corner(name: str, freq_hz: float, fs: float) -> float:
+    """A filter corner frequency: finite and strictly between 0 and the Nyquist frequency."""
+    f = float(freq_hz)
+    if not (math.isfinite(f) and 0.0 < f < 0.5 * fs):
+        raise ValueError(f"{name} = {freq_hz!r} Hz must be in (0, Nyquist = {0.5 * fs:g} Hz) at "
+                         f"the controller rate {fs:g} Hz")
+    return f
+
+
+def filter_sos(fs: float, *, highpass_hz: float | None = None, highpass_order: int = 1,
+               notch_hz: Sequence[float] = (), notch_q: float = 1.0,
+               lowpass_hz: float | None = None, lowpass_order: int = 2) -> np.ndarray:
+    """Second-order sections of a discrete filter chain at sample rate ``fs`` [Hz]: Butterworth
+    high-pass, notches (band-stop, quality ``notch_q``: bandwidth f0 / Q) and Butterworth
+    low-pass (scipy.signal). An empty chain is the identity.
+
+    Raises
+    ------
+    ValueError
+        If a corner is not in (0, fs / 2) (names the parameter) or an order or Q is not positive.
+    """
+    if not (math.isfinite(fs) and fs > 0):
+        raise ValueError(f"fs must be > 0 Hz, got {fs!r}")
+    sos = [np.array([[1.0, 0.0, 0.0, 1.0, 0.0, 0.0]])]
+    if highpass_hz is not None:
+        if int(highpass_order) < 1:
+            raise ValueError(f"highpass_order must be >= 1, got {highpass_order!r}")
+        sos.append(signal.butter(int(highpass_order), check_corner("highpass_hz", highpass_hz, fs),
+                                 "highpass", fs=fs, output="sos"))
+    if notch_hz is not None and len(notch_hz):
+        if not notch_q > 0:
+            raise ValueError(f"notch_q must be > 0, got {notch_q!r}")
+        for f0 in notch_hz:
+            b, a = signal.iirnotch(check_corner("notch_hz", f0, fs), notch_q, fs=fs)
+            sos.append(signal.tf2sos(b, a))
+    if lowpass_hz is not None:
+        if int(lowpass_order) < 1:
+            raise ValueError(f"lowpass_order must be >= 1, got {lowpass_order!r}")
+        sos.append(signal.butter(int(lowpass_order), check_corner("lowpass_hz", lowpass_hz, fs),
+                                 "lowpass", fs=fs, output="sos"))
+    return np.vstack(sos)
+
+
+class SOSFilterBank:
+    """The same discrete filter on ``n_channels`` signals, one sample at a time.
+
+    ``step(x)`` filters one sample of each channel ((n_channels,) in and out) with
+    :func:`scipy.signal.sosfilt` and its carried state; the first sample initialises the state
+    to the steady state of that input (no start-up transient).
+    """
+
+    def __init__(self, sos: np.ndarray, n_channels: int) -> None:
+        self.sos = np.atleast_2d(np.asarray(sos, float))
+        if self.sos.ndim != 2 or self.sos.shape[1] != 6:
+            raise ValueError(f"sos has shape {self.sos.shape}; expected (n_sections, 6)")
+        self.n = int(n_channels)
+        self._zi1 = signal.sosfilt_zi(self.sos)            # (n_sections, 2) for a unit step
+        self.reset()
+
+    def reset(self) -> None:
+        """Forget the filter state."""
+        self.zi: np.ndarray | None = None
+
+    def step(self, x: Any) -> np.ndarray:
+        """Filter one sample per channel."""
+        x = np.asarray(x, float).reshape(1, self.n)
+        if self.zi is None:
+            self.zi = self._zi1[:, :, None] * x[0][None, None, :]
+        y, self.zi = signal.sosfilt(self.sos, x, axis=0, zi=self.zi)
+        return y[0]
+
+    def response(self, freq_hz: Any, fs: float) -> np.ndarray:
+        """Complex frequency response at ``freq_hz``."""
+        return signal.sosfreqz(self.sos, worN=np.atleast_1d(np.asarray(freq_hz, float)),
+                               fs=fs)[1]
+
+
+def power_weight(power_W: float, rated_power_W: float, weight_range: tuple[float, float]) -> float:
+    """Activation weight rising linearly from 0 at ``weight_range[0]`` P_r to 1 at
+    ``weight_range[1]`` P_r (Pettas and Cheng sec. 3.1) [-]."""
+    lo, hi = weight_range
+    return float(min(max((power_W / rated_power_W - lo) / (hi - lo), 0.0), 1.0))
+
+
+def _check_weight_range(weight_range: tuple[float, float]) -> tuple[float, float]:
+    lo, hi = (float(v) for v in weight_range)
+    if not (0.0 <= lo < hi <= 1.0):
+        raise ValueError(f"weight_range must be two power fractions 0 <= lo < hi <= 1, got "
+                         f"{weight_range!r}")
+    return lo, hi
+
+
+def _region3_winds(turbine: linearize.Turbine, step: float = 2.0) -> np.ndarray:
+    lo = float(np.floor(linearize.rated_wind_speed(turbine))) + 1.0
+    hi = min(25.0, turbine.operation.cut_out_wind)
+    return np.unique(np.r_[np.arange(lo, hi, step), hi])
+
+
+def _freq_resp(a: np.ndarray, b: np.ndarray, c: np.ndarray, d: np.ndarray,
+               z: complex) -> np.ndarray:
+    """C (z I - A)^-1 B + D of a discrete model."""
+    return c @ np.linalg.solve(z * np.eye(a.shape[0]) - a, b) + d
+
+
+# --------------------------------------------------------------------------------------------
+# Individual blade control
+# --------------------------------------------------------------------------------------------
+@dataclass(frozen=True)
+class IBCGains:
+    """Gain schedule and filters of the individual blade controller.
+
+    Parameters
+    ----------
+    pitch_rad : (n_op,) ndarray
+        Mean-pitch breakpoints of the schedule (trim pitch at ``wind_mps``) [rad].
+    gain : (n_op,) ndarray
+        Proportional gain per breakpoint [rad/(N m)]: pitch per unit flap moment.
+    wind_mps : (n_op,) ndarray
+        Wind speeds of the operating points [m/s].
+    gain_margin : (n_op,) ndarray
+        Gain margin of the single-blade loop at each point [-] (inf: none).
+    loop_gain_1p : (n_op,) ndarray
+        Achieved loop gain |L| at 1P [-].
+    dt : float
+        Controller period the filters are designed for [s].
+    rotor_speed_rad_s : float
+        Rotor speed of the filter frequencies (rated) [rad/s].
+    highpass_hz : float
+        Input high-pass corner [Hz].
+    notch_harmonics : tuple of int
+        Output band-stop filters at these multiples of 1P.
+    notch_q : float
+        Quality factor of the band-stop filters [-].
+    weight_range : (float, float)
+        Power fractions of rated between which the IBC output rises from 0 to 1 [-].
+    rated_power : float
+        The rated (or derated) power the weight refers to [W].
+    power_fraction : float
+        Derating fraction the gains were tuned at [-].
+    """
+
+    pitch_rad: np.ndarray
+    gain: np.ndarray
+    wind_mps: np.ndarray
+    gain_margin: np.ndarray
+    loop_gain_1p: np.ndarray
+    dt: float
+    rotor_speed_rad_s: float
+    highpass_hz: float
+    notch_harmonics: tuple[float, ...]
+    notch_q: float
+    weight_range: tuple[float, float]
+    rated_power: float
+    power_fraction: float = 1.0
+    info: dict[str, Any] = field(default_factory=dict, compare=False)
+
+    def __post_init__(self) -> None:
+        for n in ("pitch_rad", "gain", "wind_mps", "gain_margin", "loop_gain_1p"):
+            arr = np.array(getattr(self, n), dtype=float)
+            arr.flags.writeable = False
+            object.__setattr__(self, n, arr)
+        if not (self.pitch_rad.shape == self.gain.shape == self.wind_mps.shape
+                and self.pitch_rad.ndim == 1 and self.pitch_rad.size >= 1):
+            raise ValueError(f"pitch_rad {self.pitch_rad.shape}, gain {self.gain.shape} and "
+                             f"wind_mps {self.wind_mps.shape} must be 1-D of equal length")
+        if np.any(np.diff(self.pitch_rad) <= 0):
+            raise ValueError("pitch_rad must be strictly increasing")
+
+    @property
+    def fs(self) -> float:
+        """Controller rate [Hz]."""
+        return 1.0 / self.dt
+
+    @property
+    def one_p_hz(self) -> float:
+        """Rotor frequency of the filters [Hz]."""
+        return self.rotor_speed_rad_s / (2 * math.pi)
+
+    def input_sos(self) -> np.ndarray:
+        """Second-order sections of the input (high-pass) filter."""
+        return filter_sos(self.fs, highpass_hz=self.highpass_hz)
+
+    def output_sos(self) -> np.ndarray:
+        """Second-order sections of the output (band-stop) filters."""
+        return filter_sos(self.fs, notch_hz=[h * self.one_p_hz for h in self.notch_harmonics],
+                          notch_q=self.notch_q)
+
+    def gain_at(self, pitch_rad: float) -> float:
+        """Scheduled gain at a mean pitch (held at the ends of the table) [rad/(N m)]."""
+        return float(np.interp(pitch_rad, self.pitch_rad, self.gain))
+
+
+def _blade_model(turbine: linearize.Turbine, v: float, p_w: float | None,
+                 params: linearize.PlantParams, coordinates: str = "blade"
+                 ) -> linearize.LinearModel:
+    return linearize.linearize(turbine, v, params=params, power_W=p_w, coordinates=coordinates)
+
+
+def tune_ibc(turbine: linearize.Turbine, *, winds: Any = None, dt: float = 1.0 / 80.0,
+             loop_gain_1p: float = 1.0, min_gain_margin: float = 2.0,
+             highpass_hz: float | None = None, notch_harmonics: Sequence[int] = (3,),
+             notch_q: float = 1.0, weight_range: tuple[float, float] = (0.8, 0.95),
+             power_fraction: float = 1.0) -> IBCGains:
+    """Tune the individual blade controller on our linear models (Pettas and Cheng sec. 3.1).
+
+    Parameters
+    ----------
+    winds : array_like, optional
+        Region-III wind speeds of the schedule [m/s]; default every 2 m/s from the first whole
+        m/s above rated to cut-out.
+    dt : float
+        Controller period [s] (the harness runs the baseline at the plant rate, 1/80 s).
+    loop_gain_1p : float
+        Target loop gain |L(1P)| of each blade loop [-].
+    min_gain_margin : float
+        Smallest gain margin allowed (the gain is lowered to meet it) [-] (2 = 6 dB).
+    highpass_hz : float, optional
+        Input high-pass corner [Hz]; default half the rated 1P frequency.
+    notch_harmonics : sequence of int
+        Output band-stop filters at these multiples of rated 1P (paper: 3P).
+    notch_q : float
+        Quality factor of the band-stop filters [-].
+    weight_range : (float, float)
+        Power fractions between which the IBC fades in [-].
+    power_fraction : float
+        Tune on the operating points derated to this fraction of rated power [-].
+
+    Raises
+    ------
+    ValueError
+        For a filter corner at or above Nyquist, a derating fraction outside (0, 1], or
+        non-positive targets.
+    RuntimeError
+        If a blade loop is unstable even at the smallest gain tried.
+    """
+    import control
+
+    frac = check_power_fraction(power_fraction)
+    if not (dt > 0 and math.isfinite(dt)):
+        raise ValueError(f"dt must be > 0 s, got {dt!r}")
+    if not (loop_gain_1p > 0 and min_gain_margin > 1):
+        raise ValueError(f"loop_gain_1p must be > 0 and min_gain_margin > 1, got "
+                         f"{loop_gain_1p!r}, {min_gain_margin!r}")
+    wr = _check_weight_range(weight_range)
+    harm = tuple(float(h) for h in notch_harmonics)
+    if any(not h > 0 for h in harm):
+        raise ValueError(f"notch_harmonics must be positive multiples of 1P, got "
+                         f"{notch_harmonics!r}")
+    om = turbine.operation.rated_rotor_speed_rad_s
+    f1p = om / (2 * math.pi)
+    fs = 1.0 / dt
+    hp = 0.5 * f1p if highpass_hz is None else highpass_hz
+    v = _region3_winds(turbine) if winds is None else np.asarray(winds, float)
+    p_rated = frac * turbine.operation.rated_power
+    p_w = None if frac == 1.0 else p_rated
+    gains = IBCGains(pitch_rad=np.arange(v.size, dtype=float), gain=np.zeros(v.size),
+                     wind_mps=v, gain_margin=np.zeros(v.size), loop_gain_1p=np.zeros(v.size),
+                     dt=dt, rotor_speed_rad_s=om, highpass_hz=check_corner("highpass_hz", hp, fs),
+                     notch_harmonics=harm, notch_q=notch_q, weight_range=wr,
+                     rated_power=p_rated, power_fraction=frac)
+    filt = np.vstack([gains.input_sos(), gains.output_sos()])
+    f_sys = _sos_ss(filt, dt)
+    zf = np.exp(1j * om * dt)
+    f1 = complex(signal.sosfreqz(filt, worN=[f1p], fs=fs)[1][0])
+    params = linearize.plant_params(turbine)
+    pitch, k_out, gm_out, l1p = [], [], [], []
+    for w in v:
+        m = _blade_model(turbine, float(w), p_w, params)
+        s = m.select(inputs=["pitch_ref_1"], outputs=["flap_moment_1"]).discretize(dt)
+        g1 = complex(_freq_resp(s.A, s.B_u, s.C_z, s.D_u, zf)[0, 0])
+        k = loop_gain_1p / abs(f1 * g1)
+        plant = control.ss(s.A, s.B_u, -s.C_z, -s.D_u, dt)     # -G: pitch up lowers the moment
+        loop = plant * f_sys
+        gm = _gain_margin(loop, k)
+        if gm < min_gain_margin:
+            k *= gm / min_gain_margin
+            gm = _gain_margin(loop, k)
+        if not gm > 1.0:
+            raise RuntimeError(f"IBC blade loop at {w:g} m/s is unstable at gain {k:g} "
+                               f"rad/(N m); check the filters")
+        pitch.append(m.info["pitch_deg"] * math.pi / 180)
+        k_out.append(k)
+        gm_out.append(gm)
+        l1p.append(k * abs(f1 * g1))
+    order = np.argsort(pitch)
+    return IBCGains(pitch_rad=np.asarray(pitch)[order], gain=np.asarray(k_out)[order],
+                    wind_mps=v[order], gain_margin=np.asarray(gm_out)[order],
+                    loop_gain_1p=np.asarray(l1p)[order], dt=dt, rotor_speed_rad_s=om,
+                    highpass_hz=gains.highpass_hz, notch_harmonics=harm, notch_q=notch_q,
+                    weight_range=wr, rated_power=p_rated, power_fraction=frac,
+                    info={"target_loop_gain_1p": loop_gain_1p,
+                          "min_gain_margin": min_gain_margin})
+
+
+def _sos_ss(sos: np.ndarray, dt: float) -> Any:
+    """A discrete filter in second-order sections as a python-control state-space system (a
+    cascade of the sections' state-space forms: no high-order polynomial in between)."""
+    import control
+
+    sys = control.ss([], [], [], [[1.0]], dt)
+    for sec in np.atleast_2d(sos):
+        a, b, c, d = signal.tf2ss(sec[:3], sec[3:])
+        sys = control.ss(a, b, c, d, dt) * sys if a.size else sys * float(d[0, 0])
+    return sys
+
+
+def _gain_margin(loop: Any, k: float) -> float:
+    """Gain margin of the negative-feedback loop k * loop (discrete): the factor by which k can
+    grow before the closed loop turns unstable, found on the closed-loop poles (exact, unlike a
+    margin read off a frequency grid); inf if none up to 1e3."""
+    import control
+
+    def stable(kk: float) -> bool:
+        cl = control.feedback(kk * loop, 1)
+        return bool(np.all(np.abs(control.poles(cl)) < 1.0 - 1e-9))
+
+    if not stable(k):
+        lo, hi = 0.0, 1.0
+        for _ in range(40):
+            mid = 0.5 * (lo + hi)
+            lo, hi = (mid, hi) if stable(mid * k) else (lo, mid)
+        return lo
+    lo, hi = 1.0, 2.0
+    while stable(hi * k):
+        lo, hi = hi, hi * 2
+        if hi > 1e3:
+            return math.inf
+    for _ in range(30):
+        mid = 0.5 * (lo + hi)
+        lo, hi = (mid, hi) if stable(mid * k) else (lo, mid)
+    return lo
+
+
+class IBCController:
+    """Individual blade control on top of a collective controller (Pettas and Cheng fig. 3).
+
+    ``collective`` is the baseline (or derated baseline) that regulates rotor speed and power;
+    this class adds the per-blade pitch w(P) BS(K(theta_mean) HP(M_i)) to its collective command
+    and enforces the pitch limits and rate on the sum. Signals: the collective's, plus
+    ``ibc_weight``, ``ibc_gain`` and ``ibc_pitch_1..3`` [rad].
+
+    ``remove_collective=True`` subtracts the blades' mean IBC pitch (the loops then act on the
+    cyclic content only and leave thrust and torque to the collective controller); the paper's
+    loops are fully decoupled (False).
+    """
+
+    def __init__(self, collective: BaselineController, gains: IBCGains, *,
+                 remove_collective: bool = False) -> None:
+        self.remove_collective = bool(remove_collective)
+        if abs(collective.dt - gains.dt) > 1e-12:
+            raise ValueError(f"IBC gains were designed for dt = {gains.dt:g} s, the collective "
+                             f"controller runs at {collective.dt:g} s")
+        self.collective = collective
+        self.gains = gains
+        self.dt = collective.dt
+        self._hp = SOSFilterBank(gains.input_sos(), 3)
+        self._bs = SOSFilterBank(gains.output_sos(), 3)
+        pa = collective.turbine.pitch_actuator
+        self.pitch_min, self.pitch_max = collective.pitch_min, pa.max_pitch_rad
+        self.step_max = pa.max_rate_rad_s * self.dt
+        self._p_tau = 1.0            # power filter of the activation weight [s]
+        self.reset()
+
+    def reset(self) -> None:
+        """Forget filters, power filter and last commands (and reset the collective)."""
+        self.collective.reset()
+        self._hp.reset()
+        self._bs.reset()
+        self._p_filt: float | None = None
+        self._last: np.ndarray | None = None
+        self.signals: dict[str, float] = {}
+
+    def _limit(self, cmd: np.ndarray, meas: dict[str, Any]) -> np.ndarray:
+        cmd = np.clip(cmd, self.pitch_min, self.pitch_max)
+        last = np.asarray(meas["pitch"], float) if self._last is None else self._last
+        cmd = np.clip(cmd, last - self.step_max, last + self.step_max)
+        self._last = cmd
+        return cmd
+
+    def _weight(self, meas: dict[str, Any]) -> float:
+        p = float(meas["gen_power"])
+        a = math.exp(-self.dt / self._p_tau)
+        self._p_filt = p if self._p_filt is None else a * self._p_filt + (1 - a) * p
+        return power_weight(self._p_filt, self.gains.rated_power, self.gains.weight_range)
+
+    def step(self, t: float, meas: dict[str, Any]) -> tuple[np.ndarray, float]:
+        """One control step; returns (pitch_ref (3,) [rad], gen_torque_ref [N m])."""
+        pc, tq = self.collective.step(t, meas)
+        m = np.asarray(meas["flap_moment"], float)
+        if m.shape != (3,) or not np.all(np.isfinite(m)):
+            raise ValueError(f"measurement flap_moment must be 3 finite moments [N m] at "
+                             f"t = {t:g} s, got {meas['flap_moment']!r}")
+        w = self._weight(meas)
+        k = self.gains.gain_at(float(np.mean(pc)))
+        u = w * self._bs.step(k * self._hp.step(m))
+        if self.remove_collective:
+            u = u - u.mean()
+        cmd = self._limit(pc + u, meas)
+        self.signals = {**self.collective.signals, "ibc_weight": w, "ibc_gain": k,
+                        **{f"ibc_pitch_{i + 1}": float(u[i]) for i in range(3)}}
+        return cmd, tq
+
+
+# --------------------------------------------------------------------------------------------
+# Coleman-frame IPC
+# --------------------------------------------------------------------------------------------
+@dataclass(frozen=True)
+class ColemanIPCGains:
+    """Gain schedule of the Coleman-frame (tilt/yaw) integral IPC.
+
+    Parameters
+    ----------
+    pitch_rad : (n_op,) ndarray
+        Mean-pitch breakpoints [rad].
+    ki : (n_op,) ndarray
+        Integral gain [rad/(N m s)].
+    azimuth_offset_rad : (n_op,) ndarray
+        Rotation phi that decouples tilt and yaw [rad].
+    wind_mps : (n_op,) ndarray
+        [m/s]
+    gain_margin : (n_op,) ndarray
+        Factor on K_I at which the MBC closed loop turns unstable [-].
+    crossover_rad_s : float
+        Design crossover of the tilt and yaw loops [rad/s].
+    max_amplitude_rad : float
+        Limit of the cyclic pitch amplitude (anti-windup) [rad].
+    weight_range : (float, float)
+        Power fractions of the fade-in [-].
+    rated_power : float
+        [W]
+    power_fraction : float
+        [-]
+    """
+
+    pitch_rad: np.ndarray
+    ki: np.ndarray
+    azimuth_offset_rad: np.ndarray
+    wind_mps: np.ndarray
+    gain_margin: np.ndarray
+    crossover_rad_s: float
+    max_amplitude_rad: float
+    weight_range: tuple[float, float]
+    rated_power: float
+    power_fraction: float = 1.0
+
+    def __post_init__(self) -> None:
+        for n in ("pitch_rad", "ki", "azimuth_offset_rad", "wind_mps", "gain_margin"):
+            arr = np.array(getattr(self, n), dtype=float)
+            arr.flags.writeable = False
+            object.__setattr__(self, n, arr)
+        if np.any(np.diff(self.pitch_rad) <= 0):
+            raise ValueError("pitch_rad must be strictly increasing")
+
+    def at(self, pitch_rad: float) -> tuple[float, float]:
+        """(K_I, phi) at a mean pitch."""
+        return (float(np.interp(pitch_rad, self.pitch_rad, self.ki)),
+                float(np.interp(pitch_rad, self.pitch_rad, self.azimuth_offset_rad)))
+
+
+def _rot(phi: float) -> np.ndarray:
+    c, s = math.cos(phi), math.sin(phi)
+    return np.array([[c, -s], [s, c]])
+
+
+def tune_coleman_ipc(turbine: linearize.Turbine, *, winds: Any = None,
+                     crossover_rad_s: float = 0.2, max_amplitude_deg: float = 5.0,
+                     weight_range: tuple[float, float] = (0.8, 0.95),
+                     power_fraction: float = 1.0) -> ColemanIPCGains:
+    """Tune the Coleman-frame integral IPC on the MBC linear models.
+
+    At each wind the static MBC gain G0 (pitch_ref_cos/sin -> flap_moment_cos/sin) is fitted as
+    g R(phi); K_I = crossover / g makes both loops integrators crossing over at
+    ``crossover_rad_s``, and phi is the azimuth offset. The 2x2 closed loop of the MBC model
+    with the integral controller is checked stable and its gain margin reported.
+    """
+    frac = check_power_fraction(power_fraction)
+    if not crossover_rad_s > 0:
+        raise ValueError(f"crossover_rad_s must be > 0, got {crossover_rad_s!r}")
+    if not 0 < max_amplitude_deg <= 20:
+        raise ValueError(f"max_amplitude_deg must be in (0, 20] deg, got {max_amplitude_deg!r}")
+    wr = _check_weight_range(weight_range)
+    v = _region3_winds(turbine) if winds is None else np.asarray(winds, float)
+    p_rated = frac * turbine.operation.rated_power
+    p_w = None if frac == 1.0 else p_rated
+    params = linearize.plant_params(turbine)
+    rows = []
+    for w in v:
+        m = _blade_model(turbine, float(w), p_w, params, coordinates="mbc")
+        s = m.select(inputs=["pitch_ref_cos", "pitch_ref_sin"],
+                     outputs=["flap_moment_cos", "flap_moment_sin"])
+        g0 = s.D_u - s.C_z @ np.linalg.solve(s.A, s.B_u)
+        a, b = 0.5 * (g0[0, 0] + g0[1, 1]), 0.5 * (g0[1, 0] - g0[0, 1])
+        g, phi = math.hypot(a, b), math.atan2(b, a)
+        ki = crossover_rad_s / g
+
+        def stable(kk: float) -> bool:
+            # x' = A x + B theta, e' = C x + D theta, theta = -kk R(-phi) e
+            kc = -kk * _rot(-phi)
+            n = s.A.shape[0]
+            acl = np.block([[s.A, s.B_u @ kc], [s.C_z, s.D_u @ kc]])
+            return bool(np.max(np.linalg.eigvals(acl).real) < -1e-9) and n > 0
+
+        if not stable(ki):
+            raise RuntimeError(f"Coleman IPC at {w:g} m/s is unstable at K_I = {ki:g}; lower "
+                               f"crossover_rad_s")
+        lo, hi = 1.0, 2.0
+        while stable(hi * ki) and hi < 1e3:
+            lo, hi = hi, 2 * hi
+        for _ in range(30):
+            mid = 0.5 * (lo + hi)
+            lo, hi = (mid, hi) if stable(mid * ki) else (lo, mid)
+        rows.append((m.info["pitch_deg"] * math.pi / 180, ki, phi, float(w), lo))
+    rows.sort()
+    arr = np.array(rows)
+    return ColemanIPCGains(pitch_rad=arr[:, 0], ki=arr[:, 1], azimuth_offset_rad=arr[:, 2],
+                           wind_mps=arr[:, 3], gain_margin=arr[:, 4],
+                           crossover_rad_s=crossover_rad_s,
+                           max_amplitude_rad=math.radians(max_amplitude_deg), weight_range=wr,
+                           rated_power=p_rated, power_fraction=frac)
+
+
+class ColemanIPCController(IBCController):
+    """Coleman-frame integral IPC (tilt and yaw to zero) on top of a collective controller.
+
+    Signals: the collective's, plus ``ipc_weight``, ``ipc_tilt_moment``, ``ipc_yaw_moment``
+    [N m] and ``ipc_pitch_cos``, ``ipc_pitch_sin`` [rad].
+    """
+
+    def __init__(self, collective: BaselineController,  # noqa: D107 - shares IBC's limits
+                 gains: ColemanIPCGains) -> None:
+        self.collective = collective
+        self.gains = gains
+        self.dt = collective.dt
+        pa = collective.turbine.pitch_actuator
+        self.pitch_min, self.pitch_max = collective.pitch_min, pa.max_pitch_rad
+        self.step_max = pa.max_rate_rad_s * self.dt
+        self._p_tau = 1.0
+        self.reset()
+
+    def reset(self) -> None:
+        """Forget the integral, power filter and last commands (and reset the collective)."""
+        self.collective.reset()
+        self._theta_cs = np.zeros(2)
+        self._p_filt = None
+        self._last = None
+        self.signals = {}
+
+    def step(self, t: float, meas: dict[str, Any]) -> tuple[np.ndarray, float]:
+        """One control step; returns (pitch_ref (3,) [rad], gen_torque_ref [N m])."""
+        pc, tq = self.collective.step(t, meas)
+        m = np.asarray(meas["flap_moment"], float)
+        psi = float(meas["azimuth"])
+        if m.shape != (3,) or not np.all(np.isfinite(m)) or not math.isfinite(psi):
+            raise ValueError(f"measurements flap_moment (3,) and azimuth must be finite at "
+                             f"t = {t:g} s, got {meas['flap_moment']!r}, {meas['azimuth']!r}")
+        ang = psi + 2 * math.pi * np.arange(3) / 3
+        m_cs = 2.0 / 3.0 * np.array([np.sum(m * np.cos(ang)), np.sum(m * np.sin(ang))])
+        w = self._weight(meas)
+        ki, phi = self.gains.at(float(np.mean(pc)))
+        self._theta_cs += -w * ki * (_rot(-phi) @ m_cs) * self.dt
+        amp = float(np.hypot(*self._theta_cs))
+        if amp > self.gains.max_amplitude_rad:            # anti-windup: clamp the amplitude
+            self._theta_cs *= self.gains.max_amplitude_rad / amp
+        th = w * self._theta_cs
+        u = th[0] * np.cos(ang) + th[1] * np.sin(ang)
+        cmd = self._limit(pc + u, meas)
+        self.signals = {**self.collective.signals, "ipc_weight": w,
+                        "ipc_tilt_moment": float(m_cs[0]), "ipc_yaw_moment": float(m_cs[1]),
+                        "ipc_pitch_cos": float(th[0]), "ipc_pitch_sin": float(th[1])}
+        return cmd, tq
+
+
+# --------------------------------------------------------------------------------------------
+# Down-regulation: steady power curve and AEP
+# --------------------------------------------------------------------------------------------
+def steady_power_curve(turbine: linearize.Turbine, gains: BaselineGains,
+                       winds: Any) -> dict[str, np.ndarray]:
+    """Steady electrical power and rotor speed of the baseline torque law with ``gains``
+    (normal or derated) in uniform steady wind, pitch at fine pitch below rated.
+
+    Below rated, the rotor speed solves Q_aero(V, Omega, fine pitch) = N T_law(N Omega), with
+    C_P from :func:`linearize.steady_coefficients`; where the aerodynamic torque exceeds the law
+    at rated speed, the pitch loop holds rated speed and the power is the (derated) rated power.
+
+    Returns
+    -------
+    dict
+        ``wind_mps``, ``power_W``, ``rotor_speed_rad_s`` (n_v,) and ``region`` (n_v,) of str.
+    """
+    from scipy.optimize import brentq
+
+    v = np.asarray(winds, float)
+    if v.ndim != 1 or not np.all(np.isfinite(v)) or np.any(v < 0):
+        raise ValueError(f"winds must be a 1-D array of finite wind speeds >= 0 m/s, got {winds!r}")
+    ctl = BaselineController(turbine, gains)
+    op = turbine.operation
+    dtr = turbine.drivetrain
+    n = dtr.gearbox_ratio
+    eta = dtr.generator_efficiency * dtr.gearbox_efficiency
+    rproj = turbine.geometry.tip_radius * math.cos(turbine.geometry.precone_rad)
+    rho = turbine.environment.air_density
+    lam = np.linspace(0.5, 25.0, 400)
+    cp, _ = linearize.steady_coefficients(turbine, lam, math.degrees(op.fine_pitch_rad))
+    fine = op.fine_pitch_rad
+    w_top = ctl.w_rated / n
+
+    def resid(om: float, vv: float) -> float:
+        q = 0.5 * rho * math.pi * rproj**2 * vv**3 * float(np.interp(om * rproj / vv, lam, cp)) / om
+        return q - n * ctl.torque(om * n, fine)
+
+    power, speed, region = [], [], []
+    for vv in v:
+        if not op.cut_in_wind <= vv <= op.cut_out_wind:
+            power.append(0.0), speed.append(0.0), region.append("off")
+            continue
+        w_lo = ctl.w_cutin / n * (1 + 1e-6)
+        if resid(w_top, vv) >= 0:
+            power.append(gains.rated_power)
+            speed.append(gains.rated_gen_speed_rad_s / n)
+            region.append("3")
+            continue
+        if resid(w_lo, vv) <= 0:
+            power.append(0.0), speed.append(w_lo), region.append("1")
+            continue
+        om = brentq(resid, w_lo, w_top, args=(vv,), xtol=1e-10)
+        power.append(eta * n * ctl.torque(om * n, fine) * om)
+        speed.append(om)
+        region.append("2.5" if om * n >= ctl.w_trans else "2")
+    return {"wind_mps": v, "power_W": np.asarray(power), "rotor_speed_rad_s": np.asarray(speed),
+            "region": np.asarray(region)}
+
+
+def aep_change(turbine: linearize.Turbine, fractions: Sequence[float] = (0.9, 0.8), *,
+               kind: str = "rayleigh", mean: float | None = 10.0, shape: float = 2.0,
+               scale: float | None = None, wind_step: float = 0.5,
+               gains: Mapping[float, BaselineGains] | None = None) -> dict[str, Any]:
+    """AEP of the steady power curve, normal and derated, weighted by a Rayleigh (IEC: mean
+    0.2 v_ref, 10 m/s for class I) or Weibull wind distribution over cut-in..cut-out.
+
+    Returns
+    -------
+    dict
+        ``aep_Wh`` per fraction (1.0 included), ``change_pct`` per derated fraction, the
+        curves (``curves``) and the distribution.
+    """
+    from .assess import wind_bin_probabilities
+    from .baseline import tune_baseline
+
+    fr = sorted({1.0, *(check_power_fraction(f, "fractions") for f in fractions)}, reverse=True)
+    op = turbine.operation
+    v = np.arange(op.cut_in_wind, op.cut_out_wind + 1e-9, wind_step)
+    prob = wind_bin_probabilities(v, kind, mean=mean if kind == "rayleigh" else None,
+                                  shape=shape, scale=scale)
+    gains = dict(gains or {})
+    out: dict[str, Any] = {"aep_Wh": {}, "change_pct": {}, "curves": {},
+                           "distribution": {"kind": kind, "mean": mean, "shape": shape,
+                                            "scale": scale}}
+    for f in fr:
+        g = gains.get(f) or tune_baseline(turbine, power_fraction=f)
+        curve = steady_power_curve(turbine, g, v)
+        out["curves"][f] = curve
+        out["aep_Wh"][f] = aep_Wh(curve["power_W"], prob)
+    for f in fr[1:]:
+        out["change_pct"][f] = 100.0 * (out["aep_Wh"][f] / out["aep_Wh"][1.0] - 1.0)
+    return out
+
+
+# --------------------------------------------------------------------------------------------
+# Metrics: lifetime-weighted comparison (Pettas and Cheng sec. 4, eq 1)
+# --------------------------------------------------------------------------------------------
+_STD_KEYS = ("gen_speed_std_rad_s", "gen_torque_std_Nm", "power_std_W")
+_PITCH_KEYS = ("pitch_travel_deg", "pitch_rate_std_degps", "pitch_acc_std_degps2")
+
+
+def lifetime_comparison(probabilities: Any, base: Sequence[Mapping[str, Any]],
+                        updated: Sequence[Mapping[str, Any]], *,
+                        woehler: Sequence[float] = (4.0, 10.0), t_base: float = 15.0,
+                        t_upd: float = 5.0, t_lifetime: float = 20.0) -> dict[str, Any]:
+    """Lifetime-weighted change of a retrofit controller against the baseline.
+
+    Parameters
+    ----------
+    probabilities : (n_bin,) array_like
+        Probability of each mean-wind bin [-].
+    base, updated : sequence of dict
+        One :func:`mpc_wt.runs.assess_series` result per bin (seeds merged by the caller).
+
+    Returns
+    -------
+    dict
+        ``del_change_pct`` per channel (lifetime DEL, Clemens eq 18, at each channel's own
+        Woehler exponent), ``lifetime_del`` {channel: (base, updated)}, ``aep_change_pct``
+        (probability-weighted mean power), ``pitch_change_pct`` and ``std_change_pct``
+        (probability-weighted means of the per-run metrics), and ``extension`` {channel: {m:
+        {"damage", "extension_years"}}} from eq 1 with the lifetime DEL ratio at each m in
+        ``woehler`` (the paper's 15 + 5 years by default).
+    """
+    p = np.asarray(probabilities, float)
+    if not (len(base) == len(updated) == p.size):
+        raise ValueError(f"probabilities ({p.size}), base ({len(base)}) and updated "
+                         f"({len(updated)}) must have one entry per wind bin")
+
+    def pct(a: float, b: float) -> float:
+        return 100.0 * (b / a - 1.0) if a else float("nan")
+
+    def wmean(runs: Sequence[Mapping[str, Any]], key: str) -> float:
+        return float(np.sum(p * np.array([r[key] for r in runs])) / p.sum())
+
+    chans = [c for c in base[0]["channels"] if all(c in r["channels"] for r in updated)]
+    out: dict[str, Any] = {"del_change_pct": {}, "lifetime_del": {}, "extension": {},
+                           "pitch_change_pct": {}, "std_change_pct": {}}
+    for c in chans:
+        m = float(base[0]["channels"][c]["m"])
+        db = np.array([r["channels"][c]["del"] for r in base])
+        du = np.array([r["channels"][c]["del"] for r in updated])
+        lb, lu = lifetime_del(db, m, p), lifetime_del(du, m, p)
+        out["lifetime_del"][c] = (lb, lu)
+        out["del_change_pct"][c] = pct(lb, lu)
+        out["extension"][c] = {}
+        for mw in woehler:
+            lbm, lum = lifetime_del(db, mw, p), lifetime_del(du, mw, p)
+            out["extension"][c][float(mw)] = lifetime_extension(
+                lbm, lum, mw, t_base=t_base, t_upd=t_upd, t_lifetime=t_lifetime)
+    if all("power_mean_W" in r for r in [*base, *updated]):
+        out["aep_change_pct"] = pct(wmean(base, "power_mean_W"), wmean(updated, "power_mean_W"))
+    for keys, dest in ((_PITCH_KEYS, "pitch_change_pct"), (_STD_KEYS, "std_change_pct")):
+        for k in keys:
+            if all(k in r for r in [*base, *updated]):
+                out[dest][k] = pct(wmean(base, k), wmean(updated, k))
+    return out
