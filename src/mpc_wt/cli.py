@@ -10,7 +10,8 @@ simulate   closed loop on the plant: ``simulate --controller baseline --wind 18 
 assess     DELs, CS1-CS5, pitch duty, energy of runs or CSV time series
 wind       turbulent wind fields: ``wind generate --mean 18 --class A --out FIELD.bts``
 lidar      CW LIDAR preview: ``lidar evaluate --field FIELD [--focus 54] [--json]``
-design     gain synthesis: ``design baseline|lqr|ts [...] --out DIR`` (DIR/design.json + plot)
+design     gain synthesis: ``design baseline|lqr|ts|ibc|coleman-ipc [...] --out DIR``
+           (DIR/design.json + plot)
 export     gain tables: ``export DIR --format csv|json|mat|rosco``
 
 Errors in the arguments or the turbine file print one line naming the parameter and the value
@@ -229,11 +230,12 @@ def _cmd_lidar_evaluate(args: argparse.Namespace) -> int:
 
 
 def _cmd_simulate(args: argparse.Namespace) -> int:
-    from .runs import CONTROLLERS, run_controller
+    from .runs import parse_controller, run_controller
 
-    if args.controller not in CONTROLLERS:
-        raise UsageError(f"--controller must be one of {list(CONTROLLERS)}, got "
-                         f"{args.controller!r}")
+    try:
+        kind, _, addon = parse_controller(args.controller)
+    except ValueError as err:
+        raise UsageError(f"--controller: {err}") from None
     turbine = linearize.load_turbine(args.turbine)
     mpc_opts: dict[str, Any] = {}
     if args.controller.startswith("mpc"):
@@ -244,11 +246,28 @@ def _cmd_simulate(args: argparse.Namespace) -> int:
             (None, "condensed", "none", False) or args.horizon != 15:
         raise UsageError(f"--backend/--formulation/--horizon/--estimator/--scheduled apply to "
                          f"the MPC controllers only, not to --controller {args.controller}")
-    if args.apc_frequency is not None and args.controller != "ts":
-        raise UsageError("--apc-frequency applies to --controller ts only")
-    res = run_controller(turbine, args.controller, args.wind, args.turbulence, args.seed,
-                         args.duration, progress=True, mpc_options=mpc_opts,
-                         apc_frequency=args.apc_frequency)
+    if args.apc_frequency is not None and kind not in ("ts", "apc"):
+        raise UsageError("--apc-frequency applies to --controller ts and apc only")
+    if kind == "apc" and args.apc_frequency is None:
+        raise UsageError("--controller apc needs --apc-frequency F [Hz] (0: constant reduction)")
+    if (args.apc_amplitude, args.apc_offset) != (0.375, 0.375) and kind not in ("ts", "apc"):
+        raise UsageError("--apc-amplitude/--apc-offset apply to --controller ts and apc only")
+    ropts = {}
+    if args.loop_gain is not None or args.remove_collective:
+        if addon != "ibc":
+            raise UsageError("--loop-gain/--remove-collective apply to the ibc controllers only")
+        ropts = {"remove_collective": args.remove_collective}
+        if args.loop_gain is not None:
+            ropts["loop_gain_1p"] = args.loop_gain
+    try:
+        res = run_controller(turbine, args.controller, args.wind, args.turbulence, args.seed,
+                             args.duration, progress=True, mpc_options=mpc_opts,
+                             apc_frequency=args.apc_frequency, apc_amplitude=args.apc_amplitude,
+                             apc_offset=args.apc_offset, retrofit_options=ropts or None)
+    except ValueError as err:
+        if "apc" in str(err) or "power" in str(err):
+            raise UsageError(str(err)) from None
+        raise
     out = Path(args.out)
     if out.suffix == "":
         out = out.with_suffix(".nc")
@@ -395,10 +414,14 @@ def _plot_design(doc: dict[str, Any], path: Path) -> None:
     rows = np.asarray(s["rows"], dtype=float)
     x = rows[:, 0]
     fig, ax = plt.subplots(figsize=(7, 4))
-    if doc["kind"] == "baseline":
-        for c in ("kp", "ki"):
+    scalar = {"baseline": (("kp", "ki"), "PI gain on generator speed [s], [-]"),
+              "ibc": (("gain",), "IBC gain [rad/(N m)]"),
+              "coleman-ipc": (("ki",), "IPC integral gain [rad/(N m s)]")}
+    if doc["kind"] in scalar:
+        names, label = scalar[doc["kind"]]
+        for c in names:
             ax.plot(x, rows[:, s["columns"].index(c)], "o-", label=c)
-        ax.set_ylabel("PI gain on generator speed [s], [-]")
+        ax.set_ylabel(label)
     else:
         k = np.asarray(doc["matrices"]["K"]["data"])
         m = doc["matrices"]["K"]
@@ -420,15 +443,35 @@ def _plot_design(doc: dict[str, Any], path: Path) -> None:
 
 
 def _cmd_design(args: argparse.Namespace) -> int:
-    from .export import baseline_table, lqr_table, save_design, ts_table
+    from .export import (baseline_table, coleman_ipc_table, ibc_table, lqr_table, save_design,
+                         ts_table)
 
     turbine = linearize.load_turbine(args.turbine)
+    try:
+        from .baseline import check_power_fraction
+
+        frac = check_power_fraction(args.power_fraction, "--power-fraction")
+    except ValueError as err:
+        raise UsageError(str(err)) from None
     if args.kind == "baseline":
         from .baseline import tune_baseline
 
         doc = baseline_table(turbine, tune_baseline(turbine, omega_n_rad_s=args.omega_n,
-                                                    zeta=args.zeta))
+                                                    zeta=args.zeta, power_fraction=frac))
         note = f"kp {doc['settings']['kp']:.4g} s, ki {doc['settings']['ki']:.4g}"
+    elif args.kind == "ibc":
+        from .retrofit import tune_ibc
+
+        g = tune_ibc(turbine, power_fraction=frac, loop_gain_1p=args.loop_gain)
+        doc = ibc_table(turbine, g)
+        note = (f"{g.gain.size} points, gain margin >= {g.gain_margin.min():.3g}, "
+                f"high-pass {g.highpass_hz:.3g} Hz")
+    elif args.kind == "coleman-ipc":
+        from .retrofit import tune_coleman_ipc
+
+        g = tune_coleman_ipc(turbine, power_fraction=frac)
+        doc = coleman_ipc_table(turbine, g)
+        note = f"{g.ki.size} points, gain margin >= {g.gain_margin.min():.3g}"
     elif args.kind == "lqr":
         from .synthesis import (REGION3_SCALES, REGION3_WEIGHTS, design_lqr_family,
                                 design_pi_observer)
@@ -515,7 +558,9 @@ def _parser() -> argparse.ArgumentParser:
     p = sub.add_parser("simulate", help="closed-loop simulation on the plant")
     p.add_argument("--turbine", **turb)
     p.add_argument("--controller", default="baseline",
-                   help="baseline | mpc | mpc-lidar | mpc-collective | lqr-pio | ts")
+                   help="baseline | mpc | mpc-lidar | mpc-collective | lqr-pio | ts | ibc | "
+                        "coleman-ipc | derateNN (NN %% of rated, e.g. derate90) | derateNN+ibc "
+                        "| derateNN+coleman-ipc | apc")
     p.add_argument("--wind", type=float, required=True, help="mean hub-height wind [m/s]")
     p.add_argument("--turbulence", choices=("A", "B", "C", "steady"), default="A")
     p.add_argument("--seed", type=int, default=1)
@@ -533,11 +578,19 @@ def _parser() -> argparse.ArgumentParser:
                    help="MPC scheduled over a model family 12-25 m/s on the estimated wind "
                         "(or the preview with mpc-lidar)")
     p.add_argument("--apc-frequency", type=float, default=None,
-                   help="ts: sinusoidal power reduction of Clemens eq 11 at this f_r [Hz]")
+                   help="ts, apc: sinusoidal power reduction of Clemens eq 11 at this f_r [Hz]")
+    p.add_argument("--apc-amplitude", type=float, default=0.375,
+                   help="ts, apc: amplitude of Delta P (fraction of rated, default 0.375)")
+    p.add_argument("--apc-offset", type=float, default=0.375,
+                   help="ts, apc: mean of Delta P (default 0.375: Delta P in [0, 0.75])")
+    p.add_argument("--loop-gain", type=float, default=None,
+                   help="ibc: loop gain at 1P of each blade loop (default 1)")
+    p.add_argument("--remove-collective", action="store_true",
+                   help="ibc: subtract the blades' mean IBC pitch (cyclic action only)")
     p.set_defaults(func=_cmd_simulate)
 
     p = sub.add_parser("design", help="gain synthesis: baseline PI, LQR family, TS by LMIs")
-    p.add_argument("kind", choices=("baseline", "lqr", "ts"))
+    p.add_argument("kind", choices=("baseline", "lqr", "ts", "ibc", "coleman-ipc"))
     p.add_argument("--turbine", **turb)
     p.add_argument("--out", required=True, help="design directory (design.json, gains.png)")
     p.add_argument("--wind", help="lqr: START:STOP:STEP (default 12:25:1); ts: comma list of "
@@ -556,6 +609,10 @@ def _parser() -> argparse.ArgumentParser:
                    help="lqr: PI observer q of Q_obs = diag(I, q I) (0: no observer)")
     p.add_argument("--omega-n", type=float, default=0.6, help="baseline: PI design [rad/s]")
     p.add_argument("--zeta", type=float, default=0.7, help="baseline: PI damping [-]")
+    p.add_argument("--power-fraction", type=float, default=1.0,
+                   help="baseline, ibc, coleman-ipc: tune for a derated turbine at this "
+                        "fraction of rated power, in (0, 1]")
+    p.add_argument("--loop-gain", type=float, default=1.0, help="ibc: loop gain at 1P [-]")
     p.set_defaults(func=_cmd_design)
 
     p = sub.add_parser("export", help="export a design's gain table")

@@ -2,15 +2,17 @@
 
 A gain table is a JSON-able dict (``design.json`` in a design directory):
 
-    {"schema": "mpc-wt gain table", "schema_version": 1, "kind": "baseline" | "lqr" | "ts",
+    {"schema": "mpc-wt gain table", "schema_version": 1,
+     "kind": "baseline" | "lqr" | "ts" | "ibc" | "coleman-ipc",
      "turbine": ..., "software": {"mpc_wt": version}, "settings": {...},
      "schedule": {"columns": [...], "units": [...], "rows": [[...], ...]},
      "matrices": {name: {"unit": ..., "rows": [...], "cols": [...], "data": [[[...]]] }}}
 
 ``schedule`` has one row per operating point (wind speed for the LQR family, premise vertex
 for TS with its membership breakpoints ``wind_grid`` / ``reduction_grid`` in ``settings``,
-pitch angle for the PI baseline); ``matrices`` stacks gain matrices over those points with
-row/column names and one unit string per matrix.
+pitch angle for the PI baseline, the individual blade control and the Coleman IPC);
+``matrices`` stacks gain matrices over those points with row/column names and one unit string
+per matrix.
 
 Formats (:func:`export`):
 
@@ -40,6 +42,7 @@ import linearize
 from . import __version__
 
 __all__ = ["SCHEMA_VERSION", "GainTableError", "baseline_table", "lqr_table", "ts_table",
+           "ibc_table", "coleman_ipc_table",
            "save_design", "load_design", "export", "read_rosco", "FORMATS"]
 
 SCHEMA_VERSION = 1
@@ -89,8 +92,9 @@ def baseline_table(turbine: linearize.Turbine, gains: Any,
         lo = math.ceil(linearize.rated_wind_speed(turbine))
         winds = np.arange(lo, op.cut_out_wind + 0.5, 1.0)
     rows = []
+    p_w = None if gains.power_fraction == 1.0 else gains.rated_power
     for v in winds:
-        p = linearize.trim(turbine, float(v))
+        p = linearize.trim(turbine, float(v), p_w)
         gk = 1.0 / (1.0 + p.pitch_rad / gains.theta_k_rad)
         rows.append([float(v), p.pitch_rad, gains.kp * gk, gains.ki * gk, p.gen_torque,
                      p.gen_speed_rad_s, p.power])
@@ -98,7 +102,7 @@ def baseline_table(turbine: linearize.Turbine, gains: Any,
                 "k_opt": gains.k_opt, "rated_gen_speed_rad_s": gains.rated_gen_speed_rad_s,
                 "rated_torque": gains.rated_torque, "rated_power": gains.rated_power,
                 "omega_n_rad_s": gains.omega_n_rad_s, "zeta": gains.zeta,
-                "min_pitch_rad": op.fine_pitch_rad,
+                "power_fraction": gains.power_fraction, "min_pitch_rad": op.fine_pitch_rad,
                 "max_pitch_rad": turbine.pitch_actuator.max_pitch_rad,
                 "max_pitch_rate_rad_s": turbine.pitch_actuator.max_rate_rad_s,
                 "max_torque": turbine.generator.max_torque,
@@ -180,6 +184,42 @@ def ts_table(turbine: linearize.Turbine, ts: Any, controller: Any,
                          "observer_disk_radius": observer.disk_radius,
                          "observer_certificate_ok": observer.certificate.ok})
     return _doc("ts", turbine, settings, cols, units, rows, mats)
+
+
+def ibc_table(turbine: linearize.Turbine, gains: Any) -> dict[str, Any]:
+    """Individual blade control (:class:`~mpc_wt.retrofit.IBCGains`) as a gain table: the
+    proportional gain per mean-pitch breakpoint, with its gain margin and 1P loop gain, and the
+    filters (high-pass corner, band-stop frequencies and Q) and power fade-in in ``settings``."""
+    rows = [[w, p, k, gm if math.isfinite(gm) else 1e300, lg] for w, p, k, gm, lg in zip(
+        gains.wind_mps, gains.pitch_rad, gains.gain, gains.gain_margin, gains.loop_gain_1p)]
+    settings = {"dt": gains.dt, "highpass_hz": gains.highpass_hz,
+                "notch_hz": [h * gains.one_p_hz for h in gains.notch_harmonics],
+                "notch_harmonics": list(gains.notch_harmonics), "notch_q": gains.notch_q,
+                "weight_range": list(gains.weight_range), "rated_power": gains.rated_power,
+                "power_fraction": gains.power_fraction,
+                "rotor_speed_rad_s": gains.rotor_speed_rad_s,
+                "convention": "theta_i = theta_collective + w(P) BS(K(theta_mean) HP(M_flap_i)) "
+                              "(Pettas and Cheng sec. 3.1); gain margin 1e300: none"}
+    return _doc("ibc", turbine, settings,
+                ["wind_speed", "pitch", "gain", "gain_margin", "loop_gain_1p"],
+                ["m/s", "rad", "rad/(N m)", "-", "-"], rows, {})
+
+
+def coleman_ipc_table(turbine: linearize.Turbine, gains: Any) -> dict[str, Any]:
+    """Coleman-frame IPC (:class:`~mpc_wt.retrofit.ColemanIPCGains`) as a gain table: integral
+    gain and azimuth offset per mean-pitch breakpoint."""
+    rows = [[w, p, k, a, gm] for w, p, k, a, gm in zip(
+        gains.wind_mps, gains.pitch_rad, gains.ki, gains.azimuth_offset_rad, gains.gain_margin)]
+    settings = {"crossover_rad_s": gains.crossover_rad_s,
+                "max_amplitude_rad": gains.max_amplitude_rad,
+                "weight_range": list(gains.weight_range), "rated_power": gains.rated_power,
+                "power_fraction": gains.power_fraction,
+                "convention": "theta_cs = -K_I R(-phi) int M_cs dt, M_cs = 2/3 sum M_i "
+                              "[cos psi_i, sin psi_i]; theta_i += theta_c cos psi_i + theta_s "
+                              "sin psi_i"}
+    return _doc("coleman-ipc", turbine, settings,
+                ["wind_speed", "pitch", "ki", "azimuth_offset", "gain_margin"],
+                ["m/s", "rad", "rad/(N m s)", "rad", "-"], rows, {})
 
 
 def _check(doc: Any, where: str) -> dict[str, Any]:

@@ -231,6 +231,8 @@ class IBCGains:
         The rated (or derated) power the weight refers to [W].
     power_fraction : float
         Derating fraction the gains were tuned at [-].
+    lowpass_hz : float or None
+        Corner of a second-order Butterworth low-pass on the output [Hz] (None: none).
     """
 
     pitch_rad: np.ndarray
@@ -246,6 +248,7 @@ class IBCGains:
     weight_range: tuple[float, float]
     rated_power: float
     power_fraction: float = 1.0
+    lowpass_hz: float | None = None
     info: dict[str, Any] = field(default_factory=dict, compare=False)
 
     def __post_init__(self) -> None:
@@ -275,9 +278,9 @@ class IBCGains:
         return filter_sos(self.fs, highpass_hz=self.highpass_hz)
 
     def output_sos(self) -> np.ndarray:
-        """Second-order sections of the output (band-stop) filters."""
+        """Second-order sections of the output (band-stop, optional low-pass) filters."""
         return filter_sos(self.fs, notch_hz=[h * self.one_p_hz for h in self.notch_harmonics],
-                          notch_q=self.notch_q)
+                          notch_q=self.notch_q, lowpass_hz=self.lowpass_hz)
 
     def gain_at(self, pitch_rad: float) -> float:
         """Scheduled gain at a mean pitch (held at the ends of the table) [rad/(N m)]."""
@@ -294,7 +297,7 @@ def tune_ibc(turbine: linearize.Turbine, *, winds: Any = None, dt: float = 1.0 /
              loop_gain_1p: float = 1.0, min_gain_margin: float = 2.0,
              highpass_hz: float | None = None, notch_harmonics: Sequence[int] = (3,),
              notch_q: float = 1.0, weight_range: tuple[float, float] = (0.8, 0.95),
-             power_fraction: float = 1.0) -> IBCGains:
+             power_fraction: float = 1.0, lowpass_hz: float | None = None) -> IBCGains:
     """Tune the individual blade controller on our linear models (Pettas and Cheng sec. 3.1).
 
     Parameters
@@ -318,6 +321,9 @@ def tune_ibc(turbine: linearize.Turbine, *, winds: Any = None, dt: float = 1.0 /
         Power fractions between which the IBC fades in [-].
     power_fraction : float
         Tune on the operating points derated to this fraction of rated power [-].
+    lowpass_hz : float, optional
+        Second-order low-pass corner on the output [Hz] (not in the paper; it limits the pitch
+        acceleration the loops ask for above 3P).
 
     Raises
     ------
@@ -351,7 +357,7 @@ def tune_ibc(turbine: linearize.Turbine, *, winds: Any = None, dt: float = 1.0 /
                      wind_mps=v, gain_margin=np.zeros(v.size), loop_gain_1p=np.zeros(v.size),
                      dt=dt, rotor_speed_rad_s=om, highpass_hz=check_corner("highpass_hz", hp, fs),
                      notch_harmonics=harm, notch_q=notch_q, weight_range=wr,
-                     rated_power=p_rated, power_fraction=frac)
+                     rated_power=p_rated, power_fraction=frac, lowpass_hz=lowpass_hz)
     filt = np.vstack([gains.input_sos(), gains.output_sos()])
     f_sys = _sos_ss(filt, dt)
     zf = np.exp(1j * om * dt)
@@ -382,7 +388,7 @@ def tune_ibc(turbine: linearize.Turbine, *, winds: Any = None, dt: float = 1.0 /
                     loop_gain_1p=np.asarray(l1p)[order], dt=dt, rotor_speed_rad_s=om,
                     highpass_hz=gains.highpass_hz, notch_harmonics=harm, notch_q=notch_q,
                     weight_range=wr, rated_power=p_rated, power_fraction=frac,
-                    info={"target_loop_gain_1p": loop_gain_1p,
+                    lowpass_hz=lowpass_hz, info={"target_loop_gain_1p": loop_gain_1p,
                           "min_gain_margin": min_gain_margin})
 
 
@@ -719,7 +725,8 @@ def steady_power_curve(turbine: linearize.Turbine, gains: BaselineGains,
         om = brentq(resid, w_lo, w_top, args=(vv,), xtol=1e-10)
         power.append(eta * n * ctl.torque(om * n, fine) * om)
         speed.append(om)
-        region.append("2.5" if om * n >= ctl.w_trans else "2")
+        region.append("2.5" if om * n >= ctl.w_trans else "2" if om * n >= ctl.w_rgn2
+                      else "1.5")
     return {"wind_mps": v, "power_W": np.asarray(power), "rotor_speed_rad_s": np.asarray(speed),
             "region": np.asarray(region)}
 

@@ -167,7 +167,19 @@ def test_assess_csv_from_another_tool(tmp_path: Path, capsys: pytest.CaptureFixt
 @pytest.mark.parametrize("argv, match", [
     (["assess", "/no/run.nc"], "file not found"),
     (["simulate", "--controller", "lqr", "--wind", "18", "--out", "x"],
-     "--controller must be one of"),
+     "--controller: controller must be one of"),
+    (["simulate", "--controller", "derate0", "--wind", "18", "--out", "x"],
+     "derating in 'derate0' is 0 % of rated power; allowed: (0, 100] %"),
+    (["simulate", "--controller", "apc", "--wind", "18", "--out", "x"],
+     "--controller apc needs --apc-frequency"),
+    (["simulate", "--controller", "apc", "--apc-frequency", "0.1", "--wind", "8",
+      "--duration", "1", "--out", "x"], "above the power available at the mean wind 8"),
+    (["simulate", "--controller", "apc", "--apc-frequency", "0.1", "--apc-offset", "0",
+      "--wind", "18", "--duration", "1", "--out", "x"], "need offset >= amplitude"),
+    (["simulate", "--controller", "baseline", "--loop-gain", "2", "--wind", "18", "--out", "x"],
+     "apply to the ibc controllers only"),
+    (["design", "ibc", "--power-fraction", "1.5", "--out", "x"],
+     "--power-fraction must be in (0, 1]"),
     (["simulate", "--controller", "baseline", "--estimator", "kalman", "--wind", "18", "--out",
       "x"], "apply to the MPC controllers only"),
     (["simulate", "--controller", "mpc", "--formulation", "sparse", "--backend", "daqp",
@@ -175,7 +187,7 @@ def test_assess_csv_from_another_tool(tmp_path: Path, capsys: pytest.CaptureFixt
     (["simulate", "--controller", "mpc", "--scheduled", "--wind", "8", "--duration", "1",
       "--out", "x"], "wind 8 m/s is outside"),
     (["simulate", "--controller", "lqr-pio", "--apc-frequency", "0.1", "--wind", "18",
-      "--out", "x"], "--apc-frequency applies to --controller ts only"),
+      "--out", "x"], "--apc-frequency applies to --controller ts and apc only"),
     (["simulate", "--controller", "ts", "--horizon", "5", "--wind", "18", "--out", "x"],
      "not to --controller ts"),
 ])
@@ -244,3 +256,37 @@ def test_simulate_gain_controllers(controller: str, extra: list[str], tmp_path: 
     if controller == "ts":
         assert r.meta["ts"]["apc_frequency_Hz"] == 0.1
         assert r.channel("power_ref").min() < 0.4 * r.channel("power_ref").max()
+
+
+@pytest.mark.parametrize("controller, extra", [("derate90+ibc", ["--loop-gain", "0.5"]),
+                                               ("coleman-ipc", []),
+                                               ("apc", ["--apc-frequency", "0.1"])])
+def test_simulate_retrofit_controllers(controller: str, extra: list[str], tmp_path: Path,
+                                       capsys: pytest.CaptureFixture[str]) -> None:
+    out = tmp_path / "run.nc"
+    assert main(["simulate", "--controller", controller, "--wind", "16", "--turbulence", "B",
+                 "--duration", "20", "--out", str(out), *extra]) == 0
+    from mpc_wt.simulate import ClosedLoopResult
+
+    r = ClosedLoopResult.load(out)
+    assert r.meta["controller"] == controller
+    assert abs(r.channel("rotor_speed").mean() / 1.2671 - 1) < 0.03
+    if controller == "derate90+ibc":
+        assert r.meta["ibc"]["loop_gain_1p"] == 0.5 and r.meta["gains"]["power_fraction"] == 0.9
+        assert abs(r.channel("gen_power").mean() / 4.5e6 - 1) < 0.03
+        assert np.abs(r.channel("ibc_pitch_1")).max() > 0
+    if controller == "apc":
+        assert r.meta["apc"]["frequency_Hz"] == 0.1
+        assert r.channel("power_reference").min() < 0.4 * 5e6
+
+
+def test_design_ibc_and_export(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    d = tmp_path / "ibc"
+    assert main(["design", "ibc", "--power-fraction", "0.9", "--out", str(d)]) == 0
+    assert (d / "gains.png").stat().st_size > 0
+    assert main(["export", str(d), "--format", "csv"]) == 0
+    rows = list(csv.reader((d / "gains_schedule.csv").open()))
+    assert rows[1][:3] == ["wind_speed [m/s]", "pitch [rad]", "gain [rad/(N m)]"]
+    assert all(float(r[2]) > 0 for r in rows[2:])
+    doc = json.loads((d / "design.json").read_text())
+    assert doc["settings"]["power_fraction"] == 0.9
