@@ -253,10 +253,10 @@ def _cmd_simulate(args: argparse.Namespace) -> int:
     if (args.apc_amplitude, args.apc_offset) != (0.375, 0.375) and kind not in ("ts", "apc"):
         raise UsageError("--apc-amplitude/--apc-offset apply to --controller ts and apc only")
     ropts = {}
-    if args.loop_gain is not None or args.remove_collective:
+    if args.loop_gain is not None or args.keep_collective:
         if addon != "ibc":
-            raise UsageError("--loop-gain/--remove-collective apply to the ibc controllers only")
-        ropts = {"remove_collective": args.remove_collective}
+            raise UsageError("--loop-gain/--keep-collective apply to the ibc controllers only")
+        ropts = {"remove_collective": not args.keep_collective}
         if args.loop_gain is not None:
             ropts["loop_gain_1p"] = args.loop_gain
     try:
@@ -585,8 +585,9 @@ def _parser() -> argparse.ArgumentParser:
                    help="ts, apc: mean of Delta P (default 0.375: Delta P in [0, 0.75])")
     p.add_argument("--loop-gain", type=float, default=None,
                    help="ibc: loop gain at 1P of each blade loop (default 1)")
-    p.add_argument("--remove-collective", action="store_true",
-                   help="ibc: subtract the blades' mean IBC pitch (cyclic action only)")
+    p.add_argument("--keep-collective", action="store_true",
+                   help="ibc: keep the blades' mean IBC pitch (the paper's independent loops; "
+                        "default: subtract it, cyclic action only)")
     p.set_defaults(func=_cmd_simulate)
 
     p = sub.add_parser("design", help="gain synthesis: baseline PI, LQR family, TS by LMIs")

@@ -185,7 +185,7 @@ def run_controller(turbine: linearize.Turbine, controller: str, wind_mps: float,
 
             opts = dict(retrofit_options or {})
             if addon == "ibc":
-                rc = bool(opts.pop("remove_collective", False))
+                rc = bool(opts.pop("remove_collective", True))
                 ig = retrofit.tune_ibc(turbine, power_fraction=frac, dt=ctl.dt, **opts)
                 ctl = retrofit.IBCController(ctl, ig, remove_collective=rc)
                 opts["remove_collective"] = rc

@@ -177,7 +177,7 @@ def test_assess_csv_from_another_tool(tmp_path: Path, capsys: pytest.CaptureFixt
     (["simulate", "--controller", "apc", "--apc-frequency", "0.1", "--apc-offset", "0",
       "--wind", "18", "--duration", "1", "--out", "x"], "need offset >= amplitude"),
     (["simulate", "--controller", "baseline", "--loop-gain", "2", "--wind", "18", "--out", "x"],
-     "apply to the ibc controllers only"),
+     "--loop-gain/--keep-collective apply to the ibc controllers only"),
     (["design", "ibc", "--power-fraction", "1.5", "--out", "x"],
      "--power-fraction must be in (0, 1]"),
     (["simulate", "--controller", "baseline", "--estimator", "kalman", "--wind", "18", "--out",
