@@ -275,16 +275,25 @@ class IBCGains:
 
     def input_sos(self) -> np.ndarray:
         """Second-order sections of the input (high-pass) filter."""
-        return filter_sos(self.fs, highpass_hz=self.highpass_hz)
+        return _ibc_sos(self.fs, self.one_p_hz, self.highpass_hz, self.notch_harmonics,
+                        self.notch_q, self.lowpass_hz)[0]
 
     def output_sos(self) -> np.ndarray:
         """Second-order sections of the output (band-stop, optional low-pass) filters."""
-        return filter_sos(self.fs, notch_hz=[h * self.one_p_hz for h in self.notch_harmonics],
-                          notch_q=self.notch_q, lowpass_hz=self.lowpass_hz)
+        return _ibc_sos(self.fs, self.one_p_hz, self.highpass_hz, self.notch_harmonics,
+                        self.notch_q, self.lowpass_hz)[1]
 
     def gain_at(self, pitch_rad: float) -> float:
         """Scheduled gain at a mean pitch (held at the ends of the table) [rad/(N m)]."""
         return float(np.interp(pitch_rad, self.pitch_rad, self.gain))
+
+
+def _ibc_sos(fs: float, one_p_hz: float, highpass_hz: float, harmonics: Sequence[float],
+             notch_q: float, lowpass_hz: float | None) -> tuple[np.ndarray, np.ndarray]:
+    """(input, output) second-order sections of the IBC filters."""
+    return (filter_sos(fs, highpass_hz=highpass_hz),
+            filter_sos(fs, notch_hz=[h * one_p_hz for h in harmonics], notch_q=notch_q,
+                       lowpass_hz=lowpass_hz))
 
 
 def _blade_model(turbine: linearize.Turbine, v: float, p_w: float | None,
@@ -353,12 +362,7 @@ def tune_ibc(turbine: linearize.Turbine, *, winds: Any = None, dt: float = 1.0 /
     v = _region3_winds(turbine) if winds is None else np.asarray(winds, float)
     p_rated = frac * turbine.operation.rated_power
     p_w = None if frac == 1.0 else p_rated
-    gains = IBCGains(pitch_rad=np.arange(v.size, dtype=float), gain=np.zeros(v.size),
-                     wind_mps=v, gain_margin=np.zeros(v.size), loop_gain_1p=np.zeros(v.size),
-                     dt=dt, rotor_speed_rad_s=om, highpass_hz=check_corner("highpass_hz", hp, fs),
-                     notch_harmonics=harm, notch_q=notch_q, weight_range=wr,
-                     rated_power=p_rated, power_fraction=frac, lowpass_hz=lowpass_hz)
-    filt = np.vstack([gains.input_sos(), gains.output_sos()])
+    filt = np.vstack(_ibc_sos(fs, f1p, hp, harm, notch_q, lowpass_hz))
     f_sys = _sos_ss(filt, dt)
     zf = np.exp(1j * om * dt)
     f1 = complex(signal.sosfreqz(filt, worN=[f1p], fs=fs)[1][0])
@@ -386,7 +390,7 @@ def tune_ibc(turbine: linearize.Turbine, *, winds: Any = None, dt: float = 1.0 /
     return IBCGains(pitch_rad=np.asarray(pitch)[order], gain=np.asarray(k_out)[order],
                     wind_mps=v[order], gain_margin=np.asarray(gm_out)[order],
                     loop_gain_1p=np.asarray(l1p)[order], dt=dt, rotor_speed_rad_s=om,
-                    highpass_hz=gains.highpass_hz, notch_harmonics=harm, notch_q=notch_q,
+                    highpass_hz=hp, notch_harmonics=harm, notch_q=notch_q,
                     weight_range=wr, rated_power=p_rated, power_fraction=frac,
                     lowpass_hz=lowpass_hz, info={"target_loop_gain_1p": loop_gain_1p,
                           "min_gain_margin": min_gain_margin})
@@ -431,14 +435,56 @@ def _gain_margin(loop: Any, k: float) -> float:
     return lo
 
 
-class IBCController:
+class _PitchAddOn:
+    """What IBC and Coleman IPC share: the collective controller underneath, the power
+    fade-in weight (power filtered over ``power_tau`` = 1 s), and pitch limits and rate on the
+    summed command. Subclasses reset their own state in ``_reset_own``."""
+
+    power_tau = 1.0
+
+    def __init__(self, collective: BaselineController, gains: Any) -> None:
+        self.collective = collective
+        self.gains = gains
+        self.dt = collective.dt
+        pa = collective.turbine.pitch_actuator
+        self.pitch_min, self.pitch_max = collective.pitch_min, pa.max_pitch_rad
+        self.step_max = pa.max_rate_rad_s * self.dt
+        self.reset()
+
+    def _reset_own(self) -> None:
+        pass
+
+    def reset(self) -> None:
+        """Forget filters, integrals, power filter and last commands (and reset the
+        collective)."""
+        self.collective.reset()
+        self._p_filt: float | None = None
+        self._last: np.ndarray | None = None
+        self.signals: dict[str, float] = {}
+        self._reset_own()
+
+    def _limit(self, cmd: np.ndarray, meas: dict[str, Any]) -> np.ndarray:
+        cmd = np.clip(cmd, self.pitch_min, self.pitch_max)
+        last = np.asarray(meas["pitch"], float) if self._last is None else self._last
+        cmd = np.clip(cmd, last - self.step_max, last + self.step_max)
+        self._last = cmd
+        return cmd
+
+    def _weight(self, meas: dict[str, Any]) -> float:
+        p = float(meas["gen_power"])
+        a = math.exp(-self.dt / self.power_tau)
+        self._p_filt = p if self._p_filt is None else a * self._p_filt + (1 - a) * p
+        return power_weight(self._p_filt, self.gains.rated_power, self.gains.weight_range)
+
+
+class IBCController(_PitchAddOn):
     """Individual blade control on top of a collective controller (Pettas and Cheng fig. 3).
 
     ``collective`` is the baseline (or derated baseline) that regulates rotor speed and power;
     this class adds the per-blade pitch w(P) BS(K(theta_mean) HP(M_i)) (less its mean over the
-    blades, see below) to its collective command
-    and enforces the pitch limits and rate on the sum. Signals: the collective's, plus
-    ``ibc_weight``, ``ibc_gain`` and ``ibc_pitch_1..3`` [rad].
+    blades, see below) to its collective command and enforces the pitch limits and rate on the
+    sum. Signals: the collective's, plus ``ibc_weight``, ``ibc_gain`` and ``ibc_pitch_1..3``
+    [rad].
 
     ``remove_collective=True`` (default) subtracts the blades' mean IBC pitch: the loops act on
     the cyclic content only and leave thrust and torque to the collective controller. The
@@ -454,38 +500,13 @@ class IBCController:
         if abs(collective.dt - gains.dt) > 1e-12:
             raise ValueError(f"IBC gains were designed for dt = {gains.dt:g} s, the collective "
                              f"controller runs at {collective.dt:g} s")
-        self.collective = collective
-        self.gains = gains
-        self.dt = collective.dt
         self._hp = SOSFilterBank(gains.input_sos(), 3)
         self._bs = SOSFilterBank(gains.output_sos(), 3)
-        pa = collective.turbine.pitch_actuator
-        self.pitch_min, self.pitch_max = collective.pitch_min, pa.max_pitch_rad
-        self.step_max = pa.max_rate_rad_s * self.dt
-        self._p_tau = 1.0            # power filter of the activation weight [s]
-        self.reset()
+        super().__init__(collective, gains)
 
-    def reset(self) -> None:
-        """Forget filters, power filter and last commands (and reset the collective)."""
-        self.collective.reset()
+    def _reset_own(self) -> None:
         self._hp.reset()
         self._bs.reset()
-        self._p_filt: float | None = None
-        self._last: np.ndarray | None = None
-        self.signals: dict[str, float] = {}
-
-    def _limit(self, cmd: np.ndarray, meas: dict[str, Any]) -> np.ndarray:
-        cmd = np.clip(cmd, self.pitch_min, self.pitch_max)
-        last = np.asarray(meas["pitch"], float) if self._last is None else self._last
-        cmd = np.clip(cmd, last - self.step_max, last + self.step_max)
-        self._last = cmd
-        return cmd
-
-    def _weight(self, meas: dict[str, Any]) -> float:
-        p = float(meas["gen_power"])
-        a = math.exp(-self.dt / self._p_tau)
-        self._p_filt = p if self._p_filt is None else a * self._p_filt + (1 - a) * p
-        return power_weight(self._p_filt, self.gains.rated_power, self.gains.weight_range)
 
     def step(self, t: float, meas: dict[str, Any]) -> tuple[np.ndarray, float]:
         """One control step; returns (pitch_ref (3,) [rad], gen_torque_ref [N m])."""
@@ -623,31 +644,15 @@ def tune_coleman_ipc(turbine: linearize.Turbine, *, winds: Any = None,
                            rated_power=p_rated, power_fraction=frac)
 
 
-class ColemanIPCController(IBCController):
+class ColemanIPCController(_PitchAddOn):
     """Coleman-frame integral IPC (tilt and yaw to zero) on top of a collective controller.
 
     Signals: the collective's, plus ``ipc_weight``, ``ipc_tilt_moment``, ``ipc_yaw_moment``
     [N m] and ``ipc_pitch_cos``, ``ipc_pitch_sin`` [rad].
     """
 
-    def __init__(self, collective: BaselineController,  # noqa: D107 - shares IBC's limits
-                 gains: ColemanIPCGains) -> None:
-        self.collective = collective
-        self.gains = gains
-        self.dt = collective.dt
-        pa = collective.turbine.pitch_actuator
-        self.pitch_min, self.pitch_max = collective.pitch_min, pa.max_pitch_rad
-        self.step_max = pa.max_rate_rad_s * self.dt
-        self._p_tau = 1.0
-        self.reset()
-
-    def reset(self) -> None:
-        """Forget the integral, power filter and last commands (and reset the collective)."""
-        self.collective.reset()
+    def _reset_own(self) -> None:
         self._theta_cs = np.zeros(2)
-        self._p_filt = None
-        self._last = None
-        self.signals = {}
 
     def step(self, t: float, meas: dict[str, Any]) -> tuple[np.ndarray, float]:
         """One control step; returns (pitch_ref (3,) [rad], gen_torque_ref [N m])."""
