@@ -13,6 +13,8 @@ lidar      CW LIDAR preview: ``lidar evaluate --field FIELD [--focus 54] [--json
 design     gain synthesis: ``design baseline|lqr|ts|ibc|coleman-ipc [...] --out DIR``
            (DIR/design.json + plot)
 export     gain tables: ``export DIR --format csv|json|mat|rosco``
+campaign   load-case campaigns on Dask: ``campaign run SPEC.yaml [--workers N | --scheduler
+           ADDR] [--out DIR]``, ``campaign status DIR``, ``campaign report DIR``
 
 Errors in the arguments or the turbine file print one line naming the parameter and the value
 to stderr and exit with status 2.
@@ -32,6 +34,8 @@ import numpy as np
 
 import linearize
 from linearize import OperatingPoint, TrimError, TurbineFileError
+
+from .campaign.store import CampaignLockedError
 
 __all__ = ["main", "parse_range"]
 
@@ -670,6 +674,32 @@ def _parser() -> argparse.ArgumentParser:
     q.add_argument("--plot", help="PNG of the solve times")
     q.set_defaults(func=_cmd_bench_mpc)
 
+    p = sub.add_parser("campaign", help="load-case campaigns (DLC 1.2) on Dask: run, status, "
+                                        "report")
+    camp = p.add_subparsers(dest="campaign_command", required=True)
+    q = camp.add_parser("run", help="run (or resume) a campaign spec")
+    q.add_argument("spec", help="campaign YAML file")
+    q.add_argument("--workers", type=int, default=None,
+                   help="local worker processes (default: one per core)")
+    q.add_argument("--scheduler", default=None,
+                   help="address of a running Dask scheduler, tcp://HOST:PORT")
+    q.add_argument("--out", default=None, help="campaign directory (default campaigns/NAME)")
+    q.add_argument("--engine", choices=("dask", "processes", "serial"), default="dask",
+                   help="dask (default), a plain process pool, or this process")
+    q.add_argument("--report", action="store_true", help="write the report when all cases "
+                                                         "finished")
+    q.add_argument("--quiet", action="store_true", help="no progress bar")
+    q.set_defaults(func=_cmd_campaign_run)
+    q = camp.add_parser("status", help="cases done, failed, pending of a campaign directory")
+    q.add_argument("dir")
+    q.add_argument("--failed", action="store_true", help="print the tracebacks of failed cases")
+    q.add_argument("--json", action="store_true")
+    q.set_defaults(func=_cmd_campaign_status)
+    q = camp.add_parser("report", help="tables (CSV, Markdown) and plots (PNG) of a campaign")
+    q.add_argument("dir")
+    q.add_argument("--out", default=None, help="report folder (default DIR/report)")
+    q.set_defaults(func=_cmd_campaign_report)
+
     p = sub.add_parser("aero", help="rotor aerodynamics")
     aero = p.add_subparsers(dest="aero_command", required=True)
     q = aero.add_parser("cp-surface", help="C_P(lambda, pitch) table and plot")
@@ -683,6 +713,88 @@ def _parser() -> argparse.ArgumentParser:
     return ap
 
 
+def _cmd_campaign_run(args: argparse.Namespace) -> int:
+    from .campaign import load_spec, run_campaign
+
+    spec = load_spec(args.spec)
+    if args.scheduler and args.workers:
+        raise UsageError("give --workers (local cluster) or --scheduler (running cluster), "
+                         "not both")
+    out = Path(args.out) if args.out else Path("campaigns") / spec.name
+    for name in ("distributed", "distributed.nanny", "distributed.scheduler",
+                 "distributed.core", "distributed.worker"):
+        logging.getLogger(name).setLevel(logging.ERROR)
+    log.info("campaign %s -> %s", spec.name, out)
+    s = run_campaign(spec, out, workers=args.workers, scheduler=args.scheduler,
+                     engine=args.engine, progress=not args.quiet)
+    print(f"campaign {spec.name}: {s.total} cases; {s.skipped} already finished, "
+          f"{s.done} done now ({s.reused} from files already written), {s.failed} failed; "
+          f"{s.wall_s:.0f} s wall, {s.cases_per_min:.2f} cases/min ({s.engine}, "
+          f"{'scheduler ' + args.scheduler if args.scheduler else f'{s.workers} workers'})")
+    print(f"  directory {out}")
+    for cid, err in s.failures[:10]:
+        print(f"  failed {cid}: {err.splitlines()[0] if err else ''}")
+    if s.failed:
+        print(f"  tracebacks: mpcwt campaign status {out} --failed; rerun the same command "
+              f"to retry failed cases")
+    if args.report and not s.failed:
+        from .campaign.report import make_report
+
+        rep = make_report(out)
+        print(f"  report {rep}")
+    return 1 if s.failed else 0
+
+
+def _cmd_campaign_status(args: argparse.Namespace) -> int:
+    from .campaign.store import CampaignStore
+
+    with CampaignStore(args.dir) as st:
+        meta = st.meta()
+        rows = st.rows()
+        counts = st.counts()
+        stray = st.stray_temp_files()
+    if args.json:
+        print(json.dumps({"meta": meta, "counts": counts,
+                          "cases": [{"case_id": r.case_id, "status": r.status,
+                                     "error": r.error, "wall_s": r.wall_s,
+                                     "software_version": r.software_version} for r in rows]},
+                         indent=1))
+        return 0
+    print(f"campaign {meta.get('name')} in {args.dir}: spec {str(meta.get('spec_hash'))[:12]}, "
+          f"last run {meta.get('last_run')}, mpc-wt {meta.get('software_version')}")
+    print("  " + ", ".join(f"{k} {v}" for k, v in counts.items() if v or k in ("done",
+                                                                              "pending")))
+    per: dict[str, list[int]] = {}
+    for r in rows:
+        d = per.setdefault(r.controller, [0, 0, 0])
+        d[0] += 1
+        d[1] += r.status == "done"
+        d[2] += r.status == "failed"
+    print(f"  {'controller':<24} {'done':>6} {'failed':>7} {'cases':>6}")
+    for k, (n, d, f) in per.items():
+        print(f"  {k:<24} {d:>6} {f:>7} {n:>6}")
+    versions = sorted({r.software_version for r in rows if r.software_version})
+    if len(versions) > 1:
+        print(f"  note: cases were computed by mpc-wt versions {versions}")
+    if stray:
+        print(f"  {len(stray)} temp files of interrupted writers in {Path(args.dir) / 'cases'} "
+              f"(safe to delete when no worker runs)")
+    for r in rows:
+        if r.status == "failed":
+            print(f"  failed {r.case_id}: {(r.error or '').splitlines()[0]}")
+            if args.failed and r.traceback:
+                print("    " + r.traceback.rstrip().replace("\n", "\n    "))
+    return 0
+
+
+def _cmd_campaign_report(args: argparse.Namespace) -> int:
+    from .campaign.report import make_report
+
+    rep = make_report(args.dir, out=args.out)
+    print(f"report {rep}")
+    return 0
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of ``mpcwt``; returns the exit status."""
     logging.basicConfig(level=logging.WARNING, format="%(levelname)s %(name)s: %(message)s")
@@ -694,7 +806,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     try:
         return int(args.func(args))
     except (UsageError, TurbineFileError, TrimError, FileNotFoundError, ValueError, KeyError,
-            linearize.LinearizationError) as err:
+            linearize.LinearizationError, CampaignLockedError) as err:
         print(f"mpcwt {args.command}: error: {err}", file=sys.stderr)
         return 2
 

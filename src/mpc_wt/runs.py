@@ -78,13 +78,18 @@ def _wind(turbine: linearize.Turbine, wind_mps: float, turbulence: str, seed: in
     return linearize.GridWind(t=f.t, y=f.y, z=f.z, u=np.maximum(f.u, 0.0)), f
 
 
+#: Designs kept per process: key -> (turbine kept alive so its id stays unique, design...).
+_DESIGNS: dict[tuple[str, int], tuple[Any, ...]] = {}
+
+
 def run_controller(turbine: linearize.Turbine, controller: str, wind_mps: float,
                    turbulence: str = "A", seed: int = 1, duration: float = 600.0,
                    progress: bool = False, shear_exponent: float = 0.2,
                    mpc_options: dict[str, Any] | None = None,
                    apc_frequency: float | None = None, apc_amplitude: float = 0.375,
                    apc_offset: float = 0.375,
-                   retrofit_options: dict[str, Any] | None = None) -> ClosedLoopResult:
+                   retrofit_options: dict[str, Any] | None = None,
+                   lidar_options: dict[str, Any] | None = None) -> ClosedLoopResult:
     """Trim, design the controller, generate the wind and simulate.
 
     ``controller``: "baseline" (tuned PI and torque law, 80 Hz), "mpc" (Madsen's 8-state
@@ -111,6 +116,11 @@ def run_controller(turbine: linearize.Turbine, controller: str, wind_mps: float,
     (both, IBC tuned on the derated points), "apc" (baseline following P_r (1 - Delta P(t)),
     ``apc_frequency`` required, pitch PI scheduled on the reference). ``retrofit_options``
     go to :func:`~mpc_wt.retrofit.tune_ibc` / :func:`~mpc_wt.retrofit.tune_coleman_ipc`.
+    ``lidar_options`` ("mpc-lidar" only) are :class:`lidar.CWLidar` settings (focus_distance,
+    noise_std, ...).
+
+    Designs that cost seconds (the TS model and its LMI gains) are kept per process for the
+    same turbine object, so a campaign worker designs once.
     """
     kind, frac, addon = parse_controller(controller)
     params = linearize.plant_params(turbine)
@@ -144,6 +154,8 @@ def run_controller(turbine: linearize.Turbine, controller: str, wind_mps: float,
     cdt = None
     if apc_frequency is not None and kind not in ("ts", "apc"):
         raise ValueError("apc_frequency applies to the 'ts' and 'apc' controllers only")
+    if lidar_options and kind != "mpc-lidar":
+        raise ValueError("lidar_options apply to the 'mpc-lidar' controller only")
     if retrofit_options and addon is None:
         raise ValueError("retrofit_options apply to the ibc and coleman-ipc controllers only")
     if kind == "lqr-pio":
@@ -158,8 +170,11 @@ def run_controller(turbine: linearize.Turbine, controller: str, wind_mps: float,
         from .retrofit import apc_reference
         from .ts import TSController, build_ts_model, design_ts_controller, design_ts_observer
 
-        ts = build_ts_model(turbine)
-        c, o = design_ts_controller(ts), design_ts_observer(ts)
+        key = ("ts", id(turbine))
+        if key not in _DESIGNS:
+            ts0 = build_ts_model(turbine)
+            _DESIGNS[key] = (turbine, ts0, design_ts_controller(ts0), design_ts_observer(ts0))
+        _, ts, c, o = _DESIGNS[key]
         ctl = TSController(ts, c, o, turbine, initial_wind=float(np.clip(
             wind_mps, ts.wind_grid[0], ts.wind_grid[-1])),
             power_reduction=None if apc_frequency is None else apc_reference(
@@ -241,7 +256,12 @@ def run_controller(turbine: linearize.Turbine, controller: str, wind_mps: float,
         if kind == "mpc-lidar":
             from .simulate import LidarPreview
 
-            preview = LidarPreview(lidar.CWLidar(turbine.geometry.tip_radius), field, hp, cdt)
+            try:
+                cw = lidar.CWLidar(turbine.geometry.tip_radius, **(lidar_options or {}))
+            except TypeError as err:
+                raise ValueError(f"lidar_options: {err}") from err
+            meta["lidar"] = dict(lidar_options or {})
+            preview = LidarPreview(cw, field, hp, cdt)
     return simulate_closed_loop(params, ctl, wind, duration, x0=op.x, u0=op.u,
                                 controller_dt=cdt, preview=preview, progress=progress, meta=meta)
 

@@ -16,6 +16,8 @@ from __future__ import annotations
 import json
 import logging
 import math
+import os
+import uuid
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Protocol
@@ -119,9 +121,13 @@ class ClosedLoopResult:
                         attrs={"schema_version": SCHEMA_VERSION, "software": "mpc-wt",
                                "software_version": __version__,
                                "meta_json": json.dumps(self.meta)})
-        tmp = path.with_suffix(path.suffix + ".tmp")
-        ds.to_netcdf(tmp, engine="scipy")
-        tmp.replace(path)
+        # a name of this writer's own: two writers of one case (a retried task) never share it
+        tmp = path.with_name(f".{path.name}.{os.getpid()}.{uuid.uuid4().hex[:8]}.tmp")
+        try:
+            ds.to_netcdf(tmp, engine="scipy")
+            tmp.replace(path)
+        finally:
+            tmp.unlink(missing_ok=True)
         return path
 
     @classmethod

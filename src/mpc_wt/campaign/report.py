@@ -1,0 +1,492 @@
+"""Aggregate a campaign into the papers' tables and figures.
+
+Per controller, turbulence and channel: short-term DELs per wind bin and seed; the DEL per bin
+over seeds (m-power mean of equal-length runs); the lifetime DEL, the m-power mean weighted by
+the wind distribution (Clemens et al. eq 18, :func:`mpc_wt.assess.lifetime_del`); AEP from the
+mean power per bin; pitch duty weighted the same way (Pettas and Cheng sec. 4); CS1-CS5 per bin
+(Do et al. eqs 21-26); lifetime extension for a retrofit after 15 of 20 years (Pettas and Cheng
+eq 1). Every comparison with the reference controller is made over the winds both ran.
+Tables go to CSV and Markdown, figures to PNG, and ``report.paper`` rows of the spec put our
+numbers next to the paper's.
+"""
+from __future__ import annotations
+
+import csv
+import math
+from collections import defaultdict
+from pathlib import Path
+from typing import Any, Sequence
+
+import numpy as np
+
+from ..assess import aep_Wh, cs_measures, lifetime_del, lifetime_extension, psd, \
+    wind_bin_probabilities
+from .spec import CampaignSpec, spec_from_dict, turbulence_tag
+from .store import CampaignStore, CaseRow
+
+__all__ = ["aggregate", "make_report"]
+
+_PITCH = ("pitch_travel_deg", "pitch_rate_std_degps", "pitch_acc_std_degps2")
+_CS = ("cs1", "cs2", "cs3", "cs4", "cs5")
+
+
+def _pct(a: float | None, b: float | None) -> float | None:
+    if a is None or b is None or not a or not math.isfinite(a) or not math.isfinite(b):
+        return None
+    return 100.0 * (b / a - 1.0)
+
+
+def _load(root: Path) -> tuple[CampaignSpec, list[CaseRow]]:
+    with CampaignStore(root) as st:
+        meta = st.meta()
+        rows = [r for r in st.rows() if r.status == "done" and r.metrics]
+    if "spec_raw" not in meta:
+        raise ValueError(f"{root}: the index holds no spec (was the campaign ever run?)")
+    spec = spec_from_dict(meta["spec_raw"])
+    if not rows:
+        raise ValueError(f"{root}: no finished case to report; run the campaign first "
+                         f"(mpcwt campaign run SPEC --out {root})")
+    return spec, rows
+
+
+def _probs(spec: CampaignSpec, winds: Sequence[float]) -> np.ndarray:
+    d = spec.wind_distribution
+    if d["kind"] == "rayleigh":
+        return wind_bin_probabilities(np.asarray(winds, float), "rayleigh", mean=d["mean"])
+    return wind_bin_probabilities(np.asarray(winds, float), "weibull", shape=d["shape"],
+                                  scale=d["scale"])
+
+
+def aggregate(root: str | Path) -> dict[str, Any]:
+    """All tables of a campaign directory as lists of row dicts (see the module docstring).
+
+    Raises
+    ------
+    ValueError
+        If no case has finished.
+    """
+    root = Path(root)
+    spec, rows = _load(root)
+    ref = spec.reference
+    by: dict[tuple[str, str], dict[float, list[CaseRow]]] = defaultdict(lambda: defaultdict(list))
+    for r in rows:
+        by[(r.controller, r.turbulence)][r.wind_mps].append(r)
+    order = [c.name for c in spec.controllers]
+    keys = sorted(by, key=lambda k: (order.index(k[0]) if k[0] in order else 99, k[1]))
+    chans = spec.channels
+    short, per_wind, life, aep, pitch, cs_rows, ext = [], [], [], [], [], [], []
+    incomplete = []
+
+    def bin_del(cases: list[CaseRow], ch: str, m: float) -> float | None:
+        d = [c.metrics["channels"][ch]["del"] for c in cases if ch in c.metrics["channels"]]
+        return float(np.mean(np.asarray(d) ** m) ** (1 / m)) if d else None
+
+    def bin_mean(cases: list[CaseRow], key: str) -> float | None:
+        v = [c.metrics.get(key) for c in cases if c.metrics.get(key) is not None]
+        return float(np.mean(v)) if v else None
+
+    for ctl, turb in keys:
+        bins = by[(ctl, turb)]
+        cs = spec.controller(ctl) if ctl in order else None
+        want = set((cs.winds if cs and cs.winds else spec.winds))
+        n_seed = len(cs.seeds if cs and cs.seeds else spec.seeds)
+        missing = sorted(v for v in want if len(bins.get(v, [])) < n_seed)
+        if missing:
+            incomplete.append(f"{ctl} ({turb}): winds {missing} lack seeds")
+        winds = sorted(bins)
+        rbins = by.get((ref, turb), {})
+        for v in winds:
+            for c in bins[v]:
+                for ch, m in chans.items():
+                    if ch in c.metrics["channels"]:
+                        short.append({"controller": ctl, "turbulence": turb, "wind_mps": v,
+                                      "seed": c.seed, "channel": ch, "m": m,
+                                      "del": c.metrics["channels"][ch]["del"]})
+            row = {"controller": ctl, "turbulence": turb, "wind_mps": v, "seeds": len(bins[v])}
+            for ch, m in chans.items():
+                d = bin_del(bins[v], ch, m)
+                row[ch] = d
+                row[f"{ch}_change_pct"] = _pct(bin_del(rbins[v], ch, m), d) if v in rbins \
+                    else None
+            per_wind.append(row)
+            crow = {"controller": ctl, "turbulence": turb, "wind_mps": v}
+            for k in _CS + ("power_mean_W", "power_std_W", "rotor_speed_std_rad_s") + _PITCH:
+                crow[k] = bin_mean(bins[v], k)
+                crow[f"{k}_change_pct"] = (_pct(bin_mean(rbins[v], k), crow[k])
+                                           if v in rbins else None)
+            cs_rows.append(crow)
+        common = [v for v in winds if v in rbins]
+        p_all = _probs(spec, winds)
+        p_com = _probs(spec, common) if common else None
+        for ch, m in chans.items():
+            d = [bin_del(bins[v], ch, m) for v in winds]
+            if any(x is None for x in d):
+                continue
+            lt = lifetime_del(d, m, p_all)
+            row = {"controller": ctl, "turbulence": turb, "channel": ch, "m": m,
+                   "winds": f"{winds[0]:g}-{winds[-1]:g}", "lifetime_del": lt,
+                   "lifetime_del_MNm": lt / 1e6,
+                   "change_pct": None, "ref_lifetime_del": None}
+            if common:
+                mine = lifetime_del([bin_del(bins[v], ch, m) for v in common], m, p_com)
+                base = lifetime_del([bin_del(rbins[v], ch, m) for v in common], m, p_com)
+                row["change_pct"] = 0.0 if ctl == ref else _pct(base, mine)
+                row["ref_lifetime_del"] = base
+                if ctl != ref and base > 0:
+                    e = lifetime_extension(base, mine, m, t_base=15.0, t_upd=5.0,
+                                           t_lifetime=spec.lifetime_years)
+                    ext.append({"controller": ctl, "turbulence": turb, "channel": ch, "m": m,
+                                "damage_15_5": e["damage"],
+                                "extension_years": e["extension_years"]})
+            life.append(row)
+        pw = [bin_mean(bins[v], "power_mean_W") for v in winds]
+        if all(x is not None for x in pw):
+            row = {"controller": ctl, "turbulence": turb,
+                   "aep_MWh": aep_Wh(pw, p_all) / 1e6, "change_pct": None}
+            if common:
+                a = aep_Wh([bin_mean(bins[v], "power_mean_W") for v in common], p_com)
+                b = aep_Wh([bin_mean(rbins[v], "power_mean_W") for v in common], p_com)
+                row["change_pct"] = _pct(b, a)
+            aep.append(row)
+        prow: dict[str, Any] = {"controller": ctl, "turbulence": turb}
+        for k in _PITCH:
+            vals = [bin_mean(bins[v], k) for v in winds]
+            if all(x is not None for x in vals):
+                prow[k] = float(np.sum(p_all * np.asarray(vals)) / p_all.sum())
+                if common:
+                    mine = np.sum(p_com * np.asarray([bin_mean(bins[v], k) for v in common]))
+                    base = np.sum(p_com * np.asarray([bin_mean(rbins[v], k) for v in common]))
+                    prow[f"{k}_change_pct"] = _pct(float(base), float(mine))
+        pitch.append(prow)
+    sweep = []
+    for c in spec.controllers:
+        f = c.options.get("apc_frequency")
+        if f is None:
+            continue
+        for r in life:
+            if r["controller"] == c.name:
+                sweep.append({"controller": c.name, "apc_frequency_Hz": f, **{
+                    k: r[k] for k in ("turbulence", "channel", "lifetime_del", "change_pct")}})
+    return {"spec": spec, "rows": rows, "short_term": short, "per_wind": per_wind,
+            "lifetime": life, "aep": aep, "pitch": pitch, "cs": cs_rows, "extension": ext,
+            "sweep": sweep, "incomplete": incomplete}
+
+
+# -- paper comparison -------------------------------------------------------------------------
+def _ours(agg: dict[str, Any], p: dict[str, Any]) -> float | None:
+    spec: CampaignSpec = agg["spec"]
+    turb = str(p.get("turbulence", spec.turbulence[0]))
+    ctl, metric = p["controller"], p["metric"]
+
+    def pick(table: str, **kw: Any) -> dict[str, Any] | None:
+        for r in agg[table]:
+            if r["controller"] == ctl and r["turbulence"] == turb and all(
+                    r.get(k) == v for k, v in kw.items()):
+                return r
+        return None
+
+    if metric == "del_change_pct":
+        r = pick("per_wind", wind_mps=float(p["wind"]))
+        return r.get(f"{p['channel']}_change_pct") if r else None
+    if metric == "lifetime_del_change_pct":
+        r = pick("lifetime", channel=p["channel"])
+        return r["change_pct"] if r else None
+    if metric == "aep_change_pct":
+        r = pick("aep")
+        return r["change_pct"] if r else None
+    if metric == "extension_years":
+        r = pick("extension", channel=p["channel"])
+        return r["extension_years"] if r else None
+    if metric == "pitch_change_pct":
+        r = pick("pitch")
+        return r.get(f"{p.get('measure', 'pitch_travel_deg')}_change_pct") if r else None
+    if metric == "cs_change_pct":
+        r = pick("cs", wind_mps=float(p["wind"]))
+        return r.get(f"{p.get('measure', 'cs1')}_change_pct") if r else None
+    r = pick("cs", wind_mps=float(p["wind"])) if "wind" in p else None
+    return r.get(p.get("measure", "")) if r else None
+
+
+def _agree(ours: float | None, paper: float) -> str:
+    if ours is None or not math.isfinite(ours):
+        return "n/a"
+    if abs(paper) < 1.0 and abs(ours) < 1.0:
+        return "yes"
+    return "yes" if np.sign(ours) == np.sign(paper) else "**no**"
+
+
+# -- output -----------------------------------------------------------------------------------
+def _fmt(v: Any) -> str:
+    if v is None:
+        return "-"
+    if isinstance(v, float):
+        if not math.isfinite(v):
+            return str(v)
+        a = abs(v)
+        return f"{v:.3g}" if a >= 1e4 or (a < 0.01 and a > 0) else f"{v:.2f}"
+    return str(v)
+
+
+def _write_csv(path: Path, rows: list[dict[str, Any]]) -> None:
+    cols: list[str] = []
+    for r in rows:
+        cols += [k for k in r if k not in cols]
+    tmp = path.with_suffix(".csv.tmp")
+    with tmp.open("w", newline="") as fh:
+        w = csv.DictWriter(fh, fieldnames=cols)
+        w.writeheader()
+        for r in rows:
+            w.writerow({k: ("" if r.get(k) is None else r.get(k)) for k in cols})
+    tmp.replace(path)
+
+
+def _md(rows: list[dict[str, Any]], cols: Sequence[str], heads: Sequence[str] | None = None
+        ) -> str:
+    if not rows:
+        return "_none_\n"
+    heads = list(heads or cols)
+    out = ["| " + " | ".join(heads) + " |", "|" + "---|" * len(heads)]
+    for r in rows:
+        out.append("| " + " | ".join(_fmt(r.get(c)) for c in cols) + " |")
+    return "\n".join(out) + "\n"
+
+
+def _plots(agg: dict[str, Any], root: Path, out: Path) -> list[str]:
+    from ..plotting import _plt, _save, plot_cs_ellipses
+    from ..simulate import ClosedLoopResult
+
+    plt = _plt()
+    spec: CampaignSpec = agg["spec"]
+    made = []
+    chans = list(spec.channels)
+    ctls = list(dict.fromkeys(r["controller"] for r in agg["per_wind"]))
+    turbs = list(dict.fromkeys(r["turbulence"] for r in agg["per_wind"]))
+    # DEL vs mean wind per controller (Clemens fig. 6 / Pettas fig. 4 layout)
+    nc = min(3, len(chans))
+    nr = math.ceil(len(chans) / nc)
+    fig, axs = plt.subplots(nr, nc, figsize=(4.2 * nc, 3.0 * nr), dpi=110, squeeze=False)
+    for ax, ch in zip(axs.flat, chans):
+        for k, ctl in enumerate(ctls):
+            for j, turb in enumerate(turbs):
+                pts = [(r["wind_mps"], r[ch]) for r in agg["per_wind"]
+                       if r["controller"] == ctl and r["turbulence"] == turb and r.get(ch)]
+                if not pts:
+                    continue
+                v, d = np.array(pts).T
+                lab = ctl if len(turbs) == 1 else f"{ctl} ({turb})"
+                ax.plot(v, d / 1e6, "o-" if j == 0 else "s--", color=f"C{k}", ms=3, lw=1.2,
+                        label=lab)
+                sv = [(r["wind_mps"], r["del"]) for r in agg["short_term"]
+                      if r["controller"] == ctl and r["turbulence"] == turb
+                      and r["channel"] == ch]
+                if sv:
+                    a, b = np.array(sv).T
+                    ax.plot(a, b / 1e6, ".", color=f"C{k}", ms=2, alpha=0.4)
+        ax.set_title(f"{ch} (m = {spec.channels[ch]:g})", fontsize=8)
+        ax.set_xlabel("mean wind [m/s]", fontsize=8)
+        ax.set_ylabel("DEL [MN m]", fontsize=8)
+        ax.grid(alpha=0.3)
+    for ax in list(axs.flat)[len(chans):]:
+        ax.axis("off")
+    axs.flat[0].legend(fontsize=6)
+    made.append(str(_save(fig, out / "del_vs_wind.png")))
+    # lifetime DEL change bars (Pettas fig. 5 / Clemens fig. 7 layout)
+    others = [c for c in ctls if c != spec.reference]
+    if others:
+        fig, ax = plt.subplots(figsize=(max(6.0, 0.6 * len(chans) * max(1, len(others))), 4.0),
+                               dpi=110)
+        w = 0.8 / (len(others) * len(turbs))
+        i = 0
+        for ctl in others:
+            for turb in turbs:
+                vals = []
+                for ch in chans:
+                    r = next((x for x in agg["lifetime"] if x["controller"] == ctl
+                              and x["turbulence"] == turb and x["channel"] == ch), None)
+                    vals.append(r["change_pct"] if r and r["change_pct"] is not None
+                                else np.nan)
+                lab = ctl if len(turbs) == 1 else f"{ctl} ({turb})"
+                ax.bar(np.arange(len(chans)) + (i - (len(others) * len(turbs) - 1) / 2) * w,
+                       vals, w, label=lab, color=f"C{ctls.index(ctl)}",
+                       alpha=1.0 if turbs.index(turb) == 0 else 0.55)
+                i += 1
+        ax.axhline(0, color="k", lw=0.8)
+        ax.set_xticks(np.arange(len(chans)))
+        ax.set_xticklabels(chans, rotation=35, ha="right", fontsize=7)
+        ax.set_ylabel(f"lifetime DEL change vs {spec.reference} [%]")
+        ax.legend(fontsize=7)
+        ax.grid(alpha=0.3, axis="y")
+        made.append(str(_save(fig, out / "lifetime_del.png")))
+    # CS ellipses and PSDs at one wind (Do fig. 4 / Madsen fig. 8)
+    winds = sorted({r.wind_mps for r in agg["rows"]})
+
+    def near(target: float) -> float:
+        return min(winds, key=lambda v: abs(v - target))
+
+    cs_w = near(float(spec.report.get("cs_wind", 18.0)))
+    psd_w = near(float(spec.report.get("psd_wind", 18.0)))
+    series: dict[tuple[str, float], list[tuple[np.ndarray, dict[str, np.ndarray]]]] = \
+        defaultdict(list)
+    turb0 = turbs[0]
+    for r in agg["rows"]:
+        if r.turbulence == turb0 and r.wind_mps in (cs_w, psd_w) and r.file:
+            try:
+                res = ClosedLoopResult.load(root / r.file)
+            except Exception:  # noqa: BLE001 - a lost file only drops it from the plot
+                continue
+            k = res.t >= res.t[0] + spec.transient
+            series[(r.controller, r.wind_mps)].append(
+                (res.t[k], {n: res.channel(n)[k] for n in ("tower_base_fa_moment", "gen_power",
+                                                            "flap_moment_1", "rotor_speed")}))
+    items = []
+    for ctl in ctls:
+        runs = series.get((ctl, cs_w), [])
+        if runs:
+            load = np.concatenate([c["tower_base_fa_moment"] for _, c in runs])
+            powr = np.concatenate([c["gen_power"] for _, c in runs])
+            items.append((ctl, cs_measures(load, powr), load, powr))
+    if items:
+        made.append(str(plot_cs_ellipses(items, out / "cs_ellipses.png")))
+    fig, axs = plt.subplots(1, 2, figsize=(11, 4.0), dpi=110)
+    frot = None
+    for k, ctl in enumerate(ctls):
+        runs = series.get((ctl, psd_w), [])
+        for ax, ch in zip(axs, ("flap_moment_1", "tower_base_fa_moment")):
+            spectra = []
+            for t, c in runs:
+                fs = 1.0 / float(np.median(np.diff(t)))
+                spectra.append(psd(c[ch], fs, nperseg=min(8192, t.size)))
+                frot = float(c["rotor_speed"].mean()) / (2 * math.pi)
+            if spectra:
+                f = spectra[0][0]
+                p = np.mean([s[1] for s in spectra if s[1].shape == spectra[0][1].shape], axis=0)
+                ax.loglog(f[1:], p[1:], lw=0.9, color=f"C{k}", label=ctl)
+    for ax, ch in zip(axs, ("blade-1 flap moment", "tower-base fore-aft moment")):
+        if frot:
+            for n in (1, 3, 6):
+                ax.axvline(n * frot, color="0.5", ls=":", lw=0.8)
+        ax.set_title(f"{ch}, {psd_w:g} m/s ({turb0}), mean over seeds", fontsize=9)
+        ax.set_xlabel("frequency [Hz]")
+        ax.set_ylabel("PSD [(N m)^2/Hz]")
+        ax.grid(alpha=0.3, which="both")
+        ax.legend(fontsize=7)
+    made.append(str(_save(fig, out / "psd.png")))
+    if agg["sweep"]:
+        fig, ax = plt.subplots(figsize=(6.5, 4.0), dpi=110)
+        for j, ch in enumerate(chans):
+            pts = sorted((r["apc_frequency_Hz"], r["change_pct"]) for r in agg["sweep"]
+                         if r["channel"] == ch and r["turbulence"] == turb0
+                         and r["change_pct"] is not None)
+            if pts:
+                f, c = np.array(pts).T
+                ax.plot(f, c, "o-", color=f"C{j % 10}", label=ch, ms=4)
+        ax.axhline(0, color="k", lw=0.8)
+        ax.set_xlabel("APC frequency f_r [Hz]")
+        ax.set_ylabel(f"lifetime DEL change vs {spec.reference} [%]")
+        ax.set_title("Lifetime DEL against APC frequency (Clemens fig. 8 layout)", fontsize=9)
+        ax.legend(fontsize=6, ncol=2)
+        ax.grid(alpha=0.3)
+        made.append(str(_save(fig, out / "apc_sweep.png")))
+    return made
+
+
+def make_report(root: str | Path, out: str | Path | None = None) -> Path:
+    """Write the tables (CSV), the plots (PNG) and ``report.md`` of a campaign directory.
+
+    Returns the path of ``report.md``.
+
+    Raises
+    ------
+    ValueError
+        If no case has finished.
+    FileNotFoundError
+        If ``root`` is not a campaign directory.
+    """
+    from .. import __version__
+
+    root = Path(root)
+    agg = aggregate(root)
+    spec: CampaignSpec = agg["spec"]
+    out = Path(out) if out else root / "report"
+    out.mkdir(parents=True, exist_ok=True)
+    for name in ("short_term", "per_wind", "lifetime", "aep", "pitch", "cs", "extension",
+                 "sweep"):
+        if agg[name]:
+            fname = {"short_term": "short_term_del", "per_wind": "del_by_wind",
+                     "lifetime": "lifetime_del"}.get(name, name)
+            _write_csv(out / f"{fname}.csv", agg[name])
+    plots = _plots(agg, root, out)
+    paper = []
+    for p in spec.report.get("paper", []) or []:
+        ours = _ours(agg, p)
+        where = p.get("channel") or p.get("measure") or ""
+        paper.append({"what": f"{p['metric']} {where}".strip(), "controller": p["controller"],
+                      "wind": p.get("wind", "lifetime"),
+                      "turbulence": p.get("turbulence", spec.turbulence[0]),
+                      "paper": float(p["value"]), "ours": ours,
+                      "direction_agrees": _agree(ours, float(p["value"])),
+                      "source": p.get("source", ""), "note": p.get("note", "")})
+    if paper:
+        _write_csv(out / "paper_comparison.csv", paper)
+    n_rows = len(agg["rows"])
+    versions = sorted({r.software_version for r in agg["rows"] if r.software_version})
+    md = [f"# {spec.report.get('title', 'Campaign ' + spec.name)}", ""]
+    if spec.description:
+        md += [spec.description.strip(), ""]
+    md += [f"Generated by `mpcwt campaign report` (mpc-wt {__version__}; cases computed by "
+           f"{', '.join(versions)}) from {n_rows} finished cases. Turbine {spec.turbine}; "
+           f"{spec.duration:g} s per case after a {spec.transient:g} s transient; turbulence "
+           f"{', '.join(turbulence_tag(t) for t in spec.turbulence)}; shear "
+           f"{spec.shear_exponent:g}; seeds {list(spec.seeds)}; wind distribution "
+           f"{spec.wind_distribution}; lifetime {spec.lifetime_years:g} years; reference "
+           f"controller `{spec.reference}`.", ""]
+    if agg["incomplete"]:
+        md += ["**Incomplete:** " + "; ".join(agg["incomplete"]) + " (failed or not run; "
+               "`mpcwt campaign status` lists them).", ""]
+    if paper:
+        md += ["## Ours next to the paper", "",
+               _md(paper, ["what", "controller", "wind", "turbulence", "paper", "ours",
+                           "direction_agrees", "source"],
+                   ["quantity", "controller", "wind [m/s]", "turbulence", "paper", "ours",
+                    "same direction", "source"]), ""]
+    if spec.report.get("notes"):
+        md += ["## Where we differ, and why", "", str(spec.report["notes"]).strip(), ""]
+    md += ["## Lifetime DEL", "", "m-power mean over the wind bins weighted by the wind "
+           "distribution (Clemens eq 18); change against the reference over the winds both ran.",
+           "", _md(agg["lifetime"], ["controller", "turbulence", "channel", "m", "winds",
+                                     "lifetime_del_MNm", "change_pct"],
+                   ["controller", "turbulence", "channel", "m", "winds [m/s]",
+                    "lifetime DEL [MN m]", "change [%]"]), "", "![lifetime DEL](lifetime_del.png)",
+           "", "## DEL per mean wind", "", "![DEL vs wind](del_vs_wind.png)", "",
+           "Per wind and channel (m-power mean over seeds) in `del_by_wind.csv`; per seed in "
+           "`short_term_del.csv`.", ""]
+    md += ["## Energy and pitch", "",
+           _md(agg["aep"], ["controller", "turbulence", "aep_MWh", "change_pct"],
+               ["controller", "turbulence", "AEP [MWh]", "change [%]"]), "",
+           _md(agg["pitch"], ["controller", "turbulence", *_PITCH,
+                              *[f"{k}_change_pct" for k in _PITCH]],
+               ["controller", "turbulence", "travel [deg/run]", "rate std [deg/s]",
+                "acc std [deg/s^2]", "travel [%]", "rate std [%]", "acc std [%]"]), ""]
+    if agg["extension"]:
+        md += ["## Lifetime extension (retrofit after 15 years, 5 more at the new rate; "
+               "Pettas and Cheng eq 1)", "",
+               _md(agg["extension"], ["controller", "turbulence", "channel", "m",
+                                      "damage_15_5", "extension_years"],
+                   ["controller", "turbulence", "channel", "m", "damage after 20 y",
+                    "extension [years]"]), ""]
+    md += ["## CS1-CS5 per wind (Do et al.)", "",
+           _md(agg["cs"], ["controller", "turbulence", "wind_mps", "cs1", "cs2", "cs3", "cs4",
+                           "cs5", "cs1_change_pct", "cs2_change_pct"],
+               ["controller", "turbulence", "wind [m/s]", "CS1 [N m]", "CS2 [W]", "CS3 [N m]",
+                "CS4 [W]", "CS5 [deg]", "CS1 [%]", "CS2 [%]"]), "",
+           "![CS ellipses](cs_ellipses.png)", "", "![PSD](psd.png)", ""]
+    if agg["sweep"]:
+        md += ["## APC frequency sweep", "", "![APC sweep](apc_sweep.png)", "",
+               _md([r for r in agg["sweep"]], ["controller", "apc_frequency_Hz", "turbulence",
+                                               "channel", "lifetime_del", "change_pct"]), ""]
+    md += ["Plots: " + ", ".join(Path(p).name for p in plots), ""]
+    path = out / "report.md"
+    tmp = path.with_suffix(".md.tmp")
+    tmp.write_text("\n".join(md))
+    tmp.replace(path)
+    return path

@@ -1,0 +1,283 @@
+"""Run a campaign on Dask (``dask.distributed``), a plain process pool or in this process.
+
+The default engine is Dask: a :class:`distributed.LocalCluster` sized to the machine (one
+single-threaded worker process per core), or any running cluster given by its scheduler
+address (``tcp://HOST:PORT``; ``dask scheduler`` + ``dask worker``, or dask-jobqueue on SLURM).
+Dask schedules; we only submit one pure task per case (:func:`~mpc_wt.campaign.task.run_case`)
+and commit each result to the index as it arrives. A worker that dies mid-case has its case
+re-run by Dask on another worker; a client that dies loses only the cases in flight, and a
+case whose file landed before the client died is picked up without simulating again.
+
+The process-pool engine (``concurrent.futures``) exists to measure Dask's overhead against
+(benchmarks/bench_campaign.py) and for machines without the ``dask`` extra; a worker killed
+there breaks the pool and the cases in flight are recorded failed (rerun them).
+"""
+from __future__ import annotations
+
+import concurrent.futures as cf
+import logging
+import os
+import time
+import traceback
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Callable
+
+from .spec import CampaignSpec
+from .store import CampaignStore
+from .task import run_case
+
+__all__ = ["run_campaign", "RunSummary", "ENGINES"]
+
+log = logging.getLogger(__name__)
+
+ENGINES = ("dask", "processes", "serial")
+
+
+@dataclass
+class RunSummary:
+    """What one ``run_campaign`` call did."""
+
+    total: int
+    skipped: int
+    submitted: int
+    done: int = 0
+    failed: int = 0
+    reused: int = 0
+    wall_s: float = 0.0
+    engine: str = "dask"
+    workers: int = 0
+    sync: dict[str, int] = field(default_factory=dict)
+    failures: list[tuple[str, str]] = field(default_factory=list)
+
+    @property
+    def cases_per_min(self) -> float:
+        """Simulated cases per minute of wall time (reused files not counted)."""
+        n = self.done - self.reused
+        return 60.0 * n / self.wall_s if self.wall_s > 0 else 0.0
+
+
+def _workers(workers: int | None) -> int:
+    if workers is None:
+        return max(1, len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity")
+                   else (os.cpu_count() or 1))
+    if isinstance(workers, bool) or not isinstance(workers, int) or workers < 1:
+        raise ValueError(f"workers must be an integer >= 1, got {workers!r}")
+    return workers
+
+
+def _dask_import() -> Any:
+    try:
+        import distributed
+    except ImportError as err:  # pragma: no cover - depends on the extra
+        raise ImportError("the dask engine needs the 'dask' extra: pip install 'mpc-wt[dask]' "
+                          "(or use engine='processes')") from err
+    return distributed
+
+
+def run_campaign(spec: CampaignSpec, out: str | Path, *, workers: int | None = None,
+                 scheduler: str | None = None, engine: str = "dask", progress: bool = True,
+                 on_result: Callable[[str, dict[str, Any]], None] | None = None) -> RunSummary:
+    """Run every case of ``spec`` that is not finished in the campaign directory ``out``.
+
+    Parameters
+    ----------
+    spec : CampaignSpec
+    out : path
+        Campaign directory (created). Must be visible to every worker (shared file system).
+    workers : int, optional
+        Worker processes of a local cluster or pool (default: the cores of this machine).
+    scheduler : str, optional
+        Address of a running Dask scheduler (``tcp://HOST:PORT``); ``workers`` is then ignored.
+    engine : {"dask", "processes", "serial"}
+    progress : bool
+        A progress bar: cases done, running, failed and the ETA.
+    on_result : callable(case_id, outcome), optional
+        Called after each case is committed (tests use it to interrupt).
+
+    Returns
+    -------
+    RunSummary
+
+    Raises
+    ------
+    ValueError
+        Unknown engine, bad worker count, ``scheduler`` with an engine other than dask.
+    CampaignLockedError
+        Another client runs the same directory.
+    """
+    if engine not in ENGINES:
+        raise ValueError(f"engine must be one of {ENGINES}, got {engine!r}")
+    if scheduler is not None and engine != "dask":
+        raise ValueError(f"scheduler {scheduler!r} needs engine='dask', got {engine!r}")
+    if scheduler is not None and not str(scheduler).startswith(("tcp://", "tls://",
+                                                                "inproc://", "ws://")):
+        raise ValueError(f"scheduler must be an address like tcp://HOST:PORT, got {scheduler!r}")
+    n_workers = 1 if engine == "serial" else _workers(workers)
+    out = Path(out)
+    t_start = time.perf_counter()
+    with CampaignStore(out, lock=True) as store:
+        from .. import __version__
+
+        if spec.source and Path(spec.source).is_file():
+            (out / "spec.yaml").write_text(Path(spec.source).read_text())
+        else:
+            import yaml
+
+            (out / "spec.yaml").write_text(yaml.safe_dump(spec.raw, sort_keys=False))
+        store.set_meta(name=spec.name, spec_hash=spec.spec_hash, software_version=__version__,
+                       spec_raw={**spec.raw, "turbine": spec.turbine},
+                       reference=spec.reference, last_run=time.strftime("%Y-%m-%dT%H:%M:%S"))
+        sync = store.sync(spec)
+        todo = store.todo()
+        total = len(spec.cases())
+        summary = RunSummary(total=total, skipped=total - len(todo), submitted=len(todo),
+                             engine=engine, workers=n_workers, sync=sync)
+        log.info("campaign %s: %d cases, %d finished, %d to run (%s)", spec.name, total,
+                 summary.skipped, len(todo), sync)
+        if not todo:
+            return summary
+        bar = _Bar(len(todo), spec.name, progress)
+        spec_hash = spec.spec_hash
+
+        def commit(case_id: str, outcome: dict[str, Any]) -> None:
+            store.record(case_id, outcome, spec_hash)
+            if outcome["status"] == "done":
+                summary.done += 1
+                summary.reused += bool(outcome.get("reused"))
+            else:
+                summary.failed += 1
+                summary.failures.append((case_id, outcome.get("error", "")))
+                log.warning("case %s failed: %s", case_id, outcome.get("error"))
+            bar.step(outcome["status"] == "done")
+            if on_result is not None:
+                on_result(case_id, outcome)
+
+        store.mark_submitted(c.case_id for c in todo)
+        root = str(out.resolve())
+        try:
+            if engine == "serial":
+                for c in todo:
+                    bar.running(1)
+                    commit(c.case_id, run_case(c.to_dict(), root))
+            elif engine == "processes":
+                _run_pool(todo, root, n_workers, commit, bar)
+            else:
+                _run_dask(todo, root, n_workers, scheduler, commit, bar)
+        finally:
+            bar.close()
+            summary.wall_s = time.perf_counter() - t_start
+        return summary
+
+
+def _failed(case_id: str, err: BaseException, tb: str | None = None) -> dict[str, Any]:
+    return {"case_id": case_id, "status": "failed", "error": f"{type(err).__name__}: {err}",
+            "traceback": tb or "".join(traceback.format_exception(err)), "worker": None}
+
+
+def _run_pool(todo: list[Any], root: str, n: int, commit: Callable[..., None],
+              bar: "_Bar") -> None:
+    import multiprocessing as mp
+
+    with cf.ProcessPoolExecutor(max_workers=n, mp_context=mp.get_context("spawn")) as ex:
+        futs = {ex.submit(run_case, c.to_dict(), root): c.case_id for c in todo}
+        pending = set(futs)
+        while pending:
+            bar.running(min(n, len(pending)))
+            done, pending = cf.wait(pending, timeout=1.0, return_when=cf.FIRST_COMPLETED)
+            for f in done:
+                try:
+                    commit(futs[f], f.result())
+                except Exception as err:  # noqa: BLE001 - a broken pool fails its cases
+                    commit(futs[f], _failed(futs[f], err))
+
+
+def _run_dask(todo: list[Any], root: str, n: int, scheduler: str | None,
+              commit: Callable[..., None], bar: "_Bar") -> None:
+    distributed = _dask_import()
+    cluster = None
+    if scheduler is None:
+        import dask
+
+        dask.config.set({"distributed.scheduler.worker-saturation": 1.0})
+        cluster = distributed.LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
+                                           dashboard_address=None, host="127.0.0.1")
+        client = distributed.Client(cluster)
+    else:
+        client = distributed.Client(scheduler, timeout="30s")
+    try:
+        futs = {}
+        for c in todo:
+            # the key carries the case and its inputs' hash: a restarted client that finds the
+            # same task still on the scheduler attaches to it instead of running it twice
+            key = f"mpcwt-{c.case_id}-{c.case_hash[:12]}-{c.assess_hash[:6]}"
+            futs[client.submit(run_case, c.to_dict(), root, key=key, pure=False)] = c.case_id
+        pending = set(futs)
+        while pending:
+            bar.running(_dask_running(client, pending))
+            try:
+                res = distributed.wait(list(pending), timeout=1.0,
+                                       return_when="FIRST_COMPLETED")
+                done = set(res.done)
+            except TimeoutError:
+                continue
+            for f in done:
+                pending.discard(f)
+                cid = futs[f]
+                if f.status == "finished":
+                    commit(cid, f.result())
+                else:   # the task itself never raises: this is a lost worker (KilledWorker)
+                    err = f.exception()
+                    tb = f.traceback()
+                    commit(cid, _failed(cid, err, "".join(traceback.format_tb(tb))
+                                        if tb else None))
+                f.release()
+    finally:
+        client.close()
+        if cluster is not None:
+            cluster.close()
+
+
+def _dask_running(client: Any, pending: set[Any]) -> int:
+    """Cases executing now: tasks processing on a worker, capped at its thread count."""
+    try:
+        proc = client.processing()
+        threads = client.nthreads()
+    except Exception:  # noqa: BLE001 - the bar is informative only
+        return 0
+    keys = {f.key for f in pending}
+    return sum(min(threads.get(w, 1), sum(1 for k in ks if k in keys))
+               for w, ks in proc.items())
+
+
+class _Bar:
+    """tqdm bar: done / running / failed and the ETA (silent when ``enabled`` is False)."""
+
+    def __init__(self, total: int, name: str, enabled: bool) -> None:
+        self.failed = 0
+        self.run = 0
+        self.bar = None
+        if enabled:
+            from tqdm import tqdm
+
+            self.bar = tqdm(total=total, desc=f"campaign {name}", unit="case", smoothing=0.1)
+            self._post()
+
+    def _post(self) -> None:
+        if self.bar is not None:
+            self.bar.set_postfix_str(f"running {self.run}, failed {self.failed}", refresh=True)
+
+    def running(self, n: int) -> None:
+        if n != self.run:
+            self.run = n
+            self._post()
+
+    def step(self, ok: bool) -> None:
+        self.failed += not ok
+        if self.bar is not None:
+            self.bar.update(1)
+            self._post()
+
+    def close(self) -> None:
+        if self.bar is not None:
+            self.bar.close()

@@ -1,0 +1,495 @@
+"""Campaign specification: a YAML file naming the turbine, the controllers, the load case grid
+(mean winds x turbulence x seeds, IEC DLC 1.2 style), the load channels with their Woehler
+exponents, the wind distribution and the lifetime; validated on load (errors name the key).
+
+A campaign expands into *cases*, one simulation each. A case's hash covers only what its
+simulation depends on (turbine files, controller settings, wind, seed, turbulence, duration,
+shear, LIDAR), so editing the spec invalidates only the cases it touches; its *assessment*
+hash covers the channels and the discarded transient, which are recomputed from the stored
+time series without simulating again.
+"""
+from __future__ import annotations
+
+import copy
+import hashlib
+import json
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Mapping
+
+import yaml
+
+__all__ = ["SpecError", "CampaignSpec", "ControllerSpec", "Case", "load_spec", "spec_from_dict"]
+
+
+class SpecError(ValueError):
+    """A campaign spec that cannot be used; the message names the key and what is allowed."""
+
+
+_TOP_KEYS = {"name": "str", "description": "str", "turbine": "str", "duration": "number",
+             "transient": "number", "turbulence": "list", "shear_exponent": "number",
+             "winds": "list", "seeds": "list", "lidar": "dict", "controllers": "list",
+             "channels": "dict", "wind_distribution": "dict", "lifetime_years": "number",
+             "reference": "str", "report": "dict"}
+_CONTROLLER_KEYS = {"name", "controller", "mpc_options", "retrofit_options", "apc_frequency",
+                    "apc_amplitude", "apc_offset", "lidar", "winds", "seeds", "turbulence",
+                    "label"}
+_LIDAR_KEYS = {"focus_distance", "span_fraction", "wavelength", "beam_radius", "sample_rate",
+               "noise_std", "misalignment_rad", "perfect_alignment", "los_error",
+               "range_weighting", "n_range"}
+_REPORT_KEYS = {"paper", "notes", "psd_wind", "cs_wind", "sweep", "title"}
+
+
+def _fail(key: str, msg: str) -> SpecError:
+    return SpecError(f"campaign spec: {key}: {msg}")
+
+
+def _number(key: str, val: Any, lo: float | None = None, hi: float | None = None,
+            lo_open: bool = False) -> float:
+    if isinstance(val, bool) or not isinstance(val, (int, float)) or not math.isfinite(val):
+        raise _fail(key, f"must be a finite number, got {val!r}")
+    x = float(val)
+    if lo is not None and (x <= lo if lo_open else x < lo):
+        raise _fail(key, f"must be {'>' if lo_open else '>='} {lo:g}, got {x:g}")
+    if hi is not None and x > hi:
+        raise _fail(key, f"must be <= {hi:g}, got {x:g}")
+    return x
+
+
+def _winds(key: str, val: Any) -> tuple[float, ...]:
+    """A list of mean winds [m/s], or {start, stop, step} (stop included)."""
+    if isinstance(val, Mapping):
+        extra = set(val) - {"start", "stop", "step"}
+        if extra or {"start", "stop"} - set(val):
+            raise _fail(key, f"a range needs start, stop and optionally step; got keys "
+                             f"{sorted(val)}")
+        a = _number(f"{key}.start", val["start"], 0.0, lo_open=True)
+        b = _number(f"{key}.stop", val["stop"], a)
+        s = _number(f"{key}.step", val.get("step", 1.0), 0.0, lo_open=True)
+        out = [round(a + i * s, 6) for i in range(int(math.floor((b - a) / s + 1e-9)) + 1)]
+    elif isinstance(val, (list, tuple)):
+        out = [_number(f"{key}[{i}]", v, 0.0, 60.0, lo_open=True) for i, v in enumerate(val)]
+    else:
+        out = [_number(key, val, 0.0, 60.0, lo_open=True)]
+    if not out:
+        raise _fail(key, "no mean wind given")
+    if len(set(out)) != len(out):
+        raise _fail(key, f"repeated mean winds {out}")
+    return tuple(sorted(float(v) for v in out))
+
+
+def _seeds(key: str, val: Any) -> tuple[int, ...]:
+    """A count n (seeds 1..n) or a list of seeds."""
+    if isinstance(val, bool):
+        raise _fail(key, f"must be a count or a list of integers, got {val!r}")
+    if isinstance(val, int):
+        if val < 1:
+            raise _fail(key, f"a seed count must be >= 1, got {val}")
+        return tuple(range(1, val + 1))
+    if isinstance(val, (list, tuple)) and val:
+        if not all(isinstance(s, int) and not isinstance(s, bool) and s >= 0 for s in val):
+            raise _fail(key, f"seeds must be integers >= 0, got {list(val)}")
+        if len(set(val)) != len(val):
+            raise _fail(key, f"repeated seeds {list(val)}")
+        return tuple(val)
+    raise _fail(key, f"must be a count >= 1 or a non-empty list of integers, got {val!r}")
+
+
+def _turbulence(key: str, val: Any) -> tuple[str | float, ...]:
+    """IEC classes "A"/"B"/"C", intensities in (0, 1), or "steady"."""
+    vals = list(val) if isinstance(val, (list, tuple)) else [val]
+    out: list[str | float] = []
+    for i, v in enumerate(vals):
+        k = f"{key}[{i}]" if isinstance(val, (list, tuple)) else key
+        if isinstance(v, str):
+            if v not in ("A", "B", "C", "steady"):
+                raise _fail(k, f"must be an IEC class 'A', 'B', 'C', 'steady' or an intensity "
+                               f"in (0, 1), got {v!r}")
+            out.append(v)
+        else:
+            out.append(_number(k, v, 0.0, 1.0, lo_open=True))
+    if not out or len(set(out)) != len(out):
+        raise _fail(key, f"needs distinct values, got {vals}")
+    return tuple(out)
+
+
+def turbulence_tag(turb: str | float) -> str:
+    """A file-name-safe tag: the class letter or the intensity in percent (``ti12``)."""
+    return turb if isinstance(turb, str) else f"ti{100 * turb:g}"
+
+
+@dataclass(frozen=True)
+class ControllerSpec:
+    """One controller of a campaign.
+
+    Parameters
+    ----------
+    name : str
+        Label in the index, the file names and the report (letters, digits, ``-_.+``).
+    controller : str
+        A :func:`mpc_wt.runs.run_controller` name (``baseline``, ``mpc-lidar``, ``ts``,
+        ``derate80+ibc`` ...).
+    options : dict
+        Keyword arguments of :func:`~mpc_wt.runs.run_controller`: ``mpc_options``,
+        ``retrofit_options``, ``apc_frequency`` [Hz], ``apc_amplitude``, ``apc_offset``,
+        ``lidar_options``.
+    winds, seeds, turbulence : tuple or None
+        This controller's own grid (default: the campaign's).
+    """
+
+    name: str
+    controller: str
+    options: dict[str, Any] = field(default_factory=dict)
+    winds: tuple[float, ...] | None = None
+    seeds: tuple[int, ...] | None = None
+    turbulence: tuple[str | float, ...] | None = None
+    label: str | None = None
+
+
+@dataclass(frozen=True)
+class Case:
+    """One simulation of a campaign (a pure task: these fields -> one result file + metrics)."""
+
+    case_id: str
+    controller: str
+    run_name: str
+    options: dict[str, Any]
+    wind_mps: float
+    seed: int
+    turbulence: str | float
+    duration: float
+    transient: float
+    shear_exponent: float
+    turbine: str
+    turbine_hash: str
+    channels: dict[str, float]
+    case_hash: str
+    assess_hash: str
+
+    def to_dict(self) -> dict[str, Any]:
+        """Plain data for a worker (pickles and JSON-serialises)."""
+        return {k: copy.deepcopy(getattr(self, k)) for k in self.__dataclass_fields__}
+
+
+@dataclass(frozen=True)
+class CampaignSpec:
+    """A validated campaign. Build it with :func:`load_spec` or :func:`spec_from_dict`."""
+
+    name: str
+    description: str
+    turbine: str
+    turbine_hash: str
+    duration: float
+    transient: float
+    turbulence: tuple[str | float, ...]
+    shear_exponent: float
+    winds: tuple[float, ...]
+    seeds: tuple[int, ...]
+    lidar: dict[str, Any]
+    controllers: tuple[ControllerSpec, ...]
+    channels: dict[str, float]
+    wind_distribution: dict[str, Any]
+    lifetime_years: float
+    reference: str
+    report: dict[str, Any]
+    raw: dict[str, Any]
+    source: str | None = None
+
+    @property
+    def spec_hash(self) -> str:
+        """SHA-256 of the canonical spec (with the turbine files' hash)."""
+        return _digest({"spec": self.raw, "turbine": self.turbine_hash})
+
+    def controller(self, name: str) -> ControllerSpec:
+        """The controller labelled ``name``."""
+        for c in self.controllers:
+            if c.name == name:
+                return c
+        raise KeyError(f"no controller {name!r}; controllers are "
+                       f"{[c.name for c in self.controllers]}")
+
+    def cases(self) -> list[Case]:
+        """Every case of the campaign, in a stable order (controller, turbulence, wind, seed)."""
+        out = []
+        assess = {"channels": self.channels, "transient": self.transient}
+        for c in self.controllers:
+            for turb in c.turbulence or self.turbulence:
+                for v in c.winds or self.winds:
+                    for s in c.seeds or self.seeds:
+                        sim = {"turbine": self.turbine_hash, "controller": c.controller,
+                               "options": c.options, "wind_mps": v, "seed": s,
+                               "turbulence": turb, "duration": self.duration + self.transient,
+                               "shear_exponent": self.shear_exponent}
+                        cid = f"{c.name}__{turbulence_tag(turb)}__v{v:g}__s{s}"
+                        out.append(Case(case_id=cid, controller=c.name,
+                                        run_name=c.controller, options=copy.deepcopy(c.options),
+                                        wind_mps=v, seed=s, turbulence=turb,
+                                        duration=self.duration, transient=self.transient,
+                                        shear_exponent=self.shear_exponent,
+                                        turbine=self.turbine, turbine_hash=self.turbine_hash,
+                                        channels=dict(self.channels), case_hash=_digest(sim),
+                                        assess_hash=_digest(assess)))
+        return out
+
+
+def _digest(obj: Any) -> str:
+    return hashlib.sha256(json.dumps(obj, sort_keys=True, default=str).encode()).hexdigest()
+
+
+def turbine_files_hash(turbine: str, base: Path | None = None) -> tuple[str, str]:
+    """(resolved turbine reference, SHA-256 over its files): a packaged name or a path to a
+    turbine file or folder (relative paths against ``base``, the spec's folder)."""
+    import linearize
+
+    if turbine in linearize.available_turbines():
+        from importlib import resources
+
+        root = resources.files("linearize") / "data" / turbine
+        with resources.as_file(root) as p:
+            folder, ref = Path(p), turbine
+    else:
+        p = Path(turbine)
+        if not p.is_absolute() and base is not None:
+            p = base / p
+        if not p.exists():
+            raise _fail("turbine", f"{turbine!r} is neither a packaged turbine "
+                                   f"{linearize.available_turbines()} nor an existing path")
+        folder = p if p.is_dir() else p.parent
+        ref = str(p.resolve())
+        try:
+            linearize.load_turbine(p)
+        except Exception as err:  # noqa: BLE001 - any loader error is reported with the key
+            raise _fail("turbine", f"{turbine!r} does not load: {err}") from err
+    h = hashlib.sha256()
+    for f in sorted(folder.rglob("*")):
+        if f.is_file() and "__pycache__" not in f.parts:
+            h.update(str(f.relative_to(folder)).encode())
+            h.update(f.read_bytes())
+    return ref, h.hexdigest()
+
+
+def _controller(i: int, raw: Any, lidar: dict[str, Any]) -> ControllerSpec:
+    key = f"controllers[{i}]"
+    if isinstance(raw, str):
+        raw = {"name": raw, "controller": raw}
+    if not isinstance(raw, Mapping):
+        raise _fail(key, f"must be a controller name or a mapping, got {raw!r}")
+    extra = set(raw) - _CONTROLLER_KEYS
+    if extra:
+        raise _fail(f"{key}.{sorted(extra)[0]}", f"unknown key; allowed: "
+                                                 f"{sorted(_CONTROLLER_KEYS)}")
+    name = raw.get("name", raw.get("controller"))
+    if not isinstance(name, str) or not name or not all(
+            ch.isalnum() or ch in "-_.+" for ch in name):
+        raise _fail(f"{key}.name", f"must be a non-empty label of letters, digits and -_.+, "
+                                   f"got {name!r}")
+    run_name = raw.get("controller", name)
+    from ..runs import parse_controller
+
+    try:
+        kind, _, _ = parse_controller(str(run_name))
+    except ValueError as err:
+        raise _fail(f"{key}.controller", str(err)) from err
+    opts: dict[str, Any] = {}
+    for k in ("mpc_options", "retrofit_options"):
+        if k in raw:
+            if not isinstance(raw[k], Mapping):
+                raise _fail(f"{key}.{k}", f"must be a mapping, got {raw[k]!r}")
+            opts[k] = dict(raw[k])
+    if "apc_frequency" in raw:
+        opts["apc_frequency"] = _number(f"{key}.apc_frequency", raw["apc_frequency"], 0.0, 5.0)
+    for k in ("apc_amplitude", "apc_offset"):
+        if k in raw:
+            opts[k] = _number(f"{key}.{k}", raw[k], 0.0, 1.0)
+    if kind in ("apc",) and "apc_frequency" not in opts:
+        raise _fail(f"{key}.apc_frequency", "controller 'apc' needs apc_frequency [Hz]")
+    if "apc_frequency" in opts and kind not in ("ts", "apc"):
+        raise _fail(f"{key}.apc_frequency", f"applies to 'ts' and 'apc' only, not {run_name!r}")
+    if kind == "mpc-lidar":
+        lid = {**lidar, **_lidar(f"{key}.lidar", raw.get("lidar", {}))}
+        if lid:
+            opts["lidar_options"] = lid
+    elif "lidar" in raw:
+        raise _fail(f"{key}.lidar", f"applies to 'mpc-lidar' only, not {run_name!r}")
+    return ControllerSpec(
+        name=name, controller=str(run_name), options=opts,
+        winds=_winds(f"{key}.winds", raw["winds"]) if "winds" in raw else None,
+        seeds=_seeds(f"{key}.seeds", raw["seeds"]) if "seeds" in raw else None,
+        turbulence=(_turbulence(f"{key}.turbulence", raw["turbulence"])
+                    if "turbulence" in raw else None),
+        label=str(raw["label"]) if "label" in raw else None)
+
+
+def _lidar(key: str, raw: Any) -> dict[str, Any]:
+    if not isinstance(raw, Mapping):
+        raise _fail(key, f"must be a mapping, got {raw!r}")
+    extra = set(raw) - _LIDAR_KEYS
+    if extra:
+        raise _fail(f"{key}.{sorted(extra)[0]}", f"unknown key; allowed: {sorted(_LIDAR_KEYS)}")
+    out: dict[str, Any] = {}
+    for k, v in raw.items():
+        if k in ("perfect_alignment", "los_error", "range_weighting"):
+            if not isinstance(v, bool):
+                raise _fail(f"{key}.{k}", f"must be true or false, got {v!r}")
+            out[k] = v
+        elif k == "n_range":
+            if isinstance(v, bool) or not isinstance(v, int) or v < 1:
+                raise _fail(f"{key}.{k}", f"must be an integer >= 1, got {v!r}")
+            out[k] = v
+        else:
+            out[k] = _number(f"{key}.{k}", v, 0.0)
+    return out
+
+
+def _distribution(raw: Any) -> dict[str, Any]:
+    key = "wind_distribution"
+    if not isinstance(raw, Mapping):
+        raise _fail(key, f"must be a mapping, got {raw!r}")
+    kind = raw.get("kind", "rayleigh")
+    if kind == "rayleigh":
+        extra = set(raw) - {"kind", "mean"}
+        if extra:
+            raise _fail(f"{key}.{sorted(extra)[0]}", "unknown key; rayleigh takes: kind, mean")
+        return {"kind": kind, "mean": _number(f"{key}.mean", raw.get("mean", 10.0), 0.0,
+                                              lo_open=True)}
+    if kind == "weibull":
+        extra = set(raw) - {"kind", "scale", "shape"}
+        if extra:
+            raise _fail(f"{key}.{sorted(extra)[0]}", "unknown key; weibull takes: kind, scale, "
+                                                     "shape")
+        if "scale" not in raw:
+            raise _fail(f"{key}.scale", "weibull needs scale [m/s]")
+        return {"kind": kind,
+                "scale": _number(f"{key}.scale", raw["scale"], 0.0, lo_open=True),
+                "shape": _number(f"{key}.shape", raw.get("shape", 2.0), 0.0, lo_open=True)}
+    raise _fail(f"{key}.kind", f"must be 'rayleigh' or 'weibull', got {kind!r}")
+
+
+def spec_from_dict(raw: Mapping[str, Any], base: Path | None = None,
+                   source: str | None = None) -> CampaignSpec:
+    """Validate a campaign given as a mapping (the parsed YAML).
+
+    Raises
+    ------
+    SpecError
+        Naming the key: unknown or missing keys, values of the wrong type or out of range,
+        repeated controllers, winds or seeds, a reference controller not in the list.
+    """
+    if not isinstance(raw, Mapping):
+        raise SpecError(f"campaign spec: must be a mapping at the top level, got "
+                        f"{type(raw).__name__}")
+    raw = copy.deepcopy(dict(raw))
+    extra = set(raw) - set(_TOP_KEYS)
+    if extra:
+        raise _fail(sorted(extra)[0], f"unknown key; allowed: {sorted(_TOP_KEYS)}")
+    missing = [k for k in ("name", "winds", "controllers") if k not in raw]
+    if missing:
+        raise _fail(missing[0], f"missing (required: name, winds, controllers; missing "
+                                f"{missing})")
+    name = raw["name"]
+    if not isinstance(name, str) or not name.strip():
+        raise _fail("name", f"must be a non-empty string, got {name!r}")
+    turbine, thash = turbine_files_hash(str(raw.get("turbine", "nrel5mw")), base)
+    duration = _number("duration", raw.get("duration", 600.0), 0.0, lo_open=True)
+    transient = _number("transient", raw.get("transient", 60.0), 0.0)
+    lidar = _lidar("lidar", raw.get("lidar", {}))
+    ctl_raw = raw["controllers"]
+    if not isinstance(ctl_raw, list) or not ctl_raw:
+        raise _fail("controllers", "must be a non-empty list")
+    ctls = tuple(_controller(i, c, lidar) for i, c in enumerate(ctl_raw))
+    names = [c.name for c in ctls]
+    dup = sorted({n for n in names if names.count(n) > 1})
+    if dup:
+        raise _fail("controllers", f"repeated names {dup}; give each a distinct name")
+    from ..runs import DEFAULT_CHANNELS
+
+    chans_raw = raw.get("channels", DEFAULT_CHANNELS)
+    if not isinstance(chans_raw, Mapping) or not chans_raw:
+        raise _fail("channels", "must be a non-empty mapping of channel name to Woehler "
+                                "exponent m")
+    import linearize
+
+    known = {*linearize.OUTPUT_NAMES, *linearize.STATE_NAMES, *linearize.INPUT_NAMES,
+             "shaft_bending_blade1"}
+    chans = {}
+    for k, m in chans_raw.items():
+        if k not in known:
+            raise _fail(f"channels.{k}", f"unknown channel; channels are {sorted(known)}")
+        chans[str(k)] = _number(f"channels.{k}", m, 0.0, 30.0, lo_open=True)
+    ref = raw.get("reference", names[0])
+    if ref not in names:
+        raise _fail("reference", f"{ref!r} is not a controller name; names are {names}")
+    report = raw.get("report", {})
+    if not isinstance(report, Mapping):
+        raise _fail("report", f"must be a mapping, got {report!r}")
+    extra = set(report) - _REPORT_KEYS
+    if extra:
+        raise _fail(f"report.{sorted(extra)[0]}", f"unknown key; allowed: {sorted(_REPORT_KEYS)}")
+    for k in ("psd_wind", "cs_wind"):
+        if k in report:
+            _number(f"report.{k}", report[k], 0.0, lo_open=True)
+    for i, p in enumerate(report.get("paper", []) or []):
+        _paper_row(f"report.paper[{i}]", p, names, chans)
+    desc = raw.get("description", "")
+    if not isinstance(desc, str):
+        raise _fail("description", f"must be a string, got {desc!r}")
+    return CampaignSpec(
+        name=name.strip(), description=desc, turbine=turbine, turbine_hash=thash,
+        duration=duration, transient=transient,
+        turbulence=_turbulence("turbulence", raw.get("turbulence", "A")),
+        shear_exponent=_number("shear_exponent", raw.get("shear_exponent", 0.2), -1.0, 1.0),
+        winds=_winds("winds", raw["winds"]), seeds=_seeds("seeds", raw.get("seeds", 1)),
+        lidar=lidar, controllers=ctls, channels=chans,
+        wind_distribution=_distribution(raw.get("wind_distribution", {})),
+        lifetime_years=_number("lifetime_years", raw.get("lifetime_years", 20.0), 0.0,
+                               lo_open=True),
+        reference=ref, report=dict(report), raw=raw, source=source)
+
+
+_PAPER_METRICS = {"del_change_pct", "lifetime_del_change_pct", "aep_change_pct",
+                  "cs_change_pct", "pitch_change_pct", "value", "extension_years"}
+
+
+def _paper_row(key: str, p: Any, names: list[str], chans: Mapping[str, float]) -> None:
+    """A paper value to place next to ours: {metric, controller, value, [channel|measure],
+    [wind], [source]}."""
+    if not isinstance(p, Mapping):
+        raise _fail(key, f"must be a mapping, got {p!r}")
+    allowed = {"metric", "controller", "value", "channel", "measure", "wind", "source",
+               "turbulence", "note"}
+    extra = set(p) - allowed
+    if extra:
+        raise _fail(f"{key}.{sorted(extra)[0]}", f"unknown key; allowed: {sorted(allowed)}")
+    if p.get("metric") not in _PAPER_METRICS:
+        raise _fail(f"{key}.metric", f"must be one of {sorted(_PAPER_METRICS)}, got "
+                                     f"{p.get('metric')!r}")
+    if p.get("controller") not in names:
+        raise _fail(f"{key}.controller", f"{p.get('controller')!r} is not a controller name; "
+                                         f"names are {names}")
+    if "channel" in p and p["channel"] not in chans:
+        raise _fail(f"{key}.channel", f"{p['channel']!r} is not a campaign channel")
+    _number(f"{key}.value", p.get("value"))
+
+
+def load_spec(path: str | Path) -> CampaignSpec:
+    """Read and validate a campaign YAML file (relative turbine paths against its folder).
+
+    Raises
+    ------
+    SpecError
+        Unreadable YAML (with its line) or an invalid spec (naming the key).
+    FileNotFoundError
+        If the file does not exist.
+    """
+    path = Path(path)
+    if not path.is_file():
+        raise FileNotFoundError(f"campaign spec {path}: file not found")
+    try:
+        raw = yaml.safe_load(path.read_text())
+    except yaml.YAMLError as err:
+        raise SpecError(f"campaign spec {path}: not valid YAML ({err})") from err
+    try:
+        return spec_from_dict(raw, base=path.parent, source=str(path))
+    except SpecError as err:
+        raise SpecError(f"{path}: {err}") from err

@@ -1,0 +1,301 @@
+"""The campaign directory: one time-series file per case and an SQLite index committed per case.
+
+Layout::
+
+    DIR/spec.yaml         the spec of the latest run (as given)
+    DIR/index.sqlite      cases, status, metrics, software version, spec hash
+    DIR/cases/ID.nc       one result per case (ClosedLoopResult netCDF, written atomically)
+    DIR/cases/ID.partial.nc   what a diverged simulation produced before it stopped
+    DIR/report/           tables and plots of ``mpcwt campaign report``
+
+Only the client writes the index (one writer: an exclusive lock on ``DIR/.lock``); workers
+write case files (temp file + rename), so a killed worker or client leaves at worst a temp
+file, never a half-written result, and the index never names a file that is not complete.
+"""
+from __future__ import annotations
+
+import fcntl
+import json
+import os
+import sqlite3
+import time
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any, Iterable, Iterator
+
+from .spec import Case, CampaignSpec
+
+__all__ = ["CampaignStore", "CampaignLockedError", "CaseRow", "STATUSES"]
+
+#: pending: not run yet; submitted: handed to the engine by a client (if that client died,
+#: the case is re-run); done: file and metrics stored; failed: raised (traceback stored);
+#: stale: in the index but no longer in the spec (kept, not reported).
+STATUSES = ("pending", "submitted", "done", "failed", "stale")
+
+_SCHEMA = """
+CREATE TABLE IF NOT EXISTS meta (key TEXT PRIMARY KEY, value TEXT NOT NULL);
+CREATE TABLE IF NOT EXISTS cases (
+    case_id TEXT PRIMARY KEY,
+    controller TEXT NOT NULL,
+    run_name TEXT NOT NULL,
+    wind_mps REAL NOT NULL,
+    seed INTEGER NOT NULL,
+    turbulence TEXT NOT NULL,
+    case_hash TEXT NOT NULL,
+    assess_hash TEXT NOT NULL,
+    case_json TEXT NOT NULL,
+    status TEXT NOT NULL CHECK (status IN ('pending', 'submitted', 'done', 'failed', 'stale')),
+    file TEXT,
+    metrics TEXT,
+    error TEXT,
+    traceback TEXT,
+    software_version TEXT,
+    spec_hash TEXT,
+    attempts INTEGER NOT NULL DEFAULT 0,
+    wall_s REAL,
+    worker TEXT,
+    updated REAL NOT NULL
+);
+"""
+
+
+class CampaignLockedError(RuntimeError):
+    """Another client is running the same campaign directory."""
+
+
+@dataclass(frozen=True)
+class CaseRow:
+    """One row of the index."""
+
+    case_id: str
+    controller: str
+    run_name: str
+    wind_mps: float
+    seed: int
+    turbulence: str
+    case_hash: str
+    assess_hash: str
+    status: str
+    file: str | None
+    metrics: dict[str, Any] | None
+    error: str | None
+    traceback: str | None
+    software_version: str | None
+    spec_hash: str | None
+    attempts: int
+    wall_s: float | None
+    worker: str | None
+
+    @property
+    def turbulence_value(self) -> str | float:
+        """The turbulence as in the spec: a class letter or an intensity."""
+        try:
+            return float(self.turbulence)
+        except ValueError:
+            return self.turbulence
+
+
+class CampaignStore:
+    """Open (and create) a campaign directory.
+
+    Parameters
+    ----------
+    root : path
+        The campaign directory.
+    lock : bool
+        Take the exclusive client lock (``run``); ``status`` and ``report`` read without it.
+
+    Raises
+    ------
+    CampaignLockedError
+        If ``lock`` and another live client holds the directory.
+    """
+
+    def __init__(self, root: str | Path, *, lock: bool = False) -> None:
+        self.root = Path(root)
+        self.cases_dir = self.root / "cases"
+        self._lock_fh = None
+        if lock:
+            self.cases_dir.mkdir(parents=True, exist_ok=True)
+            fh = open(self.root / ".lock", "a+")
+            try:
+                fcntl.flock(fh, fcntl.LOCK_EX | fcntl.LOCK_NB)
+            except BlockingIOError as err:
+                fh.seek(0)
+                who = fh.read().strip() or "?"
+                fh.close()
+                raise CampaignLockedError(f"campaign {self.root} is being run by another client "
+                                          f"({who}); wait for it or stop it") from err
+            fh.seek(0)
+            fh.truncate()
+            fh.write(f"pid {os.getpid()} on {os.uname().nodename}\n")
+            fh.flush()
+            self._lock_fh = fh
+        elif not (self.root / "index.sqlite").is_file():
+            raise FileNotFoundError(f"{self.root}: not a campaign directory (no index.sqlite)")
+        self.db = sqlite3.connect(self.root / "index.sqlite", timeout=30.0,
+                                  isolation_level=None)
+        self.db.execute("PRAGMA journal_mode=WAL")
+        self.db.execute("PRAGMA synchronous=FULL")
+        if lock:
+            self.db.executescript(_SCHEMA)
+
+    def close(self) -> None:
+        """Close the index and release the lock."""
+        self.db.close()
+        if self._lock_fh is not None:
+            fcntl.flock(self._lock_fh, fcntl.LOCK_UN)
+            self._lock_fh.close()
+            self._lock_fh = None
+
+    def __enter__(self) -> "CampaignStore":
+        return self
+
+    def __exit__(self, *exc: Any) -> None:
+        self.close()
+
+    # -- metadata -------------------------------------------------------------------------
+    def set_meta(self, **items: Any) -> None:
+        with self._tx():
+            self.db.executemany("INSERT OR REPLACE INTO meta VALUES (?, ?)",
+                                [(k, json.dumps(v)) for k, v in items.items()])
+
+    def meta(self) -> dict[str, Any]:
+        return {k: json.loads(v) for k, v in self.db.execute("SELECT key, value FROM meta")}
+
+    # -- cases ----------------------------------------------------------------------------
+    def sync(self, spec: CampaignSpec) -> dict[str, int]:
+        """Bring the index in line with ``spec`` in one transaction.
+
+        New cases are added as pending; a case whose simulation inputs changed (case hash)
+        goes back to pending (its old file is overwritten when it reruns); a case no longer in
+        the spec becomes ``stale`` (kept). Returns the counts of each action.
+        """
+        cases = spec.cases()
+        ids = {c.case_id for c in cases}
+        now = time.time()
+        counts = {"added": 0, "invalidated": 0, "reassess": 0, "kept": 0, "stale": 0}
+        with self._tx():
+            old = {r[0]: r for r in self.db.execute(
+                "SELECT case_id, case_hash, assess_hash, status FROM cases")}
+            for c in cases:
+                row = old.get(c.case_id)
+                cj = json.dumps(c.to_dict(), sort_keys=True)
+                if row is None:
+                    self.db.execute(
+                        "INSERT INTO cases (case_id, controller, run_name, wind_mps, seed, "
+                        "turbulence, case_hash, assess_hash, case_json, status, updated) "
+                        "VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, 'pending', ?)",
+                        (c.case_id, c.controller, c.run_name, c.wind_mps, c.seed,
+                         str(c.turbulence), c.case_hash, c.assess_hash, cj, now))
+                    counts["added"] += 1
+                elif row[1] != c.case_hash:
+                    self.db.execute(
+                        "UPDATE cases SET status='pending', case_hash=?, assess_hash=?, "
+                        "case_json=?, run_name=?, metrics=NULL, error=NULL, traceback=NULL, "
+                        "updated=? WHERE case_id=?",
+                        (c.case_hash, c.assess_hash, cj, c.run_name, now, c.case_id))
+                    counts["invalidated"] += 1
+                elif row[2] != c.assess_hash:
+                    self.db.execute("UPDATE cases SET assess_hash=?, case_json=?, updated=?, "
+                                    "status=CASE WHEN status='done' THEN 'pending' ELSE status "
+                                    "END WHERE case_id=?", (c.assess_hash, cj, now, c.case_id))
+                    counts["reassess"] += 1
+                else:
+                    if row[3] == "stale":
+                        self.db.execute("UPDATE cases SET status='pending' WHERE case_id=?",
+                                        (c.case_id,))
+                    counts["kept"] += 1
+            for cid, r in old.items():
+                if cid not in ids and r[3] != "stale":
+                    self.db.execute("UPDATE cases SET status='stale', updated=? WHERE case_id=?",
+                                    (now, cid))
+                    counts["stale"] += 1
+        return counts
+
+    def todo(self) -> list[Case]:
+        """Cases to submit: everything not done, and done cases whose file has gone."""
+        out = []
+        for cid, status, file, cj in self.db.execute(
+                "SELECT case_id, status, file, case_json FROM cases WHERE status != 'stale' "
+                "ORDER BY rowid"):
+            if status == "done" and file and (self.root / file).is_file():
+                continue
+            out.append(Case(**json.loads(cj)))
+        return out
+
+    def mark_submitted(self, case_ids: Iterable[str]) -> None:
+        """Record that this client handed the cases to the engine (attempts + 1)."""
+        now = time.time()
+        with self._tx():
+            self.db.executemany("UPDATE cases SET status='submitted', attempts=attempts+1, "
+                                "updated=? WHERE case_id=?", [(now, c) for c in case_ids])
+
+    def record(self, case_id: str, outcome: dict[str, Any], spec_hash: str) -> None:
+        """Commit one finished case (``outcome`` of :func:`mpc_wt.campaign.task.run_case`)."""
+        now = time.time()
+        with self._tx():
+            if outcome["status"] == "done":
+                self.db.execute(
+                    "UPDATE cases SET status='done', file=?, metrics=?, error=NULL, "
+                    "traceback=NULL, software_version=?, spec_hash=?, wall_s=?, worker=?, "
+                    "updated=? WHERE case_id=?",
+                    (outcome["file"], json.dumps(outcome["metrics"]),
+                     outcome.get("software_version"), spec_hash, outcome.get("wall_s"),
+                     outcome.get("worker"), now, case_id))
+            else:
+                self.db.execute(
+                    "UPDATE cases SET status='failed', error=?, traceback=?, "
+                    "software_version=?, spec_hash=?, wall_s=?, worker=?, updated=? "
+                    "WHERE case_id=?",
+                    (outcome.get("error", "unknown error"), outcome.get("traceback"),
+                     outcome.get("software_version"), spec_hash, outcome.get("wall_s"),
+                     outcome.get("worker"), now, case_id))
+
+    def rows(self, *, include_stale: bool = False) -> list[CaseRow]:
+        """All rows (of the current spec unless ``include_stale``), in insertion order."""
+        q = ("SELECT case_id, controller, run_name, wind_mps, seed, turbulence, case_hash, "
+             "assess_hash, status, file, metrics, error, traceback, software_version, spec_hash, "
+             "attempts, wall_s, worker FROM cases")
+        if not include_stale:
+            q += " WHERE status != 'stale'"
+        out = []
+        for r in self.db.execute(q + " ORDER BY rowid"):
+            r = list(r)
+            r[10] = json.loads(r[10]) if r[10] else None
+            out.append(CaseRow(*r))
+        return out
+
+    def counts(self) -> dict[str, int]:
+        """Number of cases per status."""
+        c = {s: 0 for s in STATUSES}
+        for s, n in self.db.execute("SELECT status, count(*) FROM cases GROUP BY status"):
+            c[s] = n
+        return c
+
+    def stray_temp_files(self) -> list[Path]:
+        """Temp files left by writers that were killed mid-write (safe to delete once no
+        worker of this campaign runs)."""
+        return sorted(self.cases_dir.glob(".*.tmp")) if self.cases_dir.is_dir() else []
+
+    def _tx(self) -> "_Tx":
+        return _Tx(self.db)
+
+
+class _Tx:
+    """BEGIN IMMEDIATE ... COMMIT (ROLLBACK on error): one durable commit per call."""
+
+    def __init__(self, db: sqlite3.Connection) -> None:
+        self.db = db
+
+    def __enter__(self) -> sqlite3.Connection:
+        self.db.execute("BEGIN IMMEDIATE")
+        return self.db
+
+    def __exit__(self, et: Any, ev: Any, tb: Any) -> None:
+        self.db.execute("ROLLBACK" if et else "COMMIT")
+
+
+def iter_done(store: CampaignStore) -> Iterator[CaseRow]:
+    """Finished rows of the current spec."""
+    return (r for r in store.rows() if r.status == "done")

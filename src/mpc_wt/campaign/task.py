@@ -1,0 +1,146 @@
+"""The campaign's unit of work: one case in, one result file and its metrics out.
+
+:func:`run_case` is a pure function of its arguments (the case's plain data and the campaign
+directory): it never touches the index and never raises for a case that fails -- it returns
+the error with its traceback -- so any engine (Dask, a process pool, a plain loop) can run it,
+retry it after a worker died, or run it twice without harm: the file is written to a name of
+the writer's own and renamed over the final name.
+"""
+from __future__ import annotations
+
+import functools
+import math
+import os
+import socket
+import time
+import traceback
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+__all__ = ["run_case", "case_metrics", "case_file"]
+
+
+def case_file(case_id: str) -> str:
+    """The result file of a case, relative to the campaign directory."""
+    return f"cases/{case_id}.nc"
+
+
+@functools.lru_cache(maxsize=8)
+def _turbine(ref: str) -> Any:
+    import linearize
+
+    return linearize.load_turbine(ref)
+
+
+def case_metrics(t: np.ndarray, cols: dict[str, np.ndarray], channels: dict[str, float],
+                 transient: float) -> dict[str, Any]:
+    """The per-case numbers a campaign aggregates, after discarding ``transient`` [s]: DEL per
+    channel (Woehler exponent of the spec, 1 Hz equivalent cycles), mean and std of power,
+    energy, CS1-CS5 (tower-base fore-aft moment vs electrical power, Do et al. eqs 21-26), pitch
+    duty, rotor/generator speed statistics and the blade-1 flap 1P/3P/6P content.
+
+    Raises
+    ------
+    ValueError
+        If less than 10 s remain after the transient, or a series holds NaN.
+    """
+    from ..runs import assess_series
+
+    k = t >= t[0] + transient
+    if np.count_nonzero(k) < 2 or t[k][-1] - t[k][0] < 10.0:
+        raise ValueError(f"transient {transient:g} s leaves {t[-1] - t[0] - transient:g} s of "
+                         f"a {t[-1] - t[0]:g} s run; allowed: at least 10 s")
+    sub = {n: np.asarray(c)[k] for n, c in cols.items()}
+    for n in channels:
+        if n in sub and not np.all(np.isfinite(sub[n])):
+            raise ValueError(f"channel {n!r} holds NaN or inf")
+    out = assess_series(t[k], sub, channels)
+    if "rotor_speed" in sub:
+        out["rotor_speed_mean_rad_s"] = float(sub["rotor_speed"].mean())
+        out["rotor_speed_std_rad_s"] = float(sub["rotor_speed"].std())
+        out["rotor_speed_max_rad_s"] = float(sub["rotor_speed"].max())
+    if "tower_base_fa_moment" in sub:
+        out["tower_base_fa_mean_Nm"] = float(sub["tower_base_fa_moment"].mean())
+    for key in ("power_ref",):
+        if key in sub:
+            out[f"{key}_mean_W"] = float(np.mean(sub[key]))
+    return _plain(out)
+
+
+def _plain(obj: Any) -> Any:
+    """JSON-safe copy: numpy scalars to float, non-finite floats to None."""
+    if isinstance(obj, dict):
+        return {str(k): _plain(v) for k, v in obj.items()}
+    if isinstance(obj, (list, tuple)):
+        return [_plain(v) for v in obj]
+    if isinstance(obj, (np.floating, float)):
+        return float(obj) if math.isfinite(obj) else None
+    if isinstance(obj, np.integer):
+        return int(obj)
+    return obj
+
+
+def run_case(case: dict[str, Any], root: str) -> dict[str, Any]:
+    """Simulate one case (or reuse its finished file) and assess it.
+
+    Parameters
+    ----------
+    case : dict
+        :meth:`mpc_wt.campaign.spec.Case.to_dict`.
+    root : str
+        The campaign directory (shared by client and workers).
+
+    Returns
+    -------
+    dict
+        ``status`` "done" with ``file`` (relative), ``metrics``, ``reused`` (the file already
+        held this case's simulation: only the assessment ran), or "failed" with ``error`` and
+        ``traceback``; both with ``wall_s``, ``worker`` (host:pid) and ``software_version``.
+    """
+    from .. import __version__
+    from ..simulate import ClosedLoopResult, ResultFileError, SimulationDivergedError
+
+    t0 = time.perf_counter()
+    base = {"case_id": case["case_id"], "worker": f"{socket.gethostname()}:{os.getpid()}",
+            "software_version": __version__}
+    rel = case_file(case["case_id"])
+    path = Path(root) / rel
+    try:
+        res = None
+        reused = False
+        if path.is_file():
+            try:
+                old = ClosedLoopResult.load(path)
+                if old.meta.get("campaign_case", {}).get("case_hash") == case["case_hash"]:
+                    res, reused = old, True
+            except ResultFileError:
+                res = None
+        if res is None:
+            from ..runs import run_controller
+
+            opts = dict(case["options"])
+            try:
+                res = run_controller(_turbine(case["turbine"]), case["run_name"],
+                                     case["wind_mps"], case["turbulence"], case["seed"],
+                                     duration=case["duration"] + case["transient"],
+                                     shear_exponent=case["shear_exponent"], **opts)
+            except SimulationDivergedError as err:
+                if getattr(err, "partial", None) is not None:
+                    err.partial.meta["campaign_case"] = {"case_id": case["case_id"],
+                                                         "case_hash": case["case_hash"],
+                                                         "partial": True}
+                    err.partial.save(path.with_name(f"{case['case_id']}.partial.nc"))
+                raise
+            res.meta["campaign_case"] = {"case_id": case["case_id"],
+                                         "case_hash": case["case_hash"]}
+            path.parent.mkdir(parents=True, exist_ok=True)
+            res.save(path)
+        cols = {n: res.channel(n) for n in res.channels()}
+        metrics = case_metrics(res.t, cols, case["channels"], case["transient"])
+        return {**base, "status": "done", "file": rel, "metrics": metrics, "reused": reused,
+                "wall_s": time.perf_counter() - t0}
+    except Exception as err:  # noqa: BLE001 - every failure is recorded, none stops others
+        return {**base, "status": "failed", "error": f"{type(err).__name__}: {err}",
+                "traceback": traceback.format_exc(), "wall_s": time.perf_counter() - t0}

@@ -1,0 +1,279 @@
+"""Campaigns: spec validation, case hashing, the results store, the Dask runner under a killed
+worker and a killed client, aggregation and the report (issue 9)."""
+from __future__ import annotations
+
+import os
+import signal
+import sqlite3
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+import yaml
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from mpc_wt.campaign import (CampaignLockedError, CampaignStore, SpecError, load_spec,
+                             run_campaign, spec_from_dict)
+from mpc_wt.simulate import ClosedLoopResult
+
+BASE = {"name": "t", "duration": 20, "transient": 5, "winds": [14],
+        "seeds": 1, "controllers": ["baseline"]}
+
+
+def _spec(**over):
+    return spec_from_dict({**BASE, **over})
+
+
+# -- spec -------------------------------------------------------------------------------------
+@pytest.mark.parametrize("over, key", [
+    ({"windz": [3]}, "windz"),
+    ({"winds": [3, -1]}, "winds[1]"),
+    ({"winds": {"start": 4, "stop": 2}}, "winds.stop"),
+    ({"winds": [8, 8]}, "winds"),
+    ({"seeds": 0}, "seeds"),
+    ({"seeds": [1, 1]}, "seeds"),
+    ({"duration": float("nan")}, "duration"),
+    ({"turbulence": "D"}, "turbulence"),
+    ({"turbulence": [0.12, 1.5]}, "turbulence[1]"),
+    ({"controllers": ["baseline", "fuzzy"]}, "controllers[1].controller"),
+    ({"controllers": ["baseline", "baseline"]}, "controllers"),
+    ({"controllers": [{"name": "x", "controller": "baseline", "gain": 2}]},
+     "controllers[0].gain"),
+    ({"controllers": [{"name": "a b", "controller": "baseline"}]}, "controllers[0].name"),
+    ({"controllers": [{"name": "p", "controller": "apc"}]}, "controllers[0].apc_frequency"),
+    ({"controllers": [{"name": "b", "controller": "baseline", "apc_frequency": 0.1}]},
+     "controllers[0].apc_frequency"),
+    ({"controllers": [{"name": "m", "controller": "mpc-lidar", "lidar": {"focus": 3}}]},
+     "controllers[0].lidar.focus"),
+    ({"channels": {"flap_moment_9": 10}}, "channels.flap_moment_9"),
+    ({"channels": {"flap_moment_1": -1}}, "channels.flap_moment_1"),
+    ({"reference": "mpc"}, "reference"),
+    ({"wind_distribution": {"kind": "weibull"}}, "wind_distribution.scale"),
+    ({"wind_distribution": {"kind": "gamma"}}, "wind_distribution.kind"),
+    ({"turbine": "no/such/turbine.yaml"}, "turbine"),
+    ({"report": {"paper": [{"metric": "del_change_pct", "controller": "baseline",
+                            "value": "x"}]}}, "report.paper[0].value"),
+])
+def test_spec_errors_name_the_key(over, key):
+    with pytest.raises(SpecError, match=key.replace("[", r"\[").replace("]", r"\]")):
+        _spec(**over)
+
+
+def test_spec_missing_keys_listed_and_bad_yaml(tmp_path):
+    with pytest.raises(SpecError, match="missing"):
+        spec_from_dict({"name": "x"})
+    p = tmp_path / "bad.yaml"
+    p.write_text("name: [unclosed\n")
+    with pytest.raises(SpecError, match="not valid YAML"):
+        load_spec(p)
+    with pytest.raises(FileNotFoundError):
+        load_spec(tmp_path / "none.yaml")
+
+
+def test_spec_grid_and_ranges():
+    s = _spec(winds={"start": 3, "stop": 25, "step": 2}, seeds=6,
+              turbulence=["A", 0.12], controllers=["baseline", {"name": "ts",
+                                                                "controller": "ts",
+                                                                "winds": [15]}])
+    assert s.winds == tuple(range(3, 26, 2))
+    cases = s.cases()
+    assert len(cases) == 12 * 6 * 2 + 1 * 6 * 2
+    assert len({c.case_id for c in cases}) == len(cases)
+    assert {c.turbulence for c in cases} == {"A", 0.12}
+
+
+@settings(max_examples=30, deadline=None)
+@given(st.lists(st.integers(3, 25), min_size=1, max_size=6, unique=True),
+       st.integers(1, 4), st.sampled_from(["baseline", "ibc", "derate90"]),
+       st.floats(0.0, 0.5))
+def test_case_hash_changes_only_for_touched_cases(winds, seeds, ctl, shear):
+    """Invariant: editing one controller's options changes the case hash of its cases only;
+    editing the channels changes only assessment hashes; the case ids are unique."""
+    raw = {**BASE, "winds": winds, "seeds": seeds, "shear_exponent": shear,
+           "controllers": ["baseline", {"name": "other", "controller": ctl}]}
+    a = spec_from_dict(raw).cases()
+    raw2 = {**raw, "controllers": ["baseline", {"name": "other", "controller": ctl,
+                                                "retrofit_options": {"gain_scale": 0.5}}]}
+    if ctl == "derate90":
+        raw2["controllers"][1] = {"name": "other", "controller": "derate80"}
+    b = spec_from_dict(raw2).cases()
+    assert len({c.case_id for c in a}) == len(a) == 2 * len(winds) * seeds
+    for x, y in zip(a, b):
+        assert x.case_id == y.case_id
+        assert (x.case_hash == y.case_hash) == (x.controller == "baseline")
+    c = spec_from_dict({**raw, "channels": {"lss_torque": 4}}).cases()
+    for x, y in zip(a, c):
+        assert x.case_hash == y.case_hash and x.assess_hash != y.assess_hash
+
+
+# -- store and runner (in this process) -------------------------------------------------------
+def test_rerun_skips_finished_reruns_failed_and_invalidates_only_touched(tmp_path):
+    # apc asks for more power than 8 m/s gives: that case raises, the others run
+    spec = _spec(winds=[8, 16], controllers=[
+        "baseline", {"name": "apc", "controller": "apc", "apc_frequency": 0.1, "winds": [8]}])
+    s1 = run_campaign(spec, tmp_path, engine="serial", progress=False)
+    assert (s1.done, s1.failed, s1.total) == (2, 1, 3)
+    with CampaignStore(tmp_path) as st_:
+        rows = {r.case_id: r for r in st_.rows()}
+    bad = rows["apc__A__v8__s1"]
+    assert bad.status == "failed" and "power" in bad.error and "Traceback" in bad.traceback
+    ok = rows["baseline__A__v16__s1"]
+    assert ok.status == "done" and ok.metrics["channels"]["flap_moment_1"]["del"] > 0
+    mtime = (tmp_path / ok.file).stat().st_mtime_ns
+    # rerun: finished cases skipped, the failed one retried (and fails again, recorded again)
+    s2 = run_campaign(spec, tmp_path, engine="serial", progress=False)
+    assert (s2.skipped, s2.submitted, s2.failed) == (2, 1, 1)
+    assert (tmp_path / ok.file).stat().st_mtime_ns == mtime
+    # channels changed: re-assessed from the files, no simulation
+    spec3 = _spec(winds=[8, 16], controllers=["baseline"], channels={"lss_torque": 4})
+    s3 = run_campaign(spec3, tmp_path, engine="serial", progress=False)
+    assert (s3.done, s3.reused) == (2, 2)
+    assert (tmp_path / ok.file).stat().st_mtime_ns == mtime
+    with CampaignStore(tmp_path) as st_:
+        rows = {r.case_id: r for r in st_.rows(include_stale=True)}
+    assert set(rows["baseline__A__v16__s1"].metrics["channels"]) == {"lss_torque"}
+    assert rows["apc__A__v8__s1"].status == "stale"
+    # one wind changed: only that wind's case runs
+    spec4 = _spec(winds=[8, 18], controllers=["baseline"], channels={"lss_torque": 4})
+    s4 = run_campaign(spec4, tmp_path, engine="serial", progress=False)
+    assert (s4.skipped, s4.done, s4.reused) == (1, 1, 0)
+
+
+def test_lost_file_is_rerun_and_lock_refuses_second_client(tmp_path):
+    spec = _spec()
+    run_campaign(spec, tmp_path, engine="serial", progress=False)
+    with CampaignStore(tmp_path) as st_:
+        (row,) = st_.rows()
+    (tmp_path / row.file).unlink()
+    s = run_campaign(spec, tmp_path, engine="serial", progress=False)
+    assert (s.submitted, s.done, s.reused) == (1, 1, 0)
+    with CampaignStore(tmp_path, lock=True):
+        with pytest.raises(CampaignLockedError, match="another client"):
+            run_campaign(spec, tmp_path, engine="serial", progress=False)
+
+
+def test_bad_runner_arguments(tmp_path):
+    spec = _spec()
+    with pytest.raises(ValueError, match="engine"):
+        run_campaign(spec, tmp_path, engine="mpi")
+    with pytest.raises(ValueError, match="workers"):
+        run_campaign(spec, tmp_path, engine="processes", workers=0)
+    with pytest.raises(ValueError, match="scheduler"):
+        run_campaign(spec, tmp_path, scheduler="localhost:8786")
+    with pytest.raises(FileNotFoundError, match="not a campaign"):
+        CampaignStore(tmp_path / "nothing")
+
+
+# -- Dask: a killed worker and a killed client ------------------------------------------------
+def _done(db: Path) -> int:
+    if not db.is_file():
+        return 0
+    con = sqlite3.connect(f"file:{db}?mode=ro", uri=True, timeout=10)
+    try:
+        return con.execute("SELECT count(*) FROM cases WHERE status='done'").fetchone()[0]
+    except sqlite3.OperationalError:
+        return 0
+    finally:
+        con.close()
+
+
+def _wait(pred, timeout: float, what: str) -> None:
+    t0 = time.monotonic()
+    while not pred():
+        if time.monotonic() - t0 > timeout:
+            raise AssertionError(f"timed out waiting for {what}")
+        time.sleep(0.2)
+
+
+def test_killed_worker_and_killed_client_lose_nothing_duplicate_nothing(tmp_path):
+    """A real LocalCluster (2 worker processes, loopback); the campaign client is a separate
+    process. One worker is killed (SIGKILL) mid-campaign, then the client is killed and
+    restarted: every case is in the index exactly once, done, with a valid file."""
+    from distributed import Client, LocalCluster
+
+    winds = [6, 9, 12, 15, 18, 21]
+    raw = {**BASE, "name": "kill", "duration": 60, "winds": winds, "seeds": 2}
+    spec_path = tmp_path / "kill.yaml"
+    spec_path.write_text(yaml.safe_dump(raw))
+    n_cases = len(winds) * 2
+    out = tmp_path / "camp"
+    db = out / "index.sqlite"
+    cmd = [sys.executable, "-m", "mpc_wt.cli", "campaign", "run", str(spec_path),
+           "--out", str(out), "--quiet"]
+    with LocalCluster(n_workers=2, threads_per_worker=1, processes=True, host="127.0.0.1",
+                      dashboard_address=None) as cluster, Client(cluster) as client:
+        cmd += ["--scheduler", cluster.scheduler_address]
+        first = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT)
+        try:
+            _wait(lambda: _done(db) >= 1, 240, "the first case")
+            pids = client.run(os.getpid)
+            os.kill(next(iter(pids.values())), signal.SIGKILL)     # a worker, mid-case
+            _wait(lambda: _done(db) >= 4, 240, "four cases after the worker kill")
+        finally:
+            first.kill()                                            # the client, mid-campaign
+            first.wait()
+        before = _done(db)
+        assert before < n_cases, "the client finished before it was killed: lengthen the cases"
+        second = subprocess.run(cmd, capture_output=True, text=True, timeout=600)
+        assert second.returncode == 0, second.stdout + second.stderr
+    con = sqlite3.connect(db)
+    attempts = [a for (a,) in con.execute("SELECT attempts FROM cases")]
+    assert max(attempts) == 2 and min(attempts) == 1    # the second client resubmitted the rest
+    rows = con.execute("SELECT case_id, status, file FROM cases").fetchall()
+    ids = [r[0] for r in rows]
+    assert len(ids) == len(set(ids)) == n_cases
+    assert {r[1] for r in rows} == {"done"}
+    expected = {c.case_id: c.case_hash for c in load_spec(spec_path).cases()}
+    assert set(ids) == set(expected)
+    files = sorted(p.name for p in (out / "cases").glob("*.nc"))
+    assert len(files) == n_cases
+    for cid, _, f in rows:
+        r = ClosedLoopResult.load(out / f)
+        assert r.meta["campaign_case"]["case_hash"] == expected[cid]
+        assert r.t[-1] == pytest.approx(65.0, abs=0.05)
+        assert np.all(np.isfinite(r.z))
+
+
+# -- aggregation and report -------------------------------------------------------------------
+def test_report_tables_and_plots(tmp_path):
+    from mpc_wt.campaign.report import aggregate, make_report
+
+    spec = _spec(winds=[10, 14], seeds=2, controllers=["baseline", "derate80"],
+                 duration=30, wind_distribution={"kind": "rayleigh", "mean": 10},
+                 report={"paper": [{"metric": "lifetime_del_change_pct",
+                                    "controller": "derate80", "channel": "lss_torque",
+                                    "value": -11.0, "source": "Pettas fig. 5"}]})
+    run_campaign(spec, tmp_path, engine="serial", progress=False)
+    agg = aggregate(tmp_path)
+    life = agg["lifetime"]
+    lss = {r["controller"]: r for r in life if r["channel"] == "lss_torque"}
+    # the m-power mean lies between the bins' DELs; derating lowers the shaft load
+    dels = [r["del"] for r in agg["short_term"] if r["controller"] == "baseline"
+            and r["channel"] == "lss_torque"]
+    assert min(dels) <= lss["baseline"]["lifetime_del"] <= max(dels)
+    assert lss["baseline"]["change_pct"] == 0.0
+    assert lss["derate80"]["change_pct"] < 0
+    aep = {r["controller"]: r for r in agg["aep"]}
+    assert aep["derate80"]["change_pct"] < -3
+    rep = make_report(tmp_path)
+    text = Path(rep).read_text()
+    assert "Pettas fig. 5" in text and "lss_torque" in text
+    for f in ("lifetime_del.csv", "short_term_del.csv", "aep.csv", "del_vs_wind.png",
+              "lifetime_del.png", "cs_ellipses.png", "psd.png"):
+        assert (Path(rep).parent / f).is_file(), f
+
+
+def test_report_refuses_empty_campaign(tmp_path):
+    from mpc_wt.campaign.report import make_report
+
+    with CampaignStore(tmp_path, lock=True) as st_:
+        st_.sync(_spec())
+        with pytest.raises(ValueError, match="holds no spec"):
+            make_report(tmp_path)
+        st_.set_meta(name="t", reference="baseline", spec_raw=BASE)
+    with pytest.raises(ValueError, match="no finished case"):
+        make_report(tmp_path)
