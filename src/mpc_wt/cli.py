@@ -721,9 +721,14 @@ def _cmd_campaign_run(args: argparse.Namespace) -> int:
         raise UsageError("give --workers (local cluster) or --scheduler (running cluster), "
                          "not both")
     out = Path(args.out) if args.out else Path("campaigns") / spec.name
-    for name in ("distributed", "distributed.nanny", "distributed.scheduler",
-                 "distributed.core", "distributed.worker"):
-        logging.getLogger(name).setLevel(logging.ERROR)
+    if args.engine == "dask":
+        try:    # import first: distributed sets its loggers' levels when imported
+            import distributed  # noqa: F401
+        except ImportError:
+            pass
+        for name in list(logging.root.manager.loggerDict):
+            if name.startswith("distributed"):
+                logging.getLogger(name).setLevel(logging.ERROR)
     log.info("campaign %s -> %s", spec.name, out)
     s = run_campaign(spec, out, workers=args.workers, scheduler=args.scheduler,
                      engine=args.engine, progress=not args.quiet)

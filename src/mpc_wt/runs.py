@@ -27,8 +27,8 @@ DEFAULT_CHANNELS = {"flap_moment_1": 10.0, "flap_moment_2": 10.0, "flap_moment_3
                     "shaft_bending_blade1": 4.0}
 
 
-CONTROLLERS = ("baseline", "mpc", "mpc-lidar", "mpc-collective", "lqr-pio", "ts", "ibc",
-               "coleman-ipc", "derate90", "derate80", "derate90+ibc", "derate80+ibc", "apc")
+CONTROLLERS = ("baseline", "baseline-ct", "mpc", "mpc-lidar", "mpc-collective", "lqr-pio", "ts",
+               "ibc", "coleman-ipc", "derate90", "derate80", "derate90+ibc", "derate80+ibc", "apc")
 _DERATE = re.compile(r"^derate(\d+(?:\.\d+)?)(\+ibc|\+coleman-ipc)?$")
 
 
@@ -104,9 +104,12 @@ def run_controller(turbine: linearize.Turbine, controller: str, wind_mps: float,
     first whole m/s above rated to 25 m/s in 1 m/s steps, scheduled on the estimated wind, or
     on the preview with "mpc-lidar").
 
-    "lqr-pio": Do et al.'s LQR on PI-observer estimates at the mean wind (region III, constant
-    torque; :mod:`mpc_wt.synthesis`). "ts": Clemens et al.'s TS controller and wind observer,
-    LMI-designed on the default vertex grid (:mod:`mpc_wt.ts`); ``apc_frequency`` [Hz] adds
+    "lqr-pio": Do et al.'s LQR on PI-observer estimates at the mean wind
+    (:mod:`mpc_wt.synthesis`): above rated wind region III (constant torque, speed regulation
+    and tower damping), below it region II (torque law, pitch moved around the operating point
+    to damp tower and blades). "baseline-ct": the baseline PI with constant torque in region
+    III (Do et al.'s PI). "ts": Clemens et al.'s TS controller and wind observer, LMI-designed
+    on the default vertex grid (:mod:`mpc_wt.ts`); ``apc_frequency`` [Hz] adds
     the sinusoidal power reduction of eq 11 (:func:`mpc_wt.retrofit.apc_reference`, with
     ``apc_amplitude`` and ``apc_offset``).
 
@@ -159,13 +162,25 @@ def run_controller(turbine: linearize.Turbine, controller: str, wind_mps: float,
     if retrofit_options and addon is None:
         raise ValueError("retrofit_options apply to the ibc and coleman-ipc controllers only")
     if kind == "lqr-pio":
-        from .synthesis import (REGION3_SCALES, REGION3_WEIGHTS, LQRPIOController, design_lqr,
+        from .synthesis import (REGION2_SCALES, REGION2_WEIGHTS, REGION3_SCALES,
+                                REGION3_WEIGHTS, LQRPIOController, design_lqr,
                                 design_pi_observer)
 
         model = linearize.linearize(turbine, wind_mps, config=linearize.PlantConfig.do())
-        lq = design_lqr(model, state_weights=REGION3_WEIGHTS, scales=REGION3_SCALES)
-        ctl = LQRPIOController(model, turbine, lq, design_pi_observer(model, q=1e3))
-        meta["lqr"] = {"weights": lq.weights, "observer_q": 1e3}
+        region = "II" if wind_mps < linearize.rated_wind_speed(turbine) else "III"
+        w, sc = ((REGION3_WEIGHTS, REGION3_SCALES) if region == "III"
+                 else (REGION2_WEIGHTS, REGION2_SCALES))
+        lq = design_lqr(model, state_weights=w, scales=sc)
+        ctl = LQRPIOController(model, turbine, lq, design_pi_observer(model, q=1e3),
+                               region=region, k_opt=(tune_baseline(turbine).k_opt
+                                                     if region == "II" else None),
+                               feedforward=region == "III")
+        meta["lqr"] = {"weights": lq.weights, "observer_q": 1e3, "region": region}
+    elif kind == "baseline-ct":
+        gains = tune_baseline(turbine)
+        ctl = BaselineController(turbine, gains, region3="constant_torque")
+        meta["gains"] = {"kp": gains.kp, "ki": gains.ki, "theta_k_rad": gains.theta_k_rad,
+                         "k_opt": gains.k_opt, "region3": "constant_torque"}
     elif kind == "ts":
         from .retrofit import apc_reference
         from .ts import TSController, build_ts_model, design_ts_controller, design_ts_observer

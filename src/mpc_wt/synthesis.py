@@ -44,6 +44,12 @@ REGION3_WEIGHTS = {"rotor_speed": 5.0, "tower_fa_velocity": 1.0}
 #: Their typical magnitudes (``scales``): 0.05 rad/s, 0.1 m/s, 1 deg of pitch per blade.
 REGION3_SCALES = {"rotor_speed": 0.05, "tower_fa_velocity": 0.1,
                   **{f"pitch_ref_{i}": math.radians(1.0) for i in (1, 2, 3)}}
+#: Region II (Do et al. sec. 4.2): the torque law keeps the speed; the pitch, moved around its
+#: operating point, adds damping to the tower fore-aft and blade flap modes only.
+REGION2_WEIGHTS = {"tower_fa_velocity": 1.0, **{f"flap_rate_{i}": 0.2 for i in (1, 2, 3)}}
+#: Their magnitudes: 0.1 m/s tower-top velocity, 1 m/s flap tip rate, 1 deg of pitch per blade.
+REGION2_SCALES = {"tower_fa_velocity": 0.1, **{f"flap_rate_{i}": 1.0 for i in (1, 2, 3)},
+                  **{f"pitch_ref_{i}": math.radians(1.0) for i in (1, 2, 3)}}
 
 
 class SynthesisError(ValueError):

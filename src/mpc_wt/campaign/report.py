@@ -207,9 +207,11 @@ def _ours(agg: dict[str, Any], p: dict[str, Any]) -> float | None:
     return r.get(p.get("measure", "")) if r else None
 
 
-def _agree(ours: float | None, paper: float) -> str:
+def _agree(ours: float | None, paper: float | str) -> str:
     if ours is None or not math.isfinite(ours):
         return "n/a"
+    if isinstance(paper, str):
+        return "yes" if (ours > 0) == (paper == "increase") else "**no**"
     if abs(paper) < 1.0 and abs(ours) < 1.0:
         return "yes"
     return "yes" if np.sign(ours) == np.sign(paper) else "**no**"
@@ -423,8 +425,9 @@ def make_report(root: str | Path, out: str | Path | None = None) -> Path:
         paper.append({"what": f"{p['metric']} {where}".strip(), "controller": p["controller"],
                       "wind": p.get("wind", "lifetime"),
                       "turbulence": p.get("turbulence", spec.turbulence[0]),
-                      "paper": float(p["value"]), "ours": ours,
-                      "direction_agrees": _agree(ours, float(p["value"])),
+                      "paper": p.get("direction") or float(p["value"]), "ours": ours,
+                      "direction_agrees": _agree(ours, p.get("direction")
+                                                 or float(p["value"])),
                       "source": p.get("source", ""), "note": p.get("note", "")})
     if paper:
         _write_csv(out / "paper_comparison.csv", paper)
@@ -446,9 +449,9 @@ def make_report(root: str | Path, out: str | Path | None = None) -> Path:
     if paper:
         md += ["## Ours next to the paper", "",
                _md(paper, ["what", "controller", "wind", "turbulence", "paper", "ours",
-                           "direction_agrees", "source"],
+                           "direction_agrees", "source", "note"],
                    ["quantity", "controller", "wind [m/s]", "turbulence", "paper", "ours",
-                    "same direction", "source"]), ""]
+                    "same direction", "source", "note"]), ""]
     if spec.report.get("notes"):
         md += ["## Where we differ, and why", "", str(spec.report["notes"]).strip(), ""]
     md += ["## Lifetime DEL", "", "m-power mean over the wind bins weighted by the wind "

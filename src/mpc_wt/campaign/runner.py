@@ -268,9 +268,12 @@ class _Bar:
             self.bar.set_postfix_str(f"running {self.run}, failed {self.failed}", refresh=True)
 
     def running(self, n: int) -> None:
+        """Called about once a second: the running count, and the elapsed time and ETA."""
         if n != self.run:
             self.run = n
             self._post()
+        elif self.bar is not None:
+            self.bar.refresh()
 
     def step(self, ok: bool) -> None:
         self.failed += not ok

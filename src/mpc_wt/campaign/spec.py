@@ -452,12 +452,12 @@ _PAPER_METRICS = {"del_change_pct", "lifetime_del_change_pct", "aep_change_pct",
 
 
 def _paper_row(key: str, p: Any, names: list[str], chans: Mapping[str, float]) -> None:
-    """A paper value to place next to ours: {metric, controller, value, [channel|measure],
-    [wind], [source]}."""
+    """A paper value to place next to ours: {metric, controller, value | direction,
+    [channel|measure], [wind], [turbulence], [source], [note]}."""
     if not isinstance(p, Mapping):
         raise _fail(key, f"must be a mapping, got {p!r}")
-    allowed = {"metric", "controller", "value", "channel", "measure", "wind", "source",
-               "turbulence", "note"}
+    allowed = {"metric", "controller", "value", "direction", "channel", "measure", "wind",
+               "source", "turbulence", "note"}
     extra = set(p) - allowed
     if extra:
         raise _fail(f"{key}.{sorted(extra)[0]}", f"unknown key; allowed: {sorted(allowed)}")
@@ -469,7 +469,15 @@ def _paper_row(key: str, p: Any, names: list[str], chans: Mapping[str, float]) -
                                          f"names are {names}")
     if "channel" in p and p["channel"] not in chans:
         raise _fail(f"{key}.channel", f"{p['channel']!r} is not a campaign channel")
-    _number(f"{key}.value", p.get("value"))
+    if "direction" in p:
+        if p["direction"] not in ("increase", "decrease") or "value" in p:
+            raise _fail(f"{key}.direction", f"must be 'increase' or 'decrease' (for a paper "
+                                            f"that gives a figure, not a number) and without "
+                                            f"value, got {p['direction']!r}")
+    else:
+        _number(f"{key}.value", p.get("value"))
+    if p["metric"] in ("del_change_pct", "cs_change_pct", "value") and "wind" not in p:
+        raise _fail(f"{key}.wind", f"metric {p['metric']!r} is per mean wind: give wind [m/s]")
 
 
 def load_spec(path: str | Path) -> CampaignSpec:
