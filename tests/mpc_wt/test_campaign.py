@@ -277,3 +277,55 @@ def test_report_refuses_empty_campaign(tmp_path):
         st_.set_meta(name="t", reference="baseline", spec_raw=BASE)
     with pytest.raises(ValueError, match="no finished case"):
         make_report(tmp_path)
+
+
+# -- controllers the studies added -------------------------------------------------------------
+def test_do_controllers_pick_their_region():
+    """lqr-pio below rated wind runs Do's region II (torque law, pitch only damps: the mean
+    power stays that of the baseline within 2 %); baseline-ct holds torque constant above rated
+    (torque std below 0.5 % of rated torque, the constant-power baseline's is larger)."""
+    import linearize
+    from mpc_wt.runs import run_controller
+
+    tb = linearize.load_turbine()
+    r2 = run_controller(tb, "lqr-pio", 8.0, 0.12, 1, 60.0)
+    b2 = run_controller(tb, "baseline", 8.0, 0.12, 1, 60.0)
+    assert r2.meta["lqr"]["region"] == "II"
+    k = r2.t > 20
+    assert r2.channel("gen_power")[k].mean() == pytest.approx(
+        b2.channel("gen_power")[k].mean(), rel=0.02)
+    assert run_controller(tb, "lqr-pio", 18.0, 0.12, 1, 5.0).meta["lqr"]["region"] == "III"
+    ct = run_controller(tb, "baseline-ct", 18.0, 0.12, 1, 60.0)
+    cp = run_controller(tb, "baseline", 18.0, 0.12, 1, 60.0)
+    q_rated = tb.operation.rated_power / tb.operation.rated_rotor_speed_rad_s / \
+        tb.drivetrain.gearbox_ratio
+    assert ct.channel("gen_torque")[k].std() < 0.005 * q_rated
+    assert cp.channel("gen_torque")[k].std() > ct.channel("gen_torque")[k].std()
+
+
+def test_aggregate_flags_a_seed_far_above_its_bin_and_weights_lifetime(tmp_path):
+    """Synthetic index (no simulation): the lifetime DEL is the eq-18 m-power mean, and a seed
+    with 10x its bin's median DEL is listed as suspect (kept in the tables)."""
+    from mpc_wt.assess import lifetime_del, wind_bin_probabilities
+    from mpc_wt.campaign.report import aggregate
+
+    raw = {**BASE, "winds": [8, 12], "seeds": 3, "channels": {"lss_torque": 4}}
+    spec = spec_from_dict(raw)
+    dels = {(8.0, 1): 1.0, (8.0, 2): 1.1, (8.0, 3): 11.0, (12.0, 1): 2.0, (12.0, 2): 2.0,
+            (12.0, 3): 2.0}
+    with CampaignStore(tmp_path, lock=True) as st_:
+        st_.sync(spec)
+        st_.set_meta(name="t", reference="baseline", spec_raw=raw)
+        for c in spec.cases():
+            d = dels[(c.wind_mps, c.seed)]
+            st_.record(c.case_id, {"status": "done", "file": None, "metrics": {
+                "channels": {"lss_torque": {"del": d, "m": 4.0}}, "power_mean_W": 1e6}},
+                spec.spec_hash)
+    agg = aggregate(tmp_path)
+    (out,) = agg["outliers"]
+    assert (out["wind_mps"], out["seed"]) == (8.0, 3)
+    assert out["ratio_to_median"] == pytest.approx(10.0)
+    bin8 = np.mean(np.array([1.0, 1.1, 11.0]) ** 4) ** 0.25
+    p = wind_bin_probabilities(np.array([8.0, 12.0]), "rayleigh", mean=10.0)
+    (life,) = agg["lifetime"]
+    assert life["lifetime_del"] == pytest.approx(lifetime_del([bin8, 2.0], 4.0, p))

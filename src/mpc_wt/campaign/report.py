@@ -26,6 +26,9 @@ from .store import CampaignStore, CaseRow
 
 __all__ = ["aggregate", "make_report"]
 
+#: A seed whose DEL exceeds this multiple of its bin's median (3 seeds or more) is listed as
+#: suspect in the report: with m = 10 one such run can carry a lifetime DEL.
+OUTLIER_RATIO = 3.0
 _PITCH = ("pitch_travel_deg", "pitch_rate_std_degps", "pitch_acc_std_degps2")
 _CS = ("cs1", "cs2", "cs3", "cs4", "cs5")
 
@@ -76,6 +79,7 @@ def aggregate(root: str | Path) -> dict[str, Any]:
     chans = spec.channels
     short, per_wind, life, aep, pitch, cs_rows, ext = [], [], [], [], [], [], []
     incomplete = []
+    outliers: list[dict[str, Any]] = []
 
     def bin_del(cases: list[CaseRow], ch: str, m: float) -> float | None:
         d = [c.metrics["channels"][ch]["del"] for c in cases if ch in c.metrics["channels"]]
@@ -95,6 +99,18 @@ def aggregate(root: str | Path) -> dict[str, Any]:
             incomplete.append(f"{ctl} ({turb}): winds {missing} lack seeds")
         winds = sorted(bins)
         rbins = by.get((ref, turb), {})
+        for v in winds:
+            if len(bins[v]) < 3:
+                continue
+            for ch in chans:
+                d = {c.seed: c.metrics["channels"][ch]["del"] for c in bins[v]
+                     if ch in c.metrics["channels"]}
+                med = float(np.median(list(d.values()))) if d else 0.0
+                for seed, x in d.items():
+                    if med > 0 and x > OUTLIER_RATIO * med:
+                        outliers.append({"controller": ctl, "turbulence": turb, "wind_mps": v,
+                                         "seed": seed, "channel": ch, "del": x,
+                                         "ratio_to_median": x / med})
         for v in winds:
             for c in bins[v]:
                 for ch, m in chans.items():
@@ -169,7 +185,7 @@ def aggregate(root: str | Path) -> dict[str, Any]:
                     k: r[k] for k in ("turbulence", "channel", "lifetime_del", "change_pct")}})
     return {"spec": spec, "rows": rows, "short_term": short, "per_wind": per_wind,
             "lifetime": life, "aep": aep, "pitch": pitch, "cs": cs_rows, "extension": ext,
-            "sweep": sweep, "incomplete": incomplete}
+            "sweep": sweep, "incomplete": incomplete, "outliers": outliers}
 
 
 # -- paper comparison -------------------------------------------------------------------------
@@ -295,8 +311,8 @@ def _plots(agg: dict[str, Any], root: Path, out: Path) -> list[str]:
     # lifetime DEL change bars (Pettas fig. 5 / Clemens fig. 7 layout)
     others = [c for c in ctls if c != spec.reference]
     if others:
-        fig, ax = plt.subplots(figsize=(max(6.0, 0.6 * len(chans) * max(1, len(others))), 4.0),
-                               dpi=110)
+        width = min(12.0, max(6.0, 0.3 * len(chans) * len(others) * len(turbs) + 2.0))
+        fig, ax = plt.subplots(figsize=(width, 4.2), dpi=110)
         w = 0.8 / (len(others) * len(turbs))
         i = 0
         for ctl in others:
@@ -412,7 +428,7 @@ def make_report(root: str | Path, out: str | Path | None = None) -> Path:
     out = Path(out) if out else root / "report"
     out.mkdir(parents=True, exist_ok=True)
     for name in ("short_term", "per_wind", "lifetime", "aep", "pitch", "cs", "extension",
-                 "sweep"):
+                 "sweep", "outliers"):
         if agg[name]:
             fname = {"short_term": "short_term_del", "per_wind": "del_by_wind",
                      "lifetime": "lifetime_del"}.get(name, name)
@@ -452,6 +468,12 @@ def make_report(root: str | Path, out: str | Path | None = None) -> Path:
                            "direction_agrees", "source", "note"],
                    ["quantity", "controller", "wind [m/s]", "turbulence", "paper", "ours",
                     "same direction", "source", "note"]), ""]
+    if agg["outliers"]:
+        md += ["## Suspect cases", "", f"Seeds whose DEL is more than {OUTLIER_RATIO:g}x the "
+               "median of their wind bin; they are kept in every table (look at their time "
+               "series in `cases/`):", "",
+               _md(agg["outliers"], ["controller", "turbulence", "wind_mps", "seed", "channel",
+                                     "del", "ratio_to_median"]), ""]
     if spec.report.get("notes"):
         md += ["## Where we differ, and why", "", str(spec.report["notes"]).strip(), ""]
     md += ["## Lifetime DEL", "", "m-power mean over the wind bins weighted by the wind "

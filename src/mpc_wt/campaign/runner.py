@@ -260,12 +260,17 @@ class _Bar:
         if enabled:
             from tqdm import tqdm
 
-            self.bar = tqdm(total=total, desc=f"campaign {name}", unit="case", smoothing=0.1)
+            import sys
+
+            # a terminal redraws twice a second; a log file gets a line every 30 s at most
+            self.bar = tqdm(total=total, desc=f"campaign {name}", unit="case", smoothing=0.1,
+                            mininterval=0.5 if sys.stderr.isatty() else 30.0)
             self._post()
 
     def _post(self) -> None:
         if self.bar is not None:
-            self.bar.set_postfix_str(f"running {self.run}, failed {self.failed}", refresh=True)
+            self.bar.set_postfix_str(f"running {self.run}, failed {self.failed}", refresh=False)
+            self.bar.update(0)
 
     def running(self, n: int) -> None:
         """Called about once a second: the running count, and the elapsed time and ETA."""
@@ -273,7 +278,7 @@ class _Bar:
             self.run = n
             self._post()
         elif self.bar is not None:
-            self.bar.refresh()
+            self.bar.update(0)      # elapsed time and ETA, within tqdm's mininterval
 
     def step(self, ok: bool) -> None:
         self.failed += not ok
