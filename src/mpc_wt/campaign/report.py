@@ -507,7 +507,7 @@ def make_report(root: str | Path, out: str | Path | None = None) -> Path:
            "![CS ellipses](cs_ellipses.png)", "", "![PSD](psd.png)", ""]
     if agg["sweep"]:
         md += ["## APC frequency sweep", "", "![APC sweep](apc_sweep.png)", "",
-               _md([r for r in agg["sweep"]], ["controller", "apc_frequency_Hz", "turbulence",
+               _md(agg["sweep"], ["controller", "apc_frequency_Hz", "turbulence",
                                                "channel", "lifetime_del", "change_pct"]), ""]
     md += ["Plots: " + ", ".join(Path(p).name for p in plots), ""]
     path = out / "report.md"

@@ -21,7 +21,7 @@ import sqlite3
 import time
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Iterable, Iterator
+from typing import Any, Iterable
 
 from .spec import Case, CampaignSpec
 
@@ -295,7 +295,3 @@ class _Tx:
     def __exit__(self, et: Any, ev: Any, tb: Any) -> None:
         self.db.execute("ROLLBACK" if et else "COMMIT")
 
-
-def iter_done(store: CampaignStore) -> Iterator[CaseRow]:
-    """Finished rows of the current spec."""
-    return (r for r in store.rows() if r.status == "done")
