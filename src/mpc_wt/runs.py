@@ -176,11 +176,6 @@ def run_controller(turbine: linearize.Turbine, controller: str, wind_mps: float,
                                                      if region == "II" else None),
                                feedforward=region == "III")
         meta["lqr"] = {"weights": lq.weights, "observer_q": 1e3, "region": region}
-    elif kind == "baseline-ct":
-        gains = tune_baseline(turbine)
-        ctl = BaselineController(turbine, gains, region3="constant_torque")
-        meta["gains"] = {"kp": gains.kp, "ki": gains.ki, "theta_k_rad": gains.theta_k_rad,
-                         "k_opt": gains.k_opt, "region3": "constant_torque"}
     elif kind == "ts":
         from .retrofit import apc_reference
         from .ts import TSController, build_ts_model, design_ts_controller, design_ts_observer
@@ -205,11 +200,12 @@ def run_controller(turbine: linearize.Turbine, controller: str, wind_mps: float,
         meta["apc"] = {"frequency_Hz": apc_frequency, "amplitude": apc_amplitude,
                        "offset": apc_offset,
                        "schedule_fractions": [g.power_fraction for g in sched]}
-    elif kind == "baseline":
+    elif kind in ("baseline", "baseline-ct"):
+        region3 = "constant_torque" if kind == "baseline-ct" else "constant_power"
         gains = tune_baseline(turbine, power_fraction=frac)
-        ctl: Any = BaselineController(turbine, gains)
+        ctl: Any = BaselineController(turbine, gains, region3=region3)
         meta["gains"] = {"kp": gains.kp, "ki": gains.ki, "theta_k_rad": gains.theta_k_rad,
-                         "k_opt": gains.k_opt, "power_fraction": frac}
+                         "k_opt": gains.k_opt, "power_fraction": frac, "region3": region3}
         if addon is not None:
             from . import retrofit
 
