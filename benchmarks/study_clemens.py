@@ -22,7 +22,8 @@ import numpy as np
 import lidar
 import linearize
 from mpc_wt.assess import tracking_response
-from mpc_wt.runs import _wind, run_baseline
+from mpc_wt import run_controller
+from mpc_wt.controllers import Scenario, make_wind
 from mpc_wt.simulate import simulate_closed_loop
 from mpc_wt.retrofit import apc_reference
 from mpc_wt.ts import TSController, build_ts_model, design_ts_controller, design_ts_observer
@@ -56,7 +57,7 @@ def main() -> int:
     figs["regulation"] = []
     keep_plot = {}
     for v in (float(s) for s in args.winds.split(",")):
-        wind, field = _wind(tb, v, "A", args.seed, dur, 0.2)
+        wind, field = make_wind(tb, Scenario(v, "A", args.seed, dur, 0.2))
         op = linearize.trim(tb, v)
         c = TSController(ts, ctl, obs, tb, initial_wind=v)
         r = simulate_closed_loop(params, c, wind, dur, x0=op.x, u0=op.u, progress=True)
@@ -66,7 +67,7 @@ def main() -> int:
         est = r.channel("wind_est")
         fs = 1.0 / float(np.median(np.diff(r.t)))
         f, g2 = lidar.coherence(est[k], truth[k], fs, nperseg=int(120 * fs))
-        b = run_baseline(tb, v, "A", seed=args.seed, duration=dur)
+        b = run_controller(tb, "baseline", v, "A", seed=args.seed, duration=dur)
         wb = b.channel("rotor_speed")[b.t >= args.transient]
         row = {"wind_mps": v, "rotor_mean_pct": 100 * (w.mean() / rated - 1),
                "rotor_std_pct": 100 * w.std() / rated, "rotor_max_pct": 100 * (w.max() / rated - 1),
@@ -86,7 +87,7 @@ def main() -> int:
             keep_plot["wind"] = (v, r.t, truth, est)
     figs["apc"] = []
     v = 15.0
-    wind, field = _wind(tb, v, "A", args.seed, dur, 0.2)
+    wind, field = make_wind(tb, Scenario(v, "A", args.seed, dur, 0.2))
     op = linearize.trim(tb, v)
     for fr in (float(s) for s in args.frequencies.split(",")):
         c = TSController(ts, ctl, obs, tb, initial_wind=v, power_reduction=apc_reference(fr))

@@ -20,8 +20,8 @@ import numpy as np
 import linearize
 from mpc_wt.assess import cs_measures, damage_equivalent_load
 from mpc_wt.baseline import BaselineController, tune_baseline
-from mpc_wt.runs import _wind
-from mpc_wt.simulate import SimulationDivergedError, simulate_closed_loop
+from mpc_wt.controllers import Scenario, make_wind
+from mpc_wt import SimulationDivergedError, simulate_closed_loop
 from mpc_wt.synthesis import (REGION3_SCALES, REGION3_WEIGHTS, LQRPIOController, design_lqr,
                               design_pi_observer)
 
@@ -68,7 +68,7 @@ def main() -> int:
                              {"rotor_speed": 0.05, **{f"flap_{i}": 2.0 for i in (1, 2, 3)}})
     res: dict = {name: [] for name in cases}
     for seed in (int(s) for s in args.seeds.split(",")):
-        wind, _ = _wind(tb, v, "C", seed, dur, 0.2)
+        wind, _ = make_wind(tb, Scenario(v, "C", seed, dur, 0.2))
         for name, spec in cases.items():
             ctl = BaselineController(tb, gains, region3="constant_torque") if spec is None \
                 else _fsf(model, tb, *spec)

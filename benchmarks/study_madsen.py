@@ -22,7 +22,7 @@ import numpy as np
 import linearize
 from mpc_wt.assess import damage_equivalent_load, harmonic_psd, psd
 from mpc_wt.plotting import plot_psd_comparison
-from mpc_wt.runs import run_controller
+from mpc_wt import run_controller
 
 from _study import study_args
 

@@ -30,7 +30,8 @@ import numpy as np
 import linearize
 from mpc_wt.assess import tracking_response, wind_bin_probabilities
 from mpc_wt.retrofit import aep_change, lifetime_comparison
-from mpc_wt.runs import assess_series, run_controller
+from mpc_wt import run_controller
+from mpc_wt.assess import assess_series
 
 from _study import study_args
 
@@ -44,10 +45,8 @@ def _case(job: tuple) -> tuple:
     """One simulation -> (key, metrics); a pure function for the process pool."""
     key, ctl, v, seed, dur, transient, opts = job
     tb = linearize.load_turbine()
-    kw = {k: opts[k] for k in ("apc_frequency",) if k in opts}
-    ro = opts.get("retrofit_options")
     r = run_controller(tb, ctl, v, "A", seed, dur + transient, shear_exponent=0.2,
-                       retrofit_options=ro, **kw)
+                       options=opts)
     k = r.t >= transient
     m = assess_series(r.t[k], {n: r.channel(n)[k] for n in r.channels()})
     m["rotor_speed_mean_rad_s"] = float(r.channel("rotor_speed")[k].mean())
@@ -73,7 +72,7 @@ def main() -> int:
     winds = [float(s) for s in args.winds.split(",")]
     jobs = [(("ibc18", c), c, 18.0, seed, dur, tr, o) for c, o in (
         ("baseline", {}), ("ibc", {}), ("coleman-ipc", {}),
-        ("ibc-paper", {"retrofit_options": {"remove_collective": False}}))]
+        ("ibc-paper", {"remove_collective": False}))]
     jobs = [(k, "ibc" if c == "ibc-paper" else c, v, s, d, t, o)
             for k, c, v, s, d, t, o in jobs]
     jobs += [(("life", c, v), c, v, seed, dur, tr, {}) for c in LIFETIME for v in winds]

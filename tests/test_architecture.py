@@ -44,3 +44,96 @@ def test_init_files_have_no_logic() -> None:
             assert isinstance(node, (ast.Expr, ast.Import, ast.ImportFrom, ast.Assign,
                                      ast.AnnAssign, ast.Try)), \
                 f"{init}: only re-exports and __all__ allowed, found {type(node).__name__}"
+
+
+def _private_imports(path: Path) -> list[str]:
+    """Names starting with ``_`` imported from linearize or lidar (modules or attributes)."""
+    tree = ast.parse(path.read_text(), filename=str(path))
+    bad = []
+    for node in ast.walk(tree):
+        if isinstance(node, ast.ImportFrom) and node.level == 0 and node.module:
+            root = node.module.split(".")[0]
+            if root in ("linearize", "lidar"):
+                parts = node.module.split(".")[1:] + [a.name for a in node.names]
+                bad += [f"{node.module}.{a.name}" for a in node.names
+                        if any(p.startswith("_") for p in parts)]
+        elif isinstance(node, ast.Import):
+            bad += [a.name for a in node.names if a.name.split(".")[0] in ("linearize", "lidar")
+                    and any(p.startswith("_") for p in a.name.split(".")[1:])]
+        elif isinstance(node, ast.Attribute) and node.attr.startswith("_") \
+                and not node.attr.startswith("__"):
+            base = node.value
+            while isinstance(base, ast.Attribute):
+                base = base.value
+            if isinstance(base, ast.Name) and base.id in ("linearize", "lidar"):
+                bad.append(f"{base.id}...{node.attr}")
+    return bad
+
+
+def test_mpc_wt_imports_no_private_name_of_linearize_or_lidar() -> None:
+    bad = {str(f.relative_to(SRC)): _private_imports(f)
+           for f in sorted((SRC / "mpc_wt").rglob("*.py"))}
+    bad = {k: v for k, v in bad.items() if v}
+    assert not bad, f"private names of linearize/lidar used in mpc_wt: {bad}"
+
+
+def test_private_import_checker_catches_one(tmp_path: Path) -> None:
+    f = tmp_path / "x.py"
+    f.write_text("from linearize.plant import _rk4\nimport linearize\nlinearize.plant._eval\n"
+                 "from linearize import trim\n")
+    assert _private_imports(f) == ["linearize.plant._rk4", "linearize..._eval"]
+
+
+def _is_numba_kernel(fn: ast.FunctionDef) -> bool:
+    for d in fn.decorator_list:
+        target = d.func if isinstance(d, ast.Call) else d
+        name = target.attr if isinstance(target, ast.Attribute) else getattr(target, "id", "")
+        if name in ("njit", "jit", "vectorize", "guvectorize"):
+            return True
+    return False
+
+
+def _long_functions(path: Path, limit: int = 80) -> list[str]:
+    tree = ast.parse(path.read_text(), filename=str(path))
+    return [f"{fn.name} ({fn.end_lineno - fn.lineno + 1} lines)" for fn in ast.walk(tree)
+            if isinstance(fn, (ast.FunctionDef, ast.AsyncFunctionDef))
+            and fn.end_lineno - fn.lineno + 1 > limit and not _is_numba_kernel(fn)]
+
+
+def test_no_function_in_mpc_wt_longer_than_80_lines() -> None:
+    """STYLE rule 12: an orchestration function past 60-80 lines hides a step."""
+    bad = {str(f.relative_to(SRC)): _long_functions(f)
+           for f in sorted((SRC / "mpc_wt").rglob("*.py"))}
+    bad = {k: v for k, v in bad.items() if v}
+    assert not bad, f"functions longer than 80 lines: {bad}"
+
+
+def test_length_checker_counts_lines_and_spares_kernels(tmp_path: Path) -> None:
+    f = tmp_path / "x.py"
+    body = "\n".join(f"    x{i} = {i}" for i in range(81))
+    f.write_text(f"import numba as nb\n\ndef long():\n{body}\n\n\n@nb.njit\ndef kern():\n"
+                 f"{body}\n")
+    assert _long_functions(f) == ["long (82 lines)"]
+
+
+def test_runs_module_is_gone_and_one_simulation_diverged_error() -> None:
+    assert not (SRC / "mpc_wt" / "runs.py").exists()
+    import linearize
+    import mpc_wt
+    from mpc_wt import simulate
+
+    assert mpc_wt.SimulationDivergedError is linearize.SimulationDivergedError
+    assert simulate.SimulationDivergedError is linearize.SimulationDivergedError
+    for pkg in ("linearize", "lidar", "mpc_wt"):
+        tree = ast.parse((SRC / pkg / "errors.py").read_text())
+        classes = [n.name for n in tree.body if isinstance(n, ast.ClassDef)]
+        assert classes, pkg
+    # exception classes are defined only in the errors modules
+    for f in sorted(SRC.rglob("*.py")):
+        if f.name == "errors.py":
+            continue
+        tree = ast.parse(f.read_text())
+        for n in ast.walk(tree):
+            if isinstance(n, ast.ClassDef) and n.name.endswith("Error"):
+                raise AssertionError(f"{f.relative_to(SRC)} defines {n.name}; errors belong "
+                                     f"in the package's errors module")

@@ -3,7 +3,8 @@
 This package imports neither ``linearize`` nor ``mpc_wt``; turbine geometry arrives as numbers.
 """
 from .cw import CWLidar, LidarMeasurement
-from .field import FieldFileError, WindField
+from .errors import FieldFileError
+from .field import WindField
 from .preview import (Preview, blade_effective_wind, coherence, coherence_bandwidth, peak_lag,
                       preview, preview_series, rms_preview_error, rotor_effective_wind)
 from .turbulence import (TurbulenceSpec, evolve_field, generate_field, iec_coherence, iec_sigma,

@@ -16,14 +16,11 @@ from typing import Any
 import numpy as np
 
 from ._typing import FloatArray
+from .errors import FieldFileError
 
 __all__ = ["WindField", "FieldFileError"]
 
 SCHEMA_VERSION = 1
-
-
-class FieldFileError(ValueError):
-    """A wind-field file is missing, truncated, or holds non-finite values."""
 
 
 def _frozen(a: Any, name: str) -> FloatArray:

@@ -3,21 +3,22 @@
 This package never imports ``mpc_wt`` or ``lidar``.
 """
 from .bem import AeroOptions, element_loads
-from .linear import (LinearizationError, LinearModel, LinearModelFamily, augment_actuator,
+from .errors import LinearizationError, SimulationDivergedError, TrimError, TurbineFileError
+from .linear import (LinearModel, LinearModelFamily, augment_actuator,
                      jacobian_check, linearize, linearize_family, sensitivities,
                      with_power_input)
 from .plant import (DOF_NAMES, INPUT_NAMES, INPUT_UNITS, MADSEN_OUTPUTS, OUTPUT_NAMES,
                     OUTPUT_UNITS, STATE_NAMES, STATE_UNITS, GridWind, PlantConfig, PlantParams,
-                    SimulationDivergedError, SimulationResult, SteadyWind, element_wind,
+                    PlantStepper, SimulationResult, SteadyWind, element_wind,
                     plant_outputs, plant_params, plant_rhs, rk4_simulate, structural_frequencies)
 from .steady import optimal_tsr, rotor_average, steady_coefficients
-from .trim import OperatingPoint, TrimError, operating_schedule, rated_wind_speed, trim
-from .turbine import Turbine, TurbineFileError, available_turbines, load_turbine
+from .trim import OperatingPoint, operating_schedule, rated_wind_speed, trim
+from .turbine import Turbine, available_turbines, load_turbine
 
 __all__ = [
     "AeroOptions", "element_loads", "DOF_NAMES", "INPUT_NAMES", "INPUT_UNITS", "MADSEN_OUTPUTS",
     "OUTPUT_NAMES", "OUTPUT_UNITS", "STATE_NAMES", "STATE_UNITS", "GridWind", "PlantConfig",
-    "PlantParams", "SimulationDivergedError", "SimulationResult", "SteadyWind", "element_wind",
+    "PlantParams", "PlantStepper", "SimulationDivergedError", "SimulationResult", "SteadyWind", "element_wind",
     "plant_outputs", "plant_params", "plant_rhs", "rk4_simulate", "structural_frequencies",
     "optimal_tsr", "rotor_average", "steady_coefficients", "OperatingPoint", "TrimError",
     "operating_schedule", "rated_wind_speed", "trim", "Turbine", "TurbineFileError", "available_turbines",

@@ -33,7 +33,7 @@ import numpy as np
 from scipy.interpolate import Akima1DInterpolator
 
 from ._typing import FloatArray
-from ._validate import check_array
+from .validate import check_array
 from .turbine import Polar, Turbine
 
 __all__ = ["AeroOptions", "PolarTable", "build_polar_table", "element_loads", "polar_table_of"]

@@ -48,7 +48,8 @@ import numpy as np
 import scipy.linalg
 
 from ._typing import FloatArray
-from ._validate import check_finite_scalar, check_positive
+from .errors import LinearizationError
+from .validate import check_finite_scalar, check_positive
 from .bem import MODE_CS, MODE_FROZEN, MODE_NOLIMITS, MODE_TIGHT
 from .plant import (INPUT_NAMES, INPUT_UNITS, OUTPUT_NAMES, OUTPUT_UNITS, STATE_NAMES,
                     STATE_UNITS, PlantConfig, PlantParams, _eval, _sample_wind, plant_params)
@@ -73,10 +74,6 @@ _BLADE_GROUPS_Z = (("pitch_1", "pitch_2", "pitch_3"),
                    ("pitch_rate_1", "pitch_rate_2", "pitch_rate_3"),
                    ("flap_moment_1", "flap_moment_2", "flap_moment_3"),
                    ("edge_moment_1", "edge_moment_2", "edge_moment_3"))
-
-
-class LinearizationError(RuntimeError):
-    """The plant could not be linearized (e.g. a Jacobian entry is not finite)."""
 
 
 # --------------------------------------------------------------------------------------------

@@ -57,7 +57,8 @@ import numba as nb
 import numpy as np
 
 from ._typing import FloatArray
-from ._validate import check_array, check_positive
+from .errors import SimulationDivergedError
+from .validate import check_array, check_positive
 from .bem import (MODE_NOLIMITS, AeroOptions, _element, _locate_cell, aero_flags,
                   polar_table_of)
 from .turbine import Turbine, mode_shape
@@ -66,7 +67,7 @@ __all__ = [
     "DOF_NAMES", "STATE_NAMES", "STATE_UNITS", "INPUT_NAMES", "INPUT_UNITS", "OUTPUT_NAMES",
     "OUTPUT_UNITS", "MADSEN_OUTPUTS", "PlantConfig", "PlantParams", "plant_params", "plant_rhs",
     "plant_outputs", "element_wind", "SteadyWind", "GridWind", "SimulationResult",
-    "SimulationDivergedError", "rk4_simulate", "structural_frequencies", "n_x", "n_u", "n_z",
+    "SimulationDivergedError", "rk4_simulate", "PlantStepper", "structural_frequencies", "n_x", "n_u", "n_z",
 ]
 
 DOF_NAMES = ("tower_fa", "tower_ss", "drivetrain", "generator", "blade_flap", "pitch_actuator")
@@ -836,14 +837,6 @@ class GridWind:
                              f"end t = {t_end:g} s")
 
 
-class SimulationDivergedError(RuntimeError):
-    """A simulation left the physical envelope; ``partial`` holds what was simulated."""
-
-    def __init__(self, message: str, partial: "SimulationResult") -> None:
-        super().__init__(message)
-        self.partial = partial
-
-
 @dataclass(frozen=True)
 class SimulationResult:
     """Open-loop simulation result.
@@ -959,6 +952,96 @@ def rk4_simulate(params: PlantParams, x0: FloatArray, u: FloatArray,
             f"{val!r} {STATE_UNITS[bad]} left its envelope {lim[0, bad]:g}..{lim[1, bad]:g}; "
             f"the {n} samples before are kept in .partial", res)
     return res
+
+
+class PlantStepper:
+    """The plant advanced one fixed RK4 step at a time, for closed loops.
+
+    :func:`rk4_simulate` runs a whole input sequence in compiled code; a closed loop needs the
+    controller between steps, so this object keeps the integrator's BEM warm start (the
+    previous step's inflow angles) and the wind's sampling data between calls. It validates
+    once, at construction; :meth:`step` trusts its arguments.
+
+    Parameters
+    ----------
+    params : PlantParams
+        The plant.
+    wind : SteadyWind or GridWind
+        The free wind over the whole run.
+    dt : float
+        Step [s], > 0 (default 1/80 s).
+    duration : float
+        Length of the run [s]; the wind must cover it.
+
+    Raises
+    ------
+    ValueError
+        If ``dt`` or ``duration`` is not > 0, or the wind does not cover the rotor or the run.
+    TypeError
+        If ``wind`` is not a :class:`SteadyWind` or :class:`GridWind`.
+    """
+
+    def __init__(self, params: PlantParams, wind: "SteadyWind | GridWind", dt: float = 1.0 / 80.0,
+                 duration: float = 0.0) -> None:
+        self.dt = check_positive("dt", dt)
+        check_positive("duration", duration, allow_zero=True)
+        if not isinstance(wind, (SteadyWind, GridWind)):
+            raise TypeError(f"wind must be SteadyWind or GridWind, got {type(wind).__name__}")
+        wind.check_covers(params, duration)
+        self.params = params
+        self._kind, self._wpar, self._grid = wind._kernel_args()
+        self._pack = params.pack
+        self.limits = _state_limits(params)
+        self.reset()
+
+    def reset(self) -> None:
+        """Forget the BEM warm start (a new run)."""
+        n_r = self._pack.r.size
+        self._hint = np.full((4, _N_BLADE, n_r), np.nan)
+        self._dphi = np.zeros((_N_BLADE, n_r))
+
+    def step(self, t: float, x: FloatArray, u: FloatArray) -> tuple[FloatArray, FloatArray]:
+        """One RK4 step from ``t`` with the inputs held.
+
+        Parameters
+        ----------
+        t : float
+            Time at the start of the step [s].
+        x : (n_x,) ndarray
+            State at ``t``.
+        u : (n_u,) ndarray
+            Inputs over the step (after any rate limit).
+
+        Returns
+        -------
+        x_next : (n_x,) ndarray
+            State at ``t + dt``.
+        z : (n_z,) ndarray
+            Outputs at ``t`` (:data:`OUTPUT_NAMES`).
+        """
+        xn, z, self._hint, self._dphi = _rk4(t, x, u, self.dt, self._pack, self._kind,
+                                             self._wpar, self._grid, self._hint, self._dphi)
+        return xn, z
+
+    def outputs(self, t: float, x: FloatArray, u: FloatArray) -> FloatArray:
+        """The outputs at ``t`` without stepping, (n_z,) (:data:`OUTPUT_NAMES`)."""
+        w = _sample_wind(t, x[16], self._pack, self._kind, self._wpar, self._grid)
+        return _eval(x, u, w, self._pack, self._hint, 0)[1]
+
+    def outside_envelope(self, x: FloatArray) -> int:
+        """Index of the first state outside the physical envelope (or non-finite), else -1.
+
+        Parameters
+        ----------
+        x : (n_x,) ndarray
+            A state.
+
+        Returns
+        -------
+        int
+            The state's index in :data:`STATE_NAMES`, or -1 when all are inside.
+        """
+        return int(_bad_state(x, self.limits))
 
 
 def structural_frequencies(params: PlantParams, rotor_speed_rad_s: float = 0.0) -> dict[str, float]:

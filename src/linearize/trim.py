@@ -23,16 +23,13 @@ import numpy as np
 from scipy.optimize import brentq
 
 from ._typing import FloatArray
-from ._validate import check_finite_scalar
+from .errors import TrimError
+from .validate import check_finite_scalar
 from .plant import STATE_NAMES, PlantConfig, PlantParams, n_x, plant_params
 from .steady import optimal_tsr, rotor_average
 from .turbine import Turbine
 
 __all__ = ["TrimError", "OperatingPoint", "trim", "operating_schedule", "rated_wind_speed"]
-
-
-class TrimError(RuntimeError):
-    """The requested operating point cannot be reached."""
 
 
 @dataclass(frozen=True)

@@ -18,7 +18,8 @@ import numpy as np
 import yaml
 
 from ._typing import FloatArray, IntArray
-from ._validate import frozen_array
+from .errors import TurbineFileError
+from .validate import frozen_array
 
 __all__ = [
     "TurbineFileError", "Geometry", "Operation", "Environment", "RotorMass", "Nacelle",
@@ -30,10 +31,6 @@ __all__ = [
 SCHEMA_VERSION = 1
 _DEG = math.pi / 180.0
 _RPM = math.pi / 30.0
-
-
-class TurbineFileError(ValueError):
-    """A turbine file is missing, malformed or holds a value out of range."""
 
 
 def _pos(v: float) -> bool:

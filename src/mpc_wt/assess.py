@@ -23,7 +23,8 @@ from scipy import stats
 
 __all__ = ["rainflow", "damage_equivalent_load", "lifetime_del", "wind_bin_probabilities",
            "miner_damage", "lifetime_extension", "CSMeasures", "cs_measures", "psd",
-           "harmonic_psd", "pitch_duty", "energy_Wh", "aep_Wh", "tracking_response"]
+           "harmonic_psd", "pitch_duty", "energy_Wh", "aep_Wh", "tracking_response",
+           "pct_change", "DEFAULT_CHANNELS", "assess_series", "reductions"]
 
 FloatArray = np.ndarray
 
@@ -394,3 +395,85 @@ def tracking_response(t: Any, reference: Any, output: Any, frequency_hz: float
         raise ValueError(f"reference has no component at {f:g} Hz")
     g = zy / zr
     return float(abs(g)), float(math.degrees(np.angle(g)))
+
+
+def pct_change(base: float, other: float) -> float:
+    """Change of ``other`` against ``base`` in percent, 100 (other / base - 1).
+
+    Parameters
+    ----------
+    base, other : float
+        The reference and the compared value.
+
+    Returns
+    -------
+    float
+        [%]; NaN when ``base`` is 0 or either value is not finite (no change can be
+        stated).
+    """
+    if not (base and math.isfinite(base) and math.isfinite(other)):
+        return float("nan")
+    return 100.0 * (other / base - 1.0)
+
+
+#: Load channels and their default Woehler exponents (10 composite blades, 4 steel elsewhere).
+DEFAULT_CHANNELS = {"flap_moment_1": 10.0, "flap_moment_2": 10.0, "flap_moment_3": 10.0,
+                    "edge_moment_1": 10.0, "edge_moment_2": 10.0, "edge_moment_3": 10.0,
+                    "tower_base_fa_moment": 4.0, "tower_base_ss_moment": 4.0,
+                    "lss_torque": 4.0, "tilt_moment": 4.0, "yaw_moment": 4.0,
+                    "shaft_bending_blade1": 4.0}
+
+
+
+def assess_series(t: np.ndarray, cols: dict[str, np.ndarray],
+                  channels: dict[str, float] | None = None,
+                  m_override: float | None = None) -> dict[str, Any]:
+    """DEL per channel, CS1-CS5 (tower-base fore-aft moment vs power), pitch duty, power std,
+    energy and the 1P/3P/6P content of the blade-1 flap moment, for one run."""
+    chans = dict(channels or {k: v for k, v in DEFAULT_CHANNELS.items() if k in cols})
+    missing = [c for c in chans if c not in cols]
+    if missing:
+        raise KeyError(f"no channel {missing[0]!r}; channels are {sorted(cols)}")
+    dt = float(np.median(np.diff(t)))
+    duration = float(t[-1] - t[0])
+    out: dict[str, Any] = {"duration_s": duration, "channels": {}}
+    for name, m in chans.items():
+        mm = m_override if m_override is not None else m
+        out["channels"][name] = {"del": damage_equivalent_load(cols[name], mm,
+                                                               duration=duration), "m": mm}
+    if "gen_power" in cols:
+        p = cols["gen_power"]
+        out["power_mean_W"] = float(p.mean())
+        out["power_std_W"] = float(p.std())
+        out["energy_Wh"] = energy_Wh(p, dt)
+        if "tower_base_fa_moment" in cols:
+            cs = cs_measures(cols["tower_base_fa_moment"], p)
+            out.update({f"cs{i}": getattr(cs, f"cs{i}") for i in range(1, 6)})
+    pitch = [cols[f"pitch_{i}"] for i in (1, 2, 3) if f"pitch_{i}" in cols]
+    if pitch:
+        out.update(pitch_duty(np.column_stack(pitch), dt))
+    if "gen_speed" in cols:
+        out["gen_speed_std_rad_s"] = float(cols["gen_speed"].std())
+    if "gen_torque" in cols:
+        out["gen_torque_std_Nm"] = float(cols["gen_torque"].std())
+    if "rotor_speed" in cols and "flap_moment_1" in cols:
+        frot = float(cols["rotor_speed"].mean()) / (2 * math.pi)
+        out["flap_1_harmonics"] = {f"{n}P": v for n, v in
+                                   harmonic_psd(cols["flap_moment_1"], 1 / dt, frot).items()}
+    return out
+
+
+def reductions(base: dict[str, Any], other: dict[str, Any]) -> dict[str, Any]:
+    """Change of ``other`` against ``base`` (two :func:`assess_series` results), in percent:
+    DEL per channel, the 1P/3P/6P content of the blade-1 flap moment (Madsen sec. IV), power
+    and generator-speed std, pitch travel."""
+    out: dict[str, Any] = {"del_change_pct": {c: pct_change(base["channels"][c]["del"], d["del"])
+                                               for c, d in other["channels"].items()
+                                               if c in base["channels"]}}
+    if "flap_1_harmonics" in base and "flap_1_harmonics" in other:
+        out["flap_1_harmonic_change_pct"] = {k: pct_change(base["flap_1_harmonics"][k], v)
+                                             for k, v in other["flap_1_harmonics"].items()}
+    for k in ("power_std_W", "gen_speed_std_rad_s", "pitch_travel_deg", "cs1", "cs2"):
+        if k in base and k in other:
+            out[f"{k}_change_pct"] = pct_change(base[k], other[k])
+    return out

@@ -32,8 +32,9 @@ import scipy.sparse as sp
 
 import linearize
 
-from . import runs
-from .mpc import MPC
+from .controllers import Scenario, make_wind
+from .mpc import MPC, MPCSettings
+from .qp import backend_installed, default_backend
 from .simulate import simulate_closed_loop
 
 
@@ -83,54 +84,43 @@ def _clarabel(qp: dict[str, np.ndarray], tol: float | None = None) -> tuple[np.n
 
 
 def run_solver_benchmark(steps: int = 3000, progress: bool = True) -> dict[str, Any]:
-    """Run the comparison; returns the figures (keys per solver: ``solver``, ``median_us``,
-    ``p95_us``, ``p99_us``, ``max_us``, ``max_move_error`` ...)."""
+    """Run the comparison on one closed loop at 18 m/s, class A.
+
+    Parameters
+    ----------
+    steps : int
+        Controller steps of the closed loop (10 Hz), >= 10.
+    progress : bool
+        Show a progress bar.
+
+    Returns
+    -------
+    dict
+        The figures: per solver ``solver``, ``median_us``, ``p95_us``, ``p99_us``, ``max_us``,
+        ``max_move_error`` ...; the closed loop's whole-step times and run time.
+
+    Raises
+    ------
+    ValueError
+        If ``steps`` < 10.
+    """
     if steps < 10:
         raise ValueError(f"steps must be >= 10, got {steps}")
     t = linearize.load_turbine()
-    wind_mps, dt = 18.0, 0.1
+    wind_mps = 18.0
     model = linearize.linearize(t, wind_mps, config=linearize.PlantConfig.madsen())
-    duration = steps * dt
     res: dict[str, Any] = {"date": time.strftime("%Y-%m-%d"), "machine": platform.machine(),
                            "python": platform.python_version(), "steps": steps,
                            "wind_mps": wind_mps, "turbulence": "A", "horizon": 15,
                            "solvers": []}
-
-    # 1. the closed loop (DAQP backend if installed), recording each step's measurements and
-    # QP data and timing the whole controller step in the loop
-    backends = ["osqp"]
-    try:
-        import daqp  # noqa: F401
-        backends.append("daqp")
-    except ImportError:
+    backends = ["osqp"] + ["daqp"] * backend_installed("daqp")
+    if "daqp" not in backends:
         res["daqp"] = "not installed (pip install 'mpc-wt[daqp]')"
-    res["closed_loop_backend"] = backends[-1]
-    ctl = MPC(model, t, backend=backends[-1])
-    rec_z: list[tuple[np.ndarray, bool]] = []
-    rec_meas: list[tuple[float, dict[str, Any]]] = []
-    step_times: list[float] = []
-    step0 = ctl.step
-
-    def timed_step(tt: float, meas: dict[str, Any]) -> Any:
-        t0 = time.perf_counter()
-        out = step0(tt, meas)
-        step_times.append(time.perf_counter() - t0)
-        rec_z.append((ctl._z.copy(), ctl._has_preview))
-        rec_meas.append((tt, {"state": np.array(meas["state"])}))
-        return out
-    ctl.step = timed_step  # type: ignore[method-assign]
-    wind, _ = runs._wind(t, wind_mps, "A", 1, duration, 0.2)
-    op = linearize.trim(t, wind_mps)
-    t0 = time.perf_counter()
-    simulate_closed_loop(linearize.plant_params(t), ctl, wind, duration, x0=op.x, u0=op.u,
-                         controller_dt=dt, progress=progress)
-    res["closed_loop_s"] = time.perf_counter() - t0
-    res["whole_step_closed_loop"] = _stats(step_times)
-    n = len(rec_z)
-
-    # 2. the QP sequence and its reference solution
+    res["closed_loop_backend"] = default_backend()
+    rec = _record_closed_loop(t, model, steps, res, progress)
+    ctl = rec["controller"]
     qps = []
-    for zz, has_preview in rec_z:
+    for zz, has_preview in rec["z"]:
         ctl._z[:] = zz
         ctl._has_preview = has_preview
         qps.append(ctl.qp())
@@ -138,53 +128,106 @@ def run_solver_benchmark(steps: int = 3000, progress: bool = True) -> dict[str, 
     su = qps[0]["scale"]
     vref = [_clarabel(qp, 1e-10)[0] for qp in qps]
     ref = np.array([v[:nu] * su[:nu] for v in vref])
+    res["constraints_active_fraction"] = _active_fraction(qps, vref)
+    err = _MoveAccuracy(ref, t.rated_generator_torque)
+    for backend, form in [("osqp", "condensed"), ("osqp", "sparse")] + \
+            [("daqp", "condensed")] * ("daqp" in backends):
+        res["solvers"].append(_replay(model, t, backend, form, rec, su, err))
+    res["solvers"] += [_cvxpy(qps, su, err), _clarabel_all(qps, su, err),
+                       _qpoases(qps, su, err)]
+    return res
+
+
+def _record_closed_loop(t: Any, model: Any, steps: int, res: dict[str, Any],
+                        progress: bool) -> dict[str, Any]:
+    """The closed loop on the default backend, recording each step's measurements and QP data
+    and timing the whole controller step in the loop."""
+    dt = 0.1
+    ctl = MPC(model, t, MPCSettings(dt=dt))
+    rec: dict[str, Any] = {"z": [], "meas": [], "controller": ctl}
+    step_times: list[float] = []
+    step0 = ctl.step
+
+    def timed_step(tt: float, meas: dict[str, Any]) -> Any:
+        t0 = time.perf_counter()
+        out = step0(tt, meas)
+        step_times.append(time.perf_counter() - t0)
+        rec["z"].append((ctl._z.copy(), ctl._has_preview))
+        rec["meas"].append((tt, {"state": np.array(meas["state"])}))
+        return out
+    ctl.step = timed_step  # type: ignore[method-assign]
+    duration = steps * dt
+    wind, _ = make_wind(t, Scenario(res["wind_mps"], "A", 1, duration, 0.2))
+    op = linearize.trim(t, res["wind_mps"])
+    t0 = time.perf_counter()
+    simulate_closed_loop(linearize.plant_params(t), ctl, wind, duration, x0=op.x, u0=op.u,
+                         controller_dt=dt, progress=progress)
+    res["closed_loop_s"] = time.perf_counter() - t0
+    res["whole_step_closed_loop"] = _stats(step_times)
+    return rec
+
+
+def _active_fraction(qps: list[dict[str, np.ndarray]], vref: list[np.ndarray]) -> float:
     active = 0
+    tol = 1e-6
     for qp, v in zip(qps, vref):
         av = qp["A"] @ v
-        tol = 1e-6
         if (np.any(v <= qp["lo_box"] + tol) or np.any(v >= qp["hi_box"] - tol)
                 or np.any(av <= qp["lo"] + tol) or np.any(av >= qp["hi"] - tol)):
             active += 1
-    res["constraints_active_fraction"] = active / n
-    rated_torque = t.rated_generator_torque
+    return active / len(qps)
 
-    def move_error(first: np.ndarray) -> dict[str, float]:
-        err = np.abs(first - ref)
+
+class _MoveAccuracy:
+    """The largest first-move error against the reference solution, in units of the
+    tolerances (0.01 deg pitch, 0.1 % of rated torque)."""
+
+    def __init__(self, ref: np.ndarray, rated_torque: float) -> None:
+        self.ref, self.rated_torque = ref, rated_torque
+
+    def __call__(self, first: np.ndarray) -> dict[str, float]:
+        err = np.abs(np.asarray(first) - self.ref)
         pitch = float(np.degrees(err[:, :3].max()))
-        torque = float(100.0 * err[:, 3].max() / rated_torque)
+        torque = float(100.0 * err[:, 3].max() / self.rated_torque)
         return {"max_move_error_pitch_deg": pitch, "max_move_error_torque_pct": torque,
                 "max_move_error": max(pitch / 0.01, torque / 0.1)}
 
-    # 3. our backends: the whole controller step replayed on the recorded measurements (the
-    # controller's own warm starts and previous commands, as in the loop, without the plant
-    # between the steps); then the recorded QPs solved in order for the move error
-    for backend, form in [("osqp", "condensed"), ("osqp", "sparse")] + \
-            [("daqp", "condensed")] * ("daqp" in backends):
-        c = MPC(model, t, backend=backend, formulation=form)
-        attr = "_osqp_ext" if backend == "osqp" else "_daqp"
-        timer = _Timed(getattr(c, attr), "solve")
-        setattr(c, attr, timer)
-        whole, iters = [], []
-        for tt, meas in rec_meas:
-            t0 = time.perf_counter()
-            c.step(tt, meas)
-            whole.append(time.perf_counter() - t0)
-            iters.append(c._info.iter if backend == "osqp" else c._info["iterations"])
-        solve_times = list(timer.times)
-        c.reset()
-        first = []
-        for zz, has_preview in rec_z:
-            c._z[:] = zz
-            v, _ = c._solve_z(has_preview)
-            first.append(v[:nu] * su[:nu] if v is not None else np.full(nu, np.nan))
-        entry = {"solver": f"{backend}-{form}", **_stats(solve_times),
-                 "iter_median": float(np.median(iters)), "iter_max": int(np.max(iters)),
-                 "whole_step": _stats(whole), **move_error(np.array(first))}
-        res["solvers"].append(entry)
 
-    # 4. cvxpy with parameters (OSQP underneath), re-solved each step
+def _replay(model: Any, t: Any, backend: str, form: str, rec: dict[str, Any],
+            su: np.ndarray, err: _MoveAccuracy) -> dict[str, Any]:
+    """Our backend: the whole controller step replayed on the recorded measurements (its own
+    warm starts and previous commands, as in the loop, without the plant between the steps);
+    then the recorded QPs solved in order for the move error."""
+    c = MPC(model, t, MPCSettings(backend=backend, formulation=form))
+    be = c.qp_backend
+    attr = "ext" if backend == "osqp" else "model"
+    timer = _Timed(getattr(be, attr), "solve")
+    setattr(be, attr, timer)
+    whole, iters = [], []
+    for tt, meas in rec["meas"]:
+        t0 = time.perf_counter()
+        c.step(tt, meas)
+        whole.append(time.perf_counter() - t0)
+        iters.append(be.iterations)
+    solve_times = list(timer.times)
+    c.reset()
+    nu = c._nu
+    first = []
+    for zz, has_preview in rec["z"]:
+        c._z[:] = zz
+        v, _ = c._solve_z(has_preview)
+        first.append(v[:nu] * su[:nu] if v is not None else np.full(nu, np.nan))
+    return {"solver": f"{backend}-{form}", **_stats(solve_times),
+            "iter_median": float(np.median(iters)), "iter_max": int(np.max(iters)),
+            "whole_step": _stats(whole), **err(np.array(first))}
+
+
+def _cvxpy(qps: list[dict[str, np.ndarray]], su: np.ndarray, err: _MoveAccuracy
+           ) -> dict[str, Any]:
+    """cvxpy with parameters (OSQP underneath), re-solved each step."""
     import cvxpy as cp
 
+    nu = len(err.ref[0])
     nv = qps[0]["H"].shape[0]
     lchol = np.linalg.cholesky(qps[0]["H"])
     v = cp.Variable(nv)
@@ -202,10 +245,13 @@ def run_solver_benchmark(steps: int = 3000, progress: bool = True) -> dict[str, 
         prob.solve(solver=cp.OSQP, warm_start=True, eps_abs=1e-6, eps_rel=1e-6)
         ts.append(time.perf_counter() - t0)
         first.append(v.value[:nu] * su[:nu])
-    res["solvers"].append({"solver": "cvxpy-params (OSQP)", **_stats(ts),
-                           **move_error(np.array(first))})
+    return {"solver": "cvxpy-params (OSQP)", **_stats(ts), **err(np.array(first))}
 
-    # 5. Clarabel (interior point, rebuilt each step)
+
+def _clarabel_all(qps: list[dict[str, np.ndarray]], su: np.ndarray, err: _MoveAccuracy
+                  ) -> dict[str, Any]:
+    """Clarabel (interior point, rebuilt each step)."""
+    nu = len(err.ref[0])
     ts, first, its = [], [], []
     for qp in qps:
         t0 = time.perf_counter()
@@ -213,12 +259,17 @@ def run_solver_benchmark(steps: int = 3000, progress: bool = True) -> dict[str, 
         ts.append(time.perf_counter() - t0)
         first.append(xs[:nu] * su[:nu])
         its.append(it)
-    res["solvers"].append({"solver": "clarabel", **_stats(ts), "iter_median": float(np.median(its)),
-                           **move_error(np.array(first))})
+    return {"solver": "clarabel", **_stats(ts), "iter_median": float(np.median(its)),
+            **err(np.array(first))}
 
-    # 6. qpOASES through CasADi
+
+def _qpoases(qps: list[dict[str, np.ndarray]], su: np.ndarray, err: _MoveAccuracy
+             ) -> dict[str, Any]:
+    """qpOASES through CasADi."""
     import casadi as ca
 
+    nu = len(err.ref[0])
+    nv = qps[0]["H"].shape[0]
     with contextlib.redirect_stdout(io.StringIO()):     # qpOASES prints a licence banner
         s = ca.conic("S", "qpoases", {"h": ca.Sparsity.dense(nv, nv),
                                       "a": ca.Sparsity.dense(*qps[0]["A"].shape)},
@@ -234,10 +285,8 @@ def run_solver_benchmark(steps: int = 3000, progress: bool = True) -> dict[str, 
         ts.append(time.perf_counter() - t0)
         first.append(np.asarray(r["x"]).ravel()[:nu] * su[:nu])
         its.append(s.stats()["iter_count"])
-    res["solvers"].append({"solver": "qpoases-casadi", **_stats(ts),
-                           "iter_median": float(np.median(its)), **move_error(np.array(first))})
-
-    return res
+    return {"solver": "qpoases-casadi", **_stats(ts), "iter_median": float(np.median(its)),
+            **err(np.array(first))}
 
 
 def format_table(res: dict[str, Any]) -> str:

@@ -117,6 +117,25 @@ class KalmanEstimator:
                                   np.zeros(self.nd) if d_dev is None else d_dev])
         self._started = False
 
+    @property
+    def started(self) -> bool:
+        """Whether a measurement has been taken since the last reset."""
+        return self._started
+
+    def hand_over(self, other: "KalmanEstimator", offset: np.ndarray) -> None:
+        """Continue from another estimator's estimate (gain scheduling).
+
+        Parameters
+        ----------
+        other : KalmanEstimator
+            The estimator being replaced.
+        offset : (n_x + n_d,) ndarray
+            Its operating point minus ours ([x0; d0] of its model minus ours), so that the
+            estimate is carried over in absolute units.
+        """
+        self.xa = other.xa + offset
+        self._started = other.started
+
     def measurement(self, meas: dict[str, Any]) -> np.ndarray:
         """The measured-signal vector from a harness measurement dict."""
         return read_signals(meas, self.signals)

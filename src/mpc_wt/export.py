@@ -40,6 +40,7 @@ import numpy as np
 import linearize
 
 from . import __version__
+from .errors import GainTableError
 
 __all__ = ["SCHEMA_VERSION", "GainTableError", "baseline_table", "lqr_table", "ts_table",
            "ibc_table", "coleman_ipc_table",
@@ -48,10 +49,6 @@ __all__ = ["SCHEMA_VERSION", "GainTableError", "baseline_table", "lqr_table", "t
 SCHEMA_VERSION = 1
 SCHEMA = "mpc-wt gain table"
 FORMATS = ("csv", "json", "mat", "rosco")
-
-
-class GainTableError(ValueError):
-    """A gain table that is missing, of another schema, or inconsistent."""
 
 
 def _unit_ratio(num: str, den: str) -> str:

@@ -19,6 +19,7 @@ applied, else the previous command is held; the fallback used is recorded in ``s
 """
 from __future__ import annotations
 
+import dataclasses
 import logging
 import math
 from dataclasses import dataclass, field
@@ -26,11 +27,12 @@ from typing import Any
 
 import numba as nb
 import numpy as np
-import scipy.sparse as sp
 
 import linearize
 
-__all__ = ["coleman_weight", "MPCWeights", "MPC", "ScheduledMPC"]
+from .qp import check_backend, default_backend, make_backend
+
+__all__ = ["coleman_weight", "MPCWeights", "MPCSettings", "MPC", "ScheduledMPC"]
 
 log = logging.getLogger(__name__)
 
@@ -86,6 +88,119 @@ class MPCWeights:
                 raise ValueError(f"scale {k!r} must be > 0, got {v!r}")
 
 
+@dataclass(frozen=True)
+class MPCSettings:
+    """Every setting of the MPC, validated once (replaces the MPC's keyword arguments).
+
+    Parameters
+    ----------
+    dt : float
+        Controller period [s] (default 0.1: Madsen's 10 Hz).
+    horizon : int
+        Prediction horizon H_p, >= 1 (default 15).
+    control_horizon : int, optional
+        H_u <= H_p (default H_p); inputs are held after H_u.
+    weights : MPCWeights
+        Cost weights and signal scales.
+    collective : bool
+        One collective pitch input instead of three (Madsen's comparison controller).
+    backend : {"osqp", "daqp"} or None
+        QP solver (:data:`mpc_wt.qp.BACKENDS`); None: :func:`mpc_wt.qp.default_backend` (DAQP
+        for the condensed QP when installed, else OSQP).
+    formulation : {"condensed", "sparse"}
+        The QP in the inputs only (default; dense, 60 variables at H_u = 15) or, with OSQP, the
+        sparse formulation with the predicted states as variables and the dynamics as equality
+        rows (block-banded, grows linearly with the horizon). Both give the same moves.
+    solver_options : dict
+        Passed to OSQP (defaults: eps_abs = eps_rel = 1e-5, polish off, warm start,
+        termination checked every 2 iterations condensed, 5 sparse).
+    max_rotor_speed : float or None
+        Soft output constraint [rad/s]: the predicted rotor speed stays below it unless a slack
+        variable s_i >= 0 pays for the excess (one slack per predicted step, cost
+        ``slack_weight * (s_i/scale)^2 + slack_linear * s_i/scale`` with the rotor-speed scale;
+        the largest is reported as the ``rotor_speed_slack`` signal). With the linear term large
+        enough the penalty is exact: the slack is zero whenever the hard constraint is
+        feasible, and the QP is always feasible. None (default): no constraint.
+    slack_weight, slack_linear : float
+        Quadratic and linear slack penalties (defaults 1e4 and 1e3), > 0.
+    estimator : None, "kalman" or KalmanEstimator
+        None (default): full-state information from the harness (``meas["state"]``), as in the
+        paper. "kalman": a :class:`~mpc_wt.estimator.KalmanEstimator` on the same model estimates
+        the states and the blade-effective winds from measured signals; without a preview the
+        disturbance over the horizon is held at the wind estimate.
+
+    Raises
+    ------
+    ValueError
+        Naming the setting, the value and what is allowed.
+    """
+
+    dt: float = 0.1
+    horizon: int = 15
+    control_horizon: int | None = None
+    weights: MPCWeights = field(default_factory=MPCWeights)
+    collective: bool = False
+    backend: str | None = None
+    formulation: str = "condensed"
+    solver_options: dict[str, Any] = field(default_factory=dict)
+    max_rotor_speed: float | None = None
+    slack_weight: float = 1e4
+    slack_linear: float = 1e3
+    estimator: Any = None
+
+    def __post_init__(self) -> None:
+        hu = self.horizon if self.control_horizon is None else self.control_horizon
+        for name, v in (("horizon", self.horizon), ("control_horizon", hu)):
+            if isinstance(v, bool) or not isinstance(v, (int, np.integer)) or v < 1:
+                raise ValueError(f"{name} must be an integer >= 1, got {v!r}")
+        if hu > self.horizon:
+            raise ValueError(f"control_horizon ({hu}) must not exceed horizon ({self.horizon})")
+        if not (isinstance(self.dt, (int, float)) and math.isfinite(self.dt) and self.dt > 0):
+            raise ValueError(f"dt must be > 0 s, got {self.dt!r}")
+        if self.formulation not in ("condensed", "sparse"):
+            raise ValueError(f"formulation must be 'condensed' or 'sparse', got "
+                             f"{self.formulation!r}")
+        if self.backend is not None:
+            check_backend(self.backend, self.formulation)
+        if not isinstance(self.weights, MPCWeights):
+            raise TypeError(f"weights must be MPCWeights, got {type(self.weights).__name__}")
+        v = self.max_rotor_speed
+        if v is not None and not (isinstance(v, (int, float)) and math.isfinite(v) and v > 0):
+            raise ValueError(f"max_rotor_speed must be a finite speed > 0 rad/s or None, got "
+                             f"{v!r}")
+        for name, w in (("slack_weight", self.slack_weight), ("slack_linear", self.slack_linear)):
+            if not (math.isfinite(w) and w > 0):
+                raise ValueError(f"{name} must be finite and > 0, got {w!r}")
+        if isinstance(self.estimator, str) and self.estimator != "kalman":
+            raise ValueError(f"estimator must be None, 'kalman' or a KalmanEstimator, got "
+                             f"{self.estimator!r}")
+
+    @property
+    def hu(self) -> int:
+        """The control horizon H_u."""
+        return int(self.horizon if self.control_horizon is None else self.control_horizon)
+
+    @property
+    def resolved_backend(self) -> str:
+        """The backend used: the one named, or :func:`mpc_wt.qp.default_backend`."""
+        return self.backend or default_backend(self.formulation)
+
+    def replace(self, **changes: Any) -> "MPCSettings":
+        """A copy with some settings changed (validated again).
+
+        Parameters
+        ----------
+        **changes
+            Setting name -> value.
+
+        Returns
+        -------
+        MPCSettings
+            The new settings.
+        """
+        return dataclasses.replace(self, **changes)
+
+
 _EMPTY = np.zeros(0)
 _EMPTY_I = np.zeros(0, dtype=np.int64)
 
@@ -122,7 +237,7 @@ def _group(name: str) -> str:
 
 
 class MPC:
-    """Condensed linear MPC on a discretized :class:`linearize.LinearModel`.
+    """Linear MPC on a discretized :class:`linearize.LinearModel` (Madsen et al. eqs 20-23).
 
     Parameters
     ----------
@@ -130,84 +245,33 @@ class MPC:
         Continuous or discrete; with Madsen's 13 outputs among its outputs.
     turbine : Turbine
         For the actuator limits.
-    dt : float
-        Controller period [s] (default 0.1).
-    horizon, control_horizon : int
-        H_p and H_u (defaults 15, 15), >= 1, H_u <= H_p.
-    weights : MPCWeights
-    collective : bool
-        One collective pitch input instead of three (Madsen's comparison controller).
-    solver_options : dict
-        Passed to OSQP (defaults: eps_abs = eps_rel = 1e-5, polish off, warm start,
-        termination checked every 2 iterations condensed, 5 sparse).
-    backend : {"osqp", "daqp"}
-        OSQP (operator splitting, the default) or DAQP (dual active set, exact to its
-        tolerances on these small dense QPs; ``pip install 'mpc-wt[daqp]'``).
-    formulation : {"condensed", "sparse"}
-        The QP in the inputs only (default; dense, 60 variables at H_u = 15) or, with OSQP, the
-        sparse formulation with the predicted states as variables and the dynamics as equality
-        rows (block-banded, grows linearly with the horizon). Both give the same moves.
-    max_rotor_speed : float or None
-        Soft output constraint [rad/s]: the predicted rotor speed stays below it unless a slack
-        variable s_i >= 0 pays for the excess (one slack per predicted step, cost
-        ``slack_weight * (s_i/scale)^2 + slack_linear * s_i/scale`` with the rotor-speed scale;
-        the largest is reported as the ``rotor_speed_slack`` signal). With
-        the linear term large enough the penalty is exact: the slack is zero whenever the hard
-        constraint is feasible, and the QP is always feasible. None (default): no constraint.
-    slack_weight, slack_linear : float
-        Quadratic and linear slack penalties (defaults 1e4 and 1e3), > 0.
-    estimator : None, "kalman" or KalmanEstimator
-        None (default): full-state information from the harness (``meas["state"]``), as in the
-        paper. "kalman": a :class:`~mpc_wt.estimator.KalmanEstimator` on the same model estimates
-        the states and the blade-effective winds from measured signals; without a preview the
-        disturbance over the horizon is held at the wind estimate.
+    settings : MPCSettings, optional
+        Horizons, weights, backend, formulation, soft limits, estimator (default
+        ``MPCSettings()``).
+
+    Raises
+    ------
+    ValueError
+        If the model lacks an output the cost needs, its dt differs from the settings', or the
+        weights make the QP non-convex.
     """
 
-    def __init__(self, model: linearize.LinearModel, turbine: linearize.Turbine, *,
-                 dt: float = 0.1, horizon: int = 15, control_horizon: int | None = None,
-                 weights: MPCWeights | None = None, collective: bool = False,
-                 solver_options: dict[str, Any] | None = None,
-                 backend: str = "osqp", max_rotor_speed: float | None = None,
-                 slack_weight: float = 1e4, slack_linear: float = 1e3,
-                 estimator: Any = None, formulation: str = "condensed") -> None:
-        hu = horizon if control_horizon is None else control_horizon
-        for name, v in (("horizon", horizon), ("control_horizon", hu)):
-            if not isinstance(v, (int, np.integer)) or v < 1:
-                raise ValueError(f"{name} must be an integer >= 1, got {v!r}")
-        if hu > horizon:
-            raise ValueError(f"control_horizon ({hu}) must not exceed horizon ({horizon})")
-        if not (math.isfinite(dt) and dt > 0):
-            raise ValueError(f"dt must be > 0 s, got {dt!r}")
-        if backend not in ("osqp", "daqp"):
-            raise ValueError(f"backend must be 'osqp' or 'daqp', got {backend!r}")
-        if formulation not in ("condensed", "sparse"):
-            raise ValueError(f"formulation must be 'condensed' or 'sparse', got {formulation!r}")
-        if formulation == "sparse" and backend != "osqp":
-            raise ValueError(f"formulation='sparse' needs backend='osqp' (DAQP is dense), got "
-                             f"backend={backend!r}")
-        self.formulation = formulation
-        if backend == "daqp":
-            try:
-                import daqp  # noqa: F401
-            except ImportError as err:
-                raise ImportError("backend='daqp' needs daqp: pip install 'mpc-wt[daqp]'") \
-                    from err
-        if max_rotor_speed is not None and not (isinstance(max_rotor_speed, (int, float))
-                                                and math.isfinite(max_rotor_speed)
-                                                and max_rotor_speed > 0):
-            raise ValueError(f"max_rotor_speed must be a finite speed > 0 rad/s or None, got "
-                             f"{max_rotor_speed!r}")
-        for name, v in (("slack_weight", slack_weight), ("slack_linear", slack_linear)):
-            if not (math.isfinite(v) and v > 0):
-                raise ValueError(f"{name} must be finite and > 0, got {v!r}")
-        self.max_rotor_speed = None if max_rotor_speed is None else float(max_rotor_speed)
-        self.slack_weight, self.slack_linear = float(slack_weight), float(slack_linear)
-        self.backend = backend
+    def __init__(self, model: linearize.LinearModel, turbine: linearize.Turbine,
+                 settings: MPCSettings | None = None) -> None:
+        st = settings or MPCSettings()
+        if not isinstance(st, MPCSettings):
+            raise TypeError(f"settings must be an MPCSettings, got {type(st).__name__}")
+        self.settings = st
+        self.formulation = st.formulation
+        self.max_rotor_speed = st.max_rotor_speed
+        self.slack_weight, self.slack_linear = st.slack_weight, st.slack_linear
+        self.backend = st.resolved_backend
         self.turbine = turbine
-        self.dt = float(dt)
-        self.hp, self.hu = int(horizon), int(hu)
-        self.w = weights or MPCWeights()
-        self.collective = collective
+        self.dt = st.dt
+        self.hp, self.hu = st.horizon, st.hu
+        self.w = st.weights
+        self.collective = st.collective
+        dt = st.dt
         m = model if model.dt is not None else model.discretize(dt)
         if abs((m.dt or dt) - dt) > 1e-12:
             raise ValueError(f"model dt {m.dt} s differs from the controller dt {dt} s")
@@ -216,10 +280,8 @@ class MPC:
         if missing:
             raise ValueError(f"model lacks Madsen outputs {missing}")
         self.model = m.select(outputs=zsel)
+        estimator = st.estimator
         if isinstance(estimator, str):
-            if estimator != "kalman":
-                raise ValueError(f"estimator must be None, 'kalman' or a KalmanEstimator, got "
-                                 f"{estimator!r}")
             from .estimator import KalmanEstimator
 
             estimator = KalmanEstimator(m)
@@ -230,25 +292,45 @@ class MPC:
         self._x_idx = np.array([linearize.STATE_NAMES.index(n) for n in m.states])
         self._n_full = len(linearize.STATE_NAMES)
         self._x_idx = self._x_idx.astype(np.int64)
-        self._build(solver_options or {})
+        self._build(dict(st.solver_options))
         # compile (or load from numba's cache) the per-step kernel now, not in the first step
         _apply_affine(self._wt, self._z.copy(), self._nzd, _EMPTY, self._x_idx, self.model.x0,
                       _EMPTY, np.empty_like(self._wbuf))
         self.reset()
 
     @classmethod
-    def from_turbine(cls, turbine: linearize.Turbine, wind_mps: float, *,
-                     horizon: int = 15, preview: str | None = None,
-                     family: linearize.LinearModelFamily | None = None,
-                     **kwargs: Any) -> "MPC":
+    def from_turbine(cls, turbine: linearize.Turbine, wind_mps: float,
+                     settings: MPCSettings | None = None, *, preview: str | None = None,
+                     family: linearize.LinearModelFamily | None = None) -> "MPC":
         """Madsen's MPC for ``turbine`` at the mean wind ``wind_mps`` in a few words.
 
         The model is the 8-state linearization of Madsen et al. (section II, eqs 1-19) at
         ``wind_mps`` -- taken from ``family`` (interpolated; the wind must lie in its range) or
-        linearized now with :meth:`linearize.PlantConfig.madsen`. ``preview="lidar"`` makes the
-        controller require a preview (``meas["preview"]``) every step; ``None`` holds the
-        disturbance at the operating point and ignores any preview. Other keywords go to
-        :class:`MPC` (``control_horizon``, ``weights``, ``collective``, ``backend``, ...).
+        linearized now with :meth:`linearize.PlantConfig.madsen`.
+
+        Parameters
+        ----------
+        turbine : Turbine
+            The turbine.
+        wind_mps : float
+            Mean wind [m/s], within the operating range (or the family's).
+        settings : MPCSettings, optional
+            The MPC's settings.
+        preview : {None, "lidar"}
+            "lidar": the controller requires a preview (``meas["preview"]``) every step; None
+            holds the disturbance at the operating point and ignores any preview.
+        family : LinearModelFamily, optional
+            Take the model from it instead of linearizing.
+
+        Returns
+        -------
+        MPC
+            The controller.
+
+        Raises
+        ------
+        ValueError
+            A wind outside the range, or an unknown preview mode.
         """
         if preview not in (None, "lidar"):
             raise ValueError(f"preview must be None or 'lidar', got {preview!r}")
@@ -262,7 +344,7 @@ class MPC:
                                  f"operating range {op.cut_in_wind:g}..{op.cut_out_wind:g} m/s, "
                                  f"got {wind_mps!r}")
             model = linearize.linearize(turbine, v, config=linearize.PlantConfig.madsen())
-        ctl = cls(model, turbine, horizon=horizon, **kwargs)
+        ctl = cls(model, turbine, settings)
         ctl.preview = preview
         return ctl
 
@@ -284,8 +366,6 @@ class MPC:
         return q, r
 
     def _build(self, solver_options: dict[str, Any]) -> None:
-        import osqp
-
         m = self.model
         a, b, bd, c, du, dd = m.A, m.B_u, m.B_d, m.C_z, m.D_u, m.D_d
         if self.collective:          # one pitch input drives all three blades
@@ -443,24 +523,15 @@ class MPC:
         self._lo = self._wbuf[nvv:nvv + ncon]
         self._hi = self._wbuf[nvv + ncon:]
         self._slack0 = nvu
-        self._daqp = None
         if self.formulation == "sparse":
             self._build_sparse(dict(a=a, b=b, bd=bd, c=c, du=du, dd=dd, q1=q1, rbar=rbar,
                                     dmat=dmat, wr=wr, su=su, lo_u=lo_u, hi_u=hi_u, trate=trate,
                                     prate=prate, plim=pa.max_rate_rad_s, sw=sw, big=big,
                                     lim=lim if soft else None), opts)
             return
-        if self.backend == "daqp":
-            import daqp
-
-            free = np.full(acon_s.shape[0], 1e30)        # bounds are set every step
-            self._daqp = daqp.Model()
-            self._daqp.setup(self._h_s, np.zeros(nvv), self._a_gen_s, free, -free)
-        self._solver = osqp.OSQP()
-        self._solver.setup(P=sp.triu(sp.csc_matrix(h_s)).tocsc(), q=np.zeros(nvv),
-                           A=sp.csc_matrix(acon_s), l=-np.inf * np.ones(acon_s.shape[0]),
-                           u=np.inf * np.ones(acon_s.shape[0]), **opts)
-        self._osqp_fast_path()
+        self.qp_backend = make_backend(self.backend, self.formulation,
+                                       opts if self.backend == "osqp" else {})
+        self.qp_backend.setup(self._h_s, np.zeros(nvv), acon_s, self._n_box)
 
     def _build_sparse(self, k: dict[str, Any], opts: dict[str, Any]) -> None:
         """OSQP on the sparse (non-condensed) formulation (issue 6, item 3).
@@ -473,8 +544,6 @@ class MPC:
         scales. As in the condensed problem, the variables are shifted to the
         equality-constrained optimum, so each step changes the bounds only.
         """
-        import osqp
-
         a, b, bd, c, du, dd = k["a"], k["b"], k["bd"], k["c"], k["du"], k["dd"]
         nx, nu, nd, nz = a.shape[0], b.shape[1], bd.shape[1], c.shape[0]
         hp, hu = self.hp, self.hu
@@ -595,30 +664,16 @@ class MPC:
         self._slack0 = nvu + nxv
         self._sparse_shape = (nv, len(rs))
         self._sparse_nnz = int(np.count_nonzero(np.triu(p_s)) + np.count_nonzero(a_s))
-        self._solver = osqp.OSQP()
-        self._solver.setup(P=sp.triu(sp.csc_matrix(p_s)).tocsc(), q=np.zeros(nv),
-                           A=sp.csc_matrix(a_s), l=np.full(len(rs), -np.inf),
-                           u=np.full(len(rs), np.inf), **opts)
-        self._osqp_fast_path()
+        self.qp_backend = make_backend(self.backend, self.formulation, opts)
+        self.qp_backend.setup(p_s, np.zeros(nv), a_s, 0)
 
-
-    def _osqp_fast_path(self) -> None:
-        """Use OSQP's compiled solver object directly (osqp >= 1.0): its Python wrapper costs
-        some 30 us per step (result namespaces, bound clipping); our bounds are finite
-        (|b| <= 1e20 < OSQP_INFTY) so the clipping is not needed. Falls back to the public
-        interface when the internals differ."""
-        ext = getattr(self._solver, "_solver", None)
-        ok = all(hasattr(ext, n) for n in ("update_data_vec", "warm_start", "solve", "info",
-                                             "solution"))
-        self._osqp_ext = ext if ok else None
-        self._ws = None
 
     # ------------------------------------------------------------------------------------
     def reset(self) -> None:
         """Forget the previous plan and command."""
         self._plan: np.ndarray | None = None
         self._u_prev: np.ndarray | None = None
-        self._ws = None
+        self.qp_backend.reset()
         self._last_slack = 0.0
         if getattr(self, "estimator", None) is not None:
             self.estimator.reset()
@@ -660,35 +715,11 @@ class MPC:
         _apply_affine(self._wt, self._z, len(self._z) if preview else self._nzd, state,
                       self._x_idx, self.model.x0, up, self._wbuf)
         self._has_preview = preview
-        if self._daqp is not None:
-            self._daqp.update(bupper=self._hi, blower=self._lo)
-            xs, _, flag, self._info = self._daqp.solve()
-            if flag != 1:
-                return None, f"daqp exitflag {flag}"
-            status = "solved"
-        elif self._osqp_ext is not None:
-            ext = self._osqp_ext
-            ext.update_data_vec(q=None, l=self._lo, u=self._hi)
-            if self._ws is not None:
-                ext.warm_start(*self._ws)
-            ext.solve()
-            info = self._info = ext.info
-            if info.status_val not in (1, 2):          # solved, solved inaccurate
-                self._ws = None
-                return None, info.status
-            status = info.status
-            xs, ys = ext.solution.x, ext.solution.y
-            # The shifted iterates sit at (or near) zero when no constraint is active; without
-            # rounding they decay into subnormal numbers over many steps, which makes every
-            # ADMM iteration some 50 times slower. Round to 2^-52 absolute before warm starting.
-            self._ws = ((xs + 1.0) - 1.0, (ys + 1.0) - 1.0)
-        else:                                         # OSQP's public interface
-            self._solver.update(l=self._lo, u=self._hi)
-            res = self._solver.solve(raise_error=False)
-            self._info = res.info
-            status, xs = res.info.status, res.x
-            if xs is None or status not in ("solved", "solved inaccurate"):
-                return None, status
+        be = self.qp_backend
+        be.update_bounds(self._lo, self._hi)
+        xs, status = be.solve()
+        if xs is None:
+            return None, status
         v = xs + self._c
         if not math.isfinite(v.sum()):
             return None, f"{status} with non-finite solution"
@@ -771,6 +802,23 @@ class MPC:
             self.signals.update(self.signals_est)
         return u[:3], float(u[3])
 
+    def hand_over(self, other: "MPC") -> None:
+        """Continue from another MPC's last command and estimate (gain scheduling): the
+        previous command and the estimator state are carried over in absolute units.
+
+        Parameters
+        ----------
+        other : MPC
+            The controller being replaced (its operating point may differ).
+        """
+        if other._u_prev is not None:
+            du = other._u_abs(other._u_prev) - self.model.u0
+            self._u_prev = np.array([du[0], du[3]]) if self.collective else du
+        if other.estimator is not None and self.estimator is not None:
+            offset = (np.concatenate([other.model.x0, other.model.d0])
+                      - np.concatenate([self.model.x0, self.model.d0]))
+            self.estimator.hand_over(other.estimator, offset)
+
     @property
     def plan(self) -> np.ndarray | None:
         """The last applied plan: input deviations (H_u, n_u) from the operating point."""
@@ -795,23 +843,25 @@ class ScheduledMPC:
     LIDAR preview's first step (``wind_source="preview"``).
     """
 
-    def __init__(self, family: linearize.LinearModelFamily, turbine: linearize.Turbine, *,
-                 wind_source: str = "estimator", time_constant: float = 30.0,
-                 hysteresis: float = 0.25, initial_wind_mps: float | None = None,
-                 **mpc_kwargs: Any) -> None:
+    def __init__(self, family: linearize.LinearModelFamily, turbine: linearize.Turbine,
+                 settings: MPCSettings | None = None, *, wind_source: str = "estimator",
+                 time_constant: float = 30.0, hysteresis: float = 0.25,
+                 initial_wind_mps: float | None = None) -> None:
         if wind_source not in ("estimator", "preview"):
             raise ValueError(f"wind_source must be 'estimator' or 'preview', got {wind_source!r}")
         for name, v in (("time_constant", time_constant), ("hysteresis", hysteresis)):
             if not (math.isfinite(v) and v >= 0):
                 raise ValueError(f"{name} must be finite and >= 0, got {v!r}")
+        st = settings or MPCSettings()
         if wind_source == "estimator":
-            mpc_kwargs.setdefault("estimator", "kalman")
-            if mpc_kwargs["estimator"] is None:
+            if settings is None:
+                st = st.replace(estimator="kalman")
+            if st.estimator is None:
                 raise ValueError("wind_source='estimator' needs estimator='kalman'")
+        self.settings = st
         self.family, self.turbine = family, turbine
         self.wind_source, self.tau, self.hyst = wind_source, float(time_constant), \
             float(hysteresis)
-        self._kw = mpc_kwargs
         self._ctl: dict[int, MPC] = {}
         grid = family.wind_speeds
         w0 = float(grid[len(grid) // 2]) if initial_wind_mps is None else initial_wind_mps
@@ -824,7 +874,7 @@ class ScheduledMPC:
     def controller(self, k: int) -> MPC:
         """The MPC of grid point ``k`` (built on first use)."""
         if k not in self._ctl:
-            self._ctl[k] = MPC(self.family.models[k], self.turbine, **self._kw)
+            self._ctl[k] = MPC(self.family.models[k], self.turbine, self.settings)
         return self._ctl[k]
 
     def reset(self) -> None:
@@ -838,14 +888,7 @@ class ScheduledMPC:
     def _switch(self, k: int) -> None:
         old, new = self.controller(self.active), self.controller(k)
         new.reset()
-        if old._u_prev is not None:
-            u_abs = old._u_abs(old._u_prev)
-            du = u_abs - new.model.u0
-            new._u_prev = np.array([du[0], du[3]]) if new.collective else du
-        if old.estimator is not None and new.estimator is not None:
-            xa_abs = old.estimator.xa + np.concatenate([old.model.x0, old.model.d0])
-            new.estimator.xa = xa_abs - np.concatenate([new.model.x0, new.model.d0])
-            new.estimator._started = old.estimator._started
+        new.hand_over(old)
         self.active = k
         self.switches += 1
 

@@ -1,6 +1,7 @@
 """Plots (PNG). matplotlib is imported here only, with the non-interactive Agg backend."""
 from __future__ import annotations
 
+import math
 from pathlib import Path
 from typing import Any, Sequence
 
@@ -9,7 +10,8 @@ import numpy as np
 from linearize import OperatingPoint
 
 __all__ = ["plot_cp_surface", "plot_operating_schedule", "plot_lidar_coherence",
-           "plot_scan_pattern", "plot_cs_ellipses", "plot_psd_comparison"]
+           "plot_scan_pattern", "plot_cs_ellipses", "plot_psd_comparison", "plot_design",
+           "assess_plots"]
 
 
 def _save(fig, path: str | Path) -> Path:  # type: ignore[no-untyped-def]
@@ -197,4 +199,78 @@ def plot_psd_comparison(items: list[tuple[str, np.ndarray, np.ndarray]], rotor_h
     ax.set_ylabel(ylabel)
     ax.legend(fontsize=8)
     ax.grid(alpha=0.3, which="both")
+    return _save(fig, path)
+
+
+def assess_plots(runs: Sequence[tuple[str, np.ndarray, dict[str, np.ndarray]]],
+                 out_dir: str | Path) -> list[str]:
+    """CS ellipses (Do et al. fig. 4) and flap-moment PSDs of several runs, as PNG."""
+    from .assess import cs_measures, psd
+
+    d = Path(out_dir)
+    d.mkdir(parents=True, exist_ok=True)
+    made = []
+    items = [(name, cs_measures(c["tower_base_fa_moment"], c["gen_power"]),
+              c["tower_base_fa_moment"], c["gen_power"]) for name, _, c in runs
+             if "tower_base_fa_moment" in c and "gen_power" in c]
+    if items:
+        made.append(str(plot_cs_ellipses(items, d / "cs_ellipses.png")))
+    spectra = []
+    frot = 0.2
+    for name, t, c in runs:
+        if "flap_moment_1" in c:
+            dt = float(np.median(np.diff(t)))
+            f, p = psd(c["flap_moment_1"], 1 / dt)
+            spectra.append((name, f, p))
+            if "rotor_speed" in c:
+                frot = float(c["rotor_speed"].mean()) / (2 * math.pi)
+    if spectra:
+        made.append(str(plot_psd_comparison(spectra, frot, d / "psd_flap_moment_1.png",
+                                             "flap moment PSD [(N m)^2/Hz]")))
+    return made
+
+
+def plot_design(doc: dict[str, Any], path: str | Path) -> Path:
+    """The gains of a design document against wind speed (TS: against the vertex), as PNG.
+
+    Parameters
+    ----------
+    doc : dict
+        A gain-table document (:mod:`mpc_wt.export`).
+    path : str or Path
+        The PNG file.
+
+    Returns
+    -------
+    Path
+        ``path``.
+    """
+    plt = _plt()
+    s = doc["schedule"]
+    rows = np.asarray(s["rows"], dtype=float)
+    x = rows[:, 0]
+    fig, ax = plt.subplots(figsize=(7, 4))
+    scalar = {"baseline": (("kp", "ki"), "PI gain on generator speed [s], [-]"),
+              "ibc": (("gain",), "IBC gain [rad/(N m)]"),
+              "coleman-ipc": (("ki",), "IPC integral gain [rad/(N m s)]")}
+    if doc["kind"] in scalar:
+        names, label = scalar[doc["kind"]]
+        for c in names:
+            ax.plot(x, rows[:, s["columns"].index(c)], "o-", label=c)
+        ax.set_ylabel(label)
+    else:
+        k = np.asarray(doc["matrices"]["K"]["data"])
+        m = doc["matrices"]["K"]
+        flat = k.reshape(k.shape[0], -1)
+        big = np.argsort(-np.abs(flat).max(axis=0))[:6]
+        for j in big:
+            lab = f"K[{m['rows'][j // len(m['cols'])]}, {m['cols'][j % len(m['cols'])]}]"
+            v = flat[:, j] / max(np.abs(flat[:, j]).max(), 1e-300)
+            ax.plot(np.arange(len(x)) if doc["kind"] == "ts" else x, v, "o-", label=lab)
+        ax.set_ylabel("gain / its largest magnitude [-]")
+    ax.set_xlabel("vertex index (wind outer, power reduction inner)" if doc["kind"] == "ts"
+                  else "wind speed [m/s]")
+    ax.set_title(f"{doc['kind']} gains, {doc['turbine']}")
+    ax.grid(True, alpha=0.3)
+    ax.legend(fontsize=7)
     return _save(fig, path)

@@ -1,9 +1,10 @@
 """Closed-loop simulation: plant + wind + controller, with results that keep everything.
 
-The plant (:mod:`linearize`) is integrated with fixed-step RK4 at its rate (default 80 Hz); the
-controller runs at its own rate and its commands are held between its steps (zero-order hold).
-A controller is any object with ``reset()`` and ``step(t, measurements) -> (pitch_ref (3,),
-gen_torque_ref)``; it may expose a dict ``signals`` of internal signals, recorded every step.
+The plant (:mod:`linearize`) is integrated with fixed-step RK4 at its rate (default 80 Hz,
+:class:`linearize.PlantStepper`); the controller runs at its own rate and its commands are held
+between its steps (zero-order hold). A controller is any object with ``reset()`` and
+``step(t, measurements) -> (pitch_ref (3,), gen_torque_ref)``; it may expose a dict ``signals``
+of internal signals, recorded every step.
 
 Measurements given to the controller: ``t``, ``gen_speed``, ``rotor_speed``, ``pitch`` (3,),
 ``flap_moment`` (3,), ``edge_moment`` (3,), ``tower_fa_acceleration``,
@@ -13,158 +14,37 @@ Measurements given to the controller: ``t``, ``gen_speed``, ``rotor_speed``, ``p
 """
 from __future__ import annotations
 
-import json
 import logging
 import math
-import os
-import uuid
-from dataclasses import dataclass, field
-from pathlib import Path
 from typing import Any, Protocol
 
 import numpy as np
 from tqdm import tqdm
 
 import linearize
-from linearize.plant import _bad_state, _rk4, _state_limits
 
 from . import __version__
+from .errors import ResultFileError, SimulationDivergedError
+from .results import ClosedLoopResult
 
 __all__ = ["Controller", "ClosedLoopResult", "ResultFileError", "LidarPreview",
-           "simulate_closed_loop"]
+           "SimulationDivergedError", "simulate_closed_loop"]
 
 log = logging.getLogger(__name__)
-SCHEMA_VERSION = 1
 _Z = {n: i for i, n in enumerate(linearize.OUTPUT_NAMES)}
+_IX_ROTOR = linearize.STATE_NAMES.index("rotor_speed")
+_IX_AZ = linearize.STATE_NAMES.index("azimuth")
 
 
 class Controller(Protocol):
-    """What the harness needs from a controller."""
+    """What the harness needs from a controller: ``reset()`` before a run and
+    ``step(t, meas) -> (pitch_ref (3,) [rad], gen_torque_ref [N m])`` at its rate."""
 
-    def reset(self) -> None: ...
+    def reset(self) -> None:
+        """Forget everything of a previous run."""
 
-    def step(self, t: float, meas: dict[str, Any]) -> tuple[np.ndarray, float]: ...
-
-
-class ResultFileError(ValueError):
-    """A result file is missing, truncated, of another schema, or misses a channel."""
-
-
-@dataclass(frozen=True)
-class ClosedLoopResult:
-    """Everything a closed-loop run produced.
-
-    Parameters
-    ----------
-    t : (n_t,) ndarray
-        [s]
-    x : (n_t, n_x) ndarray
-        Plant states (:data:`linearize.STATE_NAMES`).
-    u : (n_t, n_u) ndarray
-        Applied inputs (after the plant's torque rate limit).
-    z : (n_t, n_z) ndarray
-        Plant outputs (:data:`linearize.OUTPUT_NAMES`).
-    controller : dict of str to (n_t,) ndarray
-        The controller's internal signals.
-    meta : dict
-        Configuration and software version.
-    """
-
-    t: np.ndarray
-    x: np.ndarray
-    u: np.ndarray
-    z: np.ndarray
-    controller: dict[str, np.ndarray] = field(default_factory=dict)
-    meta: dict[str, Any] = field(default_factory=dict)
-
-    def channel(self, name: str) -> np.ndarray:
-        """A time series by name: output, state, input, controller signal, or the derived
-        ``shaft_bending_blade1``: the rotating low-speed-shaft bending moment in the direction
-        of blade 1 from the blades' flap moments, M_1 - (M_2 + M_3) / 2 [N m] (rotor weight
-        and hub inertia left out)."""
-        if name == "shaft_bending_blade1":
-            f = self.z[:, _Z["flap_moment_1"]:_Z["flap_moment_3"] + 1]
-            return f[:, 0] - 0.5 * (f[:, 1] + f[:, 2])
-        if name in _Z:
-            return self.z[:, _Z[name]]
-        if name in linearize.STATE_NAMES:
-            return self.x[:, linearize.STATE_NAMES.index(name)]
-        if name in linearize.INPUT_NAMES:
-            return self.u[:, linearize.INPUT_NAMES.index(name)]
-        if name in self.controller:
-            return self.controller[name]
-        raise KeyError(f"no channel {name!r}; channels are {self.channels()}")
-
-    def channels(self) -> list[str]:
-        """All channel names."""
-        return (list(linearize.OUTPUT_NAMES) + [n for n in linearize.STATE_NAMES
-                                                if n not in _Z]
-                + list(linearize.INPUT_NAMES) + ["shaft_bending_blade1"]
-                + list(self.controller))
-
-    def save(self, path: str | Path) -> Path:
-        """Write a self-describing netCDF file (xarray; openable without mpc-wt) with units,
-        the configuration and the software version; written to a temporary file, then renamed."""
-        import xarray as xr
-
-        path = Path(path)
-        data = {}
-        units = dict(zip(linearize.OUTPUT_NAMES, linearize.OUTPUT_UNITS))
-        units.update(zip(linearize.STATE_NAMES, linearize.STATE_UNITS))
-        units.update(zip(linearize.INPUT_NAMES, linearize.INPUT_UNITS))
-        for n in self.channels():
-            key = n if n not in data else f"{n}_state"
-            data[key] = xr.Variable("time", self.channel(n),
-                                    {"units": units.get(n, ""),
-                                     "source": "controller" if n in self.controller else "plant"})
-        ds = xr.Dataset(data, coords={"time": ("time", self.t, {"units": "s"})},
-                        attrs={"schema_version": SCHEMA_VERSION, "software": "mpc-wt",
-                               "software_version": __version__,
-                               "meta_json": json.dumps(self.meta)})
-        # a name of this writer's own: two writers of one case (a retried task) never share it
-        tmp = path.with_name(f".{path.name}.{os.getpid()}.{uuid.uuid4().hex[:8]}.tmp")
-        try:
-            ds.to_netcdf(tmp, engine="scipy")
-            tmp.replace(path)
-        finally:
-            tmp.unlink(missing_ok=True)
-        return path
-
-    @classmethod
-    def load(cls, path: str | Path) -> "ClosedLoopResult":
-        """Read a result written by :meth:`save`.
-
-        Raises
-        ------
-        ResultFileError
-            If the file is missing, truncated, of another schema or misses plant channels.
-        """
-        import xarray as xr
-
-        path = Path(path)
-        if not path.is_file():
-            raise ResultFileError(f"{path}: file not found")
-        try:
-            with xr.open_dataset(path, engine="scipy") as ds:
-                ds = ds.load()
-        except Exception as err:  # noqa: BLE001 - any reader failure means a broken file
-            raise ResultFileError(f"{path}: not a readable result file ({err})") from err
-        ver = ds.attrs.get("schema_version")
-        if isinstance(ver, (np.integer, int)):
-            ver = int(ver)
-        if ver != SCHEMA_VERSION:
-            raise ResultFileError(f"{path}: schema_version must be {SCHEMA_VERSION}, got {ver!r} "
-                                  f"(written by {ds.attrs.get('software_version', '?')})")
-        missing = [n for n in linearize.OUTPUT_NAMES if n not in ds]
-        if missing:
-            raise ResultFileError(f"{path}: missing channels {missing}")
-        z = np.column_stack([ds[n].values for n in linearize.OUTPUT_NAMES])
-        x = np.column_stack([ds[n if n not in _Z else n].values for n in linearize.STATE_NAMES])
-        u = np.column_stack([ds[n].values for n in linearize.INPUT_NAMES])
-        ctrl = {n: ds[n].values for n in ds.data_vars
-                if ds[n].attrs.get("source") == "controller"}
-        return cls(t=ds["time"].values, x=x, u=u, z=z, controller=ctrl,
-                   meta=json.loads(ds.attrs.get("meta_json", "{}")))
+    def step(self, t: float, meas: dict[str, Any]) -> tuple[np.ndarray, float]:
+        """Commands for the measurements ``meas`` at time ``t`` [s]."""
 
 
 class LidarPreview:
@@ -175,6 +55,7 @@ class LidarPreview:
     Parameters
     ----------
     lidar_model : lidar.CWLidar
+        The instrument.
     field : lidar.WindField
         The same field the plant meets (as its GridWind).
     horizon : int
@@ -197,6 +78,7 @@ class LidarPreview:
         self._az: list[np.ndarray] = []
 
     def __call__(self, t: float, azimuth_rad: float, rotor_speed_rad_s: float) -> Any:
+        """Measure at ``t`` and return the :class:`lidar.Preview` of the next H_p steps."""
         import lidar
 
         m = self.lidar.measure(self.field, np.array([t]), np.array([azimuth_rad]),
@@ -211,14 +93,6 @@ class LidarPreview:
         return lidar.preview(hist, t, self.horizon, self.dt)
 
 
-class SimulationDivergedError(RuntimeError):
-    """A closed-loop run left the physical envelope; ``partial`` keeps what was simulated."""
-
-    def __init__(self, message: str, partial: ClosedLoopResult) -> None:
-        super().__init__(message)
-        self.partial = partial
-
-
 def _measurements(t: float, x: np.ndarray, z: np.ndarray) -> dict[str, Any]:
     return {"t": t, "gen_speed": z[_Z["gen_speed"]], "rotor_speed": z[_Z["rotor_speed"]],
             "pitch": z[1:4].copy(), "flap_moment": z[10:13].copy(),
@@ -226,6 +100,102 @@ def _measurements(t: float, x: np.ndarray, z: np.ndarray) -> dict[str, Any]:
             "tower_fa_acceleration": z[_Z["tower_fa_acceleration"]],
             "tower_ss_acceleration": z[_Z["tower_ss_acceleration"]],
             "azimuth": z[_Z["azimuth"]], "gen_power": z[_Z["gen_power"]], "state": x.copy()}
+
+
+class _Loop:
+    """The state of one closed-loop run: the recorded arrays, the held commands and the
+    controller's signals. Private: :func:`simulate_closed_loop` is the interface."""
+
+    def __init__(self, params: linearize.PlantParams, controller: Any, n: int, dt: float,
+                 x0: np.ndarray, u0: np.ndarray, preview: Any) -> None:
+        self.params, self.controller, self.preview = params, controller, preview
+        self.n, self.dt = n, dt
+        self.xs, self.us = np.empty((n + 1, 17)), np.empty((n + 1, 4))
+        self.zs = np.empty((n + 1, 31))
+        self.sig: dict[str, list[float]] = {}
+        self.x = np.asarray(x0, float).copy()
+        self.u = np.asarray(u0, float).copy()
+        self.u_tq = float(self.u[3])
+        self.clipped = 0
+        self.k_done = 0
+        self.rate = params.turbine.generator.max_torque_rate * dt
+
+    def command(self, t: float, z: np.ndarray) -> None:
+        """Ask the controller for new commands and hold them."""
+        meas = _measurements(t, self.x, z)
+        if self.preview is not None:
+            meas["preview"] = self.preview(t, float(self.x[_IX_AZ]), float(self.x[_IX_ROTOR]))
+        pitch, tq = self.controller.step(t, meas)
+        pitch = np.asarray(pitch, float)
+        if pitch.shape != (3,) or not np.all(np.isfinite(pitch)) or not math.isfinite(tq):
+            raise ValueError(f"controller returned pitch {pitch!r}, torque {tq!r} at "
+                             f"t = {t:g} s: need 3 finite pitch angles [rad] and a "
+                             f"finite torque [N m]")
+        pa, gen = self.params.turbine.pitch_actuator, self.params.turbine.generator
+        if (pitch.min() < pa.min_pitch_rad - 1e-9 or pitch.max() > pa.max_pitch_rad + 1e-9
+                or not gen.min_torque - 1e-6 <= tq <= gen.max_torque + 1e-6):
+            if self.clipped == 0:
+                log.warning("controller command out of the actuator range at t = %g s "
+                            "(pitch %s rad, torque %g N m): the plant clips it; the "
+                            "count is in result.meta['commands_clipped']", t,
+                            np.round(pitch, 4), tq)
+            self.clipped += 1
+        self.u[:3] = pitch
+        self.u_tq = float(tq)
+
+    def record_signals(self) -> None:
+        """Append the controller's internal signals of this plant step."""
+        for name, val in getattr(self.controller, "signals", {}).items():
+            self.sig.setdefault(name, []).append(float(val))
+
+    def apply_torque_rate(self) -> None:
+        """Move the applied torque toward the command by at most the generator's rate."""
+        self.u[3] += min(max(self.u_tq - self.u[3], -self.rate), self.rate)
+
+    def result(self, k: int, meta: dict[str, Any]) -> ClosedLoopResult:
+        """The first ``k`` samples as a result."""
+        return ClosedLoopResult(t=self.dt * np.arange(k), x=self.xs[:k], u=self.us[:k],
+                                z=self.zs[:k],
+                                controller={s: np.array(v[:k]) for s, v in self.sig.items()},
+                                meta=meta)
+
+
+def _check_rates(duration: float, dt: float, controller_dt: float | None
+                 ) -> tuple[int, int, float]:
+    n = int(round(duration / dt))
+    if n < 1:
+        raise ValueError(f"duration ({duration!r} s) must be at least one step dt = {dt!r} s")
+    cdt = dt if controller_dt is None else controller_dt
+    ratio = int(round(cdt / dt))
+    if ratio < 1 or abs(ratio * dt - cdt) > 1e-9:
+        raise ValueError(f"controller_dt = {cdt!r} s must be a whole multiple of dt = {dt!r} s")
+    return n, ratio, cdt
+
+
+def _run(loop: _Loop, stepper: linearize.PlantStepper, ratio: int, bar: Any) -> None:
+    """Advance the loop over all its steps; raises :class:`_Diverged` at the first state
+    outside the envelope (``loop.k_done`` then counts the samples kept)."""
+    n, dt = loop.n, loop.dt
+    for k in range(n + 1):
+        t = k * dt
+        if k == n:
+            z = stepper.outputs(t, loop.x, loop.u)
+        else:
+            xn, z = stepper.step(t, loop.x, loop.u)
+        loop.xs[k], loop.us[k], loop.zs[k] = loop.x, loop.u, z
+        if k % ratio == 0 and k < n:
+            loop.command(t, z)
+        loop.record_signals()
+        if k == n:
+            break
+        loop.apply_torque_rate()
+        loop.k_done = k + 1
+        bad = stepper.outside_envelope(xn)
+        if bad >= 0:
+            raise _Diverged(k + 1, bad, float(xn[bad]))
+        loop.x = xn
+        if k % 800 == 0:
+            bar.update(min(800, n - bar.n))
 
 
 def simulate_closed_loop(params: linearize.PlantParams, controller: Any,
@@ -239,12 +209,17 @@ def simulate_closed_loop(params: linearize.PlantParams, controller: Any,
     Parameters
     ----------
     params : PlantParams
+        The plant (:func:`linearize.plant_params`).
     controller : Controller
+        Anything with ``reset()`` and ``step(t, meas)``.
     wind : SteadyWind or GridWind
+        The free wind; it must cover the rotor and the run.
     duration : float
         [s]
-    x0, u0 : ndarray
-        Initial state and inputs (e.g. a trim point's).
+    x0 : (n_x,) ndarray
+        Initial state (e.g. a trim point's).
+    u0 : (n_u,) ndarray
+        Initial inputs.
     dt : float
         Plant step [s] (default 1/80).
     controller_dt : float, optional
@@ -254,6 +229,14 @@ def simulate_closed_loop(params: linearize.PlantParams, controller: Any,
     preview : LidarPreview, optional
         A simulated LIDAR; its preview is passed to the controller as ``meas["preview"]``
         (a :class:`lidar.Preview`).
+    meta : dict, optional
+        Configuration stored with the result.
+
+    Returns
+    -------
+    ClosedLoopResult
+        ``round(duration / dt) + 1`` samples; ``meta`` gains ``dt``, ``controller_dt``,
+        ``commands_clipped`` and ``software_version``.
 
     Raises
     ------
@@ -263,99 +246,29 @@ def simulate_closed_loop(params: linearize.PlantParams, controller: Any,
     ValueError
         If the controller returns a non-finite or wrongly shaped command (names the time).
     """
-    n = int(round(duration / dt))
-    if n < 1:
-        raise ValueError(f"duration ({duration!r} s) must be at least one step dt = {dt!r} s")
-    cdt = dt if controller_dt is None else controller_dt
-    ratio = int(round(cdt / dt))
-    if ratio < 1 or abs(ratio * dt - cdt) > 1e-9:
-        raise ValueError(f"controller_dt = {cdt!r} s must be a whole multiple of dt = {dt!r} s")
-    wind.check_covers(params, n * dt)
-    kind, wpar, grid = wind._kernel_args()
-    pk = params.pack
-    lim = _state_limits(params)
+    n, ratio, cdt = _check_rates(duration, dt, controller_dt)
+    stepper = linearize.PlantStepper(params, wind, dt, n * dt)
     controller.reset()
     if preview is not None:
         preview.reset()
-    xs = np.empty((n + 1, 17))
-    us = np.empty((n + 1, 4))
-    zs = np.empty((n + 1, 31))
-    sig: dict[str, list[float]] = {}
-    x = np.asarray(x0, float).copy()
-    u = np.asarray(u0, float).copy()
-    hint = np.full((4, 3, pk.r.size), np.nan)
-    dphi = np.zeros((3, pk.r.size))
-    rate = params.turbine.generator.max_torque_rate * dt
-    applied_tq = u[3]
-    clipped = 0
-    k_done = 0
+    loop = _Loop(params, controller, n, dt, x0, u0, preview)
     bar = tqdm(total=n, desc="simulate", unit="step", disable=not progress, mininterval=0.5)
     try:
-        for k in range(n + 1):
-            t = k * dt
-            if k == n:
-                from linearize.plant import _eval, _sample_wind
-
-                w = _sample_wind(t, x[16], pk, kind, wpar, grid)
-                z = _eval(x, u, w, pk, hint, 0)[1]
-            else:
-                xn, z, hint, dphi = _rk4(t, x, u, dt, pk, kind, wpar, grid, hint, dphi)
-            xs[k], us[k], zs[k] = x, u, z
-            if k % ratio == 0 and k < n:
-                meas = _measurements(t, x, z)
-                if preview is not None:
-                    meas["preview"] = preview(t, float(x[16]), float(x[2]))
-                pitch, tq = controller.step(t, meas)
-                pitch = np.asarray(pitch, float)
-                if pitch.shape != (3,) or not np.all(np.isfinite(pitch)) or not math.isfinite(tq):
-                    raise ValueError(f"controller returned pitch {pitch!r}, torque {tq!r} at "
-                                     f"t = {t:g} s: need 3 finite pitch angles [rad] and a "
-                                     f"finite torque [N m]")
-                pa = params.turbine.pitch_actuator
-                gen = params.turbine.generator
-                if (pitch.min() < pa.min_pitch_rad - 1e-9 or pitch.max() > pa.max_pitch_rad + 1e-9
-                        or not gen.min_torque - 1e-6 <= tq <= gen.max_torque + 1e-6):
-                    if clipped == 0:
-                        log.warning("controller command out of the actuator range at t = %g s "
-                                    "(pitch %s rad, torque %g N m): the plant clips it; the "
-                                    "count is in result.meta['commands_clipped']", t,
-                                    np.round(pitch, 4), tq)
-                    clipped += 1
-                u[:3] = pitch
-                u_tq = float(tq)
-            for name, val in getattr(controller, "signals", {}).items():
-                sig.setdefault(name, []).append(float(val))
-            if k == n:
-                break
-            applied_tq += min(max(u_tq - applied_tq, -rate), rate)
-            u[3] = applied_tq
-            bad = _bad_state(xn, lim)
-            if bad >= 0:
-                k_done = k + 1
-                raise _Diverged(k + 1, bad, float(xn[bad]))
-            x = xn
-            k_done = k + 1
-            if k % 800 == 0:
-                bar.update(min(800, n - bar.n))
+        _run(loop, stepper, ratio, bar)
     except _Diverged as d:
-        part = ClosedLoopResult(t=dt * np.arange(k_done), x=xs[:k_done], u=us[:k_done],
-                                z=zs[:k_done], controller={k: np.array(v[:k_done])
-                                                           for k, v in sig.items()},
-                                meta=meta or {})
         raise SimulationDivergedError(
             f"simulation diverged at t = {d.k * dt:.4f} s: state "
             f"{linearize.STATE_NAMES[d.state]!r} = {d.value!r} "
-            f"{linearize.STATE_UNITS[d.state]} left its envelope; the {k_done} samples before "
-            f"are kept in .partial", part) from None
+            f"{linearize.STATE_UNITS[d.state]} left its envelope; the {loop.k_done} samples "
+            f"before are kept in .partial", loop.result(loop.k_done, meta or {})) from None
     finally:
         bar.close()
-    ctrl = {k: np.array(v[:n + 1]) for k, v in sig.items()}
-    return ClosedLoopResult(t=dt * np.arange(n + 1), x=xs, u=us, z=zs, controller=ctrl,
-                            meta={**(meta or {}), "dt": dt, "controller_dt": cdt,
-                                  "commands_clipped": clipped,
-                                  "software_version": __version__})
+    return loop.result(n + 1, {**(meta or {}), "dt": dt,
+                               "controller_dt": cdt, "commands_clipped": loop.clipped,
+                               "software_version": __version__})
 
 
 class _Diverged(Exception):
     def __init__(self, k: int, state: int, value: float) -> None:
+        super().__init__(k, state, value)
         self.k, self.state, self.value = k, state, value

@@ -33,6 +33,7 @@ import scipy.linalg
 
 import linearize
 
+from .errors import SynthesisError
 from .estimator import read_signals
 
 __all__ = ["LQRDesign", "PIObserver", "design_lqr", "design_lqr_family", "design_pi_observer",
@@ -50,10 +51,6 @@ REGION2_WEIGHTS = {"tower_fa_velocity": 1.0, **{f"flap_rate_{i}": 0.2 for i in (
 #: Their magnitudes: 0.1 m/s tower-top velocity, 1 m/s flap tip rate, 1 deg of pitch per blade.
 REGION2_SCALES = {"tower_fa_velocity": 0.1, **{f"flap_rate_{i}": 1.0 for i in (1, 2, 3)},
                   **{f"pitch_ref_{i}": math.radians(1.0) for i in (1, 2, 3)}}
-
-
-class SynthesisError(ValueError):
-    """A design problem that has no solution as posed (the message says what to change)."""
 
 
 def _names(model: linearize.LinearModel) -> dict[str, tuple[np.ndarray, str]]:

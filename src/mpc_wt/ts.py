@@ -51,7 +51,7 @@ import linearize
 
 from .estimator import read_signals
 from .retrofit import apc_reference  # noqa: F401 - re-exported (eq 11 lives with the APC)
-from .synthesis import SynthesisError
+from .errors import PremiseError, SynthesisError
 
 __all__ = ["TSModel", "build_ts_model", "TSControllerDesign", "TSObserverDesign",
            "Certificate", "design_ts_controller", "design_ts_observer", "verify_controller",
@@ -68,10 +68,6 @@ DEFAULT_SCALES = {"tower_fa_displacement": 0.1, "tower_fa_velocity": 0.1, "rotor
                   "gen_speed": 0.1 * 97.0, "shaft_torsion": 1e-3, "tower_ss_displacement": 0.02,
                   "tower_ss_velocity": 0.02, "pitch_ref_coll": math.radians(1.0),
                   "gen_torque_ref": 4e3, "wind": 1.0}
-
-
-class PremiseError(ValueError):
-    """A premise value outside the TS model's vertex grid."""
 
 
 def _hats(grid: np.ndarray, s: float) -> np.ndarray:

@@ -96,8 +96,10 @@ def test_case_hash_changes_only_for_touched_cases(winds, seeds, ctl, shear):
     raw = {**BASE, "winds": winds, "seeds": seeds, "shear_exponent": shear,
            "controllers": ["baseline", {"name": "other", "controller": ctl}]}
     a = spec_from_dict(raw).cases()
+    # an option the kind takes (the registry rejects others when the spec loads)
+    opt = {"baseline": {"zeta": 0.6}, "ibc": {"loop_gain_1p": 0.5}}.get(ctl, {})
     raw2 = {**raw, "controllers": ["baseline", {"name": "other", "controller": ctl,
-                                                "retrofit_options": {"gain_scale": 0.5}}]}
+                                                "options": opt}]}
     if ctl == "derate90":
         raw2["controllers"][1] = {"name": "other", "controller": "derate80"}
     b = spec_from_dict(raw2).cases()
@@ -285,7 +287,7 @@ def test_do_controllers_pick_their_region():
     power stays that of the baseline within 2 %); baseline-ct holds torque constant above rated
     (torque std below 0.5 % of rated torque, the constant-power baseline's is larger)."""
     import linearize
-    from mpc_wt.runs import run_controller
+    from mpc_wt import run_controller
 
     tb = linearize.load_turbine()
     r2 = run_controller(tb, "lqr-pio", 8.0, 0.12, 1, 60.0)

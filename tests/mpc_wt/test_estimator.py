@@ -8,7 +8,7 @@ import pytest
 
 import linearize
 from mpc_wt.estimator import KalmanEstimator
-from mpc_wt.mpc import MPC
+from mpc_wt.mpc import MPC, MPCSettings
 from mpc_wt.simulate import simulate_closed_loop
 
 
@@ -24,7 +24,7 @@ def test_mpc_on_measured_signals_estimates_the_wind(turbine: linearize.Turbine,
     # from the operating point's 18 m/s to the true wind. Measured: mean of the three estimates
     # 18.75 m/s over the last 10 s (the residual bias is the gravity/tilt 1P content of the flap
     # moments, which the averaged linear model does not have); tolerance 0.5 m/s.
-    ctl = MPC(model, turbine, estimator="kalman")
+    ctl = MPC(model, turbine, MPCSettings(estimator="kalman", backend="osqp"))
     assert ctl.estimator.spectral_radius < 1
     op = linearize.trim(turbine, 18.0)
     r = simulate_closed_loop(params, ctl, linearize.SteadyWind(19.0, 0.0), 40.0, x0=op.x,
@@ -59,7 +59,7 @@ def test_estimator_bad_input(model, turbine) -> None:
     md = model.discretize(0.1) if model.dt is None else model
     with pytest.raises(ValueError, match="estimator must be None, 'kalman' or a "
                                          "KalmanEstimator, got 'ekf'"):
-        MPC(model, turbine, estimator="ekf")
+        MPC(model, turbine, MPCSettings(estimator="ekf", backend="osqp"))
     with pytest.raises(ValueError, match="wind_std_per_step must be finite and > 0 m/s, got 0"):
         KalmanEstimator(md, wind_std_per_step=0)
     with pytest.raises(ValueError, match="measurement_std: unknown signal 'lidar'"):

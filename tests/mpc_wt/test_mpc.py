@@ -10,7 +10,7 @@ from hypothesis import strategies as st
 from numpy.testing import assert_allclose
 
 import linearize
-from mpc_wt.mpc import MPC, MPCWeights, coleman_weight
+from mpc_wt.mpc import MPC, MPCSettings, MPCWeights, coleman_weight
 
 
 @settings(max_examples=100, deadline=None)
@@ -45,7 +45,7 @@ def test_long_horizon_converges_to_discrete_lqr(model, turbine: linearize.Turbin
     # cross term C'QD, input weight R + D'QD (python-control dlqr)
     import control
 
-    ctl = MPC(model, turbine, horizon=200, control_horizon=200)
+    ctl = MPC(model, turbine, MPCSettings(horizon=200, control_horizon=200, backend="osqp"))
     q, r = ctl._weights()
     m = ctl.model
     qx = m.C_z.T @ q @ m.C_z
@@ -58,7 +58,7 @@ def test_long_horizon_converges_to_discrete_lqr(model, turbine: linearize.Turbin
 
 
 def test_qp_solution_equals_the_unconstrained_one_when_nothing_binds(model, turbine) -> None:
-    ctl = MPC(model, turbine)
+    ctl = MPC(model, turbine, MPCSettings(backend="osqp"))
     x = np.zeros(8)
     x[2] = 0.005                                     # small rotor overspeed [rad/s]
     plan, status = ctl.solve(x)
@@ -70,7 +70,7 @@ def test_qp_solution_equals_the_unconstrained_one_when_nothing_binds(model, turb
 
 
 def test_constraints_hold_when_they_bind(model, turbine: linearize.Turbine) -> None:
-    ctl = MPC(model, turbine)
+    ctl = MPC(model, turbine, MPCSettings(backend="osqp"))
     x = np.zeros(8)
     x[2] = 0.3                                       # large overspeed: the pitch rate binds
     plan, status = ctl.solve(x)
@@ -89,7 +89,7 @@ def test_constraints_hold_when_they_bind(model, turbine: linearize.Turbine) -> N
 
 
 def test_collective_variant(model, turbine: linearize.Turbine) -> None:
-    ctl = MPC(model, turbine, collective=True)
+    ctl = MPC(model, turbine, MPCSettings(collective=True, backend="osqp"))
     x = np.zeros(8)
     x[2] = 0.01
     pitch, tq = ctl.step(0.0, {"state": np.r_[model.x0 + x, np.zeros(9)]})
@@ -103,7 +103,7 @@ def test_collective_variant(model, turbine: linearize.Turbine) -> None:
 ])
 def test_bad_arguments(model, turbine, kwargs, match: str) -> None:
     with pytest.raises(ValueError, match=match):
-        MPC(model, turbine, **kwargs)
+        MPC(model, turbine, MPCSettings(**kwargs))
 
 
 def test_negative_weight_is_rejected() -> None:
@@ -113,7 +113,7 @@ def test_negative_weight_is_rejected() -> None:
 
 
 def test_preview_of_wrong_shape(model, turbine) -> None:
-    ctl = MPC(model, turbine)
+    ctl = MPC(model, turbine, MPCSettings(backend="osqp"))
     with pytest.raises(ValueError, match=r"d_preview has shape \(10, 3\); expected \(H_p, n_d\)"):
         ctl.solve(np.zeros(8), np.zeros((10, 3)))
     with pytest.raises(ValueError, match=r"x has shape \(7,\)"):
@@ -125,7 +125,7 @@ def test_mpc_in_the_loop_respects_limits(turbine: linearize.Turbine,
     from mpc_wt.simulate import simulate_closed_loop
 
     op = linearize.trim(turbine, 18.0)
-    ctl = MPC(model, turbine)
+    ctl = MPC(model, turbine, MPCSettings(backend="osqp"))
     r = simulate_closed_loop(params, ctl, linearize.SteadyWind(18.0, 0.2), 30.0, x0=op.x,
                              u0=op.u, controller_dt=0.1)
     late = r.t > 5
@@ -141,8 +141,8 @@ def test_daqp_backend_agrees_with_osqp(model, turbine, overspeed: float) -> None
     pytest.importorskip("daqp")
     x = np.zeros(8)
     x[2] = overspeed
-    a, sa = MPC(model, turbine).solve(x)
-    b, sb = MPC(model, turbine, backend="daqp").solve(x)
+    a, sa = MPC(model, turbine, MPCSettings(backend="osqp")).solve(x)
+    b, sb = MPC(model, turbine, MPCSettings(backend="daqp")).solve(x)
     assert sa == sb == "solved"
     # issue 6: first moves agree within 0.01 deg pitch and 0.1 % of rated torque
     assert np.abs(a[0, :3] - b[0, :3]).max() < math.radians(0.01)
@@ -151,7 +151,7 @@ def test_daqp_backend_agrees_with_osqp(model, turbine, overspeed: float) -> None
 
 def test_unknown_backend(model, turbine) -> None:
     with pytest.raises(ValueError, match="backend must be 'osqp' or 'daqp'"):
-        MPC(model, turbine, backend="qpoases")
+        MPC(model, turbine, MPCSettings(backend="qpoases"))
 
 
 def test_lidar_preview_reduces_asymmetric_loads(turbine: linearize.Turbine,
@@ -170,7 +170,8 @@ def test_lidar_preview_reduces_asymmetric_loads(turbine: linearize.Turbine,
     lid = lidar.CWLidar(63.0, range_weighting=False, los_error=False)
     out = {}
     for label, prev in (("none", None), ("lidar", LidarPreview(lid, f, 15, 0.1))):
-        r = simulate_closed_loop(params, MPC(model, turbine, backend="daqp"), gw, 70.0,
+        r = simulate_closed_loop(params, MPC(model, turbine, MPCSettings(backend="daqp")), gw,
+                                 70.0,
                                  x0=op.x, u0=op.u, controller_dt=0.1, preview=prev)
         late = r.t > 10.0
         frot = float(r.channel("rotor_speed")[late].mean()) / (2 * math.pi)
@@ -183,8 +184,8 @@ def test_lidar_preview_reduces_asymmetric_loads(turbine: linearize.Turbine,
 
 
 def test_from_turbine_matches_the_explicit_model(model, turbine) -> None:
-    ctl = MPC.from_turbine(turbine, 18.0, horizon=15)
-    ref = MPC(model, turbine)
+    ctl = MPC.from_turbine(turbine, 18.0, MPCSettings(horizon=15, backend="osqp"))
+    ref = MPC(model, turbine, MPCSettings(backend="osqp"))
     x = np.zeros(8)
     x[2] = 0.05
     assert_allclose(ctl.solve(x)[0], ref.solve(x)[0], atol=1e-9)
@@ -238,8 +239,9 @@ def test_soft_speed_limit_far_away_changes_nothing(model, turbine, backend: str)
     w0 = model.z0[model.outputs.index("rotor_speed")]
     x = np.zeros(8)
     x[2], x[0] = 0.01, 0.02
-    a, sa = MPC(model, turbine, backend=backend, max_rotor_speed=w0 + 1.0).solve(x)
-    b, _ = MPC(model, turbine, backend=backend).solve(x)
+    a, sa = MPC(model, turbine,
+                MPCSettings(backend=backend, max_rotor_speed=w0 + 1.0)).solve(x)
+    b, _ = MPC(model, turbine, MPCSettings(backend=backend)).solve(x)
     assert sa == "solved"
     assert np.abs(a[:, :3] - b[:, :3]).max() < math.radians(0.01)
     assert np.abs(a[:, 3] - b[:, 3]).max() < 0.001 * turbine.rated_generator_torque
@@ -251,11 +253,11 @@ def test_soft_speed_limit_keeps_the_qp_feasible(model, turbine, backend: str) ->
     w0 = model.z0[model.outputs.index("rotor_speed")]
     x = np.zeros(8)
     x[2], x[3] = 0.03, 0.03 * turbine.drivetrain.gearbox_ratio
-    soft = MPC(model, turbine, backend=backend, max_rotor_speed=w0 + 0.02)
+    soft = MPC(model, turbine, MPCSettings(backend=backend, max_rotor_speed=w0 + 0.02))
     plan, status = soft.solve(x)
     assert status == "solved"
     assert soft._last_slack == pytest.approx(0.01, abs=1e-5)
-    free, _ = MPC(model, turbine, backend=backend).solve(x)
+    free, _ = MPC(model, turbine, MPCSettings(backend=backend)).solve(x)
     s_soft, s_free = _speeds(soft, x, plan), _speeds(soft, x, free)
     assert np.all(s_soft <= s_free + 1e-6)
     assert (s_free - s_soft).max() > 1e-3       # the limit acts: the rotor is slowed faster
@@ -270,7 +272,7 @@ def test_soft_speed_limit_keeps_the_qp_feasible(model, turbine, backend: str) ->
 ])
 def test_soft_constraint_bad_arguments(model, turbine, kwargs, match: str) -> None:
     with pytest.raises(ValueError, match=match):
-        MPC(model, turbine, **kwargs)
+        MPC(model, turbine, MPCSettings(**kwargs))
 
 
 @settings(max_examples=15, deadline=None)
@@ -285,8 +287,9 @@ def test_sparse_formulation_gives_the_condensed_moves(model, turbine, seed: int,
     x = rng.normal(size=8) * 0.02 * size
     d = rng.normal(size=(15, 3)) * 0.5 * size
     up = rng.normal(size=4) * np.r_[0.005, 0.005, 0.005, 1000.0] * size
-    cond = MPC(model, turbine, max_rotor_speed=soft)
-    sparse = MPC(model, turbine, formulation="sparse", max_rotor_speed=soft)
+    cond = MPC(model, turbine, MPCSettings(max_rotor_speed=soft, backend="osqp"))
+    sparse = MPC(model, turbine, MPCSettings(formulation="sparse", max_rotor_speed=soft,
+                                             backend="osqp"))
     a, sa = cond.solve(x, d, up)
     b, sb = sparse.solve(x, d, up)
     if a is None:                  # infeasible hard constraints: both must say so
@@ -302,18 +305,18 @@ def test_sparse_formulation_is_sparse(model, turbine) -> None:
     # the point of the formulation: P and A stay block-banded (nnz linear in the horizon)
     nnz = []
     for hp in (10, 20, 40):
-        c = MPC(model, turbine, horizon=hp, formulation="sparse")
+        c = MPC(model, turbine, MPCSettings(horizon=hp, formulation="sparse", backend="osqp"))
         nnz.append(c._sparse_nnz)
     assert nnz[2] - nnz[1] == pytest.approx(2 * (nnz[1] - nnz[0]), rel=0.05)
-    dense = MPC(model, turbine, horizon=40)
+    dense = MPC(model, turbine, MPCSettings(horizon=40, backend="osqp"))
     assert dense._h_s.size + dense._a_gen_s.size > 5 * nnz[2] / 2
 
 
 def test_bad_formulation(model, turbine) -> None:
     with pytest.raises(ValueError, match="formulation must be 'condensed' or 'sparse', got 'x'"):
-        MPC(model, turbine, formulation="x")
+        MPC(model, turbine, MPCSettings(formulation="x", backend="osqp"))
     with pytest.raises(ValueError, match="formulation='sparse' needs backend='osqp'"):
-        MPC(model, turbine, formulation="sparse", backend="daqp")
+        MPC(model, turbine, MPCSettings(formulation="sparse", backend="daqp"))
 
 
 @pytest.mark.parametrize("formulation", ["condensed", "sparse"])
@@ -321,9 +324,9 @@ def test_osqp_public_interface_fallback_gives_the_same_moves(model, turbine,
                                                               formulation: str) -> None:
     # the compiled-object fast path and OSQP's public interface solve the same problem
     rng = np.random.default_rng(3)
-    fast = MPC(model, turbine, formulation=formulation)
-    slow = MPC(model, turbine, formulation=formulation)
-    slow._osqp_ext = None
+    fast = MPC(model, turbine, MPCSettings(formulation=formulation, backend="osqp"))
+    slow = MPC(model, turbine, MPCSettings(formulation=formulation, backend="osqp"))
+    slow.qp_backend.fast = False
     for _ in range(20):
         x = rng.normal(size=8) * 0.03
         a, _ = fast.solve(x)
@@ -336,18 +339,18 @@ def test_warm_start_never_holds_subnormal_numbers(model, turbine,
     # regression: in closed loop the ADMM iterates of the unconstrained steps (at the shifted
     # optimum, zero) decayed into subnormal numbers within a minute and every iteration became
     # ~50 times slower; they are rounded to 2^-52 absolute before each warm start now
-    from mpc_wt import runs
+    from mpc_wt.controllers import Scenario, make_wind
     from mpc_wt.simulate import simulate_closed_loop
 
-    c = MPC(model, turbine)
-    wind, _ = runs._wind(turbine, 18.0, "A", 1, 80.0, 0.2)
+    c = MPC(model, turbine, MPCSettings(backend="osqp"))
+    wind, _ = make_wind(turbine, Scenario(18.0, "A", 1, 80.0, 0.2))
     op = linearize.trim(turbine, 18.0)
     seen = []
     step0 = c.step
 
     def step(t: float, meas: dict) -> tuple:
         out = step0(t, meas)
-        for v in c._ws:
+        for v in c.qp_backend.warm:
             small = np.abs(v[v != 0])
             seen.append(int(np.sum(small < np.finfo(float).tiny)))
         return out
@@ -359,4 +362,4 @@ def test_warm_start_never_holds_subnormal_numbers(model, turbine,
 def test_step_rejects_a_state_of_the_wrong_length(model, turbine) -> None:
     with pytest.raises(ValueError,
                        match=r"meas\['state'\] has shape \(5,\); expected the plant's \(17,\)"):
-        MPC(model, turbine).step(0.0, {"state": np.zeros(5)})
+        MPC(model, turbine, MPCSettings(backend="osqp")).step(0.0, {"state": np.zeros(5)})

@@ -18,7 +18,9 @@ from mpc_wt.baseline import BaselineController, tune_baseline
 from mpc_wt.export import coleman_ipc_table, export, ibc_table, load_design, save_design
 from mpc_wt.retrofit import (SOSFilterBank, aep_change, apc_reference, filter_sos,
                              lifetime_comparison, steady_power_curve, tune_coleman_ipc, tune_ibc)
-from mpc_wt.runs import assess_series, parse_controller, run_controller
+from mpc_wt import run_controller
+from mpc_wt.assess import assess_series
+from mpc_wt.controllers import resolve
 
 DUR = 150.0       # s per closed-loop run; the first TRANSIENT s are left out of the metrics
 TRANSIENT = 20.0
@@ -208,13 +210,21 @@ def test_derating_fraction_outside_range_is_an_error(turbine, frac) -> None:
 @pytest.mark.parametrize("name", ["derate0", "derate120", "derate", "ibc+derate90"])
 def test_bad_controller_names(name) -> None:
     with pytest.raises(ValueError, match="derat|controller must be one of"):
-        parse_controller(name)
+        resolve(name)
+
+
+def _parse(name: str) -> tuple:
+    """(base family, power fraction, add-on) of a resolved name, as the old parser gave."""
+    s = resolve(name)
+    frac = s.preset.get("power_fraction", 1.0)
+    return ("baseline" if s.base.name in ("baseline", "derate") else s.base.name, frac,
+            s.addons[0].name if s.addons else None)
 
 
 def test_controller_names_parse() -> None:
-    assert parse_controller("derate90+ibc") == ("baseline", 0.9, "ibc")
-    assert parse_controller("derate72.5") == ("baseline", 0.725, None)
-    assert parse_controller("coleman-ipc") == ("baseline", 1.0, "coleman-ipc")
+    assert _parse("derate90+ibc") == ("baseline", 0.9, "ibc")
+    assert _parse("derate72.5") == ("baseline", 0.725, None)
+    assert _parse("coleman-ipc") == ("baseline", 1.0, "coleman-ipc")
 
 
 # --------------------------------------------------------------------------------------------
@@ -222,7 +232,8 @@ def test_controller_names_parse() -> None:
 # --------------------------------------------------------------------------------------------
 @pytest.fixture(scope="module")
 def apc_runs(turbine):
-    return {f: run_controller(turbine, "apc", 15.0, "A", 1, DUR, apc_frequency=f)
+    return {f: run_controller(turbine, "apc", 15.0, "A", 1, DUR,
+                             options={"apc_frequency": f})
             for f in (0.0, 0.1)}
 
 
@@ -259,7 +270,7 @@ def test_apc_reference_outside_the_turbine_is_an_error(kw, match) -> None:
 
 def test_apc_reference_above_available_power_is_an_error(turbine) -> None:
     with pytest.raises(ValueError, match="above the power available at the mean wind 8"):
-        run_controller(turbine, "apc", 8.0, "steady", 1, 5.0, apc_frequency=0.1)
+        run_controller(turbine, "apc", 8.0, "steady", 1, 5.0, options={"apc_frequency": 0.1})
     with pytest.raises(linearize.TrimError, match="above the power available"):
         linearize.trim(turbine, 8.0, 3e6)
 

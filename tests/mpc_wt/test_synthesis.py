@@ -153,7 +153,7 @@ def test_observer_bad_input(do_model) -> None:
 
 def test_lqr_pio_regulates_speed_in_turbulence(turbine, params, do_model) -> None:
     # in the loop on the nonlinear plant, 18 m/s class A, 60 s: the rotor stays near rated
-    from mpc_wt import runs
+    from mpc_wt.controllers import Scenario, make_wind
     from mpc_wt.simulate import simulate_closed_loop
 
     lq = design_lqr(do_model, state_weights={"rotor_speed": 5.0, "tower_fa_velocity": 1.0},
@@ -162,7 +162,7 @@ def test_lqr_pio_regulates_speed_in_turbulence(turbine, params, do_model) -> Non
     # q = 1e3: with q = 1e5 and the feedforward the loop diverges on the nonlinear plant (the
     # high-gain observer takes the plant's 1P gravity/shear flap content for wind)
     ctl = LQRPIOController(do_model, turbine, lq, design_pi_observer(do_model, q=1e3))
-    wind, _ = runs._wind(turbine, 18.0, "A", 1, 60.0, 0.2)
+    wind, _ = make_wind(turbine, Scenario(18.0, "A", 1, 60.0, 0.2))
     op = linearize.trim(turbine, 18.0)
     r = simulate_closed_loop(params, ctl, wind, 60.0, x0=op.x, u0=op.u)
     keep = r.t > 10

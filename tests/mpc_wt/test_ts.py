@@ -12,7 +12,7 @@ from hypothesis import strategies as st
 
 import lidar
 import linearize
-from mpc_wt.runs import _wind
+from mpc_wt.controllers import Scenario, make_wind
 from mpc_wt.simulate import simulate_closed_loop
 from mpc_wt.synthesis import SynthesisError
 from mpc_wt.ts import (PremiseError, TSController, apc_reference, build_ts_model,
@@ -140,7 +140,7 @@ def test_unobservable_wind_is_refused(ts) -> None:
 def test_ts_controller_regulates_and_tracks_power(turbine, params, ts, designs) -> None:
     ctl, obs = designs
     v, dur, f = 16.0, 120.0, 0.1
-    wind, field = _wind(turbine, v, "A", 3, dur, 0.2)
+    wind, field = make_wind(turbine, Scenario(v, "A", 3, dur, 0.2))
     op = linearize.trim(turbine, v)
     c = TSController(ts, ctl, obs, turbine, initial_wind=v)
     r = simulate_closed_loop(params, c, wind, dur, x0=op.x, u0=op.u)

@@ -19,8 +19,8 @@ from typing import Any, Sequence
 
 import numpy as np
 
-from ..assess import aep_Wh, cs_measures, lifetime_del, lifetime_extension, psd, \
-    wind_bin_probabilities
+from ..assess import (aep_Wh, cs_measures, lifetime_del, lifetime_extension, pct_change, psd,
+                     wind_bin_probabilities)
 from .spec import CampaignSpec, spec_from_dict, turbulence_tag
 from .store import CampaignStore, CaseRow
 
@@ -34,9 +34,11 @@ _CS = ("cs1", "cs2", "cs3", "cs4", "cs5")
 
 
 def _pct(a: float | None, b: float | None) -> float | None:
-    if a is None or b is None or not a or not math.isfinite(a) or not math.isfinite(b):
+    """:func:`mpc_wt.assess.pct_change`, None where it states no change (JSON/CSV cells)."""
+    if a is None or b is None:
         return None
-    return 100.0 * (b / a - 1.0)
+    v = pct_change(a, b)
+    return v if math.isfinite(v) else None
 
 
 def _load(root: Path) -> tuple[CampaignSpec, list[CaseRow]]:
@@ -60,132 +62,181 @@ def _probs(spec: CampaignSpec, winds: Sequence[float]) -> np.ndarray:
                                   scale=d["scale"])
 
 
+def _bin_del(cases: list[CaseRow], ch: str, m: float) -> float | None:
+    """The DEL of a wind bin over its seeds: the m-power mean of equal-length runs."""
+    d = [c.metrics["channels"][ch]["del"] for c in cases if ch in c.metrics["channels"]]
+    return float(np.mean(np.asarray(d) ** m) ** (1 / m)) if d else None
+
+
+def _bin_mean(cases: list[CaseRow], key: str) -> float | None:
+    v = [c.metrics.get(key) for c in cases if c.metrics.get(key) is not None]
+    return float(np.mean(v)) if v else None
+
+
+class _Group:
+    """The cases of one controller and turbulence, by wind, with the reference's."""
+
+    def __init__(self, spec: CampaignSpec, ctl: str, turb: str | float,
+                 bins: dict[float, list[CaseRow]], rbins: dict[float, list[CaseRow]]) -> None:
+        self.spec, self.ctl, self.turb, self.bins, self.rbins = spec, ctl, turb, bins, rbins
+        self.winds = sorted(bins)
+        self.common = [v for v in self.winds if v in rbins]
+        self.p_all = _probs(spec, self.winds)
+        self.p_com = _probs(spec, self.common) if self.common else None
+        self.key = {"controller": ctl, "turbulence": turb}
+
+    def missing_seeds(self) -> list[float]:
+        cs = self.spec.controller(self.ctl) if self.ctl in {c.name for c in
+                                                            self.spec.controllers} else None
+        want = set(cs.winds if cs and cs.winds else self.spec.winds)
+        n_seed = len(cs.seeds if cs and cs.seeds else self.spec.seeds)
+        return sorted(v for v in want if len(self.bins.get(v, [])) < n_seed)
+
+    def outliers(self) -> list[dict[str, Any]]:
+        out = []
+        for v in self.winds:
+            if len(self.bins[v]) < 3:
+                continue
+            for ch in self.spec.channels:
+                d = {c.seed: c.metrics["channels"][ch]["del"] for c in self.bins[v]
+                     if ch in c.metrics["channels"]}
+                med = float(np.median(list(d.values()))) if d else 0.0
+                out += [{**self.key, "wind_mps": v, "seed": seed, "channel": ch, "del": x,
+                         "ratio_to_median": x / med} for seed, x in d.items()
+                        if med > 0 and x > OUTLIER_RATIO * med]
+        return out
+
+    def short_term(self) -> list[dict[str, Any]]:
+        return [{**self.key, "wind_mps": v, "seed": c.seed, "channel": ch, "m": m,
+                 "del": c.metrics["channels"][ch]["del"]}
+                for v in self.winds for c in self.bins[v]
+                for ch, m in self.spec.channels.items() if ch in c.metrics["channels"]]
+
+    def per_wind(self) -> tuple[list[dict[str, Any]], list[dict[str, Any]]]:
+        dels, cs_rows = [], []
+        for v in self.winds:
+            ref = self.rbins.get(v)
+            row = {**self.key, "wind_mps": v, "seeds": len(self.bins[v])}
+            for ch, m in self.spec.channels.items():
+                row[ch] = _bin_del(self.bins[v], ch, m)
+                row[f"{ch}_change_pct"] = _pct(_bin_del(ref, ch, m), row[ch]) if ref else None
+            dels.append(row)
+            crow = {**self.key, "wind_mps": v}
+            for k in _CS + ("power_mean_W", "power_std_W", "rotor_speed_std_rad_s") + _PITCH:
+                crow[k] = _bin_mean(self.bins[v], k)
+                crow[f"{k}_change_pct"] = _pct(_bin_mean(ref, k), crow[k]) if ref else None
+            cs_rows.append(crow)
+        return dels, cs_rows
+
+    def lifetime(self) -> tuple[list[dict[str, Any]], list[dict[str, Any]]]:
+        life, ext = [], []
+        for ch, m in self.spec.channels.items():
+            d = [_bin_del(self.bins[v], ch, m) for v in self.winds]
+            if any(x is None for x in d):
+                continue
+            lt = lifetime_del(d, m, self.p_all)
+            row = {**self.key, "channel": ch, "m": m,
+                   "winds": f"{self.winds[0]:g}-{self.winds[-1]:g}", "lifetime_del": lt,
+                   "lifetime_del_MNm": lt / 1e6, "change_pct": None, "ref_lifetime_del": None}
+            if self.common:
+                mine = lifetime_del([_bin_del(self.bins[v], ch, m) for v in self.common], m,
+                                    self.p_com)
+                base = lifetime_del([_bin_del(self.rbins[v], ch, m) for v in self.common], m,
+                                    self.p_com)
+                is_ref = self.ctl == self.spec.reference
+                row["change_pct"] = 0.0 if is_ref else _pct(base, mine)
+                row["ref_lifetime_del"] = base
+                if not is_ref and base > 0:
+                    e = lifetime_extension(base, mine, m, t_base=15.0, t_upd=5.0,
+                                           t_lifetime=self.spec.lifetime_years)
+                    ext.append({**self.key, "channel": ch, "m": m, "damage_15_5": e["damage"],
+                                "extension_years": e["extension_years"]})
+            life.append(row)
+        return life, ext
+
+    def aep(self) -> list[dict[str, Any]]:
+        pw = [_bin_mean(self.bins[v], "power_mean_W") for v in self.winds]
+        if any(x is None for x in pw):
+            return []
+        row = {**self.key, "aep_MWh": aep_Wh(pw, self.p_all) / 1e6, "change_pct": None}
+        if self.common:
+            a = aep_Wh([_bin_mean(self.bins[v], "power_mean_W") for v in self.common],
+                       self.p_com)
+            b = aep_Wh([_bin_mean(self.rbins[v], "power_mean_W") for v in self.common],
+                       self.p_com)
+            row["change_pct"] = _pct(b, a)
+        return [row]
+
+    def pitch(self) -> dict[str, Any]:
+        prow: dict[str, Any] = dict(self.key)
+        for k in _PITCH:
+            vals = [_bin_mean(self.bins[v], k) for v in self.winds]
+            if any(x is None for x in vals):
+                continue
+            prow[k] = float(np.sum(self.p_all * np.asarray(vals)) / self.p_all.sum())
+            if self.common:
+                mine = np.sum(self.p_com * np.asarray([_bin_mean(self.bins[v], k)
+                                                       for v in self.common]))
+                base = np.sum(self.p_com * np.asarray([_bin_mean(self.rbins[v], k)
+                                                       for v in self.common]))
+                prow[f"{k}_change_pct"] = _pct(float(base), float(mine))
+        return prow
+
+
+def _groups(spec: CampaignSpec, rows: list[CaseRow]) -> list[_Group]:
+    by: dict[tuple[str, str], dict[float, list[CaseRow]]] = defaultdict(lambda: defaultdict(list))
+    for r in rows:
+        by[(r.controller, r.turbulence)][r.wind_mps].append(r)
+    order = [c.name for c in spec.controllers]
+    keys = sorted(by, key=lambda k: (order.index(k[0]) if k[0] in order else 99, k[1]))
+    return [_Group(spec, ctl, turb, by[(ctl, turb)], by.get((spec.reference, turb), {}))
+            for ctl, turb in keys]
+
+
 def aggregate(root: str | Path) -> dict[str, Any]:
     """All tables of a campaign directory as lists of row dicts (see the module docstring).
+
+    Parameters
+    ----------
+    root : str or Path
+        The campaign directory.
+
+    Returns
+    -------
+    dict
+        ``spec``, ``rows`` (finished cases), ``short_term``, ``per_wind``, ``lifetime``,
+        ``aep``, ``pitch``, ``cs``, ``extension``, ``sweep``, ``incomplete`` and ``outliers``.
 
     Raises
     ------
     ValueError
         If no case has finished.
     """
-    root = Path(root)
-    spec, rows = _load(root)
-    ref = spec.reference
-    by: dict[tuple[str, str], dict[float, list[CaseRow]]] = defaultdict(lambda: defaultdict(list))
-    for r in rows:
-        by[(r.controller, r.turbulence)][r.wind_mps].append(r)
-    order = [c.name for c in spec.controllers]
-    keys = sorted(by, key=lambda k: (order.index(k[0]) if k[0] in order else 99, k[1]))
-    chans = spec.channels
-    short, per_wind, life, aep, pitch, cs_rows, ext = [], [], [], [], [], [], []
-    incomplete = []
-    outliers: list[dict[str, Any]] = []
-
-    def bin_del(cases: list[CaseRow], ch: str, m: float) -> float | None:
-        d = [c.metrics["channels"][ch]["del"] for c in cases if ch in c.metrics["channels"]]
-        return float(np.mean(np.asarray(d) ** m) ** (1 / m)) if d else None
-
-    def bin_mean(cases: list[CaseRow], key: str) -> float | None:
-        v = [c.metrics.get(key) for c in cases if c.metrics.get(key) is not None]
-        return float(np.mean(v)) if v else None
-
-    for ctl, turb in keys:
-        bins = by[(ctl, turb)]
-        cs = spec.controller(ctl) if ctl in order else None
-        want = set((cs.winds if cs and cs.winds else spec.winds))
-        n_seed = len(cs.seeds if cs and cs.seeds else spec.seeds)
-        missing = sorted(v for v in want if len(bins.get(v, [])) < n_seed)
+    spec, rows = _load(Path(root))
+    out: dict[str, Any] = {"spec": spec, "rows": rows, "short_term": [], "per_wind": [],
+                           "lifetime": [], "aep": [], "pitch": [], "cs": [], "extension": [],
+                           "sweep": [], "incomplete": [], "outliers": []}
+    for g in _groups(spec, rows):
+        missing = g.missing_seeds()
         if missing:
-            incomplete.append(f"{ctl} ({turb}): winds {missing} lack seeds")
-        winds = sorted(bins)
-        rbins = by.get((ref, turb), {})
-        for v in winds:
-            if len(bins[v]) < 3:
-                continue
-            for ch in chans:
-                d = {c.seed: c.metrics["channels"][ch]["del"] for c in bins[v]
-                     if ch in c.metrics["channels"]}
-                med = float(np.median(list(d.values()))) if d else 0.0
-                for seed, x in d.items():
-                    if med > 0 and x > OUTLIER_RATIO * med:
-                        outliers.append({"controller": ctl, "turbulence": turb, "wind_mps": v,
-                                         "seed": seed, "channel": ch, "del": x,
-                                         "ratio_to_median": x / med})
-        for v in winds:
-            for c in bins[v]:
-                for ch, m in chans.items():
-                    if ch in c.metrics["channels"]:
-                        short.append({"controller": ctl, "turbulence": turb, "wind_mps": v,
-                                      "seed": c.seed, "channel": ch, "m": m,
-                                      "del": c.metrics["channels"][ch]["del"]})
-            row = {"controller": ctl, "turbulence": turb, "wind_mps": v, "seeds": len(bins[v])}
-            for ch, m in chans.items():
-                d = bin_del(bins[v], ch, m)
-                row[ch] = d
-                row[f"{ch}_change_pct"] = _pct(bin_del(rbins[v], ch, m), d) if v in rbins \
-                    else None
-            per_wind.append(row)
-            crow = {"controller": ctl, "turbulence": turb, "wind_mps": v}
-            for k in _CS + ("power_mean_W", "power_std_W", "rotor_speed_std_rad_s") + _PITCH:
-                crow[k] = bin_mean(bins[v], k)
-                crow[f"{k}_change_pct"] = (_pct(bin_mean(rbins[v], k), crow[k])
-                                           if v in rbins else None)
-            cs_rows.append(crow)
-        common = [v for v in winds if v in rbins]
-        p_all = _probs(spec, winds)
-        p_com = _probs(spec, common) if common else None
-        for ch, m in chans.items():
-            d = [bin_del(bins[v], ch, m) for v in winds]
-            if any(x is None for x in d):
-                continue
-            lt = lifetime_del(d, m, p_all)
-            row = {"controller": ctl, "turbulence": turb, "channel": ch, "m": m,
-                   "winds": f"{winds[0]:g}-{winds[-1]:g}", "lifetime_del": lt,
-                   "lifetime_del_MNm": lt / 1e6,
-                   "change_pct": None, "ref_lifetime_del": None}
-            if common:
-                mine = lifetime_del([bin_del(bins[v], ch, m) for v in common], m, p_com)
-                base = lifetime_del([bin_del(rbins[v], ch, m) for v in common], m, p_com)
-                row["change_pct"] = 0.0 if ctl == ref else _pct(base, mine)
-                row["ref_lifetime_del"] = base
-                if ctl != ref and base > 0:
-                    e = lifetime_extension(base, mine, m, t_base=15.0, t_upd=5.0,
-                                           t_lifetime=spec.lifetime_years)
-                    ext.append({"controller": ctl, "turbulence": turb, "channel": ch, "m": m,
-                                "damage_15_5": e["damage"],
-                                "extension_years": e["extension_years"]})
-            life.append(row)
-        pw = [bin_mean(bins[v], "power_mean_W") for v in winds]
-        if all(x is not None for x in pw):
-            row = {"controller": ctl, "turbulence": turb,
-                   "aep_MWh": aep_Wh(pw, p_all) / 1e6, "change_pct": None}
-            if common:
-                a = aep_Wh([bin_mean(bins[v], "power_mean_W") for v in common], p_com)
-                b = aep_Wh([bin_mean(rbins[v], "power_mean_W") for v in common], p_com)
-                row["change_pct"] = _pct(b, a)
-            aep.append(row)
-        prow: dict[str, Any] = {"controller": ctl, "turbulence": turb}
-        for k in _PITCH:
-            vals = [bin_mean(bins[v], k) for v in winds]
-            if all(x is not None for x in vals):
-                prow[k] = float(np.sum(p_all * np.asarray(vals)) / p_all.sum())
-                if common:
-                    mine = np.sum(p_com * np.asarray([bin_mean(bins[v], k) for v in common]))
-                    base = np.sum(p_com * np.asarray([bin_mean(rbins[v], k) for v in common]))
-                    prow[f"{k}_change_pct"] = _pct(float(base), float(mine))
-        pitch.append(prow)
-    sweep = []
+            out["incomplete"].append(f"{g.ctl} ({g.turb}): winds {missing} lack seeds")
+        out["outliers"] += g.outliers()
+        out["short_term"] += g.short_term()
+        dels, cs_rows = g.per_wind()
+        out["per_wind"] += dels
+        out["cs"] += cs_rows
+        life, ext = g.lifetime()
+        out["lifetime"] += life
+        out["extension"] += ext
+        out["aep"] += g.aep()
+        out["pitch"].append(g.pitch())
     for c in spec.controllers:
         f = c.options.get("apc_frequency")
-        if f is None:
-            continue
-        for r in life:
-            if r["controller"] == c.name:
-                sweep.append({"controller": c.name, "apc_frequency_Hz": f, **{
-                    k: r[k] for k in ("turbulence", "channel", "lifetime_del", "change_pct")}})
-    return {"spec": spec, "rows": rows, "short_term": short, "per_wind": per_wind,
-            "lifetime": life, "aep": aep, "pitch": pitch, "cs": cs_rows, "extension": ext,
-            "sweep": sweep, "incomplete": incomplete, "outliers": outliers}
+        if f is not None:
+            out["sweep"] += [{"controller": c.name, "apc_frequency_Hz": f, **{
+                k: r[k] for k in ("turbulence", "channel", "lifetime_del", "change_pct")}}
+                for r in out["lifetime"] if r["controller"] == c.name]
+    return out
 
 
 # -- paper comparison -------------------------------------------------------------------------
@@ -270,16 +321,24 @@ def _md(rows: list[dict[str, Any]], cols: Sequence[str], heads: Sequence[str] | 
 
 
 def _plots(agg: dict[str, Any], root: Path, out: Path) -> list[str]:
-    from ..plotting import _plt, _save, plot_cs_ellipses
-    from ..simulate import ClosedLoopResult
+    """Every figure of the report, as PNG in ``out``; returns their paths."""
+    ctls = list(dict.fromkeys(r["controller"] for r in agg["per_wind"]))
+    turbs = list(dict.fromkeys(r["turbulence"] for r in agg["per_wind"]))
+    made = [_plot_del_vs_wind(agg, ctls, turbs, out)]
+    made += _plot_lifetime_bars(agg, ctls, turbs, out)
+    series, cs_w, psd_w = _plot_series(agg, root, turbs[0])
+    made += _plot_cs_psd(agg, ctls, series, cs_w, psd_w, turbs[0], out)
+    made += _plot_sweep(agg, turbs[0], out)
+    return made
+
+
+def _plot_del_vs_wind(agg: dict[str, Any], ctls: list[str], turbs: list[Any], out: Path) -> str:
+    """DEL vs mean wind per controller (Clemens fig. 6 / Pettas fig. 4 layout)."""
+    from ..plotting import _plt, _save
 
     plt = _plt()
     spec: CampaignSpec = agg["spec"]
-    made = []
     chans = list(spec.channels)
-    ctls = list(dict.fromkeys(r["controller"] for r in agg["per_wind"]))
-    turbs = list(dict.fromkeys(r["turbulence"] for r in agg["per_wind"]))
-    # DEL vs mean wind per controller (Clemens fig. 6 / Pettas fig. 4 layout)
     nc = min(3, len(chans))
     nr = math.ceil(len(chans) / nc)
     fig, axs = plt.subplots(nr, nc, figsize=(4.2 * nc, 3.0 * nr), dpi=110, squeeze=False)
@@ -307,8 +366,18 @@ def _plots(agg: dict[str, Any], root: Path, out: Path) -> list[str]:
     for ax in list(axs.flat)[len(chans):]:
         ax.axis("off")
     axs.flat[0].legend(fontsize=6)
-    made.append(str(_save(fig, out / "del_vs_wind.png")))
-    # lifetime DEL change bars (Pettas fig. 5 / Clemens fig. 7 layout)
+    return str(_save(fig, out / "del_vs_wind.png"))
+
+
+def _plot_lifetime_bars(agg: dict[str, Any], ctls: list[str], turbs: list[Any],
+                        out: Path) -> list[str]:
+    """Lifetime DEL change bars (Pettas fig. 5 / Clemens fig. 7 layout)."""
+    from ..plotting import _plt, _save
+
+    plt = _plt()
+    spec: CampaignSpec = agg["spec"]
+    chans = list(spec.channels)
+    made: list[str] = []
     others = [c for c in ctls if c != spec.reference]
     if others:
         width = min(12.0, max(6.0, 0.3 * len(chans) * len(others) * len(turbs) + 2.0))
@@ -335,7 +404,15 @@ def _plots(agg: dict[str, Any], root: Path, out: Path) -> list[str]:
         ax.legend(fontsize=7)
         ax.grid(alpha=0.3, axis="y")
         made.append(str(_save(fig, out / "lifetime_del.png")))
-    # CS ellipses and PSDs at one wind (Do fig. 4 / Madsen fig. 8)
+    return made
+
+
+def _plot_series(agg: dict[str, Any], root: Path, turb0: Any
+                 ) -> tuple[dict[tuple[str, float], list[Any]], float, float]:
+    """The stored time series at the CS and PSD winds (Do fig. 4 / Madsen fig. 8)."""
+    from ..results import ClosedLoopResult
+
+    spec: CampaignSpec = agg["spec"]
     winds = sorted({r.wind_mps for r in agg["rows"]})
 
     def near(target: float) -> float:
@@ -345,7 +422,6 @@ def _plots(agg: dict[str, Any], root: Path, out: Path) -> list[str]:
     psd_w = near(float(spec.report.get("psd_wind", 18.0)))
     series: dict[tuple[str, float], list[tuple[np.ndarray, dict[str, np.ndarray]]]] = \
         defaultdict(list)
-    turb0 = turbs[0]
     for r in agg["rows"]:
         if r.turbulence == turb0 and r.wind_mps in (cs_w, psd_w) and r.file:
             try:
@@ -356,6 +432,16 @@ def _plots(agg: dict[str, Any], root: Path, out: Path) -> list[str]:
             series[(r.controller, r.wind_mps)].append(
                 (res.t[k], {n: res.channel(n)[k] for n in ("tower_base_fa_moment", "gen_power",
                                                             "flap_moment_1", "rotor_speed")}))
+    return series, cs_w, psd_w
+
+
+def _plot_cs_psd(agg: dict[str, Any], ctls: list[str], series: dict[tuple[str, float], Any],
+                 cs_w: float, psd_w: float, turb0: Any, out: Path) -> list[str]:
+    """CS ellipses and PSDs at one wind, mean over seeds."""
+    from ..plotting import _plt, _save, plot_cs_ellipses
+
+    plt = _plt()
+    made = []
     items = []
     for ctl in ctls:
         runs = series.get((ctl, cs_w), [])
@@ -389,6 +475,17 @@ def _plots(agg: dict[str, Any], root: Path, out: Path) -> list[str]:
         ax.grid(alpha=0.3, which="both")
         ax.legend(fontsize=7)
     made.append(str(_save(fig, out / "psd.png")))
+    return made
+
+
+def _plot_sweep(agg: dict[str, Any], turb0: Any, out: Path) -> list[str]:
+    """Lifetime DEL against APC frequency (Clemens fig. 8 layout)."""
+    from ..plotting import _plt, _save
+
+    plt = _plt()
+    spec: CampaignSpec = agg["spec"]
+    chans = list(spec.channels)
+    made: list[str] = []
     if agg["sweep"]:
         fig, ax = plt.subplots(figsize=(6.5, 4.0), dpi=110)
         for j, ch in enumerate(chans):
@@ -411,7 +508,17 @@ def _plots(agg: dict[str, Any], root: Path, out: Path) -> list[str]:
 def make_report(root: str | Path, out: str | Path | None = None) -> Path:
     """Write the tables (CSV), the plots (PNG) and ``report.md`` of a campaign directory.
 
-    Returns the path of ``report.md``.
+    Parameters
+    ----------
+    root : str or Path
+        The campaign directory.
+    out : str or Path, optional
+        The report folder (default ``root/report``).
+
+    Returns
+    -------
+    Path
+        The path of ``report.md``.
 
     Raises
     ------
@@ -420,11 +527,8 @@ def make_report(root: str | Path, out: str | Path | None = None) -> Path:
     FileNotFoundError
         If ``root`` is not a campaign directory.
     """
-    from .. import __version__
-
     root = Path(root)
     agg = aggregate(root)
-    spec: CampaignSpec = agg["spec"]
     out = Path(out) if out else root / "report"
     out.mkdir(parents=True, exist_ok=True)
     for name in ("short_term", "per_wind", "lifetime", "aep", "pitch", "cs", "extension",
@@ -434,6 +538,21 @@ def make_report(root: str | Path, out: str | Path | None = None) -> Path:
                      "lifetime": "lifetime_del"}.get(name, name)
             _write_csv(out / f"{fname}.csv", agg[name])
     plots = _plots(agg, root, out)
+    paper = _paper_rows(agg)
+    if paper:
+        _write_csv(out / "paper_comparison.csv", paper)
+    md = _md_head(agg, paper) + _md_loads(agg) + _md_more(agg)
+    md += ["Plots: " + ", ".join(Path(p).name for p in plots), ""]
+    path = out / "report.md"
+    tmp = path.with_suffix(".md.tmp")
+    tmp.write_text("\n".join(md))
+    tmp.replace(path)
+    return path
+
+
+def _paper_rows(agg: dict[str, Any]) -> list[dict[str, Any]]:
+    """The spec's ``report.paper`` rows with our numbers next to the paper's."""
+    spec: CampaignSpec = agg["spec"]
     paper = []
     for p in spec.report.get("paper", []) or []:
         ours = _ours(agg, p)
@@ -445,18 +564,23 @@ def make_report(root: str | Path, out: str | Path | None = None) -> Path:
                       "direction_agrees": _agree(ours, p.get("direction")
                                                  or float(p["value"])),
                       "source": p.get("source", ""), "note": p.get("note", "")})
-    if paper:
-        _write_csv(out / "paper_comparison.csv", paper)
-    n_rows = len(agg["rows"])
+    return paper
+
+
+def _md_head(agg: dict[str, Any], paper: list[dict[str, Any]]) -> list[str]:
+    """Title, the campaign's settings, incomplete cases, the paper table, suspect cases."""
+    from .. import __version__
+
+    spec: CampaignSpec = agg["spec"]
     versions = sorted({r.software_version for r in agg["rows"] if r.software_version})
     md = [f"# {spec.report.get('title', 'Campaign ' + spec.name)}", ""]
     if spec.description:
         md += [spec.description.strip(), ""]
     md += [f"Generated by `mpcwt campaign report` (mpc-wt {__version__}; cases computed by "
-           f"{', '.join(versions)}) from {n_rows} finished cases. Turbine {spec.turbine}; "
-           f"{spec.duration:g} s per case after a {spec.transient:g} s transient; turbulence "
-           f"{', '.join(turbulence_tag(t) for t in spec.turbulence)}; shear "
-           f"{spec.shear_exponent:g}; seeds {list(spec.seeds)}; wind distribution "
+           f"{', '.join(versions)}) from {len(agg['rows'])} finished cases. Turbine "
+           f"{spec.turbine}; {spec.duration:g} s per case after a {spec.transient:g} s "
+           f"transient; turbulence {', '.join(turbulence_tag(t) for t in spec.turbulence)}; "
+           f"shear {spec.shear_exponent:g}; seeds {list(spec.seeds)}; wind distribution "
            f"{spec.wind_distribution}; lifetime {spec.lifetime_years:g} years; reference "
            f"controller `{spec.reference}`.", ""]
     if agg["incomplete"]:
@@ -476,22 +600,32 @@ def make_report(root: str | Path, out: str | Path | None = None) -> Path:
                                      "del", "ratio_to_median"]), ""]
     if spec.report.get("notes"):
         md += ["## Where we differ, and why", "", str(spec.report["notes"]).strip(), ""]
-    md += ["## Lifetime DEL", "", "m-power mean over the wind bins weighted by the wind "
-           "distribution (Clemens eq 18); change against the reference over the winds both ran.",
-           "", _md(agg["lifetime"], ["controller", "turbulence", "channel", "m", "winds",
-                                     "lifetime_del_MNm", "change_pct"],
-                   ["controller", "turbulence", "channel", "m", "winds [m/s]",
-                    "lifetime DEL [MN m]", "change [%]"]), "", "![lifetime DEL](lifetime_del.png)",
-           "", "## DEL per mean wind", "", "![DEL vs wind](del_vs_wind.png)", "",
-           "Per wind and channel (m-power mean over seeds) in `del_by_wind.csv`; per seed in "
-           "`short_term_del.csv`.", ""]
-    md += ["## Energy and pitch", "",
-           _md(agg["aep"], ["controller", "turbulence", "aep_MWh", "change_pct"],
-               ["controller", "turbulence", "AEP [MWh]", "change [%]"]), "",
-           _md(agg["pitch"], ["controller", "turbulence", *_PITCH,
-                              *[f"{k}_change_pct" for k in _PITCH]],
-               ["controller", "turbulence", "travel [deg/run]", "rate std [deg/s]",
-                "acc std [deg/s^2]", "travel [%]", "rate std [%]", "acc std [%]"]), ""]
+    return md
+
+
+def _md_loads(agg: dict[str, Any]) -> list[str]:
+    """Lifetime DEL, DEL per wind, energy and pitch."""
+    return ["## Lifetime DEL", "", "m-power mean over the wind bins weighted by the wind "
+            "distribution (Clemens eq 18); change against the reference over the winds both "
+            "ran.", "",
+            _md(agg["lifetime"], ["controller", "turbulence", "channel", "m", "winds",
+                                  "lifetime_del_MNm", "change_pct"],
+                ["controller", "turbulence", "channel", "m", "winds [m/s]",
+                 "lifetime DEL [MN m]", "change [%]"]), "", "![lifetime DEL](lifetime_del.png)",
+            "", "## DEL per mean wind", "", "![DEL vs wind](del_vs_wind.png)", "",
+            "Per wind and channel (m-power mean over seeds) in `del_by_wind.csv`; per seed in "
+            "`short_term_del.csv`.", "", "## Energy and pitch", "",
+            _md(agg["aep"], ["controller", "turbulence", "aep_MWh", "change_pct"],
+                ["controller", "turbulence", "AEP [MWh]", "change [%]"]), "",
+            _md(agg["pitch"], ["controller", "turbulence", *_PITCH,
+                               *[f"{k}_change_pct" for k in _PITCH]],
+                ["controller", "turbulence", "travel [deg/run]", "rate std [deg/s]",
+                 "acc std [deg/s^2]", "travel [%]", "rate std [%]", "acc std [%]"]), ""]
+
+
+def _md_more(agg: dict[str, Any]) -> list[str]:
+    """Lifetime extension, CS1-CS5 and the APC sweep."""
+    md: list[str] = []
     if agg["extension"]:
         md += ["## Lifetime extension (retrofit after 15 years, 5 more at the new rate; "
                "Pettas and Cheng eq 1)", "",
@@ -508,10 +642,5 @@ def make_report(root: str | Path, out: str | Path | None = None) -> Path:
     if agg["sweep"]:
         md += ["## APC frequency sweep", "", "![APC sweep](apc_sweep.png)", "",
                _md(agg["sweep"], ["controller", "apc_frequency_Hz", "turbulence",
-                                               "channel", "lifetime_del", "change_pct"]), ""]
-    md += ["Plots: " + ", ".join(Path(p).name for p in plots), ""]
-    path = out / "report.md"
-    tmp = path.with_suffix(".md.tmp")
-    tmp.write_text("\n".join(md))
-    tmp.replace(path)
-    return path
+                                  "channel", "lifetime_del", "change_pct"]), ""]
+    return md

@@ -83,6 +83,7 @@ def run_campaign(spec: CampaignSpec, out: str | Path, *, workers: int | None = N
     Parameters
     ----------
     spec : CampaignSpec
+        The validated campaign.
     out : path
         Campaign directory (created). Must be visible to every worker (shared file system).
     workers : int, optional
@@ -90,6 +91,7 @@ def run_campaign(spec: CampaignSpec, out: str | Path, *, workers: int | None = N
     scheduler : str, optional
         Address of a running Dask scheduler (``tcp://HOST:PORT``); ``workers`` is then ignored.
     engine : {"dask", "processes", "serial"}
+        Dask (default), a plain process pool, or this process.
     progress : bool
         A progress bar: cases done, running, failed and the ETA.
     on_result : callable(case_id, outcome), optional
@@ -98,6 +100,7 @@ def run_campaign(spec: CampaignSpec, out: str | Path, *, workers: int | None = N
     Returns
     -------
     RunSummary
+        Counts, failures and wall time.
 
     Raises
     ------
@@ -106,28 +109,11 @@ def run_campaign(spec: CampaignSpec, out: str | Path, *, workers: int | None = N
     CampaignLockedError
         Another client runs the same directory.
     """
-    if engine not in ENGINES:
-        raise ValueError(f"engine must be one of {ENGINES}, got {engine!r}")
-    if scheduler is not None and engine != "dask":
-        raise ValueError(f"scheduler {scheduler!r} needs engine='dask', got {engine!r}")
-    if scheduler is not None and not str(scheduler).startswith(("tcp://", "tls://",
-                                                                "inproc://", "ws://")):
-        raise ValueError(f"scheduler must be an address like tcp://HOST:PORT, got {scheduler!r}")
-    n_workers = 1 if engine == "serial" else _workers(workers)
+    n_workers = _check_engine(engine, scheduler, workers)
     out = Path(out)
     t_start = time.perf_counter()
     with CampaignStore(out, lock=True) as store:
-        from .. import __version__
-
-        if spec.source and Path(spec.source).is_file():
-            (out / "spec.yaml").write_text(Path(spec.source).read_text())
-        else:
-            import yaml
-
-            (out / "spec.yaml").write_text(yaml.safe_dump(spec.raw, sort_keys=False))
-        store.set_meta(name=spec.name, spec_hash=spec.spec_hash, software_version=__version__,
-                       spec_raw={**spec.raw, "turbine": spec.turbine},
-                       reference=spec.reference, last_run=time.strftime("%Y-%m-%dT%H:%M:%S"))
+        _write_spec(spec, out, store)
         sync = store.sync(spec)
         todo = store.todo()
         total = len(spec.cases())
@@ -168,6 +154,33 @@ def run_campaign(spec: CampaignSpec, out: str | Path, *, workers: int | None = N
             bar.close()
             summary.wall_s = time.perf_counter() - t_start
         return summary
+
+
+def _check_engine(engine: str, scheduler: str | None, workers: int | None) -> int:
+    """Check the engine settings; the number of worker processes."""
+    if engine not in ENGINES:
+        raise ValueError(f"engine must be one of {ENGINES}, got {engine!r}")
+    if scheduler is not None and engine != "dask":
+        raise ValueError(f"scheduler {scheduler!r} needs engine='dask', got {engine!r}")
+    if scheduler is not None and not str(scheduler).startswith(("tcp://", "tls://",
+                                                                "inproc://", "ws://")):
+        raise ValueError(f"scheduler must be an address like tcp://HOST:PORT, got {scheduler!r}")
+    return 1 if engine == "serial" else _workers(workers)
+
+
+def _write_spec(spec: CampaignSpec, out: Path, store: CampaignStore) -> None:
+    """Keep the spec in the directory (its file, or the validated mapping) and in the index."""
+    from .. import __version__
+
+    if spec.source and Path(spec.source).is_file():
+        (out / "spec.yaml").write_text(Path(spec.source).read_text())
+    else:
+        import yaml
+
+        (out / "spec.yaml").write_text(yaml.safe_dump(spec.raw, sort_keys=False))
+    store.set_meta(name=spec.name, spec_hash=spec.spec_hash, software_version=__version__,
+                   spec_raw={**spec.raw, "turbine": spec.turbine},
+                   reference=spec.reference, last_run=time.strftime("%Y-%m-%dT%H:%M:%S"))
 
 
 def _failed(case_id: str, err: BaseException, tb: str | None = None) -> dict[str, Any]:

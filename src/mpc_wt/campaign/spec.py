@@ -20,22 +20,17 @@ from typing import Any, Mapping
 
 import yaml
 
+from ..errors import SpecError
+
 __all__ = ["SpecError", "CampaignSpec", "ControllerSpec", "Case", "load_spec", "spec_from_dict"]
-
-
-class SpecError(ValueError):
-    """A campaign spec that cannot be used; the message names the key and what is allowed."""
 
 
 _TOP_KEYS = {"name", "description", "turbine", "duration", "transient", "turbulence",
              "shear_exponent", "winds", "seeds", "lidar", "controllers", "channels",
-             "wind_distribution", "lifetime_years", "reference", "report"}
-_CONTROLLER_KEYS = {"name", "controller", "mpc_options", "retrofit_options", "apc_frequency",
-                    "apc_amplitude", "apc_offset", "lidar", "winds", "seeds", "turbulence",
-                    "label"}
-_LIDAR_KEYS = {"focus_distance", "span_fraction", "wavelength", "beam_radius", "sample_rate",
-               "noise_std", "misalignment_rad", "perfect_alignment", "los_error",
-               "range_weighting", "n_range"}
+             "wind_distribution", "lifetime_years", "reference", "report", "plugins"}
+#: A controller entry's own keys; any other key is an option of the controller's kind.
+_CONTROLLER_KEYS = {"name", "controller", "winds", "seeds", "turbulence", "label", "options",
+                    "mpc_options", "retrofit_options"}
 _REPORT_KEYS = {"paper", "notes", "psd_wind", "cs_wind", "sweep", "title"}
 
 
@@ -164,6 +159,7 @@ class Case:
     channels: dict[str, float]
     case_hash: str
     assess_hash: str
+    plugins: tuple[str, ...] = ()
 
     def to_dict(self) -> dict[str, Any]:
         """Plain data for a worker (pickles and JSON-serialises)."""
@@ -193,6 +189,7 @@ class CampaignSpec:
     report: dict[str, Any]
     raw: dict[str, Any]
     source: str | None = None
+    plugins: tuple[str, ...] = ()
 
     @property
     def spec_hash(self) -> str:
@@ -227,7 +224,8 @@ class CampaignSpec:
                                         shear_exponent=self.shear_exponent,
                                         turbine=self.turbine, turbine_hash=self.turbine_hash,
                                         channels=dict(self.channels), case_hash=_digest(sim),
-                                        assess_hash=_digest(assess)))
+                                        assess_hash=_digest(assess),
+                                        plugins=self.plugins))
         return out
 
 
@@ -267,51 +265,52 @@ def turbine_files_hash(turbine: str, base: Path | None = None) -> tuple[str, str
     return ref, h.hexdigest()
 
 
+def _controller_options(key: str, raw: Mapping[str, Any], run_name: str,
+                        lidar: dict[str, Any]) -> dict[str, Any]:
+    """The entry's controller options, checked by the registry: every key that is not one of
+    the campaign's own (name, grid, label) is an option of the kind; ``options:`` holds them
+    too, and the groups ``mpc_options`` / ``retrofit_options`` of older specs are flattened.
+    The campaign's ``lidar`` settings are the defaults of a kind that takes ``lidar``."""
+    from ..controllers import resolve
+    from ..errors import OptionsError
+
+    opts: dict[str, Any] = {}
+    for group in ("options", "mpc_options", "retrofit_options"):
+        if group in raw:
+            if not isinstance(raw[group], Mapping):
+                raise _fail(f"{key}.{group}", f"must be a mapping, got {raw[group]!r}")
+            opts.update(raw[group])
+    opts.update({k: v for k, v in raw.items() if k not in _CONTROLLER_KEYS})
+    try:
+        sel = resolve(run_name)
+        if "lidar" in sel.option_names() and (lidar or "lidar" in opts):
+            extra = opts.get("lidar", {})
+            if not isinstance(extra, Mapping):
+                raise _fail(f"{key}.lidar", f"must be a mapping, got {extra!r}")
+            opts["lidar"] = {**lidar, **extra}
+        sel.options(opts)
+    except OptionsError as err:
+        raise _fail(f"{key}.{err.key}", str(err)) from err
+    except ValueError as err:
+        raise _fail(f"{key}.controller", str(err)) from err
+    return copy.deepcopy(opts)
+
+
 def _controller(i: int, raw: Any, lidar: dict[str, Any]) -> ControllerSpec:
     key = f"controllers[{i}]"
     if isinstance(raw, str):
         raw = {"name": raw, "controller": raw}
     if not isinstance(raw, Mapping):
         raise _fail(key, f"must be a controller name or a mapping, got {raw!r}")
-    extra = set(raw) - _CONTROLLER_KEYS
-    if extra:
-        raise _fail(f"{key}.{sorted(extra)[0]}", f"unknown key; allowed: "
-                                                 f"{sorted(_CONTROLLER_KEYS)}")
     name = raw.get("name", raw.get("controller"))
     if not isinstance(name, str) or not name or not all(
             ch.isalnum() or ch in "-_.+" for ch in name):
         raise _fail(f"{key}.name", f"must be a non-empty label of letters, digits and -_.+, "
                                    f"got {name!r}")
-    run_name = raw.get("controller", name)
-    from ..runs import parse_controller
-
-    try:
-        kind, _, _ = parse_controller(str(run_name))
-    except ValueError as err:
-        raise _fail(f"{key}.controller", str(err)) from err
-    opts: dict[str, Any] = {}
-    for k in ("mpc_options", "retrofit_options"):
-        if k in raw:
-            if not isinstance(raw[k], Mapping):
-                raise _fail(f"{key}.{k}", f"must be a mapping, got {raw[k]!r}")
-            opts[k] = dict(raw[k])
-    if "apc_frequency" in raw:
-        opts["apc_frequency"] = _number(f"{key}.apc_frequency", raw["apc_frequency"], 0.0, 5.0)
-    for k in ("apc_amplitude", "apc_offset"):
-        if k in raw:
-            opts[k] = _number(f"{key}.{k}", raw[k], 0.0, 1.0)
-    if kind in ("apc",) and "apc_frequency" not in opts:
-        raise _fail(f"{key}.apc_frequency", "controller 'apc' needs apc_frequency [Hz]")
-    if "apc_frequency" in opts and kind not in ("ts", "apc"):
-        raise _fail(f"{key}.apc_frequency", f"applies to 'ts' and 'apc' only, not {run_name!r}")
-    if kind == "mpc-lidar":
-        lid = {**lidar, **_lidar(f"{key}.lidar", raw.get("lidar", {}))}
-        if lid:
-            opts["lidar_options"] = lid
-    elif "lidar" in raw:
-        raise _fail(f"{key}.lidar", f"applies to 'mpc-lidar' only, not {run_name!r}")
+    run_name = str(raw.get("controller", name))
+    opts = _controller_options(key, raw, run_name, lidar)
     return ControllerSpec(
-        name=name, controller=str(run_name), options=opts,
+        name=name, controller=run_name, options=opts,
         winds=_winds(f"{key}.winds", raw["winds"]) if "winds" in raw else None,
         seeds=_seeds(f"{key}.seeds", raw["seeds"]) if "seeds" in raw else None,
         turbulence=(_turbulence(f"{key}.turbulence", raw["turbulence"])
@@ -320,24 +319,17 @@ def _controller(i: int, raw: Any, lidar: dict[str, Any]) -> ControllerSpec:
 
 
 def _lidar(key: str, raw: Any) -> dict[str, Any]:
+    """The campaign's LIDAR settings (defaults of the kinds that take ``lidar``), checked by
+    :class:`mpc_wt.controllers.LidarOptions`."""
+    from ..controllers import LidarOptions
+    from ..errors import OptionsError
+
     if not isinstance(raw, Mapping):
         raise _fail(key, f"must be a mapping, got {raw!r}")
-    extra = set(raw) - _LIDAR_KEYS
-    if extra:
-        raise _fail(f"{key}.{sorted(extra)[0]}", f"unknown key; allowed: {sorted(_LIDAR_KEYS)}")
-    out: dict[str, Any] = {}
-    for k, v in raw.items():
-        if k in ("perfect_alignment", "los_error", "range_weighting"):
-            if not isinstance(v, bool):
-                raise _fail(f"{key}.{k}", f"must be true or false, got {v!r}")
-            out[k] = v
-        elif k == "n_range":
-            if isinstance(v, bool) or not isinstance(v, int) or v < 1:
-                raise _fail(f"{key}.{k}", f"must be an integer >= 1, got {v!r}")
-            out[k] = v
-        else:
-            out[k] = _number(f"{key}.{k}", v, 0.0)
-    return out
+    try:
+        return LidarOptions.from_dict(raw, prefix=f"{key}.").given()
+    except OptionsError as err:
+        raise _fail(err.key, str(err)) from err
 
 
 def _distribution(raw: Any) -> dict[str, Any]:
@@ -364,6 +356,19 @@ def _distribution(raw: Any) -> dict[str, Any]:
     raise _fail(f"{key}.kind", f"must be 'rayleigh' or 'weibull', got {kind!r}")
 
 
+def _plugins(raw: Any) -> tuple[str, ...]:
+    """Modules that register controller kinds, imported here and in every worker."""
+    from ..controllers import load_plugins
+
+    if not isinstance(raw, list) or not all(isinstance(m, str) and m for m in raw):
+        raise _fail("plugins", f"must be a list of module names, got {raw!r}")
+    try:
+        load_plugins(raw)
+    except ImportError as err:
+        raise _fail("plugins", str(err)) from err
+    return tuple(raw)
+
+
 def spec_from_dict(raw: Mapping[str, Any], base: Path | None = None,
                    source: str | None = None) -> CampaignSpec:
     """Validate a campaign given as a mapping (the parsed YAML).
@@ -388,6 +393,7 @@ def spec_from_dict(raw: Mapping[str, Any], base: Path | None = None,
     name = raw["name"]
     if not isinstance(name, str) or not name.strip():
         raise _fail("name", f"must be a non-empty string, got {name!r}")
+    plugins = _plugins(raw.get("plugins", []))
     turbine, thash = turbine_files_hash(str(raw.get("turbine", "nrel5mw")), base)
     duration = _number("duration", raw.get("duration", 600.0), 0.0, lo_open=True)
     transient = _number("transient", raw.get("transient", 60.0), 0.0)
@@ -400,7 +406,7 @@ def spec_from_dict(raw: Mapping[str, Any], base: Path | None = None,
     dup = sorted({n for n in names if names.count(n) > 1})
     if dup:
         raise _fail("controllers", f"repeated names {dup}; give each a distinct name")
-    from ..runs import DEFAULT_CHANNELS
+    from ..assess import DEFAULT_CHANNELS
 
     chans_raw = raw.get("channels", DEFAULT_CHANNELS)
     if not isinstance(chans_raw, Mapping) or not chans_raw:
@@ -442,7 +448,7 @@ def spec_from_dict(raw: Mapping[str, Any], base: Path | None = None,
         wind_distribution=_distribution(raw.get("wind_distribution", {})),
         lifetime_years=_number("lifetime_years", raw.get("lifetime_years", 20.0), 0.0,
                                lo_open=True),
-        reference=ref, report=dict(report), raw=raw, source=source)
+        reference=ref, report=dict(report), raw=raw, source=source, plugins=plugins)
 
 
 _PAPER_METRICS = {"del_change_pct", "lifetime_del_change_pct", "aep_change_pct",

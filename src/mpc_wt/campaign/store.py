@@ -23,6 +23,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Iterable
 
+from ..errors import CampaignLockedError
 from .spec import Case, CampaignSpec
 
 __all__ = ["CampaignStore", "CampaignLockedError", "CaseRow", "STATUSES"]
@@ -57,10 +58,6 @@ CREATE TABLE IF NOT EXISTS cases (
     updated REAL NOT NULL
 );
 """
-
-
-class CampaignLockedError(RuntimeError):
-    """Another client is running the same campaign directory."""
 
 
 @dataclass(frozen=True)

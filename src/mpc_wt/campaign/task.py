@@ -46,7 +46,7 @@ def case_metrics(t: np.ndarray, cols: dict[str, np.ndarray], channels: dict[str,
     ValueError
         If less than 10 s remain after the transient, or a series holds NaN.
     """
-    from ..runs import assess_series
+    from ..assess import assess_series
 
     k = t >= t[0] + transient
     if np.count_nonzero(k) < 2 or t[k][-1] - t[k][0] < 10.0:
@@ -118,14 +118,15 @@ def run_case(case: dict[str, Any], root: str) -> dict[str, Any]:
             except ResultFileError:
                 res = None
         if res is None:
-            from ..runs import run_controller
+            from ..controllers import load_plugins, run_controller
 
-            opts = dict(case["options"])
+            load_plugins(case.get("plugins", ()))
             try:
                 res = run_controller(_turbine(case["turbine"]), case["run_name"],
                                      case["wind_mps"], case["turbulence"], case["seed"],
                                      duration=case["duration"] + case["transient"],
-                                     shear_exponent=case["shear_exponent"], **opts)
+                                     shear_exponent=case["shear_exponent"],
+                                     options=case["options"])
             except SimulationDivergedError as err:
                 if getattr(err, "partial", None) is not None:
                     err.partial.meta["campaign_case"] = {"case_id": case["case_id"],

@@ -1,0 +1,156 @@
+"""``mpcwt campaign run|status|report`` (load-case campaigns on Dask) and ``mpcwt bench mpc``."""
+from __future__ import annotations
+
+import argparse
+import json
+import logging
+from pathlib import Path
+from typing import Any
+
+from ..errors import UsageError
+
+__all__ = ["add_parsers"]
+
+log = logging.getLogger(__name__)
+
+
+def add_parsers(sub: Any) -> None:
+    """Add ``campaign`` and ``bench`` to the subcommands.
+
+    Parameters
+    ----------
+    sub : argparse subparsers action
+        Of the top-level parser.
+    """
+    p = sub.add_parser("bench", help="benchmarks")
+    bench = p.add_subparsers(dest="bench_command", required=True)
+    q = bench.add_parser("mpc", help="MPC QP solver comparison on a closed-loop run (18 m/s)")
+    q.add_argument("--steps", type=int, default=3000, help="closed-loop steps (default 3000)")
+    q.add_argument("--json", action="store_true")
+    q.add_argument("--plot", help="PNG of the solve times")
+    q.set_defaults(func=_bench_mpc)
+
+    p = sub.add_parser("campaign", help="load-case campaigns (DLC 1.2) on Dask: run, status, "
+                                        "report")
+    camp = p.add_subparsers(dest="campaign_command", required=True)
+    q = camp.add_parser("run", help="run (or resume) a campaign spec")
+    q.add_argument("spec", help="campaign YAML file")
+    q.add_argument("--workers", type=int, default=None,
+                   help="local worker processes (default: one per core)")
+    q.add_argument("--scheduler", default=None,
+                   help="address of a running Dask scheduler, tcp://HOST:PORT")
+    q.add_argument("--out", default=None, help="campaign directory (default campaigns/NAME)")
+    q.add_argument("--engine", choices=("dask", "processes", "serial"), default="dask",
+                   help="dask (default), a plain process pool, or this process")
+    q.add_argument("--report", action="store_true", help="write the report when all cases "
+                                                         "finished")
+    q.add_argument("--quiet", action="store_true", help="no progress bar")
+    q.set_defaults(func=_run)
+    q = camp.add_parser("status", help="cases done, failed, pending of a campaign directory")
+    q.add_argument("dir")
+    q.add_argument("--failed", action="store_true", help="print the tracebacks of failed cases")
+    q.add_argument("--json", action="store_true")
+    q.set_defaults(func=_status)
+    q = camp.add_parser("report", help="tables (CSV, Markdown) and plots (PNG) of a campaign")
+    q.add_argument("dir")
+    q.add_argument("--out", default=None, help="report folder (default DIR/report)")
+    q.set_defaults(func=_report)
+
+
+def _bench_mpc(args: argparse.Namespace) -> int:
+    from ..bench import format_table, plot_solver_times, run_solver_benchmark
+
+    if args.steps < 10:
+        raise UsageError(f"--steps must be >= 10, got {args.steps}")
+    res = run_solver_benchmark(args.steps, progress=not args.json)
+    print(json.dumps(res, indent=1) if args.json else format_table(res))
+    if args.plot:
+        plot_solver_times(res, args.plot)
+    return 0
+
+
+def _run(args: argparse.Namespace) -> int:
+    from ..campaign import load_spec, run_campaign
+
+    if args.scheduler and args.workers:
+        raise UsageError("give --workers (local cluster) or --scheduler (running cluster), "
+                         "not both")
+    spec = load_spec(args.spec)
+    out = Path(args.out) if args.out else Path("campaigns") / spec.name
+    if args.engine == "dask":
+        try:    # import first: distributed sets its loggers' levels when imported
+            import distributed  # noqa: F401
+        except ImportError:
+            pass
+        for name in list(logging.root.manager.loggerDict):
+            if name.startswith("distributed"):
+                logging.getLogger(name).setLevel(logging.ERROR)
+    log.info("campaign %s -> %s", spec.name, out)
+    s = run_campaign(spec, out, workers=args.workers, scheduler=args.scheduler,
+                     engine=args.engine, progress=not args.quiet)
+    print(f"campaign {spec.name}: {s.total} cases; {s.skipped} already finished, "
+          f"{s.done} done now ({s.reused} from files already written), {s.failed} failed; "
+          f"{s.wall_s:.0f} s wall, {s.cases_per_min:.2f} cases/min ({s.engine}, "
+          f"{'scheduler ' + args.scheduler if args.scheduler else f'{s.workers} workers'})")
+    print(f"  directory {out}")
+    for cid, err in s.failures[:10]:
+        print(f"  failed {cid}: {err.splitlines()[0] if err else ''}")
+    if s.failed:
+        print(f"  tracebacks: mpcwt campaign status {out} --failed; rerun the same command "
+              f"to retry failed cases")
+    if args.report and not s.failed:
+        from ..campaign.report import make_report
+
+        rep = make_report(out)
+        print(f"  report {rep}")
+    return 1 if s.failed else 0
+
+
+def _status(args: argparse.Namespace) -> int:
+    from ..campaign.store import CampaignStore
+
+    with CampaignStore(args.dir) as st:
+        meta = st.meta()
+        rows = st.rows()
+        counts = st.counts()
+        stray = st.stray_temp_files()
+    if args.json:
+        print(json.dumps({"meta": meta, "counts": counts,
+                          "cases": [{"case_id": r.case_id, "status": r.status,
+                                     "error": r.error, "wall_s": r.wall_s,
+                                     "software_version": r.software_version} for r in rows]},
+                         indent=1))
+        return 0
+    print(f"campaign {meta.get('name')} in {args.dir}: spec {str(meta.get('spec_hash'))[:12]}, "
+          f"last run {meta.get('last_run')}, mpc-wt {meta.get('software_version')}")
+    print("  " + ", ".join(f"{k} {v}" for k, v in counts.items() if v or k in ("done",
+                                                                              "pending")))
+    per: dict[str, list[int]] = {}
+    for r in rows:
+        d = per.setdefault(r.controller, [0, 0, 0])
+        d[0] += 1
+        d[1] += r.status == "done"
+        d[2] += r.status == "failed"
+    print(f"  {'controller':<24} {'done':>6} {'failed':>7} {'cases':>6}")
+    for k, (n, d, f) in per.items():
+        print(f"  {k:<24} {d:>6} {f:>7} {n:>6}")
+    versions = sorted({r.software_version for r in rows if r.software_version})
+    if len(versions) > 1:
+        print(f"  note: cases were computed by mpc-wt versions {versions}")
+    if stray:
+        print(f"  {len(stray)} temp files of interrupted writers in {Path(args.dir) / 'cases'} "
+              f"(safe to delete when no worker runs)")
+    for r in rows:
+        if r.status == "failed":
+            print(f"  failed {r.case_id}: {(r.error or '').splitlines()[0]}")
+            if args.failed and r.traceback:
+                print("    " + r.traceback.rstrip().replace("\n", "\n    "))
+    return 0
+
+
+def _report(args: argparse.Namespace) -> int:
+    from ..campaign.report import make_report
+
+    rep = make_report(args.dir, out=args.out)
+    print(f"report {rep}")
+    return 0

@@ -1,0 +1,118 @@
+"""``mpcwt design`` and ``mpcwt export``: gain synthesis of the registered kinds that have a
+design function, and export of their gain tables."""
+from __future__ import annotations
+
+import argparse
+import inspect
+from pathlib import Path
+from typing import Any
+
+import linearize
+
+from ..errors import GainTableError, UsageError
+from .common import add_turbine, floats, number_pairs, parse_range
+
+__all__ = ["add_parsers"]
+
+
+def add_parsers(sub: Any) -> None:
+    """Add ``design`` and ``export`` to the subcommands.
+
+    Parameters
+    ----------
+    sub : argparse subparsers action
+        Of the top-level parser.
+    """
+    from ..controllers.registry import designs
+
+    p = sub.add_parser("design", help="gain synthesis: baseline PI, LQR family, TS by LMIs, "
+                                      "IBC, Coleman IPC")
+    p.add_argument("kind", choices=list(designs()))
+    add_turbine(p)
+    p.add_argument("--out", required=True, help="design directory (design.json, gains.png)")
+    p.add_argument("--wind", help="lqr: START:STOP:STEP (default 12:25:1); ts: comma list of "
+                                  "vertex winds (default 12,14,16,19,22,25) [m/s]")
+    p.add_argument("--reductions", default="0,0.4,0.8",
+                   help="ts: comma list of vertex power reductions (default 0,0.4,0.8)")
+    p.add_argument("--decay-rate", type=float, default=0.2, help="ts: controller decay [1/s]")
+    p.add_argument("--observer-decay-rate", type=float, default=1.0,
+                   help="ts: observer decay [1/s]")
+    p.add_argument("--weight", action="append",
+                   help="lqr: NAME=VALUE weight on a state or output (repeatable; default "
+                        "rotor_speed=5, tower_fa_velocity=1)")
+    p.add_argument("--scale", action="append",
+                   help="lqr: NAME=VALUE typical magnitude dividing a weight (repeatable)")
+    p.add_argument("--observer-q", type=float, default=1e3,
+                   help="lqr: PI observer q of Q_obs = diag(I, q I) (0: no observer)")
+    p.add_argument("--omega-n", type=float, default=0.6, help="baseline: PI design [rad/s]")
+    p.add_argument("--zeta", type=float, default=0.7, help="baseline: PI damping [-]")
+    p.add_argument("--power-fraction", type=float, default=1.0,
+                   help="baseline, ibc, coleman-ipc: tune for a derated turbine at this "
+                        "fraction of rated power, in (0, 1]")
+    p.add_argument("--loop-gain", type=float, default=1.0, help="ibc: loop gain at 1P [-]")
+    p.set_defaults(func=_design)
+
+    p = sub.add_parser("export", help="export a design's gain table")
+    p.add_argument("design", help="design directory (from `mpcwt design`) or gain-table JSON")
+    p.add_argument("--format", required=True, choices=("csv", "json", "mat", "rosco"))
+    p.add_argument("--to", help="output directory (default: the design directory)")
+    p.set_defaults(func=_export)
+
+
+def _positive(name: str, value: float, allow_zero: bool = False) -> float:
+    ok = value >= 0 if allow_zero else value > 0
+    if not (ok and value == value and abs(value) != float("inf")):
+        raise UsageError(f"{name} must be {'>= 0' if allow_zero else '> 0'}, got {value!r}")
+    return value
+
+
+def _design_args(args: argparse.Namespace) -> dict[str, Any]:
+    """Every design argument, checked before any work (names the flag)."""
+    from ..baseline import check_power_fraction
+
+    try:
+        frac = check_power_fraction(args.power_fraction, "--power-fraction")
+    except ValueError as err:
+        raise UsageError(str(err)) from None
+    lqr = args.kind == "lqr"
+    winds: Any = None
+    if args.wind:
+        winds = parse_range(args.wind, "--wind") if lqr else floats(args.wind, "--wind")
+    elif args.kind == "ts":
+        winds = [12.0, 14.0, 16.0, 19.0, 22.0, 25.0]
+    return {"power_fraction": frac, "omega_n_rad_s": _positive("--omega-n", args.omega_n),
+            "zeta": _positive("--zeta", args.zeta),
+            "loop_gain": _positive("--loop-gain", args.loop_gain), "winds": winds,
+            "reductions": floats(args.reductions, "--reductions"),
+            "decay_rate": _positive("--decay-rate", args.decay_rate),
+            "observer_decay_rate": _positive("--observer-decay-rate", args.observer_decay_rate),
+            "weights": number_pairs(args.weight, "--weight") or None,
+            "scales": number_pairs(args.scale, "--scale"),
+            "observer_q": _positive("--observer-q", args.observer_q, allow_zero=True)}
+
+
+def _design(args: argparse.Namespace) -> int:
+    from ..controllers.registry import designs
+    from ..export import save_design
+    from ..plotting import plot_design
+
+    kind = designs()[args.kind]
+    every = _design_args(args)
+    wanted = inspect.signature(kind.design).parameters
+    turbine = linearize.load_turbine(args.turbine)
+    doc, note = kind.design(turbine, **{k: v for k, v in every.items() if k in wanted})
+    p = save_design(doc, args.out)
+    plot_design(doc, Path(args.out) / "gains.png")
+    print(f"wrote {p} and {Path(args.out) / 'gains.png'} ({args.kind}: {note})")
+    return 0
+
+
+def _export(args: argparse.Namespace) -> int:
+    from ..export import export
+
+    try:
+        files = export(args.design, args.format, args.to)
+    except GainTableError as err:
+        raise UsageError(str(err)) from None
+    print("wrote " + ", ".join(str(f) for f in files))
+    return 0

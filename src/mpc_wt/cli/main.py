@@ -1,0 +1,104 @@
+"""The ``mpcwt`` command line: one module per command group, each adding its parsers.
+
+Subcommands
+-----------
+run          the main job on a turbine: steady operating table, C_P surface, baseline run
+trim         steady operating points against wind speed (table or ``--json``)
+linearize    linear models over mean wind, saved as .mat/.npz/.json (``--json`` summary)
+aero         rotor aerodynamics: ``aero cp-surface --out FILE.csv [--plot FILE.png]``
+simulate     closed loop of any registered controller kind: ``simulate --controller baseline
+             --wind 18 --out RUN``
+controllers  the registered controller kinds and their options
+assess       DELs, CS1-CS5, pitch duty, energy of runs or CSV time series
+wind         turbulent wind fields: ``wind generate --mean 18 --class A --out FIELD.bts``
+lidar        CW LIDAR preview: ``lidar evaluate --field FIELD [--focus 54] [--json]``
+design       gain synthesis: ``design baseline|lqr|ts|ibc|coleman-ipc [...] --out DIR``
+export       gain tables: ``export DIR --format csv|json|mat|rosco``
+campaign     load-case campaigns on Dask: ``campaign run SPEC.yaml``, ``status``, ``report``
+bench        ``bench mpc``: QP solver comparison
+
+``--plugin MODULE`` (before the subcommand, repeatable) imports a module that registers
+controller kinds, which ``simulate`` and campaign specs can then use.
+
+Errors in the arguments or the turbine file print one line naming the parameter and the value
+to stderr and exit with status 2; no command does its work before its arguments are checked.
+"""
+from __future__ import annotations
+
+import argparse
+import logging
+import sys
+from typing import Sequence
+
+import linearize
+
+from ..errors import CampaignLockedError, UsageError
+from . import campaign, design, runs, steady, wind
+
+__all__ = ["main", "build_parser"]
+
+_GROUPS = (runs, steady, wind, design, campaign)
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """The ``mpcwt`` parser, with the controller kinds registered now.
+
+    Returns
+    -------
+    argparse.ArgumentParser
+        Every command group's subcommands.
+    """
+    ap = argparse.ArgumentParser(prog="mpcwt", description=__doc__.split("\n")[0])
+    ap.add_argument("--plugin", action="append", default=[], metavar="MODULE",
+                    help="import MODULE, which registers controller kinds (repeatable)")
+    sub = ap.add_subparsers(dest="command", required=True)
+    for group in _GROUPS:
+        group.add_parsers(sub)
+    return ap
+
+
+def _plugins(argv: Sequence[str]) -> list[str]:
+    """The ``--plugin`` modules, read before the parser is built (its choices include them)."""
+    mods = []
+    for i, a in enumerate(argv):
+        if a == "--plugin" and i + 1 < len(argv):
+            mods.append(argv[i + 1])
+        elif a.startswith("--plugin="):
+            mods.append(a.split("=", 1)[1])
+    return mods
+
+
+_ERRORS = (UsageError, linearize.TurbineFileError, linearize.TrimError, FileNotFoundError,
+           ValueError, KeyError, ImportError, linearize.LinearizationError,
+           CampaignLockedError)
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Entry point of ``mpcwt``.
+
+    Parameters
+    ----------
+    argv : sequence of str, optional
+        The arguments (default ``sys.argv[1:]``).
+
+    Returns
+    -------
+    int
+        0 on success, 1 when a campaign finished with failed cases, 2 on a usage or input
+        error (the message names the parameter and the value).
+    """
+    logging.basicConfig(level=logging.WARNING, format="%(levelname)s %(name)s: %(message)s")
+    argv = list(sys.argv[1:] if argv is None else argv)
+    try:
+        from ..controllers import load_plugins
+
+        load_plugins(_plugins(argv))
+    except ImportError as err:
+        print(f"mpcwt: error: --plugin: {err}", file=sys.stderr)
+        return 2
+    args = build_parser().parse_args(argv)
+    try:
+        return int(args.func(args))
+    except _ERRORS as err:
+        print(f"mpcwt {args.command}: error: {err}", file=sys.stderr)
+        return 2

@@ -1,0 +1,269 @@
+"""``mpcwt run`` (the main job), ``mpcwt simulate``, ``mpcwt assess`` and ``mpcwt
+controllers``: closed loops of any registered controller kind and their assessment.
+
+``simulate`` takes its ``--controller`` names and its option flags from the controller
+registry (:mod:`mpc_wt.controllers`): each option of a kind is a flag, and any option can also
+be given as ``--option NAME=VALUE``; which options a kind takes is checked by the registry.
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import typing
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+import linearize
+
+from ..errors import UsageError
+from .common import (add_turbine, cp_surface, format_table, pairs, schedule, write_points_csv,
+                     write_surface_csv)
+
+__all__ = ["add_parsers", "controller_options"]
+
+
+def add_parsers(sub: Any) -> None:
+    """Add ``run``, ``simulate``, ``assess`` and ``controllers`` to the subcommands.
+
+    Parameters
+    ----------
+    sub : argparse subparsers action
+        Of the top-level parser.
+    """
+    p = sub.add_parser("run", help="main job: operating table, C_P surface, baseline run, "
+                                   "assessment, plots")
+    add_turbine(p)
+    p.add_argument("--out", default="mpcwt-out", help="output directory (default mpcwt-out)")
+    p.add_argument("--wind", type=float, default=18.0, help="wind of the baseline run [m/s]")
+    p.add_argument("--turbulence", choices=("A", "B", "C", "steady"), default="A")
+    p.add_argument("--seed", type=int, default=1)
+    p.add_argument("--duration", type=float, default=600.0,
+                   help="baseline run length [s] (0 skips the run)")
+    p.set_defaults(func=_run)
+    _add_simulate(sub)
+    _add_assess(sub)
+    p = sub.add_parser("controllers", help="the registered controller kinds and their options")
+    p.add_argument("--json", action="store_true")
+    p.set_defaults(func=_controllers)
+
+
+def _add_simulate(sub: Any) -> None:
+    from ..controllers import kinds
+    from ..controllers.registry import cli_flags
+
+    names = [k.pattern_help or k.name for k in kinds().values()]
+    p = sub.add_parser("simulate", help="closed-loop simulation on the plant")
+    add_turbine(p)
+    p.add_argument("--controller", default="baseline",
+                   help=" | ".join(names).replace("%", "%%") + " (+ibc, +coleman-ipc on a "
+                        "baseline); `mpcwt controllers` lists each with its options")
+    p.add_argument("--wind", type=float, required=True, help="mean hub-height wind [m/s]")
+    p.add_argument("--turbulence", choices=("A", "B", "C", "steady"), default="A")
+    p.add_argument("--seed", type=int, default=1)
+    p.add_argument("--duration", type=float, default=600.0, help="[s]")
+    p.add_argument("--out", required=True, help="result file (netCDF, .nc)")
+    p.add_argument("--option", action="append", metavar="NAME=VALUE",
+                   help="any option of the controller kind (repeatable; YAML values)")
+    g = p.add_argument_group("controller options (each applies to the kinds that take it)")
+    for name, meta in cli_flags().items():
+        _add_option_flag(g, name, meta)
+    p.set_defaults(func=_simulate)
+
+
+def _add_option_flag(g: Any, name: str, meta: dict[str, Any]) -> None:
+    """One flag of a controller option; its value is left None unless given."""
+    helptext = (meta.get("help", "") + (f" [{meta['unit']}]" if meta.get("unit") else "")
+                ).replace("%", "%%")
+    if meta.get("flag_value") is not None:
+        g.add_argument(meta["flag"], dest=f"opt_{name}", action="store_const",
+                       const=meta["flag_value"], default=None, help=helptext)
+        return
+    base = typing.get_args(meta["type"])[0] if typing.get_args(meta["type"]) else meta["type"]
+    conv = {float: float, int: int}.get(base, str)
+    choices = ["none" if c is None else c for c in meta.get("choices", ())] or None
+    g.add_argument(meta["flag"], dest=f"opt_{name}", type=conv, choices=choices, default=None,
+                   help=helptext)
+
+
+def controller_options(args: argparse.Namespace) -> dict[str, Any]:
+    """The controller options given on the command line (flags and ``--option``).
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        Parsed ``simulate`` arguments.
+
+    Returns
+    -------
+    dict
+        Option name -> value, only those given ("none" -> None).
+    """
+    opts = pairs(args.option, "--option")
+    for key, val in vars(args).items():
+        if key.startswith("opt_") and val is not None:
+            opts[key[4:]] = None if val == "none" else val
+    return opts
+
+
+def _simulate(args: argparse.Namespace) -> int:
+    from ..controllers import cli_naming, resolve, run_controller
+    from ..controllers.registry import cli_flags
+
+    naming = cli_naming({k: m["flag"] for k, m in cli_flags().items()})
+    opts = controller_options(args)
+    try:
+        resolve(args.controller).options(opts, naming)
+    except ValueError as err:
+        prefix = "" if hasattr(err, "key") else "--controller: "
+        raise UsageError(f"{prefix}{err}") from None
+    turbine = linearize.load_turbine(args.turbine)
+    res = run_controller(turbine, args.controller, args.wind, args.turbulence, args.seed,
+                         args.duration, progress=True, options=opts, naming=naming)
+    out = Path(args.out)
+    if out.suffix == "":
+        out = out.with_suffix(".nc")
+    res.save(out)
+    p = res.channel("gen_power")
+    print(f"wrote {out}: {res.t.size} samples; mean power {p.mean() / 1e6:.3f} MW, "
+          f"gen speed std {res.channel('gen_speed').std():.3f} rad/s")
+    return 0
+
+
+def _controllers(args: argparse.Namespace) -> int:
+    from ..controllers import describe
+
+    rows = describe()
+    if args.json:
+        print(json.dumps(rows, indent=1, default=str))
+        return 0
+    for r in rows:
+        head = r["pattern"] or r["name"]
+        on = f" (add-on to {', '.join(r['addon_to'])})" if r["addon_to"] else ""
+        print(f"{head}{on}: {r['summary']}")
+        for o in r["options"]:
+            unit = f" [{o['unit']}]" if o["unit"] else ""
+            print(f"    {o['name']:22s} {o['type']:14s} default {o['default']!r}{unit}  "
+                  f"{o['help']}")
+    return 0
+
+
+def _add_assess(sub: Any) -> None:
+    p = sub.add_parser("assess", help="loads and performance of runs or CSV time series")
+    p.add_argument("runs", nargs="+", help="result files (.nc) or CSV with a time column")
+    p.add_argument("--channels", help="comma list of channels (default: blade, tower, shaft)")
+    p.add_argument("--m", type=float, default=None, help="Woehler exponent for all channels")
+    p.add_argument("--time-column", default="time", help="CSV time column (default time)")
+    p.add_argument("--t-start", type=float, default=0.0,
+                   help="discard samples before this time, e.g. the start-up transient [s]")
+    p.add_argument("--json", action="store_true")
+    p.add_argument("--plots", help="directory for cs_ellipses.png and psd_flap_moment_1.png")
+    p.set_defaults(func=_assess)
+
+
+def _assess(args: argparse.Namespace) -> int:
+    from ..assess import DEFAULT_CHANNELS, assess_series, reductions
+    from ..plotting import assess_plots
+    from ..results import load_series
+
+    chans = None
+    if args.channels:
+        chans = {c: DEFAULT_CHANNELS.get(c, 4.0) for c in args.channels.split(",")}
+    rows, runs = [], []
+    for path in args.runs:
+        t, cols = load_series(path, args.time_column)
+        keep = t >= args.t_start
+        if keep.sum() < 3:
+            raise UsageError(f"--t-start = {args.t_start:g} s leaves fewer than 3 samples of "
+                             f"{path} (it ends at {t[-1]:g} s)")
+        t, cols = t[keep], {k: v[keep] for k, v in cols.items()}
+        res = assess_series(t, cols, chans, args.m)
+        row = {"run": str(path), **res}
+        if rows:
+            row["relative_to_first"] = reductions(rows[0], res)
+        rows.append(row)
+        runs.append((Path(path).stem, t, cols))
+    if args.plots:
+        made = assess_plots(runs, args.plots)
+        for r in rows:
+            r["plots"] = made
+    if args.json:
+        print(json.dumps(rows, indent=1))
+        return 0
+    for r in rows:
+        print(f"# {r['run']} ({r['duration_s']:.0f} s)")
+        for name, d in r["channels"].items():
+            print(f"  DEL {name:24s} {d['del']:14.4g}  (m = {d['m']:g})")
+        for k in ("cs1", "cs2", "cs3", "cs4", "cs5", "power_std_W", "energy_Wh",
+                  "pitch_travel_deg"):
+            if k in r:
+                print(f"  {k:28s} {r[k]:14.6g}")
+    return 0
+
+
+def _run(args: argparse.Namespace) -> int:
+    turbine = linearize.load_turbine(args.turbine)
+    out = Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    _steady_outputs(turbine, out)
+    if args.duration > 0:
+        _baseline_run(turbine, args, out)
+    return 0
+
+
+def _steady_outputs(turbine: linearize.Turbine, out: Path) -> None:
+    """The main job's steady part: operating table, C_P surface and their plots."""
+    from ..plotting import plot_cp_surface, plot_operating_schedule
+
+    op = turbine.operation
+    winds = np.arange(op.cut_in_wind, op.cut_out_wind + 1e-9, 1.0)
+    points = schedule(turbine, winds, None, progress=True)
+    v_rated = linearize.rated_wind_speed(turbine)
+    lam_opt, cp_max = linearize.optimal_tsr(turbine, math.degrees(op.fine_pitch_rad))
+    print(f"# {turbine.name}: steady operating table, cut-in to cut-out")
+    print(format_table(points))
+    print(f"# rated wind speed {v_rated:.3f} m/s; C_P max {cp_max:.4f} at tip-speed ratio "
+          f"{lam_opt:.3f} (fine pitch)")
+    write_points_csv(points, out / "operating_points.csv")
+    (out / "operating_points.json").write_text(json.dumps([p.as_dict() for p in points],
+                                                          indent=1))
+    tsr = np.arange(2.0, 16.0 + 1e-9, 0.25)
+    pitch = np.arange(-2.0, 24.0 + 1e-9, 0.5)
+    cp = cp_surface(turbine, tsr, pitch)
+    write_surface_csv(tsr, pitch, cp, out / "cp_surface.csv")
+    plot_cp_surface(tsr, pitch, cp, out / "cp_surface.png", title=f"{turbine.name}: C_P")
+    plot_operating_schedule(points, out / "operating_schedule.png",
+                            title=f"{turbine.name}: steady operating schedule")
+    print(f"# wrote {out}/operating_points.csv, operating_points.json, cp_surface.csv, "
+          f"cp_surface.png, operating_schedule.png")
+
+
+def _baseline_run(turbine: linearize.Turbine, args: argparse.Namespace, out: Path) -> None:
+    """The main job's closed loop: the tuned baseline on one turbulent field, assessed."""
+    from ..assess import assess_series
+    from ..baseline import tune_baseline
+    from ..controllers import run_controller
+    from ..plotting import assess_plots
+
+    g = tune_baseline(turbine)
+    print(f"# baseline tuned from the linear models: KP {g.kp:.5f} s, KI {g.ki:.5f}, "
+          f"theta_K {math.degrees(g.theta_k_rad):.2f} deg, K_opt {g.k_opt:.4f} "
+          f"N m/(rad/s)^2 (published 0.01883, 0.00807, 6.30 deg, 2.3323)")
+    res = run_controller(turbine, "baseline", args.wind, args.turbulence, args.seed,
+                         args.duration, progress=True)
+    res.save(out / "baseline_run.nc")
+    keep = res.t >= min(60.0, 0.1 * args.duration)
+    cols = {n: res.channel(n)[keep] for n in res.channels()}
+    a = assess_series(res.t[keep], cols)
+    (out / "baseline_assessment.json").write_text(json.dumps(a, indent=1))
+    assess_plots([("baseline", res.t[keep], cols)], out)
+    print(f"# {args.duration:g} s at {args.wind:g} m/s, turbulence {args.turbulence}, "
+          f"seed {args.seed}: mean power {a['power_mean_W'] / 1e6:.3f} MW, power std "
+          f"{a['power_std_W'] / 1e3:.1f} kW, gen speed std {a['gen_speed_std_rad_s']:.2f} "
+          f"rad/s, pitch travel {a['pitch_travel_deg']:.0f} deg")
+    for name, d in a["channels"].items():
+        print(f"#   DEL {name:22s} {d['del']:12.4g} N m (m = {d['m']:g})")
+    print(f"# wrote {out}/baseline_run.nc, baseline_assessment.json, cs_ellipses.png, "
+          f"psd_flap_moment_1.png")

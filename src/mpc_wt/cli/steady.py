@@ -1,0 +1,122 @@
+"""``mpcwt trim``, ``mpcwt linearize`` and ``mpcwt aero cp-surface``: the turbine's steady
+operation, its linear models and its rotor aerodynamics."""
+from __future__ import annotations
+
+import argparse
+import json
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+import linearize
+
+from ..errors import UsageError
+from .common import (add_turbine, check_suffix, cp_surface, format_table, parse_range, schedule,
+                     write_surface_csv)
+
+__all__ = ["add_parsers"]
+
+
+def add_parsers(sub: Any) -> None:
+    """Add ``trim``, ``linearize`` and ``aero`` to the subcommands.
+
+    Parameters
+    ----------
+    sub : argparse subparsers action
+        Of the top-level parser.
+    """
+    p = sub.add_parser("trim", help="steady operating points")
+    add_turbine(p)
+    p.add_argument("--wind", default="4:25:1", help="START:STOP:STEP in m/s (default 4:25:1)")
+    p.add_argument("--power-W", dest="power_W", type=float, default=None,
+                   help="power reference below rated [W]")
+    p.add_argument("--json", action="store_true", help="print a JSON list")
+    p.set_defaults(func=_trim)
+
+    p = sub.add_parser("linearize", help="linear models over mean wind")
+    add_turbine(p)
+    p.add_argument("--wind", default="4:25:1", help="START:STOP:STEP in m/s (default 4:25:1)")
+    p.add_argument("--frozen-wake", action="store_true",
+                   help="hold the induction at trim (as FAST/OpenFAST linearize)")
+    p.add_argument("--disturbance", choices=("blade", "rotor"), default="blade",
+                   help="one wind per blade (default) or one rotor-effective wind")
+    p.add_argument("--mbc", action="store_true", help="multi-blade (Coleman) coordinates")
+    p.add_argument("--out", help="models file: .mat (MATLAB), .npz or .json")
+    p.add_argument("--json", action="store_true", help="print sensitivities and modes as JSON")
+    p.set_defaults(func=_linearize)
+
+    p = sub.add_parser("aero", help="rotor aerodynamics")
+    aero = p.add_subparsers(dest="aero_command", required=True)
+    q = aero.add_parser("cp-surface", help="C_P(lambda, pitch) table and plot")
+    add_turbine(q)
+    q.add_argument("--out", help="CSV file (rows pitch, columns tip-speed ratio)")
+    q.add_argument("--plot", help="PNG file")
+    q.add_argument("--tsr", default="2:16:0.25", help="START:STOP:STEP (default 2:16:0.25)")
+    q.add_argument("--pitch", default="-2:24:0.5",
+                   help="START:STOP:STEP in deg; write --pitch=-2:24:0.5 for a negative start")
+    q.set_defaults(func=_cp_surface)
+
+
+def _trim(args: argparse.Namespace) -> int:
+    winds = parse_range(args.wind, "--wind")
+    turbine = linearize.load_turbine(args.turbine)
+    points = schedule(turbine, winds, args.power_W, progress=not args.json)
+    if args.json:
+        print(json.dumps([p.as_dict() for p in points], indent=1))
+    else:
+        print(f"# {turbine.name}")
+        print(format_table(points))
+    return 0
+
+
+def _cp_surface(args: argparse.Namespace) -> int:
+    if not (args.out or args.plot):
+        raise UsageError("mpcwt aero cp-surface: give --out FILE.csv and/or --plot FILE.png")
+    tsr = parse_range(args.tsr, "--tsr")
+    pitch = parse_range(args.pitch, "--pitch")
+    if np.any(tsr < 0):
+        raise UsageError(f"--tsr must be >= 0, got {args.tsr!r}")
+    turbine = linearize.load_turbine(args.turbine)
+    cp = cp_surface(turbine, tsr, pitch)
+    if args.out:
+        write_surface_csv(tsr, pitch, cp, Path(args.out))
+        print(f"wrote {args.out}")
+    if args.plot:
+        from ..plotting import plot_cp_surface
+
+        plot_cp_surface(tsr, pitch, cp, args.plot, title=f"{turbine.name}: C_P")
+        print(f"wrote {args.plot}")
+    i, j = np.unravel_index(int(np.argmax(cp)), cp.shape)
+    print(f"C_P max {cp[i, j]:.4f} at tip-speed ratio {tsr[j]:.3f}, pitch {pitch[i]:.2f} deg")
+    return 0
+
+
+def _linearize(args: argparse.Namespace) -> int:
+    winds = parse_range(args.wind, "--wind")
+    check_suffix(args.out, "--out", (".mat", ".npz", ".json"))
+    turbine = linearize.load_turbine(args.turbine)
+    fam = linearize.linearize_family(
+        turbine, winds, wake="frozen" if args.frozen_wake else "quasi-steady",
+        disturbance=args.disturbance, coordinates="mbc" if args.mbc else "blade",
+        progress=not args.json)
+    if args.out:
+        fam.save(args.out)
+        if not args.json:
+            print(f"wrote {args.out}: {len(fam.models)} models, {fam.models[0].n_x} states, "
+                  f"inputs {list(fam.models[0].inputs)}")
+    rows = [{"wind_mps": m.wind_speed, "pitch_deg": m.info["pitch_deg"],
+             "rotor_speed_rpm": m.info["rotor_speed_rpm"], **linearize.sensitivities(m),
+             "modes": m.modes()} for m in fam.models]
+    if args.json:
+        print(json.dumps(rows, indent=1))
+        return 0
+    print(f"{'wind [m/s]':>10s} {'pitch [deg]':>11s} {'dP/dpitch [MW/rad]':>18s} "
+          f"{'dQ/domega [kNms]':>16s} {'dT/dV [kN s/m]':>14s}  modes [Hz, damping]")
+    for r in rows:
+        modes = ", ".join(f"{md['name']} {md['frequency_Hz']:.3f} {md['damping_ratio']:.3f}"
+                          for md in r["modes"])
+        print(f"{r['wind_mps']:10.2f} {r['pitch_deg']:11.3f} "
+              f"{r['dP_dpitch_W_per_rad'] / 1e6:18.3f} {r['dQ_domega'] / 1e3:16.1f} "
+              f"{r['dT_dV'] / 1e3:14.2f}  {modes}")
+    return 0

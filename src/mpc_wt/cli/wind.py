@@ -1,0 +1,91 @@
+"""``mpcwt wind generate`` and ``mpcwt lidar evaluate``: turbulent fields and the CW LIDAR."""
+from __future__ import annotations
+
+import argparse
+import json
+from typing import Any
+
+import linearize
+
+from ..errors import UsageError
+from .common import add_turbine
+
+__all__ = ["add_parsers"]
+
+
+def add_parsers(sub: Any) -> None:
+    """Add ``wind`` and ``lidar`` to the subcommands.
+
+    Parameters
+    ----------
+    sub : argparse subparsers action
+        Of the top-level parser.
+    """
+    p = sub.add_parser("wind", help="turbulent wind fields")
+    wind = p.add_subparsers(dest="wind_command", required=True)
+    q = wind.add_parser("generate", help="IEC 61400-1 Kaimal field (TurbSim IECKAI model)")
+    q.add_argument("--mean", type=float, required=True, help="hub-height mean speed [m/s]")
+    q.add_argument("--class", dest="turbulence_class", choices=("A", "B", "C"), default="A")
+    q.add_argument("--ti", type=float, default=None, help="turbulence intensity instead of a class")
+    q.add_argument("--seed", type=int, default=1)
+    q.add_argument("--duration", type=float, default=600.0, help="[s]")
+    q.add_argument("--dt", type=float, default=0.05, help="[s] (default 0.05: 20 Hz)")
+    q.add_argument("--n", type=int, default=32, help="grid points per side (default 32)")
+    q.add_argument("--width", type=float, default=150.0, help="grid side [m]")
+    q.add_argument("--hub-height", type=float, default=90.0, help="[m]")
+    q.add_argument("--shear", type=float, default=0.2, help="power-law exponent")
+    q.add_argument("--out", required=True, help=".bts (TurbSim) or .npz (native)")
+    q.set_defaults(func=_generate)
+
+    p = sub.add_parser("lidar", help="CW LIDAR preview")
+    lid = p.add_subparsers(dest="lidar_command", required=True)
+    q = lid.add_parser("evaluate", help="coherence bandwidth and preview error on a field")
+    q.add_argument("--field", required=True, help=".bts or .npz wind field")
+    add_turbine(q)
+    q.add_argument("--focus", type=float, default=54.0, help="axial focus distance [m]")
+    q.add_argument("--point", action="store_true", help="point measurement (no range weighting)")
+    q.add_argument("--no-los-error", action="store_true", help="measure u directly")
+    q.add_argument("--noise", type=float, default=0.0, help="LOS noise std [m/s]")
+    q.add_argument("--json", action="store_true")
+    q.add_argument("--plots", help="directory for lidar_coherence.png and lidar_scan.png")
+    q.set_defaults(func=_evaluate)
+
+
+def _generate(args: argparse.Namespace) -> int:
+    import lidar
+
+    from .common import check_suffix
+
+    check_suffix(args.out, "--out", (".bts", ".npz"))
+    turb: str | float = args.turbulence_class if args.ti is None else args.ti
+    try:
+        spec = lidar.TurbulenceSpec(args.mean, turb, hub_height=args.hub_height,
+                                    width=args.width, height=args.width, n_y=args.n, n_z=args.n,
+                                    duration=args.duration, dt=args.dt,
+                                    shear_exponent=args.shear)
+    except TypeError as err:
+        raise UsageError(str(err)) from None
+    field = lidar.generate_field(spec, args.seed)
+    out = field.save(args.out)
+    u = field.u
+    print(f"wrote {out}: {u.shape[0]} steps x {u.shape[1]} x {u.shape[2]} points, "
+          f"hub TI {u[:, u.shape[1] // 2, u.shape[2] // 2].std() / args.mean:.3f}")
+    return 0
+
+
+def _evaluate(args: argparse.Namespace) -> int:
+    import lidar
+
+    from ..lidar_eval import evaluate_lidar
+
+    field = lidar.WindField.load(args.field)
+    turbine = linearize.load_turbine(args.turbine)
+    res = evaluate_lidar(field, turbine, focus_distance=args.focus, plots=args.plots,
+                         range_weighting=not args.point, los_error=not args.no_los_error,
+                         noise_std=args.noise)
+    if args.json:
+        print(json.dumps(res, indent=1))
+    else:
+        for k, v in res.items():
+            print(f"{k:32s} {v:.4g}" if isinstance(v, float) else f"{k:32s} {v}")
+    return 0

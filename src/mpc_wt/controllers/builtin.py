@@ -1,0 +1,462 @@
+"""The controller kinds mpc-wt ships, each one registration.
+
+baseline, baseline-ct, derateNN, apc (Jonkman's baseline and its retrofits, Pettas and Cheng),
+ibc and coleman-ipc (add-ons on a baseline), mpc, mpc-collective, mpc-lidar (Madsen et al.),
+lqr-pio (Do et al.), ts (Clemens et al.).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any, Optional
+
+import numpy as np
+
+import linearize
+
+from .context import BuildContext, Built, Scenario
+from .options import REQUIRED, Options, option
+from .registry import register
+
+__all__ = ["BaselineOptions", "DerateOptions", "APCOptions", "IBCOptions", "ColemanIPCOptions",
+           "MPCOptions", "LidarOptions", "MPCLidarOptions", "LQRPIOOptions", "TSOptions"]
+
+
+# -- designs behind `mpcwt design` ------------------------------------------------------------
+def _design_ibc(turbine: linearize.Turbine, *, power_fraction: float = 1.0,
+                loop_gain: float = 1.0) -> tuple[dict, str]:
+    from ..export import ibc_table
+    from ..retrofit import tune_ibc
+
+    g = tune_ibc(turbine, power_fraction=power_fraction, loop_gain_1p=loop_gain)
+    return ibc_table(turbine, g), (f"{g.gain.size} points, gain margin >= "
+                                   f"{g.gain_margin.min():.3g}, high-pass {g.highpass_hz:.3g} Hz")
+
+
+def _design_coleman(turbine: linearize.Turbine, *, power_fraction: float = 1.0
+                    ) -> tuple[dict, str]:
+    from ..export import coleman_ipc_table
+    from ..retrofit import tune_coleman_ipc
+
+    g = tune_coleman_ipc(turbine, power_fraction=power_fraction)
+    return coleman_ipc_table(turbine, g), (f"{g.ki.size} points, gain margin >= "
+                                           f"{g.gain_margin.min():.3g}")
+
+
+def _design_lqr(turbine: linearize.Turbine, *, winds: Any = None,
+                weights: dict[str, float] | None = None, scales: dict[str, float] | None = None,
+                observer_q: float = 1e3) -> tuple[dict, str]:
+    from ..export import lqr_table
+    from ..synthesis import (REGION3_SCALES, REGION3_WEIGHTS, design_lqr_family,
+                             design_pi_observer)
+
+    winds = np.arange(12.0, 25.5, 1.0) if winds is None else np.asarray(winds, float)
+    fam = linearize.linearize_family(turbine, winds, config=linearize.PlantConfig.do(),
+                                     progress=True)
+    weights = dict(weights or REGION3_WEIGHTS)
+    scales = {**REGION3_SCALES, **(scales or {})}
+    sw = {k: v for k, v in weights.items() if k in fam.models[0].states}
+    ow = {k: v for k, v in weights.items() if k not in sw}
+    designs = design_lqr_family(fam, state_weights=sw, output_weights=ow, scales=scales)
+    obs = [design_pi_observer(m, q=observer_q) for m in fam.models] if observer_q > 0 else None
+    note = f"{len(designs)} operating points"
+    if obs:
+        note += (f", PIO ||L2||/||L1|| {min(o.gain_ratio for o in obs):.3g}.."
+                 f"{max(o.gain_ratio for o in obs):.3g}")
+    return lqr_table(turbine, designs, obs), note
+
+
+def _design_ts(turbine: linearize.Turbine, *, winds: Any = (12, 14, 16, 19, 22, 25),
+               reductions: Any = (0.0, 0.4, 0.8), decay_rate: float = 0.2,
+               observer_decay_rate: float = 1.0) -> tuple[dict, str]:
+    from ..export import ts_table
+    from ..ts import build_ts_model, design_ts_controller, design_ts_observer
+
+    ts = build_ts_model(turbine, list(winds), list(reductions), progress=True)
+    ctl = design_ts_controller(ts, decay_rate=decay_rate)
+    obs = design_ts_observer(ts, decay_rate=observer_decay_rate)
+    return ts_table(turbine, ts, ctl, obs), (
+        f"{ts.n_vertices} vertices, {ctl.solver} {ctl.solve_time_s:.1f} s + "
+        f"{obs.solve_time_s:.1f} s, certificates ok")
+
+
+# -- baseline family ---------------------------------------------------------------------------
+@dataclass(frozen=True)
+class BaselineOptions(Options):
+    """The baseline PI's design (Jonkman et al. 2009, sec. 7.2)."""
+
+    omega_n_rad_s: float = option(0.6, help="PI closed-loop natural frequency", unit="rad/s",
+                                  lo=0.0, lo_open=True, flag="")
+    zeta: float = option(0.7, help="PI closed-loop damping ratio", unit="-", lo=0.0,
+                         lo_open=True, flag="")
+
+
+@dataclass(frozen=True)
+class DerateOptions(BaselineOptions):
+    """The baseline derated to a fraction of rated power (Pettas and Cheng sec. 3.2)."""
+
+    power_fraction: float = option(REQUIRED, help="fraction of rated power, in (0, 1]",
+                                   unit="-", lo=0.0, lo_open=True, hi=1.0, flag="")
+
+
+def _baseline(region3: str) -> Any:
+    def build(ctx: BuildContext, opts: BaselineOptions) -> Built:
+        from ..baseline import BaselineController, tune_baseline
+
+        frac = getattr(opts, "power_fraction", 1.0)
+        gains = tune_baseline(ctx.turbine, omega_n_rad_s=opts.omega_n_rad_s, zeta=opts.zeta,
+                              power_fraction=frac)
+        ctl = BaselineController(ctx.turbine, gains, region3=region3)
+        meta = {"gains": {"kp": gains.kp, "ki": gains.ki, "theta_k_rad": gains.theta_k_rad,
+                          "k_opt": gains.k_opt, "power_fraction": frac, "region3": region3}}
+        return Built(ctl, meta=meta, power_fraction=frac)
+    return build
+
+
+def _derated_trim(turbine: linearize.Turbine, sc: Scenario, opts: DerateOptions
+                  ) -> linearize.OperatingPoint:
+    """Trim at the derated power; below it (low wind) at the turbine's own optimum."""
+    try:
+        return linearize.trim(turbine, sc.wind_mps, opts.power_fraction
+                              * turbine.operation.rated_power)
+    except linearize.TrimError:
+        return linearize.trim(turbine, sc.wind_mps)
+
+
+def _derate_preset(mt: Any) -> dict[str, Any]:
+    pct = float(mt.group(1))
+    if not 0.0 < pct <= 100.0:
+        raise ValueError(f"derating in {mt.group(0)!r} is {pct:g} % of rated power; allowed: "
+                         f"(0, 100] %")
+    return {"power_fraction": pct / 100.0}
+
+
+def _design_baseline(turbine: linearize.Turbine, *, omega_n_rad_s: float = 0.6,
+                     zeta: float = 0.7, power_fraction: float = 1.0) -> tuple[dict, str]:
+    from ..baseline import tune_baseline
+    from ..export import baseline_table
+
+    doc = baseline_table(turbine, tune_baseline(turbine, omega_n_rad_s=omega_n_rad_s, zeta=zeta,
+                                                power_fraction=power_fraction))
+    return doc, f"kp {doc['settings']['kp']:.4g} s, ki {doc['settings']['ki']:.4g}"
+
+
+register("baseline", BaselineOptions, design=_design_baseline,
+         summary="tuned PI pitch and torque law, constant power in region III (80 Hz)"
+         )(_baseline("constant_power"))
+register("baseline-ct", BaselineOptions,
+         summary="the baseline with constant torque in region III (Do et al.'s PI)"
+         )(_baseline("constant_torque"))
+register("derate", DerateOptions, pattern=r"derate(\d+(?:\.\d+)?)",
+         pattern_options=_derate_preset, pattern_help="derateNN (NN % of rated power)",
+         operating_point=_derated_trim,
+         summary="the baseline derated to NN % of rated power, PI re-tuned")(
+    _baseline("constant_power"))
+
+
+# -- add-ons: IBC and Coleman IPC -----------------------------------------------------------
+@dataclass(frozen=True)
+class IBCOptions(Options):
+    """Individual blade control (Pettas and Cheng sec. 3.1; :func:`mpc_wt.retrofit.tune_ibc`)."""
+
+    loop_gain_1p: float = option(1.0, help="loop gain at 1P of each blade loop", unit="-",
+                                 lo=0.0, lo_open=True, flag="--loop-gain")
+    remove_collective: bool = option(True, help="subtract the blades' mean IBC pitch (cyclic "
+                                     "action only); --keep-collective keeps it",
+                                     flag="--keep-collective", flag_value=False)
+    min_gain_margin: float = option(2.0, help="smallest gain margin allowed", unit="-",
+                                    lo=1.0, lo_open=True, flag="")
+    highpass_hz: Optional[float] = option(None, help="input high-pass corner (default half "
+                                          "the rated 1P)", unit="Hz", lo=0.0, lo_open=True,
+                                          flag="")
+    notch_harmonics: tuple[int, ...] = option((3,), help="output band-stops at these "
+                                              "multiples of rated 1P", lo=1, flag="")
+    notch_q: float = option(1.0, help="band-stop quality factor", unit="-", lo=0.0,
+                            lo_open=True, flag="")
+    weight_range: tuple[float, ...] = option((0.8, 0.95), help="power fractions of the fade-in",
+                                             unit="-", lo=0.0, flag="")
+    lowpass_hz: Optional[float] = option(None, help="output low-pass corner", unit="Hz",
+                                         lo=0.0, lo_open=True, flag="")
+
+
+@register("ibc", IBCOptions, addon_to=("baseline", "derate"), default_base="baseline",
+          design=_design_ibc,
+          group="the ibc controllers",
+          summary="individual blade control on a baseline (ibc, derateNN+ibc)")
+def _build_ibc(ctx: BuildContext, opts: IBCOptions, base: Built) -> Built:
+    from ..retrofit import IBCController, tune_ibc
+
+    tune = {k: v for k, v in opts.to_dict().items() if k != "remove_collective"}
+    tune["notch_harmonics"] = tuple(opts.notch_harmonics)
+    tune["weight_range"] = tuple(opts.weight_range)
+    g = tune_ibc(ctx.turbine, power_fraction=base.power_fraction, dt=base.controller.dt, **tune)
+    ctl = IBCController(base.controller, g, remove_collective=opts.remove_collective)
+    meta = {"gain": g.gain.tolist(), "pitch_rad": g.pitch_rad.tolist(),
+            "highpass_hz": g.highpass_hz, "notch_harmonics": list(g.notch_harmonics),
+            **opts.to_dict()}
+    return Built(ctl, base.controller_dt, base.preview, {**base.meta, "ibc": meta},
+                 base.power_fraction)
+
+
+@dataclass(frozen=True)
+class ColemanIPCOptions(Options):
+    """Tilt/yaw integral IPC in the Coleman frame (:func:`mpc_wt.retrofit.tune_coleman_ipc`)."""
+
+    crossover_rad_s: float = option(0.2, help="crossover of the integral loops", unit="rad/s",
+                                    lo=0.0, lo_open=True, flag="")
+    max_amplitude_deg: float = option(5.0, help="largest cyclic pitch amplitude", unit="deg",
+                                      lo=0.0, lo_open=True, flag="")
+    weight_range: tuple[float, ...] = option((0.8, 0.95), help="power fractions of the fade-in",
+                                             unit="-", lo=0.0, flag="")
+
+
+@register("coleman-ipc", ColemanIPCOptions, addon_to=("baseline", "derate"),
+          default_base="baseline", design=_design_coleman,
+          summary="tilt/yaw integral IPC on a baseline (coleman-ipc, derateNN+coleman-ipc)")
+def _build_coleman(ctx: BuildContext, opts: ColemanIPCOptions, base: Built) -> Built:
+    from ..retrofit import ColemanIPCController, tune_coleman_ipc
+
+    d = opts.to_dict()
+    d["weight_range"] = tuple(opts.weight_range)
+    g = tune_coleman_ipc(ctx.turbine, power_fraction=base.power_fraction, **d)
+    meta = {"ki": g.ki.tolist(), "pitch_rad": g.pitch_rad.tolist(),
+            "azimuth_offset_rad": g.azimuth_offset_rad.tolist(), **opts.to_dict()}
+    return Built(ColemanIPCController(base.controller, g), base.controller_dt, base.preview,
+                 {**base.meta, "coleman_ipc": meta}, base.power_fraction)
+
+
+# -- MPC -----------------------------------------------------------------------------------
+@dataclass(frozen=True)
+class MPCOptions(Options):
+    """Madsen et al.'s MPC at 10 Hz (:class:`mpc_wt.MPCSettings` holds the full set)."""
+
+    backend: Optional[str] = option(None, help="QP solver (default DAQP when installed, else "
+                                    "OSQP)", choices=(None, "osqp", "daqp"))
+    formulation: str = option("condensed", help="QP formulation (sparse: OSQP only)",
+                              choices=("condensed", "sparse"))
+    horizon: int = option(15, help="H_p = H_u", lo=1)
+    estimator: Optional[str] = option(None, help="kalman: states and blade winds estimated "
+                                      "from measured signals; none: full-state information",
+                                      choices=(None, "kalman"))
+    scheduled: bool = option(False, help="scheduled over a model family above rated on the "
+                             "estimated wind (or the preview with mpc-lidar)", flag_value=True)
+
+
+_CW = "lidar.CWLidar setting (unset: its default)"
+
+
+@dataclass(frozen=True)
+class LidarOptions(Options):
+    """Settings of the CW LIDAR (:class:`lidar.CWLidar`); unset ones keep its defaults."""
+
+    focus_distance: Optional[float] = option(None, help=_CW, unit="m", lo=0.0, lo_open=True)
+    span_fraction: Optional[float] = option(None, help=_CW, unit="-", lo=0.0, lo_open=True)
+    wavelength: Optional[float] = option(None, help=_CW, unit="m", lo=0.0, lo_open=True)
+    beam_radius: Optional[float] = option(None, help=_CW, unit="m", lo=0.0, lo_open=True)
+    sample_rate: Optional[float] = option(None, help=_CW, unit="Hz", lo=0.0, lo_open=True)
+    noise_std: Optional[float] = option(None, help=_CW, unit="m/s", lo=0.0)
+    misalignment_rad: Optional[float] = option(None, help=_CW, unit="rad")
+    perfect_alignment: Optional[bool] = option(None, help=_CW)
+    los_error: Optional[bool] = option(None, help=_CW)
+    range_weighting: Optional[bool] = option(None, help=_CW)
+    n_range: Optional[int] = option(None, help=_CW, lo=1)
+
+    def given(self) -> dict[str, Any]:
+        """The settings that were set.
+
+        Returns
+        -------
+        dict
+            Name -> value of the options that are not None.
+        """
+        return {k: v for k, v in self.to_dict().items() if v is not None}
+
+
+@dataclass(frozen=True)
+class MPCLidarOptions(MPCOptions):
+    """The MPC with a CW LIDAR's per-blade preview."""
+
+    lidar: LidarOptions = option(LidarOptions(), help="CW LIDAR settings (focus_distance, "
+                                 "noise_std, ...)", flag="")
+
+
+def _mpc_settings(opts: MPCOptions, collective: bool) -> Any:
+    from ..mpc import MPCSettings
+
+    return MPCSettings(horizon=opts.horizon, backend=opts.backend,
+                       formulation=opts.formulation, estimator=opts.estimator,
+                       collective=collective)
+
+
+def _scheduled(ctx: BuildContext, settings: Any, source: str) -> Any:
+    from ..mpc import ScheduledMPC
+
+    turbine, v = ctx.turbine, ctx.scenario.wind_mps
+    lo = float(np.floor(linearize.rated_wind_speed(turbine))) + 1.0
+    winds = np.arange(lo, min(25.0, turbine.operation.cut_out_wind) + 0.5, 1.0)
+    if not winds[0] <= v <= winds[-1]:
+        raise ValueError(f"scheduled MPC covers {winds[0]:g}..{winds[-1]:g} m/s; the wind "
+                         f"{v:g} m/s is outside")
+    fam = linearize.linearize_family(turbine, winds, config=linearize.PlantConfig.madsen())
+    return ScheduledMPC(fam, turbine, settings, wind_source=source, initial_wind_mps=v)
+
+
+def _mpc(collective: bool, with_lidar: bool) -> Any:
+    def build(ctx: BuildContext, opts: MPCOptions) -> Built:
+        from ..mpc import MPC
+
+        settings = _mpc_settings(opts, collective)
+        if opts.scheduled:
+            if not with_lidar and settings.estimator is None:
+                settings = settings.replace(estimator="kalman")
+            ctl = _scheduled(ctx, settings, "preview" if with_lidar else "estimator")
+            cdt = ctl.controller(ctl.active).dt
+        else:
+            model = linearize.linearize(ctx.turbine, ctx.scenario.wind_mps,
+                                        config=linearize.PlantConfig.madsen())
+            ctl = MPC(model, ctx.turbine, settings)
+            cdt = ctl.dt
+        meta: dict[str, Any] = {"mpc": {
+            "horizon": settings.horizon, "backend": settings.resolved_backend, "dt": cdt,
+            "formulation": settings.formulation, "estimator": str(settings.estimator),
+            "scheduled": bool(opts.scheduled)}}
+        preview = None
+        if with_lidar:
+            preview = _lidar_preview(ctx, opts.lidar, settings.horizon, cdt)  # type: ignore
+            meta["lidar"] = opts.lidar.given()  # type: ignore[attr-defined]
+        return Built(ctl, cdt, preview, meta)
+    return build
+
+
+def _lidar_preview(ctx: BuildContext, opts: LidarOptions, horizon: int, dt: float) -> Any:
+    import lidar
+
+    from ..simulate import LidarPreview
+
+    try:
+        cw = lidar.CWLidar(ctx.turbine.geometry.tip_radius, **opts.given())
+    except (TypeError, ValueError) as err:
+        raise ValueError(f"lidar options: {err}") from err
+    return LidarPreview(cw, ctx.field, horizon, dt)
+
+
+_MPC_GROUP = "the MPC controllers"
+register("mpc", MPCOptions, group=_MPC_GROUP,
+         summary="Madsen's Coleman-weighted individual-pitch MPC, disturbance held at the mean"
+         )(_mpc(False, False))
+register("mpc-collective", MPCOptions, group=_MPC_GROUP,
+         summary="the MPC with one collective pitch input")(_mpc(True, False))
+register("mpc-lidar", MPCLidarOptions, group=_MPC_GROUP,
+         summary="the individual-pitch MPC with a CW LIDAR's per-blade preview "
+                 "(range weighting and LOS error on)")(_mpc(False, True))
+
+
+# -- LQR + PI observer ------------------------------------------------------------------------
+@dataclass(frozen=True)
+class LQRPIOOptions(Options):
+    """Do et al.'s LQR on PI-observer estimates."""
+
+    observer_q: float = option(1e3, help="PI observer q of Q_obs = diag(I, q I)", unit="-",
+                               lo=0.0, lo_open=True, flag="")
+
+
+@register("lqr-pio", LQRPIOOptions, design=_design_lqr, design_name="lqr",
+          summary="Do et al.'s LQR with a PI observer at the mean wind (region II or III)")
+def _build_lqr_pio(ctx: BuildContext, opts: LQRPIOOptions) -> Built:
+    from ..baseline import tune_baseline
+    from ..synthesis import (REGION2_SCALES, REGION2_WEIGHTS, REGION3_SCALES, REGION3_WEIGHTS,
+                             LQRPIOController, design_lqr, design_pi_observer)
+
+    turbine, v = ctx.turbine, ctx.scenario.wind_mps
+    model = linearize.linearize(turbine, v, config=linearize.PlantConfig.do())
+    region = "II" if v < linearize.rated_wind_speed(turbine) else "III"
+    w, sc = ((REGION3_WEIGHTS, REGION3_SCALES) if region == "III"
+             else (REGION2_WEIGHTS, REGION2_SCALES))
+    lq = design_lqr(model, state_weights=w, scales=sc)
+    ctl = LQRPIOController(model, turbine, lq, design_pi_observer(model, q=opts.observer_q),
+                           region=region,
+                           k_opt=tune_baseline(turbine).k_opt if region == "II" else None,
+                           feedforward=region == "III")
+    return Built(ctl, meta={"lqr": {"weights": lq.weights, "observer_q": opts.observer_q,
+                                    "region": region}})
+
+
+# -- Takagi-Sugeno ------------------------------------------------------------------------------
+@dataclass(frozen=True)
+class TSOptions(Options):
+    """Clemens et al.'s TS controller and wind observer, LMI-designed on the default grid."""
+
+    apc_frequency: Optional[float] = option(None, help="sinusoidal power reduction of eq 11 "
+                                            "at this f_r", unit="Hz", lo=0.0, hi=5.0)
+    apc_amplitude: float = option(0.375, help="amplitude of Delta P (fraction of rated)",
+                                  unit="-", lo=0.0, hi=1.0)
+    apc_offset: float = option(0.375, help="mean of Delta P", unit="-", lo=0.0, hi=1.0)
+    decay_rate: float = option(0.2, help="controller decay rate", unit="1/s", lo=0.0,
+                               lo_open=True, flag="")
+    observer_decay_rate: float = option(1.0, help="observer decay rate", unit="1/s", lo=0.0,
+                                        lo_open=True, flag="")
+
+
+@register("ts", TSOptions, design=_design_ts,
+          summary="Clemens et al.'s Takagi-Sugeno controller and wind observer (LMI gains)")
+def _build_ts(ctx: BuildContext, opts: TSOptions) -> Built:
+    from ..retrofit import apc_reference
+    from ..ts import TSController, build_ts_model, design_ts_controller, design_ts_observer
+
+    def make() -> tuple[Any, Any, Any]:
+        ts0 = build_ts_model(ctx.turbine)
+        return (ts0, design_ts_controller(ts0, decay_rate=opts.decay_rate),
+                design_ts_observer(ts0, decay_rate=opts.observer_decay_rate))
+
+    ts, c, o = ctx.cache.get(ctx.turbine, ("ts", opts.decay_rate, opts.observer_decay_rate),
+                             make)
+    dp = None if opts.apc_frequency is None else apc_reference(
+        opts.apc_frequency, amplitude=opts.apc_amplitude, offset=opts.apc_offset)
+    w0 = float(np.clip(ctx.scenario.wind_mps, ts.wind_grid[0], ts.wind_grid[-1]))
+    ctl = TSController(ts, c, o, ctx.turbine, initial_wind=w0, power_reduction=dp)
+    return Built(ctl, meta={"ts": {"vertices": ts.n_vertices, "decay_rate": c.decay_rate,
+                                   "observer_decay_rate": o.decay_rate,
+                                   "apc_frequency_Hz": opts.apc_frequency}})
+
+
+# -- active power control -----------------------------------------------------------------
+@dataclass(frozen=True)
+class APCOptions(Options):
+    """Sinusoidal power reduction of Clemens et al. eq 11."""
+
+    apc_frequency: float = option(REQUIRED, help="F [Hz] (0: constant reduction at the offset)",
+                                  unit="Hz", lo=0.0, hi=5.0)
+    apc_amplitude: float = option(0.375, help="amplitude of Delta P (fraction of rated)",
+                                  unit="-", lo=0.0, hi=1.0)
+    apc_offset: float = option(0.375, help="mean of Delta P (0.375: Delta P in [0, 0.75])",
+                               unit="-", lo=0.0, hi=1.0)
+
+
+def _apc_trim(turbine: linearize.Turbine, sc: Scenario, opts: APCOptions
+              ) -> linearize.OperatingPoint:
+    from ..retrofit import apc_reference
+
+    dp = apc_reference(opts.apc_frequency, amplitude=opts.apc_amplitude, offset=opts.apc_offset)
+    rated = turbine.operation.rated_power
+    p_peak = rated * (1.0 - opts.apc_offset + opts.apc_amplitude)
+    try:    # the reference peaks at P_r (1 - offset + amplitude): the mean wind must give it
+        linearize.trim(turbine, sc.wind_mps, min(p_peak, rated))
+    except linearize.TrimError as err:
+        raise ValueError(f"apc: the power reference peaks at {p_peak:g} W, above the power "
+                         f"available at the mean wind {sc.wind_mps:g} m/s ({err})") from err
+    return linearize.trim(turbine, sc.wind_mps, rated * (1.0 - dp(0.0)))
+
+
+@register("apc", APCOptions, operating_point=_apc_trim,
+          summary="the baseline following P_r (1 - Delta P(t)), PI scheduled on the reference")
+def _build_apc(ctx: BuildContext, opts: APCOptions) -> Built:
+    from ..baseline import BaselineController, tune_baseline_schedule
+    from ..retrofit import apc_reference
+
+    dp = apc_reference(opts.apc_frequency, amplitude=opts.apc_amplitude, offset=opts.apc_offset)
+    rated = ctx.turbine.operation.rated_power
+    sched = tune_baseline_schedule(ctx.turbine)
+    ctl = BaselineController(ctx.turbine, gain_schedule=sched,
+                             power_reference=lambda t: rated * (1.0 - dp(t)))
+    return Built(ctl, meta={"apc": {"frequency_Hz": opts.apc_frequency,
+                                    "amplitude": opts.apc_amplitude, "offset": opts.apc_offset,
+                                    "schedule_fractions": [g.power_fraction for g in sched]}})

@@ -1,0 +1,246 @@
+"""What a controller kind builds from: the load case (:class:`Scenario`), its wind, the
+operating point, and a cache for designs that cost seconds (:class:`DesignCache`)."""
+from __future__ import annotations
+
+import dataclasses
+import hashlib
+import math
+import threading
+from dataclasses import dataclass, field
+from typing import Any, Callable
+
+import numpy as np
+
+import lidar
+import linearize
+from linearize.validate import check_finite_scalar, check_positive, check_range
+
+__all__ = ["Scenario", "BuildContext", "Built", "DesignCache", "make_wind", "turbine_key"]
+
+
+@dataclass(frozen=True)
+class Scenario:
+    """One load case: mean wind, turbulence, seed, length and shear.
+
+    Parameters
+    ----------
+    wind_mps : float
+        Mean hub-height wind [m/s], > 0.
+    turbulence : str or float
+        IEC class "A", "B", "C", "steady", or a turbulence intensity in (0, 1) [-].
+    seed : int
+        Seed of the turbulent field, >= 0.
+    duration : float
+        Simulated time [s], > 0.
+    shear_exponent : float
+        Power-law shear exponent [-], in [-1, 1].
+    """
+
+    wind_mps: float
+    turbulence: str | float = "A"
+    seed: int = 1
+    duration: float = 600.0
+    shear_exponent: float = 0.2
+
+    def __post_init__(self) -> None:
+        check_positive("wind_mps", self.wind_mps)
+        check_positive("duration", self.duration)
+        check_range("shear_exponent", self.shear_exponent, -1.0, 1.0)
+        if isinstance(self.turbulence, str):
+            if self.turbulence not in ("A", "B", "C", "steady"):
+                raise ValueError(f"turbulence must be 'A', 'B', 'C', 'steady' or an intensity "
+                                 f"in (0, 1), got {self.turbulence!r}")
+        elif not 0.0 < check_finite_scalar("turbulence", self.turbulence) < 1.0:
+            raise ValueError(f"turbulence intensity must be in (0, 1), got {self.turbulence!r}")
+        if isinstance(self.seed, bool) or not isinstance(self.seed, (int, np.integer)) \
+                or self.seed < 0:
+            raise ValueError(f"seed must be an integer >= 0, got {self.seed!r}")
+
+    def meta(self) -> dict[str, Any]:
+        """The case as plain data for a result's ``meta``."""
+        return {"wind_mps": self.wind_mps, "turbulence": self.turbulence, "seed": self.seed,
+                "duration_s": self.duration, "shear_exponent": self.shear_exponent}
+
+
+def make_wind(turbine: linearize.Turbine, scenario: Scenario
+              ) -> tuple[linearize.SteadyWind | linearize.GridWind, lidar.WindField]:
+    """The plant's wind for a scenario and the same field for a LIDAR in the loop.
+
+    Parameters
+    ----------
+    turbine : Turbine
+        For the hub height.
+    scenario : Scenario
+        The load case; the field is 20 s longer than the run.
+
+    Returns
+    -------
+    wind : SteadyWind or GridWind
+        What the plant meets (negative speeds of a turbulent field clipped at 0).
+    field : lidar.WindField
+        The same field.
+    """
+    hub = turbine.geometry.hub_height
+    v, alpha = scenario.wind_mps, scenario.shear_exponent
+    if scenario.turbulence == "steady":
+        spec = lidar.TurbulenceSpec(v, 0.01, hub_height=hub, duration=scenario.duration + 20.0,
+                                    dt=1.0, n_y=8, n_z=8, shear_exponent=alpha)
+        t, y, z = spec.grid()
+        u = np.broadcast_to(v * (z / hub) ** alpha, (t.size, y.size, z.size))
+        zero = np.zeros(u.shape)
+        f = lidar.WindField(t=t, y=y, z=z, u=u, v=zero, w=zero, mean_speed=v, hub_height=hub,
+                            meta={"model": "steady power law"})
+        return linearize.SteadyWind(v, alpha), f
+    spec = lidar.TurbulenceSpec(v, scenario.turbulence, hub_height=hub,
+                                duration=scenario.duration + 20.0, shear_exponent=alpha)
+    f = lidar.generate_field(spec, scenario.seed)
+    return linearize.GridWind(t=f.t, y=f.y, z=f.z, u=np.maximum(f.u, 0.0)), f
+
+
+def turbine_key(turbine: linearize.Turbine) -> str:
+    """A digest of a turbine's content (every field and array), for caching designs.
+
+    Parameters
+    ----------
+    turbine : Turbine
+        Any turbine.
+
+    Returns
+    -------
+    str
+        SHA-256 hex digest; equal turbines give equal keys whatever their identity.
+    """
+    h = hashlib.sha256()
+    _feed(h, turbine)
+    return h.hexdigest()
+
+
+def _feed(h: Any, obj: Any) -> None:
+    if dataclasses.is_dataclass(obj) and not isinstance(obj, type):
+        h.update(type(obj).__name__.encode())
+        for f in dataclasses.fields(obj):
+            h.update(f.name.encode())
+            _feed(h, getattr(obj, f.name))
+    elif isinstance(obj, np.ndarray):
+        h.update(str(obj.shape).encode())
+        h.update(np.ascontiguousarray(obj, dtype=float).tobytes())
+    elif isinstance(obj, dict):
+        for k in sorted(obj, key=str):
+            h.update(str(k).encode())
+            _feed(h, obj[k])
+    elif isinstance(obj, (list, tuple)):
+        for v in obj:
+            _feed(h, v)
+    elif isinstance(obj, float) and math.isnan(obj):
+        h.update(b"nan")
+    else:
+        h.update(repr(obj).encode())
+
+
+class DesignCache:
+    """Designs kept per process, keyed on the turbine's content and the design's settings
+    (a campaign worker designs a TS controller once, not once per case).
+
+    Parameters
+    ----------
+    max_items : int
+        Entries kept; the oldest goes first (default 16).
+    """
+
+    def __init__(self, max_items: int = 16) -> None:
+        self.max_items = int(max_items)
+        self._items: dict[tuple[Any, ...], Any] = {}
+        self._lock = threading.Lock()
+        self.hits = 0
+
+    def get(self, turbine: linearize.Turbine, key: tuple[Any, ...],
+            make: Callable[[], Any]) -> Any:
+        """The cached design for (turbine content, key), made by ``make()`` on a miss.
+
+        Parameters
+        ----------
+        turbine : Turbine
+            Its content is part of the key.
+        key : tuple
+            Hashable settings of the design.
+        make : callable
+            Builds the design.
+
+        Returns
+        -------
+        object
+            The design.
+        """
+        full = (turbine_key(turbine), *key)
+        with self._lock:
+            if full in self._items:
+                self.hits += 1
+                return self._items[full]
+        value = make()
+        with self._lock:
+            self._items[full] = value
+            while len(self._items) > self.max_items:
+                self._items.pop(next(iter(self._items)))
+        return value
+
+    def clear(self) -> None:
+        """Drop every design."""
+        with self._lock:
+            self._items.clear()
+
+
+#: The process-wide cache used by :func:`~mpc_wt.controllers.run_controller` by default.
+DEFAULT_CACHE = DesignCache()
+
+
+@dataclass(frozen=True)
+class BuildContext:
+    """Everything a kind's ``build`` may use.
+
+    Parameters
+    ----------
+    turbine : Turbine
+        The turbine.
+    params : PlantParams
+        Its plant parameters.
+    op : OperatingPoint
+        The trim point the run starts from.
+    scenario : Scenario
+        The load case.
+    field : lidar.WindField
+        The wind field of the case (for a LIDAR in the loop).
+    cache : DesignCache
+        For designs that cost seconds.
+    """
+
+    turbine: linearize.Turbine
+    params: linearize.PlantParams
+    op: linearize.OperatingPoint
+    scenario: Scenario
+    field: Any
+    cache: DesignCache = DEFAULT_CACHE
+
+
+@dataclass
+class Built:
+    """A built controller and what the harness needs to run it.
+
+    Parameters
+    ----------
+    controller : Controller
+        ``reset()`` and ``step(t, meas)``.
+    controller_dt : float, optional
+        Its period [s] (None: the plant's step).
+    preview : LidarPreview, optional
+        A LIDAR in the loop.
+    meta : dict
+        Design data stored with the result.
+    power_fraction : float
+        The fraction of rated power the design targets (add-ons tune for it) [-].
+    """
+
+    controller: Any
+    controller_dt: float | None = None
+    preview: Any = None
+    meta: dict[str, Any] = field(default_factory=dict)
+    power_fraction: float = 1.0

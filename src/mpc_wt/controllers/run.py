@@ -1,0 +1,129 @@
+"""One closed-loop run from a controller name: trim, build, wind, simulate (STYLE rule 12)."""
+from __future__ import annotations
+
+from typing import Any, Mapping, Sequence
+
+import linearize
+
+from ..results import ClosedLoopResult
+from ..simulate import simulate_closed_loop
+from .context import DEFAULT_CACHE, BuildContext, Built, DesignCache, Scenario, make_wind
+from .options import Options
+from .registry import API_NAMING, Naming, Selection, resolve
+
+__all__ = ["run_controller", "build_controller"]
+
+
+def _operating_point(turbine: linearize.Turbine, sel: Selection, opts: Sequence[Options],
+                     scenario: Scenario) -> linearize.OperatingPoint:
+    if sel.base.operating_point is not None:
+        return sel.base.operating_point(turbine, scenario, opts[0])
+    return linearize.trim(turbine, scenario.wind_mps)
+
+
+def build_controller(turbine: linearize.Turbine, controller: str, scenario: Scenario,
+                     options: Mapping[str, Any] | None = None, *,
+                     cache: DesignCache = DEFAULT_CACHE, naming: Naming = API_NAMING
+                     ) -> tuple[Built, linearize.OperatingPoint, Any]:
+    """Resolve, check, trim and build a controller for one scenario (no simulation).
+
+    Parameters
+    ----------
+    turbine : Turbine
+        The turbine.
+    controller : str
+        A registered name (``mpc_wt.controllers.kinds()``), with a pattern or add-ons
+        (``derate80+ibc``).
+    scenario : Scenario
+        The load case.
+    options : mapping, optional
+        Flat option name -> value, split over the base and its add-ons.
+    cache : DesignCache
+        For designs that cost seconds.
+    naming : Naming
+        How error messages name options (keys, or command-line flags).
+
+    Returns
+    -------
+    built : Built
+        Controller, its period, LIDAR preview and design metadata.
+    op : OperatingPoint
+        The trim point the run starts from.
+    wind : SteadyWind or GridWind
+        The plant's wind.
+
+    Raises
+    ------
+    ValueError
+        An unknown name (listing the kinds); :class:`~mpc_wt.errors.OptionsError` for options.
+    """
+    sel = resolve(controller)
+    opts = sel.options(options, naming)
+    op = _operating_point(turbine, sel, opts, scenario)
+    wind, field = make_wind(turbine, scenario)
+    ctx = BuildContext(turbine=turbine, params=linearize.plant_params(turbine), op=op,
+                       scenario=scenario, field=field, cache=cache)
+    built = sel.base.build(ctx, opts[0])
+    for kind, o in zip(sel.addons, opts[1:]):
+        built = kind.build(ctx, o, built)
+    return built, op, wind
+
+
+def run_controller(turbine: linearize.Turbine, controller: str, wind_mps: float,
+                   turbulence: str | float = "A", seed: int = 1, duration: float = 600.0,
+                   progress: bool = False, shear_exponent: float = 0.2,
+                   options: Mapping[str, Any] | None = None, *,
+                   cache: DesignCache = DEFAULT_CACHE,
+                   naming: Naming = API_NAMING) -> ClosedLoopResult:
+    """Trim, build the controller, generate the wind and simulate.
+
+    Parameters
+    ----------
+    turbine : Turbine
+        The turbine (:func:`linearize.load_turbine`).
+    controller : str
+        A registered kind (``mpc_wt.controllers.kinds()`` lists them with their options):
+        ``baseline``, ``baseline-ct``, ``derateNN``, ``apc``, ``ibc``, ``coleman-ipc``,
+        ``derateNN+ibc``, ``mpc``, ``mpc-collective``, ``mpc-lidar``, ``lqr-pio``, ``ts``, or a
+        user-registered one.
+    wind_mps : float
+        Mean hub-height wind [m/s].
+    turbulence : str or float
+        IEC class "A", "B", "C", "steady", or an intensity [-].
+    seed : int
+        Seed of the turbulent field.
+    duration : float
+        [s]
+    progress : bool
+        Show a progress bar.
+    shear_exponent : float
+        Power-law shear [-].
+    options : mapping, optional
+        The kind's options by name, e.g. ``{"apc_frequency": 0.1}`` for ``apc`` or
+        ``{"horizon": 10, "lidar": {"focus_distance": 80}}`` for ``mpc-lidar``.
+    cache : DesignCache
+        For designs that cost seconds (the TS LMIs), keyed on the turbine's content.
+    naming : Naming
+        How error messages name options.
+
+    Returns
+    -------
+    ClosedLoopResult
+        With ``meta["controller"]`` and the case and design data in ``meta``.
+
+    Raises
+    ------
+    ValueError
+        Unknown controller or bad options (naming the option and what is allowed), or a wind at
+        which the kind cannot operate.
+    SimulationDivergedError
+        If the run leaves the physical envelope (``.partial`` keeps what was simulated).
+    """
+    scenario = Scenario(wind_mps, turbulence, seed, duration, shear_exponent)
+    built, op, wind = build_controller(turbine, controller, scenario, options, cache=cache,
+                                       naming=naming)
+    meta = {"controller": controller, **scenario.meta(), "turbine": turbine.name,
+            **built.meta}
+    return simulate_closed_loop(linearize.plant_params(turbine), built.controller, wind,
+                                duration, x0=op.x, u0=op.u, controller_dt=built.controller_dt,
+                                preview=built.preview, progress=progress, meta=meta)

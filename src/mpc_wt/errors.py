@@ -1,0 +1,59 @@
+"""Exceptions of ``mpc_wt``, one class per kind of failure, each a subclass of a built-in
+(python-control's ``exception.py`` is the model). :class:`SimulationDivergedError` is
+``linearize``'s own class: open and closed loops raise the same one."""
+from __future__ import annotations
+
+from linearize import SimulationDivergedError
+
+__all__ = ["UsageError", "OptionsError", "SpecError", "CampaignLockedError", "GainTableError",
+           "ResultFileError", "PremiseError", "SynthesisError", "SimulationDivergedError",
+           "QPSetupError"]
+
+
+class UsageError(ValueError):
+    """A command-line value that is not allowed."""
+
+
+class OptionsError(ValueError):
+    """Controller options that a kind does not take, or values out of range.
+
+    Parameters
+    ----------
+    message : str
+        Names the option, the value and what is allowed.
+    key : str
+        The option's name (nested options joined by dots, ``lidar.focus``), so that a campaign
+        spec can prefix its own path (``controllers[0].lidar.focus``).
+    """
+
+    def __init__(self, message: str, key: str = "") -> None:
+        super().__init__(message)
+        self.key = key
+
+
+class SpecError(ValueError):
+    """A campaign spec that cannot be used; the message names the key and what is allowed."""
+
+
+class CampaignLockedError(RuntimeError):
+    """Another client is running the same campaign directory."""
+
+
+class GainTableError(ValueError):
+    """A gain table that is missing, of another schema, or inconsistent."""
+
+
+class ResultFileError(ValueError):
+    """A result file is missing, truncated, of another schema, or misses a channel."""
+
+
+class PremiseError(ValueError):
+    """A premise value outside the TS model's vertex grid."""
+
+
+class SynthesisError(ValueError):
+    """A design problem that has no solution as posed (the message says what to change)."""
+
+
+class QPSetupError(ValueError):
+    """A QP backend that is unknown, not installed, or cannot take the formulation asked for."""
