@@ -59,7 +59,7 @@ def main() -> int:
     for v in (float(s) for s in args.winds.split(",")):
         wind, field = make_wind(tb, Scenario(v, "A", args.seed, dur, 0.2))
         op = linearize.trim(tb, v)
-        c = TSController(ts, ctl, obs, tb, initial_wind=v)
+        c = TSController(ts, ctl, obs, tb, initial_wind_mps=v)
         r = simulate_closed_loop(params, c, wind, dur, x0=op.x, u0=op.u, progress=True)
         k = r.t >= args.transient
         w = r.channel("rotor_speed")[k]
@@ -90,7 +90,7 @@ def main() -> int:
     wind, field = make_wind(tb, Scenario(v, "A", args.seed, dur, 0.2))
     op = linearize.trim(tb, v)
     for fr in (float(s) for s in args.frequencies.split(",")):
-        c = TSController(ts, ctl, obs, tb, initial_wind=v, power_reduction=apc_reference(fr))
+        c = TSController(ts, ctl, obs, tb, initial_wind_mps=v, power_reduction=apc_reference(fr))
         r = simulate_closed_loop(params, c, wind, dur, x0=op.x, u0=op.u, progress=True)
         k = r.t >= args.transient
         amp, ph = tracking_response(r.t[k], r.channel("power_ref")[k],

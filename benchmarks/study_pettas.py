@@ -29,7 +29,8 @@ import numpy as np
 
 import linearize
 from mpc_wt.assess import tracking_response, wind_bin_probabilities
-from mpc_wt.retrofit import aep_change, lifetime_comparison
+from mpc_wt.assess import lifetime_comparison
+from mpc_wt.retrofit import aep_change
 from mpc_wt import run_controller
 from mpc_wt.assess import assess_series
 

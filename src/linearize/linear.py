@@ -148,7 +148,7 @@ def _raw_jacobians(params: PlantParams, op: OperatingPoint, wake: str, shear: fl
     x0 = op.x.copy()
     x0[16] = psi
     u0 = op.u.copy()
-    w0 = _sample_wind(0.0, psi, pk, 0, np.array([op.wind_speed, shear]), np.zeros((1, 1, 1)))
+    w0 = _sample_wind(0.0, psi, pk, 0, np.array([op.wind_mps, shear]), np.zeros((1, 1, 1)))
     bem0 = _eval(x0, u0, w0, pk, np.full((4, 3, pk.r.size), np.nan), MODE_NOLIMITS)[2]
     mode = MODE_NOLIMITS | (MODE_FROZEN if wake == "frozen" else 0)
     if method == "cs":
@@ -188,7 +188,7 @@ class LinearModel:
     x0, u0, d0, z0 : ndarray
         Operating-point values of the states, inputs, disturbances and outputs; the model's
         variables are perturbations from them.
-    wind_speed : float
+    wind_mps : float
         Mean (hub-height) wind speed of the operating point [m/s].
     wake : str
         "quasi-steady" or "frozen".
@@ -218,7 +218,7 @@ class LinearModel:
     u0: FloatArray
     d0: FloatArray
     z0: FloatArray
-    wind_speed: float
+    wind_mps: float
     wake: str = "quasi-steady"
     coordinates: str = "blade"
     dt: float | None = None
@@ -355,8 +355,8 @@ class LinearModel:
         """Plain dict (lists, floats, strings) for JSON."""
         d = {k: getattr(self, k) for k in ("states", "inputs", "disturbances", "outputs",
                                             "state_units", "input_units", "disturbance_units",
-                                            "output_units", "wind_speed", "wake",
-                                            "coordinates", "dt", "info")}
+                                            "output_units", "wake", "coordinates", "dt", "info")}
+        d["wind_speed"] = self.wind_mps       # the file key (schema 1) keeps its name
         for k in ("A", "B_u", "B_d", "C_z", "D_u", "D_d", "x0", "u0", "d0", "z0"):
             d[k] = getattr(self, k).tolist()
         d = {k: (list(v) if isinstance(v, tuple) else v) for k, v in d.items()}
@@ -369,7 +369,8 @@ class LinearModel:
         if d.get("schema_version") != SCHEMA_VERSION:
             raise ValueError(f"schema_version must be {SCHEMA_VERSION}, got "
                              f"{d.get('schema_version')!r}")
-        kw = {k: v for k, v in d.items() if k != "schema_version"}
+        kw = {k: v for k, v in d.items() if k not in ("schema_version", "wind_speed")}
+        kw["wind_mps"] = d["wind_speed"]
         for k in ("states", "inputs", "disturbances", "outputs", "state_units", "input_units",
                   "disturbance_units", "output_units"):
             kw[k] = tuple(kw[k])
@@ -524,7 +525,7 @@ def _averaged(p: PlantParams, op: OperatingPoint, wake: str, shear: float,
             if not np.all(np.isfinite(m)):
                 i = np.argwhere(~np.isfinite(m))[0]
                 raise LinearizationError(
-                    f"Jacobian {name}[{i[0]}, {i[1]}] is not finite at {op.wind_speed:g} m/s, "
+                    f"Jacobian {name}[{i[0]}, {i[1]}] is not finite at {op.wind_mps:g} m/s, "
                     f"azimuth {math.degrees(psi):.0f} deg: the plant failed at a perturbed point")
         mats = _assemble(*raw, si, float(psi), op.rotor_speed_rad_s, coordinates)
         acc = list(mats) if acc is None else [a + m for a, m in zip(acc, mats)]
@@ -542,8 +543,8 @@ def _model(p: PlantParams, op: OperatingPoint, jac: tuple[FloatArray, ...], wake
     dists = ("wind_1", "wind_2", "wind_3")
     x0 = op.x[si]
     u0 = op.u.copy()
-    d0 = np.full(3, op.wind_speed)
-    w = np.full((3, p.pack.r.size), op.wind_speed)
+    d0 = np.full(3, op.wind_mps)
+    w = np.full((3, p.pack.r.size), op.wind_mps)
     z_full = _eval(op.x, op.u, w, p.pack, np.full((4, 3, p.pack.r.size), np.nan), 0)[1]
     z0 = z_full[_OUT_IDX]
     if coordinates == "mbc":
@@ -560,7 +561,7 @@ def _model(p: PlantParams, op: OperatingPoint, jac: tuple[FloatArray, ...], wake
         bd = bd.sum(axis=1, keepdims=True) if coordinates == "blade" else bd[:, :1]
         dd = dd.sum(axis=1, keepdims=True) if coordinates == "blade" else dd[:, :1]
         dists = ("wind",)
-        d0 = np.array([op.wind_speed])
+        d0 = np.array([op.wind_mps])
     unit = dict(zip(STATE_NAMES, STATE_UNITS))
     ounit = dict(zip(OUTPUT_NAMES, OUTPUT_UNITS))
     iunit = dict(zip(INPUT_NAMES, INPUT_UNITS))
@@ -571,7 +572,7 @@ def _model(p: PlantParams, op: OperatingPoint, jac: tuple[FloatArray, ...], wake
         input_units=tuple(iunit[n] for n in INPUT_NAMES),
         disturbance_units=tuple("m/s" for _ in dists),
         output_units=tuple(ounit[OUTPUT_NAMES[i]] for i in _OUT_IDX),
-        x0=x0, u0=u0, d0=d0, z0=z0, wind_speed=op.wind_speed, wake=wake,
+        x0=x0, u0=u0, d0=d0, z0=z0, wind_mps=op.wind_mps, wake=wake,
         coordinates=coordinates,
         info={"region": op.region, "pitch_deg": op.pitch_deg,
               "rotor_speed_rpm": op.rotor_speed_rpm, "gen_torque_Nm": op.gen_torque,
@@ -691,18 +692,18 @@ class LinearModelFamily:
 
     Parameters
     ----------
-    wind_speeds : (n_op,) ndarray
+    wind_mps : (n_op,) ndarray
         Strictly increasing [m/s].
     models : tuple of LinearModel
         One per wind speed, with identical names.
     """
 
-    wind_speeds: FloatArray
+    wind_mps: FloatArray
     models: tuple[LinearModel, ...]
 
     def __post_init__(self) -> None:
-        v = _frozen(self.wind_speeds)
-        object.__setattr__(self, "wind_speeds", v)
+        v = _frozen(self.wind_mps)
+        object.__setattr__(self, "wind_mps", v)
         _check_grid(v)
         if len(self.models) != v.size:
             raise ValueError(f"{len(self.models)} models for {v.size} wind speeds")
@@ -726,17 +727,17 @@ class LinearModelFamily:
             If the wind speed is outside the family's range.
         """
         v = check_finite_scalar("wind_mps", wind_mps)
-        lo, hi = float(self.wind_speeds[0]), float(self.wind_speeds[-1])
+        lo, hi = float(self.wind_mps[0]), float(self.wind_mps[-1])
         if not lo <= v <= hi:
             raise ValueError(f"wind_mps = {v:g} m/s is outside the family's range "
                              f"{lo:g}..{hi:g} m/s")
-        k = int(np.clip(np.searchsorted(self.wind_speeds, v) - 1, 0, self.wind_speeds.size - 2))
-        w = (v - self.wind_speeds[k]) / (self.wind_speeds[k + 1] - self.wind_speeds[k])
+        k = int(np.clip(np.searchsorted(self.wind_mps, v) - 1, 0, self.wind_mps.size - 2))
+        w = (v - self.wind_mps[k]) / (self.wind_mps[k + 1] - self.wind_mps[k])
         m0, m1 = self.models[k], self.models[k + 1]
         mix = {n: (1 - w) * getattr(m0, n) + w * getattr(m1, n)
                for n in ("A", "B_u", "B_d", "C_z", "D_u", "D_d", "x0", "u0", "d0", "z0")}
-        return replace(m0, wind_speed=v, info={"interpolated_between": [m0.wind_speed,
-                                                                       m1.wind_speed]}, **mix)
+        return replace(m0, wind_mps=v, info={"interpolated_between": [m0.wind_mps,
+                                                                       m1.wind_mps]}, **mix)
 
     # -- I/O
     def save(self, path: str | Path) -> Path:
@@ -756,7 +757,7 @@ class LinearModelFamily:
         if suffix == ".mat":
             import scipy.io
 
-            out: dict[str, Any] = {"wind_speed": self.wind_speeds.reshape(-1, 1)}
+            out: dict[str, Any] = {"wind_speed": self.wind_mps.reshape(-1, 1)}
             matlab = {"A": "A", "B_u": "Bu", "B_d": "Bd", "C_z": "Cz", "D_u": "Du", "D_d": "Dd"}
             for k, mk in matlab.items():
                 out[mk] = np.moveaxis(mats[k], 0, -1)   # A(:, :, k) is the k-th wind speed
@@ -767,10 +768,10 @@ class LinearModelFamily:
             out["meta_json"] = json.dumps(meta)
             scipy.io.savemat(path, out, do_compression=True)
         elif suffix == ".npz":
-            np.savez_compressed(path, wind_speed=self.wind_speeds, **mats,
+            np.savez_compressed(path, wind_speed=self.wind_mps, **mats,
                                 names_json=json.dumps(names), meta_json=json.dumps(meta))
         elif suffix == ".json":
-            path.write_text(json.dumps({"wind_speed": self.wind_speeds.tolist(), **meta,
+            path.write_text(json.dumps({"wind_speed": self.wind_mps.tolist(), **meta,
                                         **names,
                                         "models": [m.to_dict() for m in self.models]}))
         else:
@@ -825,7 +826,7 @@ class LinearModelFamily:
                 inputs=names["input_names"], disturbances=names["disturbance_names"],
                 outputs=names["output_names"], state_units=names["state_units"],
                 input_units=names["input_units"], disturbance_units=names["disturbance_units"],
-                output_units=names["output_units"], wind_speed=float(vk), wake=meta["wake"],
+                output_units=names["output_units"], wind_mps=float(vk), wake=meta["wake"],
                 coordinates=meta["coordinates"], info=meta["info"][k]))
         return cls(np.asarray(v, dtype=float), tuple(models))
 
@@ -837,14 +838,14 @@ def _check_schema(version: Any, path: Path) -> None:
 
 def _check_grid(v: FloatArray) -> None:
     if v.ndim != 1 or v.size < 1 or not np.all(np.isfinite(v)):
-        raise ValueError(f"wind_speeds must be a finite 1-D array, got {v!r}")
+        raise ValueError(f"wind_mps must be a finite 1-D array, got {v!r}")
     if np.any(np.diff(v) <= 0):
         i = int(np.argmax(np.diff(v) <= 0))
-        raise ValueError(f"wind_speeds must be strictly increasing; {v[i + 1]:g} follows "
+        raise ValueError(f"wind_mps must be strictly increasing; {v[i + 1]:g} follows "
                          f"{v[i]:g} m/s")
 
 
-def linearize_family(turbine: Turbine, wind_speeds: Sequence[float] | FloatArray | None = None,
+def linearize_family(turbine: Turbine, wind_mps: Sequence[float] | FloatArray | None = None,
                      *, progress: bool = False, **kwargs: Any) -> LinearModelFamily:
     """Linear models over a grid of mean wind speeds (default 4..25 m/s, step 1).
 
@@ -858,7 +859,7 @@ def linearize_family(turbine: Turbine, wind_speeds: Sequence[float] | FloatArray
     TrimError
         If a wind speed is outside cut-in..cut-out (the message names it).
     """
-    v = np.asarray(np.arange(4.0, 25.5, 1.0) if wind_speeds is None else wind_speeds,
+    v = np.asarray(np.arange(4.0, 25.5, 1.0) if wind_mps is None else wind_mps,
                    dtype=float)
     _check_grid(v)
     p = kwargs.pop("params", None) or plant_params(turbine, kwargs.pop("config", None))

@@ -67,7 +67,7 @@ def _n_az(params: PlantParams, shear_exponent: float) -> int:
     return 12 if (a.tilt or shear_exponent != 0.0) else 1
 
 
-def rotor_average(params: PlantParams, x: FloatArray, u: FloatArray, wind_speed: float,
+def rotor_average(params: PlantParams, x: FloatArray, u: FloatArray, wind_mps: float,
                   shear_exponent: float = 0.0) -> tuple[FloatArray, FloatArray]:
     """State derivative and outputs averaged over azimuth in steady power-law wind.
 
@@ -76,7 +76,7 @@ def rotor_average(params: PlantParams, x: FloatArray, u: FloatArray, wind_speed:
     dxdt : (n_x,) ndarray
     z : (n_z,) ndarray
     """
-    return _avg_eval(np.asarray(x, dtype=float), np.asarray(u, dtype=float), float(wind_speed),
+    return _avg_eval(np.asarray(x, dtype=float), np.asarray(u, dtype=float), float(wind_mps),
                      float(shear_exponent), params.pack, _n_az(params, shear_exponent))
 
 

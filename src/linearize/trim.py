@@ -38,7 +38,7 @@ class OperatingPoint:
 
     Parameters
     ----------
-    wind_speed : float
+    wind_mps : float
         Hub-height mean wind speed [m/s].
     region : str
         "1.5", "2", "2.5" or "3".
@@ -70,7 +70,7 @@ class OperatingPoint:
         Shear of the steady wind the point was trimmed in [-].
     """
 
-    wind_speed: float
+    wind_mps: float
     region: str
     pitch_rad: float
     rotor_speed_rad_s: float
@@ -111,7 +111,7 @@ class OperatingPoint:
     def as_dict(self) -> dict[str, Any]:
         """Plain dict with unit-suffixed keys, for JSON and tables."""
         return {
-            "wind_mps": self.wind_speed, "region": self.region, "pitch_deg": self.pitch_deg,
+            "wind_mps": self.wind_mps, "region": self.region, "pitch_deg": self.pitch_deg,
             "rotor_speed_rpm": self.rotor_speed_rpm,
             "gen_speed_rpm": self.gen_speed_rad_s * 30.0 / math.pi,
             "gen_torque_Nm": self.gen_torque, "power_W": self.power,
@@ -246,7 +246,7 @@ def trim(turbine: Turbine, wind_mps: float, power_W: float | None = None, *,
     q, thrust = float(z[22]), float(z[23])
     area = math.pi * rproj**2
     return OperatingPoint(
-        wind_speed=v, region=region, pitch_rad=float(pitch), rotor_speed_rad_s=omega,
+        wind_mps=v, region=region, pitch_rad=float(pitch), rotor_speed_rad_s=omega,
         gen_speed_rad_s=omega * ngear, gen_torque=tg, power=eta * tg * omega * ngear,
         aero_power=q * omega, aero_torque=q, thrust=thrust, tsr=omega * rproj / v if v > 0 else 0,
         cp=q * omega / (0.5 * turbine.environment.air_density * area * v**3),
@@ -296,7 +296,7 @@ def _equilibrium(p: PlantParams, v: float, omega: float, pitch: float, tg: float
     return x, u, z
 
 
-def operating_schedule(turbine: Turbine, wind_speeds: FloatArray, power_W: float | None = None,
+def operating_schedule(turbine: Turbine, wind_mps: FloatArray, power_W: float | None = None,
                        *, config: PlantConfig | None = None,
                        shear_exponent: float = 0.0) -> list[OperatingPoint]:
     """Trim at each wind speed; with ``power_W``, cap the power at min(available, power_W).
@@ -306,7 +306,7 @@ def operating_schedule(turbine: Turbine, wind_speeds: FloatArray, power_W: float
     """
     p = plant_params(turbine, config)
     out = []
-    for v in np.asarray(wind_speeds, dtype=float).ravel():
+    for v in np.asarray(wind_mps, dtype=float).ravel():
         if power_W is None:
             out.append(trim(turbine, float(v), params=p, shear_exponent=shear_exponent))
             continue

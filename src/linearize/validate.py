@@ -31,6 +31,55 @@ def check_finite_scalar(name: str, value: Any) -> float:
     return v
 
 
+def check_number(name: str, value: Any, *, lo: float | None = None, hi: float | None = None,
+                 lo_open: bool = False, unit: str = "", reason: str = "",
+                 say_finite: bool = True) -> float:
+    """Return ``value`` as float if it is a finite real number within the bounds.
+
+    Parameters
+    ----------
+    name : str
+        The argument's name, for the message.
+    value : object
+        The value.
+    lo, hi : float, optional
+        Bounds (``hi`` included; ``lo`` excluded with ``lo_open``).
+    lo_open : bool
+        Whether ``lo`` itself is not allowed.
+    unit : str
+        Unit for the message ("m/s").
+    reason : str
+        Why, for the message ("the QP must be convex").
+    say_finite : bool
+        Whether the message says "finite and" before the bounds.
+
+    Returns
+    -------
+    float
+        The value.
+
+    Raises
+    ------
+    ValueError
+        ``{name} must be finite and > 0 m/s, got -1.0`` style: names the argument, what is
+        allowed and the value (also for a non-number).
+    """
+    cond = []
+    if lo is not None:
+        cond.append(f"{'>' if lo_open else '>='} {lo:g}")
+    if hi is not None:
+        cond.append(f"<= {hi:g}")
+    head = ("finite and " if say_finite else "") if cond else "finite"
+    what = (head + " and ".join(cond) + (f" {unit}" if unit else "")
+            + (f" ({reason})" if reason else ""))
+    ok = not isinstance(value, bool) and isinstance(value, (int, float, np.integer, np.floating))
+    v = float(value) if ok else math.nan
+    if not (math.isfinite(v) and (lo is None or (v > lo if lo_open else v >= lo))
+            and (hi is None or v <= hi)):
+        raise ValueError(f"{name} must be {what}, got {value!r}")
+    return v
+
+
 def check_range(name: str, value: float, lo: float, hi: float) -> float:
     """Return ``value`` if ``lo <= value <= hi``."""
     v = check_finite_scalar(name, value)

@@ -36,7 +36,25 @@ __all__ = ["BaselineGains", "tune_baseline", "tune_baseline_schedule", "Baseline
 
 
 def check_power_fraction(value: Any, name: str = "power_fraction") -> float:
-    """A derating fraction of rated power: finite and in (0, 1]."""
+    """A derating fraction of rated power: finite and in (0, 1].
+
+    Parameters
+    ----------
+    value : float
+        The fraction [-].
+    name : str
+        The argument's name, for the message.
+
+    Returns
+    -------
+    float
+        The fraction.
+
+    Raises
+    ------
+    ValueError
+        Naming the argument and the value.
+    """
     f = float(value)
     if not (math.isfinite(f) and 0.0 < f <= 1.0):
         raise ValueError(f"{name} must be in (0, 1] (a fraction of rated power), got {value!r}")
@@ -106,6 +124,12 @@ def tune_baseline(turbine: linearize.Turbine, *, omega_n_rad_s: float = 0.6, zet
     power_fraction : float
         Derating fraction in (0, 1] [-].
 
+
+    Returns
+    -------
+    BaselineGains
+        KP, KI, the gain-scheduling angle theta_K, the torque constant and the set points.
+
     Raises
     ------
     ValueError
@@ -149,7 +173,22 @@ def tune_baseline_schedule(turbine: linearize.Turbine,
                            fractions: Sequence[float] = (1.0, 0.75, 0.5, 0.25),
                            **kwargs: Any) -> tuple[BaselineGains, ...]:
     """PI designs at several power fractions, for a pitch loop scheduled on the power reference
-    (active power control). ``kwargs`` go to :func:`tune_baseline`; sorted by fraction."""
+    (active power control). ``kwargs`` go to :func:`tune_baseline`; sorted by fraction.
+
+    Parameters
+    ----------
+    turbine : Turbine
+        The turbine.
+    fractions : sequence of float
+        Power fractions in (0, 1].
+    **kwargs
+        Passed to :func:`tune_baseline`.
+
+    Returns
+    -------
+    tuple of BaselineGains
+        One design per fraction, by increasing fraction.
+    """
     fr = sorted({check_power_fraction(f, "fractions") for f in fractions})
     if len(fr) < 1:
         raise ValueError("fractions must hold at least one power fraction")
@@ -177,6 +216,27 @@ class BaselineController:
     same designs at the present pitch (the pitch loop then only corrects). A reference outside
     (0, rated power] raises ``ValueError``; while the rotor is below rated speed at fine pitch
     the wind cannot give the reference (signal ``apc_saturated`` = 1).
+
+    Parameters
+    ----------
+    turbine : Turbine
+        The turbine.
+    gains : BaselineGains, optional
+        The design (default :func:`tune_baseline`).
+    dt : float
+        Controller period [s] (default the plant's 1/80 s).
+    region3 : {"constant_power", "constant_torque"}
+        Torque law above rated.
+    filter_hz : float
+        Corner of the generator-speed low-pass [Hz].
+    slip_pct : float
+        Region 2.5 width, in percent of rated generator speed.
+    power_reference : callable, optional
+        t [s] -> power reference [W] (active power control).
+    gain_schedule : sequence of BaselineGains, optional
+        Designs at several power fractions, interpolated on the reference.
+    feedforward : bool
+        Pitch feedforward on changes of the power reference.
     """
 
     def __init__(self, turbine: linearize.Turbine, gains: BaselineGains | None = None, *,
@@ -248,7 +308,22 @@ class BaselineController:
 
     def torque(self, w: float, pitch: float, power: float | None = None) -> float:
         """Generator torque demand for a filtered generator speed and the collective pitch;
-        ``power`` replaces rated power in region 3 (active power control) [W]."""
+        ``power`` replaces rated power in region 3 (active power control) [W].
+
+        Parameters
+        ----------
+        w : float
+            Filtered generator speed [rad/s].
+        pitch : float
+            Collective pitch [rad].
+        power : float, optional
+            Power reference [W] (default rated).
+
+        Returns
+        -------
+        float
+            Generator torque demand [N m].
+        """
         g = self.gains
         eta = self.turbine.drivetrain.generator_efficiency
         p3 = g.rated_power if power is None else power
@@ -276,7 +351,22 @@ class BaselineController:
         return p
 
     def step(self, t: float, meas: dict[str, Any]) -> tuple[np.ndarray, float]:
-        """One control step; returns (pitch_ref (3,) [rad], gen_torque_ref [N m])."""
+        """One control step; returns (pitch_ref (3,) [rad], gen_torque_ref [N m]).
+
+        Parameters
+        ----------
+        t : float
+            Time [s].
+        meas : dict
+            The harness's measurements (:mod:`mpc_wt.simulate`).
+
+        Returns
+        -------
+        pitch_ref : (3,) ndarray
+            Blade pitch commands [rad].
+        gen_torque_ref : float
+            Generator torque command [N m].
+        """
         w = float(meas["gen_speed"])
         if not math.isfinite(w):
             raise ValueError(f"measurement gen_speed is not finite at t = {t:g} s: {w!r}")

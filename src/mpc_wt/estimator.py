@@ -13,13 +13,13 @@ equation (scipy), once per operating point.
 """
 from __future__ import annotations
 
-import math
 from typing import Any
 
 import numpy as np
 import scipy.linalg
 
 import linearize
+from linearize.validate import check_number
 
 __all__ = ["KalmanEstimator", "MEASURED_SIGNALS", "read_signals"]
 
@@ -37,7 +37,20 @@ _STATE_NOISE = {"tower_fa_displacement": 1e-3, "tower_fa_velocity": 2e-3, "rotor
 
 def read_signals(meas: dict[str, Any], names: tuple[str, ...] | list[str]) -> np.ndarray:
     """Named signals from a harness measurement dict: a key of ``meas`` itself, a blade signal
-    ``<key>_<1|2|3>`` of a per-blade array, or else a plant state from ``meas["state"]``."""
+    ``<key>_<1|2|3>`` of a per-blade array, or else a plant state from ``meas["state"]``.
+
+    Parameters
+    ----------
+    meas : dict
+        The harness's measurements.
+    names : sequence of str
+        Signal names.
+
+    Returns
+    -------
+    (n,) ndarray
+        The signals in that order.
+    """
     y = np.empty(len(names))
     for i, n in enumerate(names):
         if n in meas:
@@ -71,17 +84,13 @@ class KalmanEstimator:
                  measurement_std: dict[str, float] | None = None) -> None:
         if model.dt is None:
             raise ValueError("model must be discrete: call model.discretize(dt) first")
-        if not (math.isfinite(wind_std_per_step) and wind_std_per_step > 0):
-            raise ValueError(f"wind_std_per_step must be finite and > 0 m/s, got "
-                             f"{wind_std_per_step!r}")
+        check_number("wind_std_per_step", wind_std_per_step, lo=0.0, lo_open=True, unit="m/s")
         std = dict(MEASURED_SIGNALS)
         for k, v in (measurement_std or {}).items():
             if k not in std:
                 raise ValueError(f"measurement_std: unknown signal {k!r}; signals are "
                                  f"{sorted(std)}")
-            if not (math.isfinite(v) and v > 0):
-                raise ValueError(f"measurement_std[{k!r}] must be finite and > 0, got {v!r}")
-            std[k] = float(v)
+            std[k] = check_number(f"measurement_std[{k!r}]", v, lo=0.0, lo_open=True)
         missing = [n for n in std if n not in model.outputs]
         if missing:
             raise ValueError(f"model lacks the measured outputs {missing}")
@@ -112,7 +121,15 @@ class KalmanEstimator:
         self.reset()
 
     def reset(self, x_dev: np.ndarray | None = None, d_dev: np.ndarray | None = None) -> None:
-        """Start from deviations (default: the operating point)."""
+        """Start from deviations (default: the operating point).
+
+        Parameters
+        ----------
+        x_dev : (n_x,) ndarray, optional
+            State deviation to start from.
+        d_dev : (n_d,) ndarray, optional
+            Wind deviation to start from.
+        """
         self.xa = np.concatenate([np.zeros(self.nx) if x_dev is None else x_dev,
                                   np.zeros(self.nd) if d_dev is None else d_dev])
         self._started = False
@@ -137,13 +154,39 @@ class KalmanEstimator:
         self._started = other.started
 
     def measurement(self, meas: dict[str, Any]) -> np.ndarray:
-        """The measured-signal vector from a harness measurement dict."""
+        """The measured-signal vector from a harness measurement dict.
+
+        Parameters
+        ----------
+        meas : dict
+            The harness's measurements.
+
+        Returns
+        -------
+        (n_y,) ndarray
+            The measured signals (:attr:`signals` order).
+        """
         return read_signals(meas, self.signals)
 
     def update(self, y: np.ndarray, u_dev: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """One step: predict with the input applied over the last step, correct with the
         measurement ``y`` (absolute values, :attr:`signals` order). Returns the state and wind
-        deviations from the operating point."""
+        deviations from the operating point.
+
+        Parameters
+        ----------
+        y : (n_y,) ndarray
+            Measured signals (absolute).
+        u_dev : (n_u,) ndarray
+            Input deviation applied over the last step.
+
+        Returns
+        -------
+        x_dev : (n_x,) ndarray
+            State deviation estimate.
+        d_dev : (n_d,) ndarray
+            Blade-effective wind deviation estimate [m/s].
+        """
         y = np.asarray(y, float)
         if y.shape != (len(self.signals),) or not np.all(np.isfinite(y)):
             raise ValueError(f"y must be {len(self.signals)} finite measurements "

@@ -83,7 +83,23 @@ def baseline_table(turbine: linearize.Turbine, gains: Any,
                    winds: Sequence[float] | None = None) -> dict[str, Any]:
     """The PI baseline (:class:`~mpc_wt.baseline.BaselineGains`) as a gain table: the pitch
     gain schedule kp GK(theta), ki GK(theta), GK = 1 / (1 + theta / theta_K), at the trim pitch
-    of each wind speed from rated to cut-out (default 1 m/s steps), with the set points."""
+    of each wind speed from rated to cut-out (default 1 m/s steps), with the set points.
+
+    Parameters
+    ----------
+    turbine : Turbine
+        The turbine.
+    gains : BaselineGains
+        The design.
+    winds : sequence of float, optional
+        Wind speeds of the rows [m/s].
+
+    Returns
+    -------
+    dict
+        The gain-table document (schema "mpc-wt gain table"): kind, turbine, settings, the
+        schedule (columns with units, rows) and matrices.
+    """
     op = turbine.operation
     if winds is None:
         lo = math.ceil(linearize.rated_wind_speed(turbine))
@@ -119,7 +135,25 @@ def lqr_table(turbine: linearize.Turbine, designs: Sequence[Any],
               state_units: Sequence[str] | None = None) -> dict[str, Any]:
     """An LQR family (:func:`~mpc_wt.synthesis.design_lqr_family`) as a gain table: operating
     points per wind speed, the gains K (u - u0 = -K (x - x0)) and, when given, the PI observer
-    gains L1, L2 (Do et al. eqs 13-16)."""
+    gains L1, L2 (Do et al. eqs 13-16).
+
+    Parameters
+    ----------
+    turbine : Turbine
+        The turbine.
+    designs : sequence of LQRDesign
+        One per wind.
+    observers : sequence of PIObserver, optional
+        The PI observers of the same models.
+    state_units : sequence of str, optional
+        Units of the states (default from the plant's tables).
+
+    Returns
+    -------
+    dict
+        The gain-table document (schema "mpc-wt gain table"): kind, turbine, settings, the
+        schedule (columns with units, rows) and matrices.
+    """
     if not designs:
         raise GainTableError("no LQR designs to tabulate")
     d0 = designs[0]
@@ -128,7 +162,7 @@ def lqr_table(turbine: linearize.Turbine, designs: Sequence[Any],
     iu = dict(zip(linearize.INPUT_NAMES, linearize.INPUT_UNITS))
     cols = ["wind_speed"] + [f"x0_{n}" for n in d0.states] + [f"u0_{n}" for n in d0.inputs]
     units = ["m/s"] + su + [iu.get(n, "-") for n in d0.inputs]
-    rows = [[d.wind_speed, *d.x0, *d.u0] for d in designs]
+    rows = [[d.wind_mps, *d.x0, *d.u0] for d in designs]
     mats = {"K": _matrix(np.array([d.K for d in designs]), d0.inputs, d0.states,
                          "input unit / state unit",
                          [_unit_ratio(iu.get(i, "-"), s) for i in d0.inputs for s in su])}
@@ -150,7 +184,25 @@ def ts_table(turbine: linearize.Turbine, ts: Any, controller: Any,
              observer: Any | None = None) -> dict[str, Any]:
     """A TS design (:mod:`mpc_wt.ts`) as a gain table: one row per premise vertex (wind,
     power reduction, equilibrium x0, u0), the PDC gains K_i and observer gains L_i, with the
-    membership breakpoints and the LMI settings and certificate."""
+    membership breakpoints and the LMI settings and certificate.
+
+    Parameters
+    ----------
+    turbine : Turbine
+        The turbine.
+    ts : TSModel
+        The model.
+    controller : TSControllerDesign
+        The PDC gains.
+    observer : TSObserverDesign, optional
+        The observer gains.
+
+    Returns
+    -------
+    dict
+        The gain-table document (schema "mpc-wt gain table"): kind, turbine, settings, the
+        schedule (columns with units, rows) and matrices.
+    """
     su = dict(zip(linearize.STATE_NAMES, linearize.STATE_UNITS))
     st_units = [su.get(n, "-") for n in ts.states]
     in_units = ["rad", "N m"]
@@ -186,7 +238,21 @@ def ts_table(turbine: linearize.Turbine, ts: Any, controller: Any,
 def ibc_table(turbine: linearize.Turbine, gains: Any) -> dict[str, Any]:
     """Individual blade control (:class:`~mpc_wt.retrofit.IBCGains`) as a gain table: the
     proportional gain per mean-pitch breakpoint, with its gain margin and 1P loop gain, and the
-    filters (high-pass corner, band-stop frequencies and Q) and power fade-in in ``settings``."""
+    filters (high-pass corner, band-stop frequencies and Q) and power fade-in in ``settings``.
+
+    Parameters
+    ----------
+    turbine : Turbine
+        The turbine.
+    gains : IBCGains
+        The design.
+
+    Returns
+    -------
+    dict
+        The gain-table document (schema "mpc-wt gain table"): kind, turbine, settings, the
+        schedule (columns with units, rows) and matrices.
+    """
     rows = [[w, p, k, gm if math.isfinite(gm) else 1e300, lg] for w, p, k, gm, lg in zip(
         gains.wind_mps, gains.pitch_rad, gains.gain, gains.gain_margin, gains.loop_gain_1p)]
     settings = {"dt": gains.dt, "highpass_hz": gains.highpass_hz,
@@ -204,7 +270,21 @@ def ibc_table(turbine: linearize.Turbine, gains: Any) -> dict[str, Any]:
 
 def coleman_ipc_table(turbine: linearize.Turbine, gains: Any) -> dict[str, Any]:
     """Coleman-frame IPC (:class:`~mpc_wt.retrofit.ColemanIPCGains`) as a gain table: integral
-    gain and azimuth offset per mean-pitch breakpoint."""
+    gain and azimuth offset per mean-pitch breakpoint.
+
+    Parameters
+    ----------
+    turbine : Turbine
+        The turbine.
+    gains : ColemanIPCGains
+        The design.
+
+    Returns
+    -------
+    dict
+        The gain-table document (schema "mpc-wt gain table"): kind, turbine, settings, the
+        schedule (columns with units, rows) and matrices.
+    """
     rows = [[w, p, k, a, gm] for w, p, k, a, gm in zip(
         gains.wind_mps, gains.pitch_rad, gains.ki, gains.azimuth_offset_rad, gains.gain_margin)]
     settings = {"crossover_rad_s": gains.crossover_rad_s,
@@ -236,7 +316,20 @@ def _check(doc: Any, where: str) -> dict[str, Any]:
 
 
 def save_design(doc: dict[str, Any], out_dir: str | Path) -> Path:
-    """Write ``design.json`` into ``out_dir`` (created)."""
+    """Write ``design.json`` into ``out_dir`` (created).
+
+    Parameters
+    ----------
+    doc : dict
+        A gain-table document.
+    out_dir : str or Path
+        The design directory.
+
+    Returns
+    -------
+    Path
+        The file written.
+    """
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     p = out / "design.json"
@@ -246,6 +339,17 @@ def save_design(doc: dict[str, Any], out_dir: str | Path) -> Path:
 
 def load_design(path: str | Path) -> dict[str, Any]:
     """Read a design directory's ``design.json`` (or a gain-table JSON file).
+
+
+    Parameters
+    ----------
+    path : str or Path
+        A design directory or a JSON file.
+
+    Returns
+    -------
+    dict
+        The checked document.
 
     Raises
     ------
@@ -379,7 +483,18 @@ def _write_rosco(doc: dict[str, Any], out: Path, turbine_eff: float | None = Non
 
 def read_rosco(path: str | Path) -> dict[str, Any]:
     """Parse ``NAME`` values from DISCON.IN-style lines (``values ! NAME - text``): a float,
-    or a list of floats when the line holds several. Lines without ``!`` are skipped."""
+    or a list of floats when the line holds several. Lines without ``!`` are skipped.
+
+    Parameters
+    ----------
+    path : str or Path
+        A DISCON.IN-style file.
+
+    Returns
+    -------
+    dict
+        Name -> float or list of floats.
+    """
     out: dict[str, Any] = {}
     for line in Path(path).read_text().splitlines():
         if "!" not in line or line.lstrip().startswith("!"):
@@ -401,6 +516,21 @@ def export(doc_or_dir: dict[str, Any] | str | Path, fmt: str,
            out_dir: str | Path | None = None) -> list[Path]:
     """Export a gain table (a document, or a design directory) to ``fmt`` in ``out_dir``
     (default the design directory). Returns the files written.
+
+
+    Parameters
+    ----------
+    doc_or_dir : dict or str or Path
+        A gain-table document or a design directory.
+    fmt : {"csv", "json", "mat", "rosco"}
+        The format.
+    out_dir : str or Path, optional
+        Where to write (default the design directory).
+
+    Returns
+    -------
+    list of Path
+        The files written.
 
     Raises
     ------

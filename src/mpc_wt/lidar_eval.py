@@ -24,6 +24,32 @@ def evaluate_lidar(field: lidar.WindField, turbine: linearize.Turbine, *,
     (gamma^2 = 0.5, mean of the blades) and wavenumber, the RMS preview error over the horizon
     against the wind each blade meets at 75 % span, the preview time and the lead angle.
 
+
+    Parameters
+    ----------
+    field : lidar.WindField
+        The wind field.
+    turbine : Turbine
+        The turbine (rotor radius, trimmed speed).
+    focus_distance : float
+        Axial focus distance [m].
+    sample_rate : float
+        LIDAR samples per second [Hz].
+    horizon : int
+        Preview steps H_p.
+    dt_ctrl : float
+        Controller step [s].
+    plots : str or Path, optional
+        Folder for ``lidar_coherence.png`` and ``lidar_scan.png``.
+    **lidar_options
+        Further :class:`lidar.CWLidar` settings (``range_weighting``, ``noise_std`` ...).
+
+    Returns
+    -------
+    dict
+        ``coherence_bandwidth_hz``, wavenumber, RMS preview error, preview time, lead angle and
+        the plots written.
+
     Raises
     ------
     ValueError
@@ -44,12 +70,9 @@ def evaluate_lidar(field: lidar.WindField, turbine: linearize.Turbine, *,
     meas = lid.measure(field, t, psi, omega)
     later = lidar.blade_effective_wind(field, t + tp, psi + omega * tp, lid.radius)
     fs = sample_rate
-    g_all = []
-    f = np.zeros(1)
-    for i in range(3):
-        f, g = lidar.coherence(meas.u_hat[:, i], later[:, i], fs, nperseg=256)
-        g_all.append(g)
-    gamma2 = np.column_stack(g_all)
+    f = lidar.coherence(meas.u_hat[:, 0], later[:, 0], fs, nperseg=256)[0]
+    gamma2 = np.column_stack([lidar.coherence(meas.u_hat[:, i], later[:, i], fs,
+                                              nperseg=256)[1] for i in range(3)])
     bw = lidar.coherence_bandwidth(f, gamma2.mean(axis=1))
     k_ctrl = t[(t >= t[0] + tp) & (t <= t[-1] - horizon * dt_ctrl)][::max(1, int(round(
         dt_ctrl * sample_rate)))]
@@ -65,13 +88,20 @@ def evaluate_lidar(field: lidar.WindField, turbine: linearize.Turbine, *,
            "half_width_m": lid.half_width, "cone_angle_deg": math.degrees(lid.cone_angle_rad),
            "mean_speed_mps": field.mean_speed}
     if plots:
-        from .plotting import plot_lidar_coherence, plot_scan_pattern
-
-        d = Path(plots)
-        d.mkdir(parents=True, exist_ok=True)
-        plot_lidar_coherence(f, gamma2, bw, field.mean_speed, d / "lidar_coherence.png")
-        n_rev = int(round(2 * math.pi / omega * sample_rate))
-        plot_scan_pattern(meas.beam_azimuth_rad[:n_rev], psi[:n_rev], lid.radius,
-                          turbine.geometry.tip_radius, d / "lidar_scan.png")
-        res["plots"] = [str(d / "lidar_coherence.png"), str(d / "lidar_scan.png")]
+        res["plots"] = _plots(Path(plots), f, gamma2, bw, field, meas, psi, omega, lid,
+                              turbine, sample_rate)
     return res
+
+
+def _plots(d: Path, f: np.ndarray, gamma2: np.ndarray, bw: float, field: lidar.WindField,
+           meas: Any, psi: np.ndarray, omega: float, lid: Any, turbine: linearize.Turbine,
+           sample_rate: float) -> list[str]:
+    """The coherence and the scan pattern of one revolution, as PNG in ``d``."""
+    from .plotting import plot_lidar_coherence, plot_scan_pattern
+
+    d.mkdir(parents=True, exist_ok=True)
+    plot_lidar_coherence(f, gamma2, bw, field.mean_speed, d / "lidar_coherence.png")
+    n_rev = int(round(2 * math.pi / omega * sample_rate))
+    plot_scan_pattern(meas.beam_azimuth_rad[:n_rev], psi[:n_rev], lid.radius,
+                      turbine.geometry.tip_radius, d / "lidar_scan.png")
+    return [str(d / "lidar_coherence.png"), str(d / "lidar_scan.png")]

@@ -23,12 +23,14 @@ import dataclasses
 import logging
 import math
 from dataclasses import dataclass, field
+from types import SimpleNamespace
 from typing import Any
 
 import numba as nb
 import numpy as np
 
 import linearize
+from linearize.validate import check_number
 
 from .qp import check_backend, default_backend, make_backend
 
@@ -44,6 +46,11 @@ def coleman_weight() -> np.ndarray:
     T_c^T T_c [i, j] = (4/9) cos(psi_i - psi_j): 4/9 on the diagonal and -2/9 off it, so
     T = (2^2 / 3^2) [[1, -1/2, -1/2], [-1/2, 1, -1/2], [-1/2, -1/2, 1]]. Eq 22 prints the
     constant as 2^2 / 3^3, which does not satisfy the identity (eq 21); 2^2 / 3^2 does (test).
+
+    Returns
+    -------
+    (3, 3) ndarray
+        T [-].
     """
     return 4.0 / 9.0 * np.array([[1.0, -0.5, -0.5], [-0.5, 1.0, -0.5], [-0.5, -0.5, 1.0]])
 
@@ -80,12 +87,9 @@ class MPCWeights:
     def __post_init__(self) -> None:
         for group in (self.outputs, self.inputs, self.rate):
             for k, v in group.items():
-                if not (math.isfinite(v) and v >= 0):
-                    raise ValueError(f"weight {k!r} must be finite and >= 0 (the QP must be "
-                                     f"convex), got {v!r}")
+                check_number(f"weight {k!r}", v, lo=0.0, reason="the QP must be convex")
         for k, v in self.scales.items():
-            if not (math.isfinite(v) and v > 0):
-                raise ValueError(f"scale {k!r} must be > 0, got {v!r}")
+            check_number(f"scale {k!r}", v, lo=0.0, lo_open=True)
 
 
 @dataclass(frozen=True)
@@ -168,9 +172,8 @@ class MPCSettings:
         if v is not None and not (isinstance(v, (int, float)) and math.isfinite(v) and v > 0):
             raise ValueError(f"max_rotor_speed must be a finite speed > 0 rad/s or None, got "
                              f"{v!r}")
-        for name, w in (("slack_weight", self.slack_weight), ("slack_linear", self.slack_linear)):
-            if not (math.isfinite(w) and w > 0):
-                raise ValueError(f"{name} must be finite and > 0, got {w!r}")
+        check_number("slack_weight", self.slack_weight, lo=0.0, lo_open=True)
+        check_number("slack_linear", self.slack_linear, lo=0.0, lo_open=True)
         if isinstance(self.estimator, str) and self.estimator != "kalman":
             raise ValueError(f"estimator must be None, 'kalman' or a KalmanEstimator, got "
                              f"{self.estimator!r}")
@@ -366,6 +369,26 @@ class MPC:
         return q, r
 
     def _build(self, solver_options: dict[str, Any]) -> None:
+        """Set the QP up once: prediction (eq 20), Coleman-weighted cost (eqs 21-22), actuator
+        constraints (eqs 12, 15), scaling, the affine maps of each step's vectors, and the
+        backend."""
+        k = SimpleNamespace()
+        self._prediction(k)
+        self._constraints(k)
+        self._bounds(k, solver_options)
+        self._affine_maps(k)
+        if self.formulation == "sparse":
+            self._build_sparse(dict(a=k.a, b=k.b, bd=k.bd, c=k.c, du=k.du, dd=k.dd, q1=k.q1,
+                                    rbar=k.rbar, dmat=k.dmat, wr=k.wr, su=k.su, lo_u=k.lo_u,
+                                    hi_u=k.hi_u, trate=k.trate, prate=k.prate, plim=k.plim,
+                                    sw=k.sw, big=k.big, lim=k.lim if k.soft else None), k.opts)
+            return
+        self.qp_backend = make_backend(self.backend, self.formulation,
+                                       k.opts if self.backend == "osqp" else {})
+        self.qp_backend.setup(self._h_s, np.zeros(k.nvv), k.acon_s, self._n_box)
+
+    def _prediction(self, k: SimpleNamespace) -> None:
+        """Prediction matrices and the Hessian of the condensed cost (into ``k``)."""
         m = self.model
         a, b, bd, c, du, dd = m.A, m.B_u, m.B_d, m.C_z, m.D_u, m.D_d
         if self.collective:          # one pitch input drives all three blades
@@ -411,6 +434,13 @@ class MPC:
         self._psi, self._theta, self._qbar, self._h = psi, theta, qbar, h
         self._nx, self._nu, self._nd = nx, nu, nd
         self._up0 = np.zeros(nu)
+        vars(k).update(a=a, b=b, bd=bd, c=c, du=du, dd=dd, nx=nx, nu=nu, nd=nd, nz=nz, hp=hp,
+                       hu=hu, q1=q1, psi=psi, theta=theta, phi=phi, qbar=qbar, rbar=rbar,
+                       dmat=dmat, wr=wr, h=h, m=m)
+
+    def _constraints(self, k: SimpleNamespace) -> None:
+        """Constraint rows and the scaling of variables and rows (into ``k``)."""
+        m, nu, nz, hp, hu, theta, dmat, h = k.m, k.nu, k.nz, k.hp, k.hu, k.theta, k.dmat, k.h
         # constraints: absolute input bounds (all hu moves), torque rate, pitch rate via the
         # pitch-rate outputs over the horizon
         pa, gen = self.turbine.pitch_actuator, self.turbine.generator
@@ -447,6 +477,13 @@ class MPC:
             su = np.append(su, np.full(ns, sw))
         self._su = su
         self._n_box = hu * nu + ns
+        vars(k).update(pa=pa, gen=gen, prate=prate, soft=soft, ns=ns, speed_rows=speed_rows if soft
+                       else None, su=su, sw=sw, row_s=row_s, acon_s=acon_s, h_s=h_s)
+
+    def _bounds(self, k: SimpleNamespace, solver_options: dict[str, Any]) -> None:
+        """Solver options and the bounds at the operating point (into ``k``)."""
+        m, hp, hu, pa, gen = k.m, k.hp, k.hu, k.pa, k.gen
+        soft, ns, sw, row_s = k.soft, k.ns, k.sw, k.row_s
         # termination checked every 2 (condensed) or 5 (sparse) iterations: in the shifted
         # variables an unconstrained step is solved at the warm start, so checking early pays
         # eps 1e-5 in the scaled variables (units of 1 deg pitch, 4 kN m torque) is 1e-5 deg,
@@ -477,6 +514,18 @@ class MPC:
         inv_rs = 1.0 / row_s
         lo_s = np.concatenate([lo_u, -trate, -prate_lim, spd_lo]) * inv_rs
         hi_s = np.concatenate([hi_u, trate, prate_lim, spd_hi]) * inv_rs
+        vars(k).update(opts=opts, lo_u=lo_u, hi_u=hi_u, trate=trate, big=big, lim=lim, lo_s=lo_s,
+                       hi_s=hi_s, inv_rs=inv_rs)
+        k.plim = pa.max_rate_rad_s
+
+    def _affine_maps(self, k: SimpleNamespace) -> None:
+        """Each step's QP vectors as affine maps of (1, x, u_prev, preview), shifted to the
+        unconstrained optimum (into ``self``)."""
+        nx, nu, hu, ns, soft = k.nx, k.nu, k.hu, k.ns, k.soft
+        psi, phi, theta, qbar = k.psi, k.phi, k.theta, k.qbar
+        dmat, wr, su, row_s, inv_rs = k.dmat, k.wr, k.su, k.row_s, k.inv_rs
+        lo_s, hi_s, acon_s, h_s = k.lo_s, k.hi_s, k.acon_s, k.h_s
+        speed_rows = k.speed_rows
         # every step's QP vectors [q_s; lo; hi] are affine in (x, d, u_prev): precompute the
         # maps so that a step costs three matrix-vector products
         ncon = len(row_s)
@@ -523,15 +572,7 @@ class MPC:
         self._lo = self._wbuf[nvv:nvv + ncon]
         self._hi = self._wbuf[nvv + ncon:]
         self._slack0 = nvu
-        if self.formulation == "sparse":
-            self._build_sparse(dict(a=a, b=b, bd=bd, c=c, du=du, dd=dd, q1=q1, rbar=rbar,
-                                    dmat=dmat, wr=wr, su=su, lo_u=lo_u, hi_u=hi_u, trate=trate,
-                                    prate=prate, plim=pa.max_rate_rad_s, sw=sw, big=big,
-                                    lim=lim if soft else None), opts)
-            return
-        self.qp_backend = make_backend(self.backend, self.formulation,
-                                       opts if self.backend == "osqp" else {})
-        self.qp_backend.setup(self._h_s, np.zeros(nvv), acon_s, self._n_box)
+        k.nvv = nvv
 
     def _build_sparse(self, k: dict[str, Any], opts: dict[str, Any]) -> None:
         """OSQP on the sparse (non-condensed) formulation (issue 6, item 3).
@@ -544,6 +585,13 @@ class MPC:
         scales. As in the condensed problem, the variables are shifted to the
         equality-constrained optimum, so each step changes the bounds only.
         """
+        q = SimpleNamespace()
+        self._sparse_cost(k, q)
+        self._sparse_rows(k, q)
+        self._sparse_finish(k, q, opts)
+
+    def _sparse_cost(self, k: dict[str, Any], q: SimpleNamespace) -> None:
+        """Dimensions, outputs z = G v + G0 z_data, the cost and the state scales."""
         a, b, bd, c, du, dd = k["a"], k["b"], k["bd"], k["c"], k["du"], k["dd"]
         nx, nu, nd, nz = a.shape[0], b.shape[1], bd.shape[1], c.shape[0]
         hp, hu = self.hp, self.hu
@@ -578,6 +626,16 @@ class MPC:
             resp = np.maximum(resp, np.sqrt(((ap @ b * su_u[:nu]) ** 2).sum(axis=1)))
             ap = a @ ap
         sx = np.maximum(resp, 1e-9 * resp.max())
+        vars(q).update(a=a, b=b, bd=bd, nx=nx, nu=nu, nd=nd, nz=nz, hp=hp, hu=hu, su_u=su_u,
+                       soft=soft, ns=ns, nvu=nvu, nxv=nxv, nv=nv, nzd=nzd, iu=iu, ix=ix,
+                       col_d=col_d, g=g, g0=g0, pmat=pmat, qz=qz, sx=sx)
+
+    def _sparse_rows(self, k: dict[str, Any], q: SimpleNamespace) -> None:
+        """Equality (dynamics) and inequality rows with their bound maps and row scales."""
+        a, b, bd, nx, nu, nz = q.a, q.b, q.bd, q.nx, q.nu, q.nz
+        hp, hu, su_u, soft, ns, nvu = q.hp, q.hu, q.su_u, q.soft, q.ns, q.nvu
+        nxv, nv, nzd, iu, ix, col_d = q.nxv, q.nv, q.nzd, q.iu, q.ix, q.col_d
+        g, g0, sx = q.g, q.g0, q.sx
         # equalities E v = Ez z_data
         neq = nxv
         e = np.zeros((neq, nv))
@@ -632,6 +690,14 @@ class MPC:
             hi0.append(np.full(ns, k["lim"]))
             lz.append(-g0[sr])
             rs.append(np.full(ns, k["sw"]))
+        vars(q).update(rows=rows, lo0=lo0, hi0=hi0, lz=lz, rs=rs, neq=neq)
+
+    def _sparse_finish(self, k: dict[str, Any], q: SimpleNamespace, opts: dict[str, Any]) -> None:
+        """Scale, shift to the equality-constrained optimum, keep the maps, set the backend up."""
+        nx, nu, hp, su_u, soft, ns = q.nx, q.nu, q.hp, q.su_u, q.soft, q.ns
+        nvu, nxv, nv, nzd, pmat, qz = q.nvu, q.nxv, q.nv, q.nzd, q.pmat, q.qz
+        sx, rows, lo0, hi0, lz, rs = q.sx, q.rows, q.lo0, q.hi0, q.lz, q.rs
+        neq = q.neq
         acon, rs = np.vstack(rows), np.concatenate(rs)
         sv = np.concatenate([su_u, np.tile(sx, hp - 1), np.full(ns, k["sw"])])
         p_s = pmat * np.outer(sv, sv)
@@ -689,7 +755,24 @@ class MPC:
               u_prev: np.ndarray | None = None) -> tuple[np.ndarray | None, str]:
         """One QP: state deviation ``x`` (n_x,), disturbance preview deviations (H_p, n_d) or
         None (held at zero), previous command deviation (n_u,). Returns the planned inputs
-        (H_u, n_u) (None if the solver failed) and the solver status."""
+        (H_u, n_u) (None if the solver failed) and the solver status.
+
+        Parameters
+        ----------
+        x : (n_x,) ndarray
+            State deviation from the operating point.
+        d_preview : (H_p, n_d) ndarray, optional
+            Disturbance preview deviations (None: held at zero).
+        u_prev : (n_u,) ndarray, optional
+            Previous command deviation.
+
+        Returns
+        -------
+        plan : (H_u, n_u) ndarray or None
+            Planned input deviations (None when the solver failed).
+        status : str
+            The backend's status.
+        """
         nx, nu, nd, hp, hu = self._nx, self._nu, self._nd, self.hp, self.hu
         x = np.asarray(x, float)
         if x.shape != (nx,):
@@ -730,7 +813,13 @@ class MPC:
     def qp(self) -> dict[str, np.ndarray]:
         """The scaled QP of the last :meth:`solve`, for other solvers and checks:
         minimise 0.5 v'Hv + q'v over v with lo_box <= v <= hi_box and lo <= A v <= hi; the
-        inputs are ``v * scale`` (H_u n_u, input deviations stacked by step)."""
+        inputs are ``v * scale`` (H_u n_u, input deviations stacked by step).
+
+        Returns
+        -------
+        dict
+            ``H``, ``q``, ``A``, ``lo``, ``hi``, ``lo_box``, ``hi_box`` and ``scale``.
+        """
         if getattr(self, "_has_preview", None) is None:
             raise RuntimeError("no QP yet: call solve() first")
         z = self._z.copy()
@@ -744,7 +833,22 @@ class MPC:
 
     def step(self, t: float, meas: dict[str, Any]) -> tuple[np.ndarray, float]:
         """Harness step with full-state information (``meas["state"]``) and, optionally, a
-        LIDAR preview (``meas["preview"]``, per-blade winds) as the disturbance."""
+        LIDAR preview (``meas["preview"]``, per-blade winds) as the disturbance.
+
+        Parameters
+        ----------
+        t : float
+            Time [s].
+        meas : dict
+            The harness's measurements (:mod:`mpc_wt.simulate`).
+
+        Returns
+        -------
+        pitch_ref : (3,) ndarray
+            Blade pitch commands [rad].
+        gen_torque_ref : float
+            Generator torque command [N m].
+        """
         nx, nu, z = self._nx, self._nu, self._z
         dprev, st = None, _EMPTY
         if self.estimator is not None:
@@ -841,6 +945,24 @@ class ScheduledMPC:
     The wind signal is the mean of the Kalman estimator's blade-wind estimates
     (``wind_source="estimator"``, which turns on ``estimator="kalman"``) or the rotor mean of the
     LIDAR preview's first step (``wind_source="preview"``).
+
+    Parameters
+    ----------
+    family : LinearModelFamily
+        Models over mean wind (Madsen's configuration).
+    turbine : Turbine
+        For the actuator limits.
+    settings : MPCSettings, optional
+        Settings of every MPC (default: with the Kalman estimator when ``wind_source`` is
+        "estimator").
+    wind_source : {"estimator", "preview"}
+        The scheduling signal.
+    time_constant : float
+        Low-pass time constant of the scheduling wind [s].
+    hysteresis : float
+        Beyond the midpoint between grid winds [m/s].
+    initial_wind_mps : float, optional
+        Start wind [m/s] (default the family's middle).
     """
 
     def __init__(self, family: linearize.LinearModelFamily, turbine: linearize.Turbine,
@@ -849,9 +971,8 @@ class ScheduledMPC:
                  initial_wind_mps: float | None = None) -> None:
         if wind_source not in ("estimator", "preview"):
             raise ValueError(f"wind_source must be 'estimator' or 'preview', got {wind_source!r}")
-        for name, v in (("time_constant", time_constant), ("hysteresis", hysteresis)):
-            if not (math.isfinite(v) and v >= 0):
-                raise ValueError(f"{name} must be finite and >= 0, got {v!r}")
+        check_number("time_constant", time_constant, lo=0.0)
+        check_number("hysteresis", hysteresis, lo=0.0)
         st = settings or MPCSettings()
         if wind_source == "estimator":
             if settings is None:
@@ -863,7 +984,7 @@ class ScheduledMPC:
         self.wind_source, self.tau, self.hyst = wind_source, float(time_constant), \
             float(hysteresis)
         self._ctl: dict[int, MPC] = {}
-        grid = family.wind_speeds
+        grid = family.wind_mps
         w0 = float(grid[len(grid) // 2]) if initial_wind_mps is None else initial_wind_mps
         if not (math.isfinite(w0) and grid[0] <= w0 <= grid[-1]):
             raise ValueError(f"initial_wind_mps must lie in the family's range {grid[0]:g}.."
@@ -872,14 +993,26 @@ class ScheduledMPC:
         self.reset()
 
     def controller(self, k: int) -> MPC:
-        """The MPC of grid point ``k`` (built on first use)."""
+        """The MPC of grid point ``k`` (built on first use).
+
+        Parameters
+        ----------
+        k : int
+            Index in the family.
+
+        Returns
+        -------
+        MPC
+            Its controller.
+        """
         if k not in self._ctl:
             self._ctl[k] = MPC(self.family.models[k], self.turbine, self.settings)
         return self._ctl[k]
 
     def reset(self) -> None:
+        """Back to the initial wind's controller; every controller reset."""
         self._w = self._w_init
-        self.active = int(np.argmin(np.abs(self.family.wind_speeds - self._w)))
+        self.active = int(np.argmin(np.abs(self.family.wind_mps - self._w)))
         for c in self._ctl.values():
             c.reset()
         self.switches = 0
@@ -893,6 +1026,23 @@ class ScheduledMPC:
         self.switches += 1
 
     def step(self, t: float, meas: dict[str, Any]) -> tuple[np.ndarray, float]:
+        """Update the scheduling wind, switch controllers past the hysteresis, step the active
+        one.
+
+        Parameters
+        ----------
+        t : float
+            Time [s].
+        meas : dict
+            The harness's measurements (:mod:`mpc_wt.simulate`).
+
+        Returns
+        -------
+        pitch_ref : (3,) ndarray
+            Blade pitch commands [rad].
+        gen_torque_ref : float
+            Generator torque command [N m].
+        """
         ctl = self.controller(self.active)
         if self.wind_source == "preview" and meas.get("preview") is not None:
             wsig: float | None = float(np.mean(np.asarray(meas["preview"].blade)[0]))
@@ -903,7 +1053,7 @@ class ScheduledMPC:
         if wsig is not None:
             a = 1.0 if self.tau == 0 else min(1.0, ctl.dt / self.tau)
             self._w += a * (wsig - self._w)
-        grid = self.family.wind_speeds
+        grid = self.family.wind_mps
         k = int(np.argmin(np.abs(grid - self._w)))
         if k != self.active:
             mid = 0.5 * (grid[k] + grid[self.active])

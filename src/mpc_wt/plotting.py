@@ -46,6 +46,16 @@ def plot_cp_surface(tsr: np.ndarray, pitch_deg: np.ndarray, cp: np.ndarray, path
         Pitch angles [deg].
     cp : (n_pitch, n_tsr) ndarray
         Power coefficient [-].
+
+    path : str or Path
+        The PNG file.
+    title : str
+        Title (default a generic one).
+
+    Returns
+    -------
+    Path
+        The PNG file.
     """
     plt = _plt()
     fig, ax = plt.subplots(figsize=(7.5, 5.0), dpi=120)
@@ -67,9 +77,24 @@ def plot_cp_surface(tsr: np.ndarray, pitch_deg: np.ndarray, cp: np.ndarray, path
 
 def plot_operating_schedule(points: Sequence[OperatingPoint], path: str | Path,
                             title: str = "") -> Path:
-    """Four panels against wind speed: power, rotor speed, pitch, thrust and generator torque."""
+    """Four panels against wind speed: power, rotor speed, pitch, thrust and generator torque.
+
+    Parameters
+    ----------
+    points : sequence of OperatingPoint
+        The steady operating points.
+    path : str or Path
+        The PNG file.
+    title : str
+        Title.
+
+    Returns
+    -------
+    Path
+        The PNG file.
+    """
     plt = _plt()
-    v = np.array([p.wind_speed for p in points])
+    v = np.array([p.wind_mps for p in points])
     fig, axs = plt.subplots(2, 2, figsize=(9.0, 6.5), dpi=120, sharex=True)
     axs[0, 0].plot(v, [p.power / 1e6 for p in points], "o-", ms=3, label="electrical")
     axs[0, 0].plot(v, [p.aero_power / 1e6 for p in points], "s--", ms=3, label="aerodynamic")
@@ -92,7 +117,7 @@ def plot_operating_schedule(points: Sequence[OperatingPoint], path: str | Path,
     for p in points:
         if p.region == "3":
             for ax in axs.flat:
-                ax.axvline(p.wind_speed, color="0.6", lw=0.8, ls=":")
+                ax.axvline(p.wind_mps, color="0.6", lw=0.8, ls=":")
             break
     fig.suptitle(title or "Steady operating schedule")
     return _save(fig, path)
@@ -108,6 +133,11 @@ def plot_lidar_coherence(f: np.ndarray, gamma2: np.ndarray, bandwidth_hz: float,
         [Hz]
     gamma2 : (n_f, 3) ndarray
         [-]
+
+    Returns
+    -------
+    Path
+        The PNG file.
     """
     plt = _plt()
     fig, ax = plt.subplots(figsize=(7.0, 4.2), dpi=120)
@@ -136,6 +166,11 @@ def plot_scan_pattern(beam_azimuth_rad: np.ndarray, blade_azimuth_rad: np.ndarra
         Azimuth of each beam's focus [rad] (0 = up, clockwise seen from upwind).
     blade_azimuth_rad : (n_t,) ndarray
         Azimuth of blade 1 [rad].
+
+    Returns
+    -------
+    Path
+        The PNG file.
     """
     plt = _plt()
     fig, ax = plt.subplots(figsize=(5.5, 5.5), dpi=120)
@@ -165,6 +200,20 @@ def plot_cs_ellipses(items: list[tuple[str, Any, np.ndarray, np.ndarray]], path:
     """Do et al. (2020) fig. 4: load-power samples and their 95 % ellipses for several runs.
 
     ``items``: (label, CSMeasures, load samples, power samples) per run.
+
+    Parameters
+    ----------
+    items : list of (str, CSMeasures, (n_t,) ndarray, (n_t,) ndarray)
+        Label, measures, load samples [N m] and power samples [W] per run.
+    path : str or Path
+        The PNG file.
+    load_label : str
+        Axis label of the load.
+
+    Returns
+    -------
+    Path
+        The PNG file.
     """
     plt = _plt()
     fig, ax = plt.subplots(figsize=(7.0, 5.0), dpi=120)
@@ -187,7 +236,24 @@ def plot_cs_ellipses(items: list[tuple[str, Any, np.ndarray, np.ndarray]], path:
 
 def plot_psd_comparison(items: list[tuple[str, np.ndarray, np.ndarray]], rotor_hz: float,
                         path: str | Path, ylabel: str) -> Path:
-    """PSDs of one channel for several runs, with 1P, 3P, 6P marked."""
+    """PSDs of one channel for several runs, with 1P, 3P, 6P marked.
+
+    Parameters
+    ----------
+    items : list of (str, ndarray, ndarray)
+        Label, frequencies [Hz] and PSD per run.
+    rotor_hz : float
+        Rotor frequency 1P [Hz].
+    path : str or Path
+        The PNG file.
+    ylabel : str
+        Axis label of the PSD.
+
+    Returns
+    -------
+    Path
+        The PNG file.
+    """
     plt = _plt()
     fig, ax = plt.subplots(figsize=(7.0, 4.2), dpi=120)
     for label, f, p in items:
@@ -204,7 +270,20 @@ def plot_psd_comparison(items: list[tuple[str, np.ndarray, np.ndarray]], rotor_h
 
 def assess_plots(runs: Sequence[tuple[str, np.ndarray, dict[str, np.ndarray]]],
                  out_dir: str | Path) -> list[str]:
-    """CS ellipses (Do et al. fig. 4) and flap-moment PSDs of several runs, as PNG."""
+    """CS ellipses (Do et al. fig. 4) and flap-moment PSDs of several runs, as PNG.
+
+    Parameters
+    ----------
+    runs : sequence of (str, (n_t,) ndarray, dict)
+        Label, time [s] and channels of each run.
+    out_dir : str or Path
+        Folder of ``cs_ellipses.png`` and ``psd_flap_moment_1.png`` (created).
+
+    Returns
+    -------
+    list of str
+        The files written.
+    """
     from .assess import cs_measures, psd
 
     d = Path(out_dir)

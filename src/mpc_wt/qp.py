@@ -80,7 +80,13 @@ class QPBackend:
         raise NotImplementedError
 
     def update_bounds(self, lo: np.ndarray, hi: np.ndarray) -> None:
-        """New bounds of all rows, (n_c,) each."""
+        """New bounds of all rows, (n_c,) each.
+
+        Parameters
+        ----------
+        lo, hi : (n_c,) ndarray
+            Lower and upper bounds of every row.
+        """
         raise NotImplementedError
 
     def solve(self) -> tuple[np.ndarray | None, str]:
@@ -110,6 +116,11 @@ class OSQPBackend(QPBackend):
     interface. The warm start is rounded to 2^-52 absolute: the shifted iterates sit at zero
     when no constraint binds, and without rounding they decay into subnormal numbers that make
     every iteration some 50 times slower.
+
+    Parameters
+    ----------
+    options : dict, optional
+        OSQP settings (``eps_abs``, ``max_iter``, ...).
     """
 
     name, module, extra = "osqp", "osqp", "osqp"
@@ -120,7 +131,6 @@ class OSQPBackend(QPBackend):
                   -5: "unsolved"}
 
     def setup(self, h: Any, q: np.ndarray, a: Any, n_box: int) -> None:
-        """See :meth:`QPBackend.setup`."""
         osqp = self.import_solver()
         n_c = a.shape[0]
         self.solver = osqp.OSQP()
@@ -143,14 +153,12 @@ class OSQPBackend(QPBackend):
             self.ext = None
 
     def update_bounds(self, lo: np.ndarray, hi: np.ndarray) -> None:
-        """See :meth:`QPBackend.update_bounds`."""
         if self.ext is not None:
             self.ext.update_data_vec(q=None, l=lo, u=hi)
         else:
             self.solver.update(l=lo, u=hi)
 
     def solve(self) -> tuple[np.ndarray | None, str]:
-        """See :meth:`QPBackend.solve`."""
         ext = self.ext
         if ext is None:
             res = self.solver.solve(raise_error=False)
@@ -176,12 +184,17 @@ class OSQPBackend(QPBackend):
 
     @property
     def iterations(self) -> int:
-        """See :meth:`QPBackend.iterations`."""
         return int(self.info.iter)
 
 
 class DAQPBackend(QPBackend):
-    """DAQP (dual active set; dense problems, exact to its tolerances on these small QPs)."""
+    """DAQP (dual active set; dense problems, exact to its tolerances on these small QPs).
+
+    Parameters
+    ----------
+    options : dict, optional
+        Unused (DAQP's defaults are kept).
+    """
 
     name, module, extra, dense_only = "daqp", "daqp", "daqp", True
     STATUS_MAP = {1: "solved", 2: "solved", -1: "primal infeasible", -2: "cycling detected",
@@ -189,7 +202,6 @@ class DAQPBackend(QPBackend):
                   -6: "initial working set overdetermined"}
 
     def setup(self, h: Any, q: np.ndarray, a: Any, n_box: int) -> None:
-        """See :meth:`QPBackend.setup`."""
         daqp = self.import_solver()
         a = np.asarray(a.toarray() if sp.issparse(a) else a, float)
         free = np.full(a.shape[0], 1e30)               # the bounds are set every step
@@ -198,11 +210,9 @@ class DAQPBackend(QPBackend):
                          np.ascontiguousarray(a[n_box:]), free, -free)
 
     def update_bounds(self, lo: np.ndarray, hi: np.ndarray) -> None:
-        """See :meth:`QPBackend.update_bounds`."""
         self.model.update(bupper=hi, blower=lo)
 
     def solve(self) -> tuple[np.ndarray | None, str]:
-        """See :meth:`QPBackend.solve`."""
         xs, _, flag, self.info = self.model.solve()
         if flag != 1:
             return None, f"daqp exitflag {flag} ({self.STATUS_MAP.get(flag, 'unknown')})"
@@ -213,7 +223,6 @@ class DAQPBackend(QPBackend):
 
     @property
     def iterations(self) -> int:
-        """See :meth:`QPBackend.iterations`."""
         return int(self.info["iterations"])
 
 

@@ -55,7 +55,23 @@ class ClosedLoopResult:
         """A time series by name: output, state, input, controller signal, or the derived
         ``shaft_bending_blade1``: the rotating low-speed-shaft bending moment in the direction
         of blade 1 from the blades' flap moments, M_1 - (M_2 + M_3) / 2 [N m] (rotor weight
-        and hub inertia left out)."""
+        and hub inertia left out).
+
+        Parameters
+        ----------
+        name : str
+            A name of :meth:`channels`.
+
+        Returns
+        -------
+        (n_t,) ndarray
+            The series (SI units of the name's table).
+
+        Raises
+        ------
+        KeyError
+            Naming the channel and listing the channels.
+        """
         if name == "shaft_bending_blade1":
             f = self.z[:, _Z["flap_moment_1"]:_Z["flap_moment_3"] + 1]
             return f[:, 0] - 0.5 * (f[:, 1] + f[:, 2])
@@ -70,7 +86,13 @@ class ClosedLoopResult:
         raise KeyError(f"no channel {name!r}; channels are {self.channels()}")
 
     def channels(self) -> list[str]:
-        """All channel names."""
+        """All channel names.
+
+        Returns
+        -------
+        list of str
+            Outputs, states, inputs, derived channels and controller signals.
+        """
         return (list(linearize.OUTPUT_NAMES) + [n for n in linearize.STATE_NAMES
                                                 if n not in _Z]
                 + list(linearize.INPUT_NAMES) + ["shaft_bending_blade1"]
@@ -78,7 +100,18 @@ class ClosedLoopResult:
 
     def save(self, path: str | Path) -> Path:
         """Write a self-describing netCDF file (xarray; openable without mpc-wt) with units,
-        the configuration and the software version; written to a temporary file, then renamed."""
+        the configuration and the software version; written to a temporary file, then renamed.
+
+        Parameters
+        ----------
+        path : str or Path
+            The netCDF file.
+
+        Returns
+        -------
+        Path
+            ``path``.
+        """
         import xarray as xr
 
         path = Path(path)
@@ -145,6 +178,21 @@ class ClosedLoopResult:
 def load_series(path: str | Path, time_column: str = "time") -> tuple[np.ndarray,
                                                                        dict[str, np.ndarray]]:
     """Time and channels of a run: our netCDF result, or any CSV with a time column.
+
+
+    Parameters
+    ----------
+    path : str or Path
+        A result file (.nc) or a CSV with a header row.
+    time_column : str
+        The CSV's time column.
+
+    Returns
+    -------
+    t : (n_t,) ndarray
+        Time [s].
+    cols : dict of str to (n_t,) ndarray
+        The other columns by name.
 
     Raises
     ------

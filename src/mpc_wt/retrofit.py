@@ -44,13 +44,14 @@ import numpy as np
 from scipy import signal
 
 import linearize
+from linearize.validate import check_number
 
-from .assess import aep_Wh, lifetime_del, lifetime_extension
+from .assess import aep_Wh
 from .baseline import BaselineController, BaselineGains, check_power_fraction
+from .filters import SOSFilterBank, filter_sos
 
-__all__ = ["apc_reference", "check_corner", "filter_sos", "SOSFilterBank", "IBCGains",
-           "tune_ibc", "IBCController", "ColemanIPCGains", "tune_coleman_ipc",
-           "ColemanIPCController", "steady_power_curve", "aep_change", "lifetime_comparison",
+__all__ = ["apc_reference", "IBCGains", "tune_ibc", "IBCController", "ColemanIPCGains",
+           "tune_coleman_ipc", "ColemanIPCController", "steady_power_curve", "aep_change",
            "power_weight"]
 
 
@@ -66,15 +67,28 @@ def apc_reference(frequency_hz: float, *, amplitude: float = 0.375, offset: floa
     the sine is negative, which no generator at rated can give; the default keeps the printed
     peak reduction 3/4 and shifts the sine into [0, 3/4].
 
+
+    Parameters
+    ----------
+    frequency_hz : float
+        f_r [Hz], >= 0 (0: a constant reduction at the offset).
+    amplitude : float
+        Amplitude of Delta P (fraction of rated) [-].
+    offset : float
+        Mean of Delta P [-].
+
+    Returns
+    -------
+    callable
+        t [s] -> Delta P(t) [-].
+
     Raises
     ------
     ValueError
         If the frequency is negative or not finite, or Delta P leaves [0, 1): a reduction below
         0 asks for more than rated power, one of 1 or more for no power at all.
     """
-    f = float(frequency_hz)
-    if not (math.isfinite(f) and f >= 0):
-        raise ValueError(f"frequency_hz must be finite and >= 0, got {frequency_hz!r}")
+    f = check_number("frequency_hz", frequency_hz, lo=0.0)
     a, o = float(amplitude), float(offset)
     if not (math.isfinite(a) and math.isfinite(o) and a >= 0):
         raise ValueError(f"amplitude must be finite and >= 0 and offset finite, got {amplitude!r}"
@@ -89,89 +103,24 @@ def apc_reference(frequency_hz: float, *, amplitude: float = 0.375, offset: floa
     return lambda t: o + a * math.sin(2.0 * math.pi * f * t)
 
 
-# --------------------------------------------------------------------------------------------
-# Filters
-# --------------------------------------------------------------------------------------------
-def check_corner(name: str, freq_hz: float, fs: float) -> float:
-    """A filter corner frequency: finite and strictly between 0 and the Nyquist frequency."""
-    f = float(freq_hz)
-    if not (math.isfinite(f) and 0.0 < f < 0.5 * fs):
-        raise ValueError(f"{name} = {freq_hz!r} Hz must be in (0, Nyquist = {0.5 * fs:g} Hz) at "
-                         f"the controller rate {fs:g} Hz")
-    return f
-
-
-def filter_sos(fs: float, *, highpass_hz: float | None = None, highpass_order: int = 1,
-               notch_hz: Sequence[float] = (), notch_q: float = 1.0,
-               lowpass_hz: float | None = None, lowpass_order: int = 2) -> np.ndarray:
-    """Second-order sections of a discrete filter chain at sample rate ``fs`` [Hz]: Butterworth
-    high-pass, notches (band-stop, quality ``notch_q``: bandwidth f0 / Q) and Butterworth
-    low-pass (scipy.signal). An empty chain is the identity.
-
-    Raises
-    ------
-    ValueError
-        If a corner is not in (0, fs / 2) (names the parameter) or an order or Q is not positive.
-    """
-    if not (math.isfinite(fs) and fs > 0):
-        raise ValueError(f"fs must be > 0 Hz, got {fs!r}")
-    sos = [np.array([[1.0, 0.0, 0.0, 1.0, 0.0, 0.0]])]
-    if highpass_hz is not None:
-        if int(highpass_order) < 1:
-            raise ValueError(f"highpass_order must be >= 1, got {highpass_order!r}")
-        sos.append(signal.butter(int(highpass_order), check_corner("highpass_hz", highpass_hz, fs),
-                                 "highpass", fs=fs, output="sos"))
-    if notch_hz is not None and len(notch_hz):
-        if not notch_q > 0:
-            raise ValueError(f"notch_q must be > 0, got {notch_q!r}")
-        for f0 in notch_hz:
-            b, a = signal.iirnotch(check_corner("notch_hz", f0, fs), notch_q, fs=fs)
-            sos.append(signal.tf2sos(b, a))
-    if lowpass_hz is not None:
-        if int(lowpass_order) < 1:
-            raise ValueError(f"lowpass_order must be >= 1, got {lowpass_order!r}")
-        sos.append(signal.butter(int(lowpass_order), check_corner("lowpass_hz", lowpass_hz, fs),
-                                 "lowpass", fs=fs, output="sos"))
-    return np.vstack(sos)
-
-
-class SOSFilterBank:
-    """The same discrete filter on ``n_channels`` signals, one sample at a time.
-
-    ``step(x)`` filters one sample of each channel ((n_channels,) in and out) with
-    :func:`scipy.signal.sosfilt` and its carried state; the first sample initialises the state
-    to the steady state of that input (no start-up transient).
-    """
-
-    def __init__(self, sos: np.ndarray, n_channels: int) -> None:
-        self.sos = np.atleast_2d(np.asarray(sos, float))
-        if self.sos.ndim != 2 or self.sos.shape[1] != 6:
-            raise ValueError(f"sos has shape {self.sos.shape}; expected (n_sections, 6)")
-        self.n = int(n_channels)
-        self._zi1 = signal.sosfilt_zi(self.sos)            # (n_sections, 2) for a unit step
-        self.reset()
-
-    def reset(self) -> None:
-        """Forget the filter state."""
-        self.zi: np.ndarray | None = None
-
-    def step(self, x: Any) -> np.ndarray:
-        """Filter one sample per channel."""
-        x = np.asarray(x, float).reshape(1, self.n)
-        if self.zi is None:
-            self.zi = self._zi1[:, :, None] * x[0][None, None, :]
-        y, self.zi = signal.sosfilt(self.sos, x, axis=0, zi=self.zi)
-        return y[0]
-
-    def response(self, freq_hz: Any, fs: float) -> np.ndarray:
-        """Complex frequency response at ``freq_hz``."""
-        return signal.sosfreqz(self.sos, worN=np.atleast_1d(np.asarray(freq_hz, float)),
-                               fs=fs)[1]
-
-
 def power_weight(power_W: float, rated_power_W: float, weight_range: tuple[float, float]) -> float:
     """Activation weight rising linearly from 0 at ``weight_range[0]`` P_r to 1 at
-    ``weight_range[1]`` P_r (Pettas and Cheng sec. 3.1) [-]."""
+    ``weight_range[1]`` P_r (Pettas and Cheng sec. 3.1) [-].
+
+    Parameters
+    ----------
+    power_W : float
+        Power [W].
+    rated_power_W : float
+        Rated (or derated) power [W].
+    weight_range : (float, float)
+        Power fractions where the weight starts and reaches 1 [-].
+
+    Returns
+    -------
+    float
+        The weight in [0, 1].
+    """
     lo, hi = weight_range
     return float(min(max((power_W / rated_power_W - lo) / (hi - lo), 0.0), 1.0))
 
@@ -274,17 +223,40 @@ class IBCGains:
         return self.rotor_speed_rad_s / (2 * math.pi)
 
     def input_sos(self) -> np.ndarray:
-        """Second-order sections of the input (high-pass) filter."""
+        """Second-order sections of the input (high-pass) filter.
+
+        Returns
+        -------
+        (n_sections, 6) ndarray
+            The sections.
+        """
         return _ibc_sos(self.fs, self.one_p_hz, self.highpass_hz, self.notch_harmonics,
                         self.notch_q, self.lowpass_hz)[0]
 
     def output_sos(self) -> np.ndarray:
-        """Second-order sections of the output (band-stop, optional low-pass) filters."""
+        """Second-order sections of the output (band-stop, optional low-pass) filters.
+
+        Returns
+        -------
+        (n_sections, 6) ndarray
+            The sections.
+        """
         return _ibc_sos(self.fs, self.one_p_hz, self.highpass_hz, self.notch_harmonics,
                         self.notch_q, self.lowpass_hz)[1]
 
     def gain_at(self, pitch_rad: float) -> float:
-        """Scheduled gain at a mean pitch (held at the ends of the table) [rad/(N m)]."""
+        """Scheduled gain at a mean pitch (held at the ends of the table) [rad/(N m)].
+
+        Parameters
+        ----------
+        pitch_rad : float
+            Mean pitch [rad].
+
+        Returns
+        -------
+        float
+            Gain [rad/(N m)].
+        """
         return float(np.interp(pitch_rad, self.pitch_rad, self.gain))
 
 
@@ -334,6 +306,11 @@ def tune_ibc(turbine: linearize.Turbine, *, winds: Any = None, dt: float = 1.0 /
         Second-order low-pass corner on the output [Hz] (not in the paper; it limits the pitch
         acceleration the loops ask for above 3P).
 
+    Returns
+    -------
+    IBCGains
+        The gain schedule over pitch with the filters, margins and the reached 1P loop gain.
+
     Raises
     ------
     ValueError
@@ -342,19 +319,9 @@ def tune_ibc(turbine: linearize.Turbine, *, winds: Any = None, dt: float = 1.0 /
     RuntimeError
         If a blade loop is unstable even at the smallest gain tried.
     """
-    import control
-
     frac = check_power_fraction(power_fraction)
-    if not (dt > 0 and math.isfinite(dt)):
-        raise ValueError(f"dt must be > 0 s, got {dt!r}")
-    if not (loop_gain_1p > 0 and min_gain_margin > 1):
-        raise ValueError(f"loop_gain_1p must be > 0 and min_gain_margin > 1, got "
-                         f"{loop_gain_1p!r}, {min_gain_margin!r}")
+    harm = _check_ibc_args(dt, loop_gain_1p, min_gain_margin, notch_harmonics)
     wr = _check_weight_range(weight_range)
-    harm = tuple(float(h) for h in notch_harmonics)
-    if any(not h > 0 for h in harm):
-        raise ValueError(f"notch_harmonics must be positive multiples of 1P, got "
-                         f"{notch_harmonics!r}")
     om = turbine.operation.rated_rotor_speed_rad_s
     f1p = om / (2 * math.pi)
     fs = 1.0 / dt
@@ -370,22 +337,11 @@ def tune_ibc(turbine: linearize.Turbine, *, winds: Any = None, dt: float = 1.0 /
     pitch, k_out, gm_out, l1p = [], [], [], []
     for w in v:
         m = _blade_model(turbine, float(w), p_w, params)
-        s = m.select(inputs=["pitch_ref_1"], outputs=["flap_moment_1"]).discretize(dt)
-        g1 = complex(_freq_resp(s.A, s.B_u, s.C_z, s.D_u, zf)[0, 0])
-        k = loop_gain_1p / abs(f1 * g1)
-        plant = control.ss(s.A, s.B_u, -s.C_z, -s.D_u, dt)     # -G: pitch up lowers the moment
-        loop = plant * f_sys
-        gm = _gain_margin(loop, k)
-        if gm < min_gain_margin:
-            k *= gm / min_gain_margin
-            gm = _gain_margin(loop, k)
-        if not gm > 1.0:
-            raise RuntimeError(f"IBC blade loop at {w:g} m/s is unstable at gain {k:g} "
-                               f"rad/(N m); check the filters")
+        k, gm, lg = _ibc_gain(m, dt, zf, f1, f_sys, loop_gain_1p, min_gain_margin)
         pitch.append(m.info["pitch_deg"] * math.pi / 180)
         k_out.append(k)
         gm_out.append(gm)
-        l1p.append(k * abs(f1 * g1))
+        l1p.append(lg)
     order = np.argsort(pitch)
     return IBCGains(pitch_rad=np.asarray(pitch)[order], gain=np.asarray(k_out)[order],
                     wind_mps=v[order], gain_margin=np.asarray(gm_out)[order],
@@ -394,6 +350,41 @@ def tune_ibc(turbine: linearize.Turbine, *, winds: Any = None, dt: float = 1.0 /
                     weight_range=wr, rated_power=p_rated, power_fraction=frac,
                     lowpass_hz=lowpass_hz, info={"target_loop_gain_1p": loop_gain_1p,
                           "min_gain_margin": min_gain_margin})
+
+
+def _check_ibc_args(dt: float, loop_gain_1p: float, min_gain_margin: float,
+                    notch_harmonics: Sequence[int]) -> tuple[float, ...]:
+    """Check tune_ibc's numbers; the notch harmonics as floats."""
+    check_number("dt", dt, lo=0.0, lo_open=True, unit="s")
+    if not (loop_gain_1p > 0 and min_gain_margin > 1):
+        raise ValueError(f"loop_gain_1p must be > 0 and min_gain_margin > 1, got "
+                         f"{loop_gain_1p!r}, {min_gain_margin!r}")
+    harm = tuple(float(h) for h in notch_harmonics)
+    if any(not h > 0 for h in harm):
+        raise ValueError(f"notch_harmonics must be positive multiples of 1P, got "
+                         f"{notch_harmonics!r}")
+    return harm
+
+
+def _ibc_gain(m: linearize.LinearModel, dt: float, zf: complex, f1: complex, f_sys: Any,
+              loop_gain_1p: float, min_gain_margin: float) -> tuple[float, float, float]:
+    """One blade loop's gain at one operating point: |k F G| = target at 1P, lowered until the
+    gain margin is met; returns (gain, gain margin, loop gain at 1P)."""
+    import control
+
+    s = m.select(inputs=["pitch_ref_1"], outputs=["flap_moment_1"]).discretize(dt)
+    g1 = complex(_freq_resp(s.A, s.B_u, s.C_z, s.D_u, zf)[0, 0])
+    k = loop_gain_1p / abs(f1 * g1)
+    plant = control.ss(s.A, s.B_u, -s.C_z, -s.D_u, dt)     # -G: pitch up lowers the moment
+    loop = plant * f_sys
+    gm = _gain_margin(loop, k)
+    if gm < min_gain_margin:
+        k *= gm / min_gain_margin
+        gm = _gain_margin(loop, k)
+    if not gm > 1.0:
+        raise RuntimeError(f"IBC blade loop at {m.wind_mps:g} m/s is unstable at gain {k:g} "
+                           f"rad/(N m); check the filters")
+    return k, gm, k * abs(f1 * g1)
 
 
 def _sos_ss(sos: np.ndarray, dt: float) -> Any:
@@ -492,6 +483,15 @@ class IBCController(_PitchAddOn):
     collective loop's way; on our plant at 18 m/s (600 s, shear 0.2) that raised the flap DEL
     by 3 %, the tower fore-aft DEL by 21 % and the shaft-torque DEL by 28 %, while the mean
     removal gave -21 %, +0.6 % and -0.1 % for the same 1P reduction (benchmarks/RESULTS.md).
+
+    Parameters
+    ----------
+    collective : BaselineController
+        The collective controller.
+    gains : IBCGains
+        From :func:`tune_ibc` at the collective's dt.
+    remove_collective : bool
+        Subtract the blades' mean IBC pitch (cyclic action only).
     """
 
     def __init__(self, collective: BaselineController, gains: IBCGains, *,
@@ -509,7 +509,22 @@ class IBCController(_PitchAddOn):
         self._bs.reset()
 
     def step(self, t: float, meas: dict[str, Any]) -> tuple[np.ndarray, float]:
-        """One control step; returns (pitch_ref (3,) [rad], gen_torque_ref [N m])."""
+        """One control step; returns (pitch_ref (3,) [rad], gen_torque_ref [N m]).
+
+        Parameters
+        ----------
+        t : float
+            Time [s].
+        meas : dict
+            The harness's measurements (:mod:`mpc_wt.simulate`).
+
+        Returns
+        -------
+        pitch_ref : (3,) ndarray
+            Blade pitch commands [rad].
+        gen_torque_ref : float
+            Generator torque command [N m].
+        """
         pc, tq = self.collective.step(t, meas)
         m = np.asarray(meas["flap_moment"], float)
         if m.shape != (3,) or not np.all(np.isfinite(m)):
@@ -577,7 +592,20 @@ class ColemanIPCGains:
             raise ValueError("pitch_rad must be strictly increasing")
 
     def at(self, pitch_rad: float) -> tuple[float, float]:
-        """(K_I, phi) at a mean pitch."""
+        """(K_I, phi) at a mean pitch.
+
+        Parameters
+        ----------
+        pitch_rad : float
+            Mean pitch [rad].
+
+        Returns
+        -------
+        ki : float
+            Integral gain [rad/(N m s)].
+        phi : float
+            Azimuth offset [rad].
+        """
         return (float(np.interp(pitch_rad, self.pitch_rad, self.ki)),
                 float(np.interp(pitch_rad, self.pitch_rad, self.azimuth_offset_rad)))
 
@@ -597,6 +625,26 @@ def tune_coleman_ipc(turbine: linearize.Turbine, *, winds: Any = None,
     g R(phi); K_I = crossover / g makes both loops integrators crossing over at
     ``crossover_rad_s``, and phi is the azimuth offset. The 2x2 closed loop of the MBC model
     with the integral controller is checked stable and its gain margin reported.
+
+    Parameters
+    ----------
+    turbine : Turbine
+        The turbine.
+    winds : array_like, optional
+        Region-III winds of the schedule [m/s] (default every 2 m/s above rated).
+    crossover_rad_s : float
+        Crossover of the integral loops [rad/s].
+    max_amplitude_deg : float
+        Largest cyclic pitch amplitude [deg].
+    weight_range : (float, float)
+        Power fractions of the fade-in [-].
+    power_fraction : float
+        Tune on the operating points derated to this fraction [-].
+
+    Returns
+    -------
+    ColemanIPCGains
+        K_I and the azimuth offset over pitch, with the gain margins.
     """
     frac = check_power_fraction(power_fraction)
     if not crossover_rad_s > 0:
@@ -649,13 +697,35 @@ class ColemanIPCController(_PitchAddOn):
 
     Signals: the collective's, plus ``ipc_weight``, ``ipc_tilt_moment``, ``ipc_yaw_moment``
     [N m] and ``ipc_pitch_cos``, ``ipc_pitch_sin`` [rad].
+
+    Parameters
+    ----------
+    collective : BaselineController
+        The collective controller.
+    gains : ColemanIPCGains
+        From :func:`tune_coleman_ipc`.
     """
 
     def _reset_own(self) -> None:
         self._theta_cs = np.zeros(2)
 
     def step(self, t: float, meas: dict[str, Any]) -> tuple[np.ndarray, float]:
-        """One control step; returns (pitch_ref (3,) [rad], gen_torque_ref [N m])."""
+        """One control step; returns (pitch_ref (3,) [rad], gen_torque_ref [N m]).
+
+        Parameters
+        ----------
+        t : float
+            Time [s].
+        meas : dict
+            The harness's measurements (:mod:`mpc_wt.simulate`).
+
+        Returns
+        -------
+        pitch_ref : (3,) ndarray
+            Blade pitch commands [rad].
+        gen_torque_ref : float
+            Generator torque command [N m].
+        """
         pc, tq = self.collective.step(t, meas)
         m = np.asarray(meas["flap_moment"], float)
         psi = float(meas["azimuth"])
@@ -695,6 +765,15 @@ def steady_power_curve(turbine: linearize.Turbine, gains: BaselineGains,
     -------
     dict
         ``wind_mps``, ``power_W``, ``rotor_speed_rad_s`` (n_v,) and ``region`` (n_v,) of str.
+
+    Parameters
+    ----------
+    turbine : Turbine
+        The turbine.
+    gains : BaselineGains
+        Normal or derated design.
+    winds : array_like
+        Steady winds [m/s].
     """
     from scipy.optimize import brentq
 
@@ -752,6 +831,25 @@ def aep_change(turbine: linearize.Turbine, fractions: Sequence[float] = (0.9, 0.
     dict
         ``aep_Wh`` per fraction (1.0 included), ``change_pct`` per derated fraction, the
         curves (``curves``) and the distribution.
+
+    Parameters
+    ----------
+    turbine : Turbine
+        The turbine.
+    fractions : sequence of float
+        Derating fractions to compare with full power.
+    kind : {"rayleigh", "weibull"}
+        Wind distribution.
+    mean : float, optional
+        Rayleigh mean [m/s].
+    shape : float
+        Weibull shape.
+    scale : float, optional
+        Weibull scale [m/s].
+    wind_step : float
+        Step of the steady power curve [m/s].
+    gains : mapping of float to BaselineGains, optional
+        Designs per fraction (default tuned here).
     """
     from .assess import wind_bin_probabilities
     from .baseline import tune_baseline
@@ -772,69 +870,4 @@ def aep_change(turbine: linearize.Turbine, fractions: Sequence[float] = (0.9, 0.
         out["aep_Wh"][f] = aep_Wh(curve["power_W"], prob)
     for f in fr[1:]:
         out["change_pct"][f] = 100.0 * (out["aep_Wh"][f] / out["aep_Wh"][1.0] - 1.0)
-    return out
-
-
-# --------------------------------------------------------------------------------------------
-# Metrics: lifetime-weighted comparison (Pettas and Cheng sec. 4, eq 1)
-# --------------------------------------------------------------------------------------------
-_STD_KEYS = ("gen_speed_std_rad_s", "gen_torque_std_Nm", "power_std_W")
-_PITCH_KEYS = ("pitch_travel_deg", "pitch_rate_std_degps", "pitch_acc_std_degps2")
-
-
-def lifetime_comparison(probabilities: Any, base: Sequence[Mapping[str, Any]],
-                        updated: Sequence[Mapping[str, Any]], *,
-                        woehler: Sequence[float] = (4.0, 10.0), t_base: float = 15.0,
-                        t_upd: float = 5.0, t_lifetime: float = 20.0) -> dict[str, Any]:
-    """Lifetime-weighted change of a retrofit controller against the baseline.
-
-    Parameters
-    ----------
-    probabilities : (n_bin,) array_like
-        Probability of each mean-wind bin [-].
-    base, updated : sequence of dict
-        One :func:`mpc_wt.runs.assess_series` result per bin (seeds merged by the caller).
-
-    Returns
-    -------
-    dict
-        ``del_change_pct`` per channel (lifetime DEL, Clemens eq 18, at each channel's own
-        Woehler exponent), ``lifetime_del`` {channel: (base, updated)}, ``aep_change_pct``
-        (probability-weighted mean power), ``pitch_change_pct`` and ``std_change_pct``
-        (probability-weighted means of the per-run metrics), and ``extension`` {channel: {m:
-        {"damage", "extension_years"}}} from eq 1 with the lifetime DEL ratio at each m in
-        ``woehler`` (the paper's 15 + 5 years by default).
-    """
-    p = np.asarray(probabilities, float)
-    if not (len(base) == len(updated) == p.size):
-        raise ValueError(f"probabilities ({p.size}), base ({len(base)}) and updated "
-                         f"({len(updated)}) must have one entry per wind bin")
-
-    def pct(a: float, b: float) -> float:
-        return 100.0 * (b / a - 1.0) if a else float("nan")
-
-    def wmean(runs: Sequence[Mapping[str, Any]], key: str) -> float:
-        return float(np.sum(p * np.array([r[key] for r in runs])) / p.sum())
-
-    chans = [c for c in base[0]["channels"] if all(c in r["channels"] for r in updated)]
-    out: dict[str, Any] = {"del_change_pct": {}, "lifetime_del": {}, "extension": {},
-                           "pitch_change_pct": {}, "std_change_pct": {}}
-    for c in chans:
-        m = float(base[0]["channels"][c]["m"])
-        db = np.array([r["channels"][c]["del"] for r in base])
-        du = np.array([r["channels"][c]["del"] for r in updated])
-        lb, lu = lifetime_del(db, m, p), lifetime_del(du, m, p)
-        out["lifetime_del"][c] = (lb, lu)
-        out["del_change_pct"][c] = pct(lb, lu)
-        out["extension"][c] = {}
-        for mw in woehler:
-            lbm, lum = lifetime_del(db, mw, p), lifetime_del(du, mw, p)
-            out["extension"][c][float(mw)] = lifetime_extension(
-                lbm, lum, mw, t_base=t_base, t_upd=t_upd, t_lifetime=t_lifetime)
-    if all("power_mean_W" in r for r in [*base, *updated]):
-        out["aep_change_pct"] = pct(wmean(base, "power_mean_W"), wmean(updated, "power_mean_W"))
-    for keys, dest in ((_PITCH_KEYS, "pitch_change_pct"), (_STD_KEYS, "std_change_pct")):
-        for k in keys:
-            if all(k in r for r in [*base, *updated]):
-                out[dest][k] = pct(wmean(base, k), wmean(updated, k))
     return out

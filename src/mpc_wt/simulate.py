@@ -38,13 +38,29 @@ _IX_AZ = linearize.STATE_NAMES.index("azimuth")
 
 class Controller(Protocol):
     """What the harness needs from a controller: ``reset()`` before a run and
-    ``step(t, meas) -> (pitch_ref (3,) [rad], gen_torque_ref [N m])`` at its rate."""
+    ``step(t, meas) -> (pitch_ref (3,) [rad], gen_torque_ref [N m])`` at its rate.
+    """
 
     def reset(self) -> None:
         """Forget everything of a previous run."""
 
     def step(self, t: float, meas: dict[str, Any]) -> tuple[np.ndarray, float]:
-        """Commands for the measurements ``meas`` at time ``t`` [s]."""
+        """Commands for the measurements ``meas`` at time ``t`` [s].
+
+        Parameters
+        ----------
+        t : float
+            Time [s].
+        meas : dict
+            The harness's measurements (:mod:`mpc_wt.simulate`).
+
+        Returns
+        -------
+        pitch_ref : (3,) ndarray
+            Blade pitch commands [rad].
+        gen_torque_ref : float
+            Generator torque command [N m].
+        """
 
 
 class LidarPreview:

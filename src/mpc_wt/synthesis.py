@@ -32,6 +32,7 @@ import numpy as np
 import scipy.linalg
 
 import linearize
+from linearize.validate import check_number
 
 from .errors import SynthesisError
 from .estimator import read_signals
@@ -64,10 +65,7 @@ def _names(model: linearize.LinearModel) -> dict[str, tuple[np.ndarray, str]]:
 
 
 def _check_weight(name: str, v: Any) -> float:
-    if not (isinstance(v, (int, float, np.floating)) and math.isfinite(v) and v >= 0):
-        raise ValueError(f"weight {name!r} must be finite and >= 0 (Q must be positive "
-                         f"semidefinite), got {v!r}")
-    return float(v)
+    return check_number(f"weight {name!r}", v, lo=0.0, reason="Q must be positive semidefinite")
 
 
 def _uncontrollable_modes(a: np.ndarray, b: np.ndarray, discrete: bool) -> list[complex]:
@@ -89,7 +87,7 @@ def _uncontrollable_modes(a: np.ndarray, b: np.ndarray, discrete: bool) -> list[
 class LQRDesign:
     """An LQR gain at one operating point: u - u0 = -K (x - x0).
 
-    Attributes
+    Parameters
     ----------
     K : ndarray (n_u, n_x)
         Gain on the state deviations, for the inputs ``inputs``.
@@ -110,7 +108,7 @@ class LQRDesign:
     inputs: tuple[str, ...]
     x0: np.ndarray
     u0: np.ndarray
-    wind_speed: float
+    wind_mps: float
     dt: float | None
     weights: dict[str, Any] = field(default_factory=dict)
 
@@ -135,6 +133,12 @@ def design_lqr(model: linearize.LinearModel, *,
     scales : dict of name to typical magnitude > 0
         Each weight is divided by the square of its signal's scale (default 1).
 
+    Returns
+    -------
+    LQRDesign
+        Gain K, Riccati solution P, weights Q and R, closed-loop eigenvalues and the
+        operating point.
+
     Raises
     ------
     ValueError
@@ -144,14 +148,45 @@ def design_lqr(model: linearize.LinearModel, *,
     """
     import control
 
-    scales = dict(scales or {})
-    for k, v in scales.items():
-        if not (isinstance(v, (int, float, np.floating)) and math.isfinite(v) and v > 0):
-            raise ValueError(f"scale {k!r} must be finite and > 0, got {v!r}")
+    scales = _check_scales(scales)
     sw = dict(state_weights or {})
     ow = dict(output_weights or {})
     if not sw and not ow:
         sw = {"rotor_speed": 1.0}
+    q = _state_weight_matrix(model, sw, ow, scales)
+    inputs = tuple(inputs)
+    r, iw = _input_weight_matrix(model, inputs, input_weights, scales)
+    iu = [model.inputs.index(n) for n in inputs]
+    a, b = model.A, model.B_u[:, iu]
+    discrete = model.dt is not None
+    modes = _uncontrollable_modes(a, b, discrete)
+    if modes:
+        raise SynthesisError(
+            f"(A, B) is not stabilizable with inputs {list(inputs)}: the modes "
+            f"{', '.join(f'{m.real:.4g}{m.imag:+.4g}j' for m in modes)} are "
+            f"{'outside the unit circle' if discrete else 'not in the open left half-plane'} and "
+            f"cannot be moved; add an input that acts on them or a model DOF that damps them")
+    try:
+        k, p, eig = (control.dlqr if discrete else control.lqr)(a, b, q, r)
+    except Exception as err:  # python-control raises ControlArgument / LinAlgError
+        raise SynthesisError(f"the Riccati equation has no stabilizing solution: {err}; "
+                             f"check that every unstable mode is seen by Q (detectability)") \
+            from err
+    k, p = np.asarray(k), np.asarray(p)
+    return LQRDesign(K=k, P=p, Q=q, R=r, closed_loop_eigs=np.asarray(eig),
+                     states=model.states, inputs=inputs, x0=model.x0.copy(),
+                     u0=model.u0[iu].copy(), wind_mps=float(model.wind_mps), dt=model.dt,
+                     weights={"state": sw, "output": ow, "input": iw, "scales": scales})
+
+
+def _check_scales(scales: Mapping[str, float] | None) -> dict[str, float]:
+    out = dict(scales or {})
+    return {k: check_number(f"scale {k!r}", v, lo=0.0, lo_open=True) for k, v in out.items()}
+
+
+def _state_weight_matrix(model: linearize.LinearModel, sw: Mapping[str, float],
+                         ow: Mapping[str, float], scales: Mapping[str, float]) -> np.ndarray:
+    """Q from weights on named states and outputs (w C_i' C_i), each divided by its scale^2."""
     nx = len(model.states)
     q = np.zeros((nx, nx))
     for group, kind in ((sw, "state"), (ow, "output")):
@@ -165,7 +200,16 @@ def design_lqr(model: linearize.LinearModel, *,
                    else np.eye(nx)[model.states.index(n)])
             q += w * np.outer(row, row)
     q = 0.5 * (q + q.T)
-    inputs = tuple(inputs)
+    lam = np.linalg.eigvalsh(q)
+    if lam[0] < -1e-10 * max(1.0, lam[-1]):
+        raise ValueError(f"Q is not positive semidefinite (smallest eigenvalue {lam[0]:g})")
+    return q
+
+
+def _input_weight_matrix(model: linearize.LinearModel, inputs: tuple[str, ...],
+                         input_weights: Mapping[str, float] | None,
+                         scales: Mapping[str, float]) -> tuple[np.ndarray, dict[str, float]]:
+    """R (diagonal, default 1 per input) and the weights by name."""
     bad = [n for n in inputs if n not in model.inputs]
     if bad or not inputs:
         raise ValueError(f"inputs {bad or inputs!r} not among the model's inputs "
@@ -174,42 +218,26 @@ def design_lqr(model: linearize.LinearModel, *,
     for n, w in (input_weights or {}).items():
         if n not in inputs:
             raise ValueError(f"input_weights: {n!r} is not one of the inputs {list(inputs)}")
-        if not (isinstance(w, (int, float, np.floating)) and math.isfinite(w) and w > 0):
-            raise ValueError(f"input weight {n!r} must be finite and > 0 (R must be positive "
-                             f"definite), got {w!r}")
-        iw[n] = float(w)
-    r = np.diag([iw[n] / scales.get(n, 1.0) ** 2 for n in inputs])
-    iu = [model.inputs.index(n) for n in inputs]
-    a, b = model.A, model.B_u[:, iu]
-    discrete = model.dt is not None
-    lam = np.linalg.eigvalsh(q)
-    if lam[0] < -1e-10 * max(1.0, lam[-1]):
-        raise ValueError(f"Q is not positive semidefinite (smallest eigenvalue {lam[0]:g})")
-    modes = _uncontrollable_modes(a, b, discrete)
-    if modes:
-        raise SynthesisError(
-            f"(A, B) is not stabilizable with inputs {list(inputs)}: the modes "
-            f"{', '.join(f'{m.real:.4g}{m.imag:+.4g}j' for m in modes)} are "
-            f"{'outside the unit circle' if discrete else 'not in the open left half-plane'} and "
-            f"cannot be moved; add an input that acts on them or a model DOF that damps them")
-    try:
-        if discrete:
-            k, p, eig = control.dlqr(a, b, q, r)
-        else:
-            k, p, eig = control.lqr(a, b, q, r)
-    except Exception as err:  # python-control raises ControlArgument / LinAlgError
-        raise SynthesisError(f"the Riccati equation has no stabilizing solution: {err}; "
-                             f"check that every unstable mode is seen by Q (detectability)") \
-            from err
-    k, p = np.asarray(k), np.asarray(p)
-    return LQRDesign(K=k, P=p, Q=q, R=r, closed_loop_eigs=np.asarray(eig),
-                     states=model.states, inputs=inputs, x0=model.x0.copy(),
-                     u0=model.u0[iu].copy(), wind_speed=float(model.wind_speed), dt=model.dt,
-                     weights={"state": sw, "output": ow, "input": iw, "scales": scales})
+        iw[n] = check_number(f"input weight {n!r}", w, lo=0.0, lo_open=True,
+                             reason="R must be positive definite")
+    return np.diag([iw[n] / scales.get(n, 1.0) ** 2 for n in inputs]), iw
 
 
 def design_lqr_family(family: linearize.LinearModelFamily, **kwargs: Any) -> list[LQRDesign]:
-    """:func:`design_lqr` at every model of ``family`` (same weights); a gain table over wind."""
+    """:func:`design_lqr` at every model of ``family`` (same weights); a gain table over wind.
+
+    Parameters
+    ----------
+    family : LinearModelFamily
+        Models over mean wind.
+    **kwargs
+        Passed to :func:`design_lqr`.
+
+    Returns
+    -------
+    list of LQRDesign
+        One per model.
+    """
     return [design_lqr(m, **kwargs) for m in family.models]
 
 
@@ -217,7 +245,7 @@ def design_lqr_family(family: linearize.LinearModelFamily, **kwargs: Any) -> lis
 class PIObserver:
     """PI observer gains (Do et al. eqs 13-16) on a continuous model.
 
-    Attributes
+    Parameters
     ----------
     L1, L2 : ndarray
         Proportional (n_x, n_y) and integral (n_f, n_y) gains.
@@ -264,6 +292,12 @@ def design_pi_observer(model: linearize.LinearModel, *,
     scales : dict of measured name to typical magnitude
         Measurements are divided by these before the design (R_obs = I on the scaled outputs).
 
+
+    Returns
+    -------
+    PIObserver
+        The gains L1, L2, the extended model and the error eigenvalues.
+
     Raises
     ------
     SynthesisError
@@ -274,8 +308,7 @@ def design_pi_observer(model: linearize.LinearModel, *,
     if model.dt is not None:
         raise ValueError("design_pi_observer needs a continuous model (Do et al. eqs 13-16); "
                          "it is discretized for the controller by LQRPIOController")
-    if not (isinstance(q, (int, float)) and math.isfinite(q) and q > 0):
-        raise ValueError(f"q must be finite and > 0, got {q!r}")
+    check_number("q", q, lo=0.0, lo_open=True)
     names = _names(model)
     bad = [n for n in measured if n not in names]
     if bad or not measured:
@@ -355,8 +388,7 @@ class LQRPIOController:
             raise ValueError(f"region must be 'II' or 'III', got {region!r}")
         if region == "II" and not (k_opt and k_opt > 0):
             raise ValueError("region 'II' needs k_opt > 0 [N m/(rad/s)^2]")
-        if not (math.isfinite(dt) and dt > 0):
-            raise ValueError(f"dt must be > 0 s, got {dt!r}")
+        check_number("dt", dt, lo=0.0, lo_open=True, unit="s")
         self.model, self.turbine, self.lqr, self.obs = model, turbine, lqr, observer
         self.dt, self.region, self.k_opt = float(dt), region, k_opt
         nx, nf = model.A.shape[0], observer.L2.shape[0]
@@ -391,6 +423,22 @@ class LQRPIOController:
         self.signals: dict[str, float] = {}
 
     def step(self, t: float, meas: dict[str, Any]) -> tuple[np.ndarray, float]:
+        """One control step: observer update, then u = u0 - K (x_hat - x0) (+ feedforward).
+
+        Parameters
+        ----------
+        t : float
+            Time [s].
+        meas : dict
+            The harness's measurements (:mod:`mpc_wt.simulate`).
+
+        Returns
+        -------
+        pitch_ref : (3,) ndarray
+            Blade pitch commands [rad].
+        gen_torque_ref : float
+            Generator torque command [N m].
+        """
         y = read_signals(meas, self.obs.measured) - self.obs.y0
         if not np.all(np.isfinite(y)):
             raise ValueError(f"non-finite measurement at t = {t:g} s: "

@@ -48,6 +48,7 @@ import numpy as np
 import scipy.linalg
 
 import linearize
+from linearize.validate import check_number
 
 from .estimator import read_signals
 from .retrofit import apc_reference  # noqa: F401 - re-exported (eq 11 lives with the APC)
@@ -147,7 +148,13 @@ class TSModel:
         return np.array(list(itertools.product(self.wind_grid, self.reduction_grid)))
 
     def cells(self) -> list[tuple[int, ...]]:
-        """Vertex indices of each grid cell (the vertices that can be active together)."""
+        """Vertex indices of each grid cell (the vertices that can be active together).
+
+        Returns
+        -------
+        list of tuple of int
+            Vertex indices per cell.
+        """
         na, nb = self.wind_grid.size, self.reduction_grid.size
         out = []
         for a in range(max(na - 1, 1)):
@@ -158,7 +165,15 @@ class TSModel:
         return out
 
     def check_premise(self, wind: float, reduction: float) -> None:
-        """Raise :class:`PremiseError` unless [wind, reduction] lies in the vertex grid."""
+        """Raise :class:`PremiseError` unless [wind, reduction] lies in the vertex grid.
+
+        Parameters
+        ----------
+        wind : float
+            Premise wind [m/s].
+        reduction : float
+            Premise power reduction [-].
+        """
         for name, s, g, unit in (("wind speed", wind, self.wind_grid, " m/s"),
                                  ("power reduction", reduction, self.reduction_grid, "")):
             tol = 1e-9 * max(1.0, abs(g[-1]))
@@ -169,6 +184,19 @@ class TSModel:
     def membership(self, wind: float, reduction: float = 0.0) -> np.ndarray:
         """h_i(z) for z = [wind, reduction] (N,): >= 0, summing to 1 (eq 3).
 
+
+        Parameters
+        ----------
+        wind : float
+            Premise wind [m/s].
+        reduction : float
+            Premise power reduction [-].
+
+        Returns
+        -------
+        (N,) ndarray
+            Memberships h_i [-].
+
         Raises
         ------
         PremiseError
@@ -178,12 +206,40 @@ class TSModel:
         return np.kron(_hats(self.wind_grid, wind), _hats(self.reduction_grid, reduction))
 
     def blend(self, h: np.ndarray) -> dict[str, np.ndarray]:
-        """The model's matrices and equilibria weighted by memberships ``h``."""
+        """The model's matrices and equilibria weighted by memberships ``h``.
+
+        Parameters
+        ----------
+        h : (N,) ndarray
+            Memberships.
+
+        Returns
+        -------
+        dict of str to ndarray
+            ``A``, ``B``, ``B_d``, ``x0``, ``u0``, ``v0`` weighted by ``h``.
+        """
         return {n: np.tensordot(h, getattr(self, n), axes=1)
                 for n in ("A", "B", "B_d", "x0", "u0", "v0")}
 
     def rhs(self, x: np.ndarray, u: np.ndarray, v: float, reduction: float = 0.0) -> np.ndarray:
-        """dx/dt of eq 1 with premise [v, reduction] [state units / s]."""
+        """dx/dt of eq 1 with premise [v, reduction] [state units / s].
+
+        Parameters
+        ----------
+        x : (n_x,) ndarray
+            State.
+        u : (n_u,) ndarray
+            Inputs.
+        v : float
+            Wind [m/s] (the premise and the disturbance).
+        reduction : float
+            Premise power reduction [-].
+
+        Returns
+        -------
+        (n_x,) ndarray
+            dx/dt.
+        """
         h = self.membership(v, reduction)
         x, u = np.asarray(x, dtype=float), np.asarray(u, dtype=float)
         return sum(h[i] * (self.A[i] @ (x - self.x0[i]) + self.B[i] @ (u - self.u0[i])
@@ -191,6 +247,13 @@ class TSModel:
                    for i in np.nonzero(h)[0])
 
     def to_dict(self) -> dict[str, Any]:
+        """Plain data for JSON.
+
+        Returns
+        -------
+        dict
+            Grids, names and the vertex matrices as lists.
+        """
         return {"wind_grid": self.wind_grid.tolist(), "reduction_grid":
                 self.reduction_grid.tolist(), "states": list(self.states),
                 "inputs": list(self.inputs), "measured": list(self.measured),
@@ -209,6 +272,26 @@ def build_ts_model(turbine: linearize.Turbine,
     Each vertex is a :func:`linearize.linearize` of the Clemens 7-state configuration with one
     rotor-effective wind disturbance, in multi-blade coordinates (collective pitch input), at
     the trim for electrical power (1 - Delta P) P_rated (full load: rated rotor speed).
+
+
+    Returns
+    -------
+    TSModel
+        Vertex matrices, equilibria and memberships over the grid.
+
+
+    Parameters
+    ----------
+    turbine : Turbine
+        The turbine.
+    wind_grid : sequence of float
+        Vertex winds [m/s], increasing.
+    reduction_grid : sequence of float
+        Vertex power reductions Delta P in [0, 1) [-].
+    measured : sequence of str
+        The measured outputs.
+    progress : bool
+        Show a progress bar.
 
     Raises
     ------
@@ -258,7 +341,7 @@ def build_ts_model(turbine: linearize.Turbine,
 class Certificate:
     """The result of checking an LMI design with numpy alone.
 
-    Attributes
+    Parameters
     ----------
     ok : bool
     worst_lmi : float
@@ -286,7 +369,7 @@ class Certificate:
 class TSControllerDesign:
     """PDC gains K_i [SI] on x - x0_i with common Lyapunov matrix P (in scaled coordinates).
 
-    Attributes
+    Parameters
     ----------
     K : (N, n_u, n_x [+ 1]) ndarray
         The last column acts on the integral of ``integral_of``'s deviation [unit s] when set.
@@ -313,7 +396,33 @@ class TSControllerDesign:
 
 @dataclass
 class TSObserverDesign:
-    """TS observer gains L_i [SI] for xi = [x; v] (Clemens eq 10) from the measured outputs."""
+    """TS observer gains L_i [SI] for xi = [x; v] (Clemens eq 10) from the measured outputs.
+
+    Parameters
+    ----------
+    L : (N, n_xi, n_y) ndarray
+        Observer gains per vertex [SI].
+    P : ndarray
+        Common Lyapunov matrix (scaled coordinates).
+    A_aug, B_aug, C_aug : ndarray
+        The augmented model of eq 10.
+    scale_xi, scale_y : ndarray
+        Scales of the augmented state and the outputs.
+    tau_v : float
+        Wind time constant of the augmentation [s].
+    decay_rate : float
+        Guaranteed decay rate [1/s].
+    disk_radius : float or None
+        Pole disk radius [1/s].
+    solver : str
+        The SDP solver used.
+    solve_time_s : float
+        Solve time [s].
+    certificate : Certificate
+        The numpy check.
+    margin : float
+        LMI margin.
+    """
 
     L: np.ndarray
     P: np.ndarray
@@ -336,19 +445,14 @@ def _scales(names: Sequence[str], scales: Mapping[str, float] | None) -> np.ndar
     s.update(scales or {})
     out = []
     for n in names:
-        v = s.get(n, 1.0)
-        if not (isinstance(v, (int, float, np.floating)) and math.isfinite(v) and v > 0):
-            raise ValueError(f"scale {n!r} must be finite and > 0, got {v!r}")
-        out.append(float(v))
+        out.append(check_number(f"scale {n!r}", s.get(n, 1.0), lo=0.0, lo_open=True))
     return np.array(out)
 
 
 def _check_rate(name: str, v: Any, allow_none: bool = False) -> float | None:
     if v is None and allow_none:
         return None
-    if not (isinstance(v, (int, float, np.floating)) and math.isfinite(v) and v >= 0):
-        raise ValueError(f"{name} must be finite and >= 0 [1/s], got {v!r}")
-    return float(v)
+    return check_number(name, v, lo=0.0, unit="[1/s]")
 
 
 def _solve(prob: Any, solver: str | None) -> tuple[str, str]:
@@ -472,6 +576,12 @@ def design_ts_controller(ts: TSModel, *, decay_rate: float = 0.2,
         speed: removes the steady speed offset that model mismatch leaves with eq 7 alone;
         None gives Clemens' eq 7 exactly). Its scale is that of the state times 1 s.
 
+
+    Returns
+    -------
+    TSControllerDesign
+        Gains K_i, P, scales, the solver and the certificate.
+
     Raises
     ------
     SynthesisError
@@ -489,15 +599,7 @@ def design_ts_controller(ts: TSModel, *, decay_rate: float = 0.2,
     sx, su = _scales(ts.states, scales), _scales(ts.inputs, scales)
     if integral_of is not None:
         sx = np.append(sx, sx[ts.states.index(integral_of)] * 1.0)
-    mu = None
-    if input_bounds:
-        unknown = set(input_bounds) - set(ts.inputs)
-        if unknown:
-            raise ValueError(f"input_bounds: unknown inputs {sorted(unknown)}; inputs are "
-                             f"{list(ts.inputs)}")
-        mu = np.array([float(input_bounds.get(n, np.inf)) for n in ts.inputs]) / su
-        if np.any(~(mu > 0)):
-            raise ValueError(f"input_bounds must be > 0, got {dict(input_bounds)}")
+    mu = _input_bounds(ts, input_bounds, su)
     a, b = _controller_mats(ts, integral_of, sx, su)
     cells = ts.cells()
     t0 = time.perf_counter()
@@ -520,8 +622,22 @@ def design_ts_controller(ts: TSModel, *, decay_rate: float = 0.2,
         np.full(len(ts.inputs), np.nan)
     return TSControllerDesign(K=k, P=p, scale_x=sx, scale_u=su, decay_rate=alpha,
                               disk_radius=radius, input_bounds=bounds, integral_of=integral_of,
-                              solver=used,
-                              solve_time_s=dt, certificate=cert, margin=margin)
+                              solver=used, solve_time_s=dt, certificate=cert, margin=margin)
+
+
+def _input_bounds(ts: TSModel, input_bounds: Mapping[str, float] | None, su: np.ndarray
+                  ) -> np.ndarray | None:
+    """Scaled input bounds mu_j on the ellipsoid, or None."""
+    if not input_bounds:
+        return None
+    unknown = set(input_bounds) - set(ts.inputs)
+    if unknown:
+        raise ValueError(f"input_bounds: unknown inputs {sorted(unknown)}; inputs are "
+                         f"{list(ts.inputs)}")
+    mu = np.array([float(input_bounds.get(n, np.inf)) for n in ts.inputs]) / su
+    if np.any(~(mu > 0)):
+        raise ValueError(f"input_bounds must be > 0, got {dict(input_bounds)}")
+    return mu
 
 
 def _diagnose_controller(a, b, cells, alpha, radius, mu, margin, solver) -> str:
@@ -569,7 +685,34 @@ def verify_controller(ts: TSModel, K: np.ndarray, P: np.ndarray, scale_x: np.nda
     """Check a PDC design with numpy: the LMIs at X = P^-1, Y_i = K_i X hold with ``margin``
     (scaled units, normalised by ||X||), and on a premise grid with ``grid_points`` intervals
     per cell edge the closed loop sum_ij h_i h_j (A_i - B_i K_j) has Re lambda <= -alpha and
-    Acl' P + P Acl + 2 alpha P <= 0 (all in the scaled coordinates of the design)."""
+    Acl' P + P Acl + 2 alpha P <= 0 (all in the scaled coordinates of the design).
+
+    Parameters
+    ----------
+    ts : TSModel
+        The model.
+    K : ndarray
+        Gains per vertex.
+    P : ndarray
+        Lyapunov matrix (scaled).
+    scale_x, scale_u : ndarray
+        Scales of states and inputs.
+    decay_rate : float
+        Required decay rate [1/s].
+    disk_radius : float, optional
+        Pole disk radius [1/s].
+    margin : float
+        LMI margin.
+    grid_points : int
+        Premise grid intervals per cell edge.
+    integral_of : str, optional
+        The integrated state.
+
+    Returns
+    -------
+    Certificate
+        Whether every check holds, the worst margins and the failures.
+    """
     sx, su = np.asarray(scale_x, float), np.asarray(scale_u, float)
     a, b = _controller_mats(ts, integral_of, sx, su)
     k = np.array([np.diag(1 / su) @ ki @ np.diag(sx) for ki in np.asarray(K, float)])
@@ -604,8 +747,18 @@ def verify_controller(ts: TSModel, K: np.ndarray, P: np.ndarray, scale_x: np.nda
         e = np.linalg.eigvalsh(s + s.T + 4 * alpha * x).max()
         if e > 1e-8 * nrm:
             fails.append(f"decay LMI of the pair ({i}, {j}) has eigenvalue {e:.3g} > 0")
-    worst_decay, worst_lyap = -np.inf, -np.inf
     pts = _premise_grid(ts, grid_points)
+    worst_decay, worst_lyap = _check_grid(ts, pts, a, b, k, p, alpha, fails)
+    return Certificate(ok=not fails, worst_lmi=float(worst), worst_decay=float(worst_decay),
+                       worst_lyapunov=float(worst_lyap), n_grid=len(pts), failures=fails)
+
+
+def _check_grid(ts: TSModel, pts: list[tuple[float, float]], a: np.ndarray, b: np.ndarray,
+                k: np.ndarray, p: np.ndarray, alpha: float, fails: list[str]
+                ) -> tuple[float, float]:
+    """Closed loop sum_ij h_i h_j (A_i - B_i K_j) on the premise grid: Re lambda <= -alpha and
+    a decreasing Lyapunov function; failures appended to ``fails``; the worst of each."""
+    worst_decay, worst_lyap = -np.inf, -np.inf
     for v, dp in pts:
         h = ts.membership(v, dp)
         act = np.nonzero(h)[0]
@@ -619,8 +772,7 @@ def verify_controller(ts: TSModel, K: np.ndarray, P: np.ndarray, scale_x: np.nda
                          f"{ev.real.max():.4g} > -alpha = {-alpha:g}")
         if ly > 1e-9:
             fails.append(f"Lyapunov decrease fails at v = {v:g} m/s, dP = {dp:g} ({ly:.3g})")
-    return Certificate(ok=not fails, worst_lmi=float(worst), worst_decay=float(worst_decay),
-                       worst_lyapunov=float(worst_lyap), n_grid=len(pts), failures=fails)
+    return worst_decay, worst_lyap
 
 
 def _augmented(ts: TSModel, tau_v: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -658,18 +810,19 @@ def design_ts_observer(ts: TSModel, *, tau_v: float = 4.0, decay_rate: float = 1
     disk_radius : float or None
         Error eigenvalues within |lambda| < r_o [1/s].
 
+
+    Returns
+    -------
+    TSObserverDesign
+        Gains L_i, P, the augmented model, the solver and the certificate.
+
     Raises
     ------
     SynthesisError
         The pair (A~_i, C~) not detectable at a vertex, or the LMIs infeasible (the message says
         what to relax).
     """
-    import cvxpy as cp
-
-    from .synthesis import _uncontrollable_modes
-
-    if not (isinstance(tau_v, (int, float)) and math.isfinite(tau_v) and tau_v > 0):
-        raise ValueError(f"tau_v must be finite and > 0 s, got {tau_v!r}")
+    check_number("tau_v", tau_v, lo=0.0, lo_open=True, unit="s")
     alpha = _check_rate("decay_rate", decay_rate)
     radius = _check_rate("disk_radius", disk_radius, allow_none=True)
     if radius is not None and radius <= alpha:
@@ -678,31 +831,8 @@ def design_ts_observer(ts: TSModel, *, tau_v: float = 4.0, decay_rate: float = 1
     sxi = _scales(ts.states + ("wind",), scales)
     sy = _scales(ts.measured, scales)
     a, c = _observer_mats(ts, float(tau_v), sxi, sy)
-    for i, ai in enumerate(a):
-        # modes slower than the required decay must be observable (PBH on A~ + alpha I)
-        modes = _uncontrollable_modes(ai.T + alpha * np.eye(ai.shape[0]), c.T, discrete=False)
-        if modes:
-            raise SynthesisError(
-                f"(A~, C~) is not detectable with decay rate {alpha:g} 1/s at vertex {i} "
-                f"(v = {ts.vertices[i, 0]:g} m/s, dP = {ts.vertices[i, 1]:g}) from "
-                f"{list(ts.measured)}: the modes "
-                f"{', '.join(f'{m.real - alpha:.4g}{m.imag:+.4g}j' for m in modes)} are not "
-                f"seen; measure more signals or lower decay_rate")
-    nv, n = a.shape[:2]
-    ny = c.shape[0]
-    pv = cp.Variable((n, n), symmetric=True)
-    nvar = [cp.Variable((n, ny)) for _ in range(nv)]
-    t = cp.Variable()
-    cons = [pv >> np.eye(n)]
-    for i in range(nv):
-        m = a[i].T @ pv + pv @ a[i] - c.T @ nvar[i].T - nvar[i] @ c + 2 * alpha * pv
-        cons.append(_sym(m) << -margin * np.eye(n))
-        if radius is not None:
-            g = pv @ a[i] - nvar[i] @ c
-            cons.append(_sym(cp.bmat([[-radius * pv, g], [g.T, -radius * pv]]))
-                        << -margin * np.eye(2 * n))
-        cons.append(_sym(cp.bmat([[t * np.eye(n), nvar[i]], [nvar[i].T, t * np.eye(ny)]])) >> 0)
-    prob = cp.Problem(cp.Minimize(t), cons)
+    _check_detectable(ts, a, c, alpha)
+    prob, pv, nvar = _observer_problem(a, c, alpha, radius, margin)
     t0 = time.perf_counter()
     used, status = _solve(prob, solver)
     dt = time.perf_counter() - t0
@@ -725,12 +855,77 @@ def design_ts_observer(ts: TSModel, *, tau_v: float = 4.0, decay_rate: float = 1
                             certificate=cert, margin=margin)
 
 
+def _check_detectable(ts: TSModel, a: np.ndarray, c: np.ndarray, alpha: float) -> None:
+    """Modes slower than the required decay must be observable (PBH on A~ + alpha I)."""
+    from .synthesis import _uncontrollable_modes
+
+    for i, ai in enumerate(a):
+        modes = _uncontrollable_modes(ai.T + alpha * np.eye(ai.shape[0]), c.T, discrete=False)
+        if modes:
+            raise SynthesisError(
+                f"(A~, C~) is not detectable with decay rate {alpha:g} 1/s at vertex {i} "
+                f"(v = {ts.vertices[i, 0]:g} m/s, dP = {ts.vertices[i, 1]:g}) from "
+                f"{list(ts.measured)}: the modes "
+                f"{', '.join(f'{m.real - alpha:.4g}{m.imag:+.4g}j' for m in modes)} are not "
+                f"seen; measure more signals or lower decay_rate")
+
+
+def _observer_problem(a: np.ndarray, c: np.ndarray, alpha: float, radius: float | None,
+                      margin: float) -> tuple[Any, Any, list[Any]]:
+    """The observer LMIs (Clemens eq 10) with the decay rate and the optional pole disk; the
+    objective bounds the gains' norm."""
+    import cvxpy as cp
+
+    nv, n = a.shape[:2]
+    ny = c.shape[0]
+    pv = cp.Variable((n, n), symmetric=True)
+    nvar = [cp.Variable((n, ny)) for _ in range(nv)]
+    t = cp.Variable()
+    cons = [pv >> np.eye(n)]
+    for i in range(nv):
+        m = a[i].T @ pv + pv @ a[i] - c.T @ nvar[i].T - nvar[i] @ c + 2 * alpha * pv
+        cons.append(_sym(m) << -margin * np.eye(n))
+        if radius is not None:
+            g = pv @ a[i] - nvar[i] @ c
+            cons.append(_sym(cp.bmat([[-radius * pv, g], [g.T, -radius * pv]]))
+                        << -margin * np.eye(2 * n))
+        cons.append(_sym(cp.bmat([[t * np.eye(n), nvar[i]], [nvar[i].T, t * np.eye(ny)]])) >> 0)
+    return cp.Problem(cp.Minimize(t), cons), pv, nvar
+
+
 def verify_observer(ts: TSModel, L: np.ndarray, P: np.ndarray, scale_xi: np.ndarray,
                     scale_y: np.ndarray, decay_rate: float, disk_radius: float | None = None,
                     *, tau_v: float = 4.0, margin: float = 5e-5,
                     grid_points: int = 6) -> Certificate:
     """Check TS observer gains with numpy: vertex LMIs at P with ``margin`` and, on a premise
-    grid, sum_i h_i (A~_i - L_i C~) Hurwitz with the decay rate and decreasing e' P e."""
+    grid, sum_i h_i (A~_i - L_i C~) Hurwitz with the decay rate and decreasing e' P e.
+
+    Parameters
+    ----------
+    ts : TSModel
+        The model.
+    L : ndarray
+        Gains per vertex.
+    P : ndarray
+        Lyapunov matrix (scaled).
+    scale_xi, scale_y : ndarray
+        Scales of the augmented state and outputs.
+    decay_rate : float
+        Required decay rate [1/s].
+    disk_radius : float, optional
+        Pole disk radius [1/s].
+    tau_v : float
+        Wind time constant [s].
+    margin : float
+        LMI margin.
+    grid_points : int
+        Premise grid intervals per cell edge.
+
+    Returns
+    -------
+    Certificate
+        Whether every check holds, the worst margins and the failures.
+    """
     sxi, sy = np.asarray(scale_xi, float), np.asarray(scale_y, float)
     a, c = _observer_mats(ts, tau_v, sxi, sy)
     ls = np.array([np.diag(1 / sxi) @ li @ np.diag(sy) for li in np.asarray(L, float)])
@@ -787,7 +982,7 @@ class TSController:
     turbine : Turbine (actuator limits)
     dt : controller period [s]
     power_reduction : callable t -> Delta P [-], optional (active power control, eq 11)
-    initial_wind : float, optional
+    initial_wind_mps : float, optional
         Initial wind estimate [m/s] (default the middle of the grid).
 
     Signals recorded: ``wind_est`` [m/s], ``power_reduction`` [-], ``power_ref`` [W],
@@ -798,13 +993,12 @@ class TSController:
                  observer: TSObserverDesign, turbine: linearize.Turbine, *,
                  dt: float = 1.0 / 80.0,
                  power_reduction: Callable[[float], float] | None = None,
-                 initial_wind: float | None = None) -> None:
-        if not (math.isfinite(dt) and dt > 0):
-            raise ValueError(f"dt must be finite and > 0 s, got {dt!r}")
+                 initial_wind_mps: float | None = None) -> None:
+        check_number("dt", dt, lo=0.0, lo_open=True, unit="s")
         self.ts, self.ctl, self.obs, self.turbine = ts, controller, observer, turbine
         self.dt = float(dt)
         self.power_reduction = power_reduction
-        v_init = float(np.mean(ts.wind_grid) if initial_wind is None else initial_wind)
+        v_init = float(np.mean(ts.wind_grid) if initial_wind_mps is None else initial_wind_mps)
         ts.check_premise(v_init, float(ts.reduction_grid[0]))
         self._v_init = v_init
         aa, bb, cc = observer.A_aug, observer.B_aug, observer.C_aug
@@ -850,6 +1044,22 @@ class TSController:
         return vc, dc, clipped
 
     def step(self, t: float, meas: dict[str, Any]) -> tuple[np.ndarray, float]:
+        """Observer update, memberships, PDC control law (Clemens eqs 5-10).
+
+        Parameters
+        ----------
+        t : float
+            Time [s].
+        meas : dict
+            The harness's measurements (:mod:`mpc_wt.simulate`).
+
+        Returns
+        -------
+        pitch_ref : (3,) ndarray
+            Blade pitch commands [rad].
+        gen_torque_ref : float
+            Generator torque command [N m].
+        """
         y = read_signals(meas, self.ts.measured)
         if not np.all(np.isfinite(y)):
             raise ValueError(f"non-finite measurement at t = {t:g} s: "

@@ -110,7 +110,7 @@ def test_frozen_wake_pitch_sensitivity_matches_report(turbine: linearize.Turbine
     for m in fam.models:
         pub = -25.52e6 * (1.0 + m.info["pitch_deg"] / 6.302336)
         assert_allclose(sensitivities(m)["dP_dpitch_W_per_rad"], pub, rtol=0.15, atol=0,
-                        err_msg=f"{m.wind_speed} m/s")
+                        err_msg=f"{m.wind_mps} m/s")
 
 
 @pytest.mark.parametrize("wind", [13.0, 18.0, 24.0])
@@ -365,7 +365,7 @@ def test_family_interpolation(family: LinearModelFamily) -> None:
 def test_family_round_trip(family: LinearModelFamily, tmp_path: Path, suffix: str) -> None:
     path = family.save(tmp_path / f"fam{suffix}")
     back = LinearModelFamily.load(path)
-    assert_allclose(back.wind_speeds, family.wind_speeds, rtol=0, atol=0)
+    assert_allclose(back.wind_mps, family.wind_mps, rtol=0, atol=0)
     for a, b in zip(back.models, family.models):
         for k in ("A", "B_u", "B_d", "C_z", "D_u", "D_d", "x0", "u0", "z0"):
             assert_allclose(getattr(a, k), getattr(b, k), rtol=1e-15, atol=0)

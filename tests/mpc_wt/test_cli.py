@@ -95,7 +95,7 @@ def test_linearize_json_and_mat(tmp_path: Path, capsys: pytest.CaptureFixture[st
     import linearize
 
     fam = linearize.LinearModelFamily.load(out)
-    assert fam.models[0].wake == "frozen" and fam.wind_speeds.tolist() == [12.0, 13.0]
+    assert fam.models[0].wake == "frozen" and fam.wind_mps.tolist() == [12.0, 13.0]
 
 
 def test_linearize_bad_grid(capsys: pytest.CaptureFixture[str]) -> None:

@@ -16,10 +16,11 @@ import linearize
 from mpc_wt.assess import lifetime_extension, tracking_response
 from mpc_wt.baseline import BaselineController, tune_baseline
 from mpc_wt.export import coleman_ipc_table, export, ibc_table, load_design, save_design
-from mpc_wt.retrofit import (SOSFilterBank, aep_change, apc_reference, filter_sos,
-                             lifetime_comparison, steady_power_curve, tune_coleman_ipc, tune_ibc)
 from mpc_wt import run_controller
-from mpc_wt.assess import assess_series
+from mpc_wt.assess import assess_series, lifetime_comparison
+from mpc_wt.filters import SOSFilterBank, filter_sos
+from mpc_wt.retrofit import (aep_change, apc_reference, steady_power_curve, tune_coleman_ipc,
+                             tune_ibc)
 from mpc_wt.controllers import resolve
 
 DUR = 150.0       # s per closed-loop run; the first TRANSIENT s are left out of the metrics

@@ -79,7 +79,7 @@ def test_lqr_family_gives_one_gain_per_wind(turbine) -> None:
     fam = linearize.linearize_family(turbine, [14.0, 18.0, 22.0],
                                      config=linearize.PlantConfig.do())
     gains = design_lqr_family(fam, state_weights={"rotor_speed": 1.0})
-    assert [g.wind_speed for g in gains] == [14.0, 18.0, 22.0]
+    assert [g.wind_mps for g in gains] == [14.0, 18.0, 22.0]
     # the pitch sensitivity grows with wind, so the speed gain needed falls
     ks = [abs(g.K[0, g.states.index("rotor_speed")]) for g in gains]
     assert ks[0] > ks[1] > ks[2]

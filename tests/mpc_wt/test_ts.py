@@ -142,7 +142,7 @@ def test_ts_controller_regulates_and_tracks_power(turbine, params, ts, designs) 
     v, dur, f = 16.0, 120.0, 0.1
     wind, field = make_wind(turbine, Scenario(v, "A", 3, dur, 0.2))
     op = linearize.trim(turbine, v)
-    c = TSController(ts, ctl, obs, turbine, initial_wind=v)
+    c = TSController(ts, ctl, obs, turbine, initial_wind_mps=v)
     r = simulate_closed_loop(params, c, wind, dur, x0=op.x, u0=op.u)
     w = r.channel("rotor_speed")[r.t > 20]
     rated = turbine.operation.rated_rotor_speed_rad_s
@@ -153,7 +153,7 @@ def test_ts_controller_regulates_and_tracks_power(turbine, params, ts, designs) 
     err = (r.channel("wind_est") - truth)[r.t > 20]
     assert np.sqrt(np.mean(err**2)) < 0.5 * truth[r.t > 20].std() + 0.3
     # active power control: the sinusoidal reduction of eq 11 at 0.1 Hz
-    c = TSController(ts, ctl, obs, turbine, initial_wind=v, power_reduction=apc_reference(f))
+    c = TSController(ts, ctl, obs, turbine, initial_wind_mps=v, power_reduction=apc_reference(f))
     r = simulate_closed_loop(params, c, wind, dur, x0=op.x, u0=op.u)
     sel = r.t > 20
     t = r.t[sel]
@@ -167,8 +167,8 @@ def test_ts_controller_regulates_and_tracks_power(turbine, params, ts, designs) 
 def test_ts_controller_bad_input(turbine, ts, designs) -> None:
     ctl, obs = designs
     with pytest.raises(PremiseError):
-        TSController(ts, ctl, obs, turbine, initial_wind=30.0)
-    c = TSController(ts, ctl, obs, turbine, initial_wind=16.0)
+        TSController(ts, ctl, obs, turbine, initial_wind_mps=30.0)
+    c = TSController(ts, ctl, obs, turbine, initial_wind_mps=16.0)
     meas = {"gen_speed": math.nan, "rotor_speed": 1.2,
             "state": np.zeros(len(linearize.STATE_NAMES))}
     with pytest.raises(ValueError, match="non-finite measurement"):

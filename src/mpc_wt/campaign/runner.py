@@ -36,7 +36,25 @@ ENGINES = ("dask", "processes", "serial")
 
 @dataclass
 class RunSummary:
-    """What one ``run_campaign`` call did."""
+    """What one ``run_campaign`` call did.
+
+    Parameters
+    ----------
+    total, skipped, submitted : int
+        Cases in the spec, already finished, handed to the engine.
+    done, failed, reused : int
+        Finished now, failed, and done from a file already written.
+    wall_s : float
+        Wall time [s].
+    engine : str
+        The engine used.
+    workers : int
+        Worker processes.
+    sync : dict
+        What :meth:`CampaignStore.sync` did.
+    failures : list of (str, str)
+        (case id, error) of the failed cases.
+    """
 
     total: int
     skipped: int

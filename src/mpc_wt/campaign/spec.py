@@ -121,12 +121,11 @@ class ControllerSpec:
     name : str
         Label in the index, the file names and the report (letters, digits, ``-_.+``).
     controller : str
-        A :func:`mpc_wt.runs.run_controller` name (``baseline``, ``mpc-lidar``, ``ts``,
-        ``derate80+ibc`` ...).
+        A registered controller name (``baseline``, ``mpc-lidar``, ``ts``, ``derate80+ibc``
+        ...; :func:`mpc_wt.controllers.kinds`).
     options : dict
-        Keyword arguments of :func:`~mpc_wt.runs.run_controller`: ``mpc_options``,
-        ``retrofit_options``, ``apc_frequency`` [Hz], ``apc_amplitude``, ``apc_offset``,
-        ``lidar_options``.
+        The kind's options as given (checked by the registry when the spec loads), e.g.
+        ``apc_frequency`` [Hz], ``horizon``, ``lidar``.
     winds, seeds, turbulence : tuple or None
         This controller's own grid (default: the campaign's).
     """
@@ -142,7 +141,39 @@ class ControllerSpec:
 
 @dataclass(frozen=True)
 class Case:
-    """One simulation of a campaign (a pure task: these fields -> one result file + metrics)."""
+    """One simulation of a campaign (a pure task: these fields -> one result file + metrics).
+
+    Parameters
+    ----------
+    case_id : str
+        ``controller__turbulence__vWIND__sSEED``.
+    controller : str
+        The controller's label in the spec.
+    run_name : str
+        The registered kind it runs.
+    options : dict
+        The kind's options.
+    wind_mps : float
+        Mean wind [m/s].
+    seed : int
+        Seed of the field.
+    turbulence : str or float
+        Class letter or intensity.
+    duration, transient : float
+        Assessed length and discarded start [s].
+    shear_exponent : float
+        Power-law shear [-].
+    turbine : str
+        Packaged name or resolved path.
+    turbine_hash : str
+        SHA-256 over the turbine's files.
+    channels : dict of str to float
+        Channel -> Woehler exponent.
+    case_hash, assess_hash : str
+        Hashes of the simulation and the assessment inputs.
+    plugins : tuple of str
+        Modules that register controller kinds, imported by the worker.
+    """
 
     case_id: str
     controller: str
@@ -162,13 +193,57 @@ class Case:
     plugins: tuple[str, ...] = ()
 
     def to_dict(self) -> dict[str, Any]:
-        """Plain data for a worker (pickles and JSON-serialises)."""
+        """Plain data for a worker (pickles and JSON-serialises).
+
+        Returns
+        -------
+        dict
+            Every field.
+        """
         return {k: copy.deepcopy(getattr(self, k)) for k in self.__dataclass_fields__}
 
 
 @dataclass(frozen=True)
 class CampaignSpec:
-    """A validated campaign. Build it with :func:`load_spec` or :func:`spec_from_dict`."""
+    """A validated campaign. Build it with :func:`load_spec` or :func:`spec_from_dict`.
+
+    Parameters
+    ----------
+    name, description : str
+        Name and text of the campaign.
+    turbine, turbine_hash : str
+        Packaged name or resolved path, and the hash of its files.
+    duration, transient : float
+        Assessed length and discarded start of each case [s].
+    turbulence : tuple
+        Classes or intensities.
+    shear_exponent : float
+        Power-law shear [-].
+    winds : tuple of float
+        Mean winds [m/s].
+    seeds : tuple of int
+        Seeds.
+    lidar : dict
+        LIDAR settings of the kinds that take ``lidar``.
+    controllers : tuple of ControllerSpec
+        The controllers.
+    channels : dict of str to float
+        Channel -> Woehler exponent.
+    wind_distribution : dict
+        Rayleigh or Weibull parameters.
+    lifetime_years : float
+        Design life [years].
+    reference : str
+        The reference controller's label.
+    report : dict
+        Report settings and paper rows.
+    raw : dict
+        The spec as given.
+    source : str, optional
+        The spec's file.
+    plugins : tuple of str
+        Modules that register controller kinds.
+    """
 
     name: str
     description: str
@@ -197,7 +272,18 @@ class CampaignSpec:
         return _digest({"spec": self.raw, "turbine": self.turbine_hash})
 
     def controller(self, name: str) -> ControllerSpec:
-        """The controller labelled ``name``."""
+        """The controller labelled ``name``.
+
+        Parameters
+        ----------
+        name : str
+            A label of the spec.
+
+        Returns
+        -------
+        ControllerSpec
+            That controller.
+        """
         for c in self.controllers:
             if c.name == name:
                 return c
@@ -205,7 +291,13 @@ class CampaignSpec:
                        f"{[c.name for c in self.controllers]}")
 
     def cases(self) -> list[Case]:
-        """Every case of the campaign, in a stable order (controller, turbulence, wind, seed)."""
+        """Every case of the campaign, in a stable order (controller, turbulence, wind, seed).
+
+        Returns
+        -------
+        list of Case
+            Every case.
+        """
         out = []
         assess = {"channels": self.channels, "transient": self.transient}
         for c in self.controllers:
@@ -369,9 +461,59 @@ def _plugins(raw: Any) -> tuple[str, ...]:
     return tuple(raw)
 
 
+def _channels(raw: Any) -> dict[str, float]:
+    """Channel -> Woehler exponent (default :data:`mpc_wt.assess.DEFAULT_CHANNELS`)."""
+    import linearize
+
+    from ..assess import DEFAULT_CHANNELS
+
+    chans_raw = DEFAULT_CHANNELS if raw is None else raw
+    if not isinstance(chans_raw, Mapping) or not chans_raw:
+        raise _fail("channels", "must be a non-empty mapping of channel name to Woehler "
+                                "exponent m")
+    known = {*linearize.OUTPUT_NAMES, *linearize.STATE_NAMES, *linearize.INPUT_NAMES,
+             "shaft_bending_blade1"}
+    chans = {}
+    for k, m in chans_raw.items():
+        if k not in known:
+            raise _fail(f"channels.{k}", f"unknown channel; channels are {sorted(known)}")
+        chans[str(k)] = _number(f"channels.{k}", m, 0.0, 30.0, lo_open=True)
+    return chans
+
+
+def _report(report: Any, names: list[str], chans: Mapping[str, float]) -> dict[str, Any]:
+    """The report settings and the paper rows, checked."""
+    if not isinstance(report, Mapping):
+        raise _fail("report", f"must be a mapping, got {report!r}")
+    extra = set(report) - _REPORT_KEYS
+    if extra:
+        raise _fail(f"report.{sorted(extra)[0]}", f"unknown key; allowed: {sorted(_REPORT_KEYS)}")
+    for k in ("psd_wind", "cs_wind"):
+        if k in report:
+            _number(f"report.{k}", report[k], 0.0, lo_open=True)
+    for i, p in enumerate(report.get("paper", []) or []):
+        _paper_row(f"report.paper[{i}]", p, names, chans)
+    return dict(report)
+
+
 def spec_from_dict(raw: Mapping[str, Any], base: Path | None = None,
                    source: str | None = None) -> CampaignSpec:
     """Validate a campaign given as a mapping (the parsed YAML).
+
+
+    Parameters
+    ----------
+    raw : mapping
+        The parsed YAML.
+    base : Path, optional
+        Folder against which relative turbine paths are resolved.
+    source : str, optional
+        The spec's file, kept for the record.
+
+    Returns
+    -------
+    CampaignSpec
+        The validated campaign.
 
     Raises
     ------
@@ -406,35 +548,11 @@ def spec_from_dict(raw: Mapping[str, Any], base: Path | None = None,
     dup = sorted({n for n in names if names.count(n) > 1})
     if dup:
         raise _fail("controllers", f"repeated names {dup}; give each a distinct name")
-    from ..assess import DEFAULT_CHANNELS
-
-    chans_raw = raw.get("channels", DEFAULT_CHANNELS)
-    if not isinstance(chans_raw, Mapping) or not chans_raw:
-        raise _fail("channels", "must be a non-empty mapping of channel name to Woehler "
-                                "exponent m")
-    import linearize
-
-    known = {*linearize.OUTPUT_NAMES, *linearize.STATE_NAMES, *linearize.INPUT_NAMES,
-             "shaft_bending_blade1"}
-    chans = {}
-    for k, m in chans_raw.items():
-        if k not in known:
-            raise _fail(f"channels.{k}", f"unknown channel; channels are {sorted(known)}")
-        chans[str(k)] = _number(f"channels.{k}", m, 0.0, 30.0, lo_open=True)
+    chans = _channels(raw.get("channels"))
     ref = raw.get("reference", names[0])
     if ref not in names:
         raise _fail("reference", f"{ref!r} is not a controller name; names are {names}")
-    report = raw.get("report", {})
-    if not isinstance(report, Mapping):
-        raise _fail("report", f"must be a mapping, got {report!r}")
-    extra = set(report) - _REPORT_KEYS
-    if extra:
-        raise _fail(f"report.{sorted(extra)[0]}", f"unknown key; allowed: {sorted(_REPORT_KEYS)}")
-    for k in ("psd_wind", "cs_wind"):
-        if k in report:
-            _number(f"report.{k}", report[k], 0.0, lo_open=True)
-    for i, p in enumerate(report.get("paper", []) or []):
-        _paper_row(f"report.paper[{i}]", p, names, chans)
+    report = _report(raw.get("report", {}), names, chans)
     desc = raw.get("description", "")
     if not isinstance(desc, str):
         raise _fail("description", f"must be a string, got {desc!r}")
@@ -448,7 +566,7 @@ def spec_from_dict(raw: Mapping[str, Any], base: Path | None = None,
         wind_distribution=_distribution(raw.get("wind_distribution", {})),
         lifetime_years=_number("lifetime_years", raw.get("lifetime_years", 20.0), 0.0,
                                lo_open=True),
-        reference=ref, report=dict(report), raw=raw, source=source, plugins=plugins)
+        reference=ref, report=report, raw=raw, source=source, plugins=plugins)
 
 
 _PAPER_METRICS = {"del_change_pct", "lifetime_del_change_pct", "aep_change_pct",
@@ -486,6 +604,17 @@ def _paper_row(key: str, p: Any, names: list[str], chans: Mapping[str, float]) -
 
 def load_spec(path: str | Path) -> CampaignSpec:
     """Read and validate a campaign YAML file (relative turbine paths against its folder).
+
+
+    Parameters
+    ----------
+    path : str or Path
+        The YAML file.
+
+    Returns
+    -------
+    CampaignSpec
+        The validated campaign.
 
     Raises
     ------

@@ -62,7 +62,37 @@ CREATE TABLE IF NOT EXISTS cases (
 
 @dataclass(frozen=True)
 class CaseRow:
-    """One row of the index."""
+    """One row of the index.
+
+    Parameters
+    ----------
+    case_id, controller, run_name : str
+        The case, its controller label and the registered kind it runs.
+    wind_mps : float
+        Mean wind [m/s].
+    seed : int
+        Seed of the field.
+    turbulence : str
+        Class letter or intensity, as text.
+    case_hash, assess_hash : str
+        Hashes of the simulation and the assessment inputs.
+    status : str
+        pending, submitted, done, failed or stale.
+    file : str or None
+        The result file, relative to the campaign directory.
+    metrics : dict or None
+        :func:`~mpc_wt.campaign.task.case_metrics` of a done case.
+    error, traceback : str or None
+        Of a failed case.
+    software_version, spec_hash : str or None
+        Who computed it, under which spec.
+    attempts : int
+        Submissions so far.
+    wall_s : float or None
+        Wall time of the last attempt [s].
+    worker : str or None
+        host:pid of the last attempt.
+    """
 
     case_id: str
     controller: str
@@ -153,11 +183,25 @@ class CampaignStore:
 
     # -- metadata -------------------------------------------------------------------------
     def set_meta(self, **items: Any) -> None:
+        """Store campaign-level values (JSON) in one transaction.
+
+        Parameters
+        ----------
+        **items
+            Key -> JSON-serialisable value.
+        """
         with self._tx():
             self.db.executemany("INSERT OR REPLACE INTO meta VALUES (?, ?)",
                                 [(k, json.dumps(v)) for k, v in items.items()])
 
     def meta(self) -> dict[str, Any]:
+        """The campaign-level values.
+
+        Returns
+        -------
+        dict
+            Key -> value (name, spec hash, software version, spec, last run ...).
+        """
         return {k: json.loads(v) for k, v in self.db.execute("SELECT key, value FROM meta")}
 
     # -- cases ----------------------------------------------------------------------------
@@ -167,6 +211,16 @@ class CampaignStore:
         New cases are added as pending; a case whose simulation inputs changed (case hash)
         goes back to pending (its old file is overwritten when it reruns); a case no longer in
         the spec becomes ``stale`` (kept). Returns the counts of each action.
+
+        Parameters
+        ----------
+        spec : CampaignSpec
+            The campaign.
+
+        Returns
+        -------
+        dict of str to int
+            Counts of ``added``, ``invalidated``, ``stale``, ``reassess``.
         """
         cases = spec.cases()
         ids = {c.case_id for c in cases}
@@ -211,7 +265,13 @@ class CampaignStore:
         return counts
 
     def todo(self) -> list[Case]:
-        """Cases to submit: everything not done, and done cases whose file has gone."""
+        """Cases to submit: everything not done, and done cases whose file has gone.
+
+        Returns
+        -------
+        list of Case
+            In insertion order.
+        """
         out = []
         for cid, status, file, cj in self.db.execute(
                 "SELECT case_id, status, file, case_json FROM cases WHERE status != 'stale' "
@@ -222,14 +282,30 @@ class CampaignStore:
         return out
 
     def mark_submitted(self, case_ids: Iterable[str]) -> None:
-        """Record that this client handed the cases to the engine (attempts + 1)."""
+        """Record that this client handed the cases to the engine (attempts + 1).
+
+        Parameters
+        ----------
+        case_ids : iterable of str
+            The cases.
+        """
         now = time.time()
         with self._tx():
             self.db.executemany("UPDATE cases SET status='submitted', attempts=attempts+1, "
                                 "updated=? WHERE case_id=?", [(now, c) for c in case_ids])
 
     def record(self, case_id: str, outcome: dict[str, Any], spec_hash: str) -> None:
-        """Commit one finished case (``outcome`` of :func:`mpc_wt.campaign.task.run_case`)."""
+        """Commit one finished case (``outcome`` of :func:`mpc_wt.campaign.task.run_case`).
+
+        Parameters
+        ----------
+        case_id : str
+            The case.
+        outcome : dict
+            What the task returned.
+        spec_hash : str
+            The spec it ran under.
+        """
         now = time.time()
         with self._tx():
             if outcome["status"] == "done":
@@ -250,7 +326,18 @@ class CampaignStore:
                      outcome.get("worker"), now, case_id))
 
     def rows(self, *, include_stale: bool = False) -> list[CaseRow]:
-        """All rows (of the current spec unless ``include_stale``), in insertion order."""
+        """All rows (of the current spec unless ``include_stale``), in insertion order.
+
+        Parameters
+        ----------
+        include_stale : bool
+            Also the cases no longer in the spec.
+
+        Returns
+        -------
+        list of CaseRow
+            The rows.
+        """
         q = ("SELECT case_id, controller, run_name, wind_mps, seed, turbulence, case_hash, "
              "assess_hash, status, file, metrics, error, traceback, software_version, spec_hash, "
              "attempts, wall_s, worker FROM cases")
@@ -264,7 +351,13 @@ class CampaignStore:
         return out
 
     def counts(self) -> dict[str, int]:
-        """Number of cases per status."""
+        """Number of cases per status.
+
+        Returns
+        -------
+        dict of str to int
+            Status -> count.
+        """
         c = {s: 0 for s in STATUSES}
         for s, n in self.db.execute("SELECT status, count(*) FROM cases GROUP BY status"):
             c[s] = n
@@ -272,7 +365,13 @@ class CampaignStore:
 
     def stray_temp_files(self) -> list[Path]:
         """Temp files left by writers that were killed mid-write (safe to delete once no
-        worker of this campaign runs)."""
+        worker of this campaign runs).
+
+        Returns
+        -------
+        list of Path
+            The files.
+        """
         return sorted(self.cases_dir.glob(".*.tmp")) if self.cases_dir.is_dir() else []
 
     def _tx(self) -> "_Tx":

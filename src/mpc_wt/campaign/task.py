@@ -23,7 +23,18 @@ __all__ = ["run_case", "case_metrics", "case_file"]
 
 
 def case_file(case_id: str) -> str:
-    """The result file of a case, relative to the campaign directory."""
+    """The result file of a case, relative to the campaign directory.
+
+    Parameters
+    ----------
+    case_id : str
+        The case.
+
+    Returns
+    -------
+    str
+        ``cases/CASE_ID.nc``.
+    """
     return f"cases/{case_id}.nc"
 
 
@@ -40,6 +51,23 @@ def case_metrics(t: np.ndarray, cols: dict[str, np.ndarray], channels: dict[str,
     channel (Woehler exponent of the spec, 1 Hz equivalent cycles), mean and std of power,
     energy, CS1-CS5 (tower-base fore-aft moment vs electrical power, Do et al. eqs 21-26), pitch
     duty, rotor/generator speed statistics and the blade-1 flap 1P/3P/6P content.
+
+
+    Parameters
+    ----------
+    t : (n_t,) ndarray
+        Time [s].
+    cols : dict of str to (n_t,) ndarray
+        The run's channels.
+    channels : dict of str to float
+        Channel -> Woehler exponent.
+    transient : float
+        Discarded start [s].
+
+    Returns
+    -------
+    dict
+        JSON-safe metrics (:func:`mpc_wt.assess.assess_series` plus rotor-speed statistics).
 
     Raises
     ------

@@ -105,7 +105,7 @@ def _linearize(args: argparse.Namespace) -> int:
         if not args.json:
             print(f"wrote {args.out}: {len(fam.models)} models, {fam.models[0].n_x} states, "
                   f"inputs {list(fam.models[0].inputs)}")
-    rows = [{"wind_mps": m.wind_speed, "pitch_deg": m.info["pitch_deg"],
+    rows = [{"wind_mps": m.wind_mps, "pitch_deg": m.info["pitch_deg"],
              "rotor_speed_rpm": m.info["rotor_speed_rpm"], **linearize.sensitivities(m),
              "modes": m.modes()} for m in fam.models]
     if args.json:

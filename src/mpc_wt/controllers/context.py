@@ -57,7 +57,14 @@ class Scenario:
             raise ValueError(f"seed must be an integer >= 0, got {self.seed!r}")
 
     def meta(self) -> dict[str, Any]:
-        """The case as plain data for a result's ``meta``."""
+        """The case as plain data for a result's ``meta``.
+
+        Returns
+        -------
+        dict
+            ``wind_mps``, ``turbulence``, ``seed``, ``duration_s``, ``shear_exponent`` (the I/O keys
+            carry units).
+        """
         return {"wind_mps": self.wind_mps, "turbulence": self.turbulence, "seed": self.seed,
                 "duration_s": self.duration, "shear_exponent": self.shear_exponent}
 

@@ -198,7 +198,13 @@ class Options:
         return cls(**vals)
 
     def to_dict(self) -> dict[str, Any]:
-        """Every option with its value (nested options as mappings)."""
+        """Every option with its value (nested options as mappings).
+
+        Returns
+        -------
+        dict
+            Name -> value (tuples as lists, nested options as mappings).
+        """
         out = {}
         for f in fields(self):
             v = getattr(self, f.name)

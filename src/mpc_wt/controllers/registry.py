@@ -250,7 +250,13 @@ class Selection:
         return (self.base, *self.addons)
 
     def option_names(self) -> set[str]:
-        """Every option any part takes."""
+        """Every option any part takes.
+
+        Returns
+        -------
+        set of str
+            The option names of the base and its add-ons.
+        """
         return {f.name for k in self.parts for f in option_fields(k.options)}
 
     def options(self, raw: Mapping[str, Any] | None = None,
