@@ -31,6 +31,8 @@ import numpy as np
 
 import linearize
 
+from .simulate import ControllerBase
+
 __all__ = ["BaselineGains", "tune_baseline", "tune_baseline_schedule", "BaselineController",
            "check_power_fraction"]
 
@@ -195,7 +197,7 @@ def tune_baseline_schedule(turbine: linearize.Turbine,
     return tuple(tune_baseline(turbine, power_fraction=f, **kwargs) for f in fr)
 
 
-class BaselineController:
+class BaselineController(ControllerBase):
     """NREL 5-MW style baseline (torque law + gain-scheduled PI pitch) as a harness controller.
 
     ``step(t, meas)`` takes a measurement dict with at least ``gen_speed`` [rad/s] and
@@ -351,22 +353,7 @@ class BaselineController:
         return p
 
     def step(self, t: float, meas: dict[str, Any]) -> tuple[np.ndarray, float]:
-        """One control step; returns (pitch_ref (3,) [rad], gen_torque_ref [N m]).
-
-        Parameters
-        ----------
-        t : float
-            Time [s].
-        meas : dict
-            The harness's measurements (:mod:`mpc_wt.simulate`).
-
-        Returns
-        -------
-        pitch_ref : (3,) ndarray
-            Blade pitch commands [rad].
-        gen_torque_ref : float
-            Generator torque command [N m].
-        """
+        # One control step; returns (pitch_ref (3,) [rad], gen_torque_ref [N m]).
         w = float(meas["gen_speed"])
         if not math.isfinite(w):
             raise ValueError(f"measurement gen_speed is not finite at t = {t:g} s: {w!r}")

@@ -33,6 +33,7 @@ import linearize
 from linearize.validate import check_number
 
 from .qp import check_backend, default_backend, make_backend
+from .simulate import ControllerBase
 
 __all__ = ["coleman_weight", "MPCWeights", "MPCSettings", "MPC", "ScheduledMPC"]
 
@@ -239,7 +240,7 @@ def _group(name: str) -> str:
     return name
 
 
-class MPC:
+class MPC(ControllerBase):
     """Linear MPC on a discretized :class:`linearize.LinearModel` (Madsen et al. eqs 20-23).
 
     Parameters
@@ -931,7 +932,7 @@ class MPC:
         return (self._plan * self._su[:self._nvu]).reshape(self.hu, self._nu)
 
 
-class ScheduledMPC:
+class ScheduledMPC(ControllerBase):
     """MPC scheduled over a :class:`linearize.LinearModelFamily` by mean wind (issue 6, item 3).
 
     One :class:`MPC` per grid wind of the family, built on first use and kept, so that the QP
@@ -1026,23 +1027,7 @@ class ScheduledMPC:
         self.switches += 1
 
     def step(self, t: float, meas: dict[str, Any]) -> tuple[np.ndarray, float]:
-        """Update the scheduling wind, switch controllers past the hysteresis, step the active
-        one.
-
-        Parameters
-        ----------
-        t : float
-            Time [s].
-        meas : dict
-            The harness's measurements (:mod:`mpc_wt.simulate`).
-
-        Returns
-        -------
-        pitch_ref : (3,) ndarray
-            Blade pitch commands [rad].
-        gen_torque_ref : float
-            Generator torque command [N m].
-        """
+        # Update the scheduling wind, switch controllers past the hysteresis, step the active one.
         ctl = self.controller(self.active)
         if self.wind_source == "preview" and meas.get("preview") is not None:
             wsig: float | None = float(np.mean(np.asarray(meas["preview"].blade)[0]))

@@ -49,6 +49,7 @@ from linearize.validate import check_number
 from .assess import aep_Wh
 from .baseline import BaselineController, BaselineGains, check_power_fraction
 from .filters import SOSFilterBank, filter_sos
+from .simulate import ControllerBase
 
 __all__ = ["apc_reference", "IBCGains", "tune_ibc", "IBCController", "ColemanIPCGains",
            "tune_coleman_ipc", "ColemanIPCController", "steady_power_curve", "aep_change",
@@ -426,7 +427,7 @@ def _gain_margin(loop: Any, k: float) -> float:
     return lo
 
 
-class _PitchAddOn:
+class _PitchAddOn(ControllerBase):
     """What IBC and Coleman IPC share: the collective controller underneath, the power
     fade-in weight (power filtered over ``power_tau`` = 1 s), and pitch limits and rate on the
     summed command. Subclasses reset their own state in ``_reset_own``."""
@@ -509,22 +510,7 @@ class IBCController(_PitchAddOn):
         self._bs.reset()
 
     def step(self, t: float, meas: dict[str, Any]) -> tuple[np.ndarray, float]:
-        """One control step; returns (pitch_ref (3,) [rad], gen_torque_ref [N m]).
-
-        Parameters
-        ----------
-        t : float
-            Time [s].
-        meas : dict
-            The harness's measurements (:mod:`mpc_wt.simulate`).
-
-        Returns
-        -------
-        pitch_ref : (3,) ndarray
-            Blade pitch commands [rad].
-        gen_torque_ref : float
-            Generator torque command [N m].
-        """
+        # One control step; returns (pitch_ref (3,) [rad], gen_torque_ref [N m]).
         pc, tq = self.collective.step(t, meas)
         m = np.asarray(meas["flap_moment"], float)
         if m.shape != (3,) or not np.all(np.isfinite(m)):
@@ -710,22 +696,7 @@ class ColemanIPCController(_PitchAddOn):
         self._theta_cs = np.zeros(2)
 
     def step(self, t: float, meas: dict[str, Any]) -> tuple[np.ndarray, float]:
-        """One control step; returns (pitch_ref (3,) [rad], gen_torque_ref [N m]).
-
-        Parameters
-        ----------
-        t : float
-            Time [s].
-        meas : dict
-            The harness's measurements (:mod:`mpc_wt.simulate`).
-
-        Returns
-        -------
-        pitch_ref : (3,) ndarray
-            Blade pitch commands [rad].
-        gen_torque_ref : float
-            Generator torque command [N m].
-        """
+        # One control step; returns (pitch_ref (3,) [rad], gen_torque_ref [N m]).
         pc, tq = self.collective.step(t, meas)
         m = np.asarray(meas["flap_moment"], float)
         psi = float(meas["azimuth"])

@@ -27,7 +27,7 @@ from . import __version__
 from .errors import ResultFileError, SimulationDivergedError
 from .results import ClosedLoopResult
 
-__all__ = ["Controller", "ClosedLoopResult", "ResultFileError", "LidarPreview",
+__all__ = ["Controller", "ControllerBase", "ClosedLoopResult", "ResultFileError", "LidarPreview",
            "SimulationDivergedError", "simulate_closed_loop"]
 
 log = logging.getLogger(__name__)
@@ -36,23 +36,29 @@ _IX_ROTOR = linearize.STATE_NAMES.index("rotor_speed")
 _IX_AZ = linearize.STATE_NAMES.index("azimuth")
 
 
-class Controller(Protocol):
-    """What the harness needs from a controller: ``reset()`` before a run and
-    ``step(t, meas) -> (pitch_ref (3,) [rad], gen_torque_ref [N m])`` at its rate.
+class ControllerBase:
+    """Base of the controllers mpc-wt ships; a user's controller need not subclass it (any
+    object with ``reset`` and ``step`` runs, see :class:`Controller`).
+
+    ``signals`` holds the controller's internal signals of the last step, recorded by the
+    harness at every plant step.
     """
+
+    signals: dict[str, float]
 
     def reset(self) -> None:
         """Forget everything of a previous run."""
+        raise NotImplementedError
 
     def step(self, t: float, meas: dict[str, Any]) -> tuple[np.ndarray, float]:
-        """Commands for the measurements ``meas`` at time ``t`` [s].
+        """Commands for the measurements at time ``t``.
 
         Parameters
         ----------
         t : float
             Time [s].
         meas : dict
-            The harness's measurements (:mod:`mpc_wt.simulate`).
+            The harness's measurements (this module's docstring lists them).
 
         Returns
         -------
@@ -61,6 +67,21 @@ class Controller(Protocol):
         gen_torque_ref : float
             Generator torque command [N m].
         """
+        raise NotImplementedError
+
+
+class Controller(Protocol):
+    """What the harness needs from a controller: ``reset()`` before a run and
+    ``step(t, meas) -> (pitch_ref (3,) [rad], gen_torque_ref [N m])`` at its rate."""
+
+    def reset(self) -> None:
+        """Forget everything of a previous run."""
+
+    def step(self, t: float, meas: dict[str, Any]) -> tuple[np.ndarray, float]:
+        ...
+
+
+Controller.step.__doc__ = ControllerBase.step.__doc__
 
 
 class LidarPreview:

@@ -36,6 +36,7 @@ from linearize.validate import check_number
 
 from .errors import SynthesisError
 from .estimator import read_signals
+from .simulate import ControllerBase
 
 __all__ = ["LQRDesign", "PIObserver", "design_lqr", "design_lqr_family", "design_pi_observer",
            "LQRPIOController", "SynthesisError", "REGION3_WEIGHTS", "REGION3_SCALES"]
@@ -352,7 +353,7 @@ def design_pi_observer(model: linearize.LinearModel, *,
                       gain_ratio=ratio, measured=tuple(measured), y0=y0, q=float(q))
 
 
-class LQRPIOController:
+class LQRPIOController(ControllerBase):
     """LQR state feedback on PI-observer estimates (Do et al. Fig. 2) for the harness.
 
     Parameters
@@ -423,22 +424,7 @@ class LQRPIOController:
         self.signals: dict[str, float] = {}
 
     def step(self, t: float, meas: dict[str, Any]) -> tuple[np.ndarray, float]:
-        """One control step: observer update, then u = u0 - K (x_hat - x0) (+ feedforward).
-
-        Parameters
-        ----------
-        t : float
-            Time [s].
-        meas : dict
-            The harness's measurements (:mod:`mpc_wt.simulate`).
-
-        Returns
-        -------
-        pitch_ref : (3,) ndarray
-            Blade pitch commands [rad].
-        gen_torque_ref : float
-            Generator torque command [N m].
-        """
+        # One control step: observer update, then u = u0 - K (x_hat - x0) (+ feedforward).
         y = read_signals(meas, self.obs.measured) - self.obs.y0
         if not np.all(np.isfinite(y)):
             raise ValueError(f"non-finite measurement at t = {t:g} s: "

@@ -53,6 +53,7 @@ from linearize.validate import check_number
 from .estimator import read_signals
 from .retrofit import apc_reference  # noqa: F401 - re-exported (eq 11 lives with the APC)
 from .errors import PremiseError, SynthesisError
+from .simulate import ControllerBase
 
 __all__ = ["TSModel", "build_ts_model", "TSControllerDesign", "TSObserverDesign",
            "Certificate", "design_ts_controller", "design_ts_observer", "verify_controller",
@@ -967,7 +968,7 @@ def verify_observer(ts: TSModel, L: np.ndarray, P: np.ndarray, scale_xi: np.ndar
 # --------------------------------------------------------------------------------------------
 # Controller in the harness
 # --------------------------------------------------------------------------------------------
-class TSController:
+class TSController(ControllerBase):
     """TS controller (eq 7) on TS observer estimates (eq 10) for the simulation harness.
 
     The observer is integrated exactly (zero-order hold on u and y) per vertex at the controller
@@ -1044,22 +1045,7 @@ class TSController:
         return vc, dc, clipped
 
     def step(self, t: float, meas: dict[str, Any]) -> tuple[np.ndarray, float]:
-        """Observer update, memberships, PDC control law (Clemens eqs 5-10).
-
-        Parameters
-        ----------
-        t : float
-            Time [s].
-        meas : dict
-            The harness's measurements (:mod:`mpc_wt.simulate`).
-
-        Returns
-        -------
-        pitch_ref : (3,) ndarray
-            Blade pitch commands [rad].
-        gen_torque_ref : float
-            Generator torque command [N m].
-        """
+        # Observer update, memberships, PDC control law (Clemens eqs 5-10).
         y = read_signals(meas, self.ts.measured)
         if not np.all(np.isfinite(y)):
             raise ValueError(f"non-finite measurement at t = {t:g} s: "

@@ -190,5 +190,33 @@ def test_option_class_for_users_validates_its_fields() -> None:
     assert Mine.from_dict({"gain": 2}).gain == 2.0
     with pytest.raises(OptionsError, match=r"gain must be > 0 rad/s, got -1"):
         Mine.from_dict({"gain": -1})
-    with pytest.raises(OptionsError, match="gain must be a finite number, got nan"):
+    with pytest.raises(OptionsError, match="gain must be > 0 rad/s, got nan"):
         Mine.from_dict({"gain": float("nan")})
+
+
+@pytest.mark.parametrize("argv, match", [
+    (["linearize", "--wind", "12", "--out", "models.lin"], "--out must end in .mat, .npz, .json"),
+    (["design", "ts", "--decay-rate=-1"], "--decay-rate must be > 0, got -1.0"),
+    (["design", "lqr", "--observer-q=-5"], "--observer-q must be >= 0, got -5.0"),
+    (["wind", "generate", "--mean", "18", "--out", "field.txt"], "--out must end in .bts, .npz"),
+    (["simulate", "--controller", "mpc", "--horizon", "0", "--wind", "18"],
+     "horizon must be >= 1, got 0"),
+])
+def test_commands_check_their_arguments_before_working(argv, match, tmp_path: Path,
+                                                       capsys: pytest.CaptureFixture[str],
+                                                       monkeypatch: pytest.MonkeyPatch) -> None:
+    """The argument error comes first: nothing is computed or written (the commands would
+    otherwise linearize, solve LMIs or generate a field before failing)."""
+    import linearize as lz
+
+    def boom(*a, **k):  # any plant work before the check fails the test
+        raise AssertionError("work done before the arguments were checked")
+
+    monkeypatch.setattr(lz, "linearize_family", boom)
+    monkeypatch.setattr(lz, "load_turbine", boom)
+    out = tmp_path / "d"
+    assert main([*argv, "--out", str(out)] if "--out" not in argv else
+                [a if a not in ("models.lin", "field.txt") else str(tmp_path / a)
+                 for a in argv]) == 2
+    assert match in capsys.readouterr().err
+    assert not out.exists()

@@ -40,14 +40,14 @@ def _fail(key: str, msg: str) -> SpecError:
 
 def _number(key: str, val: Any, lo: float | None = None, hi: float | None = None,
             lo_open: bool = False) -> float:
-    if isinstance(val, bool) or not isinstance(val, (int, float)) or not math.isfinite(val):
-        raise _fail(key, f"must be a finite number, got {val!r}")
-    x = float(val)
-    if lo is not None and (x <= lo if lo_open else x < lo):
-        raise _fail(key, f"must be {'>' if lo_open else '>='} {lo:g}, got {x:g}")
-    if hi is not None and x > hi:
-        raise _fail(key, f"must be <= {hi:g}, got {x:g}")
-    return x
+    """A finite number within bounds (:func:`linearize.validate.check_number`), or a
+    :class:`SpecError` naming the key."""
+    from linearize.validate import check_number
+
+    try:
+        return check_number(key, val, lo=lo, hi=hi, lo_open=lo_open)
+    except ValueError as err:
+        raise _fail(key, str(err).removeprefix(f"{key} ")) from None
 
 
 def _winds(key: str, val: Any) -> tuple[float, ...]:

@@ -8,10 +8,11 @@ specs read the same metadata (flag name, help, choices), so a rule is written on
 from __future__ import annotations
 
 import dataclasses
-import math
 import typing
 from dataclasses import dataclass, fields
 from typing import Any, Callable, Mapping, TypeVar
+
+from linearize.validate import check_number
 
 from ..errors import OptionsError
 
@@ -111,20 +112,17 @@ def _convert(key: str, val: Any, tp: Any, meta: Mapping[str, Any]) -> Any:
 
 
 def _number(key: str, val: Any, base: Any, meta: Mapping[str, Any]) -> float | int:
-    if isinstance(val, bool) or not isinstance(val, (int, float)) or not math.isfinite(val):
-        raise OptionsError(f"{key} must be a finite number, got {val!r}", key)
+    try:
+        v = check_number(key, val, lo=meta.get("lo"), hi=meta.get("hi"),
+                         lo_open=bool(meta.get("lo_open")), unit=meta.get("unit") or "",
+                         say_finite=False)
+    except ValueError as err:
+        raise OptionsError(str(err), key) from None
     if base is int:
-        if int(val) != val:
+        if int(v) != v or isinstance(val, float):
             raise OptionsError(f"{key} must be an integer, got {val!r}", key)
-        val = int(val)
-    lo, hi = meta.get("lo"), meta.get("hi")
-    unit = f" {meta['unit']}" if meta.get("unit") else ""
-    if lo is not None and (val <= lo if meta.get("lo_open") else val < lo):
-        raise OptionsError(f"{key} must be {'>' if meta.get('lo_open') else '>='} {lo:g}{unit}, "
-                           f"got {val!r}", key)
-    if hi is not None and val > hi:
-        raise OptionsError(f"{key} must be <= {hi:g}{unit}, got {val!r}", key)
-    return float(val) if base is float else val
+        return int(v)
+    return v
 
 
 @dataclass(frozen=True)
