@@ -46,7 +46,7 @@ from scipy import signal
 import linearize
 from linearize.validate import check_number
 
-from .assess import aep_Wh
+from .assess import aep_Wh, pct_change
 from .baseline import BaselineController, BaselineGains, check_power_fraction
 from .filters import SOSFilterBank, filter_sos
 from .simulate import ControllerBase
@@ -840,5 +840,5 @@ def aep_change(turbine: linearize.Turbine, fractions: Sequence[float] = (0.9, 0.
         out["curves"][f] = curve
         out["aep_Wh"][f] = aep_Wh(curve["power_W"], prob)
     for f in fr[1:]:
-        out["change_pct"][f] = 100.0 * (out["aep_Wh"][f] / out["aep_Wh"][1.0] - 1.0)
+        out["change_pct"][f] = pct_change(out["aep_Wh"][1.0], out["aep_Wh"][f])
     return out

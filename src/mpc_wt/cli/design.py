@@ -30,8 +30,8 @@ def add_parsers(sub: Any) -> None:
     p.add_argument("kind", choices=list(designs()))
     add_turbine(p)
     p.add_argument("--out", required=True, help="design directory (design.json, gains.png)")
-    p.add_argument("--wind", help="lqr: START:STOP:STEP (default 12:25:1); ts: comma list of "
-                                  "vertex winds (default 12,14,16,19,22,25) [m/s]")
+    p.add_argument("--wind", help="lqr, ts: START:STOP:STEP or a comma list (default lqr "
+                                  "12:25:1, ts 12,14,16,19,22,25) [m/s]")
     p.add_argument("--reductions", default="0,0.4,0.8",
                    help="ts: comma list of vertex power reductions (default 0,0.4,0.8)")
     p.add_argument("--decay-rate", type=float, default=0.2, help="ts: controller decay [1/s]")
@@ -74,12 +74,7 @@ def _design_args(args: argparse.Namespace) -> dict[str, Any]:
         frac = check_power_fraction(args.power_fraction, "--power-fraction")
     except ValueError as err:
         raise UsageError(str(err)) from None
-    lqr = args.kind == "lqr"
-    winds: Any = None
-    if args.wind:
-        winds = parse_range(args.wind, "--wind") if lqr else floats(args.wind, "--wind")
-    elif args.kind == "ts":
-        winds = [12.0, 14.0, 16.0, 19.0, 22.0, 25.0]
+    winds = parse_range(args.wind, "--wind") if args.wind else None
     return {"power_fraction": frac, "omega_n_rad_s": _positive("--omega-n", args.omega_n),
             "zeta": _positive("--zeta", args.zeta),
             "loop_gain": _positive("--loop-gain", args.loop_gain), "winds": winds,

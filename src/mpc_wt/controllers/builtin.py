@@ -65,13 +65,14 @@ def _design_lqr(turbine: linearize.Turbine, *, winds: Any = None,
     return lqr_table(turbine, designs, obs), note
 
 
-def _design_ts(turbine: linearize.Turbine, *, winds: Any = (12, 14, 16, 19, 22, 25),
+def _design_ts(turbine: linearize.Turbine, *, winds: Any = None,
                reductions: Any = (0.0, 0.4, 0.8), decay_rate: float = 0.2,
                observer_decay_rate: float = 1.0) -> tuple[dict, str]:
     from ..export import ts_table
     from ..ts import build_ts_model, design_ts_controller, design_ts_observer
 
-    ts = build_ts_model(turbine, list(winds), list(reductions), progress=True)
+    grid = (12.0, 14.0, 16.0, 19.0, 22.0, 25.0) if winds is None else winds
+    ts = build_ts_model(turbine, [float(v) for v in grid], list(reductions), progress=True)
     ctl = design_ts_controller(ts, decay_rate=decay_rate)
     obs = design_ts_observer(ts, decay_rate=observer_decay_rate)
     return ts_table(turbine, ts, ctl, obs), (
