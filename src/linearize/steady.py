@@ -12,7 +12,7 @@ import numpy as np
 from scipy.optimize import minimize_scalar
 
 from ._typing import FloatArray
-from .bem import AeroOptions
+from .bem import MODE_NOLIMITS, AeroOptions
 from .plant import PlantConfig, PlantParams, _eval, _sample_wind, plant_params
 from .turbine import Turbine
 
@@ -22,8 +22,9 @@ _TWO_PI_3 = 2.0 * math.pi / 3.0
 
 
 @nb.njit(cache=True, error_model="numpy")
-def _avg_eval(x, u, speed, shear, p, n_az):  # pragma: no cover - compiled
-    """Derivatives and outputs averaged over ``n_az`` azimuths in [0, 2 pi / 3)."""
+def _avg_eval(x, u, speed, shear, p, n_az, mode=0):  # pragma: no cover - compiled
+    """Derivatives and outputs averaged over ``n_az`` azimuths in [0, 2 pi / 3); ``mode`` as
+    the plant kernel's (MODE_NOLIMITS: no actuator limits on the pitch and torque given)."""
     dx_avg = np.zeros(17)
     z_avg = np.zeros(31)
     hint = np.full((4, 3, p.r.size), np.nan)
@@ -33,7 +34,7 @@ def _avg_eval(x, u, speed, shear, p, n_az):  # pragma: no cover - compiled
     for k in range(n_az):
         xx[16] = k * _TWO_PI_3 / n_az
         w = _sample_wind(0.0, xx[16], p, 0, wpar, dummy)
-        dx, z, phis = _eval(xx, u, w, p, hint, 0)
+        dx, z, phis = _eval(xx, u, w, p, hint, mode)
         hint = phis
         dx_avg += dx
         z_avg += z
@@ -56,7 +57,7 @@ def _coeff_grid(tsr, pitch, speed, shear, p, n_az, ngear):  # pragma: no cover -
         for i in range(3):
             x[5 + i] = pitch[k]
             u[i] = pitch[k]
-        _, z = _avg_eval(x, u, speed, shear, p, n_az)
+        _, z = _avg_eval(x, u, speed, shear, p, n_az, MODE_NOLIMITS)
         cp[k] = z[22] * om / (qdyn * speed)
         ct[k] = z[23] / qdyn
     return cp, ct
@@ -87,7 +88,8 @@ def steady_coefficients(turbine: Turbine, tsr: FloatArray | float, pitch_deg: Fl
 
     Rigid rotor in steady wind. Tip-speed ratio and coefficients use the projected rotor
     radius R cos(precone) when precone is on (as CCBlade does). With tilt or shear the loads
-    are averaged over azimuth.
+    are averaged over azimuth. The pitch is taken as asked for: actuator limits belong to the
+    plant and the controllers, not to the aerodynamic tables (ROSCO's tables start at -5 deg).
 
     Parameters
     ----------

@@ -290,3 +290,19 @@ def test_design_ibc_and_export(tmp_path: Path, capsys: pytest.CaptureFixture[str
     assert all(float(r[2]) > 0 for r in rows[2:])
     doc = json.loads((d / "design.json").read_text())
     assert doc["settings"]["power_fraction"] == 0.9
+
+
+def test_cp_surface_has_distinct_rows_below_zero_pitch(tmp_path: Path,
+                                                      capsys: pytest.CaptureFixture[str]) -> None:
+    """Issue 17, defect 1: the rows below the actuator's 0 deg were copies of the 0 deg row."""
+    out = tmp_path / "cp.csv"
+    assert main(["aero", "cp-surface", "--pitch=-4:20:1", "--tsr", "6:10:1", "--out",
+                 str(out)]) == 0
+    rows = list(csv.reader(out.open()))[1:]
+    cp = {float(r[0]): np.array(r[1:], float) for r in rows}
+    below = [cp[b] for b in (-4.0, -3.0, -2.0, -1.0, 0.0)]
+    for a, b in zip(below, below[1:]):
+        assert np.abs(a - b).max() > 1e-3
+    # the reported maximum is a real row, near 0 deg (ROSCO's table: 0.4659 at TSR 7.5, 0 deg)
+    text = capsys.readouterr().out
+    assert "pitch -4.00 deg" not in text and "pitch 0.00 deg" in text
