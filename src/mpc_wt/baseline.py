@@ -34,7 +34,7 @@ import linearize
 from .simulate import ControllerBase
 
 __all__ = ["BaselineGains", "tune_baseline", "tune_baseline_schedule", "BaselineController",
-           "check_power_fraction"]
+           "check_power_fraction", "effective_pi_gains"]
 
 
 def check_power_fraction(value: Any, name: str = "power_fraction") -> float:
@@ -61,6 +61,38 @@ def check_power_fraction(value: Any, name: str = "power_fraction") -> float:
     if not (math.isfinite(f) and 0.0 < f <= 1.0):
         raise ValueError(f"{name} must be in (0, 1] (a fraction of rated power), got {value!r}")
     return f
+
+
+def effective_pi_gains(kp: float, ki: float, theta_k_rad: float, pitch_rad: Any
+                       ) -> tuple[np.ndarray, np.ndarray]:
+    """Small-signal PI gains of the DISCON-form pitch loop at collective pitch theta.
+
+    :class:`BaselineController` (as Jonkman's DISCON, report sec. 7.4) commands
+    theta_k = GK(theta_{k-1}) (kp e_k + ki sum e dt), GK(theta) = 1 / (1 + theta / theta_K),
+    with GK taken at the previous command and the integral of the raw speed error. Holding
+    theta = GK(theta) X with X = kp e + ki int e makes a small change obey
+    d theta (1 + theta GK / theta_K) = GK dX, i.e. d theta = dX / (1 + 2 theta / theta_K) in the
+    control band. The loop therefore acts with kp / (1 + 2 theta / theta_K) and
+    ki / (1 + 2 theta / theta_K), not with kp GK(theta): 0.62x of it at 0.15 rad for the
+    NREL 5-MW. A PI that holds its integral in pitch units and applies its table's gains
+    directly (ROSCO) regulates as ours with these gains.
+
+    Parameters
+    ----------
+    kp, ki : float
+        The design's gains at zero pitch [s], [-].
+    theta_k_rad : float
+        Gain-schedule corner [rad].
+    pitch_rad : array_like
+        Collective pitch [rad].
+
+    Returns
+    -------
+    kp_eff, ki_eff : ndarray
+        Effective proportional [s] and integral [-] gains at each pitch.
+    """
+    f = 1.0 / (1.0 + 2.0 * np.asarray(pitch_rad, float) / theta_k_rad)
+    return kp * f, ki * f
 
 
 @dataclass(frozen=True)

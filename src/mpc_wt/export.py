@@ -40,6 +40,7 @@ import numpy as np
 import linearize
 
 from . import __version__
+from .baseline import effective_pi_gains
 from .errors import GainTableError
 
 __all__ = ["SCHEMA_VERSION", "GainTableError", "baseline_table", "lqr_table", "ts_table",
@@ -82,8 +83,10 @@ def _matrix(stack: np.ndarray, rows: Sequence[str], cols: Sequence[str], unit: s
 def baseline_table(turbine: linearize.Turbine, gains: Any,
                    winds: Sequence[float] | None = None) -> dict[str, Any]:
     """The PI baseline (:class:`~mpc_wt.baseline.BaselineGains`) as a gain table: the pitch
-    gain schedule kp GK(theta), ki GK(theta), GK = 1 / (1 + theta / theta_K), at the trim pitch
-    of each wind speed from rated to cut-out (default 1 m/s steps), with the set points.
+    gain schedule -- the gains the controller applies, :func:`~mpc_wt.baseline.effective_pi_gains`
+    (kp, ki / (1 + 2 theta / theta_K) of the DISCON form), not the design's kp GK(theta) --
+    at the trim pitch of each wind speed from rated (the first row: the wind at which the design's rated or
+    derated power is reached at fine pitch) to cut-out in 1 m/s steps, with the set points.
 
     Parameters
     ----------
@@ -101,15 +104,15 @@ def baseline_table(turbine: linearize.Turbine, gains: Any,
         schedule (columns with units, rows) and matrices.
     """
     op = turbine.operation
-    if winds is None:
-        lo = math.ceil(linearize.rated_wind_speed(turbine))
-        winds = np.arange(lo, op.cut_out_wind + 0.5, 1.0)
-    rows = []
     p_w = None if gains.power_fraction == 1.0 else gains.rated_power
+    if winds is None:
+        v0 = _rated_wind(turbine, p_w)
+        winds = np.r_[v0, np.arange(math.floor(v0) + 1.0, op.cut_out_wind + 0.5, 1.0)]
+    rows = []
     for v in winds:
         p = linearize.trim(turbine, float(v), p_w)
-        gk = 1.0 / (1.0 + p.pitch_rad / gains.theta_k_rad)
-        rows.append([float(v), p.pitch_rad, gains.kp * gk, gains.ki * gk, p.gen_torque,
+        kp, ki = effective_pi_gains(gains.kp, gains.ki, gains.theta_k_rad, p.pitch_rad)
+        rows.append([float(v), p.pitch_rad, float(kp), float(ki), p.gen_torque,
                      p.gen_speed_rad_s, p.power])
     settings = {"kp": gains.kp, "ki": gains.ki, "theta_k_rad": gains.theta_k_rad,
                 "k_opt": gains.k_opt, "rated_gen_speed_rad_s": gains.rated_gen_speed_rad_s,
@@ -128,6 +131,20 @@ def baseline_table(turbine: linearize.Turbine, gains: Any,
     return _doc("baseline", turbine, settings,
                 ["wind_speed", "pitch", "kp", "ki", "gen_torque", "gen_speed", "power"],
                 ["m/s", "rad", "s", "-", "N m", "rad/s", "W"], rows, {})
+
+
+def _rated_wind(turbine: linearize.Turbine, power_W: float | None) -> float:
+    """The lowest wind at which ``power_W`` (default rated) is reached at fine pitch [m/s]."""
+    v_rated = linearize.rated_wind_speed(turbine)
+    if power_W is None:
+        return v_rated
+    from scipy.optimize import brentq
+
+    def short(v: float) -> float:
+        return linearize.trim(turbine, v).power - power_W
+
+    lo = turbine.operation.cut_in_wind
+    return float(brentq(short, lo, v_rated, xtol=1e-6)) if short(lo) < 0 else lo
 
 
 def lqr_table(turbine: linearize.Turbine, designs: Sequence[Any],
@@ -429,10 +446,14 @@ def _write_rosco(doc: dict[str, Any], out: Path, turbine_eff: float | None = Non
                              f"a {doc['kind']!r} design has none: export the baseline design "
                              f"(`mpcwt design baseline`) for ROSCO, or use csv/json/mat")
     s, st = doc["schedule"], doc["settings"]
-    cols = s["columns"]
     rows = np.asarray(s["rows"], dtype=float)
-    ang, kp, ki = (rows[:, cols.index(c)] for c in ("pitch", "kp", "ki"))
-    order = np.argsort(ang)
+    # ROSCO interpolates PC_GS_* linearly and holds the end values: tabulate the effective gains
+    # on a 0.25 deg grid from fine pitch to the schedule's last pitch (cut-out), so the
+    # hyperbola is followed to 0.2 % between the points
+    top = float(rows[:, s["columns"].index("pitch")].max())
+    ang = np.unique(np.r_[np.arange(st["min_pitch_rad"], top, math.radians(0.25)), top])
+    kp, ki = effective_pi_gains(st["kp"], st["ki"], st["theta_k_rad"], ang)
+    order = np.arange(ang.size)
     eff_pct = 100.0 * (turbine_eff if turbine_eff is not None else
                        st["rated_power"] / (st["rated_torque"] * st["rated_gen_speed_rad_s"]))
 
