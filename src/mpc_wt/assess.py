@@ -23,7 +23,8 @@ from scipy import stats
 
 from linearize.validate import check_number
 
-__all__ = ["rainflow", "damage_equivalent_load", "lifetime_del", "wind_bin_probabilities",
+__all__ = ["rainflow", "damage_equivalent_load", "DELConvention", "DEL_CONVENTIONS",
+           "del_convention", "CycleCount", "cycle_count", "lifetime_del", "wind_bin_probabilities",
            "miner_damage", "lifetime_extension", "CSMeasures", "cs_measures", "psd",
            "harmonic_psd", "pitch_duty", "energy_Wh", "aep_Wh", "tracking_response",
            "pct_change", "DEFAULT_CHANNELS", "assess_series", "reductions",
@@ -140,13 +141,170 @@ def rainflow(x: Any) -> tuple[FloatArray, FloatArray, FloatArray]:
     return r, mu, c
 
 
+@dataclass(frozen=True)
+class DELConvention:
+    """How a damage-equivalent load is stated.
+
+    Parameters
+    ----------
+    name : str
+        Its name in :data:`DEL_CONVENTIONS`.
+    amplitude : bool
+        Cycles as amplitudes S_a = range / 2 (Clemens et al.) instead of ranges.
+    counted : bool
+        N_eq = the counted cycle number sum n_i (Clemens eq 17) instead of f_eq x duration.
+    counting : {"astm", "pcrunch"}
+        ASTM E1049 with half cycles (our kernel), or pCrunch's quantised fatpack counting.
+    """
+
+    name: str
+    amplitude: bool
+    counted: bool
+    counting: str
+
+
+#: The DEL conventions by name: ``range-1hz`` (the IEC / MLife convention, the default and
+#: what the studies use), ``clemens`` (Clemens et al. eqs 17-18: amplitudes, counted cycles)
+#: and ``pcrunch`` (ranges, 1 Hz, pCrunch's counting).
+DEL_CONVENTIONS: dict[str, DELConvention] = {
+    c.name: c for c in (DELConvention("range-1hz", False, False, "astm"),
+                        DELConvention("clemens", True, True, "astm"),
+                        DELConvention("pcrunch", False, False, "pcrunch"))}
+
+
+def del_convention(name: str) -> DELConvention:
+    """The convention called ``name``.
+
+    Parameters
+    ----------
+    name : str
+        A key of :data:`DEL_CONVENTIONS`.
+
+    Returns
+    -------
+    DELConvention
+        The convention.
+
+    Raises
+    ------
+    ValueError
+        Naming the conventions.
+    """
+    if name not in DEL_CONVENTIONS:
+        raise ValueError(f"convention must be one of {list(DEL_CONVENTIONS)}, got {name!r}")
+    return DEL_CONVENTIONS[name]
+
+
+@dataclass(frozen=True)
+class CycleCount:
+    """The rainflow cycles of one series in a convention, from which its DEL at any Woehler
+    exponent follows (Clemens eq 17): DEL(m) = (sum_i n_i S_i^m / N_eq)^(1/m).
+
+    Parameters
+    ----------
+    sizes : (n_c,) ndarray
+        Cycle sizes S_i: ranges, or amplitudes in the ``clemens`` convention [unit of x].
+    counts : (n_c,) ndarray
+        Their counts n_i (1 or 0.5; histogram counts with pCrunch's counting) [-].
+    n_eq : float
+        The equivalent cycle number N_eq [-].
+    convention : str
+        The convention's name.
+    """
+
+    sizes: FloatArray
+    counts: FloatArray
+    n_eq: float
+    convention: str
+
+    def del_at(self, m: float) -> float:
+        """The DEL at Woehler exponent ``m``.
+
+        Parameters
+        ----------
+        m : float
+            Woehler exponent, > 0.
+
+        Returns
+        -------
+        float
+            (sum n_i S_i^m / N_eq)^(1/m) [unit of x]; 0 without cycles.
+        """
+        check_number("m (Woehler exponent)", m, lo=0.0, lo_open=True, say_finite=False)
+        if self.sizes.size == 0:
+            return 0.0
+        scale = float(self.sizes.max())
+        if scale == 0.0:
+            return 0.0
+        return float(scale * (np.sum(self.counts * (self.sizes / scale) ** m) / self.n_eq)
+                     ** (1.0 / m))
+
+
+def cycle_count(x: Any, *, convention: str = "range-1hz", n_eq: float | None = None,
+                duration: float | None = None, f_eq: float = 1.0, bins: int = 100
+                ) -> CycleCount:
+    """Count the rainflow cycles of a load series in a DEL convention.
+
+    Parameters
+    ----------
+    x : (n_t,) array_like
+        Load series.
+    convention : str
+        A key of :data:`DEL_CONVENTIONS`.
+    n_eq : float, optional
+        Equivalent cycle count (ranges conventions); else ``f_eq * duration``.
+    duration : float, optional
+        Record length [s] (ranges conventions, unless ``n_eq`` is given).
+    f_eq : float
+        Equivalent-load frequency [Hz].
+    bins : int
+        Range histogram bins of the ``pcrunch`` counting.
+
+    Returns
+    -------
+    CycleCount
+        Sizes, counts and N_eq.
+
+    Raises
+    ------
+    ValueError
+        A non-finite series, an unknown convention, a non-positive duration or n_eq.
+    """
+    conv = del_convention(convention)
+    if conv.counting == "pcrunch":
+        try:
+            import fatpack
+        except ImportError as err:
+            raise ImportError("convention='pcrunch' needs fatpack: pip install "
+                              "'mpc-wt[pcrunch]'") from err
+        ranges = fatpack.find_rainflow_ranges(_check_series("x", x), k=256)
+        c, r = fatpack.find_range_count(ranges, bins) if ranges.size else (np.zeros(0),
+                                                                          np.zeros(0))
+    else:
+        r, _, c = rainflow(x)
+    r, c = np.asarray(r, float), np.asarray(c, float)
+    if conv.counted:
+        neq = float(c.sum()) if c.size else 1.0
+    elif n_eq is None:
+        neq = f_eq * check_number("duration", duration, lo=0.0, lo_open=True, unit="s",
+                                  reason="n_eq is not given", say_finite=False)
+    else:
+        neq = check_number("n_eq", n_eq, lo=0.0, lo_open=True, say_finite=False)
+    return CycleCount(sizes=0.5 * r if conv.amplitude else r, counts=c, n_eq=neq,
+                      convention=conv.name)
+
+
 def damage_equivalent_load(x: Any, m: float, *, n_eq: float | None = None,
                            duration: float | None = None, f_eq: float = 1.0,
-                           method: str = "astm", bins: int = 100) -> float:
-    """Short-term damage-equivalent load as a range (Do et al. eq 20; Clemens eq 17).
+                           method: str = "astm", bins: int = 100,
+                           convention: str = "range-1hz") -> float:
+    """Short-term damage-equivalent load (Do et al. eq 20; Clemens eq 17).
 
-    DEL = (sum_i n_i S_i^m / N_eq)^(1/m) with S_i the rainflow ranges, n_i their counts and
-    N_eq = f_eq * duration (default 1 Hz times the record's duration).
+    DEL = (sum_i n_i S_i^m / N_eq)^(1/m) with the rainflow cycles S_i, their counts n_i and,
+    by ``convention`` (:data:`DEL_CONVENTIONS`): ``"range-1hz"`` (default; IEC / MLife) S_i
+    ranges and N_eq = f_eq * duration; ``"clemens"`` (Clemens et al. eq 17) S_i amplitudes
+    (range / 2) and N_eq the counted cycle number; ``"pcrunch"`` ranges counted as pCrunch
+    does.
 
     Parameters
     ----------
@@ -157,53 +315,39 @@ def damage_equivalent_load(x: Any, m: float, *, n_eq: float | None = None,
     n_eq : float, optional
         Equivalent cycle count; else ``f_eq * duration``.
     duration : float, optional
-        Record length [s] (required unless ``n_eq`` is given).
+        Record length [s] (required unless ``n_eq`` is given or the convention counts).
     f_eq : float
         Equivalent-load frequency [Hz] (default 1).
     method : {"astm", "pcrunch"}
         ASTM counting with half-cycle residue (our kernel); or exactly what pCrunch does
         (``FatigueParams.compute_del``): fatpack's rainflow on reversals quantized to 256
         levels with the residue repeated, ranges histogrammed into ``bins`` bins at their
-        centres. ``"pcrunch"`` needs the optional fatpack (``pip install 'mpc-wt[pcrunch]'``).
+        centres (the same as ``convention="pcrunch"``; needs the optional fatpack, ``pip
+        install 'mpc-wt[pcrunch]'``).
+    bins : int
+        Histogram bins of the pCrunch counting.
+    convention : str
+        A key of :data:`DEL_CONVENTIONS`.
 
     Returns
     -------
     float
-        The DEL as a range [unit of x]; 0 for a constant series.
+        The DEL [unit of x]: a range, or an amplitude in the ``clemens`` convention; 0 for a
+        constant series.
 
     Raises
     ------
     ValueError
-        On a non-positive m, duration or n_eq, a non-finite series or an unknown method.
+        On a non-positive m, duration or n_eq, a non-finite series or an unknown method or
+        convention.
     """
     check_number("m (Woehler exponent)", m, lo=0.0, lo_open=True, say_finite=False)
-    if n_eq is None:
-        n_eq = f_eq * check_number("duration", duration, lo=0.0, lo_open=True, unit="s",
-                                   reason="n_eq is not given", say_finite=False)
-    check_number("n_eq", n_eq, lo=0.0, lo_open=True, say_finite=False)
-    if method == "astm":
-        r, _, c = rainflow(x)
-    elif method == "pcrunch":
-        try:
-            import fatpack
-        except ImportError as err:
-            raise ImportError("method='pcrunch' needs fatpack: pip install 'mpc-wt[pcrunch]'") \
-                from err
-        arr = _check_series("x", x)
-        ranges = fatpack.find_rainflow_ranges(arr, k=256)
-        if ranges.size == 0:
-            return 0.0
-        c, r = fatpack.find_range_count(ranges, bins)
-    else:
+    if method not in ("astm", "pcrunch"):
         raise ValueError(f"method must be 'astm' or 'pcrunch', got {method!r}")
-    r = np.asarray(r, float)
-    c = np.asarray(c, float)
-    if r.size == 0:
-        return 0.0
-    scale = r.max()
-    if scale == 0.0:
-        return 0.0
-    return float(scale * (np.sum(c * (r / scale) ** m) / n_eq) ** (1.0 / m))
+    if method == "pcrunch":
+        convention = "pcrunch"
+    return cycle_count(x, convention=convention, n_eq=n_eq, duration=duration, f_eq=f_eq,
+                       bins=bins).del_at(m)
 
 
 def wind_bin_probabilities(v: Any, kind: str = "rayleigh", *, mean: float | None = None,
@@ -625,6 +769,11 @@ def pct_change(base: float, other: float) -> float:
     return 100.0 * (other / base - 1.0)
 
 
+#: Woehler exponents at which every assessed channel's DEL is kept (besides its own), so that
+#: lifetime DELs at another exponent come from the channel's cycles (Pettas and Cheng's
+#: lifetime extension at m = 4 and 10 of every channel).
+WOEHLER_EXPONENTS = (3.0, 4.0, 5.0, 6.0, 8.0, 10.0, 12.0)
+
 #: Load channels and their default Woehler exponents (10 composite blades, 4 steel elsewhere).
 DEFAULT_CHANNELS = {"flap_moment_1": 10.0, "flap_moment_2": 10.0, "flap_moment_3": 10.0,
                     "edge_moment_1": 10.0, "edge_moment_2": 10.0, "edge_moment_3": 10.0,
@@ -636,7 +785,8 @@ DEFAULT_CHANNELS = {"flap_moment_1": 10.0, "flap_moment_2": 10.0, "flap_moment_3
 
 def assess_series(t: np.ndarray, cols: dict[str, np.ndarray],
                   channels: dict[str, float] | None = None,
-                  m_override: float | None = None) -> dict[str, Any]:
+                  m_override: float | None = None,
+                  convention: str = "range-1hz") -> dict[str, Any]:
     """DEL per channel, CS1-CS5 (tower-base fore-aft moment vs power), pitch duty, power std,
     energy and the 1P/3P/6P content of the blade-1 flap moment, for one run.
 
@@ -650,11 +800,15 @@ def assess_series(t: np.ndarray, cols: dict[str, np.ndarray],
         Channel -> Woehler exponent (default: the :data:`DEFAULT_CHANNELS` present).
     m_override : float, optional
         One Woehler exponent for every channel.
+    convention : str
+        The DEL convention (:data:`DEL_CONVENTIONS`; default ``range-1hz``).
 
     Returns
     -------
     dict
-        ``duration_s``, ``channels`` {name: {del, m}}, and when the signals are there
+        ``duration_s``, ``del_convention``, ``channels`` {name: {del, m, n_eq, del_at_m}}
+        (``del_at_m``: the DEL at each exponent of :data:`WOEHLER_EXPONENTS` and the channel's,
+        keyed ``f"{m:g}"``, from the channel's own cycles), and when the signals are there
         ``power_mean_W``, ``power_std_W``, ``energy_Wh``, ``cs1``..``cs5``, the pitch duty,
         ``gen_speed_std_rad_s``, ``gen_torque_std_Nm``, ``flap_1_harmonics``.
 
@@ -669,11 +823,14 @@ def assess_series(t: np.ndarray, cols: dict[str, np.ndarray],
         raise KeyError(f"no channel {missing[0]!r}; channels are {sorted(cols)}")
     dt = float(np.median(np.diff(t)))
     duration = float(t[-1] - t[0])
-    out: dict[str, Any] = {"duration_s": duration, "channels": {}}
+    out: dict[str, Any] = {"duration_s": duration, "del_convention": convention,
+                           "channels": {}}
     for name, m in chans.items():
         mm = m_override if m_override is not None else m
-        out["channels"][name] = {"del": damage_equivalent_load(cols[name], mm,
-                                                               duration=duration), "m": mm}
+        cc = cycle_count(cols[name], convention=convention, duration=duration)
+        out["channels"][name] = {"del": cc.del_at(mm), "m": mm, "n_eq": cc.n_eq,
+                                 "del_at_m": {f"{w:g}": cc.del_at(w)
+                                              for w in sorted({*WOEHLER_EXPONENTS, mm})}}
     if "gen_power" in cols:
         p = cols["gen_power"]
         out["power_mean_W"] = float(p.mean())
@@ -729,6 +886,26 @@ _STD_KEYS = ("gen_speed_std_rad_s", "gen_torque_std_Nm", "power_std_W")
 _PITCH_KEYS = ("pitch_travel_deg", "pitch_rate_std_degps", "pitch_acc_std_degps2")
 
 
+def _lifetime_at(runs: Sequence[Mapping[str, Any]], channel: str, m: float,
+                 p: np.ndarray) -> float:
+    """Lifetime DEL of ``channel`` at exponent ``m`` over bins (Clemens eq 18), each bin's DEL
+    at m from its own cycles and weighted by its equivalent cycle count."""
+    dels, weights = [], []
+    for r in runs:
+        ch = r["channels"][channel]
+        if float(ch["m"]) == m:
+            dels.append(ch["del"])
+        else:
+            at = ch.get("del_at_m", {})
+            if f"{m:g}" not in at:
+                raise ValueError(f"the {channel} DELs hold exponents {sorted(at)} and the "
+                                 f"channel's own m = {ch['m']:g}, not m = {m:g}: assess the runs "
+                                 f"with that exponent")
+            dels.append(at[f"{m:g}"])
+        weights.append(ch.get("n_eq", 1.0))
+    return lifetime_del(np.array(dels), m, p, np.array(weights, float))
+
+
 def lifetime_comparison(probabilities: Any, base: Sequence[Mapping[str, Any]],
                         updated: Sequence[Mapping[str, Any]], *,
                         woehler: Sequence[float] = (4.0, 10.0), t_base: float = 15.0,
@@ -750,7 +927,14 @@ def lifetime_comparison(probabilities: Any, base: Sequence[Mapping[str, Any]],
         (probability-weighted mean power), ``pitch_change_pct`` and ``std_change_pct``
         (probability-weighted means of the per-run metrics), and ``extension`` {channel: {m:
         {"damage", "extension_years"}}} from eq 1 with the lifetime DEL ratio at each m in
-        ``woehler`` (the paper's 15 + 5 years by default).
+        ``woehler`` (the paper's 15 + 5 years by default). Each lifetime DEL at an exponent m
+        aggregates the bins' DELs at m computed from their own cycles (``del_at_m``), weighted
+        by probability and equivalent cycle count (eq 18).
+
+    Raises
+    ------
+    ValueError
+        Bins that differ in number, or an exponent not among a channel's ``del_at_m``.
     """
     p = np.asarray(probabilities, float)
     if not (len(base) == len(updated) == p.size):
@@ -765,14 +949,12 @@ def lifetime_comparison(probabilities: Any, base: Sequence[Mapping[str, Any]],
                            "pitch_change_pct": {}, "std_change_pct": {}}
     for c in chans:
         m = float(base[0]["channels"][c]["m"])
-        db = np.array([r["channels"][c]["del"] for r in base])
-        du = np.array([r["channels"][c]["del"] for r in updated])
-        lb, lu = lifetime_del(db, m, p), lifetime_del(du, m, p)
+        lb, lu = (_lifetime_at(runs, c, m, p) for runs in (base, updated))
         out["lifetime_del"][c] = (lb, lu)
         out["del_change_pct"][c] = pct_change(lb, lu)
         out["extension"][c] = {}
         for mw in woehler:
-            lbm, lum = lifetime_del(db, mw, p), lifetime_del(du, mw, p)
+            lbm, lum = (_lifetime_at(runs, c, float(mw), p) for runs in (base, updated))
             out["extension"][c][float(mw)] = lifetime_extension(
                 lbm, lum, mw, t_base=t_base, t_upd=t_upd, t_lifetime=t_lifetime)
     if all("power_mean_W" in r for r in [*base, *updated]):

@@ -1,7 +1,9 @@
 """Assessment: rainflow (ASTM, oracle), DEL, lifetime DEL, Miner, lifetime extension, CS1-CS5."""
 from __future__ import annotations
 
+import json
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -12,6 +14,8 @@ from numpy.testing import assert_allclose
 from mpc_wt.assess import (aep_Wh, cs_measures, damage_equivalent_load, energy_Wh,
                            harmonic_psd, lifetime_del, lifetime_extension, miner_damage,
                            pitch_duty, rainflow, wind_bin_probabilities)
+
+DATA = Path(__file__).resolve().parents[1] / "data"
 
 
 def _aggregate(r: np.ndarray, c: np.ndarray) -> dict[float, float]:
@@ -68,13 +72,41 @@ def test_del_invariances(seed: int, shift: float, scale: float, m: float) -> Non
                     rtol=1e-9, atol=1e-12)
 
 
-def test_lifetime_del_is_the_m_power_mean() -> None:
-    p = np.array([0.2, 0.5, 0.3])
-    d = np.array([1.0, 2.0, 4.0])
-    m = 4.0
-    assert_allclose(lifetime_del(d, m, p), (np.sum(p * d**m) / p.sum()) ** (1 / m), rtol=1e-14)
-    assert lifetime_del(d, m, p) > np.sum(p * d)        # never the arithmetic mean
-    assert_allclose(lifetime_del(np.full(3, 2.5), m, p), 2.5, rtol=1e-14)
+def test_lifetime_del_worked_cases() -> None:
+    """Clemens eq 18 on the hand-worked cases of ``tests/data/lifetime_del_cases.json``
+    (equal and unequal equivalent cycle counts, probabilities not summing to one)."""
+    cases = json.loads((DATA / "lifetime_del_cases.json").read_text())
+    c = cases["case_equal_durations"]
+    got = lifetime_del(c["DEL_j"], c["m"], c["p_j"])
+    assert_allclose(got, c["expected_lifetime_DEL"], rtol=1e-12)
+    assert got > c["pcrunch_2.1.5_compute_total_fatigue_weighted_DEL (arithmetic p-weighted "
+                   "mean, NOT the same)"]
+    c = cases["case_unequal_durations"]
+    assert_allclose(lifetime_del(c["DEL_j"], c["m"], c["p_j"], c["n_eq_j"]),
+                    c["expected_lifetime_DEL"], rtol=1e-12)
+    c = cases["case_probabilities_not_summing_to_one"]       # we normalise as Clemens does
+    assert_allclose(lifetime_del(c["DEL_j"], c["m"], c["p_j"], c["n_eq_j"]),
+                    c["clemens_normalised"], rtol=1e-12)
+
+
+def test_clemens_convention_on_the_astm_example() -> None:
+    """The ``clemens`` convention (eq 17: amplitudes S_a = range / 2, N_eq = the counted
+    cycles) on ASTM E1049-85 Fig. 6, by hand from its rainflow table (ranges 3, 4, 6, 8, 9
+    with counts 0.5, 1.5, 0.5, 1, 0.5; 4 cycles): DEL = (sum n (S/2)^m / 4)^(1/m)."""
+    ref = json.loads((DATA / "astm_e1049_fig6_del.json").read_text())
+    v = ref["variants"]["single_pass_half_cycles_0.5"]
+    x = ref["history"]
+    for m in (3, 4, 5, 8, 10, 12):
+        by_hand = (v["sum_n_S_pow_m"][str(m)] / 2 ** m / v["sum_counts"]) ** (1 / m)
+        assert_allclose(damage_equivalent_load(x, m, convention="clemens"), by_hand,
+                        rtol=1e-12)
+        # the default range-1hz convention, N_eq = 8 (1 Hz over the 8 s between A and I)
+        assert_allclose(damage_equivalent_load(x, m, duration=8.0),
+                        ref["variants"]["single_pass_half_cycles_0.5"][
+                            "DEL_Neq_8 (samples 1 s apart, 1 Hz equivalent, T=t[-1]-t[0]=8 s)"]
+                        [str(m)], rtol=1e-12)
+    with pytest.raises(ValueError, match="convention must be one of"):
+        damage_equivalent_load(x, 4, duration=8.0, convention="mlife")
 
 
 def test_rayleigh_bins_sum_to_the_probability_in_range() -> None:
@@ -88,11 +120,17 @@ def test_rayleigh_bins_sum_to_the_probability_in_range() -> None:
 def test_miner_and_lifetime_extension() -> None:
     # analytic: one cycle at the reference range uses 1 / n_ref of the life
     assert_allclose(miner_damage([10.0], [1.0], 4.0, 10.0, 1e7), 1e-7, rtol=1e-14)
-    # Pettas and Cheng eq 1 with 15 + 5 years and 10 % lower DEL, m = 4
+    # Pettas and Cheng eq 1, worked by hand in tests/data/lifetime_del_cases.json
+    cases = json.loads((DATA / "lifetime_del_cases.json").read_text())
+    for c in cases["lifetime_extension_damage"]["cases"]:
+        out = lifetime_extension(1.0, c["ratio"], c["m"], t_base=c["T_base"], t_upd=c["T_upd"],
+                                 t_lifetime=c["T_life"])
+        assert_allclose(out["damage"], c["D_comb"], rtol=1e-10)
+    # 15 + 5 years at 0.9 of the DEL, m = 4: D = 0.75 + 0.25 * 0.6561 = 0.914025; the reserve
+    # 0.085975 used at 0.6561 / 20 per year lasts 2.6208 years (by hand)
     out = lifetime_extension(1.0, 0.9, 4.0)
-    d = 15 / 20 + 5 / 20 * 0.9**4
-    assert_allclose(out["damage"], d, rtol=1e-14)
-    assert_allclose(out["extension_years"], (1 - d) / (0.9**4 / 20), rtol=1e-14)
+    assert_allclose([out["damage"], out["extension_years"]], [0.914025, 2.62079],
+                    rtol=1e-5)
     assert lifetime_extension(1.0, 1.0, 4.0)["extension_years"] == pytest.approx(0.0, abs=1e-12)
 
 

@@ -331,3 +331,29 @@ def test_aggregate_flags_a_seed_far_above_its_bin_and_weights_lifetime(tmp_path)
     p = wind_bin_probabilities(np.array([8.0, 12.0]), "rayleigh", mean=10.0)
     (life,) = agg["lifetime"]
     assert life["lifetime_del"] == pytest.approx(lifetime_del([bin8, 2.0], 4.0, p))
+
+
+def test_clemens_convention_weights_bins_by_counted_cycles(tmp_path):
+    """Issue 17, defect 4: with ``del_convention: clemens`` the per-case DEL is an amplitude
+    over the counted cycles (eq 17) and the lifetime DEL weights each bin by its counted cycles
+    (eq 18). Independent check: eq 18 equals the DEL of all bins' cycles pooled with the wind
+    probabilities, computed here from the stored series' rainflow cycles."""
+    from mpc_wt.assess import rainflow, wind_bin_probabilities
+    from mpc_wt.campaign.report import aggregate
+
+    spec = _spec(winds=[12, 18], duration=20, transient=5, turbulence="steady",
+                 channels={"flap_moment_1": 10}, del_convention="clemens")
+    assert run_campaign(spec, tmp_path / "c", engine="serial", progress=False).failed == 0
+    agg = aggregate(tmp_path / "c")
+    row = next(r for r in agg["lifetime"] if r["channel"] == "flap_moment_1")
+    p = wind_bin_probabilities(np.array([12.0, 18.0]), "rayleigh", mean=10.0)
+    num = den = 0.0
+    for pj, v in zip(p, (12, 18)):
+        res = ClosedLoopResult.load(tmp_path / "c" / "cases" / f"baseline__steady__v{v}__s1.nc")
+        x = res.channel("flap_moment_1")[res.t >= res.t[0] + 5.0]
+        r, _, n = rainflow(x)
+        num += pj * np.sum(n * (r / 2) ** 10)
+        den += pj * np.sum(n)
+    np.testing.assert_allclose(row["lifetime_del"], (num / den) ** 0.1, rtol=1e-9)
+    with pytest.raises(SpecError, match="del_convention"):
+        _spec(del_convention="mlife")

@@ -306,3 +306,20 @@ def test_cp_surface_has_distinct_rows_below_zero_pitch(tmp_path: Path,
     # the reported maximum is a real row, near 0 deg (ROSCO's table: 0.4659 at TSR 7.5, 0 deg)
     text = capsys.readouterr().out
     assert "pitch -4.00 deg" not in text and "pitch 0.00 deg" in text
+
+
+def test_assess_csv_without_known_channels_names_what_it_found(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """Issue 17, defect 6: exit 0 with an empty assessment before; now exit 2 naming the
+    columns found and the channels expected, and --channels takes any numeric column."""
+    p = tmp_path / "field.csv"
+    t = np.arange(0, 50, 0.1)
+    p.write_text("time,TwrBsMyt,GenPwr\n" + "\n".join(
+        f"{a},{1e3 * np.sin(a)},{5e3}" for a in t))
+    assert main(["assess", str(p)]) == 2
+    err = capsys.readouterr().err
+    assert "no column is a load channel we know" in err and "'TwrBsMyt'" in err
+    assert "tower_base_fa_moment" in err
+    assert main(["assess", str(p), "--channels", "TwrBsMyt", "--json"]) == 0
+    d = json.loads(capsys.readouterr().out)[0]["channels"]["TwrBsMyt"]
+    assert d["m"] == 4.0 and d["del"] > 0

@@ -13,7 +13,7 @@ from numpy.testing import assert_allclose
 from scipy import signal
 
 import linearize
-from mpc_wt.assess import lifetime_extension, tracking_response
+from mpc_wt.assess import tracking_response
 from mpc_wt.baseline import BaselineController, tune_baseline
 from mpc_wt.export import coleman_ipc_table, export, ibc_table, load_design, save_design
 from mpc_wt import run_controller
@@ -306,19 +306,50 @@ def _run(del_scale: float, power: float, travel: float) -> dict:
             "gen_torque_std_Nm": 1.0, "power_std_W": 1.0}
 
 
-def test_lifetime_comparison_of_a_uniform_reduction() -> None:
+def _alternating(amplitude: float, n: int, dt: float) -> dict:
+    """assess_series of a load alternating between 0 and ``amplitude`` at n + 1 points
+    ``dt`` apart: n half cycles of range ``amplitude`` over n dt seconds."""
+    t = dt * np.arange(n + 1)
+    x = amplitude * (np.arange(n + 1) % 2)
+    r = assess_series(t, {"flap_moment_1": x}, {"flap_moment_1": 4.0})
+    r.update({"power_mean_W": 1.0, "pitch_travel_deg": 1.0})
+    return r
+
+
+def test_lifetime_comparison_computes_each_exponent_from_the_cycles() -> None:
+    """Issue 17, defect 3: DELs computed at the channel's m = 4 were re-aggregated at m = 10.
+    Two bins of different cycle content, by hand (ranges, 1 Hz over 100 s):
+    A: 100 half cycles of range 2 -> DEL_A(m) = (50 2^m / 100)^(1/m);
+    B: 10 half cycles of range 10 -> DEL_B(m) = (5 10^m / 100)^(1/m);
+    lifetime (eq 18, p = 0.6, 0.4, equal N_eq): L(m) = (0.3 2^m + 0.02 10^m)^(1/m).
+    The old way, (0.6 DEL_A(4)^10 + 0.4 DEL_B(4)^10)^(1/10) = 4.33, is far from L(10) = 6.76.
+    The update halves bin B's range: L_u(m) = (0.3 2^m + 0.02 5^m)^(1/m)."""
+    p = np.array([0.6, 0.4])
+    base = [_alternating(2.0, 100, 1.0), _alternating(10.0, 10, 10.0)]
+    upd = [_alternating(2.0, 100, 1.0), _alternating(5.0, 10, 10.0)]
+    r = lifetime_comparison(p, base, upd, woehler=(4.0, 10.0))
+
+    def life(b: float, m: float) -> float:
+        return (0.3 * 2.0 ** m + 0.02 * b ** m) ** (1 / m)
+
+    lb, lu = r["lifetime_del"]["flap_moment_1"]
+    assert_allclose([lb, lu], [life(10.0, 4.0), life(5.0, 4.0)], rtol=1e-12)
+    for m in (4.0, 10.0):
+        d = 0.75 + 0.25 * (life(5.0, m) / life(10.0, m)) ** m      # Pettas and Cheng eq 1
+        assert_allclose(r["extension"]["flap_moment_1"][m]["damage"], d, rtol=1e-10)
+    assert r["extension"]["flap_moment_1"][10.0]["damage"] == pytest.approx(0.75, abs=5e-3)
+    with pytest.raises(ValueError, match="not m = 7"):
+        lifetime_comparison(p, base, upd, woehler=(7.0,))
+
+
+def test_lifetime_comparison_of_energy_and_pitch() -> None:
+    # by hand: every bin's power at 0.9x gives -10 % AEP; pitch travel 3x gives +200 %
     p = np.array([0.2, 0.5, 0.3])
     base = [_run(1.0, 1e6 * k, 100.0) for k in (1, 2, 3)]
     upd = [_run(0.9, 0.9e6 * k, 300.0) for k in (1, 2, 3)]
-    r = lifetime_comparison(p, base, upd)
+    r = lifetime_comparison(p, base, upd, woehler=())
     assert r["del_change_pct"]["flap_moment_1"] == pytest.approx(-10.0)
     assert r["aep_change_pct"] == pytest.approx(-10.0)
     assert r["pitch_change_pct"]["pitch_travel_deg"] == pytest.approx(200.0)
-    for m in (4.0, 10.0):
-        ext = r["extension"]["tower_base_fa_moment"][m]
-        d = 0.75 + 0.25 * 0.9**m                       # Pettas and Cheng eq 1
-        assert ext["damage"] == pytest.approx(d)
-        assert ext["extension_years"] == pytest.approx((1 - d) / (0.9**m / 20))
-        assert ext == lifetime_extension(3.0, 2.7, m)
     with pytest.raises(ValueError, match="one entry per wind bin"):
         lifetime_comparison(p[:2], base, upd)

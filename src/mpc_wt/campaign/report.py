@@ -63,9 +63,22 @@ def _probs(spec: CampaignSpec, winds: Sequence[float]) -> np.ndarray:
 
 
 def _bin_del(cases: list[CaseRow], ch: str, m: float) -> float | None:
-    """The DEL of a wind bin over its seeds: the m-power mean of equal-length runs."""
-    d = [c.metrics["channels"][ch]["del"] for c in cases if ch in c.metrics["channels"]]
-    return float(np.mean(np.asarray(d) ** m) ** (1 / m)) if d else None
+    """The DEL of a wind bin over its seeds: their cycles taken together, i.e. the m-power mean
+    of the seeds' DELs weighted by their equivalent cycle counts (equal for ``range-1hz``)."""
+    d, n = _seed_dels(cases, ch)
+    return float((np.sum(n * d ** m) / n.sum()) ** (1 / m)) if d.size else None
+
+
+def _bin_neq(cases: list[CaseRow], ch: str) -> float:
+    """The equivalent cycle count of a bin per run (its seeds' mean; Clemens eq 18's n_eq,j)."""
+    d, n = _seed_dels(cases, ch)
+    return float(n.mean()) if d.size else 1.0
+
+
+def _seed_dels(cases: list[CaseRow], ch: str) -> tuple[np.ndarray, np.ndarray]:
+    rows = [c.metrics["channels"][ch] for c in cases if ch in c.metrics["channels"]]
+    return (np.array([r["del"] for r in rows], float),
+            np.array([r.get("n_eq", 1.0) for r in rows], float))
 
 
 def _bin_mean(cases: list[CaseRow], key: str) -> float | None:
@@ -134,15 +147,13 @@ class _Group:
             d = [_bin_del(self.bins[v], ch, m) for v in self.winds]
             if any(x is None for x in d):
                 continue
-            lt = lifetime_del(d, m, self.p_all)
+            lt = lifetime_del(d, m, self.p_all, [_bin_neq(self.bins[v], ch) for v in self.winds])
             row = {**self.key, "channel": ch, "m": m,
                    "winds": f"{self.winds[0]:g}-{self.winds[-1]:g}", "lifetime_del": lt,
                    "lifetime_del_MNm": lt / 1e6, "change_pct": None, "ref_lifetime_del": None}
             if self.common:
-                mine = lifetime_del([_bin_del(self.bins[v], ch, m) for v in self.common], m,
-                                    self.p_com)
-                base = lifetime_del([_bin_del(self.rbins[v], ch, m) for v in self.common], m,
-                                    self.p_com)
+                mine = self._life(self.bins, ch, m)
+                base = self._life(self.rbins, ch, m)
                 is_ref = self.ctl == self.spec.reference
                 row["change_pct"] = 0.0 if is_ref else _pct(base, mine)
                 row["ref_lifetime_del"] = base
@@ -153,6 +164,11 @@ class _Group:
                                 "extension_years": e["extension_years"]})
             life.append(row)
         return life, ext
+
+    def _life(self, bins: dict[float, list[CaseRow]], ch: str, m: float) -> float:
+        """Lifetime DEL over the winds both controllers ran (Clemens eq 18)."""
+        return lifetime_del([_bin_del(bins[v], ch, m) for v in self.common], m, self.p_com,
+                            [_bin_neq(bins[v], ch) for v in self.common])
 
     def aep(self) -> list[dict[str, Any]]:
         pw = [_bin_mean(self.bins[v], "power_mean_W") for v in self.winds]

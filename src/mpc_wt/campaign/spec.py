@@ -27,7 +27,8 @@ __all__ = ["SpecError", "CampaignSpec", "ControllerSpec", "Case", "load_spec", "
 
 _TOP_KEYS = {"name", "description", "turbine", "duration", "transient", "turbulence",
              "shear_exponent", "winds", "seeds", "lidar", "controllers", "channels",
-             "wind_distribution", "lifetime_years", "reference", "report", "plugins"}
+             "wind_distribution", "lifetime_years", "reference", "report", "plugins",
+             "del_convention"}
 #: A controller entry's own keys; any other key is an option of the controller's kind.
 _CONTROLLER_KEYS = {"name", "controller", "winds", "seeds", "turbulence", "label", "options",
                     "mpc_options", "retrofit_options"}
@@ -173,6 +174,8 @@ class Case:
         Hashes of the simulation and the assessment inputs.
     plugins : tuple of str
         Modules that register controller kinds, imported by the worker.
+    del_convention : str
+        The DEL convention of the assessment (:data:`mpc_wt.assess.DEL_CONVENTIONS`).
     """
 
     case_id: str
@@ -191,6 +194,7 @@ class Case:
     case_hash: str
     assess_hash: str
     plugins: tuple[str, ...] = ()
+    del_convention: str = "range-1hz"
 
     def to_dict(self) -> dict[str, Any]:
         """Plain data for a worker (pickles and JSON-serialises).
@@ -243,6 +247,9 @@ class CampaignSpec:
         The spec's file.
     plugins : tuple of str
         Modules that register controller kinds.
+    del_convention : str
+        The DEL convention (``range-1hz``, default; ``clemens``; ``pcrunch``): DEL per case and
+        the lifetime DEL's weights (Clemens eq 18 weights bins by their counted cycles).
     """
 
     name: str
@@ -265,6 +272,7 @@ class CampaignSpec:
     raw: dict[str, Any]
     source: str | None = None
     plugins: tuple[str, ...] = ()
+    del_convention: str = "range-1hz"
 
     @property
     def spec_hash(self) -> str:
@@ -299,7 +307,9 @@ class CampaignSpec:
             Every case.
         """
         out = []
-        assess = {"channels": self.channels, "transient": self.transient}
+        assess: dict[str, Any] = {"channels": self.channels, "transient": self.transient}
+        if self.del_convention != "range-1hz":      # the default keeps older hashes valid
+            assess["del_convention"] = self.del_convention
         for c in self.controllers:
             for turb in c.turbulence or self.turbulence:
                 for v in c.winds or self.winds:
@@ -317,7 +327,8 @@ class CampaignSpec:
                                         turbine=self.turbine, turbine_hash=self.turbine_hash,
                                         channels=dict(self.channels), case_hash=_digest(sim),
                                         assess_hash=_digest(assess),
-                                        plugins=self.plugins))
+                                        plugins=self.plugins,
+                                        del_convention=self.del_convention))
         return out
 
 
@@ -448,6 +459,14 @@ def _distribution(raw: Any) -> dict[str, Any]:
     raise _fail(f"{key}.kind", f"must be 'rayleigh' or 'weibull', got {kind!r}")
 
 
+def _convention(raw: Any) -> str:
+    from ..assess import DEL_CONVENTIONS
+
+    if raw not in DEL_CONVENTIONS:
+        raise _fail("del_convention", f"must be one of {list(DEL_CONVENTIONS)}, got {raw!r}")
+    return str(raw)
+
+
 def _plugins(raw: Any) -> tuple[str, ...]:
     """Modules that register controller kinds, imported here and in every worker."""
     from ..controllers import load_plugins
@@ -566,7 +585,8 @@ def spec_from_dict(raw: Mapping[str, Any], base: Path | None = None,
         wind_distribution=_distribution(raw.get("wind_distribution", {})),
         lifetime_years=_number("lifetime_years", raw.get("lifetime_years", 20.0), 0.0,
                                lo_open=True),
-        reference=ref, report=report, raw=raw, source=source, plugins=plugins)
+        reference=ref, report=report, raw=raw, source=source, plugins=plugins,
+        del_convention=_convention(raw.get("del_convention", "range-1hz")))
 
 
 _PAPER_METRICS = {"del_change_pct", "lifetime_del_change_pct", "aep_change_pct",

@@ -46,7 +46,7 @@ def _turbine(ref: str) -> Any:
 
 
 def case_metrics(t: np.ndarray, cols: dict[str, np.ndarray], channels: dict[str, float],
-                 transient: float) -> dict[str, Any]:
+                 transient: float, convention: str = "range-1hz") -> dict[str, Any]:
     """The per-case numbers a campaign aggregates, after discarding ``transient`` [s]: DEL per
     channel (Woehler exponent of the spec, 1 Hz equivalent cycles), mean and std of power,
     energy, CS1-CS5 (tower-base fore-aft moment vs electrical power, Do et al. eqs 21-26), pitch
@@ -63,6 +63,8 @@ def case_metrics(t: np.ndarray, cols: dict[str, np.ndarray], channels: dict[str,
         Channel -> Woehler exponent.
     transient : float
         Discarded start [s].
+    convention : str
+        The DEL convention (:data:`mpc_wt.assess.DEL_CONVENTIONS`).
 
     Returns
     -------
@@ -84,7 +86,7 @@ def case_metrics(t: np.ndarray, cols: dict[str, np.ndarray], channels: dict[str,
     for n in channels:
         if n in sub and not np.all(np.isfinite(sub[n])):
             raise ValueError(f"channel {n!r} holds NaN or inf")
-    out = assess_series(t[k], sub, channels)
+    out = assess_series(t[k], sub, channels, convention=convention)
     if "rotor_speed" in sub:
         out["rotor_speed_mean_rad_s"] = float(sub["rotor_speed"].mean())
         out["rotor_speed_std_rad_s"] = float(sub["rotor_speed"].std())
@@ -167,7 +169,8 @@ def run_case(case: dict[str, Any], root: str) -> dict[str, Any]:
             path.parent.mkdir(parents=True, exist_ok=True)
             res.save(path)
         cols = {n: res.channel(n) for n in res.channels()}
-        metrics = case_metrics(res.t, cols, case["channels"], case["transient"])
+        metrics = case_metrics(res.t, cols, case["channels"], case["transient"],
+                               case.get("del_convention", "range-1hz"))
         return {**base, "status": "done", "file": rel, "metrics": metrics, "reused": reused,
                 "wall_s": time.perf_counter() - t0}
     except Exception as err:  # noqa: BLE001 - every failure is recorded, none stops others

@@ -158,6 +158,11 @@ def _add_assess(sub: Any) -> None:
     p.add_argument("--time-column", default="time", help="CSV time column (default time)")
     p.add_argument("--t-start", type=float, default=0.0,
                    help="discard samples before this time, e.g. the start-up transient [s]")
+    p.add_argument("--del-convention", default="range-1hz",
+                   choices=("range-1hz", "clemens", "pcrunch"),
+                   help="DEL as ranges over 1 Hz equivalent cycles (default; IEC, MLife), as "
+                        "amplitudes over the counted cycles (Clemens et al. eq 17), or as "
+                        "pCrunch counts")
     p.add_argument("--json", action="store_true")
     p.add_argument("--plots", help="directory for cs_ellipses.png and psd_flap_moment_1.png")
     p.set_defaults(func=_assess)
@@ -179,7 +184,11 @@ def _assess(args: argparse.Namespace) -> int:
             raise UsageError(f"--t-start = {args.t_start:g} s leaves fewer than 3 samples of "
                              f"{path} (it ends at {t[-1]:g} s)")
         t, cols = t[keep], {k: v[keep] for k, v in cols.items()}
-        res = assess_series(t, cols, chans, args.m)
+        if chans is None and not set(cols) & set(DEFAULT_CHANNELS):
+            raise UsageError(f"{path}: no column is a load channel we know; columns "
+                             f"{sorted(cols)}, channels {sorted(DEFAULT_CHANNELS)}; name any "
+                             f"numeric column with --channels NAME[,NAME...]")
+        res = assess_series(t, cols, chans, args.m, convention=args.del_convention)
         row = {"run": str(path), **res}
         if rows:
             row["relative_to_first"] = reductions(rows[0], res)
