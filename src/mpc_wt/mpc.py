@@ -2,8 +2,11 @@
 
 Formulation (eqs 20-23): the discrete linear model (zero-order hold, 10 Hz by default) predicts
 the performance outputs z over H_p steps from the inputs over H_u steps (held after H_u) and the
-disturbance preview; the cost is sum ||z||_Q^2 + sum ||u||_R^2 (+ an optional input-rate
-penalty), with Q = blockdiag(I, T) Q_w where T = T_c^T T_c turns the three flap moments into
+disturbance preview; the cost is sum_{i=0}^{H_p-1} ||z(k+i|k)||_Q^2 +
+sum_{i=0}^{H_u-1} ||u(k+i|k)||_R^2 (+ an optional input-rate penalty). Madsen's eq 20 sums the
+outputs to i = H_p, H_p + 1 terms; ours has H_p terms, so our ``horizon`` H_p equals the paper's
+H_p + 1 (our default 15 is the paper's 14), and the preview covers the H_p steps the cost
+sees, with Q = blockdiag(I, T) Q_w where T = T_c^T T_c turns the three flap moments into
 M_tilt^2 + M_yaw^2 for every azimuth (eqs 8, 9, 21). Constraints (eqs 12, 15): pitch angle
 and rate per blade (the rate through the model's pitch-rate outputs), generator torque and its
 rate, all on absolute values about the operating point.
@@ -102,7 +105,8 @@ class MPCSettings:
     dt : float
         Controller period [s] (default 0.1: Madsen's 10 Hz).
     horizon : int
-        Prediction horizon H_p, >= 1 (default 15).
+        Prediction horizon H_p, >= 1 (default 15): the cost sums the outputs z(k+i|k) for
+        i = 0..H_p-1 (Madsen's eq 20 sums to i = H_p: its H_p is ours minus one).
     control_horizon : int, optional
         H_u <= H_p (default H_p); inputs are held after H_u.
     weights : MPCWeights

@@ -10,7 +10,9 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import linearize
-from mpc_wt.synthesis import (LQRPIOController, SynthesisError, design_lqr, design_lqr_family,
+from mpc_wt import SimulationDivergedError
+from mpc_wt.synthesis import (REGION3_SCALES, REGION3_WEIGHTS, LQRPIOController,
+                              SynthesisError, design_lqr, design_lqr_family,
                               design_pi_observer)
 
 
@@ -59,20 +61,28 @@ def do_model(turbine: linearize.Turbine) -> linearize.LinearModel:
     return linearize.linearize(turbine, 18.0, config=linearize.PlantConfig.do())
 
 
-def test_lqr_on_the_turbine_equals_python_control(do_model) -> None:
-    import control
-
+def test_lqr_on_the_turbine_solves_the_riccati_equation(do_model) -> None:
+    """Independent of the solver it wraps: with the weights built by hand (state and output
+    weights, R = I), K = R^-1 B' P where P solves A'P + PA - PBR^-1B'P + Q = 0 (Do et al. eq 10)
+    to the Riccati residual's rounding, P is symmetric positive semidefinite and A - BK is
+    Hurwitz."""
     w = {"rotor_speed": 5.0, "tower_fa_velocity": 1.0, "flap_rate_1": 1.0}
     d = design_lqr(do_model, state_weights=w, output_weights={"flap_moment_2": 1e-12})
-    q = np.zeros((14, 14))
+    nx = do_model.A.shape[0]
+    q = np.zeros((nx, nx))
     for n, v in w.items():
         i = do_model.states.index(n)
         q[i, i] = v
     c = do_model.C_z[do_model.outputs.index("flap_moment_2")]
     q += 1e-12 * np.outer(c, c)
-    k, _, _ = control.lqr(do_model.A, do_model.B_u[:, :3], q, np.eye(3))
-    np.testing.assert_allclose(d.K, k, rtol=1e-7, atol=1e-10)
-    assert d.closed_loop_eigs.real.max() < 0
+    a, b, p = do_model.A, do_model.B_u[:, :3], d.P
+    res = a.T @ p + p @ a - p @ b @ b.T @ p + q
+    scale = np.abs(a.T @ p).max() + np.abs(q).max()
+    assert np.abs(res).max() < 1e-8 * scale
+    np.testing.assert_allclose(d.K, b.T @ p, rtol=1e-9, atol=1e-12 * np.abs(d.K).max())
+    np.testing.assert_allclose(p, p.T, atol=1e-9 * np.abs(p).max())
+    assert np.linalg.eigvalsh(0.5 * (p + p.T)).min() > -1e-9 * np.abs(p).max()
+    assert np.linalg.eigvals(a - b @ d.K).real.max() < 0
 
 
 def test_lqr_family_gives_one_gain_per_wind(turbine) -> None:
@@ -97,10 +107,8 @@ def test_pi_observer_is_stable_and_integral_gain_grows_with_q(do_model) -> None:
 
 def test_pi_observer_recovers_a_constant_unknown_input(do_model) -> None:
     # on its own (linear) model, a step of blade wind is estimated exactly in steady state
-    import scipy.linalg
-
     ob = design_pi_observer(do_model, q=1e5)
-    nx, nf = do_model.A.shape[0], 3
+    nx = do_model.A.shape[0]
     f = np.array([1.0, -0.5, 0.25])
     # the plant's steady state under the step, stabilized by an LQR (the open loop drifts)
     lq = design_lqr(do_model)
@@ -114,7 +122,6 @@ def test_pi_observer_recovers_a_constant_unknown_input(do_model) -> None:
     xe = -np.linalg.solve(ao, ob.B_e @ u + ob.L @ y)
     np.testing.assert_allclose(xe[nx:], f, rtol=1e-6, atol=1e-9)
     np.testing.assert_allclose(xe[:nx], x_ss, rtol=1e-6, atol=1e-9)
-    assert scipy.linalg.norm(xe) > 0
 
 
 @pytest.mark.parametrize("kwargs, match", [
@@ -171,3 +178,31 @@ def test_lqr_pio_regulates_speed_in_turbulence(turbine, params, do_model) -> Non
     assert speed.std() < 0.05
     est = np.asarray(r.controller["wind_est"])
     assert abs(np.mean(est[len(est) // 6:]) - 18.0) < 2.0
+
+
+def test_high_gain_pi_observer_diverges_in_turbulence_on_our_plant(turbine, params,
+                                                                   do_model) -> None:
+    """Issue 17, defect 5: Do et al. (sec. 2.4) ask for ||L2||_F >> ||L1||_F. On our plant the
+    condition cannot be met in the loop: in steady wind every q holds the rotor, but in class-A
+    turbulence at 18 m/s the loop with the unknown-input feedforward diverges from q = 1e4
+    (ratio 0.69) on; at q = 1e7 (ratio 1.98) it diverges within 30 s, and without the
+    feedforward it survives but regulates 3x worse (rotor-speed std 7.4 % against 2.6 %). The
+    observer takes the turbulence's fast blade-wind content (and the plant's 1P gravity and
+    shear flap content) for unknown inputs and the feedforward -K_f f_hat feeds it back. So
+    the default q = 1e3 (ratio 0.28) is the highest gain that keeps the loop; the README says so.
+    """
+    from mpc_wt.controllers import Scenario, make_wind
+    from mpc_wt.simulate import simulate_closed_loop
+
+    lq = design_lqr(do_model, state_weights=REGION3_WEIGHTS, scales=REGION3_SCALES)
+    default, high = design_pi_observer(do_model), design_pi_observer(do_model, q=1e7)
+    # the ratio of the default and of the paper's "high gain" direction (Do et al. sec. 2.4)
+    assert default.q == 1e3 and default.gain_ratio < 0.3 and high.gain_ratio > 1.9
+    wind, _ = make_wind(turbine, Scenario(18.0, "A", 1, 40.0, 0.2))
+    op = linearize.trim(turbine, 18.0)
+    with pytest.raises(SimulationDivergedError):
+        simulate_closed_loop(params, LQRPIOController(do_model, turbine, lq, high), wind, 40.0,
+                             x0=op.x, u0=op.u)
+    r = simulate_closed_loop(params, LQRPIOController(do_model, turbine, lq, default), wind,
+                             40.0, x0=op.x, u0=op.u)
+    assert r.x[r.t > 10, 2].std() < 0.05
