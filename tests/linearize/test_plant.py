@@ -6,6 +6,8 @@ import math
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 from numpy.testing import assert_allclose
 
 import linearize
@@ -97,8 +99,9 @@ def test_coleman_moments_of_equal_blades_vanish(params_axisym: linearize.PlantPa
 
 
 def test_coleman_tilt_of_one_loaded_blade(params: linearize.PlantParams) -> None:
-    # analytic: with only the blade at azimuth 0 (up) carrying load, M_tilt = 2/3 M_b and
-    # M_yaw = 0 (Madsen eq 9). Shear makes the top blade see more wind, so tilt > 0 there.
+    """Worked by hand for this configuration, not through the transform's sum: blade 1 up
+    (psi = 0) in wind, blades 2 and 3 at +-120 deg in none, so M_2 = M_3 by symmetry and
+    M_tilt = (2/3)(M_1 - M_2) (cos 120 = cos 240 = -1/2), M_yaw = 0 (sin 120 = -sin 240)."""
     x = np.zeros(17)
     x[2], x[3] = 1.0, 97.0
     d = np.zeros((3, 17))
@@ -106,8 +109,29 @@ def test_coleman_tilt_of_one_loaded_blade(params: linearize.PlantParams) -> None
     z = plant_outputs(0.0, x, np.zeros(4), d, params)
     m1 = z[OUTPUT_NAMES.index("flap_moment_1")]
     m2, m3 = z[OUTPUT_NAMES.index("flap_moment_2")], z[OUTPUT_NAMES.index("flap_moment_3")]
-    expected = 2 / 3 * (m1 + m2 * math.cos(2 * math.pi / 3) + m3 * math.cos(4 * math.pi / 3))
-    assert_allclose(z[OUTPUT_NAMES.index("tilt_moment")], expected, rtol=1e-12, atol=1e-6)
+    assert_allclose(m2, m3, rtol=1e-9)
+    assert_allclose(z[OUTPUT_NAMES.index("tilt_moment")], 2 / 3 * (m1 - m2), rtol=1e-9)
+    assert abs(z[OUTPUT_NAMES.index("yaw_moment")]) <= 1e-9 * abs(m1)
+
+
+@settings(max_examples=25, deadline=None)
+@given(psi=st.floats(0.0, 2 * math.pi), w=st.lists(st.floats(0.0, 20.0), min_size=3,
+                                                    max_size=3))
+def test_coleman_moments_are_those_of_the_rotor_not_of_the_blade_labels(
+        params_axisym: linearize.PlantParams, psi: float, w: list[float]) -> None:
+    """Invariant: turning the rotor on by 120 deg and passing each blade's wind to the blade
+    that now stands where it stood gives the same fixed-frame tilt and yaw moments (the rotor
+    looks the same; only the labels moved: blade i now stands where blade i + 1 stood)."""
+    x = np.zeros(17)
+    x[2], x[3], x[16] = 1.0, 97.0, psi
+    d = np.repeat(np.array(w)[:, None], 17, axis=1)
+    z0 = plant_outputs(0.0, x, np.zeros(4), d, params_axisym)
+    x[16] = psi + 2 * math.pi / 3
+    z1 = plant_outputs(0.0, x, np.zeros(4), np.roll(d, -1, axis=0), params_axisym)
+    for name in ("tilt_moment", "yaw_moment"):
+        i = OUTPUT_NAMES.index(name)
+        scale = np.abs(z0[10:13]).max() + 1.0
+        assert abs(z1[i] - z0[i]) <= 1e-8 * scale
 
 
 @pytest.mark.parametrize("cfg, active", [

@@ -24,26 +24,27 @@ def gains(turbine: linearize.Turbine):
 def test_gains_match_the_published_baseline(gains) -> None:
     # published: DISCON.F90 (Jonkman's baseline, report sec. 7.4): PC_KP = 0.01882681 s,
     # PC_KI = 0.008068634, PC_KK = 0.1099965 rad (6.302336 deg), dP/dtheta at zero pitch
-    # -25.52e6 W/rad, VS_Rgn2K = 2.332287 N m/(rad/s)^2. Issue 5: within 20 %. Differences:
-    # our frozen-wake sensitivities (within 8.3 % of the report's), the fit's points, and the
-    # rotor inertia from the blade table (0.6 % below the report's).
-    assert_allclose(gains.kp, 0.01882681, rtol=0.20)
-    assert_allclose(gains.ki, 0.008068634, rtol=0.20)
-    assert_allclose(gains.theta_k_rad, math.radians(6.302336), rtol=0.20)
-    assert_allclose(gains.dpdtheta_0, -25.52e6, rtol=0.20)
-    assert_allclose(gains.k_opt, 2.332287, rtol=0.05)
+    # -25.52e6 W/rad, VS_Rgn2K = 2.332287 N m/(rad/s)^2. Issue 5 asked for 20 %; measured:
+    # KP and KI +4.6 %, theta_K -9.7 %, dP/dtheta_0 -5.0 %, K_opt -2.5 % (our frozen-wake
+    # sensitivities are within 8.3 % of the report's, the fit's points differ, and the rotor
+    # inertia from the blade table is 0.6 % below the report's). Bounds: the measured value
+    # plus about 1.5 points (the README states both).
+    assert_allclose(gains.kp, 0.01882681, rtol=0.06)
+    assert_allclose(gains.ki, 0.008068634, rtol=0.06)
+    assert_allclose(gains.theta_k_rad, math.radians(6.302336), rtol=0.11)
+    assert_allclose(gains.dpdtheta_0, -25.52e6, rtol=0.065)
+    assert_allclose(gains.k_opt, 2.332287, rtol=0.035)
 
 
-def test_pole_placement_formula(gains, turbine: linearize.Turbine) -> None:
+def test_pole_placement_formula() -> None:
     # analytic: with the report's own numbers (J = 43,784,725 kg m^2, dP/dtheta = -25.52e6,
     # Omega = 12.1 rpm, N = 97, 0.6 rad/s, 0.7) the formulas give DISCON's KP and KI
     j, om = 43784725.0, 12.1 * math.pi / 30
     kp = 2 * j * om * 0.7 * 0.6 / (97 * 25.52e6)
     ki = j * om * 0.36 / (97 * 25.52e6)
     assert_allclose([kp, ki], [0.01882681, 0.008068634], rtol=2e-4)
-    # and ours are the same formulas with our inertia and sensitivity
-    assert_allclose(gains.kp, 2 * gains.info["inertia_lss"] * om * 0.7 * 0.6
-                    / (97 * -gains.dpdtheta_0), rtol=1e-12)
+    # (the tuning's own gains are checked against DISCON's in the test above; re-deriving them
+    # here from its own inertia and sensitivity would test the code against itself)
 
 
 def _field(v: float, turb, seed: int) -> tuple[linearize.GridWind, lidar.WindField]:
@@ -60,11 +61,12 @@ def run18(turbine: linearize.Turbine, params: linearize.PlantParams, gains):
 
 
 def test_region3_closed_loop(run18: ClosedLoopResult) -> None:
-    # issue 5: 18 m/s, turbulent (class A): rated power held (mean within 1 %), generator
-    # speed std below 5 % of rated (first 60 s of start-up transient left out)
+    # issue 5: 18 m/s, turbulent (class A): rated power held, generator speed std below 5 %
+    # of rated (first 60 s of start-up transient left out). Measured: mean power 0.005 % off
+    # 5 MW, speed std 3.5 %; bounds 0.05 % and 4 % (the README states both).
     late = run18.t > 60.0
-    assert_allclose(run18.channel("gen_power")[late].mean(), 5e6, rtol=0.01)
-    assert run18.channel("gen_speed")[late].std() < 0.05 * 122.9096
+    assert_allclose(run18.channel("gen_power")[late].mean(), 5e6, rtol=5e-4)
+    assert run18.channel("gen_speed")[late].std() < 0.04 * 122.9096
 
 
 def test_no_actuator_limit_violated(run18: ClosedLoopResult, turbine: linearize.Turbine) -> None:
@@ -92,7 +94,8 @@ def test_region2_tracks_optimal_tsr(turbine: linearize.Turbine, params: lineariz
     late = r.t > 60.0
     rews = np.interp(r.t[late], f.t, lidar.rotor_effective_wind(f, 63.0))
     tsr = r.channel("rotor_speed")[late].mean() * 63.0 * math.cos(math.radians(2.5)) / rews.mean()
-    assert_allclose(tsr, gains.info["tsr_opt"], rtol=0.03)
+    # measured 1.4 % above optimal; bound 2 % (issue 5 asked for 3 %; the README states both)
+    assert_allclose(tsr, gains.info["tsr_opt"], rtol=0.02)
 
 
 def test_result_round_trip(run18: ClosedLoopResult, tmp_path: Path) -> None:

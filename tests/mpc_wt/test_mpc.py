@@ -26,12 +26,22 @@ def test_coleman_weight_gives_tilt_and_yaw_squared(psi: float, m: list[float]) -
                     atol=1e-9 * (mv @ mv + 1.0))
 
 
-def test_printed_constant_fails_the_identity() -> None:
-    mv = np.array([1.0, 0.0, 0.0])
-    tc = 2 / 3 * np.vstack([np.cos(2 * math.pi * np.arange(3) / 3),
-                            np.sin(2 * math.pi * np.arange(3) / 3)])
-    printed = (4 / 27) / (4 / 9) * coleman_weight()
-    assert abs(mv @ printed @ mv - np.sum((tc @ mv) ** 2)) > 0.2
+@settings(max_examples=60, deadline=None)
+@given(psi=st.floats(0, 2 * math.pi), m=st.lists(st.floats(-1e7, 1e7), min_size=3, max_size=3))
+def test_printed_constant_fails_the_identity(psi: float, m: list[float]) -> None:
+    """Madsen eq 21 (M' T M = M_t^2 + M_y^2) checked directly on random blade moments with
+    eq 22 as printed, T = (2^2 / 3^3) [[1, -1/2, -1/2], ...] written out here: it gives a third
+    of M_t^2 + M_y^2 whenever the moments are not all equal, so the printed constant is wrong
+    by 3 (coleman_weight uses 2^2 / 3^2, the property test above)."""
+    ang = psi + 2 * math.pi * np.arange(3) / 3
+    tc = 2 / 3 * np.vstack([np.cos(ang), np.sin(ang)])
+    mv = np.array(m)
+    tilt_yaw = float(np.sum((tc @ mv) ** 2))
+    printed = 2 ** 2 / 3 ** 3 * np.array([[1.0, -0.5, -0.5], [-0.5, 1.0, -0.5],
+                                          [-0.5, -0.5, 1.0]])
+    assert_allclose(mv @ printed @ mv, tilt_yaw / 3, rtol=1e-9, atol=1e-9 * (mv @ mv + 1.0))
+    if tilt_yaw > 1e-6 * (mv @ mv):
+        assert abs(mv @ printed @ mv - tilt_yaw) > 0.6 * tilt_yaw
 
 
 @pytest.fixture(scope="module")
@@ -163,24 +173,25 @@ def test_lidar_preview_reduces_asymmetric_loads(turbine: linearize.Turbine,
     from mpc_wt.assess import harmonic_psd
     from mpc_wt.simulate import LidarPreview, simulate_closed_loop
 
-    pytest.importorskip("daqp")
     f = lidar.generate_field(lidar.TurbulenceSpec(18.0, "A", duration=80.0), 3)
     gw = linearize.GridWind(t=f.t, y=f.y, z=f.z, u=np.maximum(f.u, 0.0))
     op = linearize.trim(turbine, 18.0)
     lid = lidar.CWLidar(63.0, range_weighting=False, los_error=False)
     out = {}
     for label, prev in (("none", None), ("lidar", LidarPreview(lid, f, 15, 0.1))):
-        r = simulate_closed_loop(params, MPC(model, turbine, MPCSettings(backend="daqp")), gw,
-                                 70.0,
-                                 x0=op.x, u0=op.u, controller_dt=0.1, preview=prev)
+        # OSQP: runs where DAQP is not installed (both give the same moves, tested above)
+        r = simulate_closed_loop(params, MPC(model, turbine, MPCSettings(backend="osqp")), gw,
+                                 70.0, x0=op.x, u0=op.u, controller_dt=0.1, preview=prev)
         late = r.t > 10.0
         frot = float(r.channel("rotor_speed")[late].mean()) / (2 * math.pi)
         out[label] = (r.channel("tilt_moment")[late].std(), r.channel("yaw_moment")[late].std(),
                       harmonic_psd(r.channel("flap_moment_1")[late], 80.0, frot, (1,),
-                                   nperseg=2048)[1])
+                                   nperseg=2048)[1], r.channel("gen_power")[late].std())
         assert r.controller["qp_fallback"].sum() == 0
-    for k in range(3):
-        assert out["lidar"][k] < 0.8 * out["none"][k], (k, out)
+    # measured (2026-11-22): tilt std x0.58, yaw std x0.48, 1P flap x0.16, power std x0.44;
+    # bounds about 10 % of the measured ratio above each (the README states both)
+    for k, bound in enumerate((0.65, 0.55, 0.25, 0.50)):
+        assert out["lidar"][k] < bound * out["none"][k], (k, out)
 
 
 def test_from_turbine_matches_the_explicit_model(model, turbine) -> None:
