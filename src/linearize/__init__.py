@@ -2,7 +2,7 @@
 
 This package never imports ``mpc_wt`` or ``lidar``.
 """
-from .bem import AeroOptions, element_loads
+from .bem import AeroOptions, element_induction, element_loads
 from .errors import LinearizationError, SimulationDivergedError, TrimError, TurbineFileError
 from .linear import (LinearModel, LinearModelFamily, augment_actuator,
                      jacobian_check, linearize, linearize_family, sensitivities,
@@ -16,7 +16,7 @@ from .trim import OperatingPoint, operating_schedule, rated_wind_speed, trim
 from .turbine import Turbine, available_turbines, load_turbine
 
 __all__ = [
-    "AeroOptions", "element_loads", "DOF_NAMES", "INPUT_NAMES", "INPUT_UNITS", "MADSEN_OUTPUTS",
+    "AeroOptions", "element_induction", "element_loads", "DOF_NAMES", "INPUT_NAMES", "INPUT_UNITS", "MADSEN_OUTPUTS",
     "OUTPUT_NAMES", "OUTPUT_UNITS", "STATE_NAMES", "STATE_UNITS", "GridWind", "PlantConfig",
     "PlantParams", "PlantStepper", "SimulationDivergedError", "SimulationResult", "SteadyWind",
     "element_wind",

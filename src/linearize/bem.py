@@ -36,7 +36,8 @@ from ._typing import FloatArray
 from .validate import check_array
 from .turbine import Polar, Turbine
 
-__all__ = ["AeroOptions", "PolarTable", "build_polar_table", "element_loads", "polar_table_of"]
+__all__ = ["AeroOptions", "PolarTable", "build_polar_table", "element_induction", "element_loads",
+           "polar_table_of"]
 
 _PI = math.pi
 _EPS_PHI = 1e-6          # Ning's epsilon: bracket ends stay clear of the phi = 0 singularity
@@ -124,7 +125,7 @@ def build_polar_table(polars: tuple[Polar, ...], n_alpha: int = _N_ALPHA) -> Pol
 _JIT = dict(cache=True, error_model="numpy", fastmath=False)
 
 # Mode bits of _element (and of the plant kernel that passes them on).
-MODE_FROZEN = 1    # frozen wake: induction factors given, no solve
+MODE_FROZEN = 1    # frozen wake: induced velocities given, no solve
 MODE_CS = 2        # complex step: implicit-function step around a tight real root
 MODE_TIGHT = 4     # warm-started solves run to _XTOL instead of _XTOL_WARM
 MODE_NOLIMITS = 8  # plant: no actuator position/rate clipping (linearization)
@@ -394,13 +395,20 @@ def _loads_at(phi, vx, vy, one_m_a, one_p_ap, chord, theta, k_af, table, alpha0,
 
 
 @nb.njit(**_JIT)
-def _element_frozen(vx, vy, chord, theta, k_af, table, alpha0, dalpha, rho, one_m_a,
-                    one_p_ap):  # pragma: no cover - compiled
-    """Frozen wake: induction held, tan(phi) = V_x (1 - a) / (V_y (1 + a')); no solve."""
-    phi = _atan2(vx * one_m_a, vy * one_p_ap)
-    npr, tpr = _loads_at(phi, vx, vy, one_m_a, one_p_ap, chord, theta, k_af, table, alpha0,
-                         dalpha, rho)
-    return npr, tpr, phi, math.nan, one_m_a + 0.0 * phi, one_p_ap + 0.0 * phi
+def _element_frozen(vx, vy, chord, theta, k_af, table, alpha0, dalpha, rho, u_ind,
+                    v_ind):  # pragma: no cover - compiled
+    """Frozen wake as FAST/OpenFAST define it: the induced velocities are held, the axial
+    u_ind = V_x a and the tangential v_ind = V_y a', so W_x = V_x - u_ind and
+    W_y = V_y + v_ind follow the kinematics one for one; no solve."""
+    ua = vx - u_ind
+    ut = vy + v_ind
+    phi = _atan2(ua, ut)
+    cl, cd = _polar_lookup(table, k_af, phi - theta, alpha0, dalpha)
+    s = np.sin(phi)
+    c = np.cos(phi)
+    q = 0.5 * rho * (ua * ua + ut * ut) * chord
+    return q * (cl * c + cd * s), q * (cl * s - cd * c), phi, math.nan, u_ind + 0.0 * phi, \
+        v_ind + 0.0 * phi
 
 
 @nb.njit(**_JIT)
@@ -424,25 +432,26 @@ def _element_cs(vx, vy, r, chord, theta, k_af, table, alpha0, dalpha, nb_, rtip,
     _, oma, opa, _, _ = _induction(phi, vx, vy, r, chord, theta, k_af, table, alpha0, dalpha,
                                    nb_, rtip, rhub, flags)
     npr, tpr = _loads_at(phi, vx, vy, oma, opa, chord, theta, k_af, table, alpha0, dalpha, rho)
-    return npr, tpr, phi, math.nan, oma, opa
+    return npr, tpr, phi, math.nan, vx * (1.0 - oma), vy * (opa - 1.0)
 
 
 @nb.njit(**_JIT)
 def _element(vx, vy, r, chord, theta, k_af, table, alpha0, dalpha, nb_, rtip, rhub, flags, rho,
-             hint, hint_slope, frozen_oma, frozen_opa, mode):  # pragma: no cover - compiled
-    """Loads per unit length on one element: (N', T', phi, dR/dphi, 1 - a, 1 + a').
+             hint, hint_slope, frozen_u, frozen_v, mode):  # pragma: no cover - compiled
+    """Loads per unit length on one element: (N', T', phi, dR/dphi, u_ind, v_ind), the last two
+    the axial and tangential induced velocities V_x a and V_y a' [m/s].
 
     N' is normal to the rotor plane (positive downwind) and T' in the plane (positive driving
     the rotor) [N/m]. Reversed or stalled kinematics (V_x <= 0 or V_y <= 0, where momentum
     theory has no meaning) use the geometric inflow without induction.
 
-    ``mode`` bits: MODE_FROZEN holds the induction at (frozen_oma, frozen_opa) (frozen wake,
-    :func:`_element_frozen`); MODE_CS differentiates the implicit solve by complex step
+    ``mode`` bits: MODE_FROZEN holds the induced velocities at (frozen_u, frozen_v) (frozen
+    wake, :func:`_element_frozen`); MODE_CS differentiates the implicit solve by complex step
     (:func:`_element_cs`); MODE_TIGHT makes warm solves converge to 1e-13 rad.
     """
     if mode & MODE_FROZEN:
         return _element_frozen(vx, vy, chord, theta, k_af, table, alpha0, dalpha, rho,
-                               frozen_oma, frozen_opa)
+                               frozen_u, frozen_v)
     if vx.real > 1e-9 and vy.real > 1e-9 * max(1.0, vx.real):
         if mode & MODE_CS:
             return _element_cs(vx, vy, r, chord, theta, k_af, table, alpha0, dalpha, nb_, rtip,
@@ -455,11 +464,11 @@ def _element(vx, vy, r, chord, theta, k_af, table, alpha0, dalpha, nb_, rtip, rh
         ua = vx * one_m_a
         ut = vy * one_p_ap
         q = 0.5 * rho * (ua * ua + ut * ut) * chord
-        return q * cn, q * ct, phi + 0.0 * vx, slope, one_m_a + 0.0 * vx, one_p_ap + 0.0 * vx
+        return q * cn, q * ct, phi + 0.0 * vx, slope, vx - ua, ut - vy
     phi = _atan2(vx, vy)
     one = 1.0 + 0.0 * phi
     npr, tpr = _loads_at(phi, vx, vy, one, one, chord, theta, k_af, table, alpha0, dalpha, rho)
-    return npr, tpr, phi, math.nan, one, one
+    return npr, tpr, phi, math.nan, 0.0 * phi, 0.0 * phi
 
 
 # --------------------------------------------------------------------------------------------
@@ -520,5 +529,47 @@ def element_loads(turbine: Turbine, vx: FloatArray, vy: FloatArray, pitch_rad: f
         out[:, j] = _element(vx[j], vy[j], b.r[j], b.chord[j], b.twist_rad[j] + pitch_rad,
                              b.airfoil[j], tab.table, tab.alpha0, tab.dalpha,
                              float(g.number_of_blades), g.tip_radius, g.hub_radius, flags,
-                             turbine.environment.air_density, math.nan, math.nan, 1.0, 1.0, 0)
+                             turbine.environment.air_density, math.nan, math.nan, 0.0, 0.0, 0)
     return out[0], out[1], out[2]
+
+
+def element_induction(turbine: Turbine, vx: FloatArray, vy: FloatArray, pitch_rad: float,
+                      options: AeroOptions | None = None) -> tuple[FloatArray, FloatArray]:
+    """Induced velocities on every element of one blade for given free-stream velocities
+    relative to the blade: what a frozen-wake linearization holds (FAST/OpenFAST).
+
+    Parameters
+    ----------
+    turbine : Turbine
+        The blade and its polars.
+    vx : (n_r,) array_like
+        Velocity normal to the rotor plane, before induction [m/s].
+    vy : (n_r,) array_like
+        In-plane velocity (rotation), before induction [m/s].
+    pitch_rad : float
+        Blade pitch [rad].
+    options : AeroOptions, optional
+        Loss models and tangential induction.
+
+    Returns
+    -------
+    u_ind : (n_r,) ndarray
+        Axial induced velocity V_x a [m/s]: the flow through the element is V_x - u_ind.
+    v_ind : (n_r,) ndarray
+        Tangential induced velocity V_y a' [m/s]: the in-plane flow is V_y + v_ind.
+    """
+    opts = options or AeroOptions()
+    n = turbine.blade.r.size
+    vx = check_array("vx", vx, (n,), shape_names="(n_r,)")
+    vy = check_array("vy", vy, (n,), shape_names="(n_r,)")
+    tab = polar_table_of(turbine)
+    b, g = turbine.blade, turbine.geometry
+    flags = aero_flags(opts)
+    out = np.empty((2, n))
+    for j in range(n):
+        out[:, j] = _element(vx[j], vy[j], b.r[j], b.chord[j], b.twist_rad[j] + pitch_rad,
+                             b.airfoil[j], tab.table, tab.alpha0, tab.dalpha,
+                             float(g.number_of_blades), g.tip_radius, g.hub_radius, flags,
+                             turbine.environment.air_density, math.nan, math.nan, 0.0, 0.0,
+                             0)[4:]
+    return out[0], out[1]

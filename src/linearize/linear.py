@@ -15,13 +15,21 @@ derivative used by the tests.
 Wake assumption (``wake``):
 
 * ``"quasi-steady"`` re-solves the induction at every perturbation, as Madsen's numerical
-  linearization does. Use it for controllers whose time scale is long compared with the wake's
-  (the steady power and thrust surfaces are its limit): baseline PI tuning, MPC at 10 Hz in a
-  quasi-steady BEM plant like ours.
-* ``"frozen"`` holds the axial and tangential induction at their trim values, as FAST/OpenFAST
-  linearize and as the NREL 5-MW report's pitch sensitivities were computed. Use it to compare
-  with OpenFAST models and for fast pitch action (IPC, load control), where the wake has no time
-  to respond within a control period; it predicts a stronger immediate pitch sensitivity.
+  linearization does and as OpenFAST linearizes unless its ``FrozenWake`` switch is set (our
+  quasi-steady dQ/dV, dQ/dOmega and dT/dV follow the slopes of ROSCO's C_P/C_T tables to 3 %,
+  tested). Use it to compare with OpenFAST's default ``.lin`` files and for controllers whose
+  time scale is long compared with the wake's: baseline PI tuning of the speed loop, MPC at
+  10 Hz on a quasi-steady BEM plant like ours.
+* ``"frozen"`` holds the axial and tangential induced *velocities* (V_x a, V_y a') at their
+  trim values, as FAST/OpenFAST do with ``FrozenWake = True``, and as the NREL 5-MW report's
+  pitch sensitivities were computed (report sec. 7.4, hence the baseline's tuning). The
+  kinematics then change the flow through the rotor one for one (tested against the element
+  equations written out). Use it for the report's gain schedule and for fast pitch action
+  (IPC, load control), where the wake has no time to respond within a control period; it
+  predicts stronger immediate sensitivities (dP/dpitch 30 % and dT/dV 19 % above the
+  quasi-steady ones at 18 m/s). Before issue 18 the induction *factors* were held, which made
+  the induced velocities scale with V and Omega: dT/dV, dQ/dV 27-88 % off and a dQ/dOmega of the
+  wrong sign near rated.
 
 With tilt, cone, gravity or shear on, the plant is periodic in azimuth; the models are averaged
 over azimuth in blade coordinates (Madsen's azimuth-independent models), or in multi-blade

@@ -370,7 +370,8 @@ def _eval(x, u, wind, p, hint, mode):  # pragma: no cover - compiled
     """Derivatives, outputs and BEM state at one instant (generic over float and complex).
 
     ``wind``: (3, n_r) [m/s]. ``hint``: (4, 3, n_r) BEM state of a nearby earlier solve --
-    inflow angle, residual slope, 1 - a, 1 + a' (NaN: none); the same layout is returned.
+    inflow angle, residual slope, axial and tangential induced velocities (NaN: none); the same
+    layout is returned.
     ``mode``: bits of :mod:`linearize.bem` (frozen wake, complex step, tight, no limits).
     """
     dof_fa, dof_ss, dof_dt, dof_gen, dof_flap, dof_pitch = (p.dof[0], p.dof[1], p.dof[2],
@@ -429,14 +430,14 @@ def _eval(x, u, wind, p, hint, mode):  # pragma: no cover - compiled
             vrel = wind[i, j] - vhub_x - nod * rj * cc * cp
             vx = vrel * (ct * cc + st * sc * cp) - qd * p.phi_flap[j]
             vy = (wr + roll) * rj * cc + vrel * st * sp - vhub_y * cp
-            npr, tpr, ph, sl, oma, opa = _element(
+            npr, tpr, ph, sl, u_ind, v_ind = _element(
                 vx, vy, rj, p.chord[j], p.twist[j] + pitch[i], p.af[j], p.table, p.alpha0,
                 p.dalpha, p.nb, p.rtip, p.rhub, p.flags, p.rho, hint[0, i, j].real,
                 hint[1, i, j].real, hint[2, i, j].real, hint[3, i, j].real, mode)
             bem[0, i, j] = ph
             bem[1, i, j] = sl
-            bem[2, i, j] = oma
-            bem[3, i, j] = opa
+            bem[2, i, j] = u_ind
+            bem[3, i, j] = v_ind
             wj = p.w[j]
             tor_i += tpr * rj * cc * wj
             thr_i += npr * cc * wj

@@ -440,3 +440,84 @@ def test_nan_jacobian_is_reported(turbine: linearize.Turbine, params: linearize.
     with pytest.raises(LinearizationError,
                        match=r"Jacobian A\[2, 5\] is not finite at 18 m/s, azimuth 0 deg"):
         lin(turbine, 18.0, params=params)
+
+
+# --------------------------------------------------------------------------------------------
+# Frozen wake as FAST/OpenFAST define it (issue 18): the induced velocities are held
+# --------------------------------------------------------------------------------------------
+def _frozen_rotor_loads(turbine, ua, ut, pitch_rad):
+    """Thrust and torque of three equal blades from the element equations written out here:
+    inflow angle, angle of attack, the airfoil polars interpolated with numpy (not the
+    kernel's table), W^2 = u_a^2 + u_t^2, midpoint rule with the element lengths."""
+    b, rho = turbine.blade, turbine.environment.air_density
+    phi = np.arctan2(ua, ut)
+    alpha = phi - (b.twist_rad + pitch_rad)
+    cl = np.array([np.interp(a, turbine.polars[k].alpha_rad, turbine.polars[k].cl)
+                   for a, k in zip(alpha, b.airfoil)])
+    cd = np.array([np.interp(a, turbine.polars[k].alpha_rad, turbine.polars[k].cd)
+                   for a, k in zip(alpha, b.airfoil)])
+    q = 0.5 * rho * (ua ** 2 + ut ** 2) * b.chord
+    normal = q * (cl * np.cos(phi) + cd * np.sin(phi))
+    tangential = q * (cl * np.sin(phi) - cd * np.cos(phi))
+    return 3 * np.sum(normal * b.dr), 3 * np.sum(tangential * b.r * b.dr)
+
+
+@pytest.mark.parametrize("wind", [8.0, 11.0, 14.0, 18.0])
+def test_frozen_wake_holds_the_induced_velocities(turbine: linearize.Turbine, wind: float
+                                                  ) -> None:
+    """dT/dV, dQ/dV and dT/dOmega of the frozen-wake model against central differences of the
+    element equations with the trim's induced velocities held (computed in this test; no tilt,
+    cone or gravity, so V_x = V and V_y = Omega r). Before issue 18 the factors (1 - a),
+    (1 + a') were held and dT/dV, dQ/dV came out 27-88 % off. Tolerance 2 %: the kernel
+    interpolates a resampled polar table, this test the published polar points (measured
+    0.75 % at most)."""
+    opts = linearize.AeroOptions(tilt=False, cone=False, gravity=False)
+    cfg = PlantConfig(frozenset({"generator"}), opts)
+    op = linearize.trim(turbine, wind, config=cfg)
+    om, pitch = op.rotor_speed_rad_s, op.pitch_rad
+    r = turbine.blade.r
+    vx, vy = np.full(r.size, wind), om * r
+    u_ind, v_ind = linearize.element_induction(turbine, vx, vy, pitch, opts)
+    ua, ut = vx - u_ind, vy + v_ind
+    hv, hw = 1e-3 * wind, 1e-4 * om
+    (tp, qp), (tm, qm) = (_frozen_rotor_loads(turbine, ua + s * hv, ut, pitch) for s in (1, -1))
+    (tpw, _), (tmw, _) = (_frozen_rotor_loads(turbine, ua, ut + s * hw * r, pitch)
+                          for s in (1, -1))
+    m = lin(turbine, wind, wake="frozen", config=cfg)
+    i_t, i_q = m.outputs.index("thrust"), m.outputs.index("aero_torque")
+    j_w = m.states.index("rotor_speed")
+    assert_allclose([m.D_d[i_t].sum(), m.D_d[i_q].sum(), m.C_z[i_t, j_w]],
+                    [(tp - tm) / (2 * hv), (qp - qm) / (2 * hv), (tpw - tmw) / (2 * hw)],
+                    rtol=0.02)
+
+
+@pytest.mark.parametrize("wind, tol_qw", [(7.0, 0.03), (9.0, 0.03), (11.0, 0.12), (14.0, 0.03),
+                                          (18.0, 0.03), (22.0, 0.03)])
+def test_quasi_steady_derivatives_follow_rosco_table_slopes(turbine: linearize.Turbine,
+                                                            rosco_nrel5mw, wind: float,
+                                                            tol_qw: float) -> None:
+    """Quasi-steady dQ/dV, dQ/dOmega and dT/dV against the slopes of ROSCO's NREL 5-MW C_P and
+    C_T tables (CCBlade; bicubic spline of the table) at the trim of the same options
+    (trapezoid rule, precone, tilt, shear 0.2): P = q A V^3 C_P(lambda, theta),
+    T = q A V^2 C_T with lambda = Omega 63 m / V and A = pi (63 cos 2.5 deg)^2 as in the table.
+    Tolerance 3 % (measured 0.4-2.4 %: the tables differ by up to 0.006 in C_P here); 12 % for
+    dQ/dOmega at 11 m/s, a difference of two near-equal terms at the C_P optimum (measured
+    10 %)."""
+    from scipy.interpolate import RectBivariateSpline
+
+    pitch, tsr, cp, ct = rosco_nrel5mw
+    s_cp, s_ct = RectBivariateSpline(tsr, pitch, cp), RectBivariateSpline(tsr, pitch, ct)
+    cfg = PlantConfig(frozenset({"generator"}), linearize.AeroOptions(), "trapezoid")
+    op = linearize.trim(turbine, wind, config=cfg, shear_exponent=0.2)
+    om, th = op.rotor_speed_rad_s, math.degrees(op.pitch_rad)
+    lam = om * 63.0 / wind
+    qa = 0.5 * 1.225 * math.pi * (63.0 * math.cos(math.radians(2.5))) ** 2
+    c_p, dcp = s_cp(lam, th)[0, 0], s_cp(lam, th, dx=1)[0, 0]
+    c_t, dct = s_ct(lam, th)[0, 0], s_ct(lam, th, dx=1)[0, 0]
+    dq_dv = qa * wind ** 2 * (3 * c_p - lam * dcp) / om
+    dq_dw = qa * wind ** 2 * dcp * 63.0 / om - qa * wind ** 3 * c_p / om ** 2
+    dt_dv = qa * wind * (2 * c_t - lam * dct)
+    m = lin(turbine, wind, config=cfg, shear_exponent=0.2)
+    i_t, i_q = m.outputs.index("thrust"), m.outputs.index("aero_torque")
+    assert_allclose([m.D_d[i_q].sum(), m.D_d[i_t].sum()], [dq_dv, dt_dv], rtol=0.03)
+    assert_allclose(m.C_z[i_q, m.states.index("rotor_speed")], dq_dw, rtol=tol_qw)

@@ -38,7 +38,8 @@ def add_parsers(sub: Any) -> None:
     add_turbine(p)
     p.add_argument("--wind", default="4:25:1", help="START:STOP:STEP in m/s (default 4:25:1)")
     p.add_argument("--frozen-wake", action="store_true",
-                   help="hold the induction at trim (as FAST/OpenFAST linearize)")
+                   help="hold the induced velocities at trim (OpenFAST's FrozenWake; default: "
+                        "quasi-steady, as OpenFAST linearizes without it)")
     p.add_argument("--disturbance", choices=("blade", "rotor"), default="blade",
                    help="one wind per blade (default) or one rotor-effective wind")
     p.add_argument("--mbc", action="store_true", help="multi-blade (Coleman) coordinates")
