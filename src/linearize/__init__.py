@@ -12,7 +12,8 @@ from .plant import (DOF_NAMES, INPUT_NAMES, INPUT_UNITS, MADSEN_OUTPUTS, OUTPUT_
                     PlantStepper, SimulationResult, SteadyWind, element_wind,
                     plant_outputs, plant_params, plant_rhs, rk4_simulate, structural_frequencies)
 from .steady import optimal_tsr, rotor_average, steady_coefficients
-from .trim import OperatingPoint, operating_schedule, rated_wind_speed, trim
+from .trim import (OperatingPoint, operating_point, operating_schedule, rated_wind_speed,
+                   trim)
 from .turbine import Turbine, available_turbines, load_turbine
 
 __all__ = [
@@ -22,6 +23,7 @@ __all__ = [
     "element_wind",
     "plant_outputs", "plant_params", "plant_rhs", "rk4_simulate", "structural_frequencies",
     "optimal_tsr", "rotor_average", "steady_coefficients", "OperatingPoint", "TrimError",
+    "operating_point",
     "operating_schedule", "rated_wind_speed", "trim", "Turbine", "TurbineFileError",
     "available_turbines",
     "load_turbine", "LinearizationError", "LinearModel", "LinearModelFamily",

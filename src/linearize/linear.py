@@ -498,8 +498,12 @@ def linearize(turbine: Turbine, wind_mps: float, *, config: PlantConfig | None =
         Azimuth samples averaged over a revolution. Default 8 whenever the plant is periodic
         in azimuth: with tilt, gravity or shear, and also with a tower DOF on, since tower
         nodding and side-side motion reach each blade weighted by cos(psi_i); else 1.
-    params, operating_point : optional
-        Prebuilt plant parameters and trim point (must match turbine, config and wind).
+    params : PlantParams, optional
+        Prebuilt plant parameters (must match turbine and config).
+    operating_point : OperatingPoint, optional
+        Linearize here instead of at the trim: :func:`linearize.trim` with other settings, or
+        :func:`linearize.operating_point` at a given rotor speed and pitch (an OpenFAST
+        ``.lin`` file's point); its wind must be ``wind_mps``.
 
     Returns
     -------
@@ -515,6 +519,9 @@ def linearize(turbine: Turbine, wind_mps: float, *, config: PlantConfig | None =
     """
     v = check_finite_scalar("wind_mps", wind_mps)
     _check_options(wake, disturbance, coordinates)
+    if operating_point is not None and abs(operating_point.wind_mps - v) > 1e-9 * max(1.0, v):
+        raise ValueError(f"wind_mps = {v:g} m/s differs from the operating point's "
+                         f"{operating_point.wind_mps:g} m/s")
     p = params if params is not None else plant_params(turbine, config)
     op = operating_point if operating_point is not None else trim(
         turbine, v, power_W, params=p, shear_exponent=shear_exponent)
@@ -552,9 +559,7 @@ def _model(p: PlantParams, op: OperatingPoint, jac: tuple[FloatArray, ...], wake
     x0 = op.x[si]
     u0 = op.u.copy()
     d0 = np.full(3, op.wind_mps)
-    w = np.full((3, p.pack.r.size), op.wind_mps)
-    z_full = _eval(op.x, op.u, w, p.pack, np.full((4, 3, p.pack.r.size), np.nan), 0)[1]
-    z0 = z_full[_OUT_IDX]
+    z0 = _z0(p, op, shear)[_OUT_IDX]
     if coordinates == "mbc":
         states = _rename(states, _BLADE_GROUPS_X)
         outputs = _rename(outputs, _BLADE_GROUPS_Z)
@@ -587,6 +592,21 @@ def _model(p: PlantParams, op: OperatingPoint, jac: tuple[FloatArray, ...], wake
               "power_W": op.power, "thrust_N": op.thrust, "shear_exponent": shear,
               "power_reference_W": op.power_reference,
               "dofs": sorted(p.config.dofs), "turbine": p.turbine.name})
+
+
+def _z0(p: PlantParams, op: OperatingPoint, shear: float, n_azimuth: int = 24) -> FloatArray:
+    """The outputs at the operating point with the inflow the trim used -- the sheared power-law
+    wind at every element -- averaged over a revolution (every blade equally; the rotor totals
+    then equal the trim's, which averages over azimuth too)."""
+    pk = p.pack
+    wpar = np.array([op.wind_mps, shear])
+    z = np.zeros(len(OUTPUT_NAMES))
+    x = op.x.copy()
+    for psi in 2 * math.pi * np.arange(n_azimuth) / n_azimuth:
+        x[16] = psi
+        w = _sample_wind(0.0, float(psi), pk, 0, wpar, np.zeros((1, 1, 1)))
+        z += _eval(x, op.u, w, pk, np.full((4, 3, pk.r.size), np.nan), 0)[1]
+    return z / n_azimuth
 
 
 def _to_mbc_values(names: Sequence[str], vals: FloatArray) -> FloatArray:

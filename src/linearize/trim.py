@@ -29,7 +29,8 @@ from .plant import STATE_NAMES, PlantConfig, PlantParams, n_x, plant_params
 from .steady import optimal_tsr, rotor_average
 from .turbine import Turbine
 
-__all__ = ["TrimError", "OperatingPoint", "trim", "operating_schedule", "rated_wind_speed"]
+__all__ = ["TrimError", "OperatingPoint", "trim", "operating_point", "operating_schedule",
+           "rated_wind_speed"]
 
 
 @dataclass(frozen=True)
@@ -41,7 +42,7 @@ class OperatingPoint:
     wind_mps : float
         Hub-height mean wind speed [m/s].
     region : str
-        "1.5", "2", "2.5" or "3".
+        "1.5", "2", "2.5" or "3" (:func:`trim`), or "given" (:func:`operating_point`).
     pitch_rad : float
         Collective pitch [rad].
     rotor_speed_rad_s, gen_speed_rad_s : float
@@ -252,6 +253,85 @@ def trim(turbine: Turbine, wind_mps: float, power_W: float | None = None, *,
         cp=q * omega / (0.5 * turbine.environment.air_density * area * v**3),
         ct=thrust / (0.5 * turbine.environment.air_density * area * v**2),
         x=x, u=u, power_reference=pref, shear_exponent=shear)
+
+
+def operating_point(turbine: Turbine, wind_mps: float, rotor_speed_rad_s: float,
+                    pitch_rad: float, *, config: PlantConfig | None = None,
+                    shear_exponent: float = 0.0, params: PlantParams | None = None
+                    ) -> OperatingPoint:
+    """The operating point at a given wind, rotor speed and pitch: the structure in
+    equilibrium and the generator torque balancing the aerodynamic torque.
+
+    Where :func:`trim` follows the turbine's own schedule, this takes the point from elsewhere
+    -- an OpenFAST ``.lin`` file's operating point, a measurement -- so a linear model can be
+    made at exactly that point (``linearize(..., operating_point=op)``).
+
+    Parameters
+    ----------
+    turbine : Turbine
+        The turbine.
+    wind_mps : float
+        Mean hub-height wind [m/s], >= 0.
+    rotor_speed_rad_s : float
+        Rotor speed [rad/s], > 0.
+    pitch_rad : float
+        Collective pitch [rad], within the actuator's range.
+    config : PlantConfig, optional
+        Degrees of freedom and aerodynamic options (default: all on).
+    shear_exponent : float
+        Power-law shear of the steady wind [-].
+    params : PlantParams, optional
+        Prebuilt parameters; must match ``turbine`` and ``config``.
+
+    Returns
+    -------
+    OperatingPoint
+        With region ``"given"``; power is the electrical power of the balancing torque.
+
+    Raises
+    ------
+    ValueError
+        A non-finite or out-of-range argument (names it and the allowed range).
+    TrimError
+        If the balancing generator torque is negative (the rotor would be motored) or above the
+        generator's limit, or the structure finds no equilibrium.
+    """
+    v = check_finite_scalar("wind_mps", wind_mps)
+    if v < 0:
+        raise ValueError(f"wind_mps must be >= 0 m/s, got {wind_mps!r}")
+    omega = check_finite_scalar("rotor_speed_rad_s", rotor_speed_rad_s)
+    if omega <= 0:
+        raise ValueError(f"rotor_speed_rad_s must be > 0, got {rotor_speed_rad_s!r}")
+    pitch = check_finite_scalar("pitch_rad", pitch_rad)
+    pa = turbine.pitch_actuator
+    if not pa.min_pitch_rad - 1e-12 <= pitch <= pa.max_pitch_rad + 1e-12:
+        raise ValueError(f"pitch_rad = {pitch:g} rad is outside the actuator's range "
+                         f"{pa.min_pitch_rad:g}..{pa.max_pitch_rad:g} rad")
+    p = params if params is not None else plant_params(turbine, config)
+    shear = float(shear_exponent)
+    dt = turbine.drivetrain
+    ngear = dt.gearbox_ratio
+    q, _ = _aero(p, v, omega, pitch, shear)
+    tg = q / ngear
+    if not 0.0 <= tg <= turbine.generator.max_torque * (1 + 1e-9):
+        raise TrimError(f"at {v:g} m/s, {omega:g} rad/s and pitch {pitch:g} rad the generator "
+                        f"torque balancing the rotor would be {tg:g} N m; allowed: 0.."
+                        f"{turbine.generator.max_torque:g} N m")
+    x, u, z = _equilibrium(p, v, omega, pitch, tg, shear)
+    eta = dt.generator_efficiency * dt.gearbox_efficiency
+    cone = turbine.geometry.precone_rad if p.config.aero.cone else 0.0
+    rproj = turbine.geometry.tip_radius * math.cos(cone)
+    area = math.pi * rproj**2
+    qa, thrust = float(z[22]), float(z[23])
+    qdyn = 0.5 * turbine.environment.air_density * area
+    return OperatingPoint(
+        wind_mps=v, region="given", pitch_rad=pitch, rotor_speed_rad_s=omega,
+        gen_speed_rad_s=omega * ngear, gen_torque=tg, power=eta * tg * omega * ngear,
+        aero_power=qa * omega, aero_torque=qa, thrust=thrust,
+        tsr=omega * rproj / v if v > 0 else 0.0,
+        cp=qa * omega / (qdyn * v**3) if v > 0 else 0.0,
+        ct=thrust / (qdyn * v**2) if v > 0 else 0.0,
+        x=x, u=u, power_reference=None, shear_exponent=shear)
 
 
 def _equilibrium(p: PlantParams, v: float, omega: float, pitch: float, tg: float,

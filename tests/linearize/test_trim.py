@@ -108,3 +108,32 @@ def test_schedule_invariants(turbine: linearize.Turbine, v: float) -> None:
 def test_region3_pitch_increases_with_wind(turbine: linearize.Turbine) -> None:
     pts = operating_schedule(turbine, np.arange(12.0, 25.5, 1.0))
     assert np.all(np.diff([p.pitch_rad for p in pts]) > 0)
+
+
+def test_operating_point_at_the_trim_equals_the_trim(turbine: linearize.Turbine) -> None:
+    op = trim(turbine, 18.0)
+    given = linearize.operating_point(turbine, 18.0, op.rotor_speed_rad_s, op.pitch_rad)
+    assert given.region == "given"
+    assert_allclose(given.x, op.x, rtol=1e-9, atol=1e-12)
+    assert_allclose([given.power, given.aero_torque, given.thrust],
+                    [op.power, op.aero_torque, op.thrust], rtol=1e-9)
+
+
+def test_operating_point_off_schedule_balances_the_torque(turbine: linearize.Turbine) -> None:
+    # OpenFAST's FASTLin.lin point (11 m/s, 11.81 rpm, pitch 0): below rated speed, a torque
+    # the schedule would not choose; the generator torque balances the rotor's (efficiency
+    # 94.4 %: electrical power = 0.944 x aerodynamic power)
+    op = linearize.operating_point(turbine, 11.0, 11.81 * np.pi / 30, 0.0)
+    assert_allclose(op.power, 0.944 * op.aero_power, rtol=1e-12)
+    assert_allclose(op.gen_torque * 97.0, op.aero_torque, rtol=1e-12)
+
+
+@pytest.mark.parametrize("args, match", [
+    ((18.0, -1.0, 0.1), "rotor_speed_rad_s must be > 0"),
+    ((18.0, 1.2, 3.0), r"pitch_rad = 3 rad is outside the actuator's range"),
+    ((-2.0, 1.2, 0.1), "wind_mps must be >= 0"),
+    ((25.0, 1.27, 0.0), "generator torque balancing the rotor would be"),
+])
+def test_operating_point_bad_input(turbine: linearize.Turbine, args, match: str) -> None:
+    with pytest.raises((ValueError, TrimError), match=match):
+        linearize.operating_point(turbine, *args)

@@ -323,3 +323,15 @@ def test_assess_csv_without_known_channels_names_what_it_found(
     assert main(["assess", str(p), "--channels", "TwrBsMyt", "--json"]) == 0
     d = json.loads(capsys.readouterr().out)[0]["channels"]["TwrBsMyt"]
     assert d["m"] == 4.0 and d["del"] > 0
+
+
+def test_linearize_at_a_given_operating_point(capsys: pytest.CaptureFixture[str]) -> None:
+    # OpenFAST's FASTLin.lin point: 11 m/s, 11.81 rpm, pitch 0
+    assert main(["linearize", "--wind", "11", "--rotor-speed-rpm", "11.81", "--pitch-deg", "0",
+                 "--json"]) == 0
+    row = json.loads(capsys.readouterr().out)[0]
+    assert row["rotor_speed_rpm"] == pytest.approx(11.81, rel=1e-12)
+    assert row["pitch_deg"] == 0.0
+    assert main(["linearize", "--wind", "11:12:1", "--rotor-speed-rpm", "11.81",
+                 "--pitch-deg", "0"]) == 2
+    assert "go together, with a single --wind" in capsys.readouterr().err

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import math
 from pathlib import Path
 from typing import Any
 
@@ -43,6 +44,11 @@ def add_parsers(sub: Any) -> None:
     p.add_argument("--disturbance", choices=("blade", "rotor"), default="blade",
                    help="one wind per blade (default) or one rotor-effective wind")
     p.add_argument("--mbc", action="store_true", help="multi-blade (Coleman) coordinates")
+    p.add_argument("--rotor-speed-rpm", type=float, default=None,
+                   help="linearize at this rotor speed instead of the trim (with --pitch-deg and "
+                        "a single --wind): e.g. an OpenFAST .lin file's operating point")
+    p.add_argument("--pitch-deg", type=float, default=None,
+                   help="collective pitch of that operating point [deg]")
     p.add_argument("--out", help="models file: .mat (MATLAB), .npz or .json")
     p.add_argument("--json", action="store_true", help="print sensitivities and modes as JSON")
     p.set_defaults(func=_linearize)
@@ -96,11 +102,20 @@ def _cp_surface(args: argparse.Namespace) -> int:
 def _linearize(args: argparse.Namespace) -> int:
     winds = parse_range(args.wind, "--wind")
     check_suffix(args.out, "--out", (".mat", ".npz", ".json"))
+    given = (args.rotor_speed_rpm, args.pitch_deg)
+    if given != (None, None) and (None in given or winds.size != 1):
+        raise UsageError("--rotor-speed-rpm and --pitch-deg go together, with a single --wind")
     turbine = linearize.load_turbine(args.turbine)
-    fam = linearize.linearize_family(
-        turbine, winds, wake="frozen" if args.frozen_wake else "quasi-steady",
-        disturbance=args.disturbance, coordinates="mbc" if args.mbc else "blade",
-        progress=not args.json)
+    opts = dict(wake="frozen" if args.frozen_wake else "quasi-steady",
+                disturbance=args.disturbance, coordinates="mbc" if args.mbc else "blade")
+    if None in given:
+        fam = linearize.linearize_family(turbine, winds, progress=not args.json, **opts)
+    else:
+        op = linearize.operating_point(turbine, float(winds[0]),
+                                       args.rotor_speed_rpm * math.pi / 30.0,
+                                       math.radians(args.pitch_deg))
+        fam = linearize.LinearModelFamily(
+            winds, (linearize.linearize(turbine, float(winds[0]), operating_point=op, **opts),))
     if args.out:
         fam.save(args.out)
         if not args.json:
