@@ -413,8 +413,13 @@ def _mbc_matrices(psi: float, omega: float) -> tuple[FloatArray, FloatArray, Flo
 
 def _assemble(jx: FloatArray, ju: FloatArray, jd: FloatArray, hx: FloatArray, hu: FloatArray,
               hd: FloatArray, si: list[int], psi: float, omega: float,
-              coordinates: str) -> tuple[FloatArray, ...]:
+              coordinates: str, ngear: float) -> tuple[FloatArray, ...]:
     """Select active states, then (MBC) transform to non-rotating coordinates at psi."""
+    ig, ir = STATE_NAMES.index("gen_speed"), STATE_NAMES.index("rotor_speed")
+    if ig not in si and ir in si:       # rigid shaft: omega_g = N omega_r, fold the column in
+        jx, hx = jx.copy(), hx.copy()
+        jx[:, ir] += ngear * jx[:, ig]
+        hx[:, ir] += ngear * hx[:, ig]
     a = jx[np.ix_(si, si)]
     b = ju[si]
     bd = jd[si]
@@ -542,7 +547,8 @@ def _averaged(p: PlantParams, op: OperatingPoint, wake: str, shear: float,
                 raise LinearizationError(
                     f"Jacobian {name}[{i[0]}, {i[1]}] is not finite at {op.wind_mps:g} m/s, "
                     f"azimuth {math.degrees(psi):.0f} deg: the plant failed at a perturbed point")
-        mats = _assemble(*raw, si, float(psi), op.rotor_speed_rad_s, coordinates)
+        mats = _assemble(*raw, si, float(psi), op.rotor_speed_rad_s, coordinates,
+                         p.pack.ngear)
         acc = list(mats) if acc is None else [a + m for a, m in zip(acc, mats)]
     assert acc is not None
     return tuple(m / len(psis) for m in acc)

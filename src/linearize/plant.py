@@ -153,7 +153,17 @@ class PlantConfig:
                               "pitch_actuator"}), aero or AeroOptions())
 
     def active_states(self) -> tuple[str, ...]:
-        """Names of the states that evolve under this configuration (azimuth excluded)."""
+        """Names of the states that evolve under this configuration (azimuth excluded).
+
+        With a rigid drivetrain (no ``drivetrain`` DOF) the generator speed is N times the rotor
+        speed: it is not a state of the linear models (an exact zero, uncontrollable eigenvalue
+        otherwise), and the outputs that depend on it act through the rotor speed.
+
+        Returns
+        -------
+        tuple of str
+            Names of :data:`STATE_NAMES`, in their order.
+        """
         groups = {
             "tower_fa": ("tower_fa_displacement", "tower_fa_velocity"),
             "generator": ("rotor_speed", "gen_speed"),
@@ -165,7 +175,9 @@ class PlantConfig:
         }
         on = {n for d in self.dofs for n in groups[d]}
         if "drivetrain" not in self.dofs:
+            # rigid shaft: the generator turns at N times the rotor, no state of its own
             on.discard("shaft_torsion")
+            on.discard("gen_speed")
         return tuple(n for n in STATE_NAMES if n in on)
 
 

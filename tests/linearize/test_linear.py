@@ -534,3 +534,21 @@ def test_operating_point_outputs_use_the_trims_inflow(turbine: linearize.Turbine
     assert_allclose([z["aero_torque"], z["thrust"]], [op.aero_torque, op.thrust], rtol=1e-5)
     with pytest.raises(ValueError, match="differs from the operating point's 18 m/s"):
         lin(turbine, 17.0, operating_point=op)
+
+
+def test_rigid_drivetrain_has_no_generator_speed_state(turbine: linearize.Turbine) -> None:
+    """Issue 18: with a rigid shaft the generator turns at N = 97 times the rotor, so
+    gen_speed was a redundant state (an exact zero, uncontrollable eigenvalue). Now it is not
+    a state; the outputs act through the rotor speed: gen_speed = 97 omega_r and, at 18 m/s in
+    region 3, d(gen_power)/d(omega_r) = eta T_g N = 0.944 x 43,093.55 N m x 97 (published
+    efficiency, rated torque, gearbox ratio; report Table 1-1 / DISCON)."""
+    cfg = PlantConfig(frozenset({"generator", "tower_fa"}))
+    m = lin(turbine, 18.0, config=cfg)
+    assert "gen_speed" not in m.states and "shaft_torsion" not in m.states
+    assert np.abs(np.linalg.eigvals(m.A)).min() > 1e-3
+    j = m.states.index("rotor_speed")
+    assert_allclose(m.C_z[m.outputs.index("gen_speed"), j], 97.0, rtol=1e-9)
+    assert_allclose(m.C_z[m.outputs.index("gen_power"), j], 0.944 * 43093.55 * 97.0, rtol=1e-5)
+    flexible = lin(turbine, 18.0, config=PlantConfig(frozenset({"generator", "drivetrain",
+                                                                "tower_fa"})))
+    assert "gen_speed" in flexible.states
