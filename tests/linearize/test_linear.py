@@ -552,3 +552,44 @@ def test_rigid_drivetrain_has_no_generator_speed_state(turbine: linearize.Turbin
     flexible = lin(turbine, 18.0, config=PlantConfig(frozenset({"generator", "drivetrain",
                                                                 "tower_fa"})))
     assert "gen_speed" in flexible.states
+
+
+def _lin_matrix(text: list[str], name: str) -> np.ndarray:
+    """One matrix of an OpenFAST .lin file (``NAME: r x c`` then r rows)."""
+    import re
+
+    i = next(k for k, ln in enumerate(text) if ln.strip().startswith(name + ":"))
+    r, c = map(int, re.findall(r"(\d+) x (\d+)", text[i])[0])
+    return np.array([ln.split() for ln in text[i + 1:i + 1 + r]], float)
+
+
+def test_fine_pitch_derivatives_against_openfast(turbine: linearize.Turbine) -> None:
+    """OpenFAST's FASTLin.lin (tests/data; quasi-steady BEM, 11 m/s, 11.81 rpm, pitch 0) at
+    the same operating point (`operating_point`), tower fore-aft and generator DOFs: the wind
+    derivatives of thrust and torque and the pitch derivative of thrust agree to 3 % (measured
+    0.1-1.7 %). The pitch derivative of torque does not: ours -2.35e6 against -1.56e6 N m/rad
+    (+50 %). It is small because fine pitch sits near the C_P-optimal pitch, where
+    dQ/dtheta = Q'' (theta - theta_opt) with Q'' = -2.7e8 N m/rad^2: the whole difference is
+    the optimum 0.16 deg apart (CCBlade's table puts it another 0.4 deg away, -2.01e6). The
+    test states the +50 % and bounds the equivalent optimum shift by 0.25 deg."""
+    text = (Path(__file__).resolve().parents[1] / "data" / "FASTLin.lin").read_text().splitlines()
+    d = _lin_matrix(text, "D")
+    of = {"dQ_dV": d[15, 0], "dT_dV": d[14, 0], "dT_dpitch": d[14, 8], "dQ_dpitch": d[15, 8]}
+    cfg = PlantConfig(frozenset({"generator", "tower_fa"}))
+    op = linearize.operating_point(turbine, 11.0, 1.23670995, 0.0, config=cfg)
+    m = lin(turbine, 11.0, config=cfg, operating_point=op)
+    i_q, i_t = m.outputs.index("aero_torque"), m.outputs.index("thrust")
+    ours = {"dQ_dV": m.D_d[i_q].sum(), "dT_dV": m.D_d[i_t].sum(),
+            "dT_dpitch": m.D_u[i_t, :3].sum(), "dQ_dpitch": m.D_u[i_q, :3].sum()}
+    for k in ("dQ_dV", "dT_dV", "dT_dpitch"):
+        assert_allclose(ours[k], of[k], rtol=0.03, err_msg=k)
+    assert ours["dQ_dpitch"] / of["dQ_dpitch"] == pytest.approx(1.50, abs=0.03)
+    # Q'' from our steady torque at this rotor speed, over pitch +-1 deg
+    r_proj = 63.0 * math.cos(math.radians(2.5))
+    th = np.radians(np.linspace(-1.0, 1.0, 21))
+    cp, _ = linearize.steady_coefficients(turbine, np.full(th.size, 1.23670995 * r_proj / 11.0),
+                                          np.degrees(th))
+    torque = 0.5 * 1.225 * math.pi * r_proj ** 2 * 11.0 ** 3 * cp / 1.23670995
+    q2 = np.polyfit(th, torque, 2)[0] * 2
+    shift = (of["dQ_dpitch"] - ours["dQ_dpitch"]) / q2
+    assert abs(math.degrees(shift)) < 0.25
