@@ -328,7 +328,9 @@ def _solve_phi(vx, vy, r, chord, theta, k_af, table, alpha0, dalpha, nb_, rtip, 
     to ``_XTOL`` (1e-13 rad); this always converges and is what trim uses. With a hint (an
     earlier solution nearby, as in time stepping) a secant iteration starts from it with the
     slope cached at that solve, confined to the hint's Ning region, and stops at the evaluated
-    point whose Newton correction is below ``tol``; if it does not get there in 8 steps it falls
+    point whose Newton correction is below ``tol`` (with ``tol <= _XTOL``, as linearization asks,
+    that last correction is applied too, which puts phi at rounding level: finite differences
+    of a 1e7 N m rotor sum then resolve 1e-7 N m); if it does not get there in 8 steps it falls
     back to the global brackets.
     """
     args = (vx, vy, r, chord, theta, k_af, table, alpha0, dalpha, nb_, rtip, rhub, flags)
@@ -349,6 +351,10 @@ def _solve_phi(vx, vy, r, chord, theta, k_af, table, alpha0, dalpha, nb_, rtip, 
                     break
                 step = f0 / slope
                 if abs(step) <= tol:
+                    if tol <= _XTOL and step != 0.0 and lo_b < x0 - step < hi_b:
+                        # tight: take the last correction too (superlinear: to rounding)
+                        x0 = x0 - step
+                        _, oma, opa, cn, ct = _induction(x0, *args)
                     return x0, slope, oma, opa, cn, ct
                 x1 = x0 - step
                 if x1 <= lo_b or x1 >= hi_b:

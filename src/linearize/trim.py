@@ -356,7 +356,9 @@ def _equilibrium(p: PlantParams, v: float, omega: float, pitch: float, tg: float
                       [pk.m_c, 0.0, pk.m_b, 0.0],
                       [pk.m_c, 0.0, 0.0, pk.m_b]])
         k = np.diag([pk.k_fa, kq, kq, kq])
-        a0 = np.array([dx0[1], dx0[13], dx0[14], dx0[15]])
+        # rotor_average samples a third of a revolution (rotor totals repeat every 120 deg);
+        # a blade's full-revolution mean is the mean over the three blades
+        a0 = np.array([dx0[1]] + [dx0[13:16].mean()] * 3)
         on = np.array([p.dof("tower_fa")] + [p.dof("blade_flap")] * 3)
         idx = np.flatnonzero(on)
         delta = np.zeros(4)
@@ -368,6 +370,8 @@ def _equilibrium(p: PlantParams, v: float, omega: float, pitch: float, tg: float
     dx, z = rotor_average(p, x, u, v, shear)
     scale = np.array([1.0, 1e-2, 1e-3, 1e-1, 1e-3, 1e-3, 1e-3, 1e-3, 1.0, 1e-2, 1.0, 1.0, 1.0,
                       1e-2, 1e-2, 1e-2, 1.0])
+    dx = dx.copy()
+    dx[13:16] = dx[13:16].mean()
     resid = np.abs(dx[:16]) / scale[:16]
     resid[[0, 8, 10, 11, 12]] = 0.0   # displacement rates are velocities (zero by construction)
     if not np.all(np.isfinite(dx)) or resid.max() > 1e-6:
