@@ -216,6 +216,12 @@ class PlantParams:
         [N s/m].
     blade_tower_coupling : float
         int m phi ds, the flap mode's inertial coupling to rotor translation [kg].
+    edge_modal_mass, edge_modal_stiffness, edge_centrifugal_stiffness : float
+        First edgewise mode per blade referred to the tip deflection (ElastoDyn's edge mode
+        shape and EdgStff): int m phi_e^2 [kg], int EI_e phi_e''^2 [N/m], int N phi_e'^2 per
+        Omega^2 [N s^2/m]; NaN when the turbine has no edge mode shape.
+    edge_rotor_coupling : float
+        int m phi_e r ds, the edge mode's inertial coupling to rotor rotation [kg m].
     """
 
     turbine: Turbine
@@ -234,6 +240,10 @@ class PlantParams:
     blade_centrifugal_stiffness: float
     blade_modal_damping: float
     blade_tower_coupling: float
+    edge_modal_mass: float = math.nan
+    edge_modal_stiffness: float = math.nan
+    edge_centrifugal_stiffness: float = math.nan
+    edge_rotor_coupling: float = math.nan
     pack: Any = field(repr=False, compare=False, default=None)
 
     def dof(self, name: str) -> bool:
@@ -362,7 +372,28 @@ def plant_params(turbine: Turbine, config: PlantConfig | None = None) -> PlantPa
         tower_fa_modal_damping=c_fa, tower_ss_modal_mass=m_ss, tower_ss_modal_stiffness=k_ss,
         tower_ss_modal_damping=c_ss, blade_modal_mass=m_b, blade_modal_stiffness=k_b,
         blade_centrifugal_stiffness=k_cf, blade_modal_damping=c_b, blade_tower_coupling=m_c,
-        pack=pack)
+        **_edge_mode(t, s, mu, tension), pack=pack)
+
+
+def _edge_mode(t: Turbine, s: FloatArray, mu: FloatArray,
+               tension: FloatArray) -> dict[str, float]:
+    """Edgewise modal properties of one blade (assumed mode, as the flap one; Hansen 2015,
+    ch. 11) on the span grid ``s`` [m] from the root, with mass per length ``mu`` and the
+    centrifugal tension per Omega^2 ``tension``."""
+    shape = t.mode_shapes.blade_edge1
+    if shape is None:
+        return {}
+    g = t.geometry
+    lb = g.tip_radius - g.hub_radius
+    xs = s / lb
+    phi = mode_shape(shape, xs)
+    dphi = mode_shape(shape, xs, 1) / lb
+    ddphi = mode_shape(shape, xs, 2) / lb**2
+    ei = np.interp(xs, t.blade_structure.span_fraction, t.blade_structure.edge_stiffness)
+    return {"edge_modal_mass": float(np.trapezoid(mu * phi**2, s)),
+            "edge_modal_stiffness": float(np.trapezoid(ei * ddphi**2, s)),
+            "edge_centrifugal_stiffness": float(np.trapezoid(tension * dphi**2, s)),
+            "edge_rotor_coupling": float(np.trapezoid(mu * phi * (g.hub_radius + s), s))}
 
 
 # --------------------------------------------------------------------------------------------
@@ -1063,13 +1094,22 @@ def structural_frequencies(params: PlantParams, rotor_speed_rad_s: float = 0.0) 
     Tower fore-aft coupled with the three flap modes through the mass matrix (so a collective
     and two asymmetric flap modes appear), tower side-side alone. The flap stiffness includes
     centrifugal stiffening at ``rotor_speed_rad_s``; the drivetrain torsion frequency is that
-    of the free-free two-mass system.
+    of the free-free two-mass system (rigid blades).
+
+    With an edge mode shape in the turbine data, also the edgewise modes: the asymmetric edge
+    mode of one blade (stiffness K_e + Omega^2 (K_cf,e - M_e): centrifugal stiffening and the
+    in-plane softening), and, with the generator locked as in the NREL 5-MW report's Table 9-1
+    (RotSpeed = 0, GenDOF = False), the collective edge mode and the shaft torsion coupled
+    through the rotor inertia: M = [[J_r, 3 S_e], [3 S_e, 3 M_e]], K = diag(K_shaft, 3 K_e)
+    with S_e = int m phi_e r ds. The plant's state equations do not carry the edge DOF yet.
 
     Returns
     -------
     dict
         Keys ``tower_fa``, ``tower_ss``, ``flap_collective``, ``flap_asymmetric``,
-        ``drivetrain`` [Hz].
+        ``drivetrain``, ``drivetrain_locked_generator_rigid_blades`` [Hz]; with an edge mode
+        shape also ``edge_asymmetric``, ``edge_collective_locked_generator`` and
+        ``drivetrain_locked_generator`` [Hz].
     """
     import scipy.linalg as sl
 
@@ -1086,6 +1126,23 @@ def structural_frequencies(params: PlantParams, rotor_speed_rad_s: float = 0.0) 
     coll = max(others, key=lambda i: abs(vec[0, i]))
     asym = [i for i in others if i != coll]
     j_eq = pk.j_rot * pk.j_gen * pk.ngear**2 / (pk.j_rot + pk.j_gen * pk.ngear**2)
-    return {"tower_fa": float(f[i_tower]), "tower_ss": math.sqrt(pk.k_ss / pk.m_ss) / (2 * math.pi),
-            "flap_collective": float(f[coll]), "flap_asymmetric": float(np.mean(f[asym])),
-            "drivetrain": math.sqrt(pk.k_shaft / j_eq) / (2 * math.pi)}
+    out = {"tower_fa": float(f[i_tower]),
+           "tower_ss": math.sqrt(pk.k_ss / pk.m_ss) / (2 * math.pi),
+           "flap_collective": float(f[coll]), "flap_asymmetric": float(np.mean(f[asym])),
+           "drivetrain": math.sqrt(pk.k_shaft / j_eq) / (2 * math.pi),
+           "drivetrain_locked_generator_rigid_blades":
+               math.sqrt(pk.k_shaft / pk.j_rot) / (2 * math.pi)}
+    if math.isfinite(params.edge_modal_mass):
+        me, se = params.edge_modal_mass, params.edge_rotor_coupling
+        ke = (params.edge_modal_stiffness
+              + rotor_speed_rad_s**2 * (params.edge_centrifugal_stiffness - me))
+        w2e, vece = sl.eigh(np.diag([pk.k_shaft, 3 * ke]),
+                            np.array([[pk.j_rot, 3 * se], [3 * se, 3 * me]]))
+        # the drivetrain mode is the one whose strain energy is mostly the shaft's
+        shaft_energy = pk.k_shaft * vece[0] ** 2
+        i_dt = int(np.argmax(shaft_energy / (shaft_energy + 3 * ke * vece[1] ** 2)))
+        fe = np.sqrt(w2e) / (2 * math.pi)
+        out.update(edge_asymmetric=math.sqrt(ke / me) / (2 * math.pi),
+                   drivetrain_locked_generator=float(fe[i_dt]),
+                   edge_collective_locked_generator=float(fe[1 - i_dt]))
+    return out

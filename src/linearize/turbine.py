@@ -374,16 +374,22 @@ class ModeShapes:
     """Polynomial mode shapes phi(x) = sum_k c_k x^k, k = 2..6, with phi(1) = 1.
 
     Each field is a (5,) ndarray of coefficients for x^2..x^6 (x = fraction of height/span).
+    ``blade_edge1`` (ElastoDyn's first edgewise blade mode) is optional: without it the
+    edgewise modal properties of :class:`~linearize.PlantParams` are NaN.
     """
 
     tower_fa1: FloatArray
     tower_ss1: FloatArray
     blade_flap1: FloatArray
+    blade_edge1: FloatArray | None = None
 
     def __post_init__(self) -> None:
-        _freeze(self, ("tower_fa1", "tower_ss1", "blade_flap1"))
+        names = ("tower_fa1", "tower_ss1", "blade_flap1")
+        _freeze(self, names + (("blade_edge1",) if self.blade_edge1 is not None else ()))
         for f in fields(self):
             c = getattr(self, f.name)
+            if c is None:
+                continue
             if c.shape != (5,):
                 raise ValueError(f"ModeShapes.{f.name} has shape {c.shape}; expected (5,)")
             if abs(c.sum() - 1.0) > 2e-3:
@@ -701,6 +707,8 @@ def _read_mode_shapes(path: Path) -> ModeShapes:
     missing = [m for m in need.values() if m not in by_name]
     if missing:
         raise TurbineFileError(f"{path}: missing modes {missing}")
+    if "blade_edge_1" in by_name:
+        need["blade_edge1"] = "blade_edge_1"
     kwargs = {}
     for fname, mode in need.items():
         try:
