@@ -72,12 +72,13 @@ SCHEMA_VERSION = 1
 _OUT_IDX = [i for i, n in enumerate(OUTPUT_NAMES) if n != "azimuth"]
 #: variables scales for the finite-difference steps (state, input, disturbance)
 _X_SCALE = np.array([0.1, 0.1, 0.1, 10.0, 1e-3, 0.01, 0.01, 0.01, 0.1, 0.1, 0.1, 0.1, 0.1,
-                     0.1, 0.1, 0.1, 1.0])
+                     0.1, 0.1, 0.1, 1.0, 0.01, 0.01, 0.01, 0.1, 0.1, 0.1])
 _U_SCALE = np.array([0.01, 0.01, 0.01, 1000.0])
 _D_SCALE = np.array([1.0, 1.0, 1.0])
 _REL_STEP = 2e-5
 _BLADE_GROUPS_X = (("pitch_1", "pitch_2", "pitch_3"), ("flap_1", "flap_2", "flap_3"),
-                   ("flap_rate_1", "flap_rate_2", "flap_rate_3"))
+                   ("flap_rate_1", "flap_rate_2", "flap_rate_3"), ("edge_1", "edge_2", "edge_3"),
+                   ("edge_rate_1", "edge_rate_2", "edge_rate_3"))
 _BLADE_GROUPS_Z = (("pitch_1", "pitch_2", "pitch_3"),
                    ("pitch_rate_1", "pitch_rate_2", "pitch_rate_3"),
                    ("flap_moment_1", "flap_moment_2", "flap_moment_3"),
@@ -89,27 +90,27 @@ _BLADE_GROUPS_Z = (("pitch_1", "pitch_2", "pitch_3"),
 # --------------------------------------------------------------------------------------------
 @nb.njit(cache=True, error_model="numpy")
 def _perturbed(x0, u0, w0, j, delta):  # pragma: no cover - compiled
-    """(x, u, wind) with variable j of the combined vector [x (17), u (4), blade winds (3)]
+    """(x, u, wind) with variable j of the combined vector [x (23), u (4), blade winds (3)]
     moved by delta (a blade wind moves every element of that blade)."""
     x = x0.copy()
     u = u0.copy()
     w = w0.copy()
-    if j < 17:
+    if j < 23:
         x[j] += delta
-    elif j < 21:
-        u[j - 17] += delta
+    elif j < 27:
+        u[j - 23] += delta
     else:
-        w[j - 21] += delta
+        w[j - 27] += delta
     return x, u, w
 
 
 @nb.njit(cache=True, error_model="numpy")
 def _jac_fd(x0, u0, w0, p, bem0, mode, h):  # pragma: no cover - compiled
     """Central-difference Jacobians of (dx/dt, z) w.r.t. the combined vector [x, u, blade
-    winds], with step h[j] per variable: (17, 24) and (31, 24)."""
-    jf = np.zeros((17, 24))
-    jz = np.zeros((31, 24))
-    for j in range(24):
+    winds], with step h[j] per variable: (23, 30) and (31, 30)."""
+    jf = np.zeros((23, 30))
+    jz = np.zeros((31, 30))
+    for j in range(30):
         xp, up, wp = _perturbed(x0, u0, w0, j, h[j])
         xm, um, wm = _perturbed(x0, u0, w0, j, -h[j])
         fp, zp, _ = _eval(xp, up, wp, p, bem0, mode)
@@ -123,9 +124,9 @@ def _jac_fd(x0, u0, w0, p, bem0, mode, h):  # pragma: no cover - compiled
 def _jac_cs(x0, u0, w0, p, bem0, mode):  # pragma: no cover - compiled
     """Complex-step Jacobians (step 1e-30 i): exact to rounding, no subtraction error."""
     h = 1e-30
-    jf = np.zeros((17, 24))
-    jz = np.zeros((31, 24))
-    for j in range(24):
+    jf = np.zeros((23, 30))
+    jz = np.zeros((31, 30))
+    for j in range(30):
         x, u, w = _perturbed(x0 + 0j, u0 + 0j, w0 + 0j, j, 1j * h)
         f, z, _ = _eval(x, u, w, p, bem0, mode)
         jf[:, j] = f.imag / h
@@ -135,7 +136,7 @@ def _jac_cs(x0, u0, w0, p, bem0, mode):  # pragma: no cover - compiled
 
 def _split(jf: FloatArray, jz: FloatArray) -> tuple[FloatArray, ...]:
     """(df/dx, df/du, df/dd, dz/dx, dz/du, dz/dd) from the combined Jacobians."""
-    return (jf[:, :17], jf[:, 17:21], jf[:, 21:], jz[:, :17], jz[:, 17:21], jz[:, 21:])
+    return (jf[:, :23], jf[:, 23:27], jf[:, 27:], jz[:, :23], jz[:, 23:27], jz[:, 27:])
 
 
 def _azimuths(params: PlantParams, shear: float, n_azimuth: int | None) -> FloatArray:
@@ -151,7 +152,7 @@ def _azimuths(params: PlantParams, shear: float, n_azimuth: int | None) -> Float
 
 def _raw_jacobians(params: PlantParams, op: OperatingPoint, wake: str, shear: float,
                    psi: float, method: str = "fd") -> tuple[FloatArray, ...]:
-    """Full (17-state, 4-input, 3-blade-wind, 31-output) Jacobians at one azimuth."""
+    """Full (23-state, 4-input, 3-blade-wind, 31-output) Jacobians at one azimuth."""
     pk = params.pack
     x0 = op.x.copy()
     x0[16] = psi
@@ -319,7 +320,7 @@ class LinearModel:
 
         The name is the state group with the largest participation factor |phi_k psi_k|
         (right and left eigenvectors): tower fore-aft, tower side-side, drivetrain torsion,
-        blade flap (collective or asymmetric), rotor, pitch actuator.
+        blade flap or blade edge (collective or asymmetric), rotor, pitch actuator.
         """
         a = self.A
         if self.dt is not None:
@@ -341,14 +342,16 @@ class LinearModel:
     def _mode_name(self, part: FloatArray, vec: np.ndarray) -> str:
         groups = {"tower fore-aft": ("tower_fa_",), "tower side-side": ("tower_ss_",),
                   "drivetrain torsion": ("shaft_torsion", "gen_speed"),
-                  "rotor": ("rotor_speed",), "blade flap": ("flap",), "pitch actuator": ("pitch",)}
+                  "rotor": ("rotor_speed",), "blade flap": ("flap",), "blade edge": ("edge",),
+                  "pitch actuator": ("pitch",)}
         score = {}
         for g, prefixes in groups.items():
             idx = [i for i, n in enumerate(self.states) if n.startswith(prefixes)]
             score[g] = float(part[idx].sum()) if idx else 0.0
         best = max(score, key=score.get)
-        if best == "blade flap":
-            idx = [i for i, n in enumerate(self.states) if n.startswith("flap_") and "rate" not in n]
+        if best in ("blade flap", "blade edge"):
+            stem = best.split()[1] + "_"
+            idx = [i for i, n in enumerate(self.states) if n.startswith(stem) and "rate" not in n]
             if self.coordinates == "mbc":
                 coll = [i for i in idx if self.states[i].endswith("_coll")]
                 share = part[coll].sum() / max(part[idx].sum(), 1e-300)
@@ -439,9 +442,11 @@ def _assemble(jx: FloatArray, ju: FloatArray, jd: FloatArray, hx: FloatArray, hu
         ix = [names.index(g) for g in grp]
         tx[np.ix_(ix, ix)] = t
         txdot[np.ix_(ix, ix)] = tdot
-    if "flap_1" in names:   # velocity states of a second-order group
-        ip = [names.index(g) for g in _BLADE_GROUPS_X[1]]
-        iv = [names.index(g) for g in _BLADE_GROUPS_X[2]]
+    for pos, vel in ((1, 2), (3, 4)):   # velocity states of the second-order groups
+        if _BLADE_GROUPS_X[pos][0] not in names:
+            continue
+        ip = [names.index(g) for g in _BLADE_GROUPS_X[pos]]
+        iv = [names.index(g) for g in _BLADE_GROUPS_X[vel]]
         tx[np.ix_(iv, ip)] = tdot
         txdot[np.ix_(iv, ip)] = tddot
         txdot[np.ix_(iv, iv)] = tdot
@@ -633,7 +638,7 @@ def jacobian_check(turbine: Turbine, wind_mps: float, *, config: PlantConfig | N
     Returns
     -------
     fd, cs : tuple of 6 ndarray
-        (df/dx, df/du, df/dd, dz/dx, dz/du, dz/dd) on all 17 states, 4 inputs, 3 blade winds
+        (df/dx, df/du, df/dd, dz/dx, dz/du, dz/dd) on all 23 states, 4 inputs, 3 blade winds
         and 31 outputs, from each method.
     """
     p = params if params is not None else plant_params(turbine, config)

@@ -70,14 +70,16 @@ __all__ = [
     "SimulationDivergedError", "rk4_simulate", "PlantStepper", "structural_frequencies", "n_x", "n_u", "n_z",
 ]
 
-DOF_NAMES = ("tower_fa", "tower_ss", "drivetrain", "generator", "blade_flap", "pitch_actuator")
+DOF_NAMES = ("tower_fa", "tower_ss", "drivetrain", "generator", "blade_flap", "pitch_actuator",
+             "blade_edge")
 
 STATE_NAMES = (
     "tower_fa_displacement", "tower_fa_velocity", "rotor_speed", "gen_speed", "shaft_torsion",
     "pitch_1", "pitch_2", "pitch_3", "tower_ss_displacement", "tower_ss_velocity",
-    "flap_1", "flap_2", "flap_3", "flap_rate_1", "flap_rate_2", "flap_rate_3", "azimuth")
+    "flap_1", "flap_2", "flap_3", "flap_rate_1", "flap_rate_2", "flap_rate_3", "azimuth",
+    "edge_1", "edge_2", "edge_3", "edge_rate_1", "edge_rate_2", "edge_rate_3")
 STATE_UNITS = ("m", "m/s", "rad/s", "rad/s", "rad", "rad", "rad", "rad", "m", "m/s",
-               "m", "m", "m", "m/s", "m/s", "m/s", "rad")
+               "m", "m", "m", "m/s", "m/s", "m/s", "rad", "m", "m", "m", "m/s", "m/s", "m/s")
 INPUT_NAMES = ("pitch_ref_1", "pitch_ref_2", "pitch_ref_3", "gen_torque_ref")
 INPUT_UNITS = ("rad", "rad", "rad", "N m")
 OUTPUT_NAMES = (
@@ -172,6 +174,8 @@ class PlantConfig:
             "tower_ss": ("tower_ss_displacement", "tower_ss_velocity"),
             "blade_flap": ("flap_1", "flap_2", "flap_3", "flap_rate_1", "flap_rate_2",
                            "flap_rate_3"),
+            "blade_edge": ("edge_1", "edge_2", "edge_3", "edge_rate_1", "edge_rate_2",
+                           "edge_rate_3"),
         }
         on = {n for d in self.dofs for n in groups[d]}
         if "drivetrain" not in self.dofs:
@@ -188,7 +192,8 @@ _Pack = namedtuple("_Pack", [
     "m_fa", "k_fa", "c_fa", "hub_fa", "slope_fa", "m_ss", "k_ss", "c_ss", "hub_ss", "slope_ss",
     "m_b", "k_b", "k_cf", "c_b", "m_c", "s1", "s_phi_s", "s_phi_r", "i_edge",
     "tau_p", "rate_p", "min_p", "max_p", "min_tq", "max_tq",
-    "fa_static", "fa_pdelta", "fa_inertia", "ss_pdelta", "ss_inertia"])
+    "fa_static", "fa_pdelta", "fa_inertia", "ss_pdelta", "ss_inertia",
+    "phi_edge", "m_e", "k_e", "k_cf_e", "c_e", "s_e", "g_e", "s_phie_s"])
 
 
 @dataclass(frozen=True)
@@ -345,6 +350,11 @@ def plant_params(turbine: Turbine, config: PlantConfig | None = None) -> PlantPa
         rr = np.concatenate(([g.hub_radius], b.r, [g.tip_radius]))
         weights = 0.5 * (rr[2:] - rr[:-2])
     phi_el = mode_shape(t.mode_shapes.blade_flap1, (b.r - g.hub_radius) / lb)
+    edge, edge_pack = _edge_mode(t, s, mu, tension)
+    if "blade_edge" in cfg.dofs and not edge:
+        raise ValueError("config.dofs has 'blade_edge' but the turbine's mode-shape table has "
+                         "no 'blade_edge_1' row; add it or leave the DOF out "
+                         f"(PlantConfig(dofs={sorted(cfg.dofs - {'blade_edge'})!r}))")
     tab = polar_table_of(t)
     pa = t.pitch_actuator
     dofs = np.array([d in cfg.dofs for d in DOF_NAMES], dtype=np.int64)
@@ -365,24 +375,28 @@ def plant_params(turbine: Turbine, config: PlantConfig | None = None) -> PlantPa
         s_phi_r=s_phi_r, i_edge=i_edge, tau_p=pa.time_constant, rate_p=pa.max_rate_rad_s,
         min_p=pa.min_pitch_rad, max_p=pa.max_pitch_rad, min_tq=t.generator.min_torque,
         max_tq=t.generator.max_torque, fa_static=fa_static, fa_pdelta=pd_fa,
-        fa_inertia=in_fa, ss_pdelta=pd_ss, ss_inertia=in_ss)
+        fa_inertia=in_fa, ss_pdelta=pd_ss, ss_inertia=in_ss, **edge_pack)
     return PlantParams(
         turbine=t, config=cfg, rotor_inertia=rotor_inertia, rotor_mass=rotor_mass,
         blade_mass=blade_mass, tower_fa_modal_mass=m_fa, tower_fa_modal_stiffness=k_fa,
         tower_fa_modal_damping=c_fa, tower_ss_modal_mass=m_ss, tower_ss_modal_stiffness=k_ss,
         tower_ss_modal_damping=c_ss, blade_modal_mass=m_b, blade_modal_stiffness=k_b,
         blade_centrifugal_stiffness=k_cf, blade_modal_damping=c_b, blade_tower_coupling=m_c,
-        **_edge_mode(t, s, mu, tension), pack=pack)
+        **edge, pack=pack)
 
 
 def _edge_mode(t: Turbine, s: FloatArray, mu: FloatArray,
-               tension: FloatArray) -> dict[str, float]:
+               tension: FloatArray) -> tuple[dict[str, float], dict[str, Any]]:
     """Edgewise modal properties of one blade (assumed mode, as the flap one; Hansen 2015,
     ch. 11) on the span grid ``s`` [m] from the root, with mass per length ``mu`` and the
-    centrifugal tension per Omega^2 ``tension``."""
+    centrifugal tension per Omega^2 ``tension``: the :class:`PlantParams` fields and the
+    kernel's (zeros when the turbine has no edge mode shape). The damping ratio is the flap
+    mode's (ElastoDyn's BldEdDmp1 = BldFlDmp1 = 0.477 % for the NREL 5-MW)."""
     shape = t.mode_shapes.blade_edge1
+    b = t.blade
     if shape is None:
-        return {}
+        zero = dict.fromkeys(("m_e", "k_e", "k_cf_e", "c_e", "s_e", "g_e", "s_phie_s"), 0.0)
+        return {}, {"phi_edge": np.zeros_like(b.r), **zero}
     g = t.geometry
     lb = g.tip_radius - g.hub_radius
     xs = s / lb
@@ -390,10 +404,17 @@ def _edge_mode(t: Turbine, s: FloatArray, mu: FloatArray,
     dphi = mode_shape(shape, xs, 1) / lb
     ddphi = mode_shape(shape, xs, 2) / lb**2
     ei = np.interp(xs, t.blade_structure.span_fraction, t.blade_structure.edge_stiffness)
-    return {"edge_modal_mass": float(np.trapezoid(mu * phi**2, s)),
-            "edge_modal_stiffness": float(np.trapezoid(ei * ddphi**2, s)),
-            "edge_centrifugal_stiffness": float(np.trapezoid(tension * dphi**2, s)),
-            "edge_rotor_coupling": float(np.trapezoid(mu * phi * (g.hub_radius + s), s))}
+    m_e = float(np.trapezoid(mu * phi**2, s))
+    k_e = float(np.trapezoid(ei * ddphi**2, s))
+    k_cf_e = float(np.trapezoid(tension * dphi**2, s))
+    s_e = float(np.trapezoid(mu * phi * (g.hub_radius + s), s))
+    public = {"edge_modal_mass": m_e, "edge_modal_stiffness": k_e,
+              "edge_centrifugal_stiffness": k_cf_e, "edge_rotor_coupling": s_e}
+    kernel = {"phi_edge": mode_shape(shape, (b.r - g.hub_radius) / lb), "m_e": m_e, "k_e": k_e,
+              "k_cf_e": k_cf_e, "c_e": 2.0 * t.damping.blade * math.sqrt(k_e * m_e),
+              "s_e": s_e, "g_e": float(np.trapezoid(mu * phi, s)),
+              "s_phie_s": float(np.trapezoid(mu * phi * s, s))}
+    return public, kernel
 
 
 # --------------------------------------------------------------------------------------------
@@ -419,9 +440,10 @@ def _eval(x, u, wind, p, hint, mode):  # pragma: no cover - compiled
     """
     dof_fa, dof_ss, dof_dt, dof_gen, dof_flap, dof_pitch = (p.dof[0], p.dof[1], p.dof[2],
                                                             p.dof[3], p.dof[4], p.dof[5])
+    dof_edge = p.dof[6]
     limits = (mode & MODE_NOLIMITS) == 0
     nr = p.r.size
-    dx = np.zeros(17, dtype=x.dtype)
+    dx = np.zeros(23, dtype=x.dtype)
     z = np.zeros(31, dtype=x.dtype)
     bem = np.empty((4, 3, nr), dtype=x.dtype)
     xd = x[1]
@@ -458,11 +480,13 @@ def _eval(x, u, wind, p, hint, mode):  # pragma: no cover - compiled
     mflap_aero = np.zeros(3, dtype=x.dtype)
     medge_aero = np.zeros(3, dtype=x.dtype)
     gq = np.zeros(3, dtype=x.dtype)
+    ge = np.zeros(3, dtype=x.dtype)
     for i in range(3):
         psi_i = psi + i * _TWO_PI_3
         sp = np.sin(psi_i)
         cp = np.cos(psi_i)
         qd = x[13 + i] if dof_flap else 0.0 * x[13 + i]
+        ed = x[20 + i] if dof_edge else 0.0 * x[20 + i]
         tor_i = 0.0 * wr
         thr_i = 0.0 * wr
         mf = 0.0 * wr
@@ -472,7 +496,7 @@ def _eval(x, u, wind, p, hint, mode):  # pragma: no cover - compiled
             rj = p.r[j]
             vrel = wind[i, j] - vhub_x - nod * rj * cc * cp
             vx = vrel * (ct * cc + st * sc * cp) - qd * p.phi_flap[j]
-            vy = (wr + roll) * rj * cc + vrel * st * sp - vhub_y * cp
+            vy = (wr + roll) * rj * cc + vrel * st * sp - vhub_y * cp + ed * p.phi_edge[j]
             npr, tpr, ph, sl, u_ind, v_ind = _element(
                 vx, vy, rj, p.chord[j], p.twist[j] + pitch[i], p.af[j], p.table, p.alpha0,
                 p.dalpha, p.nb, p.rtip, p.rhub, p.flags, p.rho, hint[0, i, j].real,
@@ -487,32 +511,52 @@ def _eval(x, u, wind, p, hint, mode):  # pragma: no cover - compiled
             mf += npr * (rj - p.rhub) * wj
             me += tpr * (rj - p.rhub) * wj
             gqi += npr * p.phi_flap[j] * wj
+            ge[i] += tpr * p.phi_edge[j] * wj
             fy += -tpr * cp * wj
         torque += tor_i
         thrust += thr_i
         mflap_aero[i] = mf
         medge_aero[i] = me
         gq[i] = gqi
+        if p.opt[0]:
+            ge[i] += p.grav * p.g_e * sp * ct
         mtilt += mf * cp
         myaw += mf * sp
-    # drivetrain (Madsen eq 11)
+    # edgewise modes: elastic, damping and aerodynamic/gravity forces F_i; the rotor and the
+    # edges share the inertia S_e = int m phi_e r ds (M_e q'' + S_e Omega' = F)
+    fe = np.zeros(3, dtype=x.dtype)
+    cpl = 0.0 * wr
+    j_cut = 0.0
+    if dof_edge:
+        ke = p.k_e + wr * wr * (p.k_cf_e - p.m_e)
+        for i in range(3):
+            fe[i] = ge[i] - p.c_e * x[20 + i] - ke * x[17 + i]
+        cpl = p.s_e / p.m_e * (fe[0] + fe[1] + fe[2])
+        j_cut = 3.0 * p.s_e * p.s_e / p.m_e
+    # drivetrain (Madsen eq 11), rotor inertia less what the edge modes carry
     if dof_gen:
         if dof_dt:
             qs = p.k_shaft * th + p.c_shaft * (wr - wg / p.ngear)
-            dwr = (torque - qs) / p.j_rot
+            dwr = (torque - qs - cpl) / (p.j_rot - j_cut)
             dwg = (qs / p.ngear - tq) / p.j_gen
             dth = wr - wg / p.ngear
         else:
             jt = p.j_rot + p.ngear * p.ngear * p.j_gen
-            dwr = (torque - p.ngear * tq) / jt
+            dwr = (torque - p.ngear * tq - cpl) / (jt - j_cut)
             dwg = p.ngear * dwr
             dth = 0.0 * dwr
-            qs = torque - p.j_rot * dwr
     else:
         dwr = 0.0 * wr
         dwg = 0.0 * wr
         dth = 0.0 * wr
         qs = p.k_shaft * th if dof_dt else p.ngear * tq
+    edd = np.zeros(3, dtype=x.dtype)
+    if dof_edge:
+        for i in range(3):
+            edd[i] = (fe[i] - p.s_e * dwr) / p.m_e
+    if dof_gen and not dof_dt:
+        # rotor side: J_r Omega' + S_e sum q'' = Q_aero - Q_shaft
+        qs = torque - p.j_rot * dwr - p.s_e * (edd[0] + edd[1] + edd[2])
     # reaction torque on the nacelle about +x (rotor and generator spin the same way)
     m_react = tq + (1.0 - 1.0 / p.ngear) * qs
     # tower fore-aft + blade flap (inertially coupled)
@@ -557,6 +601,10 @@ def _eval(x, u, wind, p, hint, mode):  # pragma: no cover - compiled
             dx[10 + i] = x[13 + i]
             dx[13 + i] = qdd[i]
     dx[16] = wr
+    if dof_edge:
+        for i in range(3):
+            dx[17 + i] = x[20 + i]
+            dx[20 + i] = edd[i]
     # outputs
     z[0] = p.eta_gen * tq * wg
     for i in range(3):
@@ -570,7 +618,7 @@ def _eval(x, u, wind, p, hint, mode):  # pragma: no cover - compiled
         q = x[10 + i] if dof_flap else 0.0 * x[10 + i]
         mf = (mflap_aero[i] - p.hub_fa * xdd * p.s1 - qdd[i] * p.s_phi_s
               - omega2 * q * p.s_phi_r)
-        me = medge_aero[i] - dwr * p.i_edge
+        me = medge_aero[i] - dwr * p.i_edge - edd[i] * p.s_phie_s
         if p.opt[0]:
             me += p.grav * p.s1 * np.sin(psi_i) * ct
         z[10 + i] = mf
@@ -931,6 +979,8 @@ def _state_limits(params: PlantParams) -> FloatArray:
     lim[10:13] = 0.5 * (t.geometry.tip_radius - t.geometry.hub_radius)
     lim[13:16] = 200.0
     lim[16] = 1e12
+    lim[17:20] = 0.25 * (t.geometry.tip_radius - t.geometry.hub_radius)
+    lim[20:23] = 200.0
     lo = -lim
     lo[2], lo[3] = -0.1 * wr, -0.1 * wr * t.drivetrain.gearbox_ratio
     return np.vstack([lo, lim])

@@ -25,7 +25,7 @@ _TWO_PI_3 = 2.0 * math.pi / 3.0
 def _avg_eval(x, u, speed, shear, p, n_az, mode=0):  # pragma: no cover - compiled
     """Derivatives and outputs averaged over ``n_az`` azimuths in [0, 2 pi / 3); ``mode`` as
     the plant kernel's (MODE_NOLIMITS: no actuator limits on the pitch and torque given)."""
-    dx_avg = np.zeros(17)
+    dx_avg = np.zeros(23)
     z_avg = np.zeros(31)
     hint = np.full((4, 3, p.r.size), np.nan)
     wpar = np.array([speed, shear])
@@ -48,7 +48,7 @@ def _coeff_grid(tsr, pitch, speed, shear, p, n_az, ngear):  # pragma: no cover -
     ct = np.empty(n)
     rproj = p.rtip * math.cos(p.cone)
     qdyn = 0.5 * p.rho * math.pi * rproj * rproj * speed * speed
-    x = np.zeros(17)
+    x = np.zeros(23)
     u = np.zeros(4)
     for k in range(n):
         om = tsr[k] * speed / rproj

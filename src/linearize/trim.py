@@ -367,13 +367,20 @@ def _equilibrium(p: PlantParams, v: float, omega: float, pitch: float, tg: float
         x[10:13] = delta[1:]
     if p.dof("tower_ss"):
         x[8] = pk.m_ss * dx0[9] / pk.k_ss
+    if p.dof("blade_edge"):
+        # edge force per blade (mean over a revolution) from the accelerations at q = 0:
+        # M_e q'' + S_e Omega' = F  =>  F = M_e q'' + S_e Omega'
+        force = pk.m_e * dx0[20:23].mean() + pk.s_e * dx0[2]
+        x[17:20] = force / (pk.k_e + omega**2 * (pk.k_cf_e - pk.m_e))
     dx, z = rotor_average(p, x, u, v, shear)
     scale = np.array([1.0, 1e-2, 1e-3, 1e-1, 1e-3, 1e-3, 1e-3, 1e-3, 1.0, 1e-2, 1.0, 1.0, 1.0,
-                      1e-2, 1e-2, 1e-2, 1.0])
+                      1e-2, 1e-2, 1e-2, 1.0, 1.0, 1.0, 1.0, 1e-2, 1e-2, 1e-2])
     dx = dx.copy()
     dx[13:16] = dx[13:16].mean()
-    resid = np.abs(dx[:16]) / scale[:16]
-    resid[[0, 8, 10, 11, 12]] = 0.0   # displacement rates are velocities (zero by construction)
+    dx[20:23] = dx[20:23].mean()
+    resid = np.abs(dx) / scale
+    # displacement rates are velocities (zero by construction); the azimuth's is the speed
+    resid[[0, 8, 10, 11, 12, 16, 17, 18, 19]] = 0.0
     if not np.all(np.isfinite(dx)) or resid.max() > 1e-6:
         k = int(np.argmax(resid))
         raise TrimError(f"trim did not reach equilibrium: d({STATE_NAMES[k]})/dt = {dx[k]!r}")

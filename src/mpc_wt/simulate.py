@@ -147,7 +147,7 @@ class _Loop:
                  x0: np.ndarray, u0: np.ndarray, preview: Any) -> None:
         self.params, self.controller, self.preview = params, controller, preview
         self.n, self.dt = n, dt
-        self.xs, self.us = np.empty((n + 1, 17)), np.empty((n + 1, 4))
+        self.xs, self.us = np.empty((n + 1, len(linearize.STATE_NAMES))), np.empty((n + 1, 4))
         self.zs = np.empty((n + 1, 31))
         self.sig: dict[str, list[float]] = {}
         self.x = np.asarray(x0, float).copy()

@@ -58,7 +58,7 @@ def test_aerodynamic_power_is_sum_of_element_work(params_axisym: linearize.Plant
     # analytic: rotor power = sum over blades and elements of T' * Omega * r * dr, computed here
     # from element_loads independently of the plant's aggregation; also = torque * speed.
     v, omega, pitch = 9.0, 1.05, math.radians(1.0)
-    x = np.zeros(17)
+    x = np.zeros(len(linearize.STATE_NAMES))
     x[2], x[3], x[5:8] = omega, omega * 97, pitch
     u = np.array([pitch, pitch, pitch, 0.0])
     z = linearize.plant_outputs(0.0, x, u, np.full((3, 17), v), params_axisym)
@@ -133,7 +133,7 @@ def test_rotor_loads_finite_everywhere(params: linearize.PlantParams, tsr: float
     still air, and reversed flow (tower or flap moving downwind faster than the wind)."""
     omega = tsr * max(wind, 1.0) / 63.0
     pitch = math.radians(pitch_deg)
-    x = np.zeros(17)
+    x = np.zeros(len(linearize.STATE_NAMES))
     x[1], x[2], x[3], x[5:8], x[13:16], x[16] = tower_vel, omega, omega * 97, pitch, flap_vel, \
         azimuth
     u = np.array([pitch, pitch, pitch, 20000.0])

@@ -70,7 +70,11 @@ def test_edge_mode_in_rotation(params: linearize.PlantParams) -> None:
 def test_turbine_without_edge_mode_has_no_edge_frequencies(turbine: linearize.Turbine) -> None:
     import dataclasses
     modes = dataclasses.replace(turbine.mode_shapes, blade_edge1=None)
-    p = linearize.plant_params(dataclasses.replace(turbine, mode_shapes=modes))
+    no_edge = dataclasses.replace(turbine, mode_shapes=modes)
+    with pytest.raises(ValueError, match="blade_edge_1"):
+        linearize.plant_params(no_edge)
+    cfg = PlantConfig(frozenset(linearize.DOF_NAMES) - {"blade_edge"})
+    p = linearize.plant_params(no_edge, cfg)
     assert math.isnan(p.edge_modal_mass)
     f = structural_frequencies(p, 0.0)
     assert "edge_asymmetric" not in f and "drivetrain" in f
@@ -85,10 +89,15 @@ def test_flap_mode_stiffens_with_rotor_speed(params: linearize.PlantParams) -> N
                     atol=0)
 
 
+_NOT_AZIMUTH = [i for i, n in enumerate(STATE_NAMES) if n != "azimuth"]
+X0 = np.zeros(len(STATE_NAMES))
+
+
 def _rel_drift(res: linearize.SimulationResult, x0: np.ndarray) -> float:
-    scale = np.maximum(np.abs(x0[:16]), [1e-2, 1e-2, 1, 1, 1e-3, 1e-2, 1e-2, 1e-2, 1e-2, 1e-2,
-                                         1e-1, 1e-1, 1e-1, 1e-1, 1e-1, 1e-1])
-    return float(np.max(np.abs(res.x[:, :16] - x0[:16]) / scale))
+    floor = np.array([1e-2, 1e-2, 1, 1, 1e-3, 1e-2, 1e-2, 1e-2, 1e-2, 1e-2, 1e-1, 1e-1, 1e-1,
+                      1e-1, 1e-1, 1e-1, 1.0, 1e-2, 1e-2, 1e-2, 1e-1, 1e-1, 1e-1])[_NOT_AZIMUTH]
+    scale = np.maximum(np.abs(x0[_NOT_AZIMUTH]), floor)
+    return float(np.max(np.abs(res.x[:, _NOT_AZIMUTH] - x0[_NOT_AZIMUTH]) / scale))
 
 
 @pytest.mark.parametrize("wind", [8.0, 18.0])
@@ -115,7 +124,8 @@ def test_with_azimuth_effects_settles_to_1p_periodic_motion(turbine: linearize.T
     w = res.state("rotor_speed")[late].mean()
     period = 2 * math.pi / w
     last = res.t > res.t[-1] - period
-    for k, name in enumerate(STATE_NAMES[:16]):
+    for k in _NOT_AZIMUTH:
+        name = STATE_NAMES[k]
         x = res.x[:, k]
         amp = max(float(np.ptp(x[late])), 1e-9)
         prev = np.interp(res.t[last] - period, res.t, x)
@@ -144,7 +154,7 @@ def test_coleman_tilt_of_one_loaded_blade(params: linearize.PlantParams) -> None
     """Worked by hand for this configuration, not through the transform's sum: blade 1 up
     (psi = 0) in wind, blades 2 and 3 at +-120 deg in none, so M_2 = M_3 by symmetry and
     M_tilt = (2/3)(M_1 - M_2) (cos 120 = cos 240 = -1/2), M_yaw = 0 (sin 120 = -sin 240)."""
-    x = np.zeros(17)
+    x = np.zeros(len(linearize.STATE_NAMES))
     x[2], x[3] = 1.0, 97.0
     d = np.zeros((3, 17))
     d[0] = 10.0
@@ -164,7 +174,7 @@ def test_coleman_moments_are_those_of_the_rotor_not_of_the_blade_labels(
     """Invariant: turning the rotor on by 120 deg and passing each blade's wind to the blade
     that now stands where it stood gives the same fixed-frame tilt and yaw moments (the rotor
     looks the same; only the labels moved: blade i now stands where blade i + 1 stood)."""
-    x = np.zeros(17)
+    x = np.zeros(len(linearize.STATE_NAMES))
     x[2], x[3], x[16] = 1.0, 97.0, psi
     d = np.repeat(np.array(w)[:, None], 17, axis=1)
     z0 = plant_outputs(0.0, x, np.zeros(4), d, params_axisym)
@@ -186,7 +196,7 @@ def test_dof_switches_freeze_states(turbine: linearize.Turbine, cfg: PlantConfig
     op = trim(turbine, 16.0, config=cfg)
     x = op.x + 0.01
     dx = plant_rhs(0.0, x, op.u, np.full(3, 16.0), p)
-    frozen = [i for i, n in enumerate(STATE_NAMES[:16]) if n not in cfg.active_states()]
+    frozen = [i for i in _NOT_AZIMUTH if STATE_NAMES[i] not in cfg.active_states()]
     assert np.all(dx[frozen] == 0.0)
     moving = [STATE_NAMES.index(n) for n in cfg.active_states()]
     assert np.all(dx[moving] != 0.0)
@@ -244,11 +254,11 @@ def test_grid_wind_must_cover_rotor_and_time(params: linearize.PlantParams) -> N
     z = np.linspace(20, 160, 5)
     g = GridWind(t=np.array([0.0, 10.0]), y=y, z=z, u=np.full((2, 5, 5), 10.0))
     with pytest.raises(ValueError, match=r"does not cover the rotor"):
-        rk4_simulate(params, np.zeros(17), np.zeros(4), g, 1.0)
+        rk4_simulate(params, X0, np.zeros(4), g, 1.0)
     g = GridWind(t=np.array([0.0, 10.0]), y=np.linspace(-70, 70, 5), z=z,
                  u=np.full((2, 5, 5), 10.0))
     with pytest.raises(ValueError, match=r"ends at t = 10 s, before the simulation end t = 20 s"):
-        rk4_simulate(params, np.zeros(17), np.zeros(4), g, 20.0)
+        rk4_simulate(params, X0, np.zeros(4), g, 20.0)
 
 
 def test_grid_wind_rejects_nan_and_shape() -> None:
@@ -275,11 +285,11 @@ def test_steady_wind_bad_values(speed: float, shear: float, match: str) -> None:
 
 @pytest.mark.parametrize("x, u, d, match", [
     (np.zeros(16), np.zeros(4), np.full(3, 10.0), r"x has shape \(16,\); expected \(n_x,\)"),
-    (np.zeros(17), np.zeros(3), np.full(3, 10.0), r"u has shape \(3,\); expected \(n_u,\)"),
-    (np.zeros(17), np.zeros(4), np.full((3, 5), 10.0), r"d \(wind\) has shape \(3, 5\)"),
-    (np.zeros(17), np.zeros(4), np.array([10.0, np.nan, 10.0]), r"d \(wind\) must be finite"),
-    (np.zeros(17), np.zeros(4), np.array([10.0, -1.0, 10.0]), r"d \(wind\) must be >= 0 m/s"),
-    (np.full(17, np.nan), np.zeros(4), np.full(3, 10.0), r"x must be finite"),
+    (X0, np.zeros(3), np.full(3, 10.0), r"u has shape \(3,\); expected \(n_u,\)"),
+    (X0, np.zeros(4), np.full((3, 5), 10.0), r"d \(wind\) has shape \(3, 5\)"),
+    (X0, np.zeros(4), np.array([10.0, np.nan, 10.0]), r"d \(wind\) must be finite"),
+    (X0, np.zeros(4), np.array([10.0, -1.0, 10.0]), r"d \(wind\) must be >= 0 m/s"),
+    (np.full(len(STATE_NAMES), np.nan), np.zeros(4), np.full(3, 10.0), r"x must be finite"),
 ])
 def test_rhs_bad_input(params: linearize.PlantParams, x, u, d, match: str) -> None:
     with pytest.raises(ValueError, match=match):
@@ -298,7 +308,7 @@ def test_diverging_run_names_time_and_state_and_keeps_data(
         rk4_simulate(params, x0, u, SteadyWind(25.0), 300.0)
     part = exc.value.partial
     assert part.t.size > 100 and np.all(np.isfinite(part.x))
-    assert part.x.shape == (part.t.size, 17) and part.z.shape == (part.t.size, 31)
+    assert part.x.shape == (part.t.size, len(STATE_NAMES)) and part.z.shape == (part.t.size, 31)
 
 
 @pytest.mark.parametrize("kwargs, match", [
@@ -308,7 +318,7 @@ def test_diverging_run_names_time_and_state_and_keeps_data(
 ])
 def test_simulate_bad_arguments(params: linearize.PlantParams, kwargs, match: str) -> None:
     with pytest.raises(ValueError, match=match):
-        rk4_simulate(params, np.zeros(17), np.zeros(4), SteadyWind(10.0), **kwargs)
+        rk4_simulate(params, X0, np.zeros(4), SteadyWind(10.0), **kwargs)
 
 
 def test_plant_config_rejects_unknown_dof() -> None:

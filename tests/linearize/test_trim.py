@@ -47,7 +47,7 @@ def test_trim_is_an_equilibrium(turbine: linearize.Turbine,
         op = trim(turbine, v, config=params_axisym.config)
         dx = linearize.plant_rhs(0.0, op.x, op.u, np.full(3, v), params_axisym)
         # tolerance from the solvers: brentq on pitch to 1e-14 rad, BEM to 1e-13 rad
-        assert np.max(np.abs(dx[:16])) < 1e-8, (v, dx)
+        assert np.max(np.abs(np.delete(dx, 16))) < 1e-8, (v, dx)
 
 
 @pytest.mark.parametrize("wind", [8.0, 18.0])

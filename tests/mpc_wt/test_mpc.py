@@ -102,7 +102,8 @@ def test_collective_variant(model, turbine: linearize.Turbine) -> None:
     ctl = MPC(model, turbine, MPCSettings(collective=True, backend="osqp"))
     x = np.zeros(8)
     x[2] = 0.01
-    pitch, tq = ctl.step(0.0, {"state": np.r_[model.x0 + x, np.zeros(9)]})
+    pitch, tq = ctl.step(0.0, {"state": np.r_[model.x0 + x,
+                                               np.zeros(len(linearize.STATE_NAMES) - 8)]})
     assert np.allclose(pitch, pitch[0]) and pitch[0] > model.u0[0]
 
 
@@ -372,5 +373,5 @@ def test_warm_start_never_holds_subnormal_numbers(model, turbine,
 
 def test_step_rejects_a_state_of_the_wrong_length(model, turbine) -> None:
     with pytest.raises(ValueError,
-                       match=r"meas\['state'\] has shape \(5,\); expected the plant's \(17,\)"):
+                       match=r"meas\['state'\] has shape \(5,\); expected the plant's \(23,\)"):
         MPC(model, turbine, MPCSettings(backend="osqp")).step(0.0, {"state": np.zeros(5)})
