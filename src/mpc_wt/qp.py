@@ -10,6 +10,7 @@ variables so that a step changes the bounds only).
 from __future__ import annotations
 
 import importlib
+import logging
 from typing import Any, ClassVar
 
 import numpy as np
@@ -22,6 +23,7 @@ __all__ = ["QPBackend", "OSQPBackend", "DAQPBackend", "BACKENDS", "SOLVED", "def
 
 #: Our status of a usable solution; any other status means the step needs a fallback.
 SOLVED = ("solved", "solved inaccurate")
+log = logging.getLogger(__name__)
 
 
 class QPBackend:
@@ -117,6 +119,13 @@ class OSQPBackend(QPBackend):
     when no constraint binds, and without rounding they decay into subnormal numbers that make
     every iteration some 50 times slower.
 
+    When OSQP stops without an answer to its tolerance (iteration limit, "solved inaccurate",
+    or an infeasibility it cannot certify), the same QP is solved again by Clarabel (interior
+    point, exact to its tolerances; a dependency of cvxpy) and its answer is returned, with a
+    logged warning: ADMM converges slowly on the ill-conditioned QPs of far-off states, and
+    there a feasible QP otherwise counts as failed and an infeasible one is not reported as
+    such.
+
     Parameters
     ----------
     options : dict, optional
@@ -133,6 +142,7 @@ class OSQPBackend(QPBackend):
     def setup(self, h: Any, q: np.ndarray, a: Any, n_box: int) -> None:
         osqp = self.import_solver()
         n_c = a.shape[0]
+        self.problem = [sp.csc_matrix(h), np.asarray(q, float), sp.csc_matrix(a), None, None]
         self.solver = osqp.OSQP()
         self.solver.setup(P=sp.triu(sp.csc_matrix(h)).tocsc(), q=np.asarray(q, float),
                           A=sp.csc_matrix(a), l=np.full(n_c, -np.inf), u=np.full(n_c, np.inf),
@@ -153,12 +163,23 @@ class OSQPBackend(QPBackend):
             self.ext = None
 
     def update_bounds(self, lo: np.ndarray, hi: np.ndarray) -> None:
+        self.problem[3:] = [np.asarray(lo, float), np.asarray(hi, float)]
         if self.ext is not None:
             self.ext.update_data_vec(q=None, l=lo, u=hi)
         else:
             self.solver.update(l=lo, u=hi)
 
     def solve(self) -> tuple[np.ndarray | None, str]:
+        x, status = self._solve_osqp()
+        if status in _UNANSWERED and self.problem[3] is not None:
+            x2, status2 = _clarabel_solve(*self.problem,
+                                          eps=float(self.options.get("eps_abs", 1e-3)))
+            if status2 != "unavailable":
+                log.warning("OSQP: %s; the same QP re-solved by Clarabel: %s", status, status2)
+                return x2, status2
+        return x, status
+
+    def _solve_osqp(self) -> tuple[np.ndarray | None, str]:
         ext = self.ext
         if ext is None:
             res = self.solver.solve(raise_error=False)
@@ -185,6 +206,48 @@ class OSQPBackend(QPBackend):
     @property
     def iterations(self) -> int:
         return int(self.info.iter)
+
+
+_UNANSWERED = ("solved inaccurate", "maximum iterations reached", "primal infeasible inaccurate",
+               "dual infeasible inaccurate", "run time limit reached")
+
+
+def _clarabel_solve(h: Any, q: np.ndarray, a: Any, lo: np.ndarray, hi: np.ndarray, *,
+                    eps: float) -> tuple[np.ndarray | None, str]:
+    """min 1/2 x'Hx + q'x s.t. lo <= Ax <= hi by Clarabel: rows with lo == hi as equalities,
+    the others as A x <= hi and -A x <= -lo (infinite bounds dropped). Status in OSQP's words
+    ("solved", "primal infeasible", ...), or "unavailable" without the package. Clarabel's
+    "almost solved" counts as "solved" when the primal and dual residuals are within ``eps``,
+    OSQP's own absolute criterion."""
+    try:
+        import clarabel
+    except ImportError:
+        return None, "unavailable"
+    eq = lo == hi
+    up = ~eq & np.isfinite(hi) & (hi < 1e19)
+    dn = ~eq & np.isfinite(lo) & (lo > -1e19)
+    a = sp.csr_matrix(a)
+    big = sp.vstack([a[eq], a[up], -a[dn]]).tocsc()
+    b = np.concatenate([hi[eq], hi[up], -lo[dn]])
+    cones = ([clarabel.ZeroConeT(int(eq.sum()))] if eq.any() else []) + \
+        [clarabel.NonnegativeConeT(int(up.sum() + dn.sum()))]
+    settings = clarabel.DefaultSettings()
+    settings.verbose = False
+    sol = clarabel.DefaultSolver(sp.triu(sp.csc_matrix(h)).tocsc(), q, big, b, cones,
+                                 settings).solve()
+    name = str(sol.status)
+    if name in ("Solved", "AlmostSolved"):
+        x, z = np.asarray(sol.x), np.asarray(sol.z)
+        primal = max(float(np.max(np.maximum(big @ x - b, 0.0), initial=0.0)),
+                     float(np.max(np.abs((big @ x - b)[:int(eq.sum())]), initial=0.0)))
+        dual = float(np.max(np.abs(sp.csc_matrix(h) @ x + q + big.T @ z)))
+        exact = name == "Solved" or max(primal, dual) <= eps
+        return x, "solved" if exact else "solved inaccurate"
+    if "PrimalInfeasible" in name:
+        return None, "primal infeasible"
+    if "DualInfeasible" in name:
+        return None, "dual infeasible"
+    return None, f"clarabel: {name}"
 
 
 class DAQPBackend(QPBackend):
