@@ -60,7 +60,8 @@ from .errors import LinearizationError
 from .validate import check_finite_scalar, check_positive
 from .bem import MODE_CS, MODE_FROZEN, MODE_NOLIMITS, MODE_TIGHT
 from .plant import (INPUT_NAMES, INPUT_UNITS, OUTPUT_NAMES, OUTPUT_UNITS, STATE_NAMES,
-                    STATE_UNITS, PlantConfig, PlantParams, _eval, _sample_wind, plant_params)
+                    STATE_UNITS, PlantConfig, PlantParams, _eval, _sample_wind, n_x, n_z,
+                    plant_params)
 from .trim import OperatingPoint, trim
 from .turbine import Turbine
 
@@ -95,22 +96,22 @@ def _perturbed(x0, u0, w0, j, delta):  # pragma: no cover - compiled
     x = x0.copy()
     u = u0.copy()
     w = w0.copy()
-    if j < 23:
+    if j < n_x:
         x[j] += delta
-    elif j < 27:
-        u[j - 23] += delta
+    elif j < n_x + 4:
+        u[j - n_x] += delta
     else:
-        w[j - 27] += delta
+        w[j - n_x - 4] += delta
     return x, u, w
 
 
 @nb.njit(cache=True, error_model="numpy")
 def _jac_fd(x0, u0, w0, p, bem0, mode, h):  # pragma: no cover - compiled
     """Central-difference Jacobians of (dx/dt, z) w.r.t. the combined vector [x, u, blade
-    winds], with step h[j] per variable: (23, 30) and (31, 30)."""
-    jf = np.zeros((23, 30))
-    jz = np.zeros((31, 30))
-    for j in range(30):
+    winds], with step h[j] per variable: (n_x, n_x + 7) and (n_z, n_x + 7)."""
+    jf = np.zeros((n_x, n_x + 7))
+    jz = np.zeros((n_z, n_x + 7))
+    for j in range(n_x + 7):
         xp, up, wp = _perturbed(x0, u0, w0, j, h[j])
         xm, um, wm = _perturbed(x0, u0, w0, j, -h[j])
         fp, zp, _ = _eval(xp, up, wp, p, bem0, mode)
@@ -124,9 +125,9 @@ def _jac_fd(x0, u0, w0, p, bem0, mode, h):  # pragma: no cover - compiled
 def _jac_cs(x0, u0, w0, p, bem0, mode):  # pragma: no cover - compiled
     """Complex-step Jacobians (step 1e-30 i): exact to rounding, no subtraction error."""
     h = 1e-30
-    jf = np.zeros((23, 30))
-    jz = np.zeros((31, 30))
-    for j in range(30):
+    jf = np.zeros((n_x, n_x + 7))
+    jz = np.zeros((n_z, n_x + 7))
+    for j in range(n_x + 7):
         x, u, w = _perturbed(x0 + 0j, u0 + 0j, w0 + 0j, j, 1j * h)
         f, z, _ = _eval(x, u, w, p, bem0, mode)
         jf[:, j] = f.imag / h
@@ -136,7 +137,8 @@ def _jac_cs(x0, u0, w0, p, bem0, mode):  # pragma: no cover - compiled
 
 def _split(jf: FloatArray, jz: FloatArray) -> tuple[FloatArray, ...]:
     """(df/dx, df/du, df/dd, dz/dx, dz/du, dz/dd) from the combined Jacobians."""
-    return (jf[:, :23], jf[:, 23:27], jf[:, 27:], jz[:, :23], jz[:, 23:27], jz[:, 27:])
+    return (jf[:, :n_x], jf[:, n_x:n_x + 4], jf[:, n_x + 4:], jz[:, :n_x], jz[:, n_x:n_x + 4],
+            jz[:, n_x + 4:])
 
 
 def _azimuths(params: PlantParams, shear: float, n_azimuth: int | None) -> FloatArray:

@@ -443,7 +443,7 @@ def _eval(x, u, wind, p, hint, mode):  # pragma: no cover - compiled
     dof_edge = p.dof[6]
     limits = (mode & MODE_NOLIMITS) == 0
     nr = p.r.size
-    dx = np.zeros(23, dtype=x.dtype)
+    dx = np.zeros(n_x, dtype=x.dtype)
     z = np.zeros(31, dtype=x.dtype)
     bem = np.empty((4, 3, nr), dtype=x.dtype)
     xd = x[1]

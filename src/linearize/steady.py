@@ -13,7 +13,7 @@ from scipy.optimize import minimize_scalar
 
 from ._typing import FloatArray
 from .bem import MODE_NOLIMITS, AeroOptions
-from .plant import PlantConfig, PlantParams, _eval, _sample_wind, plant_params
+from .plant import PlantConfig, PlantParams, _eval, _sample_wind, n_x, plant_params
 from .turbine import Turbine
 
 __all__ = ["steady_coefficients", "optimal_tsr", "rotor_average"]
@@ -25,7 +25,7 @@ _TWO_PI_3 = 2.0 * math.pi / 3.0
 def _avg_eval(x, u, speed, shear, p, n_az, mode=0):  # pragma: no cover - compiled
     """Derivatives and outputs averaged over ``n_az`` azimuths in [0, 2 pi / 3); ``mode`` as
     the plant kernel's (MODE_NOLIMITS: no actuator limits on the pitch and torque given)."""
-    dx_avg = np.zeros(23)
+    dx_avg = np.zeros(n_x)
     z_avg = np.zeros(31)
     hint = np.full((4, 3, p.r.size), np.nan)
     wpar = np.array([speed, shear])
@@ -48,7 +48,7 @@ def _coeff_grid(tsr, pitch, speed, shear, p, n_az, ngear):  # pragma: no cover -
     ct = np.empty(n)
     rproj = p.rtip * math.cos(p.cone)
     qdyn = 0.5 * p.rho * math.pi * rproj * rproj * speed * speed
-    x = np.zeros(23)
+    x = np.zeros(n_x)
     u = np.zeros(4)
     for k in range(n):
         om = tsr[k] * speed / rproj

@@ -375,8 +375,7 @@ def _equilibrium(p: PlantParams, v: float, omega: float, pitch: float, tg: float
     dx, z = rotor_average(p, x, u, v, shear)
     scale = np.array([1.0, 1e-2, 1e-3, 1e-1, 1e-3, 1e-3, 1e-3, 1e-3, 1.0, 1e-2, 1.0, 1.0, 1.0,
                       1e-2, 1e-2, 1e-2, 1.0, 1.0, 1.0, 1.0, 1e-2, 1e-2, 1e-2])
-    dx = dx.copy()
-    dx[13:16] = dx[13:16].mean()
+    dx[13:16] = dx[13:16].mean()   # rotor_average returns a new array
     dx[20:23] = dx[20:23].mean()
     resid = np.abs(dx) / scale
     # displacement rates are velocities (zero by construction); the azimuth's is the speed
