@@ -11,10 +11,13 @@ from .plant import (DOF_NAMES, INPUT_NAMES, INPUT_UNITS, MADSEN_OUTPUTS, OUTPUT_
                     OUTPUT_UNITS, STATE_NAMES, STATE_UNITS, GridWind, PlantConfig, PlantParams,
                     PlantStepper, SimulationResult, SteadyWind, element_wind,
                     plant_outputs, plant_params, plant_rhs, rk4_simulate, structural_frequencies)
+from .openfast import load_openfast
+from .performance import (RotorPerformance, read_rotor_performance, rotor_performance,
+                          write_rotor_performance)
 from .steady import optimal_tsr, rotor_average, steady_coefficients
 from .trim import (OperatingPoint, operating_point, operating_schedule, rated_wind_speed,
                    trim)
-from .turbine import Turbine, available_turbines, load_turbine
+from .turbine import LoadReport, Turbine, available_turbines, load_turbine
 
 __all__ = [
     "AeroOptions", "element_induction", "element_loads", "DOF_NAMES", "INPUT_NAMES", "INPUT_UNITS", "MADSEN_OUTPUTS",
@@ -28,5 +31,6 @@ __all__ = [
     "available_turbines",
     "load_turbine", "LinearizationError", "LinearModel", "LinearModelFamily",
     "augment_actuator", "jacobian_check", "linearize", "linearize_family", "sensitivities",
-    "with_power_input",
+    "with_power_input", "load_openfast", "LoadReport", "RotorPerformance",
+    "read_rotor_performance", "rotor_performance", "write_rotor_performance",
 ]

@@ -305,7 +305,7 @@ def plant_params(turbine: Turbine, config: PlantConfig | None = None) -> PlantPa
     rotor_mass = t.rotor.hub_mass + nblade * blade_mass
 
     # --- tower
-    ht = g.tower_height
+    ht = g.tower_height - g.tower_base_height          # flexible length, clamped at its base
     xh = np.linspace(0.0, 1.0, 2001)
     h = xh * ht
     ts = t.tower_structure
@@ -970,7 +970,7 @@ def _state_limits(params: PlantParams) -> FloatArray:
     t = params.turbine
     wr = t.operation.rated_rotor_speed_rad_s
     lim = np.full(n_x, np.inf)
-    lim[0] = lim[8] = 0.5 * t.geometry.tower_height          # tower deflection [m]
+    lim[0] = lim[8] = 0.5 * t.geometry.tower_height         # tower deflection [m]
     lim[1] = lim[9] = 50.0                                   # [m/s]
     lim[2] = 4.0 * wr
     lim[3] = 4.0 * wr * t.drivetrain.gearbox_ratio

@@ -25,7 +25,7 @@ __all__ = [
     "TurbineFileError", "Geometry", "Operation", "Environment", "RotorMass", "Nacelle",
     "Drivetrain", "Generator", "PitchActuator", "Damping", "BladeAero", "Polar",
     "BladeStructure", "TowerStructure", "ModeShapes", "Turbine", "load_turbine",
-    "available_turbines",
+    "available_turbines", "LoadReport", "ReportEntry",
 ]
 
 SCHEMA_VERSION = 1
@@ -82,6 +82,10 @@ class Geometry(_Section):
         Hub centre above ground [m].
     tower_height : float
         Tower top (yaw bearing) above ground [m].
+    tower_base_height : float
+        Tower base above ground, where the tower is clamped [m] (ElastoDyn ``TowerBsHt``; 0
+        for a land-based tower, the transition piece of a monopile). Optional in the YAML
+        (``tower_base_height_m``, default 0).
     twr2shft : float
         Tower top to shaft axis, vertical [m].
     overhang : float
@@ -105,9 +109,15 @@ class Geometry(_Section):
     shaft_tilt_rad: float = _f("shaft_tilt_deg", -20.0, 20.0, _DEG)
     nacelle_cm_downwind: float = _f("nacelle_cm_downwind_m", -30.0, 30.0)
     nacelle_cm_vertical: float = _f("nacelle_cm_vertical_m", -30.0, 30.0)
+    tower_base_height: float = field(default=0.0, metadata={
+        "key": "tower_base_height_m", "lo": 0.0, "hi": 400.0, "scale": 1.0, "lo_open": False,
+        "optional": True})
 
     def __post_init__(self) -> None:
         super().__post_init__()
+        if not self.tower_base_height < self.tower_height:
+            raise ValueError(f"Geometry.tower_base_height ({self.tower_base_height} m) must be "
+                             f"below tower_height ({self.tower_height} m)")
         if not self.hub_radius < self.tip_radius:
             raise ValueError(f"Geometry.hub_radius ({self.hub_radius} m) must be smaller than "
                              f"tip_radius ({self.tip_radius} m)")
@@ -229,7 +239,7 @@ class PitchActuator(_Section):
 
     min_pitch_rad: float = _f("min_pitch_deg", -30.0, 30.0, _DEG)
     max_pitch_rad: float = _f("max_pitch_deg", 0.0, 95.0, _DEG)
-    max_rate_rad_s: float = _f("max_rate_degps", 0.0, 50.0, _DEG, lo_open=True)
+    max_rate_rad_s: float = _f("max_rate_degps", 0.0, 180.0, _DEG, lo_open=True)
     time_constant: float = _f("time_constant_s", 0.0, 5.0, lo_open=True)
 
     def __post_init__(self) -> None:
@@ -271,6 +281,11 @@ class BladeAero:
         Aerodynamic twist, positive toward feather [rad].
     airfoil : (n_r,) ndarray of int
         Index into :attr:`Turbine.polars`.
+    layout : {"elements", "nodes"}
+        ``"elements"``: ``r`` is the centre of an element ``dr`` long (AeroDyn v13, our YAML
+        files). ``"nodes"``: ``r`` are AeroDyn 15 nodes strictly inside the rotor and ``dr``
+        their trapezoid weights with zero load at hub and tip (OpenFAST decks); the midpoint
+        sum is then the trapezoid rule over the nodes.
     """
 
     r: FloatArray
@@ -278,6 +293,7 @@ class BladeAero:
     chord: FloatArray
     twist_rad: FloatArray
     airfoil: IntArray
+    layout: str = "elements"
 
     def __post_init__(self) -> None:
         _freeze(self, ("r", "dr", "chord", "twist_rad"))
@@ -293,6 +309,9 @@ class BladeAero:
             raise ValueError("BladeAero.r (element radius) must be strictly increasing")
         if np.any(self.dr <= 0) or np.any(self.chord <= 0):
             raise ValueError("BladeAero.dr and chord must be > 0")
+        if self.layout not in ("elements", "nodes"):
+            raise ValueError(f"BladeAero.layout must be 'elements' or 'nodes', "
+                             f"got {self.layout!r}")
 
 
 @dataclass(frozen=True)
@@ -414,8 +433,51 @@ def mode_shape(coeffs: FloatArray, x: FloatArray, derivative: int = 0) -> FloatA
 
 
 @dataclass(frozen=True)
+class ReportEntry:
+    """One line of a :class:`LoadReport`: a quantity, its value with unit, and where it came
+    from (``file:line key`` or ``default: why``)."""
+
+    quantity: str
+    value: str
+    source: str
+
+
+@dataclass(frozen=True)
+class LoadReport:
+    """What a turbine loader read from where and what it defaulted.
+
+    Parameters
+    ----------
+    entries : tuple of ReportEntry
+        One per quantity.
+    notes : tuple of str
+        What was read but not modelled, or modelled differently (e.g. a monopile clamped at
+        the tower base).
+    """
+
+    entries: tuple[ReportEntry, ...] = ()
+    notes: tuple[str, ...] = ()
+
+    @property
+    def defaulted(self) -> tuple[ReportEntry, ...]:
+        """The entries that were not in the files."""
+        return tuple(e for e in self.entries if e.source.startswith("default"))
+
+    def __str__(self) -> str:
+        w = max([len(e.quantity) for e in self.entries] + [8])
+        v = max([len(e.value) for e in self.entries] + [5])
+        lines = [f"{e.quantity:<{w}}  {e.value:>{v}}  {e.source}" for e in self.entries]
+        lines += [f"note: {n}" for n in self.notes]
+        return "\n".join(lines)
+
+
+@dataclass(frozen=True)
 class Turbine:
-    """A reference turbine as the BEM plant sees it. All quantities SI, angles in rad."""
+    """A reference turbine as the BEM plant sees it. All quantities SI, angles in rad.
+
+    ``report`` says what was read from where (OpenFAST decks) or holds nothing (YAML files,
+    whose comments carry the sources).
+    """
 
     name: str
     source: str
@@ -433,12 +495,22 @@ class Turbine:
     blade_structure: BladeStructure
     tower_structure: TowerStructure
     mode_shapes: ModeShapes
+    report: LoadReport = field(default_factory=LoadReport, compare=False)
 
     def __post_init__(self) -> None:
         g = self.geometry
         b = self.blade
-        lo = b.r - 0.5 * b.dr
-        hi = b.r + 0.5 * b.dr
+        if b.layout == "nodes":
+            rr = np.concatenate(([g.hub_radius], b.r, [g.tip_radius]))
+            if b.r[0] <= g.hub_radius or b.r[-1] >= g.tip_radius:
+                raise ValueError(f"blade nodes span {b.r[0]:.4g}..{b.r[-1]:.4g} m; they must "
+                                 f"lie strictly within hub_radius..tip_radius = "
+                                 f"{g.hub_radius:g}..{g.tip_radius:g} m")
+            if not np.allclose(b.dr, 0.5 * (rr[2:] - rr[:-2]), rtol=1e-9, atol=1e-12):
+                raise ValueError("blade node weights dr must be the trapezoid weights of the "
+                                 "nodes between hub and tip")
+        lo = b.r - 0.5 * b.dr if b.layout == "elements" else np.array([g.hub_radius])
+        hi = b.r + 0.5 * b.dr if b.layout == "elements" else np.array([g.tip_radius])
         if lo[0] < g.hub_radius - 1e-3 or hi[-1] > g.tip_radius + 1e-3:
             raise ValueError(
                 f"blade elements span {lo[0]:.4g}..{hi[-1]:.4g} m; they must lie within "
@@ -480,19 +552,20 @@ _FILE_KEYS = {"blade_aero", "airfoil_index", "blade_structure", "tower_structure
 
 
 def available_turbines() -> list[str]:
-    """Names of the turbines shipped as package data."""
+    """Names of the turbines shipped as package data (``nrel5mw``, ``iea15mw``)."""
     root = resources.files("linearize") / "data"
     return sorted(p.name for p in root.iterdir() if (p / "turbine.yaml").is_file())
 
 
 def load_turbine(name_or_path: str | Path = "nrel5mw") -> Turbine:
-    """Load a turbine shipped with mpc-wt (by name) or a user's turbine file (by path).
+    """Load a turbine shipped with mpc-wt (by name), a turbine file or an OpenFAST deck.
 
     Parameters
     ----------
     name_or_path : str or Path
         A packaged name (see :func:`available_turbines`, default ``"nrel5mw"``), a path to a
-        ``turbine.yaml`` file, or a directory holding one.
+        ``turbine.yaml`` file or a directory holding one, or an OpenFAST ``.fst`` deck (read by
+        :func:`linearize.load_openfast`, whose report is ``Turbine.report``).
 
     Returns
     -------
@@ -503,7 +576,7 @@ def load_turbine(name_or_path: str | Path = "nrel5mw") -> Turbine:
     TurbineFileError
         Naming the file, the field and the allowed range: unknown or missing keys, values out of
         range, non-monotonic span, polars not covering -180..180 deg, non-positive masses or
-        stiffnesses, elements outside the rotor.
+        stiffnesses, elements outside the rotor; for decks, the file and key.
     FileNotFoundError
         If neither a packaged name nor an existing path.
     """
@@ -518,7 +591,10 @@ def load_turbine(name_or_path: str | Path = "nrel5mw") -> Turbine:
     if not path.is_file():
         raise FileNotFoundError(
             f"turbine {text!r} is neither a packaged turbine {available_turbines()} "
-            f"nor an existing turbine file")
+            f"nor an existing turbine file or OpenFAST .fst deck")
+    if path.suffix.lower() == ".fst":
+        from .openfast import load_openfast
+        return load_openfast(path)
     return _load_path(path)
 
 
@@ -529,6 +605,8 @@ def _load_path(path: Path) -> Turbine:
         raise TurbineFileError(f"{path}: not valid YAML: {err}") from err
     if not isinstance(raw, dict):
         raise TurbineFileError(f"{path}: top level must be a mapping, got {type(raw).__name__}")
+    if "openfast_deck" in raw:
+        return _load_deck_pointer(path, raw)
     _check_keys(path, "top level", raw, _TOP_KEYS)
     if raw["schema_version"] != SCHEMA_VERSION:
         raise TurbineFileError(f"{path}: schema_version must be {SCHEMA_VERSION}, got "
@@ -559,6 +637,17 @@ def _load_path(path: Path) -> Turbine:
         raise TurbineFileError(f"{path}: {err}") from err
 
 
+def _load_deck_pointer(path: Path, raw: dict[str, Any]) -> Turbine:
+    """A ``turbine.yaml`` that names an OpenFAST deck: ``schema_version``, ``name`` and
+    ``openfast_deck`` (path relative to the YAML file)."""
+    _check_keys(path, "top level", raw, {"schema_version", "name", "openfast_deck"})
+    if raw["schema_version"] != SCHEMA_VERSION:
+        raise TurbineFileError(f"{path}: schema_version must be {SCHEMA_VERSION}, got "
+                               f"{raw['schema_version']!r}")
+    from .openfast import load_openfast
+    return load_openfast(path.parent / str(raw["openfast_deck"]), name=str(raw["name"]))
+
+
 def _check_keys(path: Path, where: str, d: Any, allowed: set[str]) -> None:
     if not isinstance(d, dict):
         raise TurbineFileError(f"{path}: section {where!r} must be a mapping")
@@ -575,6 +664,9 @@ def _check_keys(path: Path, where: str, d: Any, allowed: set[str]) -> None:
 
 def _build_section(path: Path, sec: str, d: Any, cls: type) -> Any:
     meta = {f.metadata["key"]: f for f in fields(cls)}
+    optional = {k for k, f in meta.items() if f.metadata.get("optional")}
+    if isinstance(d, dict):
+        d = {**{k: meta[k].default for k in optional if k not in d}, **d}
     _check_keys(path, sec, d, set(meta))
     kwargs = {}
     for key, f in meta.items():

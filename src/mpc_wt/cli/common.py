@@ -18,7 +18,8 @@ from ..errors import UsageError
 __all__ = ["parse_range", "add_turbine", "schedule", "format_table", "write_points_csv",
            "cp_surface", "write_surface_csv", "pairs", "floats", "check_suffix"]
 
-TURBINE_HELP = "packaged turbine name or path to a turbine.yaml (default nrel5mw)"
+TURBINE_HELP = ("packaged turbine name (nrel5mw, iea15mw), a turbine.yaml or an OpenFAST .fst "
+                "deck (default nrel5mw)")
 
 
 def add_turbine(p: argparse.ArgumentParser) -> None:

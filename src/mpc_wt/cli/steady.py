@@ -13,7 +13,7 @@ import numpy as np
 import linearize
 
 from ..errors import UsageError
-from .common import (add_turbine, check_suffix, cp_surface, format_table, parse_range, schedule,
+from .common import (add_turbine, check_suffix, format_table, parse_range, schedule,
                      write_surface_csv)
 
 __all__ = ["add_parsers"]
@@ -33,6 +33,9 @@ def add_parsers(sub: Any) -> None:
     p.add_argument("--power-W", dest="power_W", type=float, default=None,
                    help="power reference below rated [W]")
     p.add_argument("--json", action="store_true", help="print a JSON list")
+    p.add_argument("--report", action="store_true",
+                   help="print what the turbine loader read from which file and key (OpenFAST "
+                        "decks) before the table")
     p.set_defaults(func=_trim)
 
     p = sub.add_parser("linearize", help="linear models over mean wind")
@@ -57,7 +60,13 @@ def add_parsers(sub: Any) -> None:
     aero = p.add_subparsers(dest="aero_command", required=True)
     q = aero.add_parser("cp-surface", help="C_P(lambda, pitch) table and plot")
     add_turbine(q)
-    q.add_argument("--out", help="CSV file (rows pitch, columns tip-speed ratio)")
+    q.add_argument("--out", help="CSV file (rows pitch, columns tip-speed ratio), or with "
+                                 "--format rosco a Cp_Ct_Cq.txt performance table")
+    q.add_argument("--format", choices=("csv", "rosco"), default="csv",
+                   help="csv: C_P only; rosco: C_P, C_T and C_Q in ROSCO's Cp_Ct_Cq.txt layout "
+                        "(read by linearize.read_rotor_performance and by ROSCO's toolbox)")
+    q.add_argument("--shear", type=float, default=0.0,
+                   help="power-law shear exponent of the steady wind (ROSCO's tuning uses 0.2)")
     q.add_argument("--plot", help="PNG file")
     q.add_argument("--tsr", default="2:16:0.25", help="START:STOP:STEP (default 2:16:0.25)")
     q.add_argument("--pitch", default="-2:24:0.5",
@@ -68,6 +77,8 @@ def add_parsers(sub: Any) -> None:
 def _trim(args: argparse.Namespace) -> int:
     winds = parse_range(args.wind, "--wind")
     turbine = linearize.load_turbine(args.turbine)
+    if args.report and str(turbine.report):
+        print(turbine.report)
     points = schedule(turbine, winds, args.power_W, progress=not args.json)
     if args.json:
         print(json.dumps([p.as_dict() for p in points], indent=1))
@@ -85,10 +96,22 @@ def _cp_surface(args: argparse.Namespace) -> int:
     if np.any(tsr < 0):
         raise UsageError(f"--tsr must be >= 0, got {args.tsr!r}")
     turbine = linearize.load_turbine(args.turbine)
-    cp = cp_surface(turbine, tsr, pitch)
-    if args.out:
-        write_surface_csv(tsr, pitch, cp, Path(args.out))
-        print(f"wrote {args.out}")
+    if args.format == "rosco":
+        if not args.out:
+            raise UsageError("--format rosco needs --out FILE.txt")
+        if np.any(tsr <= 0):
+            raise UsageError(f"--tsr must be > 0 for a ROSCO table (C_Q = C_P / TSR), "
+                             f"got {args.tsr!r}")
+        perf = linearize.rotor_performance(turbine, tsr, pitch, shear_exponent=args.shear)
+        linearize.write_rotor_performance(perf, args.out)
+        print(f"wrote {args.out} (ROSCO Cp_Ct_Cq layout, {tsr.size} TSR x {pitch.size} pitch)")
+        cp = perf.cp.T
+    else:
+        lam, pit = np.meshgrid(tsr, pitch)
+        cp = linearize.steady_coefficients(turbine, lam, pit, shear_exponent=args.shear)[0]
+        if args.out:
+            write_surface_csv(tsr, pitch, cp, Path(args.out))
+            print(f"wrote {args.out}")
     if args.plot:
         from ..plotting import plot_cp_surface
 
