@@ -3,7 +3,8 @@
 This package never imports ``mpc_wt`` or ``lidar``.
 """
 from .bem import AeroOptions, element_induction, element_loads
-from .errors import LinearizationError, SimulationDivergedError, TrimError, TurbineFileError
+from .errors import (LinearizationError, LinFileError, SimulationDivergedError, TrimError,
+                     TurbineFileError)
 from .linear import (LinearModel, LinearModelFamily, augment_actuator,
                      jacobian_check, linearize, linearize_family, sensitivities,
                      with_power_input)
@@ -12,6 +13,7 @@ from .plant import (DOF_NAMES, INPUT_NAMES, INPUT_UNITS, MADSEN_OUTPUTS, OUTPUT_
                     PlantStepper, SimulationResult, SteadyWind, element_wind,
                     plant_outputs, plant_params, plant_rhs, rk4_simulate, structural_frequencies)
 from .openfast import load_openfast
+from .openfast_lin import read_lin, read_lin_set, write_lin
 from .performance import (RotorPerformance, read_rotor_performance, rotor_performance,
                           write_rotor_performance)
 from .steady import optimal_tsr, rotor_average, steady_coefficients
@@ -32,5 +34,6 @@ __all__ = [
     "load_turbine", "LinearizationError", "LinearModel", "LinearModelFamily",
     "augment_actuator", "jacobian_check", "linearize", "linearize_family", "sensitivities",
     "with_power_input", "load_openfast", "LoadReport", "RotorPerformance",
-    "read_rotor_performance", "rotor_performance", "write_rotor_performance",
+    "read_rotor_performance", "rotor_performance", "write_rotor_performance", "LinFileError",
+    "read_lin", "read_lin_set", "write_lin",
 ]

@@ -4,11 +4,16 @@ from __future__ import annotations
 
 from typing import Any
 
-__all__ = ["TurbineFileError", "TrimError", "LinearizationError", "SimulationDivergedError"]
+__all__ = ["TurbineFileError", "TrimError", "LinearizationError", "SimulationDivergedError",
+           "LinFileError"]
 
 
 class TurbineFileError(ValueError):
     """A turbine file is missing, malformed or holds a value out of range."""
+
+
+class LinFileError(ValueError):
+    """An OpenFAST ``.lin`` file is missing, malformed, or not a set that MBC3 can take."""
 
 
 class TrimError(RuntimeError):

@@ -484,7 +484,8 @@ def linearize(turbine: Turbine, wind_mps: float, *, config: PlantConfig | None =
               coordinates: str = "blade", power_W: float | None = None,
               shear_exponent: float = 0.0, n_azimuth: int | None = None,
               params: PlantParams | None = None,
-              operating_point: OperatingPoint | None = None) -> LinearModel:
+              operating_point: OperatingPoint | None = None,
+              azimuth_rad: float | None = None) -> LinearModel:
     """Linearize the plant at the trim point of a mean wind speed.
 
     Parameters
@@ -516,6 +517,9 @@ def linearize(turbine: Turbine, wind_mps: float, *, config: PlantConfig | None =
         Linearize here instead of at the trim: :func:`linearize.trim` with other settings, or
         :func:`linearize.operating_point` at a given rotor speed and pitch (an OpenFAST
         ``.lin`` file's point); its wind must be ``wind_mps``.
+    azimuth_rad : float, optional
+        Linearize at this rotor azimuth (blade 1) only, as one OpenFAST ``.lin`` file is,
+        instead of averaging over ``n_azimuth`` azimuths [rad].
 
     Returns
     -------
@@ -537,15 +541,17 @@ def linearize(turbine: Turbine, wind_mps: float, *, config: PlantConfig | None =
     p = params if params is not None else plant_params(turbine, config)
     op = operating_point if operating_point is not None else trim(
         turbine, v, power_W, params=p, shear_exponent=shear_exponent)
-    jac = _averaged(p, op, wake, shear_exponent, n_azimuth, coordinates, "fd")
+    psis = None if azimuth_rad is None else [check_finite_scalar("azimuth_rad", azimuth_rad)]
+    jac = _averaged(p, op, wake, shear_exponent, n_azimuth, coordinates, "fd", psis)
     return _model(p, op, jac, wake, disturbance, coordinates, shear_exponent)
 
 
 def _averaged(p: PlantParams, op: OperatingPoint, wake: str, shear: float,
-              n_azimuth: int | None, coordinates: str, method: str) -> tuple[FloatArray, ...]:
+              n_azimuth: int | None, coordinates: str, method: str,
+              psis: Sequence[float] | None = None) -> tuple[FloatArray, ...]:
     si = [STATE_NAMES.index(n) for n in p.config.active_states()]
     acc: list[FloatArray] | None = None
-    psis = _azimuths(p, shear, n_azimuth)
+    psis = _azimuths(p, shear, n_azimuth) if psis is None else np.asarray(psis, dtype=float)
     for psi in psis:
         raw = _raw_jacobians(p, op, wake, shear, float(psi), method)
         for name, m in zip(("A", "B_u", "B_d", "C", "D_u", "D_d"), raw):

@@ -3,7 +3,12 @@
 Schedule (Madsen et al. 2012, sec. II-D: "maximizing the power output at low wind speeds ...
 limiting the power to the rated level"; Jonkman et al. 2009, sec. 7):
 
-* region 1.5: rotor speed held at its minimum, fine pitch;
+* region 1.5: rotor speed held at its minimum, fine pitch. If at cut-in the rotor at its
+  minimum speed and fine pitch would brake (aerodynamic torque below the generator's minimum,
+  e.g. the IEA-15-240-RWT at 3 m/s and 5 rpm, tip-speed ratio 21), the whole of region 1.5
+  takes the pitch (>= fine) that maximizes the aerodynamic torque at that speed, as WISDEM's
+  schedule and ROSCO's minimum-pitch table do; deciding once per turbine keeps the schedule
+  continuous. The NREL 5-MW (6.9 rpm) stays at fine pitch, as Jonkman's baseline;
 * region 2: maximum C_P tracking, omega = lambda_opt V / R, fine pitch;
 * region 2.5: rotor speed held at rated, fine pitch, power still below the cap;
 * region 3: power held at the cap (rated, or a power reference below rated) by pitching to
@@ -20,7 +25,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
-from scipy.optimize import brentq
+from scipy.optimize import brentq, minimize_scalar
 
 from ._typing import FloatArray
 from .errors import TrimError
@@ -157,6 +162,14 @@ def _aero(params: PlantParams, v: float, omega: float, pitch: float,
     return float(z[22]), float(z[23])
 
 
+def _best_pitch(p: PlantParams, v: float, omega: float, fine: float, shear: float) -> float:
+    """Pitch in [fine, fine + 30 deg] that maximizes the aerodynamic torque at ``omega``."""
+    res = minimize_scalar(lambda b: -_aero(p, v, omega, b, shear)[0],
+                          bounds=(fine, fine + math.radians(30.0)), method="bounded",
+                          options={"xatol": 1e-9})
+    return float(res.x)
+
+
 def trim(turbine: Turbine, wind_mps: float, power_W: float | None = None, *,
          config: PlantConfig | None = None, shear_exponent: float = 0.0,
          params: PlantParams | None = None) -> OperatingPoint:
@@ -215,6 +228,18 @@ def trim(turbine: Turbine, wind_mps: float, power_W: float | None = None, *,
     w_opt = lam * v / rproj
     omega = min(max(w_opt, op.min_rotor_speed_rad_s), op.rated_rotor_speed_rad_s)
     q_fine, _ = _aero(p, v, omega, fine, shear)
+    if (omega <= op.min_rotor_speed_rad_s * (1 + 1e-12) and w_opt < omega
+            and _aero(p, op.cut_in_wind, op.min_rotor_speed_rad_s, fine, shear)[0] / ngear
+            < turbine.generator.min_torque):
+        fine = _best_pitch(p, v, omega, fine, shear)
+        q_fine, _ = _aero(p, v, omega, fine, shear)
+        if q_fine / ngear < turbine.generator.min_torque:
+            raise TrimError(
+                f"at {v:g} m/s the rotor cannot run at its minimum speed "
+                f"{omega * 30 / math.pi:.3g} rpm: the aerodynamic torque is at most "
+                f"{q_fine:.4g} N m (pitch {math.degrees(fine):.2f} deg), below the generator's "
+                f"minimum {turbine.generator.min_torque * ngear:.4g} N m (low-speed shaft); "
+                f"raise cut-in above {v:g} m/s")
     p_fine = eta * q_fine * omega
     if p_fine <= cap * (1 + 1e-12):
         if pref is not None and p_fine < pref * (1 - 1e-9):

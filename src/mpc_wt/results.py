@@ -177,15 +177,19 @@ class ClosedLoopResult:
 
 def load_series(path: str | Path, time_column: str = "time") -> tuple[np.ndarray,
                                                                        dict[str, np.ndarray]]:
-    """Time and channels of a run: our netCDF result, or any CSV with a time column.
+    """Time and channels of a run: ours (netCDF), an OpenFAST output (``.out``, ``.outb``) or a
+    CSV with a time column.
 
+    OpenFAST channels (also as CSV headers, ``RootMyb1``, ``RootMyb1_[kN-m]`` or ``RootMyb1
+    (kN-m)``; a bare name is taken in OpenFAST's unit) are mapped to ours in SI by
+    :data:`mpc_wt.openfast_output.CHANNEL_MAP`; the notes on unmapped channels are logged.
 
     Parameters
     ----------
     path : str or Path
-        A result file (.nc) or a CSV with a header row.
+        A result file (.nc), an OpenFAST output (.out, .outb) or a CSV with a header row.
     time_column : str
-        The CSV's time column.
+        The CSV's time column (``Time`` is also taken when ``time`` is absent).
 
     Returns
     -------
@@ -197,26 +201,66 @@ def load_series(path: str | Path, time_column: str = "time") -> tuple[np.ndarray
     Raises
     ------
     ResultFileError
-        If the file cannot be read, has no time column or non-numeric cells.
+        If the file cannot be read, has no time column, non-numeric cells, an OpenFAST channel
+        with a unit it cannot have, or a suffix other than .nc, .out, .outb, .csv.
     """
+    import logging
+
+    from .openfast_output import read_openfast_output, to_mpcwt_channels
+
+    log = logging.getLogger("mpc_wt.results")
     path = Path(path)
-    if path.suffix.lower() == ".csv":
-        if not path.is_file():
-            raise ResultFileError(f"{path}: file not found")
-        with path.open(newline="") as fh:
-            rows = list(csv.reader(fh))
-        if not rows:
-            raise ResultFileError(f"{path}: empty file")
-        head = [h.strip() for h in rows[0]]
-        if time_column not in head:
-            raise ResultFileError(f"{path}: no time column {time_column!r}; columns {head}")
-        try:
-            data = np.array([[float(c) for c in r] for r in rows[1:] if r], dtype=float)
-        except ValueError as err:
-            raise ResultFileError(f"{path}: non-numeric cell ({err})") from err
-        if data.ndim != 2 or data.shape[1] != len(head):
-            raise ResultFileError(f"{path}: ragged rows")
-        cols = {h: data[:, i] for i, h in enumerate(head)}
-        return cols.pop(time_column), cols
+    suffix = path.suffix.lower()
+    if suffix in (".out", ".outb"):
+        series = read_openfast_output(path)
+        cols, notes = to_mpcwt_channels(series, str(path))
+        for n in notes:
+            log.info("%s: %s", path, n)
+        return series.t, cols
+    if suffix == ".csv":
+        return _load_csv(path, time_column, log)
+    if suffix != ".nc":
+        raise ResultFileError(f"{path}: suffix {path.suffix!r} is not a run file mpc-wt reads; "
+                              f"allowed .nc (ours), .out / .outb (OpenFAST), .csv")
     res = ClosedLoopResult.load(path)
     return res.t, {n: res.channel(n) for n in res.channels()}
+
+
+def _load_csv(path: Path, time_column: str, log: Any) -> tuple[np.ndarray,
+                                                               dict[str, np.ndarray]]:
+    """A CSV run; columns with OpenFAST channel names are mapped to ours in SI."""
+    from .openfast_output import (CHANNEL_MAP, DEFAULT_UNITS, OpenFASTSeries, split_csv_header,
+                                  to_mpcwt_channels)
+
+    if not path.is_file():
+        raise ResultFileError(f"{path}: file not found")
+    with path.open(newline="") as fh:
+        rows = list(csv.reader(fh))
+    if not rows:
+        raise ResultFileError(f"{path}: empty file")
+    head = [h.strip() for h in rows[0]]
+    split = [split_csv_header(h) for h in head]
+    bare = [n for n, _ in split]
+    if time_column not in head and time_column == "time" and "Time" in bare:
+        time_column = head[bare.index("Time")]
+    if time_column not in head:
+        raise ResultFileError(f"{path}: no time column {time_column!r}; columns {head}")
+    try:
+        data = np.array([[float(c) for c in r] for r in rows[1:] if r], dtype=float)
+    except ValueError as err:
+        raise ResultFileError(f"{path}: non-numeric cell ({err})") from err
+    if data.ndim != 2 or data.shape[1] != len(head):
+        raise ResultFileError(f"{path}: ragged rows")
+    it = head.index(time_column)
+    if any(n in CHANNEL_MAP for n in bare):
+        names = tuple(n for k, n in enumerate(bare) if k != it)
+        units = tuple((u if u is not None else DEFAULT_UNITS.get(n, "-"))
+                      for k, (n, u) in enumerate(split) if k != it)
+        series = OpenFASTSeries(t=data[:, it], names=names, units=units,
+                                data=np.delete(data, it, axis=1))
+        cols, notes = to_mpcwt_channels(series, str(path))
+        for n in notes:
+            log.info("%s: %s", path, n)
+        return series.t, cols
+    cols = {h: data[:, i] for i, h in enumerate(head)}
+    return cols.pop(time_column), cols

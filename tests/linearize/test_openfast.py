@@ -161,7 +161,8 @@ def test_iea15mw_schedule_against_published(decks) -> None:
     """IEA-15-240-RWT, rigid rotor, no shear, against the references and tolerances of
     ``shared/validation/iea15mw/README.md``: C_P max 0.470 +- 0.02 (ROSCO table; not the 0.489
     normalized by 118 m), optimal TSR 9.0 +- 0.5, rated wind 10.6 +- 0.3 m/s, rated speed the
-    deck's 7.56 rpm, 5.0 rpm held in region 1.5, region-3 pitch +- 1 deg and thrust +- 8 % of
+    deck's 7.56 rpm, 5.0 rpm held in region 1.5 with WISDEM's pitch +- 1.5 deg (the trim
+    maximizes power at minimum speed, as WISDEM does: measured within 0.1 deg), region-3 pitch +- 1 deg and thrust +- 8 % of
     WISDEM's 2024 table (12-25 m/s), 15 MW in region 3.
 
     Measured: C_P max 0.4832 (with the deck's projected radius 120.68 m), TSR 9.04, rated
@@ -172,10 +173,12 @@ def test_iea15mw_schedule_against_published(decks) -> None:
     assert abs(cp - 0.470) <= 0.02 and abs(lam - 9.0) <= 0.5
     assert abs(linearize.rated_wind_speed(t) - 10.6) <= 0.3
     assert t.operation.rated_rotor_speed_rad_s * 30 / math.pi == pytest.approx(7.56, abs=0.01)
-    low = linearize.trim(t, 5.0)
-    assert low.region == "1.5" and low.rotor_speed_rad_s * 30 / math.pi == pytest.approx(5.0,
-                                                                                        abs=0.05)
     ref = np.genfromtxt(VALIDATION, delimiter=",", names=True)
+    for row in ref[ref["wind_speed_mps"] < 6.9]:       # region 1.5: pitch maximizing power
+        low = linearize.trim(t, float(row["wind_speed_mps"]))
+        assert low.region == "1.5"
+        assert low.rotor_speed_rad_s * 30 / math.pi == pytest.approx(5.0, abs=0.05)
+        assert abs(math.degrees(low.pitch_rad) - row["pitch_deg"]) <= 1.5
     for v in (12.0, 15.0, 20.0, 25.0):
         op = linearize.trim(t, v)
         pitch_ref = np.interp(v, ref["wind_speed_mps"], ref["pitch_deg"])

@@ -257,9 +257,11 @@ def _baseline_run(turbine: linearize.Turbine, args: argparse.Namespace, out: Pat
     from ..plotting import assess_plots
 
     g = tune_baseline(turbine)
-    print(f"# baseline tuned from the linear models: KP {g.kp:.5f} s, KI {g.ki:.5f}, "
-          f"theta_K {math.degrees(g.theta_k_rad):.2f} deg, K_opt {g.k_opt:.4f} "
-          f"N m/(rad/s)^2 (published 0.01883, 0.00807, 6.30 deg, 2.3323)")
+    published = (" (published 0.01883, 0.00807, 6.30 deg, 2.3323)"
+                 if args.turbine == "nrel5mw" else "")
+    print(f"# baseline tuned from the linear models: KP {g.kp:.5g} s, KI {g.ki:.5g}, "
+          f"theta_K {math.degrees(g.theta_k_rad):.2f} deg, K_opt {g.k_opt:.5g} "
+          f"N m/(rad/s)^2{published}")
     res = run_controller(turbine, "baseline", args.wind, args.turbulence, args.seed,
                          args.duration, progress=True)
     res.save(out / "baseline_run.nc")

@@ -15,7 +15,8 @@ import lidar
 import linearize
 from linearize.validate import check_finite_scalar, check_positive, check_range
 
-__all__ = ["Scenario", "BuildContext", "Built", "DesignCache", "make_wind", "turbine_key"]
+__all__ = ["Scenario", "BuildContext", "Built", "DesignCache", "make_wind", "field_grid",
+           "turbine_key"]
 
 
 @dataclass(frozen=True)
@@ -69,6 +70,29 @@ class Scenario:
                 "duration_s": self.duration, "shear_exponent": self.shear_exponent}
 
 
+def field_grid(turbine: linearize.Turbine) -> tuple[float, int]:
+    """Side [m] and points per side of a square turbulence grid that covers the rotor.
+
+    150 m and 32 points (4.8 m spacing) for rotors up to 63 m; larger rotors get 12 m of margin
+    on each side of the tip and the same spacing (the IEA-15-240-RWT: 266 m, 56 points).
+
+    Parameters
+    ----------
+    turbine : Turbine
+        For the tip radius.
+
+    Returns
+    -------
+    width : float
+        [m].
+    n : int
+        Even number of points per side.
+    """
+    width = max(150.0, 2.0 * turbine.geometry.tip_radius + 24.0)
+    n = max(32, 2 * math.ceil(width / 150.0 * 16))
+    return width, n
+
+
 def make_wind(turbine: linearize.Turbine, scenario: Scenario
               ) -> tuple[linearize.SteadyWind | linearize.GridWind, lidar.WindField]:
     """The plant's wind for a scenario and the same field for a LIDAR in the loop.
@@ -89,16 +113,19 @@ def make_wind(turbine: linearize.Turbine, scenario: Scenario
     """
     hub = turbine.geometry.hub_height
     v, alpha = scenario.wind_mps, scenario.shear_exponent
+    width, n = field_grid(turbine)
     if scenario.turbulence == "steady":
         spec = lidar.TurbulenceSpec(v, 0.01, hub_height=hub, duration=scenario.duration + 20.0,
-                                    dt=1.0, n_y=8, n_z=8, shear_exponent=alpha)
+                                    dt=1.0, n_y=8, n_z=8, width=width, height=width,
+                                    shear_exponent=alpha)
         t, y, z = spec.grid()
         u = np.broadcast_to(v * (z / hub) ** alpha, (t.size, y.size, z.size))
         zero = np.zeros(u.shape)
         f = lidar.WindField(t=t, y=y, z=z, u=u, v=zero, w=zero, mean_speed=v, hub_height=hub,
                             meta={"model": "steady power law"})
         return linearize.SteadyWind(v, alpha), f
-    spec = lidar.TurbulenceSpec(v, scenario.turbulence, hub_height=hub,
+    spec = lidar.TurbulenceSpec(v, scenario.turbulence, hub_height=hub, width=width,
+                                height=width, n_y=n, n_z=n,
                                 duration=scenario.duration + 20.0, shear_exponent=alpha)
     f = lidar.generate_field(spec, scenario.seed)
     return linearize.GridWind(t=f.t, y=f.y, z=f.z, u=np.maximum(f.u, 0.0)), f

@@ -1,0 +1,82 @@
+"""Issue 19: the other turbines everywhere a turbine is taken: the IEA-15-240-RWT in the main job
+and a closed loop, OpenFAST decks on the command line, ROSCO tables written by the CLI."""
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+import rosco  # in the test extras
+
+import linearize
+from mpc_wt.cli import main
+from mpc_wt.controllers import run_controller
+
+CASES = Path(rosco.__file__).parents[1] / "Examples" / "Test_Cases"
+
+
+def test_iea15mw_baseline_600s_regulates() -> None:
+    """600 s at 18 m/s, IEC class A turbulence, seed 1, the tuned baseline on the IEA-15
+    (direct drive, rotor 242 m: the turbulence grid grows to 266 m, 56 points): mean electrical
+    power within 1 % of 15 MW after the first 60 s (measured +0.01 %), and no actuator limit
+    exceeded: pitch inside [PC_MinPit, PC_MaxPit], pitch rate <= PC_MaxRat = 2.0 deg/s
+    (measured 1.72), generator torque <= VS_MaxTq = 21.77 MN m (21.35), torque rate <=
+    VS_MaxRat = 4.5 MN m/s (1.05)."""
+    t = linearize.load_turbine("iea15mw")
+    res = run_controller(t, "baseline", 18.0, "A", 1, 600.0)
+    keep = res.t >= 60.0
+    assert abs(res.channel("gen_power")[keep].mean() / 15e6 - 1) <= 0.01
+    pa, gen = t.pitch_actuator, t.generator
+    for b in (1, 2, 3):
+        pitch = res.channel(f"pitch_{b}")
+        assert pa.min_pitch_rad - 1e-9 <= pitch.min() and pitch.max() <= pa.max_pitch_rad
+        assert np.abs(res.channel(f"pitch_rate_{b}")).max() <= pa.max_rate_rad_s * (1 + 1e-9)
+    tq = res.channel("gen_torque")
+    assert tq.max() <= gen.max_torque * (1 + 1e-9) and tq.min() >= gen.min_torque - 1e-6
+    assert np.abs(np.diff(tq) / np.diff(res.t)).max() <= gen.max_torque_rate * (1 + 1e-6)
+
+
+def test_trim_of_a_deck_from_the_cli(capsys: pytest.CaptureFixture[str]) -> None:
+    """``mpcwt trim --turbine PATH.fst --json`` on the BAR_10 deck: 5 MW in region 3, the
+    region-3 pitch of test_openfast.py's Cp-table reference (15 m/s: 14.22 deg +- 1)."""
+    fst = CASES / "BAR_10" / "BAR_10.fst"
+    assert main(["trim", "--turbine", str(fst), "--wind", "15", "--json"]) == 0
+    row = json.loads(capsys.readouterr().out)[0]
+    assert row["power_W"] == pytest.approx(5e6, rel=1e-9)
+    assert abs(row["pitch_deg"] - 14.22) <= 1.0
+    assert main(["trim", "--turbine", str(fst), "--wind", "15", "--report"]) == 0
+    out = capsys.readouterr().out
+    assert "BAR_10_ElastoDyn.dat:" in out and "default:" in out
+
+
+def test_main_job_steady_part_on_iea15mw(tmp_path: Path, capsys) -> None:
+    """``mpcwt run --turbine iea15mw`` (steady part; the closed loop is the test above):
+    the operating table from cut-in to cut-out, 15 MW in region 3, the plots."""
+    assert main(["run", "--turbine", "iea15mw", "--duration", "0", "--out", str(tmp_path)]) == 0
+    rows = json.loads((tmp_path / "operating_points.json").read_text())
+    assert [r["wind_mps"] for r in rows] == list(np.arange(3.0, 25.5, 1.0))
+    assert rows[-1]["power_W"] == pytest.approx(15e6, rel=1e-9)
+    assert rows[0]["region"] == "1.5" and rows[0]["rotor_speed_rpm"] == pytest.approx(5.0, abs=1e-4)
+    assert (tmp_path / "operating_schedule.png").stat().st_size > 10_000
+    assert "rated wind speed 10.4" in capsys.readouterr().out
+
+
+def test_cp_surface_rosco_format_is_read_by_rosco(tmp_path: Path) -> None:
+    """``mpcwt aero cp-surface --format rosco``: ROSCO's reader takes it; C_P max of the
+    IEA-15 at shear 0.2 within 0.02 of the ROSCO table's 0.4704."""
+    from rosco.toolbox.utilities import load_from_txt
+
+    out = tmp_path / "Cp_Ct_Cq.txt"
+    assert main(["aero", "cp-surface", "--turbine", "iea15mw", "--format", "rosco", "--out",
+                 str(out), "--tsr", "3:12:0.5", "--pitch=-2:10:1", "--shear", "0.2"]) == 0
+    pitch, tsr, cp, ct, cq = load_from_txt(str(out))
+    assert cp.shape == (tsr.size, pitch.size) == (19, 13)
+    assert abs(cp.max() - 0.4704) <= 0.02
+    np.testing.assert_allclose(np.degrees(pitch), np.arange(-2.0, 10.5, 1.0), atol=1e-12)
+
+
+def test_cp_surface_rosco_format_needs_out(capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(["aero", "cp-surface", "--format", "rosco", "--plot", "x.png"]) == 2
+    assert "--format rosco needs --out FILE.txt" in capsys.readouterr().err
