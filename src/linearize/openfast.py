@@ -47,6 +47,7 @@ _RPM = math.pi / 30.0
 _TOKEN = re.compile(r'"[^"]*"|\'[^\']*\'|[^\s,]+')
 _KEY = re.compile(r"^[A-Za-z_][A-Za-z0-9_]*(\(\d+\))?$")
 _LITERALS = {"true", "false", "t", "f", "default", "none", "unused"}
+_NUMERIC_ROW = re.compile(r"^[\s\d.eEdD+\-,]*$")
 #: Defaults for what a deck does not hold, with the reason the report gives.
 DEFAULTS = {
     "cut_in_wind": (3.0, "not in an OpenFAST deck; IEC class default 3 m/s"),
@@ -93,10 +94,15 @@ class OpenFASTFile:
         except OSError as err:
             raise TurbineFileError(f"{self.path}: cannot be read: {err}") from err
         self.keys: dict[str, tuple[list[str], int]] = {}
+        #: every key line in file order, (normalized key, values, line index)
+        self.entries: list[tuple[str, list[str], int]] = []
         for i, line in enumerate(self.lines):
+            if _NUMERIC_ROW.match(line):
+                continue
             parsed = _key_line(line)
             if parsed is not None:
                 values, key = parsed
+                self.entries.append((_norm(key), values, i))
                 self.keys.setdefault(_norm(key), (values, i))
 
     def has(self, key: str) -> bool:
@@ -257,13 +263,8 @@ def read_airfoil_polar(path: str | Path, name: str | None = None,
         Naming the file and line: no ``NumAlf``, short rows, alpha not covering -180..180 deg.
     """
     f = OpenFASTFile(path)
-    starts = []
-    for i, line in enumerate(f.lines):
-        parsed = _key_line(line)
-        if parsed is None:
-            continue
-        vals, key = parsed
-        k = key.lower()
+    starts: list[dict] = []
+    for k, vals, i in f.entries:
         if k == "re":
             starts.append({"re": _num(f, i, vals)})
         elif k in ("userprop", "ctrl") and starts:

@@ -33,7 +33,7 @@ from .errors import LinearizationError, LinFileError
 from .linear import LinearModel, _mbc_matrices
 from .openfast_channels import SI_UNIT, resolve_channels, unit_key
 
-__all__ = ["read_lin", "read_lin_set", "write_lin", "LinFileError"]
+__all__ = ["read_lin", "read_lin_set", "write_lin", "compare_with_openfast", "LinFileError"]
 
 _log = logging.getLogger("linearize.openfast_lin")
 
@@ -553,9 +553,9 @@ def write_lin(model: LinearModel, path: str | Path, *, azimuth_rad: float,
     out = ["", "Linearized model: written by mpc-wt (linearize.write_lin)", "",
            f"Description from the FAST input file: {model.info.get('turbine', 'mpc-wt model')}",
            "", "Simulation information:", f"   Simulation time:  {0.0:20.4f} s",
-           f"   Rotor Speed:      {omega:20.6f} rad/s",
-           f"   Azimuth:          {azimuth_rad:20.6f} rad",
-           f"   Wind Speed:       {model.wind_mps:20.6f} m/s",
+           f"   Rotor Speed:      {omega!r:>20s} rad/s",
+           f"   Azimuth:          {float(azimuth_rad)!r:>20s} rad",
+           f"   Wind Speed:       {float(model.wind_mps)!r:>20s} m/s",
            f"   Number of continuous states: {n_x:8d}",
            f"   Number of discrete states:   {0:8d}",
            f"   Number of constraint states: {0:8d}",
@@ -586,3 +586,103 @@ def write_lin(model: LinearModel, path: str | Path, *, azimuth_rad: float,
     p = Path(path)
     p.write_text("\n".join(out) + "\n")
     return p
+
+
+# --------------------------------------------------------------------------------------------
+# Comparison with our plant
+# --------------------------------------------------------------------------------------------
+_DOF_OF_STATE = {"tower_fa_displacement": "tower_fa", "tower_ss_displacement": "tower_ss",
+                 "shaft_torsion": "drivetrain", "flap_1": "blade_flap", "flap_coll": "blade_flap",
+                 "edge_1": "blade_edge", "edge_coll": "blade_edge"}
+
+
+def _collective(model: LinearModel, kind: str, mat: FloatArray) -> float | None:
+    names = model.inputs
+    for n in ("pitch_ref_collective", "pitch_ref_coll"):
+        if n in names:
+            return float(mat[names.index(n)])
+    if all(f"pitch_ref_{b}" in names for b in (1, 2, 3)):
+        return float(sum(mat[names.index(f"pitch_ref_{b}")] for b in (1, 2, 3)))
+    return None
+
+
+def _derivatives(model: LinearModel) -> dict[str, float | None]:
+    out: dict[str, float | None] = {}
+    wind = next((k for k, n in enumerate(model.disturbances)
+                 if n in ("wind", "wind_coll")), None)
+    for sym, name in (("Q", "aero_torque"), ("T", "thrust")):
+        if name not in model.outputs:
+            for k in ("V", "pitch", "Omega", "tower_velocity"):
+                out[f"d{sym}/d{k}"] = None
+            continue
+        i = model.outputs.index(name)
+        if wind is not None:
+            out[f"d{sym}/dV"] = float(model.D_d[i, wind])
+        elif all(f"wind_{b}" in model.disturbances for b in (1, 2, 3)):
+            out[f"d{sym}/dV"] = float(model.D_d[i].sum())
+        else:
+            out[f"d{sym}/dV"] = None
+        out[f"d{sym}/dpitch"] = _collective(model, "input", model.D_u[i])
+        for k, state in (("Omega", "rotor_speed"), ("tower_velocity", "tower_fa_velocity")):
+            out[f"d{sym}/d{k}"] = (float(model.C_z[i, model.states.index(state)])
+                                   if state in model.states else None)
+    return out
+
+
+def compare_with_openfast(turbine: object, openfast: LinearModel) -> dict[str, object]:
+    """Our plant linearized at an OpenFAST model's operating point, beside it.
+
+    The operating point is the file's wind (``Wind Speed`` or InflowWind's input), rotor speed
+    and collective pitch (:func:`linearize.operating_point`); our plant gets the degrees of
+    freedom the file has (tower fore-aft and side-side, drivetrain, blade flap and edge; the
+    generator always), the quasi-steady wake OpenFAST linearizes with, one rotor wind, and an
+    average over azimuth.
+
+    Parameters
+    ----------
+    turbine : Turbine
+    openfast : LinearModel
+        From :func:`read_lin` or :func:`read_lin_set`.
+
+    Returns
+    -------
+    dict
+        ``operating_point`` (wind, rotor speed, pitch), ``derivatives``: {name: {"openfast",
+        "mpc_wt", "ratio"}} for the aerodynamic torque Q and thrust T against wind V,
+        collective pitch, rotor speed and tower fore-aft velocity [SI], and ``modes`` of each.
+
+    Raises
+    ------
+    LinFileError
+        If the model has no finite wind speed or no pitch operating point.
+    """
+    from .linear import linearize
+    from .plant import PlantConfig
+    from .trim import operating_point
+
+    v = openfast.wind_mps
+    if not math.isfinite(v):
+        raise LinFileError("the OpenFAST model has no wind speed (no 'Wind Speed' header and "
+                           "no InflowWind input)")
+    omega = float(openfast.info["rotor_speed_rad_s"])
+    pitch = None
+    for n in ("pitch_ref_collective", "pitch_ref_coll", "pitch_ref_1"):
+        if n in openfast.inputs:
+            pitch = float(openfast.u0[openfast.inputs.index(n)])
+            break
+    if pitch is None:
+        raise LinFileError(f"the OpenFAST model has no pitch input among {openfast.inputs}")
+    dofs = {"generator"} | {d for s, d in _DOF_OF_STATE.items() if s in openfast.states}
+    cfg = PlantConfig(frozenset(dofs))
+    op = operating_point(turbine, v, omega, pitch, config=cfg)  # type: ignore[arg-type]
+    ours = linearize(turbine, v, config=cfg, operating_point=op,  # type: ignore[arg-type]
+                     disturbance="rotor")
+    a, b = _derivatives(openfast), _derivatives(ours)
+    table = {}
+    for k in a:
+        fa, fb = a[k], b.get(k)
+        table[k] = {"openfast": fa, "mpc_wt": fb,
+                    "ratio": (fb / fa) if fa not in (None, 0.0) and fb is not None else None}
+    return {"operating_point": {"wind_mps": v, "rotor_speed_rpm": omega * 30 / math.pi,
+                                "pitch_deg": math.degrees(pitch), "dofs": sorted(dofs)},
+            "derivatives": table, "modes": {"openfast": openfast.modes(), "mpc_wt": ours.modes()}}

@@ -480,7 +480,7 @@ class Turbine:
     """
 
     name: str
-    source: str
+    source: str = field(compare=False)
     geometry: Geometry
     operation: Operation
     environment: Environment

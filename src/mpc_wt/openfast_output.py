@@ -96,21 +96,28 @@ def _read_text(p: Path) -> OpenFASTSeries:
     if len(units) != len(names):
         raise ResultFileError(f"{p}: line {head + 2}: {len(units)} units for {len(names)} "
                               f"channels")
-    rows = []
-    for k, ln in enumerate(lines[head + 2:], start=head + 3):
-        if not ln.strip():
-            continue
-        toks = ln.split()
-        if len(toks) != len(names):
-            raise ResultFileError(f"{p}: line {k}: {len(toks)} values; expected {len(names)}")
-        try:
-            rows.append([float(x) for x in toks])
-        except ValueError:
-            raise ResultFileError(f"{p}: line {k}: non-numeric value in "
-                                  f"{ln.strip()[:60]!r}") from None
-    if len(rows) < 2:
+    body = [ln for ln in lines[head + 2:] if ln.strip()]
+    try:
+        flat = np.array(" ".join(body).split(), dtype=float)
+    except ValueError:
+        flat = None
+    if flat is None or flat.size != len(body) * len(names):
+        for k, ln in enumerate(lines[head + 2:], start=head + 3):   # name the bad line
+            toks = ln.split()
+            if not toks:
+                continue
+            if len(toks) != len(names):
+                raise ResultFileError(f"{p}: line {k}: {len(toks)} values; expected "
+                                      f"{len(names)}")
+            try:
+                [float(x) for x in toks]
+            except ValueError:
+                raise ResultFileError(f"{p}: line {k}: non-numeric value in "
+                                      f"{ln.strip()[:60]!r}") from None
+    assert flat is not None
+    if len(body) < 2:
         raise ResultFileError(f"{p}: fewer than 2 rows of data")
-    data = np.array(rows)
+    data = flat.reshape(len(body), len(names))
     desc = lines[head - 2].strip() if head >= 2 else ""
     return OpenFASTSeries(t=data[:, 0], names=tuple(names[1:]), units=tuple(units[1:]),
                           data=data[:, 1:], description=desc)

@@ -156,12 +156,17 @@ def test_assess_csv_from_another_tool(tmp_path: Path, capsys: pytest.CaptureFixt
     t = np.arange(0, 100, 0.05)
     x = 1e6 * np.sin(2 * np.pi * 0.5 * t)
     p = tmp_path / "field.csv"
-    p.write_text("Time,RootMyc1\n" + "\n".join(f"{a},{b}" for a, b in zip(t, x)))
-    assert main(["assess", str(p), "--time-column", "Time", "--channels", "RootMyc1",
+    p.write_text("Time,RootMyc1_[N-m]\n" + "\n".join(f"{a},{b}" for a, b in zip(t, x)))
+    assert main(["assess", str(p), "--time-column", "Time", "--channels", "flap_moment_1",
                  "--m", "4", "--json"]) == 0
-    d = json.loads(capsys.readouterr().out)[0]["channels"]["RootMyc1"]
+    d = json.loads(capsys.readouterr().out)[0]["channels"]["flap_moment_1"]
     # analytic: 50 cycles of range 2e6 over 100 s, N_eq = 100: DEL = 2e6 (0.5)^(1/4)
     assert d["del"] == pytest.approx(2e6 * 0.5 ** 0.25, rel=0.01)
+    # issue 19: an OpenFAST name without a unit is taken in OpenFAST's (kN-m)
+    p.write_text("Time,RootMyc1\n" + "\n".join(f"{a},{b}" for a, b in zip(t, x)))
+    assert main(["assess", str(p), "--channels", "flap_moment_1", "--m", "4", "--json"]) == 0
+    d = json.loads(capsys.readouterr().out)[0]["channels"]["flap_moment_1"]
+    assert d["del"] == pytest.approx(2e9 * 0.5 ** 0.25, rel=0.01)
 
 
 @pytest.mark.parametrize("argv, match", [
@@ -311,18 +316,25 @@ def test_cp_surface_has_distinct_rows_below_zero_pitch(tmp_path: Path,
 def test_assess_csv_without_known_channels_names_what_it_found(
         tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     """Issue 17, defect 6: exit 0 with an empty assessment before; now exit 2 naming the
-    columns found and the channels expected, and --channels takes any numeric column."""
+    columns found and the channels expected, and --channels takes any numeric column. Issue 19:
+    OpenFAST names are channels we know (TwrBsMyt -> tower_base_fa_moment, kN-m -> N m)."""
     p = tmp_path / "field.csv"
     t = np.arange(0, 50, 0.1)
-    p.write_text("time,TwrBsMyt,GenPwr\n" + "\n".join(
+    p.write_text("time,strain_gauge_3,power_kw\n" + "\n".join(
         f"{a},{1e3 * np.sin(a)},{5e3}" for a in t))
     assert main(["assess", str(p)]) == 2
     err = capsys.readouterr().err
-    assert "no column is a load channel we know" in err and "'TwrBsMyt'" in err
+    assert "no column is a load channel we know" in err and "'strain_gauge_3'" in err
     assert "tower_base_fa_moment" in err
-    assert main(["assess", str(p), "--channels", "TwrBsMyt", "--json"]) == 0
-    d = json.loads(capsys.readouterr().out)[0]["channels"]["TwrBsMyt"]
+    assert main(["assess", str(p), "--channels", "strain_gauge_3", "--json"]) == 0
+    d = json.loads(capsys.readouterr().out)[0]["channels"]["strain_gauge_3"]
     assert d["m"] == 4.0 and d["del"] > 0
+    p.write_text("time,TwrBsMyt,GenPwr\n" + "\n".join(
+        f"{a},{1e3 * np.sin(a)},{5e3}" for a in t))
+    assert main(["assess", str(p), "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)[0]
+    assert out["channels"]["tower_base_fa_moment"]["m"] == 4.0
+    assert out["power_mean_W"] == pytest.approx(5e6)
 
 
 def test_linearize_at_a_given_operating_point(capsys: pytest.CaptureFixture[str]) -> None:

@@ -80,3 +80,23 @@ def test_cp_surface_rosco_format_is_read_by_rosco(tmp_path: Path) -> None:
 def test_cp_surface_rosco_format_needs_out(capsys: pytest.CaptureFixture[str]) -> None:
     assert main(["aero", "cp-surface", "--format", "rosco", "--plot", "x.png"]) == 2
     assert "--format rosco needs --out FILE.txt" in capsys.readouterr().err
+
+
+def test_campaign_hash_of_a_deck_follows_what_was_read(tmp_path: Path) -> None:
+    """A campaign names its turbine by a hash; for a deck that is the content of what the
+    loader read (the IEA-15 deck reads files outside its folder): two copies hash alike, a
+    changed nacelle mass does not."""
+    import shutil
+
+    from mpc_wt.campaign.spec import turbine_files_hash
+
+    src = CASES / "NREL-5MW"
+    a, b = tmp_path / "a", tmp_path / "b"
+    for d in (a, b):
+        shutil.copytree(src, d, ignore=shutil.ignore_patterns("*.inp", "Ice*", "*BeamDyn*"))
+    assert turbine_files_hash(str(a / "NREL-5MW.fst"))[1] == \
+        turbine_files_hash(str(b / "NREL-5MW.fst"))[1]
+    ed = b / "NRELOffshrBsline5MW_Onshore_ElastoDyn.dat"
+    ed.write_text(ed.read_text().replace("     240000   NacMass", "     242000   NacMass"))
+    assert turbine_files_hash(str(a / "NREL-5MW.fst"))[1] != \
+        turbine_files_hash(str(b / "NREL-5MW.fst"))[1]

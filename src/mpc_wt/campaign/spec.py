@@ -357,9 +357,12 @@ def turbine_files_hash(turbine: str, base: Path | None = None) -> tuple[str, str
         folder = p if p.is_dir() else p.parent
         ref = str(p.resolve())
         try:
-            linearize.load_turbine(p)
+            loaded = linearize.load_turbine(p)
         except Exception as err:  # noqa: BLE001 - any loader error is reported with the key
             raise _fail("turbine", f"{turbine!r} does not load: {err}") from err
+        if p.suffix.lower() == ".fst":      # a deck reads files outside its folder: hash what
+            from ..controllers.context import turbine_key   # was read, not the folder
+            return ref, turbine_key(loaded)
     h = hashlib.sha256()
     for f in sorted(folder.rglob("*")):
         if f.is_file() and "__pycache__" not in f.parts:

@@ -54,6 +54,10 @@ def add_parsers(sub: Any) -> None:
                    help="collective pitch of that operating point [deg]")
     p.add_argument("--out", help="models file: .mat (MATLAB), .npz or .json")
     p.add_argument("--json", action="store_true", help="print sensitivities and modes as JSON")
+    p.add_argument("--compare", nargs="+", metavar="FILE.lin",
+                   help="OpenFAST .lin file(s) (several: one operating point at several "
+                        "azimuths, MBC3-averaged): linearize our plant at the file's operating "
+                        "point and print the aerodynamic derivatives and modes side by side")
     p.set_defaults(func=_linearize)
 
     p = sub.add_parser("aero", help="rotor aerodynamics")
@@ -122,7 +126,35 @@ def _cp_surface(args: argparse.Namespace) -> int:
     return 0
 
 
+def _compare(args: argparse.Namespace) -> int:
+    from linearize.openfast_lin import compare_with_openfast
+
+    files = args.compare
+    model = linearize.read_lin(files[0]) if len(files) == 1 else linearize.read_lin_set(files)
+    res = compare_with_openfast(linearize.load_turbine(args.turbine), model)
+    if args.json:
+        print(json.dumps(res, indent=1))
+        return 0
+    op = res["operating_point"]
+    print(f"# {files[0]}{' + %d more' % (len(files) - 1) if len(files) > 1 else ''}: "
+          f"{op['wind_mps']:g} m/s, {op['rotor_speed_rpm']:.3f} rpm, pitch "
+          f"{op['pitch_deg']:.3f} deg; our DOFs {', '.join(op['dofs'])}")
+    print(f"{'derivative [SI]':22s} {'OpenFAST':>14s} {'mpc-wt':>14s} {'ratio':>8s}")
+    for k, d in res["derivatives"].items():
+        cells = [f"{d[c]:14.5g}" if d[c] is not None else f"{'n/a':>14s}"
+                 for c in ("openfast", "mpc_wt")]
+        ratio = f"{d['ratio']:8.4f}" if d["ratio"] is not None else f"{'n/a':>8s}"
+        print(f"{k:22s} {cells[0]} {cells[1]} {ratio}")
+    for who in ("openfast", "mpc_wt"):
+        modes = ", ".join(f"{m['name']} {m['frequency_Hz']:.3f} Hz ({m['damping_ratio']:.3f})"
+                          for m in res["modes"][who][:8])
+        print(f"# modes {who}: {modes}")
+    return 0
+
+
 def _linearize(args: argparse.Namespace) -> int:
+    if args.compare:
+        return _compare(args)
     winds = parse_range(args.wind, "--wind")
     check_suffix(args.out, "--out", (".mat", ".npz", ".json"))
     given = (args.rotor_speed_rpm, args.pitch_deg)

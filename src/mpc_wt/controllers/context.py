@@ -132,7 +132,8 @@ def make_wind(turbine: linearize.Turbine, scenario: Scenario
 
 
 def turbine_key(turbine: linearize.Turbine) -> str:
-    """A digest of a turbine's content (every field and array), for caching designs.
+    """A digest of a turbine's content (every field and array; not where it was read from),
+    for caching designs and naming a campaign's turbine.
 
     Parameters
     ----------
@@ -153,6 +154,8 @@ def _feed(h: Any, obj: Any) -> None:
     if dataclasses.is_dataclass(obj) and not isinstance(obj, type):
         h.update(type(obj).__name__.encode())
         for f in dataclasses.fields(obj):
+            if not f.compare:           # provenance (a turbine's source path, its load report)
+                continue
             h.update(f.name.encode())
             _feed(h, getattr(obj, f.name))
     elif isinstance(obj, np.ndarray):
