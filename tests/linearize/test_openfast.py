@@ -274,3 +274,37 @@ def test_elastodyn_aerodyn_pair_loads_with_discon(deck_copy) -> None:
                       discon=deck_copy / "DISCON.IN")
     assert t.operation.rated_power == 5e6 and t.blade.layout == "nodes"
     assert any("AirDens" in e.source for e in t.report.entries)
+
+
+DISCON = {"nrel5mw": "NREL-5MW/DISCON.IN",
+          "iea15mw": "IEA-15-240-RWT/IEA-15-240-RWT-Monopile/IEA-15-240-RWT-Monopile_DISCON.IN",
+          "bar10": "BAR_10/BAR_10_DISCON.IN",
+          "nrel2p8": "NREL_2p8_127/NREL-2p8-127_DISCON.IN"}
+
+
+@pytest.mark.parametrize("key", list(DECKS))
+def test_optimal_tsr_and_region2_gain_against_discon(decks, key) -> None:
+    """Each deck's ROSCO tuning against our C_P (shear 0.2 and fine pitch, as ROSCO tunes):
+    the C_P-optimal TSR within 0.3 of ``VS_TSRopt`` (measured 7.7 / 9.0 / 9.8 / 8.0 against
+    7.5 / 9.0 / 10.0 / 8.207), and ``VS_Rgn2K`` = rho pi R^5 C_P / (2 lambda^3 N^3) from our
+    C_P within 2 % where the TSR ROSCO used is known: at ``VS_TSRopt`` for the NREL 5-MW
+    (+1.2 %) and the NREL-2.8-127 (+1.1 %); for the IEA-15 ROSCO took its table's optimum,
+    TSR 8.5 (-1.3 % there; -16 % at VS_TSRopt = 9.0). BAR_10's gain is not asserted: ours at
+    VS_TSRopt is +5.3 %, and we could not tell which TSR its tuning used."""
+    from linearize.openfast import OpenFASTFile
+
+    t = decks[key]
+    dis = OpenFASTFile(CASES / DISCON[key])
+    fine = math.degrees(t.operation.fine_pitch_rad)
+    assert dis.number("PC_FinePit" if dis.has("PC_FinePit") else "PC_MinPit") == \
+        pytest.approx(t.operation.fine_pitch_rad, abs=1e-12)
+    lam = np.linspace(6.0, 12.0, 121)
+    cp, _ = linearize.steady_coefficients(t, lam, np.full(lam.size, fine), shear_exponent=0.2)
+    assert abs(lam[np.argmax(cp)] - dis.number("VS_TSRopt")) <= 0.3
+    if key == "bar10":
+        return
+    lam_k = 8.5 if key == "iea15mw" else dis.number("VS_TSRopt")
+    cp_k, _ = linearize.steady_coefficients(t, lam_k, fine, shear_exponent=0.2)
+    r, n = t.geometry.tip_radius, t.drivetrain.gearbox_ratio
+    k = 0.5 * t.environment.air_density * math.pi * r**5 * float(cp_k) / lam_k**3 / n**3
+    assert k == pytest.approx(dis.number("VS_Rgn2K"), rel=0.02)
