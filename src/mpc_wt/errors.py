@@ -7,7 +7,7 @@ from linearize import SimulationDivergedError
 
 __all__ = ["UsageError", "OptionsError", "SpecError", "CampaignLockedError", "GainTableError",
            "ResultFileError", "PremiseError", "SynthesisError", "SimulationDivergedError",
-           "QPSetupError"]
+           "QPSetupError", "ControllerLibraryError"]
 
 
 class UsageError(ValueError):
@@ -57,3 +57,21 @@ class SynthesisError(ValueError):
 
 class QPSetupError(ValueError):
     """A QP backend that is unknown, not installed, or cannot take the formulation asked for."""
+
+
+class ControllerLibraryError(RuntimeError):
+    """A Bladed-style controller library that cannot be loaded, or that stopped the run
+    (``aviFAIL < 0``) with its message.
+
+    Parameters
+    ----------
+    message : str
+        Names the library and file, or the time and the library's own message.
+    partial : object, optional
+        The :class:`mpc_wt.ClosedLoopResult` simulated before the library stopped the run (set
+        by :func:`mpc_wt.simulate_closed_loop`); nothing computed is lost.
+    """
+
+    def __init__(self, message: str, partial: object = None) -> None:
+        super().__init__(message)
+        self.partial = partial

@@ -8,9 +8,13 @@ of internal signals, recorded every step.
 
 Measurements given to the controller: ``t``, ``gen_speed``, ``rotor_speed``, ``pitch`` (3,),
 ``flap_moment`` (3,), ``edge_moment`` (3,), ``tower_fa_acceleration``,
-``tower_ss_acceleration``, ``azimuth``, ``gen_power``; ``state``, the full plant state
+``tower_ss_acceleration``, ``azimuth``, ``gen_power``, ``gen_torque`` (applied),
+``aero_power``, ``lss_torque``, ``thrust``, ``tilt_moment``, ``yaw_moment``,
+``hub_wind_speed`` (the free wind at the hub, as a nacelle anemometer would see it without the
+rotor: OpenFAST's ``HorWindV``); ``state``, the full plant state
 (:data:`linearize.STATE_NAMES`), for full-state-information designs (Madsen's MPC); and
-``preview`` when a LIDAR preview is attached.
+``preview`` when a LIDAR preview is attached. A controller with a ``finalize()`` method gets
+it called once after the run (also after a failed one): a Bladed-style library's last call.
 """
 from __future__ import annotations
 
@@ -24,7 +28,7 @@ from tqdm import tqdm
 import linearize
 
 from . import __version__
-from .errors import ResultFileError, SimulationDivergedError
+from .errors import ControllerLibraryError, ResultFileError, SimulationDivergedError
 from .results import ClosedLoopResult
 
 __all__ = ["Controller", "ControllerBase", "ClosedLoopResult", "ResultFileError", "LidarPreview",
@@ -136,7 +140,23 @@ def _measurements(t: float, x: np.ndarray, z: np.ndarray) -> dict[str, Any]:
             "edge_moment": z[13:16].copy(),
             "tower_fa_acceleration": z[_Z["tower_fa_acceleration"]],
             "tower_ss_acceleration": z[_Z["tower_ss_acceleration"]],
-            "azimuth": z[_Z["azimuth"]], "gen_power": z[_Z["gen_power"]], "state": x.copy()}
+            "azimuth": z[_Z["azimuth"]], "gen_power": z[_Z["gen_power"]],
+            "gen_torque": z[_Z["gen_torque"]], "aero_power": z[_Z["aero_power"]],
+            "lss_torque": z[_Z["lss_torque"]], "thrust": z[_Z["thrust"]],
+            "tilt_moment": z[_Z["tilt_moment"]], "yaw_moment": z[_Z["yaw_moment"]],
+            "state": x.copy()}
+
+
+def _hub_wind(wind: Any, hub_height: float) -> Any:
+    """t -> free wind speed at the hub [m/s] (the grid point nearest the hub, linear in t)."""
+    if isinstance(wind, linearize.GridWind):
+        j = int(np.argmin(np.abs(wind.y)))
+        k = int(np.argmin(np.abs(wind.z - hub_height)))
+        series = np.asarray(wind.u[:, j, k], dtype=float)
+        tt = np.asarray(wind.t, dtype=float)
+        return lambda t: float(np.interp(t, tt, series))
+    speed = float(getattr(wind, "speed", math.nan))
+    return lambda t: speed
 
 
 class _Loop:
@@ -144,8 +164,9 @@ class _Loop:
     controller's signals. Private: :func:`simulate_closed_loop` is the interface."""
 
     def __init__(self, params: linearize.PlantParams, controller: Any, n: int, dt: float,
-                 x0: np.ndarray, u0: np.ndarray, preview: Any) -> None:
+                 x0: np.ndarray, u0: np.ndarray, preview: Any, hub_wind: Any = None) -> None:
         self.params, self.controller, self.preview = params, controller, preview
+        self.hub_wind = hub_wind
         self.n, self.dt = n, dt
         self.xs, self.us = np.empty((n + 1, len(linearize.STATE_NAMES))), np.empty((n + 1, 4))
         self.zs = np.empty((n + 1, 31))
@@ -160,6 +181,8 @@ class _Loop:
     def command(self, t: float, z: np.ndarray) -> None:
         """Ask the controller for new commands and hold them."""
         meas = _measurements(t, self.x, z)
+        if self.hub_wind is not None:
+            meas["hub_wind_speed"] = self.hub_wind(t)
         if self.preview is not None:
             meas["preview"] = self.preview(t, float(self.x[_IX_AZ]), float(self.x[_IX_ROTOR]))
         pitch, tq = self.controller.step(t, meas)
@@ -288,7 +311,8 @@ def simulate_closed_loop(params: linearize.PlantParams, controller: Any,
     controller.reset()
     if preview is not None:
         preview.reset()
-    loop = _Loop(params, controller, n, dt, x0, u0, preview)
+    loop = _Loop(params, controller, n, dt, x0, u0, preview,
+                 _hub_wind(wind, params.turbine.geometry.hub_height))
     bar = tqdm(total=n, desc="simulate", unit="step", disable=not progress, mininterval=0.5)
     try:
         _run(loop, stepper, ratio, bar)
@@ -298,8 +322,14 @@ def simulate_closed_loop(params: linearize.PlantParams, controller: Any,
             f"{linearize.STATE_NAMES[d.state]!r} = {d.value!r} "
             f"{linearize.STATE_UNITS[d.state]} left its envelope; the {loop.k_done} samples "
             f"before are kept in .partial", loop.result(loop.k_done, meta or {})) from None
+    except ControllerLibraryError as err:
+        raise ControllerLibraryError(f"{err} ({loop.k_done} samples before are kept in "
+                                     f".partial)", loop.result(loop.k_done, meta or {})) from None
     finally:
         bar.close()
+        finalize = getattr(controller, "finalize", None)
+        if callable(finalize):
+            finalize()
     return loop.result(n + 1, {**(meta or {}), "dt": dt,
                                "controller_dt": cdt, "commands_clipped": loop.clipped,
                                "software_version": __version__})

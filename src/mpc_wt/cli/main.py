@@ -32,7 +32,7 @@ from typing import Sequence
 
 import linearize
 
-from ..errors import CampaignLockedError, UsageError
+from ..errors import CampaignLockedError, ControllerLibraryError, UsageError
 from . import campaign, design, runs, steady, wind
 
 __all__ = ["main", "build_parser"]
@@ -70,7 +70,7 @@ def _plugins(argv: Sequence[str]) -> list[str]:
 
 _ERRORS = (UsageError, linearize.TurbineFileError, linearize.TrimError, FileNotFoundError,
            ValueError, KeyError, ImportError, linearize.LinearizationError,
-           CampaignLockedError)
+           CampaignLockedError, ControllerLibraryError)
 
 
 def main(argv: Sequence[str] | None = None) -> int:

@@ -2,7 +2,8 @@
 
 baseline, baseline-ct, derateNN, apc (Jonkman's baseline and its retrofits, Pettas and Cheng),
 ibc and coleman-ipc (add-ons on a baseline), mpc, mpc-collective, mpc-lidar (Madsen et al.),
-lqr-pio (Do et al.), ts (Clemens et al.).
+lqr-pio (Do et al.), ts (Clemens et al.); rosco and discon (Bladed-style libraries in the
+loop, :mod:`mpc_wt.discon`).
 """
 from __future__ import annotations
 
@@ -18,7 +19,8 @@ from .options import REQUIRED, Options, option
 from .registry import register
 
 __all__ = ["BaselineOptions", "DerateOptions", "APCOptions", "IBCOptions", "ColemanIPCOptions",
-           "MPCOptions", "LidarOptions", "MPCLidarOptions", "LQRPIOOptions", "TSOptions"]
+           "MPCOptions", "LidarOptions", "MPCLidarOptions", "LQRPIOOptions", "TSOptions",
+           "DisconOptions", "RoscoOptions"]
 
 
 # -- designs behind `mpcwt design` ------------------------------------------------------------
@@ -461,3 +463,66 @@ def _build_apc(ctx: BuildContext, opts: APCOptions) -> Built:
     return Built(ctl, meta={"apc": {"frequency_Hz": opts.apc_frequency,
                                     "amplitude": opts.apc_amplitude, "offset": opts.apc_offset,
                                     "schedule_fractions": [g.power_fraction for g in sched]}})
+
+
+# -- Bladed-style libraries: ROSCO and any DISCON ---------------------------------------------
+@dataclass(frozen=True)
+class DisconOptions(Options):
+    """Any Bladed-style controller library (``DISCON``) in the loop (:mod:`mpc_wt.discon`)."""
+
+    discon_library: str = option(REQUIRED, help="the shared library exporting DISCON")
+    discon_in: str = option(REQUIRED, help="its input file (accINFILE, e.g. DISCON.IN)")
+    pitch_control: str = option("individual", help="avrSWAP(28): read records 42-44 "
+                                "(individual) or 45 (collective)",
+                                choices=("individual", "collective"))
+    discon_dt: float = option(1.0 / 80.0, help="communication interval, a multiple of the "
+                              "plant step", unit="s", lo=0.0, lo_open=True, hi=1.0)
+
+
+@dataclass(frozen=True)
+class RoscoOptions(Options):
+    """ROSCO, the rosco package's compiled controller, in the loop."""
+
+    discon_in: Optional[str] = option(None, help="ROSCO input file (default: the DISCON.IN "
+                                      "ROSCO ships for the turbine: nrel5mw, iea15mw)")
+    pitch_control: str = option("individual", help="avrSWAP(28): read records 42-44 "
+                                "(individual) or 45 (collective)",
+                                choices=("individual", "collective"))
+    discon_dt: float = option(1.0 / 80.0, help="communication interval, a multiple of the "
+                              "plant step", unit="s", lo=0.0, lo_open=True, hi=1.0)
+
+
+def _discon_built(ctx: BuildContext, library: Any, discon_in: Any, opts: Any,
+                  kind: str) -> Built:
+    from ..discon import DisconController
+
+    ctl = DisconController(library, discon_in, ctx.turbine, dt=opts.discon_dt,
+                           pitch_control=opts.pitch_control)
+    return Built(ctl, controller_dt=opts.discon_dt,
+                 meta={kind: {"library": str(ctl.library), "discon_in": str(ctl.discon_in),
+                              "pitch_control": opts.pitch_control, "dt": opts.discon_dt}})
+
+
+@register("discon", DisconOptions,
+          summary="any Bladed-style controller library (DISCON) with its input file")
+def _build_discon(ctx: BuildContext, opts: DisconOptions) -> Built:
+    return _discon_built(ctx, opts.discon_library, opts.discon_in, opts, "discon")
+
+
+_ROSCO_FILES = {"NREL 5-MW": "NREL-5MW", "IEA-15-240-RWT": "IEA-15-240-RWT"}
+
+
+@register("rosco", RoscoOptions,
+          summary="ROSCO (the rosco package's libdiscon) with its DISCON.IN for the turbine")
+def _build_rosco(ctx: BuildContext, opts: RoscoOptions) -> Built:
+    from ..discon import rosco_discon, rosco_library
+
+    discon_in = opts.discon_in
+    if discon_in is None:
+        name = next((v for k, v in _ROSCO_FILES.items() if ctx.turbine.name.startswith(k)),
+                    None)
+        if name is None:
+            raise ValueError(f"rosco: no DISCON.IN shipped for turbine {ctx.turbine.name!r}; "
+                             f"give discon_in (--discon-in FILE)")
+        discon_in = str(rosco_discon(name))
+    return _discon_built(ctx, rosco_library(), discon_in, opts, "rosco")

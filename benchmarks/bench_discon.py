@@ -1,0 +1,72 @@
+"""A Bladed-style library in the loop (issue 20): 600 s with ROSCO against the same run with our
+baseline, closed loop only (the field and the trim are made before the clock starts).
+
+Run:  python benchmarks/bench_discon.py [--json]
+
+Prints best-of-3 wall times of ``simulate_closed_loop`` for 600 s at 18 m/s, IEC class A, seed
+1, NREL 5-MW: ROSCO (the rosco package's libdiscon.so with its own NREL-5MW DISCON.IN, called
+at 80 Hz through ctypes) and our baseline; the real-time factor (floor for ROSCO: 30x) and the
+cost of one library call (the difference over 48,000 calls).
+"""
+from __future__ import annotations
+
+import argparse
+import contextlib
+import json
+import os
+import platform
+import time
+import timeit
+
+import linearize
+from mpc_wt.controllers import Scenario, build_controller
+from mpc_wt.simulate import simulate_closed_loop
+
+
+def _quiet():
+    """ROSCO prints its banner and status lines on the process's stdout: send them away."""
+    devnull = os.open(os.devnull, os.O_WRONLY)
+    saved = os.dup(1)
+
+    @contextlib.contextmanager
+    def cm():
+        os.dup2(devnull, 1)
+        try:
+            yield
+        finally:
+            os.dup2(saved, 1)
+    return cm()
+
+
+def main() -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--json", action="store_true")
+    args = ap.parse_args()
+    t = linearize.load_turbine()
+    p = linearize.plant_params(t)
+    sc = Scenario(wind_mps=18.0, turbulence="A", seed=1, duration=600.0)
+    res = {"date": time.strftime("%Y-%m-%d %H:%M"), "machine": platform.machine(),
+           "python": platform.python_version()}
+    for kind in ("rosco", "baseline"):
+        built, op, wind = build_controller(t, kind, sc)
+
+        def run() -> None:
+            simulate_closed_loop(p, built.controller, wind, 600.0, x0=op.x, u0=op.u,
+                                 controller_dt=built.controller_dt)
+        with _quiet():
+            best = min(timeit.repeat(run, number=1, repeat=3))
+        res[kind] = {"seconds": best, "real_time_factor": 600.0 / best}
+    res["per_call_us"] = (res["rosco"]["seconds"] - res["baseline"]["seconds"]) / 48000 * 1e6
+    if args.json:
+        print(json.dumps(res, indent=1))
+        return 0
+    print(f"# {res['date']} {res['machine']} Python {res['python']}")
+    for kind in ("rosco", "baseline"):
+        print(f"600 s, {kind:9s}: {res[kind]['seconds']:.2f} s "
+              f"({res[kind]['real_time_factor']:.0f}x real time)")
+    print(f"ROSCO call through ctypes, net of our baseline: {res['per_call_us']:.1f} us")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

@@ -1,0 +1,32 @@
+/* A Bladed-style test controller for tests/mpc_wt/test_discon.py: it appends every record it
+ * receives (1..130) to <OUTNAME>.swap.csv, counts its calls in a global (one count per loaded
+ * copy), answers fixed demands, and stops the run (aviFAIL = -1) at t >= 0.5 s when its input
+ * file is named PROBE_STOP.IN. */
+#include <stdio.h>
+#include <string.h>
+
+static int calls = 0;
+
+void DISCON(float *swap, int *fail, const char *infile, char *outname, char *msg)
+{
+    char path[4200];
+    FILE *f;
+    int k;
+    calls++;
+    snprintf(path, sizeof path, "%s.swap.csv", outname);
+    f = fopen(path, "a");
+    if (f) {
+        fprintf(f, "%d", calls);
+        for (k = 0; k < 130; k++) fprintf(f, ",%.9g", swap[k]);
+        fprintf(f, ",%s\n", infile);
+        fclose(f);
+    }
+    swap[41] = 0.11f; swap[42] = 0.12f; swap[43] = 0.13f;   /* records 42-44 */
+    swap[44] = 0.2f;                                        /* record 45 */
+    swap[46] = 1000.0f + (float)calls;                      /* record 47 */
+    swap[34] = (swap[1] >= 0.25f && swap[1] < 0.3f) ? 0.0f : 1.0f;  /* record 35 */
+    if (strstr(infile, "PROBE_STOP.IN") && swap[1] >= 0.5f) {
+        *fail = -1;
+        strcpy(msg, "probe: stop requested by its input file");
+    }
+}
