@@ -388,6 +388,14 @@ class DisconController(ControllerBase):
             pitch = np.full(3, float(v[44]))
         contactor = float(v[34])
         torque = float(v[46]) if contactor != 0.0 else 0.0
+        # the swap array is float32: a demand at a limit may sit one rounding step beyond it
+        hi = self.turbine.generator.max_torque
+        if hi < torque <= hi * (1 + 1e-6):
+            torque = hi
+        lo_p, hi_p = self.turbine.pitch_actuator.min_pitch_rad, \
+            self.turbine.pitch_actuator.max_pitch_rad
+        pitch = np.where((pitch < lo_p) & (pitch >= lo_p - 1e-6), lo_p, pitch)
+        pitch = np.where((pitch > hi_p) & (pitch <= hi_p + 1e-6), hi_p, pitch)
         if not (math.isfinite(pitch[0] + pitch[1] + pitch[2]) and math.isfinite(torque)):
             raise ControllerLibraryError(
                 f"controller library {self.library.name} returned pitch {pitch} rad, torque "

@@ -22,7 +22,8 @@ Formats (:func:`export`):
   schema and kind (``pandas.read_csv(..., comment="#")``);
 * ``mat``: ``gains.mat`` (scipy.io.savemat) with the schedule columns as vectors and every
   matrix as an (n_points, n_rows, n_cols) array, names and units as cell strings;
-* ``rosco``: ``DISCON_gains.IN``, the PI schedule and set points as ROSCO ``DISCON.IN`` lines
+* ``rosco``: a complete ROSCO 2.10 ``DISCON.IN`` (every parameter; the design's PI schedule,
+  torque law, limits, filters and IPC, ROSCO's defaults elsewhere) and its ``Cp_Ct_Cq`` table
   (PC_GS_n/angles/KP/KI/KD/TF, PC_RefSpd, PC_MaxPit/MinPit/MaxRat/MinRat, VS_Rgn2K, VS_RtTq,
   VS_RefSpd, VS_RtPwr, VS_MaxTq, VS_MinTq, VS_MaxRat, VS_MinOMSpd); ROSCO's pitch gains act on
   the speed error (reference minus measured), so they carry the opposite sign of ours.
@@ -433,73 +434,34 @@ def _write_mat(doc: dict[str, Any], out: Path) -> list[Path]:
     return [p]
 
 
-#: ROSCO DISCON.IN names written by the rosco export, with their units.
-ROSCO_KEYS = ("PC_GS_n", "PC_GS_angles", "PC_GS_KP", "PC_GS_KI", "PC_GS_KD", "PC_GS_TF",
-              "PC_MaxPit", "PC_MinPit", "PC_MaxRat", "PC_MinRat", "PC_RefSpd", "VS_GenEff",
-              "VS_ArSatTq", "VS_MaxRat", "VS_MaxTq", "VS_MinTq", "VS_MinOMSpd", "VS_Rgn2K",
-              "VS_RtPwr", "VS_RtTq", "VS_RefSpd")
+def _turbine_of(doc: dict[str, Any], turbine: linearize.Turbine | None) -> linearize.Turbine:
+    if turbine is not None:
+        return turbine
+    for name in linearize.available_turbines():
+        t = linearize.load_turbine(name)
+        if t.name == doc["turbine"]:
+            return t
+    raise GainTableError(f"the design's turbine {doc['turbine']!r} is not a packaged one "
+                         f"{linearize.available_turbines()}: give its turbine (export(..., "
+                         f"turbine=...), mpcwt export --turbine PATH) for the rosco format")
 
 
-def _write_rosco(doc: dict[str, Any], out: Path, turbine_eff: float | None = None) -> list[Path]:
-    if doc["kind"] != "baseline":
-        raise GainTableError(f"the rosco format holds a PI pitch schedule and torque set points; "
-                             f"a {doc['kind']!r} design has none: export the baseline design "
-                             f"(`mpcwt design baseline`) for ROSCO, or use csv/json/mat")
-    s, st = doc["schedule"], doc["settings"]
-    rows = np.asarray(s["rows"], dtype=float)
-    # ROSCO interpolates PC_GS_* linearly and holds the end values: tabulate the effective gains
-    # on a 0.25 deg grid from fine pitch to the schedule's last pitch (cut-out), so the
-    # hyperbola is followed to 0.2 % between the points
-    top = float(rows[:, s["columns"].index("pitch")].max())
-    ang = np.unique(np.r_[np.arange(st["min_pitch_rad"], top, math.radians(0.25)), top])
-    kp, ki = effective_pi_gains(st["kp"], st["ki"], st["theta_k_rad"], ang)
-    order = np.arange(ang.size)
-    eff_pct = 100.0 * (turbine_eff if turbine_eff is not None else
-                       st["rated_power"] / (st["rated_torque"] * st["rated_gen_speed_rad_s"]))
+def _write_rosco(doc: dict[str, Any], out: Path,
+                 turbine: linearize.Turbine | None = None) -> list[Path]:
+    from .baseline import tune_baseline
+    from .rosco_export import write_rosco_discon
 
-    def vec(a: np.ndarray) -> str:
-        return "  ".join(f"{float(v):.8g}" for v in a)
-
-    lines = [
-        f"! DISCON.IN lines from mpc-wt {__version__} (gain table schema {SCHEMA_VERSION}), "
-        f"turbine {doc['turbine']}; paste into the matching sections of ROSCO's DISCON.IN",
-        "!------- BLADE PITCH CONTROL ----------------------------------------------",
-        f"{len(ang):<20d} ! PC_GS_n       - Amount of gain-scheduling table entries",
-        f"{vec(ang[order])} ! PC_GS_angles  - Gain-schedule table: pitch angles [rad].",
-        f"{vec(-kp[order])} ! PC_GS_KP      - Gain-schedule table: pitch controller kp gains [s].",
-        f"{vec(-ki[order])} ! PC_GS_KI      - Gain-schedule table: pitch controller ki gains [-].",
-        f"{vec(np.zeros(len(ang)))} ! PC_GS_KD      - Gain-schedule table: pitch controller kd "
-        f"gains",
-        f"{vec(np.zeros(len(ang)))} ! PC_GS_TF      - Gain-schedule table: pitch controller tf "
-        f"gains (derivative filter)",
-        f"{st['max_pitch_rad']:<20.8g} ! PC_MaxPit     - Maximum physical pitch limit, [rad].",
-        f"{st['min_pitch_rad']:<20.8g} ! PC_MinPit     - Minimum physical pitch limit, [rad].",
-        f"{st['max_pitch_rate_rad_s']:<20.8g} ! PC_MaxRat     - Maximum pitch rate (in absolute "
-        f"value) in pitch controller, [rad/s].",
-        f"{-st['max_pitch_rate_rad_s']:<20.8g} ! PC_MinRat     - Minimum pitch rate (in absolute "
-        f"value) in pitch controller, [rad/s].",
-        f"{st['rated_gen_speed_rad_s']:<20.8g} ! PC_RefSpd     - Desired (reference) HSS speed "
-        f"for pitch controller, [rad/s].",
-        "!------- VS TORQUE CONTROL ------------------------------------------------",
-        f"{eff_pct:<20.8g} ! VS_GenEff     - Generator efficiency mechanical power -> electrical "
-        f"power, [should match the efficiency defined in the generator properties!], [%]",
-        f"{st['rated_torque']:<20.8g} ! VS_ArSatTq    - Above rated generator torque PI control "
-        f"saturation, [Nm]",
-        f"{st['max_torque_rate']:<20.8g} ! VS_MaxRat     - Maximum torque rate (in absolute "
-        f"value) in torque controller, [Nm/s].",
-        f"{st['max_torque']:<20.8g} ! VS_MaxTq      - Maximum generator torque in Region 3 "
-        f"(HSS side), [Nm].",
-        f"{st['min_torque']:<20.8g} ! VS_MinTq      - Minimum generator (HSS side), [Nm].",
-        f"{st['min_gen_speed_rad_s']:<20.8g} ! VS_MinOMSpd   - Minimum generator speed [rad/s]",
-        f"{st['k_opt']:<20.8g} ! VS_Rgn2K      - Generator torque constant in Region 2 (HSS "
-        f"side), [Nm/(rad/s)^2]",
-        f"{st['rated_power']:<20.8g} ! VS_RtPwr      - Wind turbine rated power [W]",
-        f"{st['rated_torque']:<20.8g} ! VS_RtTq       - Rated torque, [Nm].",
-        f"{st['rated_gen_speed_rad_s']:<20.8g} ! VS_RefSpd     - Rated generator speed [rad/s]",
-    ]
-    p = out / "DISCON_gains.IN"
-    p.write_text("\n".join(lines) + "\n")
-    return [p]
+    if doc["kind"] not in ("baseline", "coleman-ipc"):
+        raise GainTableError(f"the rosco format holds a PI pitch schedule, torque set points and "
+                             f"Coleman IPC; a {doc['kind']!r} design has none: export a baseline "
+                             f"(`mpcwt design baseline`), derated or not, or a coleman-ipc design "
+                             f"for ROSCO, or use csv/json/mat")
+    t = _turbine_of(doc, turbine)
+    if doc["kind"] == "coleman-ipc":
+        frac = float(doc["settings"].get("power_fraction", 1.0))
+        base = baseline_table(t, tune_baseline(t, power_fraction=frac))
+        return write_rosco_discon(t, base, out, ipc=doc)
+    return write_rosco_discon(t, doc, out)
 
 
 def read_rosco(path: str | Path) -> dict[str, Any]:
@@ -534,7 +496,8 @@ def read_rosco(path: str | Path) -> dict[str, Any]:
 
 
 def export(doc_or_dir: dict[str, Any] | str | Path, fmt: str,
-           out_dir: str | Path | None = None) -> list[Path]:
+           out_dir: str | Path | None = None,
+           turbine: linearize.Turbine | None = None) -> list[Path]:
     """Export a gain table (a document, or a design directory) to ``fmt`` in ``out_dir``
     (default the design directory). Returns the files written.
 
@@ -547,11 +510,14 @@ def export(doc_or_dir: dict[str, Any] | str | Path, fmt: str,
         The format.
     out_dir : str or Path, optional
         Where to write (default the design directory).
+    turbine : Turbine, optional
+        For ``rosco``: the design's turbine (default: the packaged turbine of that name).
 
     Returns
     -------
     list of Path
-        The files written.
+        The files written (``rosco``: a complete ROSCO 2.10 ``DISCON.IN`` and its
+        ``Cp_Ct_Cq`` table, :mod:`mpc_wt.rosco_export`).
 
     Raises
     ------
@@ -581,4 +547,4 @@ def export(doc_or_dir: dict[str, Any] | str | Path, fmt: str,
         return _write_csv(doc, out)
     if fmt == "mat":
         return _write_mat(doc, out)
-    return _write_rosco(doc, out)
+    return _write_rosco(doc, out, turbine)

@@ -63,7 +63,7 @@ def test_rosco_schedule_starts_at_fine_pitch_and_matches_the_controller(turbine,
     (0.2 %) and the fit's error in KP from the loop's fast transient (measured 0.6 %; KI
     0.01 %)."""
     g = tune_baseline(turbine, power_fraction=fraction)
-    (path,) = export(baseline_table(turbine, g), "rosco", tmp_path)
+    path, _ = export(baseline_table(turbine, g), "rosco", tmp_path)
     r = read_rosco(path)
     ang, kp, ki = (np.array(r[k]) for k in ("PC_GS_angles", "PC_GS_KP", "PC_GS_KI"))
     assert r["PC_GS_n"] == len(ang) and np.all(np.diff(ang) > 0)
@@ -81,7 +81,7 @@ def test_rosco_schedule_starts_at_fine_pitch_and_matches_the_controller(turbine,
 
 def test_rosco_set_points_read_back(turbine, base_doc, tmp_path) -> None:
     g = tune_baseline(turbine)
-    (path,) = export(base_doc, "rosco", tmp_path)
+    path, _ = export(base_doc, "rosco", tmp_path)
     r = read_rosco(path)
     assert r["VS_Rgn2K"] == pytest.approx(g.k_opt, rel=1e-7)
     assert r["PC_RefSpd"] == r["VS_RefSpd"]

@@ -56,6 +56,9 @@ def add_parsers(sub: Any) -> None:
     p.add_argument("design", help="design directory (from `mpcwt design`) or gain-table JSON")
     p.add_argument("--format", required=True, choices=("csv", "json", "mat", "rosco"))
     p.add_argument("--to", help="output directory (default: the design directory)")
+    p.add_argument("--turbine", default=None,
+                   help="rosco: the design's turbine, if it is not a packaged one (a "
+                        "turbine.yaml or an OpenFAST .fst deck)")
     p.set_defaults(func=_export)
 
 
@@ -105,8 +108,9 @@ def _design(args: argparse.Namespace) -> int:
 def _export(args: argparse.Namespace) -> int:
     from ..export import export
 
+    turbine = linearize.load_turbine(args.turbine) if args.turbine else None
     try:
-        files = export(args.design, args.format, args.to)
+        files = export(args.design, args.format, args.to, turbine)
     except GainTableError as err:
         raise UsageError(str(err)) from None
     print("wrote " + ", ".join(str(f) for f in files))

@@ -483,8 +483,12 @@ class DisconOptions(Options):
 class RoscoOptions(Options):
     """ROSCO, the rosco package's compiled controller, in the loop."""
 
-    discon_in: Optional[str] = option(None, help="ROSCO input file (default: the DISCON.IN "
-                                      "ROSCO ships for the turbine: nrel5mw, iea15mw)")
+    discon_in: Optional[str] = option(None, help="ROSCO input file; 'shipped' for the DISCON.IN "
+                                      "ROSCO ships for the turbine (nrel5mw, iea15mw); default: "
+                                      "one exported from our baseline design")
+    power_fraction: float = option(1.0, help="with the exported design: derate to this "
+                                   "fraction of rated power", unit="-", lo=0.0, lo_open=True,
+                                   hi=1.0, flag="--rosco-power-fraction")
     pitch_control: str = option("individual", help="avrSWAP(28): read records 42-44 "
                                 "(individual) or 45 (collective)",
                                 choices=("individual", "collective"))
@@ -512,17 +516,45 @@ def _build_discon(ctx: BuildContext, opts: DisconOptions) -> Built:
 _ROSCO_FILES = {"NREL 5-MW": "NREL-5MW", "IEA-15-240-RWT": "IEA-15-240-RWT"}
 
 
-@register("rosco", RoscoOptions,
-          summary="ROSCO (the rosco package's libdiscon) with its DISCON.IN for the turbine")
+def _rosco_operating_point(turbine: linearize.Turbine, sc: Scenario, opts: RoscoOptions
+                           ) -> linearize.OperatingPoint:
+    if opts.discon_in is None and opts.power_fraction < 1.0:
+        return _derated_trim(turbine, sc, opts)     # type: ignore[arg-type]
+    return linearize.trim(turbine, sc.wind_mps)
+
+
+@register("rosco", RoscoOptions, operating_point=_rosco_operating_point,
+          summary="ROSCO (the rosco package's libdiscon) with a DISCON.IN exported from our "
+                  "baseline, ROSCO's own ('shipped') or any file")
 def _build_rosco(ctx: BuildContext, opts: RoscoOptions) -> Built:
     from ..discon import rosco_discon, rosco_library
 
     discon_in = opts.discon_in
-    if discon_in is None:
+    if discon_in == "shipped":
         name = next((v for k, v in _ROSCO_FILES.items() if ctx.turbine.name.startswith(k)),
                     None)
         if name is None:
             raise ValueError(f"rosco: no DISCON.IN shipped for turbine {ctx.turbine.name!r}; "
                              f"give discon_in (--discon-in FILE)")
         discon_in = str(rosco_discon(name))
-    return _discon_built(ctx, rosco_library(), discon_in, opts, "rosco")
+    elif discon_in is None:
+        discon_in = ctx.cache.get(ctx.turbine, ("rosco-export", opts.power_fraction),
+                                  lambda: _export_rosco(ctx.turbine, opts.power_fraction))
+    built = _discon_built(ctx, rosco_library(), discon_in, opts, "rosco")
+    built.meta["rosco"]["design"] = ("ours" if opts.discon_in is None else
+                                     "shipped" if opts.discon_in == "shipped" else "file")
+    return Built(built.controller, built.controller_dt, meta=built.meta,
+                 power_fraction=opts.power_fraction if opts.discon_in is None else 1.0)
+
+
+def _export_rosco(turbine: linearize.Turbine, power_fraction: float) -> str:
+    """Our baseline design as a ROSCO DISCON.IN in a folder kept for the process."""
+    import tempfile
+
+    from ..baseline import tune_baseline
+    from ..export import baseline_table
+    from ..rosco_export import write_rosco_discon
+
+    out = tempfile.mkdtemp(prefix="mpcwt_rosco_export_")
+    doc = baseline_table(turbine, tune_baseline(turbine, power_fraction=power_fraction))
+    return str(write_rosco_discon(turbine, doc, out)[0])
