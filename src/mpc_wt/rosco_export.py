@@ -412,10 +412,12 @@ def rosco_values(turbine: linearize.Turbine, doc: dict[str, Any],
     if ipc is not None:
         cols = ipc["schedule"]["columns"]
         r = np.asarray(ipc["schedule"]["rows"], dtype=float)
+        # ours: theta_cs = -K_I R(-phi) int M_cs; ROSCO: theta_cs = K_I R(-phi_R) int M_cs
+        # (its offset enters the inverse transform only), so phi_R = phi - pi
+        phi = float(np.median(r[:, cols.index("azimuth_offset")]))
         out.update({"IPC_ControlMode": 1,
                     "IPC_KI": [float(np.median(r[:, cols.index("ki")])), 0.0],
-                    "IPC_aziOffset": [float(np.median(r[:, cols.index("azimuth_offset")])),
-                                      0.0]})
+                    "IPC_aziOffset": [math.remainder(phi - math.pi, 2.0 * math.pi), 0.0]})
     return out
 
 
