@@ -147,6 +147,8 @@ def _preload_dependencies(original: Path) -> None:
     between copies; the controller's own globals are not."""
     import re
 
+    # unbuffered Fortran units, so that a quiet controller's redirect catches what is printed
+    os.environ.setdefault("GFORTRAN_UNBUFFERED_PRECONNECTED", "y")
     data = original.read_bytes()
     dirs = []
     for m in re.finditer(rb"\$(?:ORIGIN|\{ORIGIN\})([^\x00:]*)", data):
@@ -190,6 +192,10 @@ class DisconController(ControllerBase):
         ``workdir/root_name``. Default: a temporary folder removed by :meth:`finalize`.
     root_name : str
         The simulation root name given to the library.
+    quiet : bool
+        Send what the library prints on the process's standard output (ROSCO's banner and
+        status lines) to the null device during its calls (default); its ``aviFAIL`` messages
+        are kept either way.
 
     Raises
     ------
@@ -200,7 +206,8 @@ class DisconController(ControllerBase):
 
     def __init__(self, library: str | Path, discon_in: str | Path, turbine: Any, *,
                  dt: float = 1.0 / 80.0, pitch_control: str = "individual",
-                 workdir: str | Path | None = None, root_name: str = "mpcwt_discon") -> None:
+                 workdir: str | Path | None = None, root_name: str = "mpcwt_discon",
+                 quiet: bool = True) -> None:
         self.library = Path(library).resolve()
         self.discon_in = Path(discon_in).resolve()
         _check_library(self.library)
@@ -216,6 +223,8 @@ class DisconController(ControllerBase):
         self._own_workdir = workdir is None
         self.workdir = Path(workdir) if workdir is not None else None
         self.root_name = root_name
+        self.quiet = quiet
+        self._fds: tuple[int, int] | None = None
         self._lib: Any = None
         self._copy_dir: str | None = None
         self._swap = (ctypes.c_float * SWAP_SIZE)()
@@ -291,6 +300,10 @@ class DisconController(ControllerBase):
                 log.warning("%s", err)
         self._status = -1
         self._unload()
+        if self._fds is not None:
+            for fd in self._fds:
+                os.close(fd)
+            self._fds = None
         if self._own_workdir and self.workdir is not None:
             shutil.rmtree(self.workdir, ignore_errors=True)
 
@@ -341,7 +354,17 @@ class DisconController(ControllerBase):
         fail = ctypes.c_int(0)
         self._msg[0] = b"\0"
         ctypes.memmove(self._out, self._outname + b"\0", len(self._outname) + 1)
-        self._fn(self._swap, ctypes.byref(fail), self._infile, self._out, self._msg)
+        if self.quiet:
+            if self._fds is None:
+                sys.stdout.flush()
+                self._fds = (os.open(os.devnull, os.O_WRONLY), os.dup(1))
+            os.dup2(self._fds[0], 1)
+            try:
+                self._fn(self._swap, ctypes.byref(fail), self._infile, self._out, self._msg)
+            finally:
+                os.dup2(self._fds[1], 1)
+        else:
+            self._fn(self._swap, ctypes.byref(fail), self._infile, self._out, self._msg)
         if fail.value == 0:
             return
         text = self._msg.value.decode(errors="replace").strip()
