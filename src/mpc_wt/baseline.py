@@ -336,6 +336,10 @@ class BaselineController(ControllerBase):
         """Forget the filter, integral and last commands."""
         self.w_filt: float | None = None
         self.integral = 0.0
+        #: an add-on's feedforward pitch [rad], set before each step (None: none); its change
+        #: from step to step enters the integral, so the PI stays consistent with it
+        self.pitch_feedforward: float | None = None
+        self._ff_last: float | None = None
         self.last_pitch: float | None = None
         self.last_torque: float | None = None
         self.signals: dict[str, float] = {}
@@ -375,6 +379,16 @@ class BaselineController(ControllerBase):
             tq = self.slope25 * (w - self.w_sync)
         return min(tq, self.tq_cap, p3 / eta / max(w, 1e-6))
 
+    def _ff_step(self) -> float:
+        """The feedforward pitch's change since the last step [rad]."""
+        ff = self.pitch_feedforward
+        if ff is None:
+            self._ff_last = None
+            return 0.0
+        d = 0.0 if self._ff_last is None else ff - self._ff_last
+        self._ff_last = ff
+        return d
+
     def _reference(self, t: float) -> float | None:
         if self.power_reference is None:
             return None
@@ -404,7 +418,7 @@ class BaselineController(ControllerBase):
             gk = 1.0 / (1.0 + self.last_pitch / g.theta_k_rad)
             if first:                       # bumpless start at the measured pitch
                 self.integral = (pitch_meas / gk - g.kp * err) / g.ki
-            self.integral += err * self.dt
+            self.integral += err * self.dt + self._ff_step() / (gk * g.ki)
             # anti-windup: keep the integral term within the pitch limits
             lo, hi = self.pitch_min / (gk * g.ki), self.pitch_max / (gk * g.ki)
             self.integral = min(max(self.integral, lo), hi)
@@ -429,8 +443,8 @@ class BaselineController(ControllerBase):
                 eta = self.turbine.drivetrain.generator_efficiency
                 ff = (p_ref - self._p_ref_last) / eta / dpdt
                 self._p_ref_last = p_ref
-            self.integral = min(max(self.integral + ki * err * self.dt + ff, self.pitch_min),
-                                self.pitch_max)
+            self.integral = min(max(self.integral + ki * err * self.dt + ff + self._ff_step(),
+                                    self.pitch_min), self.pitch_max)
             cmd = kp * err + self.integral
         cmd = min(max(cmd, self.pitch_min), self.pitch_max)
         step = self.rate * self.dt

@@ -7,6 +7,7 @@ loop, :mod:`mpc_wt.discon`).
 """
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from typing import Any, Optional
 
@@ -558,3 +559,52 @@ def _export_rosco(turbine: linearize.Turbine, power_fraction: float) -> str:
     out = tempfile.mkdtemp(prefix="mpcwt_rosco_export_")
     doc = baseline_table(turbine, tune_baseline(turbine, power_fraction=power_fraction))
     return str(write_rosco_discon(turbine, doc, out)[0])
+
+
+# -- LIDAR collective pitch feedforward -------------------------------------------------------
+@dataclass(frozen=True)
+class LidarFFOptions(Options):
+    """Collective pitch feedforward from the CW LIDAR (:class:`mpc_wt.lidar_ff.LidarFeedforward`)."""
+
+    lidar: LidarOptions = option(LidarOptions(), help="CW LIDAR settings (focus_distance, "
+                                 "range_weighting, los_error, ...)", flag="")
+    filter_corner_hz: Optional[float] = option(None, help="low-pass corner of the wind estimate "
+                                               "(default: where the coherence of the LIDAR's "
+                                               "and the rotor's effective wind falls to 0.5 on "
+                                               "the run's field)", unit="Hz",
+                                               lo=0.0, lo_open=True, flag="--ff-corner-hz")
+    lead_time: Optional[float] = option(None, help="lead of the pitch over the wind's arrival "
+                                        "(default: actuator time constant + 1 / omega_c)",
+                                        unit="s", lo=0.0, flag="--ff-lead-time")
+
+
+@register("lidar-ff", LidarFFOptions, addon_to=("baseline", "derate"), default_base="baseline",
+          group="the lidar feedforward",
+          summary="collective pitch feedforward from the CW LIDAR on a baseline "
+                  "(baseline+lidar-ff, derate80+lidar-ff)")
+def _build_lidar_ff(ctx: BuildContext, opts: LidarFFOptions, base: Built) -> Built:
+    import lidar
+
+    from ..lidar_ff import LidarFeedforward, rews_coherence_corner
+
+    given = opts.lidar.given()
+    try:
+        cw = lidar.CWLidar(ctx.turbine.geometry.tip_radius, **given)
+    except (TypeError, ValueError) as err:
+        raise ValueError(f"lidar options: {err}") from err
+    v = ctx.scenario.wind_mps
+    if opts.filter_corner_hz is None:
+        corner = ctx.cache.get(ctx.turbine, ("lidar-ff-corner", v, ctx.scenario.turbulence,
+                                             ctx.scenario.seed, tuple(sorted(given.items()))),
+                               lambda: rews_coherence_corner(cw, ctx.field, ctx.turbine, v))
+    else:
+        corner = 2.0 * math.pi * opts.filter_corner_hz
+    frac = base.power_fraction
+    ctl = LidarFeedforward(base.controller, cw, ctx.field, ctx.turbine, mean_wind_mps=v,
+                           corner_rad_s=corner, lead_s=opts.lead_time,
+                           power_W=None if frac == 1.0
+                           else frac * ctx.turbine.operation.rated_power)
+    meta = {"corner_rad_s": corner, "lead_s": ctl.lead, "preview_time_s": ctl.preview_time,
+            "focus_distance_m": cw.focus_distance}
+    return Built(ctl, base.controller_dt, base.preview, {**base.meta, "lidar_ff": meta},
+                 base.power_fraction)

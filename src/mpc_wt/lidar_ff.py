@@ -1,0 +1,177 @@
+"""Collective pitch feedforward from a CW LIDAR on the baseline PI (Schlipf et al. 2013,
+"LIDAR-assisted collective pitch control"; Schlipf 2015, dissertation, ch. 5).
+
+At each LIDAR sample the rotor-effective wind is estimated as the mean of the three beams'
+reconstructed speeds, low-pass filtered (first order, corner at the LIDAR-rotor coherence
+bandwidth: the wavenumber k_c where the coherence falls to 0.5, omega_c = k_c V), and stored
+under the time it reaches the rotor, t + T_p (T_p = focus distance / mean wind). At control
+time t the feedforward pitch is the static pitch curve theta_ss(v) of the trim at the filtered
+wind due at t + tau, tau = the actuator's time constant + the filter's delay 1 / omega_c, so the
+pitch arrives when the wind does. Its change enters the PI's integral at every step
+(:attr:`mpc_wt.baseline.BaselineController.pitch_feedforward`), so the feedback acts on what the
+feedforward leaves and the two never fight.
+"""
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+
+import linearize
+
+from .simulate import ControllerBase
+
+__all__ = ["LidarFeedforward", "static_pitch_curve"]
+
+
+def static_pitch_curve(turbine: linearize.Turbine, power_W: float | None = None
+                       ) -> tuple[np.ndarray, np.ndarray]:
+    """theta_ss(v): the trimmed collective pitch over wind, cut-in to cut-out every 0.5 m/s.
+
+    Parameters
+    ----------
+    turbine : Turbine
+    power_W : float, optional
+        A derated power reference [W].
+
+    Returns
+    -------
+    wind : (n,) ndarray
+        [m/s]
+    pitch : (n,) ndarray
+        [rad]
+    """
+    op = turbine.operation
+    v = np.arange(op.cut_in_wind, op.cut_out_wind + 1e-9, 0.5)
+    pts = linearize.operating_schedule(turbine, v, power_W)
+    return v, np.array([p.pitch_rad for p in pts])
+
+
+class LidarFeedforward(ControllerBase):
+    """The baseline PI with LIDAR collective pitch feedforward.
+
+    Parameters
+    ----------
+    base : BaselineController
+        The feedback controller (derated or not).
+    lidar_model : lidar.CWLidar
+        The instrument (range weighting and line-of-sight error on by default).
+    field : lidar.WindField
+        The wind field the plant meets.
+    turbine : Turbine
+        For the static pitch curve and the actuator lag.
+    mean_wind_mps : float
+        The preview time's mean wind [m/s].
+    corner_rad_s : float
+        The estimate's low-pass corner omega_c [rad/s].
+    lead_s : float, optional
+        tau [s]; default the actuator time constant + 1 / omega_c.
+    sample_dt : float
+        LIDAR sample period [s] (default 0.1).
+    power_W : float, optional
+        A derated design's power for its pitch curve [W].
+    """
+
+    def __init__(self, base: Any, lidar_model: Any, field: Any, turbine: linearize.Turbine, *,
+                 mean_wind_mps: float, corner_rad_s: float, lead_s: float | None = None,
+                 sample_dt: float = 0.1, power_W: float | None = None) -> None:
+        if not (math.isfinite(corner_rad_s) and corner_rad_s > 0):
+            raise ValueError(f"corner_rad_s must be > 0, got {corner_rad_s!r}")
+        if not (math.isfinite(mean_wind_mps) and mean_wind_mps > 0):
+            raise ValueError(f"mean_wind_mps must be > 0, got {mean_wind_mps!r}")
+        self.base, self.lidar, self.field = base, lidar_model, field
+        self.dt = base.dt
+        self.corner = float(corner_rad_s)
+        self.lead = (turbine.pitch_actuator.time_constant + 1.0 / self.corner
+                     if lead_s is None else float(lead_s))
+        self.preview_time = lidar_model.preview_time(mean_wind_mps)
+        if self.lead > self.preview_time:
+            raise ValueError(f"lead time {self.lead:.3g} s exceeds the preview time "
+                             f"{self.preview_time:.3g} s (focus {lidar_model.focus_distance:g} m "
+                             f"at {mean_wind_mps:g} m/s): focus further upstream or raise "
+                             f"the filter corner")
+        self.sample_dt = float(sample_dt)
+        self.curve_v, self.curve_pitch = static_pitch_curve(turbine, power_W)
+        self.reset()
+
+    def reset(self) -> None:
+        """Forget the measurements and the filter; reset the base."""
+        self.base.reset()
+        self._arrival: list[float] = []
+        self._v: list[float] = []
+        self._vf: float | None = None
+        self._next = -math.inf
+        self.signals: dict[str, float] = {}
+
+    def _sample(self, t: float, meas: dict[str, Any]) -> None:
+        m = self.lidar.measure(self.field, np.array([t]), np.array([float(meas["azimuth"])]),
+                               float(meas["rotor_speed"]))
+        u = float(np.mean(m.u_hat[0]))
+        a = math.exp(-self.corner * self.sample_dt)
+        self._vf = u if self._vf is None else a * self._vf + (1.0 - a) * u
+        self._arrival.append(t + self.preview_time)
+        self._v.append(self._vf)
+
+    def step(self, t: float, meas: dict[str, Any]) -> tuple[np.ndarray, float]:
+        """Sample the LIDAR when due, set the feedforward pitch, step the PI.
+
+        Parameters
+        ----------
+        t : float
+            Control time; the LIDAR samples when a sample period has passed [s].
+        meas : dict
+            The harness's measurements; ``azimuth`` and ``rotor_speed`` aim the beams.
+
+        Returns
+        -------
+        pitch_ref : (3,) ndarray
+            The PI's command with the feedforward in its integral [rad].
+        gen_torque_ref : float
+            The baseline's torque demand [N m].
+        """
+        if t >= self._next - 1e-9:
+            self._sample(t, meas)
+            self._next = t + self.sample_dt
+        v = float(np.interp(t + self.lead, self._arrival, self._v))
+        ff = float(np.interp(v, self.curve_v, self.curve_pitch))
+        self.base.pitch_feedforward = ff
+        out = self.base.step(t, meas)
+        self.signals = {**self.base.signals, "ff_wind": v, "ff_pitch": ff}
+        return out
+
+
+def rews_coherence_corner(lidar_model: Any, field: Any, turbine: linearize.Turbine,
+                          mean_wind_mps: float, sample_dt: float = 0.1) -> float:
+    """The feedforward filter's corner from the coherence between the LIDAR's rotor-effective
+    wind estimate (mean of the three beams, moved by T_p) and the true rotor-effective wind of
+    the field (disc average, :func:`lidar.rotor_effective_wind`) where it falls to 0.5
+    (Schlipf 2015, sec. 5.2: the filter passes what the LIDAR can see of the rotor's wind).
+
+    Parameters
+    ----------
+    lidar_model : lidar.CWLidar
+    field : lidar.WindField
+    turbine : Turbine
+        Rotor radius and the rotor speed of the trim (the beams turn with it).
+    mean_wind_mps : float
+        [m/s]
+    sample_dt : float
+        LIDAR sample period [s].
+
+    Returns
+    -------
+    float
+        omega_c [rad/s].
+    """
+    import lidar
+
+    tp = lidar_model.preview_time(mean_wind_mps)
+    t = np.arange(field.t[0], field.t[-1] - tp - 1e-9, sample_dt)
+    omega = linearize.trim(turbine, mean_wind_mps).rotor_speed_rad_s
+    m = lidar_model.measure(field, t, omega * t, omega)
+    est = m.u_hat.mean(axis=1)
+    truth = np.interp(t + tp, field.t, lidar.rotor_effective_wind(
+        field, turbine.geometry.tip_radius))
+    f, g2 = lidar.coherence(est - est.mean(), truth - truth.mean(), 1.0 / sample_dt)
+    return 2.0 * math.pi * lidar.coherence_bandwidth(f, g2)

@@ -1,0 +1,93 @@
+"""Issue 21: collective pitch feedforward from the CW LIDAR on the baseline (mpc_wt.lidar_ff)."""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import lidar
+import linearize
+from mpc_wt.baseline import BaselineController, tune_baseline
+from mpc_wt.controllers import run_controller
+from mpc_wt.lidar_ff import LidarFeedforward, rews_coherence_corner, static_pitch_curve
+from mpc_wt.simulate import simulate_closed_loop
+
+
+def _gust_field(v: float, dv: float, t_gust: float, ramp: float, hub: float) -> lidar.WindField:
+    t = np.arange(0.0, 40.0, 0.05)
+    y = np.linspace(-80.0, 80.0, 9)
+    z = hub + np.linspace(-80.0, 80.0, 9)
+    u_t = v + dv * np.clip((t - t_gust) / ramp, 0.0, 1.0)
+    u = np.broadcast_to(u_t[:, None, None], (t.size, y.size, z.size)).copy()
+    zero = np.zeros_like(u)
+    return lidar.WindField(t=t, y=y, z=z, u=u, v=zero, w=zero, mean_speed=v, hub_height=hub)
+
+
+def test_feedforward_arrives_with_the_wind(turbine) -> None:
+    """A frozen, uniform gust (18 -> 20 m/s, a 1 s ramp at the rotor from t = 20 s) measured by
+    an ideal LIDAR (no range weighting, no line-of-sight error) 3 s ahead: the feedforward's
+    wind crosses 19 m/s within one controller step (12.5 ms) of 20.5 s minus the lead (the
+    actuator's 0.1 s and the filter's 1 / omega_c, here 3 ms), and its pitch is the trim's
+    static pitch at that wind."""
+    v = 18.0
+    field = _gust_field(v, 2.0, 20.0, 1.0, turbine.geometry.hub_height)
+    cw = lidar.CWLidar(turbine.geometry.tip_radius, range_weighting=False, los_error=False)
+    g = tune_baseline(turbine)
+    base = BaselineController(turbine, g)
+    ctl = LidarFeedforward(base, cw, field, turbine, mean_wind_mps=v, corner_rad_s=300.0)
+    assert ctl.lead == pytest.approx(0.1 + 1.0 / 300.0)
+    p = linearize.plant_params(turbine)
+    op = linearize.trim(turbine, v, params=p)
+    wind = linearize.GridWind(t=field.t, y=field.y, z=field.z, u=field.u)
+    res = simulate_closed_loop(p, ctl, wind, 30.0, x0=op.x, u0=op.u)
+    vf = res.controller["ff_wind"]
+    k = int(np.argmax(vf >= 19.0))
+    t_cross = np.interp(19.0, vf[k - 1:k + 1], res.t[k - 1:k + 1])
+    assert abs(t_cross - (20.5 - ctl.lead)) <= 0.0125
+    curve_v, curve_p = static_pitch_curve(turbine)
+    np.testing.assert_allclose(res.controller["ff_pitch"][-1], np.interp(20.0, curve_v, curve_p),
+                               rtol=1e-9)
+
+
+def test_filter_corner_follows_the_coherence_bandwidth(turbine) -> None:
+    """The corner is where the coherence of the LIDAR's and the rotor's effective wind falls to
+    0.5; with frozen turbulence it is a wavenumber, so omega_c / V holds between 12 and 18 m/s
+    (class A, seed 3: within 25 %), and the realistic LIDAR (range weighting, line-of-sight
+    error) sees less of the rotor's wind than the ideal one (lower corner)."""
+    cw = lidar.CWLidar(turbine.geometry.tip_radius)
+    ideal = lidar.CWLidar(turbine.geometry.tip_radius, range_weighting=False, los_error=False)
+    k = {}
+    for v in (12.0, 18.0):
+        spec = lidar.TurbulenceSpec(v, "A", hub_height=turbine.geometry.hub_height,
+                                    duration=400.0)
+        f = lidar.generate_field(spec, 3)
+        k[v] = rews_coherence_corner(cw, f, turbine, v) / v
+        if v == 18.0:
+            assert rews_coherence_corner(ideal, f, turbine, v) / v > k[v]
+    assert k[18.0] == pytest.approx(k[12.0], rel=0.25)
+    assert 0.005 < k[18.0] < 0.2                   # rad/m
+
+
+def test_feedforward_lowers_speed_variation_at_18ms() -> None:
+    """18 m/s, class A, seed 1, 600 s, the realistic LIDAR at 54 m: rotor-speed std at least
+    20 % below the baseline's and pitch travel at most 25 % above it (the issue's bounds;
+    measured -40.5 % and +20 %; published results with realistic LIDARs: 30-50 % lower)."""
+    t = linearize.load_turbine()
+    out = {}
+    for kind in ("baseline", "baseline+lidar-ff"):
+        res = run_controller(t, kind, 18.0, "A", 1, 600.0)
+        k = res.t >= 30.0
+        out[kind] = (res.channel("rotor_speed")[k].std(),
+                     np.abs(np.diff(res.channel("pitch_1")[k])).sum())
+    b, f = out["baseline"], out["baseline+lidar-ff"]
+    assert f[0] <= 0.80 * b[0]
+    assert f[1] <= 1.25 * b[1]
+
+
+def test_bad_feedforward_settings_are_named(turbine) -> None:
+    field = _gust_field(18.0, 0.0, 10.0, 1.0, turbine.geometry.hub_height)
+    cw = lidar.CWLidar(turbine.geometry.tip_radius, focus_distance=10.0)
+    base = BaselineController(turbine, tune_baseline(turbine))
+    with pytest.raises(ValueError, match=r"lead time .* exceeds the preview time"):
+        LidarFeedforward(base, cw, field, turbine, mean_wind_mps=18.0, corner_rad_s=0.3)
+    with pytest.raises(ValueError, match=r"corner_rad_s must be > 0"):
+        LidarFeedforward(base, cw, field, turbine, mean_wind_mps=18.0, corner_rad_s=-1.0)
