@@ -25,6 +25,7 @@ from __future__ import annotations
 import dataclasses
 import logging
 import math
+import time
 from dataclasses import dataclass, field
 from types import SimpleNamespace
 from typing import Any
@@ -888,8 +889,10 @@ class MPC(ControllerBase):
                 raise ValueError(f"preview has shape {dprev.shape}; expected (H_p, n_d) = "
                                  f"({self.hp}, {self._nd})")
             z[1 + nx + nu:] = dprev.ravel()
+        t_qp = time.perf_counter()
         v, status = self._solve_z(dprev is not None, st,
                                   self._up0 if self._u_prev is None else self._u_prev)
+        qp_ms = 1e3 * (time.perf_counter() - t_qp)
         fallback = 0.0
         if v is None:
             if self._plan is not None and len(self._plan) > nu:
@@ -906,7 +909,7 @@ class MPC(ControllerBase):
         self._u_prev = du
         u = self._u_abs(du)
         self.signals = {"qp_fallback": fallback, "pitch_ref_1": u[0], "torque_ref": u[3],
-                        "rotor_speed_slack": self._last_slack}
+                        "rotor_speed_slack": self._last_slack, "qp_solve_ms": qp_ms}
         if self.estimator is not None:
             self.signals.update(self.signals_est)
         return u[:3], float(u[3])

@@ -353,3 +353,44 @@ def plot_design(doc: dict[str, Any], path: str | Path) -> Path:
     ax.grid(True, alpha=0.3)
     ax.legend(fontsize=7)
     return _save(fig, path)
+
+
+def plot_comparison(runs: Sequence[tuple[str, np.ndarray, dict[str, np.ndarray]]],
+                    path: str | Path) -> list[str]:
+    """Rotor speed, collective pitch, blade-1 flap moment and tower-base fore-aft moment of
+    several runs over time, one panel each, as PNG.
+
+    Parameters
+    ----------
+    runs : sequence of (str, (n_t,) ndarray, dict)
+        Label, time [s] and channels of each run.
+    path : str or Path
+        The PNG file.
+
+    Returns
+    -------
+    list of str
+        The file written.
+    """
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    panels = (("rotor_speed", 30 / np.pi, "rotor speed [rpm]"),
+              ("pitch_1", 180 / np.pi, "pitch [deg]"),
+              ("flap_moment_1", 1e-6, "flap moment, blade 1 [MN m]"),
+              ("tower_base_fa_moment", 1e-6, "tower-base fore-aft [MN m]"))
+    fig, axes = plt.subplots(len(panels), 1, figsize=(9, 9), sharex=True)
+    for ax, (ch, scale, label) in zip(axes, panels):
+        for name, t, cols in runs:
+            if ch in cols:
+                ax.plot(t, cols[ch] * scale, lw=0.7, label=name)
+        ax.set_ylabel(label)
+    axes[0].legend(loc="upper right", fontsize=8)
+    axes[-1].set_xlabel("time [s]")
+    fig.tight_layout()
+    p = Path(path)
+    p.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(p, dpi=110)
+    plt.close(fig)
+    return [str(p)]

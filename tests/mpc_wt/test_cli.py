@@ -43,13 +43,23 @@ def test_cp_surface_csv_and_plot(tmp_path: Path, capsys: pytest.CaptureFixture[s
 
 
 def test_run_writes_table_and_plots(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """The main job (issue 21): steady outputs, the linear models, the baseline's gain tables
+    (CSV, JSON, ROSCO), and baseline, baseline + LIDAR feedforward and MPC with LIDAR preview
+    on one field, compared in one table (the MPC's QP times in it) and plots."""
     assert main(["run", "--out", str(tmp_path), "--duration", "30"]) == 0
     out = capsys.readouterr().out
     assert "rated wind speed" in out and out.count("\n") > 20
     for name in ("operating_points.csv", "operating_points.json", "cp_surface.csv",
-                 "cp_surface.png", "operating_schedule.png", "baseline_run.nc",
-                 "baseline_assessment.json", "cs_ellipses.png", "psd_flap_moment_1.png"):
+                 "cp_surface.png", "operating_schedule.png", "linear_models.mat",
+                 "gains/gains.json", "gains/gains_schedule.csv", "gains/DISCON.IN",
+                 "baseline_run.nc", "baseline_lidar-ff_run.nc", "mpc-lidar_run.nc",
+                 "comparison.json", "comparison.png", "cs_ellipses.png",
+                 "psd_flap_moment_1.png"):
         assert (tmp_path / name).stat().st_size > 100, name
+    rows = json.loads((tmp_path / "comparison.json").read_text())
+    assert [r["controller"] for r in rows] == ["baseline", "baseline+lidar-ff", "mpc-lidar"]
+    assert rows[2]["qp_median_ms"] > 0 and rows[0]["qp_median_ms"] is None
+    assert "mpc-lidar" in out and "QP med/p99" in out
     pts = json.loads((tmp_path / "operating_points.json").read_text())
     assert pts[0]["wind_mps"] == 3.0 and pts[-1]["wind_mps"] == 25.0
 

@@ -33,15 +33,19 @@ def add_parsers(sub: Any) -> None:
     sub : argparse subparsers action
         Of the top-level parser.
     """
-    p = sub.add_parser("run", help="main job: operating table, C_P surface, baseline run, "
-                                   "assessment, plots")
+    p = sub.add_parser("run", help="main job: operating table, C_P surface, linear models, "
+                                   "gain tables, and baseline / baseline + LIDAR feedforward / "
+                                   "MPC with LIDAR preview on one field, compared")
     add_turbine(p)
     p.add_argument("--out", default="mpcwt-out", help="output directory (default mpcwt-out)")
     p.add_argument("--wind", type=float, default=18.0, help="wind of the baseline run [m/s]")
     p.add_argument("--turbulence", choices=("A", "B", "C", "steady"), default="A")
     p.add_argument("--seed", type=int, default=1)
     p.add_argument("--duration", type=float, default=600.0,
-                   help="baseline run length [s] (0 skips the run)")
+                   help="length of the closed-loop runs [s] (0 skips them)")
+    p.add_argument("--controllers", default="baseline,baseline+lidar-ff,mpc-lidar",
+                   help="comma list of the controllers compared (default baseline, "
+                        "baseline+lidar-ff, mpc-lidar)")
     p.set_defaults(func=_run)
     _add_simulate(sub)
     _add_assess(sub)
@@ -217,9 +221,83 @@ def _run(args: argparse.Namespace) -> int:
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     _steady_outputs(turbine, out)
+    _design_outputs(turbine, out)
     if args.duration > 0:
-        _baseline_run(turbine, args, out)
+        _comparison_runs(turbine, args, out)
     return 0
+
+
+def _design_outputs(turbine: linearize.Turbine, out: Path) -> None:
+    """The linear model family and the baseline's gain tables (CSV, JSON, ROSCO)."""
+    from ..baseline import tune_baseline
+    from ..export import baseline_table, export
+
+    fam = linearize.linearize_family(turbine, progress=True)
+    fam.save(out / "linear_models.mat")
+    g = tune_baseline(turbine)
+    doc = baseline_table(turbine, g)
+    files = [f for fmt in ("csv", "json", "rosco")
+             for f in export(doc, fmt, out / "gains", turbine)]
+    published = (" (published 0.01883, 0.00807, 6.30 deg, 2.3323)"
+                 if turbine.name.startswith("NREL 5-MW") else "")
+    print(f"# baseline tuned from the linear models: KP {g.kp:.5g} s, KI {g.ki:.5g}, "
+          f"theta_K {math.degrees(g.theta_k_rad):.2f} deg, K_opt {g.k_opt:.5g} "
+          f"N m/(rad/s)^2{published}")
+    print(f"# wrote {out}/linear_models.mat ({len(fam.models)} models, "
+          f"{fam.models[0].n_x} states), " + ", ".join(str(f.relative_to(out)) for f in files))
+
+
+def _comparison_row(name: str, a: dict[str, Any], cols: dict[str, np.ndarray],
+                    qp: Any, fname: str) -> dict[str, Any]:
+    return {"controller": name, "power_mean_MW": a["power_mean_W"] / 1e6,
+            "power_std_kW": a["power_std_W"] / 1e3,
+            "rotor_speed_std_rpm": float(np.std(cols["rotor_speed"])) * 30 / math.pi,
+            "pitch_travel_deg": a["pitch_travel_deg"],
+            **{f"del_{c}_MNm": a["channels"][c]["del"] / 1e6
+               for c in ("flap_moment_1", "tower_base_fa_moment", "shaft_bending_blade1")
+               if c in a["channels"]},
+            "qp_median_ms": float(np.median(qp)) if qp is not None else None,
+            "qp_p99_ms": float(np.percentile(qp, 99)) if qp is not None else None,
+            "file": fname}
+
+
+def _comparison_runs(turbine: linearize.Turbine, args: argparse.Namespace, out: Path) -> None:
+    """The controllers on one field, assessed and compared in one table and plots."""
+    from ..assess import assess_series
+    from ..controllers import run_controller
+    from ..plotting import assess_plots, plot_comparison
+
+    names = [c.strip() for c in args.controllers.split(",") if c.strip()]
+    rows, runs = [], []
+    for name in names:
+        res = run_controller(turbine, name, args.wind, args.turbulence, args.seed,
+                             args.duration, progress=True)
+        fname = name.replace("+", "_") + "_run.nc"
+        res.save(out / fname)
+        keep = res.t >= min(60.0, 0.1 * args.duration)
+        cols = {n: res.channel(n)[keep] for n in res.channels()}
+        a = assess_series(res.t[keep], cols)
+        rows.append(_comparison_row(name, a, cols, res.controller.get("qp_solve_ms"), fname))
+        runs.append((name, res.t[keep], cols))
+    (out / "comparison.json").write_text(json.dumps(rows, indent=1))
+    made = assess_plots(runs, out) + plot_comparison(runs, out / "comparison.png")
+    print(f"# {args.duration:g} s at {args.wind:g} m/s, turbulence {args.turbulence}, seed "
+          f"{args.seed}, the same field for all")
+    print(f"{'controller':20s} {'P mean':>8s} {'P std':>8s} {'speed std':>9s} "
+          f"{'pitch':>7s} {'DEL flap':>9s} {'DEL tower':>9s} {'DEL shaft':>9s} "
+          f"{'QP med/p99':>12s}")
+    print(f"{'':20s} {'[MW]':>8s} {'[kW]':>8s} {'[rpm]':>9s} {'[deg]':>7s} {'[MN m]':>9s} "
+          f"{'[MN m]':>9s} {'[MN m]':>9s} {'[ms]':>12s}")
+    for r in rows:
+        qp = (f"{r['qp_median_ms']:.2f}/{r['qp_p99_ms']:.2f}" if r["qp_median_ms"] is not None
+              else "-")
+        print(f"{r['controller']:20s} {r['power_mean_MW']:8.3f} {r['power_std_kW']:8.1f} "
+              f"{r['rotor_speed_std_rpm']:9.3f} {r['pitch_travel_deg']:7.0f} "
+              f"{r.get('del_flap_moment_1_MNm', float('nan')):9.3f} "
+              f"{r.get('del_tower_base_fa_moment_MNm', float('nan')):9.3f} "
+              f"{r.get('del_shaft_bending_blade1_MNm', float('nan')):9.3f} {qp:>12s}")
+    print(f"# wrote {out}/comparison.json, " + ", ".join(r["file"] for r in rows) + ", "
+          + ", ".join(Path(m).name for m in made))
 
 
 def _steady_outputs(turbine: linearize.Turbine, out: Path) -> None:
@@ -247,34 +325,3 @@ def _steady_outputs(turbine: linearize.Turbine, out: Path) -> None:
                             title=f"{turbine.name}: steady operating schedule")
     print(f"# wrote {out}/operating_points.csv, operating_points.json, cp_surface.csv, "
           f"cp_surface.png, operating_schedule.png")
-
-
-def _baseline_run(turbine: linearize.Turbine, args: argparse.Namespace, out: Path) -> None:
-    """The main job's closed loop: the tuned baseline on one turbulent field, assessed."""
-    from ..assess import assess_series
-    from ..baseline import tune_baseline
-    from ..controllers import run_controller
-    from ..plotting import assess_plots
-
-    g = tune_baseline(turbine)
-    published = (" (published 0.01883, 0.00807, 6.30 deg, 2.3323)"
-                 if args.turbine == "nrel5mw" else "")
-    print(f"# baseline tuned from the linear models: KP {g.kp:.5g} s, KI {g.ki:.5g}, "
-          f"theta_K {math.degrees(g.theta_k_rad):.2f} deg, K_opt {g.k_opt:.5g} "
-          f"N m/(rad/s)^2{published}")
-    res = run_controller(turbine, "baseline", args.wind, args.turbulence, args.seed,
-                         args.duration, progress=True)
-    res.save(out / "baseline_run.nc")
-    keep = res.t >= min(60.0, 0.1 * args.duration)
-    cols = {n: res.channel(n)[keep] for n in res.channels()}
-    a = assess_series(res.t[keep], cols)
-    (out / "baseline_assessment.json").write_text(json.dumps(a, indent=1))
-    assess_plots([("baseline", res.t[keep], cols)], out)
-    print(f"# {args.duration:g} s at {args.wind:g} m/s, turbulence {args.turbulence}, "
-          f"seed {args.seed}: mean power {a['power_mean_W'] / 1e6:.3f} MW, power std "
-          f"{a['power_std_W'] / 1e3:.1f} kW, gen speed std {a['gen_speed_std_rad_s']:.2f} "
-          f"rad/s, pitch travel {a['pitch_travel_deg']:.0f} deg")
-    for name, d in a["channels"].items():
-        print(f"#   DEL {name:22s} {d['del']:12.4g} N m (m = {d['m']:g})")
-    print(f"# wrote {out}/baseline_run.nc, baseline_assessment.json, cs_ellipses.png, "
-          f"psd_flap_moment_1.png")

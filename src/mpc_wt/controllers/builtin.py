@@ -594,8 +594,9 @@ def _build_lidar_ff(ctx: BuildContext, opts: LidarFFOptions, base: Built) -> Bui
         raise ValueError(f"lidar options: {err}") from err
     v = ctx.scenario.wind_mps
     if opts.filter_corner_hz is None:
-        corner = ctx.cache.get(ctx.turbine, ("lidar-ff-corner", v, ctx.scenario.turbulence,
-                                             ctx.scenario.seed, tuple(sorted(given.items()))),
+        # keyed on the whole scenario: the estimate depends on the field's length too
+        corner = ctx.cache.get(ctx.turbine, ("lidar-ff-corner", ctx.scenario,
+                                             tuple(sorted(given.items()))),
                                lambda: rews_coherence_corner(cw, ctx.field, ctx.turbine, v))
     else:
         corner = 2.0 * math.pi * opts.filter_corner_hz
