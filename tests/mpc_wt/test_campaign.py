@@ -261,12 +261,35 @@ def test_report_tables_and_plots(tmp_path):
     assert lss["derate80"]["change_pct"] < 0
     aep = {r["controller"]: r for r in agg["aep"]}
     assert aep["derate80"]["change_pct"] < -3
+    # regulation (issue 21): the rotor-speed std of each case from its own result file,
+    # averaged over seeds and weighted over the two winds as the report says
+    from mpc_wt.results import ClosedLoopResult
+    reg = {r["controller"]: r for r in agg["regulation"]}
+    assert reg["baseline"]["rotor_speed_std_rad_s_change_pct"] == 0.0
+    p = _probs_rayleigh([10.0, 14.0], 10.0)
+    by_wind = {10.0: [], 14.0: []}
+    for row in agg["rows"]:
+        if row.controller == "baseline":
+            res = ClosedLoopResult.load(tmp_path / row.file)
+            k = res.t >= res.t[0] + spec.transient
+            by_wind[row.wind_mps].append(res.channel("rotor_speed")[k].std())
+    want = sum(pw * np.mean(by_wind[v]) for pw, v in zip(p, (10.0, 14.0))) / p.sum()
+    assert reg["baseline"]["rotor_speed_std_rad_s"] == pytest.approx(want, rel=1e-9)
     rep = make_report(tmp_path)
     text = Path(rep).read_text()
     assert "Pettas fig. 5" in text and "lss_torque" in text
+    assert "## Regulation and 1P content" in text
     for f in ("lifetime_del.csv", "short_term_del.csv", "aep.csv", "del_vs_wind.png",
               "lifetime_del.png", "cs_ellipses.png", "psd.png"):
         assert (Path(rep).parent / f).is_file(), f
+
+
+def _probs_rayleigh(winds, mean):
+    """Rayleigh probabilities of bins centred on ``winds`` (edges halfway), as IEC 61400-1."""
+    w = np.asarray(winds, float)
+    edges = np.r_[w[0] - (w[1] - w[0]) / 2, (w[1:] + w[:-1]) / 2, w[-1] + (w[-1] - w[-2]) / 2]
+    cdf = 1 - np.exp(-np.pi / 4 * (edges / mean) ** 2)
+    return np.diff(cdf)
 
 
 def test_report_refuses_empty_campaign(tmp_path):

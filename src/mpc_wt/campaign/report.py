@@ -30,6 +30,9 @@ __all__ = ["aggregate", "make_report"]
 #: suspect in the report: with m = 10 one such run can carry a lifetime DEL.
 OUTLIER_RATIO = 3.0
 _PITCH = ("pitch_travel_deg", "pitch_rate_std_degps", "pitch_acc_std_degps2")
+#: regulation measures: metric key, or (key, sub-key) for nested metrics
+_REGULATION = (("rotor_speed_std_rad_s",), ("power_std_W",), ("flap_1_harmonics", "1P"),
+               ("flap_1_harmonics", "3P"))
 _CS = ("cs1", "cs2", "cs3", "cs4", "cs5")
 
 
@@ -81,8 +84,15 @@ def _seed_dels(cases: list[CaseRow], ch: str) -> tuple[np.ndarray, np.ndarray]:
             np.array([r.get("n_eq", 1.0) for r in rows], float))
 
 
-def _bin_mean(cases: list[CaseRow], key: str) -> float | None:
-    v = [c.metrics.get(key) for c in cases if c.metrics.get(key) is not None]
+def _metric(c: CaseRow, key: str | tuple[str, ...]) -> Any:
+    v: Any = c.metrics
+    for k in (key,) if isinstance(key, str) else key:
+        v = v.get(k) if isinstance(v, dict) else None
+    return v
+
+
+def _bin_mean(cases: list[CaseRow], key: str | tuple[str, ...]) -> float | None:
+    v = [_metric(c, key) for c in cases if _metric(c, key) is not None]
     return float(np.mean(v)) if v else None
 
 
@@ -183,20 +193,26 @@ class _Group:
             row["change_pct"] = _pct(b, a)
         return [row]
 
-    def pitch(self) -> dict[str, Any]:
+    def pitch(self, keys: Sequence[Any] = _PITCH) -> dict[str, Any]:
         prow: dict[str, Any] = dict(self.key)
-        for k in _PITCH:
+        for k in keys:
             vals = [_bin_mean(self.bins[v], k) for v in self.winds]
             if any(x is None for x in vals):
                 continue
-            prow[k] = float(np.sum(self.p_all * np.asarray(vals)) / self.p_all.sum())
+            name = k if isinstance(k, str) else "_".join(k)
+            prow[name] = float(np.sum(self.p_all * np.asarray(vals)) / self.p_all.sum())
             if self.common:
                 mine = np.sum(self.p_com * np.asarray([_bin_mean(self.bins[v], k)
                                                        for v in self.common]))
                 base = np.sum(self.p_com * np.asarray([_bin_mean(self.rbins[v], k)
                                                        for v in self.common]))
-                prow[f"{k}_change_pct"] = _pct(float(base), float(mine))
+                prow[f"{name}_change_pct"] = _pct(float(base), float(mine))
         return prow
+
+    def regulation(self) -> dict[str, Any]:
+        """Rotor-speed std, power std and the blade-1 flap 1P and 3P content, weighted over
+        the winds like the pitch duty, with their changes against the reference."""
+        return self.pitch(_REGULATION)
 
 
 def _groups(spec: CampaignSpec, rows: list[CaseRow]) -> list[_Group]:
@@ -230,7 +246,8 @@ def aggregate(root: str | Path) -> dict[str, Any]:
     """
     spec, rows = _load(Path(root))
     out: dict[str, Any] = {"spec": spec, "rows": rows, "short_term": [], "per_wind": [],
-                           "lifetime": [], "aep": [], "pitch": [], "cs": [], "extension": [],
+                           "lifetime": [], "aep": [], "pitch": [], "regulation": [], "cs": [],
+                           "extension": [],
                            "sweep": [], "incomplete": [], "outliers": []}
     for g in _groups(spec, rows):
         missing = g.missing_seeds()
@@ -246,6 +263,7 @@ def aggregate(root: str | Path) -> dict[str, Any]:
         out["extension"] += ext
         out["aep"] += g.aep()
         out["pitch"].append(g.pitch())
+        out["regulation"].append(g.regulation())
     for c in spec.controllers:
         f = c.options.get("apc_frequency")
         if f is not None:
@@ -649,6 +667,17 @@ def _md_more(agg: dict[str, Any]) -> list[str]:
                                       "damage_15_5", "extension_years"],
                    ["controller", "turbulence", "channel", "m", "damage after 20 y",
                     "extension [years]"]), ""]
+    reg = ["rotor_speed_std_rad_s", "power_std_W", "flap_1_harmonics_1P",
+           "flap_1_harmonics_3P"]
+    md += ["## Regulation and 1P content", "",
+           "Wind-weighted like the pitch duty; changes against the reference. The nP content "
+           "is the variance of the blade-1 flap moment in a band around n times the rotor "
+           "frequency.", "",
+           _md(agg["regulation"], ["controller", "turbulence", *reg,
+                                   *[f"{k}_change_pct" for k in reg]],
+               ["controller", "turbulence", "speed std [rad/s]", "power std [W]",
+                "flap 1P [(N m)^2]", "flap 3P [(N m)^2]", "speed std [%]", "power std [%]",
+                "flap 1P [%]", "flap 3P [%]"]), ""]
     md += ["## CS1-CS5 per wind (Do et al.)", "",
            _md(agg["cs"], ["controller", "turbulence", "wind_mps", "cs1", "cs2", "cs3", "cs4",
                            "cs5", "cs1_change_pct", "cs2_change_pct"],
