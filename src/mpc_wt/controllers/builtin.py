@@ -574,8 +574,10 @@ class LidarFFOptions(Options):
                                                "the run's field)", unit="Hz",
                                                lo=0.0, lo_open=True, flag="--ff-corner-hz")
     lead_time: Optional[float] = option(None, help="lead of the pitch over the wind's arrival "
-                                        "(default: actuator time constant + 1 / omega_c)",
-                                        unit="s", lo=0.0, flag="--ff-lead-time")
+                                        "(default: actuator time constant + the filter's "
+                                        "delay)", unit="s", lo=0.0, flag="--ff-lead-time")
+    filter_order: int = option(2, help="order of the low-pass (2: damping 0.7)",
+                               choices=(1, 2), flag="--ff-filter-order")
 
 
 @register("lidar-ff", LidarFFOptions, addon_to=("baseline", "derate"), default_base="baseline",
@@ -603,9 +605,11 @@ def _build_lidar_ff(ctx: BuildContext, opts: LidarFFOptions, base: Built) -> Bui
     frac = base.power_fraction
     ctl = LidarFeedforward(base.controller, cw, ctx.field, ctx.turbine, mean_wind_mps=v,
                            corner_rad_s=corner, lead_s=opts.lead_time,
+                           filter_order=opts.filter_order,
                            power_W=None if frac == 1.0
                            else frac * ctx.turbine.operation.rated_power)
     meta = {"corner_rad_s": corner, "lead_s": ctl.lead, "preview_time_s": ctl.preview_time,
+            "filter_order": opts.filter_order,
             "focus_distance_m": cw.focus_distance}
     return Built(ctl, base.controller_dt, base.preview, {**base.meta, "lidar_ff": meta},
                  base.power_fraction)
