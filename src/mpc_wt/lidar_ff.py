@@ -15,6 +15,7 @@ feedforward leaves and the two never fight.
 """
 from __future__ import annotations
 
+import logging
 import math
 from typing import Any
 
@@ -194,6 +195,11 @@ def rews_coherence_corner(lidar_model: Any, field: Any, turbine: linearize.Turbi
 
     tp = lidar_model.preview_time(mean_wind_mps)
     t = np.arange(field.t[0], field.t[-1] - tp - 1e-9, sample_dt)
+    if t.size * sample_dt < 120.0:
+        logging.getLogger(__name__).warning(
+            "feedforward corner estimated from %.0f s of field only (Welch segments of 25.6 s): "
+            "it scatters; give filter_corner_hz (--ff-corner-hz) for short runs",
+            t.size * sample_dt)
     omega = linearize.trim(turbine, mean_wind_mps).rotor_speed_rad_s
     m = lidar_model.measure(field, t, omega * t, omega)
     est = m.u_hat.mean(axis=1)
