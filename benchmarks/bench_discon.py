@@ -12,9 +12,7 @@ one library call net of our baseline's (the difference over 48,000 calls).
 from __future__ import annotations
 
 import argparse
-import contextlib
 import json
-import os
 import platform
 import time
 import timeit
@@ -22,21 +20,6 @@ import timeit
 import linearize
 from mpc_wt.controllers import Scenario, build_controller
 from mpc_wt.simulate import simulate_closed_loop
-
-
-def _quiet():
-    """ROSCO prints its banner and status lines on the process's stdout: send them away."""
-    devnull = os.open(os.devnull, os.O_WRONLY)
-    saved = os.dup(1)
-
-    @contextlib.contextmanager
-    def cm():
-        os.dup2(devnull, 1)
-        try:
-            yield
-        finally:
-            os.dup2(saved, 1)
-    return cm()
 
 
 def main() -> int:
@@ -56,8 +39,7 @@ def main() -> int:
         def run() -> None:
             simulate_closed_loop(p, built.controller, wind, 600.0, x0=op.x, u0=op.u,
                                  controller_dt=built.controller_dt)
-        with _quiet():
-            best = min(timeit.repeat(run, number=1, repeat=3))
+        best = min(timeit.repeat(run, number=1, repeat=3))
         res[key] = {"seconds": best, "real_time_factor": 600.0 / best}
     res["per_call_us"] = (res["rosco"]["seconds"] - res["baseline"]["seconds"]) / 48000 * 1e6
     if args.json:

@@ -13,9 +13,7 @@ peak shaving) runs beside as the industry's reference.
 from __future__ import annotations
 
 import argparse
-import contextlib
 import json
-import os
 import platform
 import time
 
@@ -26,19 +24,6 @@ import linearize
 from mpc_wt.controllers import run_controller
 
 BOUNDS = {"speed_std": 0.15, "power_mean": 0.005, "pitch_travel": 0.20}
-
-
-@contextlib.contextmanager
-def _quiet():
-    """ROSCO prints its banner and status lines on the process's stdout."""
-    devnull, saved = os.open(os.devnull, os.O_WRONLY), os.dup(1)
-    os.dup2(devnull, 1)
-    try:
-        yield
-    finally:
-        os.dup2(saved, 1)
-        os.close(devnull)
-        os.close(saved)
 
 
 def _metrics(res) -> dict[str, float]:
@@ -58,13 +43,12 @@ def main() -> int:
     rows = []
     for design, v in tqdm(cases, desc="cases"):
         frac = 0.8 if design == "derate80" else 1.0
-        with _quiet():
-            ours = _metrics(run_controller(t, design, v, "A", 1, 600.0))
-            ro = _metrics(run_controller(t, "rosco", v, "A", 1, 600.0,
-                                         options={"power_fraction": frac}))
-            shipped = (_metrics(run_controller(t, "rosco", v, "A", 1, 600.0,
-                                               options={"discon_in": "shipped"}))
-                       if design == "baseline" else None)
+        ours = _metrics(run_controller(t, design, v, "A", 1, 600.0))
+        ro = _metrics(run_controller(t, "rosco", v, "A", 1, 600.0,
+                                     options={"power_fraction": frac}))
+        shipped = (_metrics(run_controller(t, "rosco", v, "A", 1, 600.0,
+                                           options={"discon_in": "shipped"}))
+                   if design == "baseline" else None)
         ratio = {k: ro[k] / ours[k] - 1 for k in ours}
         rows.append({"design": design, "wind_mps": v, "ours": ours, "rosco_export": ro,
                      "rosco_shipped": shipped, "relative": ratio,

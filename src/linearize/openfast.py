@@ -425,7 +425,7 @@ def load_openfast(fst: str | Path | None = None, *, elastodyn: str | Path | None
 
     _check_elastodyn(ed, fixed_bottom, notes)
     _check_aerodyn(ad)
-    geometry, tower_base = _geometry(ed, rec)
+    geometry = _geometry(ed, rec)
     drive = _drivetrain(ed, srv, dis, rec)
     blade_file = _resolve(ed.path.parent, ed, "BldFile1")
     tower_file = _resolve(ed.path.parent, ed, "TwrFile")
@@ -512,7 +512,7 @@ def _check_aerodyn(ad: OpenFASTFile) -> None:
                                f"supported; allowed 0-2 (BEM; mpc-wt runs its own BEM)")
 
 
-def _geometry(ed: OpenFASTFile, rec: _Recorder) -> tuple[Geometry, float]:
+def _geometry(ed: OpenFASTFile, rec: _Recorder) -> Geometry:
     tip = rec.read("tip radius", ed.number("TipRad", 0), "m", ed, "TipRad")
     hub = rec.read("hub radius", ed.number("HubRad", 0), "m", ed, "HubRad")
     cone = -ed.number("PreCone1", -20, 20)
@@ -539,7 +539,7 @@ def _geometry(ed: OpenFASTFile, rec: _Recorder) -> tuple[Geometry, float]:
                        nacelle_cm_downwind=0.0, nacelle_cm_vertical=0.0)
     except ValueError as err:
         raise TurbineFileError(f"{ed.path}: {err}") from err
-    return geo, base
+    return geo
 
 
 def _with_nacelle_cm(geo: Geometry, ed: OpenFASTFile, nac: float, yaw_br: float) -> Geometry:

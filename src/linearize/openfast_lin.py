@@ -596,7 +596,7 @@ _DOF_OF_STATE = {"tower_fa_displacement": "tower_fa", "tower_ss_displacement": "
                  "edge_1": "blade_edge", "edge_coll": "blade_edge"}
 
 
-def _collective(model: LinearModel, kind: str, mat: FloatArray) -> float | None:
+def _collective(model: LinearModel, mat: FloatArray) -> float | None:
     names = model.inputs
     for n in ("pitch_ref_collective", "pitch_ref_coll"):
         if n in names:
@@ -622,7 +622,7 @@ def _derivatives(model: LinearModel) -> dict[str, float | None]:
             out[f"d{sym}/dV"] = float(model.D_d[i].sum())
         else:
             out[f"d{sym}/dV"] = None
-        out[f"d{sym}/dpitch"] = _collective(model, "input", model.D_u[i])
+        out[f"d{sym}/dpitch"] = _collective(model, model.D_u[i])
         for k, state in (("Omega", "rotor_speed"), ("tower_velocity", "tower_fa_velocity")):
             out[f"d{sym}/d{k}"] = (float(model.C_z[i, model.states.index(state)])
                                    if state in model.states else None)

@@ -120,7 +120,8 @@ def rosco_discon(turbine_name: str = "NREL-5MW") -> Path:
 def _check_library(path: Path) -> None:
     if not path.is_file():
         raise ControllerLibraryError(f"controller library {path}: file not found")
-    head = path.read_bytes()[:20]
+    with path.open("rb") as fh:
+        head = fh.read(20)
     magic = {"linux": b"\x7fELF", "darwin": (b"\xcf\xfa\xed\xfe", b"\xca\xfe\xba\xbe"),
              "win32": b"MZ"}.get(sys.platform, b"\x7fELF")
     magics = magic if isinstance(magic, tuple) else (magic,)

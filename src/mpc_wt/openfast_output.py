@@ -17,7 +17,7 @@ OpenFAST names, converted to SI when their unit is in :data:`UNIT_SCALE` (and re
 from __future__ import annotations
 
 import re
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -52,7 +52,6 @@ class OpenFASTSeries:
     units: tuple[str, ...]
     data: np.ndarray
     description: str = ""
-    notes: tuple[str, ...] = field(default=())
 
 
 def read_openfast_output(path: str | Path) -> OpenFASTSeries:

@@ -498,14 +498,16 @@ class RoscoOptions(Options):
 
 
 def _discon_built(ctx: BuildContext, library: Any, discon_in: Any, opts: Any,
-                  kind: str) -> Built:
+                  kind: str, power_fraction: float = 1.0, **meta: Any) -> Built:
     from ..discon import DisconController
 
     ctl = DisconController(library, discon_in, ctx.turbine, dt=opts.discon_dt,
                            pitch_control=opts.pitch_control)
     return Built(ctl, controller_dt=opts.discon_dt,
                  meta={kind: {"library": str(ctl.library), "discon_in": str(ctl.discon_in),
-                              "pitch_control": opts.pitch_control, "dt": opts.discon_dt}})
+                              "pitch_control": opts.pitch_control, "dt": opts.discon_dt,
+                              **meta}},
+                 power_fraction=power_fraction)
 
 
 @register("discon", DisconOptions,
@@ -541,11 +543,11 @@ def _build_rosco(ctx: BuildContext, opts: RoscoOptions) -> Built:
     elif discon_in is None:
         discon_in = ctx.cache.get(ctx.turbine, ("rosco-export", opts.power_fraction),
                                   lambda: _export_rosco(ctx.turbine, opts.power_fraction))
-    built = _discon_built(ctx, rosco_library(), discon_in, opts, "rosco")
-    built.meta["rosco"]["design"] = ("ours" if opts.discon_in is None else
-                                     "shipped" if opts.discon_in == "shipped" else "file")
-    return Built(built.controller, built.controller_dt, meta=built.meta,
-                 power_fraction=opts.power_fraction if opts.discon_in is None else 1.0)
+    ours = opts.discon_in is None
+    return _discon_built(ctx, rosco_library(), discon_in, opts, "rosco",
+                         power_fraction=opts.power_fraction if ours else 1.0,
+                         design=("ours" if ours else
+                                 "shipped" if opts.discon_in == "shipped" else "file"))
 
 
 def _export_rosco(turbine: linearize.Turbine, power_fraction: float) -> str:
