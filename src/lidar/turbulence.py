@@ -46,7 +46,7 @@ from ._typing import FloatArray
 from .field import WindField
 
 __all__ = ["TurbulenceSpec", "iec_sigma", "kaimal_spectrum", "iec_coherence", "generate_field",
-           "evolve_field"]
+           "evolve_field", "evolution_coherence", "simley_pao_evolution"]
 
 log = logging.getLogger(__name__)
 
@@ -345,44 +345,150 @@ def generate_field(spec: TurbulenceSpec, seed: int | np.random.Generator | None 
                      mean_speed=v, hub_height=spec.hub_height, meta=meta)
 
 
-def evolve_field(field: WindField, distance: float, spec: TurbulenceSpec,
-                 seed: int | np.random.Generator | None = None, *, a: float = 0.4,
-                 b: float = 0.0) -> WindField:
+def simley_pao_evolution(mean_speed: float, sigma: Any, length_scale: float
+                         ) -> tuple[float, float]:
+    """Parameters (a [-], b [1/m]) of Simley and Pao's wind-evolution coherence.
+
+    The magnitude-squared longitudinal coherence of the wind at two points ``d`` apart along
+    the mean wind (the exponential model of Simley and Pao 2015)
+
+        gamma^2(f, d) = exp(-a sqrt((f d / V)^2 + (b d)^2))
+
+    with the parameters fitted to large-eddy simulations
+
+        a = 8.4 sigma / V + 0.05,    b = 0.25 L^(-1.24),
+
+    sigma the total turbulence standard deviation sqrt(sigma_u^2 + sigma_v^2 + sigma_w^2) and L
+    the integral length scale of u (IEC Kaimal: 8.1 Lambda_1). The same parameterization is
+    the ``Exp-Simley`` model of Chen et al.'s evoTurb 4-D wind-field generator.
+
+    Parameters
+    ----------
+    mean_speed : float
+        V [m/s], > 0.
+    sigma : float or array of 3
+        Total standard deviation, or (sigma_u, sigma_v, sigma_w) [m/s].
+    length_scale : float
+        L [m], > 0.
+
+    Returns
+    -------
+    a, b : float
+
+    Raises
+    ------
+    ValueError
+        If a value is not finite or not positive.
+
+    References
+    ----------
+    Simley and Pao (2015), A longitudinal spatial coherence model for wind evolution based on
+    large-eddy simulation, American Control Conference, 3708-3714. Chen, Schlipf and Cheng
+    (2021), Parameterization of wind evolution using lidar, Wind Energ. Sci. 6, 61-91.
+    """
+    sig = np.atleast_1d(np.asarray(sigma, dtype=float))
+    total = float(np.sqrt(np.sum(sig**2)))
+    for name, val in (("mean_speed", mean_speed), ("sigma", total),
+                      ("length_scale", length_scale)):
+        if not (math.isfinite(val) and val > 0):
+            raise ValueError(f"{name} must be finite and > 0, got {val!r}")
+    return 8.4 * total / mean_speed + 0.05, 0.25 * length_scale ** -1.24
+
+
+def evolution_coherence(f: FloatArray, distance: float, mean_speed: float, a: float,
+                        b: float) -> FloatArray:
+    """Magnitude-squared coherence gamma^2 = exp(-a sqrt((f d / V)^2 + (b d)^2)) [-]
+    (Simley and Pao 2015; see :func:`simley_pao_evolution`)."""
+    f = np.asarray(f, dtype=float)
+    return np.exp(-a * np.sqrt((f * distance / mean_speed) ** 2 + (b * distance) ** 2))
+
+
+def _spec_like(field: WindField) -> TurbulenceSpec:
+    """A spec on the field's grid with its turbulence (the class in its meta, else the
+    intensity of u measured at the grid centre)."""
+    turb = field.meta.get("turbulence")
+    if not (isinstance(turb, str) and turb.upper() in _I_REF
+            or isinstance(turb, (int, float)) and 0 < turb < 1):
+        u = field.u[:, field.y.size // 2, field.z.size // 2]
+        turb = float(min(max(u.std() / field.mean_speed, 1e-3), 0.99))
+    width = float(field.y[-1] - field.y[0])
+    height = float(field.z[-1] - field.z[0])
+    return TurbulenceSpec(field.mean_speed, turb, hub_height=float(field.z[0]) + height / 2,
+                          width=width, height=height, n_y=field.y.size, n_z=field.z.size,
+                          duration=field.t.size * field.dt, dt=field.dt)
+
+
+def evolve_field(field: WindField, distance: float, spec: TurbulenceSpec | None = None,
+                 seed: int | np.random.Generator | None = None, *, a: float | None = None,
+                 b: float | None = None) -> WindField:
     """The field as it is upstream, ``distance`` ahead of the rotor, with wind evolution.
 
     Frozen turbulence would make the upstream wind equal to the field (shifted by
     distance / V). With evolution the upstream turbulence decorrelates from what arrives: each
     Fourier coefficient becomes gamma u + sqrt(1 - gamma^2) u', with u' an independent field of
-    the same statistics and the longitudinal coherence
+    the same statistics, so that the two fields have the magnitude-squared coherence gamma^2 of
+    :func:`evolution_coherence` at every grid point (and keep their spectra and lateral
+    coherence). The mean of every point is kept.
 
-        gamma(f) = exp(-a sqrt((f d / V)^2 + (b d)^2))
+    Parameters
+    ----------
+    field : WindField
+        The field at the rotor.
+    distance : float
+        Upstream distance d [m], >= 0 (0: the field itself).
+    spec : TurbulenceSpec, optional
+        The statistics of u' (default: the field's grid with the turbulence class in its meta,
+        else the intensity of u measured at the grid centre).
+    seed : int or Generator, optional
+        Of u'.
+    a, b : float, optional
+        The coherence parameters (default: :func:`simley_pao_evolution` of the spec's sigma and
+        the field's hub height).
 
-    (the form of Simley and Pao's evolution model; ``a`` [-] and ``b`` [1/m] are parameters to
-    fit to site data -- the defaults are illustrative, not a published fit).
+    Returns
+    -------
+    WindField
+        With ``meta["evolution"]`` = {distance, a, b, model}.
 
     Raises
     ------
     ValueError
-        If the distance or parameters are negative or not finite.
+        If the distance or parameters are negative or not finite, or the spec's grid is not the
+        field's.
     """
+    spec = _spec_like(field) if spec is None else spec
+    model = "given"
+    if a is None or b is None:
+        lam = 0.7 * field.hub_height if field.hub_height <= 60.0 else 42.0
+        sa, sb = simley_pao_evolution(field.mean_speed, spec.sigma, 8.1 * lam)
+        a = sa if a is None else a
+        b = sb if b is None else b
+        model = "Simley and Pao (2015)"
     for name, val in (("distance", distance), ("a", a), ("b", b)):
         if not (math.isfinite(val) and val >= 0):
             raise ValueError(f"{name} must be finite and >= 0, got {val!r}")
-    other = generate_field(spec, seed)
     n_t = field.t.size
-    if other.u.shape != field.u.shape:
-        raise ValueError(f"spec grid {other.u.shape} does not match the field {field.u.shape}")
+    t, y, z = spec.grid()
+    if (t.size, y.size, z.size) != field.u.shape:
+        raise ValueError(f"spec grid {(t.size, y.size, z.size)} does not match the field "
+                         f"{field.u.shape}")
+    meta = {**field.meta, "evolution": {"distance": distance, "a": a, "b": b, "model": model}}
+    if distance == 0.0:
+        return WindField(t=field.t, y=field.y, z=field.z, u=field.u, v=field.v, w=field.w,
+                         mean_speed=field.mean_speed, hub_height=field.hub_height, meta=meta)
+    other = generate_field(spec, seed)
     f = np.fft.rfftfreq(n_t, field.dt)
-    g = np.exp(-a * np.sqrt((f * distance / field.mean_speed) ** 2 + (b * distance) ** 2))
+    g = np.sqrt(evolution_coherence(f, distance, field.mean_speed, a, b))
+    keep, fresh = g[:, None, None], np.sqrt(1.0 - g**2)[:, None, None]
     out = {}
     for comp in ("u", "v", "w"):
         x = getattr(field, comp)
         xo = getattr(other, comp)
         mean = x.mean(axis=0, keepdims=True)
         fx = np.fft.rfft(x - mean, axis=0)
-        fo = np.fft.rfft(xo - xo.mean(axis=0, keepdims=True), axis=0)
-        mixed = g[:, None, None] * fx + np.sqrt(1 - g**2)[:, None, None] * fo
-        out[comp] = np.fft.irfft(mixed, n=n_t, axis=0) + mean
-    meta = {**field.meta, "evolution": {"distance": distance, "a": a, "b": b}}
+        fx *= keep
+        fx += fresh * np.fft.rfft(xo - xo.mean(axis=0, keepdims=True), axis=0)
+        out[comp] = np.fft.irfft(fx, n=n_t, axis=0) + mean
+        del fx
     return WindField(t=field.t, y=field.y, z=field.z, u=out["u"], v=out["v"], w=out["w"],
                      mean_speed=field.mean_speed, hub_height=field.hub_height, meta=meta)

@@ -16,6 +16,7 @@ __all__ = ["evaluate_lidar"]
 def evaluate_lidar(field: lidar.WindField, turbine: linearize.Turbine, *,
                    focus_distance: float = 54.0, sample_rate: float = 10.0, horizon: int = 15,
                    dt_ctrl: float = 0.1, plots: str | Path | None = None,
+                   evolution: bool = False, evolution_seed: int = 0,
                    **lidar_options: Any) -> dict[str, Any]:
     """Run the LIDAR over the field with the rotor at its trimmed speed and judge the preview.
 
@@ -41,6 +42,11 @@ def evaluate_lidar(field: lidar.WindField, turbine: linearize.Turbine, *,
         Controller step [s].
     plots : str or Path, optional
         Folder for ``lidar_coherence.png`` and ``lidar_scan.png``.
+    evolution : bool
+        Measure the field evolved over the focus distance (:func:`lidar.evolve_field`, Simley
+        and Pao's coherence) instead of frozen turbulence (Madsen's assumption, the default).
+    evolution_seed : int
+        Seed of the evolution's independent field.
     **lidar_options
         Further :class:`lidar.CWLidar` settings (``range_weighting``, ``noise_std`` ...).
 
@@ -67,30 +73,39 @@ def evaluate_lidar(field: lidar.WindField, turbine: linearize.Turbine, *,
                          f"{tp:.2f} s plus a {horizon * dt_ctrl:g} s horizon")
     t = np.arange(field.t[0], t_end, 1.0 / sample_rate)
     psi = omega * t
-    meas = lid.measure(field, t, psi, omega)
+    seen = lidar.evolve_field(field, focus_distance, seed=evolution_seed) if evolution else field
+    meas = lid.measure(seen, t, psi, omega)
     later = lidar.blade_effective_wind(field, t + tp, psi + omega * tp, lid.radius)
     fs = sample_rate
     f = lidar.coherence(meas.u_hat[:, 0], later[:, 0], fs, nperseg=256)[0]
     gamma2 = np.column_stack([lidar.coherence(meas.u_hat[:, i], later[:, i], fs,
                                               nperseg=256)[1] for i in range(3)])
     bw = lidar.coherence_bandwidth(f, gamma2.mean(axis=1))
+    res = {"focus_m": focus_distance, "preview_time_s": tp,
+           "lead_angle_deg": math.degrees(omega * tp) % 360.0,
+           "rotor_speed_rpm": omega * 30 / math.pi, "coherence_bandwidth_Hz": bw,
+           "coherence_bandwidth_rad_per_m": 2 * math.pi * bw / field.mean_speed,
+           "rms_preview_error_mps": _rms_preview_error(meas, field, lid, omega, horizon,
+                                                       dt_ctrl, sample_rate),
+           "half_width_m": lid.half_width, "cone_angle_deg": math.degrees(lid.cone_angle_rad),
+           "mean_speed_mps": field.mean_speed, "evolution": bool(evolution)}
+    if plots:
+        res["plots"] = _plots(Path(plots), f, gamma2, bw, field, meas, psi, omega, lid,
+                              turbine, sample_rate)
+    return res
+
+
+def _rms_preview_error(meas: Any, field: lidar.WindField, lid: Any, omega: float, horizon: int,
+                       dt_ctrl: float, sample_rate: float) -> float:
+    """RMS error of the preview over the horizon against the wind each blade meets."""
+    t, tp = meas.t, meas.preview_time
     k_ctrl = t[(t >= t[0] + tp) & (t <= t[-1] - horizon * dt_ctrl)][::max(1, int(round(
         dt_ctrl * sample_rate)))]
     prev = lidar.preview_series(meas, k_ctrl, horizon, dt_ctrl)
     steps = k_ctrl[:, None] + dt_ctrl * np.arange(1, horizon + 1)[None, :]
     truth = np.stack([lidar.blade_effective_wind(field, steps[:, j], omega * steps[:, j],
                                                  lid.radius) for j in range(horizon)], axis=1)
-    res = {"focus_m": focus_distance, "preview_time_s": tp,
-           "lead_angle_deg": math.degrees(omega * tp) % 360.0,
-           "rotor_speed_rpm": omega * 30 / math.pi, "coherence_bandwidth_Hz": bw,
-           "coherence_bandwidth_rad_per_m": 2 * math.pi * bw / field.mean_speed,
-           "rms_preview_error_mps": lidar.rms_preview_error(prev, truth),
-           "half_width_m": lid.half_width, "cone_angle_deg": math.degrees(lid.cone_angle_rad),
-           "mean_speed_mps": field.mean_speed}
-    if plots:
-        res["plots"] = _plots(Path(plots), f, gamma2, bw, field, meas, psi, omega, lid,
-                              turbine, sample_rate)
-    return res
+    return lidar.rms_preview_error(prev, truth)
 
 
 def _plots(d: Path, f: np.ndarray, gamma2: np.ndarray, bw: float, field: lidar.WindField,

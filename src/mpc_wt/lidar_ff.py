@@ -25,7 +25,11 @@ import linearize
 
 from .simulate import ControllerBase
 
-__all__ = ["LidarFeedforward", "static_pitch_curve"]
+__all__ = ["LidarFeedforward", "static_pitch_curve", "rews_coherence_corner",
+           "corner_within_preview"]
+
+#: Low-frequency group delay of the low-pass times its corner, by order (second: damping 0.7).
+FILTER_DELAY = {1: 1.0, 2: 1.4}
 
 
 def static_pitch_curve(turbine: linearize.Turbine, power_W: float | None = None
@@ -61,7 +65,9 @@ class LidarFeedforward(ControllerBase):
     lidar_model : lidar.CWLidar
         The instrument (range weighting and line-of-sight error on by default).
     field : lidar.WindField
-        The wind field the plant meets.
+        The wind field the LIDAR measures: the plant's, evolved over the focus distance
+        (:meth:`mpc_wt.controllers.BuildContext.lidar_field`), or the plant's own under frozen
+        turbulence.
     turbine : Turbine
         For the static pitch curve and the actuator lag.
     mean_wind_mps : float
@@ -95,7 +101,7 @@ class LidarFeedforward(ControllerBase):
         self.dt = base.dt
         self.corner = float(corner_rad_s)
         self.order = filter_order
-        delay = (1.0 if filter_order == 1 else 1.4) / self.corner
+        delay = FILTER_DELAY[filter_order] / self.corner
         self.lead = (turbine.pitch_actuator.time_constant + delay
                      if lead_s is None else float(lead_s))
         self.preview_time = lidar_model.preview_time(mean_wind_mps)
@@ -169,7 +175,8 @@ class LidarFeedforward(ControllerBase):
 
 
 def rews_coherence_corner(lidar_model: Any, field: Any, turbine: linearize.Turbine,
-                          mean_wind_mps: float, sample_dt: float = 0.1) -> float:
+                          mean_wind_mps: float, sample_dt: float = 0.1, *,
+                          seen: Any = None) -> float:
     """The feedforward filter's corner from the coherence between the LIDAR's rotor-effective
     wind estimate (mean of the three beams, moved by T_p) and the true rotor-effective wind of
     the field (disc average, :func:`lidar.rotor_effective_wind`) where it falls to 0.5
@@ -179,12 +186,16 @@ def rews_coherence_corner(lidar_model: Any, field: Any, turbine: linearize.Turbi
     ----------
     lidar_model : lidar.CWLidar
     field : lidar.WindField
+        The field the rotor meets.
     turbine : Turbine
         Rotor radius and the rotor speed of the trim (the beams turn with it).
     mean_wind_mps : float
         [m/s]
     sample_dt : float
         LIDAR sample period [s].
+    seen : lidar.WindField, optional
+        The field the LIDAR measures (default ``field``: frozen turbulence; with wind evolution,
+        :func:`lidar.evolve_field` of it over the focus distance).
 
     Returns
     -------
@@ -201,9 +212,59 @@ def rews_coherence_corner(lidar_model: Any, field: Any, turbine: linearize.Turbi
             "it scatters; give filter_corner_hz (--ff-corner-hz) for short runs",
             t.size * sample_dt)
     omega = linearize.trim(turbine, mean_wind_mps).rotor_speed_rad_s
-    m = lidar_model.measure(field, t, omega * t, omega)
+    m = lidar_model.measure(field if seen is None else seen, t, omega * t, omega)
     est = m.u_hat.mean(axis=1)
     truth = np.interp(t + tp, field.t, lidar.rotor_effective_wind(
         field, turbine.geometry.tip_radius))
     f, g2 = lidar.coherence(est - est.mean(), truth - truth.mean(), 1.0 / sample_dt)
     return 2.0 * math.pi * lidar.coherence_bandwidth(f, g2)
+
+
+def corner_within_preview(corner_rad_s: float, preview_time_s: float, actuator_tau_s: float,
+                          filter_order: int = 2, sample_dt: float = 0.1) -> tuple[float, bool]:
+    """The coherence corner, raised where needed so that the lead (actuator time constant + the
+    filter's delay) fits in the preview time less one LIDAR sample.
+
+    With wind evolution the coherence bandwidth can fall so low that the filter's delay alone
+    exceeds the preview (54 m at 18 m/s: 3 s, which a second-order filter spends at
+    omega_c = 0.48 rad/s). Then the feedforward would act late on everything it passes; the
+    smallest corner that keeps it on time, omega = k / (T_p - tau - dt_s), passes a little
+    more of the incoherent band instead (Schlipf 2015, sec. 5.2: the filter delay must be
+    covered by the preview). The raise is logged.
+
+    Parameters
+    ----------
+    corner_rad_s : float
+        The coherence corner [rad/s].
+    preview_time_s : float
+        T_p [s].
+    actuator_tau_s : float
+        Pitch actuator time constant [s].
+    filter_order : {1, 2}
+    sample_dt : float
+        LIDAR sample period [s].
+
+    Returns
+    -------
+    corner : float
+        [rad/s]
+    raised : bool
+
+    Raises
+    ------
+    ValueError
+        If the preview is too short for any corner (naming the preview and what it must cover).
+    """
+    room = preview_time_s - actuator_tau_s - sample_dt
+    if room <= 0:
+        raise ValueError(f"preview time {preview_time_s:.3g} s does not cover the actuator time "
+                         f"constant {actuator_tau_s:.3g} s and one LIDAR sample "
+                         f"{sample_dt:.3g} s: focus further upstream")
+    need = FILTER_DELAY[filter_order] / room
+    if corner_rad_s >= need:
+        return corner_rad_s, False
+    logging.getLogger(__name__).warning(
+        "feedforward corner raised from %.3f to %.3f rad/s so that the filter's delay fits the "
+        "%.2f s preview (the LIDAR-rotor coherence falls to 0.5 below that)", corner_rad_s, need,
+        preview_time_s)
+    return need, True

@@ -218,3 +218,66 @@ def test_evolution_decorrelates_with_distance(small: WindField) -> None:
     assert_allclose(far.u.mean(axis=0), small.u.mean(axis=0), rtol=0, atol=1e-9)
     with pytest.raises(ValueError, match="distance must be finite and >= 0"):
         lidar.evolve_field(small, -1.0, spec)
+
+
+def test_simley_pao_parameters_hand_worked() -> None:
+    # hand-worked from Simley and Pao (2015): a = 8.4 sigma / V + 0.05, b = 0.25 L^-1.24, with
+    # the IEC class-A sigmas at 18 m/s, 3.056 / 2.4448 / 1.528 m/s (total sqrt(9.339 + 5.977 + 2.335) = 4.2013 m/s), and
+    # L = 8.1 * 42 = 340.2 m: a = 8.4 * 4.2013 / 18 + 0.05 = 2.0106, b = 0.25 * 340.2^-1.24
+    # = 0.25 * exp(-1.24 * 5.8295) = 1.8138e-4 1/m
+    a, b = lidar.simley_pao_evolution(V, [3.056, 2.4448, 1.528], 340.2)
+    assert a == pytest.approx(2.0106, abs=2e-4)
+    assert b == pytest.approx(1.8138e-4, rel=1e-3)
+    with pytest.raises(ValueError, match="length_scale must be finite and > 0, got -1"):
+        lidar.simley_pao_evolution(V, 3.0, -1.0)
+    with pytest.raises(ValueError, match="mean_speed must be finite and > 0, got nan"):
+        lidar.simley_pao_evolution(float("nan"), 3.0, 340.2)
+
+
+def test_evolved_field_has_the_model_coherence() -> None:
+    """The realised magnitude-squared coherence of the rotor field and its evolved upstream
+    copy against the closed form exp(-a sqrt((f d/V)^2 + (b d)^2)), d = 54 m (Madsen's focus)
+    and 150 m, 18 m/s class A. The estimate is the definition |sum X Y*|^2 / (sum |X|^2 sum
+    |Y|^2) over the record's DFT bins in 0.04 Hz bands and a 5 x 5 grid (Welch's windowed
+    estimate leaks the red spectrum's coherent low frequencies upward by 0.03-0.1 here).
+    Tolerance 0.05 absolute: the scatter of ~100 bins x 25 spatially correlated points.
+    Mixing with gamma^2 in place of gamma would be off by 0.25 at 0.1 Hz, 54 m."""
+    spec = TurbulenceSpec(V, "A", width=40, height=40, n_y=5, n_z=5, duration=2400, dt=0.1)
+    rotor = generate_field(spec, 11)
+    f = np.fft.rfftfreq(rotor.t.size, spec.dt)
+    x = np.fft.rfft(rotor.u - rotor.u.mean(axis=0), axis=0).reshape(f.size, -1)
+    edges = np.arange(0.02, 0.5, 0.04)
+    for d in (54.0, 150.0):
+        up = lidar.evolve_field(rotor, d, seed=12)
+        a, b = up.meta["evolution"]["a"], up.meta["evolution"]["b"]
+        assert a == pytest.approx(8.4 * np.linalg.norm(spec.sigma) / V + 0.05, rel=1e-12)
+        y = np.fft.rfft(up.u - up.u.mean(axis=0), axis=0).reshape(f.size, -1)
+        for lo, hi in zip(edges[:-1], edges[1:]):
+            s = (f >= lo) & (f < hi)
+            g2 = abs(np.sum(x[s] * y[s].conj())) ** 2 / (np.sum(abs(x[s]) ** 2)
+                                                          * np.sum(abs(y[s]) ** 2))
+            # the closed form's gamma weighted by the band's power (it falls steeply within
+            # the lowest bands): E|sum X Y*|^2 / (sum|X|^2)^2 = (sum gamma |X|^2 / sum|X|^2)^2
+            gam = np.exp(-0.5 * a * np.sqrt((f[s] * d / V) ** 2 + (b * d) ** 2))
+            px = np.sum(abs(x[s]) ** 2, axis=1)
+            model = (np.sum(gam * px) / np.sum(px)) ** 2
+            assert g2 == pytest.approx(model, abs=0.05), (d, lo)
+        # the upstream field keeps the statistics: std of u within 5 % of the rotor field's
+        assert up.u.std(axis=0).mean() == pytest.approx(rotor.u.std(axis=0).mean(), rel=0.05)
+
+
+def test_evolution_of_a_field_without_a_class() -> None:
+    """A field read from a file (no class in its meta) evolves with the intensity measured at
+    its centre; a spec for another grid is refused, naming both shapes."""
+    spec = TurbulenceSpec(12.0, 0.12, width=40, height=40, n_y=5, n_z=5, duration=300, dt=0.1)
+    f0 = generate_field(spec, 4)
+    bare = WindField(t=f0.t, y=f0.y, z=f0.z, u=f0.u, v=f0.v, w=f0.w, mean_speed=12.0,
+                     hub_height=90.0, meta={})
+    up = lidar.evolve_field(bare, 80.0, seed=5)
+    sig_u = f0.u[:, 2, 2].std()
+    assert up.meta["evolution"]["a"] == pytest.approx(
+        8.4 * math.sqrt(1 + 0.8**2 + 0.5**2) * sig_u / 12.0 + 0.05, rel=1e-9)
+    other = TurbulenceSpec(12.0, 0.12, width=40, height=40, n_y=4, n_z=5, duration=300, dt=0.1)
+    with pytest.raises(ValueError, match=r"spec grid \(3000, 4, 5\) does not match the field "
+                                         r"\(3000, 5, 5\)"):
+        lidar.evolve_field(bare, 80.0, other)

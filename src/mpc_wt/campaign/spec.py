@@ -433,7 +433,8 @@ def _lidar(key: str, raw: Any) -> dict[str, Any]:
     if not isinstance(raw, Mapping):
         raise _fail(key, f"must be a mapping, got {raw!r}")
     try:
-        return LidarOptions.from_dict(raw, prefix=f"{key}.").given()
+        opts = LidarOptions.from_dict(raw, prefix=f"{key}.")
+        return {k: getattr(opts, k) for k in raw}
     except OptionsError as err:
         raise _fail(err.key, str(err)) from err
 

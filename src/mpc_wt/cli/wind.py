@@ -46,6 +46,8 @@ def add_parsers(sub: Any) -> None:
     q.add_argument("--point", action="store_true", help="point measurement (no range weighting)")
     q.add_argument("--no-los-error", action="store_true", help="measure u directly")
     q.add_argument("--noise", type=float, default=0.0, help="LOS noise std [m/s]")
+    q.add_argument("--evolution", action="store_true",
+                   help="wind evolution between the focus and the rotor (Simley and Pao)")
     q.add_argument("--json", action="store_true")
     q.add_argument("--plots", help="directory for lidar_coherence.png and lidar_scan.png")
     q.set_defaults(func=_evaluate)
@@ -82,7 +84,7 @@ def _evaluate(args: argparse.Namespace) -> int:
     turbine = linearize.load_turbine(args.turbine)
     res = evaluate_lidar(field, turbine, focus_distance=args.focus, plots=args.plots,
                          range_weighting=not args.point, los_error=not args.no_los_error,
-                         noise_std=args.noise)
+                         noise_std=args.noise, evolution=args.evolution)
     if args.json:
         print(json.dumps(res, indent=1))
     else:

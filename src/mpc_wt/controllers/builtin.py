@@ -263,16 +263,47 @@ class LidarOptions(Options):
     los_error: Optional[bool] = option(None, help=_CW)
     range_weighting: Optional[bool] = option(None, help=_CW)
     n_range: Optional[int] = option(None, help=_CW, lo=1)
+    evolution: bool = option(True, help="wind evolution between the focus and the rotor "
+                             "(Simley and Pao's coherence, lidar.evolve_field); false: frozen "
+                             "turbulence, Madsen's assumption")
 
     def given(self) -> dict[str, Any]:
-        """The settings that were set.
+        """The :class:`lidar.CWLidar` settings that were set.
 
         Returns
         -------
         dict
-            Name -> value of the options that are not None.
+            Name -> value of the CWLidar options that are not None (``evolution`` is not one:
+            it acts on the field the LIDAR sees, :meth:`BuildContext.lidar_field`).
         """
-        return {k: v for k, v in self.to_dict().items() if v is not None}
+        return {k: v for k, v in self.to_dict().items() if v is not None and k != "evolution"}
+
+    def lidar(self, ctx: BuildContext) -> tuple[Any, Any]:
+        """The CW LIDAR and the field it measures for a build.
+
+        Parameters
+        ----------
+        ctx : BuildContext
+            The build's turbine and wind.
+
+        Returns
+        -------
+        cw : lidar.CWLidar
+        field : lidar.WindField
+            The case's field, evolved over the focus distance unless ``evolution`` is off.
+
+        Raises
+        ------
+        ValueError
+            A setting CWLidar refuses, prefixed "lidar options:".
+        """
+        import lidar
+
+        try:
+            cw = lidar.CWLidar(ctx.turbine.geometry.tip_radius, **self.given())
+        except (TypeError, ValueError) as err:
+            raise ValueError(f"lidar options: {err}") from err
+        return cw, ctx.lidar_field(cw.focus_distance if self.evolution else 0.0)
 
 
 @dataclass(frozen=True)
@@ -326,21 +357,17 @@ def _mpc(collective: bool, with_lidar: bool) -> Any:
         preview = None
         if with_lidar:
             preview = _lidar_preview(ctx, opts.lidar, settings.horizon, cdt)  # type: ignore
-            meta["lidar"] = opts.lidar.given()  # type: ignore[attr-defined]
+            meta["lidar"] = {**opts.lidar.given(),  # type: ignore[attr-defined]
+                             "evolution": opts.lidar.evolution}  # type: ignore[attr-defined]
         return Built(ctl, cdt, preview, meta)
     return build
 
 
 def _lidar_preview(ctx: BuildContext, opts: LidarOptions, horizon: int, dt: float) -> Any:
-    import lidar
-
     from ..simulate import LidarPreview
 
-    try:
-        cw = lidar.CWLidar(ctx.turbine.geometry.tip_radius, **opts.given())
-    except (TypeError, ValueError) as err:
-        raise ValueError(f"lidar options: {err}") from err
-    return LidarPreview(cw, ctx.field, horizon, dt)
+    cw, seen = opts.lidar(ctx)
+    return LidarPreview(cw, seen, horizon, dt)
 
 
 _MPC_GROUP = "the MPC controllers"
@@ -351,7 +378,7 @@ register("mpc-collective", MPCOptions, group=_MPC_GROUP,
          summary="the MPC with one collective pitch input")(_mpc(True, False))
 register("mpc-lidar", MPCLidarOptions, group=_MPC_GROUP,
          summary="the individual-pitch MPC with a CW LIDAR's per-blade preview "
-                 "(range weighting and LOS error on)")(_mpc(False, True))
+                 "(range weighting, LOS error and wind evolution on)")(_mpc(False, True))
 
 
 # -- LQR + PI observer ------------------------------------------------------------------------
@@ -573,7 +600,8 @@ class LidarFFOptions(Options):
     filter_corner_hz: Optional[float] = option(None, help="low-pass corner of the wind estimate "
                                                "(default: where the coherence of the LIDAR's "
                                                "and the rotor's effective wind falls to 0.5 on "
-                                               "the run's field)", unit="Hz",
+                                               "the run's field, raised if its delay would not "
+                                               "fit the preview)", unit="Hz",
                                                lo=0.0, lo_open=True, flag="--ff-corner-hz")
     lead_time: Optional[float] = option(None, help="lead of the pitch over the wind's arrival "
                                         "(default: actuator time constant + the filter's "
@@ -587,31 +615,33 @@ class LidarFFOptions(Options):
           summary="collective pitch feedforward from the CW LIDAR on a baseline "
                   "(baseline+lidar-ff, derate80+lidar-ff)")
 def _build_lidar_ff(ctx: BuildContext, opts: LidarFFOptions, base: Built) -> Built:
-    import lidar
+    from ..lidar_ff import LidarFeedforward, corner_within_preview, rews_coherence_corner
 
-    from ..lidar_ff import LidarFeedforward, rews_coherence_corner
-
-    given = opts.lidar.given()
-    try:
-        cw = lidar.CWLidar(ctx.turbine.geometry.tip_radius, **given)
-    except (TypeError, ValueError) as err:
-        raise ValueError(f"lidar options: {err}") from err
+    cw, seen = opts.lidar.lidar(ctx)
     v = ctx.scenario.wind_mps
+    coherence_corner, raised = None, False
     if opts.filter_corner_hz is None:
         # keyed on the whole scenario: the estimate depends on the field's length too
-        corner = ctx.cache.get(ctx.turbine, ("lidar-ff-corner", ctx.scenario,
-                                             tuple(sorted(given.items()))),
-                               lambda: rews_coherence_corner(cw, ctx.field, ctx.turbine, v))
+        key = (*sorted(opts.lidar.given().items()), ("evolution", opts.lidar.evolution))
+        corner = coherence_corner = ctx.cache.get(
+            ctx.turbine, ("lidar-ff-corner", ctx.scenario, key),
+            lambda: rews_coherence_corner(cw, ctx.field, ctx.turbine, v, seen=seen))
+        if opts.lead_time is None:
+            corner, raised = corner_within_preview(
+                corner, cw.preview_time(v), ctx.turbine.pitch_actuator.time_constant,
+                opts.filter_order)
     else:
         corner = 2.0 * math.pi * opts.filter_corner_hz
     frac = base.power_fraction
-    ctl = LidarFeedforward(base.controller, cw, ctx.field, ctx.turbine, mean_wind_mps=v,
+    ctl = LidarFeedforward(base.controller, cw, seen, ctx.turbine, mean_wind_mps=v,
                            corner_rad_s=corner, lead_s=opts.lead_time,
                            filter_order=opts.filter_order,
                            power_W=None if frac == 1.0
                            else frac * ctx.turbine.operation.rated_power)
-    meta = {"corner_rad_s": corner, "lead_s": ctl.lead, "preview_time_s": ctl.preview_time,
+    meta = {"corner_rad_s": corner, "corner_raised": raised,
+            **({} if coherence_corner is None else {"coherence_corner_rad_s": coherence_corner}),
+            "lead_s": ctl.lead, "preview_time_s": ctl.preview_time,
             "filter_order": opts.filter_order,
-            "focus_distance_m": cw.focus_distance}
+            "focus_distance_m": cw.focus_distance, "evolution": opts.lidar.evolution}
     return Built(ctl, base.controller_dt, base.preview, {**base.meta, "lidar_ff": meta},
                  base.power_fraction)

@@ -230,6 +230,10 @@ class DesignCache:
 DEFAULT_CACHE = DesignCache()
 
 
+#: Second word of the seed of the wind-evolution field (ASCII "evol"): a stream of its own.
+_EVOLUTION_STREAM = 0x65766F6C
+
+
 @dataclass(frozen=True)
 class BuildContext:
     """Everything a kind's ``build`` may use.
@@ -256,6 +260,25 @@ class BuildContext:
     scenario: Scenario
     field: Any
     cache: DesignCache = DEFAULT_CACHE
+
+    def lidar_field(self, distance: float) -> Any:
+        """The field a LIDAR focused ``distance`` upstream measures: the case's field evolved
+        over that distance with Simley and Pao's coherence (:func:`lidar.evolve_field`; its
+        independent part seeded from the case's seed, so every kind sees the same wind).
+
+        Parameters
+        ----------
+        distance : float
+            [m], >= 0; 0 (or a steady case) gives the field itself: frozen turbulence.
+
+        Returns
+        -------
+        lidar.WindField
+        """
+        if distance == 0.0 or self.scenario.turbulence == "steady":
+            return self.field
+        seed = np.random.default_rng([self.scenario.seed, _EVOLUTION_STREAM])
+        return lidar.evolve_field(self.field, distance, seed=seed)
 
 
 @dataclass
