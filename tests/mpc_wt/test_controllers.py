@@ -16,7 +16,8 @@ from hypothesis import strategies as st
 import linearize
 from mpc_wt import controllers
 from mpc_wt.cli import main
-from mpc_wt.controllers import (DesignCache, IBCOptions, MPCOptions, Options, option, resolve,
+from mpc_wt.controllers import (DesignCache, IBCOptions, MPCOptions, Options, Scenario,
+                                build_controller, option, resolve,
                                 turbine_key)
 from mpc_wt.controllers.registry import _KINDS
 from mpc_wt.errors import OptionsError
@@ -50,7 +51,7 @@ def test_registry_lists_every_kind_with_its_options() -> None:
     rows = {r["name"]: r for r in controllers.describe()}
     assert list(rows)[:len(BUILTIN)] == BUILTIN
     assert {o["name"] for o in rows["mpc"]["options"]} == {
-        "backend", "formulation", "horizon", "estimator", "scheduled"}
+        "backend", "formulation", "horizon", "estimator", "scheduled", "weights"}
     assert rows["ibc"]["addon_to"] == ["baseline", "derate"]
     assert rows["derate"]["pattern"].startswith("derateNN")
     horizon = next(o for o in rows["mpc"]["options"] if o["name"] == "horizon")
@@ -220,3 +221,28 @@ def test_commands_check_their_arguments_before_working(argv, match, tmp_path: Pa
                  for a in argv]) == 2
     assert match in capsys.readouterr().err
     assert not out.exists()
+
+
+def test_design_weights_reach_the_designs() -> None:
+    """Issue 22's tunable options: the MPC's cost weights (unset ones keep MPCWeights'
+    defaults) and the LQR's weights (unset ones keep the region's) are the ones designed with;
+    a larger pitch weight gives a smaller LQR gain."""
+    from mpc_wt.mpc import MPCWeights
+
+    t = linearize.load_turbine()
+    sc = Scenario(18.0, "A", 1, 30.0)
+    built, _, _ = build_controller(t, "mpc", sc, {"weights": {"flap_moment": 2.0,
+                                                              "pitch_ref": 0.05}})
+    w = built.controller.settings.weights
+    assert w.outputs["flap_moment"] == 2.0 and w.inputs["pitch_ref"] == 0.05
+    assert w.outputs["rotor_speed"] == MPCWeights().outputs["rotor_speed"]
+    gains = {}
+    for wp in (1.0, 10.0):
+        b, _, _ = build_controller(t, "lqr-pio", sc, {"w_pitch": wp, "w_rotor_speed": 2.0})
+        lq = b.meta["lqr"]["weights"]
+        assert lq["state"] == {"rotor_speed": 2.0, "tower_fa_velocity": 1.0}
+        assert lq["input"] == {f"pitch_ref_{i}": wp for i in (1, 2, 3)}
+        gains[wp] = np.linalg.norm(b.controller.lqr.K)
+    assert gains[10.0] < gains[1.0]
+    with pytest.raises(OptionsError, match="weights.flap_moment must be >= 0"):
+        resolve("mpc").options({"weights": {"flap_moment": -1}})

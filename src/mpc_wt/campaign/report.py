@@ -24,7 +24,7 @@ from ..assess import (aep_Wh, cs_measures, lifetime_del, lifetime_extension, pct
 from .spec import CampaignSpec, spec_from_dict, turbulence_tag
 from .store import CampaignStore, CaseRow
 
-__all__ = ["aggregate", "make_report"]
+__all__ = ["aggregate", "make_report", "relative_metrics", "RELATIVE_METRICS"]
 
 #: A seed whose DEL exceeds this multiple of its bin's median (3 seeds or more) is listed as
 #: suspect in the report: with m = 10 one such run can carry a lifetime DEL.
@@ -34,6 +34,13 @@ _PITCH = ("pitch_travel_deg", "pitch_rate_std_degps", "pitch_acc_std_degps2")
 _REGULATION = (("rotor_speed_std_rad_s",), ("power_std_W",), ("flap_1_harmonics", "1P"),
                ("flap_1_harmonics", "3P"))
 _CS = ("cs1", "cs2", "cs3", "cs4", "cs5")
+#: Scalar measures of :func:`relative_metrics`: name -> metric key (or key path) of a case.
+RELATIVE_METRICS: dict[str, tuple[str, ...]] = {
+    **{k: (k,) for k in _CS}, "power_mean": ("power_mean_W",), "power_std": ("power_std_W",),
+    "rotor_speed_std": ("rotor_speed_std_rad_s",), "rotor_speed_max": ("rotor_speed_max_rad_s",),
+    "pitch_travel": ("pitch_travel_deg",), "pitch_rate_std": ("pitch_rate_std_degps",),
+    "pitch_acc_std": ("pitch_acc_std_degps2",), "flap_1p": ("flap_1_harmonics", "1P"),
+    "flap_3p": ("flap_1_harmonics", "3P")}
 
 
 def _pct(a: float | None, b: float | None) -> float | None:
@@ -223,6 +230,58 @@ def _groups(spec: CampaignSpec, rows: list[CaseRow]) -> list[_Group]:
     keys = sorted(by, key=lambda k: (order.index(k[0]) if k[0] in order else 99, k[1]))
     return [_Group(spec, ctl, turb, by[(ctl, turb)], by.get((spec.reference, turb), {}))
             for ctl, turb in keys]
+
+
+def relative_metrics(spec: CampaignSpec, rows: Sequence[CaseRow], controller: str
+                     ) -> dict[str, float]:
+    """A controller's measures as ratios to the spec's reference over the winds both ran (1:
+    the same as the reference), for a tuning objective.
+
+    ``del:CHANNEL``: lifetime DEL (Clemens eq 18, the spec's wind distribution and Woehler
+    exponent); every name of :data:`RELATIVE_METRICS`: the seed mean per wind, weighted over
+    the winds by the distribution (as the report's pitch duty). Several turbulences: the
+    ratios' mean.
+
+    Parameters
+    ----------
+    spec : CampaignSpec
+    rows : sequence of CaseRow
+        Finished cases of the controller and of the reference.
+    controller : str
+        Its name in the spec.
+
+    Returns
+    -------
+    dict of str to float
+        Name -> ratio; a measure the reference has as 0 (or either lacks) is left out.
+
+    Raises
+    ------
+    ValueError
+        If the controller and the reference share no wind with finished cases.
+    """
+    done = [r for r in rows if r.status == "done" and r.metrics]
+    groups = [g for g in _groups(spec, done) if g.ctl == controller and g.common]
+    if not groups:
+        raise ValueError(f"controller {controller!r} and the reference {spec.reference!r} "
+                         f"share no wind with finished cases")
+    acc: dict[str, list[float]] = defaultdict(list)
+    for g in groups:
+        for ch, m in spec.channels.items():
+            if any(_bin_del(b[v], ch, m) is None for b in (g.bins, g.rbins) for v in g.common):
+                continue
+            mine, base = g._life(g.bins, ch, m), g._life(g.rbins, ch, m)
+            if base > 0 and math.isfinite(mine):
+                acc[f"del:{ch}"].append(mine / base)
+        for name, key in RELATIVE_METRICS.items():
+            mine_v = [_bin_mean(g.bins[v], key) for v in g.common]
+            base_v = [_bin_mean(g.rbins[v], key) for v in g.common]
+            if any(x is None for x in mine_v + base_v):
+                continue
+            b = float(np.sum(g.p_com * np.asarray(base_v)))
+            if b > 0:
+                acc[name].append(float(np.sum(g.p_com * np.asarray(mine_v))) / b)
+    return {k: float(np.mean(v)) for k, v in acc.items()}
 
 
 def aggregate(root: str | Path) -> dict[str, Any]:

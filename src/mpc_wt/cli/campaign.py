@@ -1,4 +1,5 @@
-"""``mpcwt campaign run|status|report`` (load-case campaigns on Dask) and ``mpcwt bench mpc``."""
+"""``mpcwt campaign run|status|report`` (load-case campaigns on Dask), ``mpcwt tune`` (design
+parameters optimized over load cases) and ``mpcwt bench mpc``."""
 from __future__ import annotations
 
 import argparse
@@ -15,7 +16,7 @@ log = logging.getLogger(__name__)
 
 
 def add_parsers(sub: Any) -> None:
-    """Add ``campaign`` and ``bench`` to the subcommands.
+    """Add ``campaign``, ``tune`` and ``bench`` to the subcommands.
 
     Parameters
     ----------
@@ -56,6 +57,20 @@ def add_parsers(sub: Any) -> None:
     q.add_argument("--out", default=None, help="report folder (default DIR/report)")
     q.set_defaults(func=_report)
 
+    q = sub.add_parser("tune", help="tune a controller kind's design parameters over load "
+                                    "cases (Optuna; resumable)")
+    q.add_argument("spec", help="tuning YAML file")
+    q.add_argument("--out", default=None, help="tuning directory (default tunings/NAME)")
+    q.add_argument("--trials", type=int, default=None, help="total trials (default: the "
+                                                            "spec's)")
+    q.add_argument("--workers", type=int, default=None,
+                   help="local worker processes (default: one per core)")
+    q.add_argument("--scheduler", default=None,
+                   help="address of a running Dask scheduler, tcp://HOST:PORT")
+    q.add_argument("--engine", choices=("dask", "processes", "serial"), default="dask")
+    q.add_argument("--quiet", action="store_true", help="no progress bar")
+    q.set_defaults(func=_tune)
+
 
 def _bench_mpc(args: argparse.Namespace) -> int:
     from ..bench import format_table, plot_solver_times, run_solver_benchmark
@@ -78,13 +93,7 @@ def _run(args: argparse.Namespace) -> int:
     spec = load_spec(args.spec)
     out = Path(args.out) if args.out else Path("campaigns") / spec.name
     if args.engine == "dask":
-        try:    # import first: distributed sets its loggers' levels when imported
-            import distributed  # noqa: F401
-        except ImportError:
-            pass
-        for name in list(logging.root.manager.loggerDict):
-            if name.startswith("distributed"):
-                logging.getLogger(name).setLevel(logging.ERROR)
+        _quiet_dask()
     log.info("campaign %s -> %s", spec.name, out)
     s = run_campaign(spec, out, workers=args.workers, scheduler=args.scheduler,
                      engine=args.engine, progress=not args.quiet)
@@ -154,3 +163,44 @@ def _report(args: argparse.Namespace) -> int:
     rep = make_report(args.dir, out=args.out)
     print(f"report {rep}")
     return 0
+
+
+def _quiet_dask() -> None:
+    try:    # import first: distributed sets its loggers' levels when imported
+        import distributed  # noqa: F401
+    except ImportError:
+        return
+    for name in list(logging.root.manager.loggerDict):
+        if name.startswith("distributed"):
+            logging.getLogger(name).setLevel(logging.ERROR)
+
+
+def _tune(args: argparse.Namespace) -> int:
+    from ..tuning.run import tune
+    from ..tuning.spec import load_tune_spec
+
+    if args.scheduler and args.workers:
+        raise UsageError("give --workers (local cluster) or --scheduler (running cluster), "
+                         "not both")
+    if args.trials is not None and args.trials < 1:
+        raise UsageError(f"--trials must be >= 1, got {args.trials}")
+    spec = load_tune_spec(args.spec)
+    out = Path(args.out) if args.out else Path("tunings") / spec.name
+    if args.engine == "dask":
+        _quiet_dask()
+    res = tune(spec, out, engine=args.engine, workers=args.workers, scheduler=args.scheduler,
+               n_trials=args.trials, progress=not args.quiet)
+    r = res.result
+    print(f"tuning {spec.name}: {len(r.trials)} trials ({len(r.completed)} completed, "
+          f"{sum(t.feasible for t in r.trials)} feasible; {r.evaluated} run now), "
+          f"{res.wall_s:.0f} s")
+    if r.best is None:
+        print("  no trial met the constraints")
+    else:
+        print(f"  best trial {r.best.number}: objective {r.best.value:.4f} x the reference; "
+              + ", ".join(f"{k} = {v:.4g}" for k, v in r.best.params.items()))
+    for label, tab in (("tuning seeds", res.tuning), ("held-out seeds", res.holdout)):
+        for name, m in tab.items():
+            print(f"  {label:14s} {name:8s} objective {m['objective']:.4f}")
+    print(f"  directory {out}: report.md, best.json, trials.csv, pareto.png")
+    return 0 if r.best is not None else 1

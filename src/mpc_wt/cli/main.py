@@ -15,6 +15,7 @@ lidar        CW LIDAR preview: ``lidar evaluate --field FIELD [--focus 54] [--js
 design       gain synthesis: ``design baseline|lqr|ts|ibc|coleman-ipc [...] --out DIR``
 export       gain tables: ``export DIR --format csv|json|mat|rosco``
 campaign     load-case campaigns on Dask: ``campaign run SPEC.yaml``, ``status``, ``report``
+tune         design parameters optimized over load cases: ``tune SPEC.yaml --out DIR``
 bench        ``bench mpc``: QP solver comparison
 
 ``--plugin MODULE`` (before the subcommand, repeatable) imports a module that registers

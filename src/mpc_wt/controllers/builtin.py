@@ -20,7 +20,7 @@ from .options import REQUIRED, Options, option
 from .registry import register
 
 __all__ = ["BaselineOptions", "DerateOptions", "APCOptions", "IBCOptions", "ColemanIPCOptions",
-           "MPCOptions", "LidarOptions", "MPCLidarOptions", "LQRPIOOptions", "TSOptions",
+           "MPCOptions", "MPCWeightOptions", "LidarOptions", "MPCLidarOptions", "LQRPIOOptions", "TSOptions",
            "DisconOptions", "RoscoOptions"]
 
 
@@ -47,19 +47,21 @@ def _design_coleman(turbine: linearize.Turbine, *, power_fraction: float = 1.0
 
 def _design_lqr(turbine: linearize.Turbine, *, winds: Any = None,
                 weights: dict[str, float] | None = None, scales: dict[str, float] | None = None,
-                observer_q: float = 1e3) -> tuple[dict, str]:
+                observer_q: float = 1e3, input_weights: dict[str, float] | None = None
+                ) -> tuple[dict, str]:
     from ..export import lqr_table
-    from ..synthesis import (REGION3_SCALES, REGION3_WEIGHTS, design_lqr_family,
-                             design_pi_observer)
+    from ..synthesis import (REGION2_SCALES, REGION3_SCALES, REGION3_WEIGHTS,
+                             design_lqr_family, design_pi_observer)
 
     winds = np.arange(12.0, 25.5, 1.0) if winds is None else np.asarray(winds, float)
     fam = linearize.linearize_family(turbine, winds, config=linearize.PlantConfig.do(),
                                      progress=True)
     weights = dict(weights or REGION3_WEIGHTS)
-    scales = {**REGION3_SCALES, **(scales or {})}
+    scales = {**REGION2_SCALES, **REGION3_SCALES, **(scales or {})}
     sw = {k: v for k, v in weights.items() if k in fam.models[0].states}
     ow = {k: v for k, v in weights.items() if k not in sw}
-    designs = design_lqr_family(fam, state_weights=sw, output_weights=ow, scales=scales)
+    designs = design_lqr_family(fam, state_weights=sw, output_weights=ow, scales=scales,
+                                input_weights=input_weights)
     obs = [design_pi_observer(m, q=observer_q) for m in fam.models] if observer_q > 0 else None
     note = f"{len(designs)} operating points"
     if obs:
@@ -229,6 +231,36 @@ def _build_coleman(ctx: BuildContext, opts: ColemanIPCOptions, base: Built) -> B
 
 
 # -- MPC -----------------------------------------------------------------------------------
+_MW = "weight of the MPC cost on the scaled signal (unset: mpc_wt.MPCWeights' default)"
+
+
+@dataclass(frozen=True)
+class MPCWeightOptions(Options):
+    """Weights of Madsen's MPC cost (:class:`mpc_wt.MPCWeights`); unset ones keep the default.
+    Outputs are divided by their scales (0.5 MW, 1 deg/s, 0.1 m/s, 0.05 rad/s, 1 mrad, 1 MN m)
+    and inputs by theirs (1 deg, 4 kN m) before weighting."""
+
+    gen_power: Optional[float] = option(None, help=_MW, unit="-", lo=0.0)
+    pitch_rate: Optional[float] = option(None, help=_MW, unit="-", lo=0.0)
+    tower_fa_velocity: Optional[float] = option(None, help=_MW, unit="-", lo=0.0)
+    rotor_speed: Optional[float] = option(None, help=_MW, unit="-", lo=0.0)
+    shaft_torsion: Optional[float] = option(None, help=_MW, unit="-", lo=0.0)
+    flap_moment: Optional[float] = option(None, help=_MW + "; Coleman-weighted", unit="-",
+                                          lo=0.0)
+    pitch_ref: Optional[float] = option(None, help="input " + _MW, unit="-", lo=0.0)
+    gen_torque_ref: Optional[float] = option(None, help="input " + _MW, unit="-", lo=0.0)
+
+    def weights(self) -> Any:
+        """The :class:`mpc_wt.MPCWeights` with the set options in place of the defaults."""
+        from ..mpc import MPCWeights
+
+        w = MPCWeights()
+        given = {k: v for k, v in self.to_dict().items() if v is not None}
+        ins = {k: given.pop(k) for k in ("pitch_ref", "gen_torque_ref") if k in given}
+        return MPCWeights(outputs={**w.outputs, **given}, inputs={**w.inputs, **ins},
+                          rate=dict(w.rate), scales=dict(w.scales))
+
+
 @dataclass(frozen=True)
 class MPCOptions(Options):
     """Madsen et al.'s MPC at 10 Hz (:class:`mpc_wt.MPCSettings` holds the full set)."""
@@ -243,6 +275,8 @@ class MPCOptions(Options):
                                       choices=(None, "kalman"))
     scheduled: bool = option(False, help="scheduled over a model family above rated on the "
                              "estimated wind (or the preview with mpc-lidar)", flag_value=True)
+    weights: MPCWeightOptions = option(MPCWeightOptions(), help="cost weights (gen_power, "
+                                       "flap_moment, rotor_speed, ...)", flag="")
 
 
 _CW = "lidar.CWLidar setting (unset: its default)"
@@ -319,7 +353,7 @@ def _mpc_settings(opts: MPCOptions, collective: bool) -> Any:
 
     return MPCSettings(horizon=opts.horizon, backend=opts.backend,
                        formulation=opts.formulation, estimator=opts.estimator,
-                       collective=collective)
+                       collective=collective, weights=opts.weights.weights())
 
 
 def _scheduled(ctx: BuildContext, settings: Any, source: str) -> Any:
@@ -388,21 +422,48 @@ class LQRPIOOptions(Options):
 
     observer_q: float = option(1e3, help="PI observer q of Q_obs = diag(I, q I)", unit="-",
                                lo=0.0, lo_open=True, flag="")
+    w_rotor_speed: Optional[float] = option(None, help="LQR weight on the rotor speed (scale "
+                                            "0.05 rad/s; default 5 in region III, 0 in II)",
+                                            unit="-", lo=0.0)
+    w_tower_fa_velocity: Optional[float] = option(None, help="LQR weight on the tower-top "
+                                                  "fore-aft velocity (scale 0.1 m/s; default 1)",
+                                                  unit="-", lo=0.0)
+    w_flap_rate: Optional[float] = option(None, help="LQR weight on each blade's flap tip rate "
+                                          "(scale 1 m/s; default 0 in region III, 0.2 in II)",
+                                          unit="-", lo=0.0)
+    w_pitch: float = option(1.0, help="LQR input weight on each blade's pitch (scale 1 deg)",
+                            unit="-", lo=0.0, lo_open=True)
+
+    def lqr_weights(self, region: str) -> tuple[dict[str, float], dict[str, float]]:
+        """The state weights and input weights of the design in ``region`` ("II", "III"):
+        the region's defaults (:data:`mpc_wt.synthesis.REGION3_WEIGHTS`, ``REGION2_WEIGHTS``)
+        with the options that are set in their place."""
+        from ..synthesis import REGION2_WEIGHTS, REGION3_WEIGHTS
+
+        w = dict(REGION3_WEIGHTS if region == "III" else REGION2_WEIGHTS)
+        for name, val in (("rotor_speed", self.w_rotor_speed),
+                          ("tower_fa_velocity", self.w_tower_fa_velocity)):
+            if val is not None:
+                w[name] = val
+        if self.w_flap_rate is not None:
+            w.update({f"flap_rate_{i}": self.w_flap_rate for i in (1, 2, 3)})
+        return ({k: v for k, v in w.items() if v > 0},
+                {f"pitch_ref_{i}": self.w_pitch for i in (1, 2, 3)})
 
 
 @register("lqr-pio", LQRPIOOptions, design=_design_lqr, design_name="lqr",
           summary="Do et al.'s LQR with a PI observer at the mean wind (region II or III)")
 def _build_lqr_pio(ctx: BuildContext, opts: LQRPIOOptions) -> Built:
     from ..baseline import tune_baseline
-    from ..synthesis import (REGION2_SCALES, REGION2_WEIGHTS, REGION3_SCALES, REGION3_WEIGHTS,
-                             LQRPIOController, design_lqr, design_pi_observer)
+    from ..synthesis import (REGION2_SCALES, REGION3_SCALES, LQRPIOController, design_lqr,
+                             design_pi_observer)
 
     turbine, v = ctx.turbine, ctx.scenario.wind_mps
     model = linearize.linearize(turbine, v, config=linearize.PlantConfig.do())
     region = "II" if v < linearize.rated_wind_speed(turbine) else "III"
-    w, sc = ((REGION3_WEIGHTS, REGION3_SCALES) if region == "III"
-             else (REGION2_WEIGHTS, REGION2_SCALES))
-    lq = design_lqr(model, state_weights=w, scales=sc)
+    w, iw = opts.lqr_weights(region)
+    lq = design_lqr(model, state_weights=w, input_weights=iw,
+                    scales={**REGION2_SCALES, **REGION3_SCALES})
     ctl = LQRPIOController(model, turbine, lq, design_pi_observer(model, q=opts.observer_q),
                            region=region,
                            k_opt=tune_baseline(turbine).k_opt if region == "II" else None,

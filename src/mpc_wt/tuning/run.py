@@ -1,0 +1,217 @@
+"""Tune a controller kind over load cases: every trial a small campaign (``mpcwt tune``).
+
+A trial's design runs the tuning spec's load cases (winds x tuning seeds) next to the reference
+in one campaign directory, ``OUT/campaign``, on the campaigns' engines (one Dask cluster for
+the whole tuning, so workers keep their caches); cases are keyed by the design's parameters, so
+a design met again -- a resumed trial, the best one on its re-evaluation -- reuses them. The
+Optuna study is ``OUT/study.sqlite``: an interrupted tuning continues where it stopped. After the
+search the best feasible design and the hand-set one (the kind's defaults) are run on the
+held-out seeds. Written to ``OUT``: ``best.json``, ``trials.csv``, ``pareto.png``,
+``report.md`` and, for kinds with a gain synthesis, ``best/`` with the gain table (design.json,
+CSV, JSON, and ROSCO's DISCON.IN for a baseline).
+"""
+from __future__ import annotations
+
+import contextlib
+import csv
+import fcntl
+import json
+import logging
+import math
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Iterator, Mapping
+
+import numpy as np
+
+from ..campaign import CampaignStore, run_campaign
+from ..campaign.report import relative_metrics
+from ..campaign.runner import _dask_import
+from ..errors import CampaignLockedError
+from .optimizer import TrialFailed, TuneResult, optimize
+from .spec import TuneSpec
+
+__all__ = ["tune", "TuneOutcome", "REPORT_METRICS"]
+
+log = logging.getLogger(__name__)
+
+#: Measures the report always shows (besides the objective's and the constraints').
+REPORT_METRICS = ("rotor_speed_std", "power_std", "pitch_travel", "cs1", "cs2")
+
+
+@dataclass
+class TuneOutcome:
+    """What :func:`tune` found and wrote.
+
+    Parameters
+    ----------
+    result : TuneResult
+        The search (best trial, every trial).
+    tuning : dict
+        Ratios to the reference on the tuning seeds: ``tuned`` and ``hand-set``.
+    holdout : dict
+        The same on the held-out seeds (empty without ``holdout_seeds``).
+    files : list of Path
+        What was written.
+    wall_s : float
+    """
+
+    result: TuneResult
+    tuning: dict[str, dict[str, float]] = field(default_factory=dict)
+    holdout: dict[str, dict[str, float]] = field(default_factory=dict)
+    files: list[Path] = field(default_factory=list)
+    wall_s: float = 0.0
+
+
+@contextlib.contextmanager
+def _lock(out: Path) -> Iterator[None]:
+    out.mkdir(parents=True, exist_ok=True)
+    f = open(out / ".tune.lock", "w")
+    try:
+        try:
+            fcntl.flock(f, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except OSError:
+            raise CampaignLockedError(f"{out}: another `mpcwt tune` runs this directory") \
+                from None
+        yield
+    finally:
+        f.close()
+
+
+@contextlib.contextmanager
+def _engine(engine: str, workers: int | None, scheduler: str | None
+            ) -> Iterator[dict[str, Any]]:
+    """run_campaign's engine arguments; for Dask without a scheduler, one local cluster for
+    every trial (its workers keep their design caches and compiled kernels)."""
+    if engine != "dask" or scheduler is not None:
+        yield {"engine": engine, "workers": workers, "scheduler": scheduler}
+        return
+    distributed = _dask_import()
+    import dask
+
+    from ..campaign.runner import _workers
+
+    dask.config.set({"distributed.scheduler.worker-saturation": 1.0})
+    cluster = distributed.LocalCluster(n_workers=_workers(workers), threads_per_worker=1,
+                                       processes=True, dashboard_address=None,
+                                       host="127.0.0.1")
+    try:
+        yield {"engine": "dask", "workers": None, "scheduler": cluster.scheduler_address}
+    finally:
+        cluster.close()
+
+
+def _ratios(spec: TuneSpec, root: Path, designs: Mapping[str, Mapping[str, float] | None],
+            run: dict[str, Any], seeds: Any = None) -> dict[str, dict[str, float]]:
+    """Run the designs (and the reference) on the spec's cases and return their ratios."""
+    cspec = spec.campaign(designs, seeds=seeds)
+    summary = run_campaign(cspec, root, progress=False, **run)
+    if summary.failed:
+        cid, err = summary.failures[0]
+        raise TrialFailed(f"{summary.failed} case(s) failed, e.g. {cid}: {err}")
+    with CampaignStore(root) as st:
+        rows = st.rows()
+    return {name: spec.metrics(relative_metrics(cspec, rows, name)) for name in designs}
+
+
+def tune(spec: TuneSpec, out: str | Path, *, engine: str = "dask", workers: int | None = None,
+         scheduler: str | None = None, n_trials: int | None = None,
+         progress: bool = True) -> TuneOutcome:
+    """Search the spec's parameters, then assess the best design on the held-out seeds.
+
+    Parameters
+    ----------
+    spec : TuneSpec
+        :func:`mpc_wt.tuning.spec.load_tune_spec`.
+    out : path
+        The tuning directory (created; an existing one is continued).
+    engine : {"dask", "processes", "serial"}
+        How a trial's cases run (:func:`mpc_wt.campaign.run_campaign`).
+    workers : int, optional
+        Local worker processes (default one per core).
+    scheduler : str, optional
+        A running Dask scheduler's address.
+    n_trials : int, optional
+        Total trials (default the spec's ``trials``).
+    progress : bool
+        Progress bar over the trials.
+
+    Returns
+    -------
+    TuneOutcome
+
+    Raises
+    ------
+    CampaignLockedError
+        Another tuning runs the directory.
+    """
+    out = Path(out)
+    t0 = time.perf_counter()
+    with _lock(out), _engine(engine, workers, scheduler) as run:
+        (out / "spec.json").write_text(json.dumps(spec.raw, indent=1, default=str))
+        root = out / "campaign"
+
+        def evaluate(params: dict[str, Any]) -> dict[str, float]:
+            name = spec.candidate_name(params)
+            return _ratios(spec, root, {name: params}, run)[name]
+
+        result = optimize(evaluate, spec.parameters, storage=out / "study.sqlite",
+                          objective="objective", constraints=spec.constraints,
+                          n_trials=n_trials or spec.trials, study_name=spec.name,
+                          sampler=spec.sampler, seed=spec.seed, initial=spec.initial,
+                          progress=progress)
+        outcome = TuneOutcome(result=result)
+        designs: dict[str, Mapping[str, float] | None] = {"hand-set": None}
+        if result.best is not None:
+            designs[spec.candidate_name(result.best.params)] = result.best.params
+        for label, seeds, target in (("tuning", None, outcome.tuning),
+                                     ("holdout", spec.holdout_seeds, outcome.holdout)):
+            if label == "holdout" and not seeds:
+                continue
+            try:
+                got = _ratios(spec, root, designs, run, seeds=seeds)
+            except TrialFailed as err:
+                log.warning("tuning: the %s evaluation failed: %s", label, err)
+                continue
+            target.update({("hand-set" if k == "hand-set" else "tuned"): v
+                           for k, v in got.items()})
+    outcome.wall_s = time.perf_counter() - t0
+    from .report import write_outputs
+
+    outcome.files = write_outputs(spec, outcome, out)
+    return outcome
+
+
+def trials_table(result: TuneResult) -> list[dict[str, Any]]:
+    """One row per trial: number, state, feasible, objective, parameters, measures, error."""
+    keys = sorted({k for t in result.trials for k in t.metrics} - {"objective"})
+    pnames = sorted({k for t in result.trials for k in t.params})
+    return [{"trial": t.number, "state": t.state, "feasible": t.feasible, "objective": t.value,
+             **{f"param:{k}": t.params.get(k) for k in pnames},
+             **{k: t.metrics.get(k) for k in keys}, "error": t.error or ""}
+            for t in result.trials]
+
+
+def write_trials_csv(result: TuneResult, path: Path) -> Path:
+    """``trials.csv`` of :func:`trials_table`."""
+    rows = trials_table(result)
+    with open(path, "w", newline="") as f:
+        if rows:
+            w = csv.DictWriter(f, fieldnames=list(rows[0]))
+            w.writeheader()
+            for r in rows:
+                w.writerow({k: ("" if v is None else f"{v:.6g}" if isinstance(v, float)
+                                and math.isfinite(v) else v) for k, v in r.items()})
+    return path
+
+
+def pareto_front(points: np.ndarray) -> np.ndarray:
+    """Indices of the non-dominated rows of ``points`` (every column minimized), in order of
+    the first column."""
+    idx = []
+    for i, p in enumerate(points):
+        dominated = np.any(np.all(points <= p, axis=1) & np.any(points < p, axis=1))
+        if not dominated:
+            idx.append(i)
+    return np.array(sorted(idx, key=lambda i: points[i, 0]), dtype=int)
