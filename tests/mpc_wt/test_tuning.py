@@ -178,7 +178,9 @@ def _spec_raw(**over: object) -> dict:
     ({"objective": [{"metric": "del:flap_moment_1"}]}, "objective[0].metric",
      "unknown measure 'del:flap_moment_1'"),
     ({"constraints": [{"metric": "cs1", "max_ratio": 1, "max_change_pct": 0}]},
-     "constraints[0]", "must be {metric, max_ratio} or {metric, max_change_pct}"),
+     "constraints[0]", "must be {metric, max_ratio}, {metric, max_change_pct} or "),
+    ({"constraints": [{"metric": "cs1", "max_value": 3}]}, "constraints[0].metric",
+     "max_value bounds a measure per case"),
     ({"controller": {"controller": "baseline", "zeta": 0}}, "controller.zeta",
      "zeta must be > 0"),
     ({"reference": {"controller": "baseline"}}, "reference", "must be a mapping with `name`"),
@@ -204,11 +206,14 @@ def test_tune_over_load_cases_end_to_end_and_resume(tmp_path: Path) -> None:
     from mpc_wt.tuning.run import tune
     from mpc_wt.tuning.spec import tune_spec_from_dict
 
-    spec = tune_spec_from_dict(_spec_raw())
+    spec = tune_spec_from_dict(_spec_raw(constraints=[
+        {"metric": "rotor_speed_std", "max_ratio": 1.3},
+        {"metric": "pitch_rate_limit_hits", "max_value": 50}]))
     out = tmp_path / "tune"
     res = tune(spec, out, engine="serial", progress=False)
     assert len(res.result.completed) == 3 and res.result.best is not None
     assert res.result.best.metrics["rotor_speed_std"] <= 1.3
+    assert 0 <= res.result.best.metrics["pitch_rate_limit_hits"] <= 50
     assert res.tuning["tuned"]["objective"] == pytest.approx(res.result.best.value, rel=1e-9)
     assert set(res.holdout) == {"hand-set", "tuned"}
     for f in ("best.json", "trials.csv", "report.md", "pareto.png", "best/design.json",
@@ -238,3 +243,21 @@ def test_tune_cli_names_bad_arguments(tmp_path: Path, capsys: pytest.CaptureFixt
     f.write_text(yaml.safe_dump(_spec_raw()))
     assert main(["tune", str(f), "--trials", "0"]) == 2
     assert "--trials must be >= 1, got 0" in capsys.readouterr().err
+
+
+def test_actuator_limit_hits_hand_worked() -> None:
+    """Blade 1 ramps at the 8 deg/s limit during 1-2 s and 5-5.5 s, blade 2 at 4 deg/s
+    throughout (half the limit); 10 s at 0.05 s after a 0.5 s transient: two hits, 1.5 s at the
+    limit, largest rate 8 deg/s."""
+    from mpc_wt.campaign.task import actuator_limit_metrics
+
+    dt, lim = 0.05, math.radians(8.0)
+    t = np.arange(0.0, 10.0 + dt / 2, dt)
+    rate1 = np.where(((t >= 1.0) & (t < 2.0)) | ((t >= 5.0) & (t < 5.5)), lim, 0.0)
+    p1 = np.concatenate([[0.0], np.cumsum(rate1[:-1] * dt)])
+    p2 = 0.5 * lim * t
+    m = actuator_limit_metrics(t, {"pitch_1": p1, "pitch_2": p2, "pitch_3": 0 * t}, lim, 0.5)
+    assert m["pitch_rate_limit_hits"] == 2
+    assert m["pitch_rate_limit_s"] == pytest.approx(1.5, abs=1e-9)
+    assert m["pitch_rate_max_degps"] == pytest.approx(8.0, rel=1e-9)
+    assert actuator_limit_metrics(t, {"rotor_speed": t}, lim, 0.5) == {}

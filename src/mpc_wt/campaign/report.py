@@ -24,7 +24,8 @@ from ..assess import (aep_Wh, cs_measures, lifetime_del, lifetime_extension, pct
 from .spec import CampaignSpec, spec_from_dict, turbulence_tag
 from .store import CampaignStore, CaseRow
 
-__all__ = ["aggregate", "make_report", "relative_metrics", "RELATIVE_METRICS"]
+__all__ = ["aggregate", "make_report", "relative_metrics", "absolute_metrics",
+           "RELATIVE_METRICS", "ABSOLUTE_METRICS"]
 
 #: A seed whose DEL exceeds this multiple of its bin's median (3 seeds or more) is listed as
 #: suspect in the report: with m = 10 one such run can carry a lifetime DEL.
@@ -41,6 +42,11 @@ RELATIVE_METRICS: dict[str, tuple[str, ...]] = {
     "pitch_travel": ("pitch_travel_deg",), "pitch_rate_std": ("pitch_rate_std_degps",),
     "pitch_acc_std": ("pitch_acc_std_degps2",), "flap_1p": ("flap_1_harmonics", "1P"),
     "flap_3p": ("flap_1_harmonics", "3P")}
+#: Measures of :func:`absolute_metrics` (per case, not relative: the reference may have none).
+ABSOLUTE_METRICS: dict[str, tuple[str, ...]] = {
+    "pitch_rate_limit_hits": ("pitch_rate_limit_hits",),
+    "pitch_rate_limit_s": ("pitch_rate_limit_s",),
+    "pitch_rate_max_degps": ("pitch_rate_max_degps",)}
 
 
 def _pct(a: float | None, b: float | None) -> float | None:
@@ -281,6 +287,32 @@ def relative_metrics(spec: CampaignSpec, rows: Sequence[CaseRow], controller: st
             b = float(np.sum(g.p_com * np.asarray(base_v)))
             if b > 0:
                 acc[name].append(float(np.sum(g.p_com * np.asarray(mine_v))) / b)
+    return {k: float(np.mean(v)) for k, v in acc.items()}
+
+
+def absolute_metrics(spec: CampaignSpec, rows: Sequence[CaseRow], controller: str
+                     ) -> dict[str, float]:
+    """A controller's :data:`ABSOLUTE_METRICS` per case: the seed mean per wind, weighted over
+    its winds by the spec's distribution (several turbulences: their mean).
+
+    Parameters
+    ----------
+    spec : CampaignSpec
+    rows : sequence of CaseRow
+    controller : str
+
+    Returns
+    -------
+    dict of str to float
+        Name -> value; a measure some wind lacks is left out.
+    """
+    done = [r for r in rows if r.status == "done" and r.metrics]
+    acc: dict[str, list[float]] = defaultdict(list)
+    for g in (g for g in _groups(spec, done) if g.ctl == controller):
+        for name, key in ABSOLUTE_METRICS.items():
+            vals = [_bin_mean(g.bins[v], key) for v in g.winds]
+            if vals and all(x is not None for x in vals):
+                acc[name].append(float(np.sum(g.p_all * np.asarray(vals)) / g.p_all.sum()))
     return {k: float(np.mean(v)) for k, v in acc.items()}
 
 

@@ -19,7 +19,10 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["run_case", "case_metrics", "case_file"]
+__all__ = ["run_case", "case_metrics", "case_file", "actuator_limit_metrics"]
+
+#: A pitch rate at or above this fraction of the actuator's limit counts as at the limit.
+RATE_LIMIT_FRACTION = 0.98
 
 
 def case_file(case_id: str) -> str:
@@ -99,6 +102,40 @@ def case_metrics(t: np.ndarray, cols: dict[str, np.ndarray], channels: dict[str,
     return _plain(out)
 
 
+def actuator_limit_metrics(t: np.ndarray, cols: dict[str, np.ndarray], max_rate_rad_s: float,
+                           transient: float) -> dict[str, Any]:
+    """How often the pitch actuator ran at its rate limit, after ``transient`` [s].
+
+    Parameters
+    ----------
+    t : (n_t,) ndarray
+        Time [s].
+    cols : dict
+        The run's channels (``pitch_1..3`` [rad]).
+    max_rate_rad_s : float
+        The actuator's rate limit [rad/s].
+    transient : float
+        Discarded start [s].
+
+    Returns
+    -------
+    dict
+        ``pitch_rate_max_degps`` (largest rate of any blade), ``pitch_rate_limit_hits`` (times
+        any blade reached :data:`RATE_LIMIT_FRACTION` of the limit: rising edges) and
+        ``pitch_rate_limit_s`` (time spent there); empty without pitch channels.
+    """
+    k = t >= t[0] + transient
+    blades = [np.asarray(cols[n])[k] for n in ("pitch_1", "pitch_2", "pitch_3") if n in cols]
+    if not blades or np.count_nonzero(k) < 3:
+        return {}
+    dt = float(np.median(np.diff(t[k])))
+    rate = np.abs(np.diff(np.column_stack(blades), axis=0)) / dt
+    at = (rate >= RATE_LIMIT_FRACTION * max_rate_rad_s).any(axis=1)
+    hits = int(at[0]) + int(np.count_nonzero(at[1:] & ~at[:-1]))
+    return {"pitch_rate_max_degps": float(np.degrees(rate.max())),
+            "pitch_rate_limit_hits": hits, "pitch_rate_limit_s": float(at.sum() * dt)}
+
+
 def _plain(obj: Any) -> Any:
     """JSON-safe copy: numpy scalars to float, non-finite floats to None."""
     if isinstance(obj, dict):
@@ -171,6 +208,9 @@ def run_case(case: dict[str, Any], root: str) -> dict[str, Any]:
         cols = {n: res.channel(n) for n in res.channels()}
         metrics = case_metrics(res.t, cols, case["channels"], case["transient"],
                                case.get("del_convention", "range-1hz"))
+        metrics.update(_plain(actuator_limit_metrics(
+            res.t, cols, _turbine(case["turbine"]).pitch_actuator.max_rate_rad_s,
+            case["transient"])))
         return {**base, "status": "done", "file": rel, "metrics": metrics, "reused": reused,
                 "wall_s": time.perf_counter() - t0}
     except Exception as err:  # noqa: BLE001 - every failure is recorded, none stops others

@@ -26,7 +26,7 @@ from typing import Any, Iterator, Mapping
 import numpy as np
 
 from ..campaign import CampaignStore, run_campaign
-from ..campaign.report import relative_metrics
+from ..campaign.report import absolute_metrics, relative_metrics
 from ..campaign.runner import _dask_import
 from ..errors import CampaignLockedError
 from .optimizer import TrialFailed, TuneResult, optimize
@@ -112,7 +112,8 @@ def _ratios(spec: TuneSpec, root: Path, designs: Mapping[str, Mapping[str, float
         raise TrialFailed(f"{summary.failed} case(s) failed, e.g. {cid}: {err}")
     with CampaignStore(root) as st:
         rows = st.rows()
-    return {name: spec.metrics(relative_metrics(cspec, rows, name)) for name in designs}
+    return {name: spec.metrics({**relative_metrics(cspec, rows, name),
+                                **absolute_metrics(cspec, rows, name)}) for name in designs}
 
 
 def tune(spec: TuneSpec, out: str | Path, *, engine: str = "dask", workers: int | None = None,

@@ -23,7 +23,9 @@ Every measure is a ratio to the reference over the same cases
 (:func:`mpc_wt.campaign.report.relative_metrics`): ``del:CHANNEL`` (lifetime DEL of a channel
 of ``channels``), ``cs1``..``cs5``, ``power_mean``, ``power_std``, ``rotor_speed_std``,
 ``rotor_speed_max``, ``pitch_travel``, ``pitch_rate_std``, ``pitch_acc_std``, ``flap_1p``,
-``flap_3p``. A constraint may give ``max_change_pct`` instead (``max_ratio = 1 + pct/100``).
+``flap_3p``. A constraint may give ``max_change_pct`` instead (``max_ratio = 1 + pct/100``),
+or bound a measure per case with ``max_value``: ``pitch_rate_limit_hits`` (times a blade
+reached its pitch-rate limit per case), ``pitch_rate_limit_s``, ``pitch_rate_max_degps``.
 """
 from __future__ import annotations
 
@@ -37,7 +39,7 @@ from typing import Any, Mapping
 
 import yaml
 
-from ..campaign.report import RELATIVE_METRICS
+from ..campaign.report import ABSOLUTE_METRICS, RELATIVE_METRICS
 from ..campaign.spec import CampaignSpec, spec_from_dict
 from ..errors import SpecError
 from .optimizer import SAMPLERS, Constraint, Parameter
@@ -217,15 +219,22 @@ def _objective(raw: Any, channels: Mapping[str, float]) -> tuple[tuple[str, floa
 def _constraints(raw: Any, channels: Mapping[str, float]) -> tuple[Constraint, ...]:
     if not isinstance(raw, list):
         raise _fail("constraints", f"must be a list of {{metric, max_ratio | "
-                                   f"max_change_pct}}, got {raw!r}")
+                                   f"max_change_pct | max_value}}, got {raw!r}")
     out = []
+    bounds = ("max_ratio", "max_change_pct", "max_value")
     for i, e in enumerate(raw):
         key = f"constraints[{i}]"
         if not isinstance(e, Mapping) or "metric" not in e or \
-                set(e) - {"metric", "max_ratio", "max_change_pct"} or \
-                ("max_ratio" in e) == ("max_change_pct" in e):
-            raise _fail(key, f"must be {{metric, max_ratio}} or {{metric, max_change_pct}}, "
-                             f"got {e!r}")
+                set(e) - {"metric", *bounds} or sum(b in e for b in bounds) != 1:
+            raise _fail(key, f"must be {{metric, max_ratio}}, {{metric, max_change_pct}} or "
+                             f"{{metric, max_value}}, got {e!r}")
+        if "max_value" in e:
+            if e["metric"] not in ABSOLUTE_METRICS:
+                raise _fail(f"{key}.metric", f"max_value bounds a measure per case: one of "
+                                             f"{sorted(ABSOLUTE_METRICS)}, got {e['metric']!r}")
+            out.append(Constraint(str(e["metric"]), _number(f"{key}.max_value",
+                                                            e["max_value"], 0.0)))
+            continue
         m = _metric_name(f"{key}.metric", e["metric"], channels)
         bound = (_number(f"{key}.max_ratio", e["max_ratio"], 0.0, lo_open=True)
                  if "max_ratio" in e else
