@@ -95,7 +95,23 @@ def _rows(spec: TuneSpec, outcome: TuneOutcome) -> list[str]:
     return lines
 
 
+def _zoom(ax: Any, pts: np.ndarray, extra: list[Any]) -> None:
+    """Axis limits over the trials up to 1.5x their 80th percentile (and the reference and
+    hand-set): a few diverging designs would otherwise squash the front into a corner."""
+    if pts.shape[0] < 3:
+        return
+    for col, setter in ((1, ax.set_xlim), (0, ax.set_ylim)):
+        v = np.concatenate([pts[:, col], [1.0], [e for e in extra[1 - col:2 - col]
+                                                 if e is not None]])
+        hi = min(float(v.max()), 1.5 * float(np.percentile(v, 80)))
+        lo = float(v.min())
+        pad = 0.05 * (hi - lo) if hi > lo else 0.05
+        setter(lo - pad, hi + pad)
+
+
 def _plot_pareto(spec: TuneSpec, outcome: TuneOutcome, path: Path) -> Path | None:
+    """Objective, and each of its measures, against each constraint measure: every completed
+    trial (feasible or not), the non-dominated front of the pair, the bound, hand-set, best."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -105,34 +121,43 @@ def _plot_pareto(spec: TuneSpec, outcome: TuneOutcome, path: Path) -> Path | Non
     if not done:
         return None
     xs = [c.metric for c in spec.constraints] or ["rotor_speed_std", "pitch_travel"]
-    fig, axes = plt.subplots(1, len(xs), figsize=(5.2 * len(xs), 4.2), squeeze=False)
-    for ax, x in zip(axes[0], xs):
-        pts = np.array([[t.value, t.metrics.get(x, math.nan)] for t in done], float)
-        ok = np.array([t.feasible for t in done])
-        ax.scatter(pts[~ok, 1], pts[~ok, 0], c="0.7", s=18, label="infeasible")
-        ax.scatter(pts[ok, 1], pts[ok, 0], c="tab:blue", s=18, label="feasible")
-        good = np.all(np.isfinite(pts), axis=1)
-        if good.sum() >= 2:
-            front = np.flatnonzero(good)[pareto_front(pts[good][:, ::-1])]
-            ax.plot(pts[front, 1], pts[front, 0], "-", c="tab:orange", lw=1.2,
-                    label="Pareto front")
-        for c in spec.constraints:
-            if c.metric == x:
-                ax.axvline(c.upper, ls="--", c="k", lw=0.8, label="constraint")
-        hand = outcome.tuning.get("hand-set")
-        if hand and x in hand:
-            ax.plot(hand[x], hand["objective"], "D", c="k", label="hand-set")
-        b = outcome.result.best
-        if b is not None:
-            ax.plot(b.metrics.get(x, math.nan), b.value, "*", c="tab:red", ms=14, label="best")
-        ax.axhline(1.0, c="0.5", lw=0.6)
-        ax.set_xlabel(f"{x} / reference")
-        ax.set_ylabel("objective / reference")
-        ax.grid(alpha=0.3)
-    axes[0][0].legend(fontsize=8)
-    fig.suptitle(f"{spec.name}: {len(done)} trials")
+    ys = list(dict.fromkeys(["objective"] + [m for m, _ in spec.objective]))
+    fig, axes = plt.subplots(len(ys), len(xs), figsize=(4.6 * len(xs), 3.4 * len(ys)),
+                             squeeze=False)
+    ok = np.array([t.feasible for t in done])
+    hand = outcome.tuning.get("hand-set", {})
+    b = outcome.result.best
+    for r, y in enumerate(ys):
+        for c, x in enumerate(xs):
+            ax = axes[r][c]
+            pts = np.array([[t.metrics.get(y, math.nan), t.metrics.get(x, math.nan)]
+                            for t in done], float)
+            ax.scatter(pts[~ok, 1], pts[~ok, 0], c="0.7", s=16, label="infeasible")
+            ax.scatter(pts[ok, 1], pts[ok, 0], c="tab:blue", s=16, label="feasible")
+            good = np.all(np.isfinite(pts), axis=1)
+            if good.sum() >= 2:
+                front = np.flatnonzero(good)[pareto_front(pts[good][:, ::-1])]
+                ax.plot(pts[front, 1], pts[front, 0], "-", c="tab:orange", lw=1.2,
+                        label="Pareto front")
+            for con in spec.constraints:
+                if con.metric == x:
+                    ax.axvline(con.upper, ls="--", c="k", lw=0.8, label="bound")
+            if x in hand and y in hand:
+                ax.plot(hand[x], hand[y], "D", c="k", label="hand-set")
+            if b is not None:
+                ax.plot(b.metrics.get(x, math.nan), b.metrics.get(y, math.nan), "*",
+                        c="tab:red", ms=13, label="best")
+            ax.axhline(1.0, c="0.5", lw=0.6)
+            _zoom(ax, pts[good], [hand.get(x), hand.get(y)])
+            ax.set_xlabel(x if x in ("pitch_rate_limit_hits", "pitch_rate_limit_s",
+                                     "pitch_rate_max_degps") else f"{x} / reference")
+            ax.set_ylabel(f"{y} / reference")
+            ax.grid(alpha=0.3)
+    axes[0][0].legend(fontsize=7)
+    fig.suptitle(f"{spec.name}: {len(done)} completed trials (ratios to "
+                 f"{spec.reference['name']})")
     fig.tight_layout()
-    fig.savefig(path, dpi=110)
+    fig.savefig(path, dpi=100)
     plt.close(fig)
     return path
 
@@ -179,7 +204,8 @@ def write_outputs(spec: TuneSpec, outcome: TuneOutcome, out: Path) -> list[Path]
     lines += _rows(spec, outcome) + ["", "![Pareto](pareto.png)", ""]
     failed = [t for t in res.trials if t.state == "FAIL"]
     if failed:
-        lines += ["Failed trials: " + "; ".join(f"{t.number} ({t.error})" for t in failed), ""]
+        lines += [f"Failed trials ({len(failed)}): " + "; ".join(
+            f"{t.number} ({(t.error or '')[:90]})" for t in failed), ""]
     (out / "report.md").write_text("\n".join(lines))
     files.append(out / "report.md")
     return files
