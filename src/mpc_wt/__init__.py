@@ -28,6 +28,7 @@ from .retrofit import (ColemanIPCController, IBCController, apc_reference, tune_
 from .simulate import LidarPreview, simulate_closed_loop
 from .synthesis import LQRPIOController, design_lqr, design_lqr_family, design_pi_observer
 from .ts import (TSController, build_ts_model, design_ts_controller, design_ts_observer)
+from .tuning.run import tune
 
 __all__ = ["__version__", "controllers", "DEFAULT_CHANNELS", "assess_series", "cs_measures",
            "damage_equivalent_load", "lifetime_del", "reductions", "BaselineController",
@@ -38,4 +39,5 @@ __all__ = ["__version__", "controllers", "DEFAULT_CHANNELS", "assess_series", "c
            "ColemanIPCController", "IBCController", "apc_reference", "tune_coleman_ipc",
            "tune_ibc", "LidarPreview", "simulate_closed_loop", "LQRPIOController", "design_lqr",
            "design_lqr_family", "design_pi_observer", "TSController", "build_ts_model",
-           "design_ts_controller", "design_ts_observer"]
+           "design_ts_controller", "design_ts_observer", "tune"]
+

@@ -7,7 +7,7 @@ from linearize import SimulationDivergedError
 
 __all__ = ["UsageError", "OptionsError", "SpecError", "CampaignLockedError", "GainTableError",
            "ResultFileError", "PremiseError", "SynthesisError", "SimulationDivergedError",
-           "QPSetupError", "ControllerLibraryError"]
+           "QPSetupError", "ControllerLibraryError", "TrialFailed"]
 
 
 class UsageError(ValueError):
@@ -75,3 +75,8 @@ class ControllerLibraryError(RuntimeError):
     def __init__(self, message: str, partial: object = None) -> None:
         super().__init__(message)
         self.partial = partial
+
+
+class TrialFailed(RuntimeError):
+    """A tuning trial's design that could not be assessed (a diverged case, a synthesis error):
+    the trial is recorded as failed with this message, and the search goes on."""

@@ -11,7 +11,7 @@ from linearize import OperatingPoint
 
 __all__ = ["plot_cp_surface", "plot_operating_schedule", "plot_lidar_coherence",
            "plot_scan_pattern", "plot_cs_ellipses", "plot_psd_comparison", "plot_design",
-           "assess_plots"]
+           "assess_plots", "plot_pareto"]
 
 
 def _save(fig, path: str | Path) -> Path:  # type: ignore[no-untyped-def]
@@ -394,3 +394,79 @@ def plot_comparison(runs: Sequence[tuple[str, np.ndarray, dict[str, np.ndarray]]
     fig.savefig(p, dpi=110)
     plt.close(fig)
     return [str(p)]
+
+
+def _zoom(ax: Any, pts: np.ndarray, extra: Sequence[Any]) -> None:
+    """Axis limits over the points up to 1.5x their 80th percentile (and 1 and ``extra``, per
+    axis): a few diverging designs would otherwise squash the front into a corner."""
+    if pts.shape[0] < 3:
+        return
+    for col, setter in ((0, ax.set_xlim), (1, ax.set_ylim)):
+        v = np.concatenate([pts[:, col], [1.0], [e for e in extra[col:col + 1]
+                                                 if e is not None]])
+        hi = min(float(v.max()), 1.5 * float(np.percentile(v, 80)))
+        lo = float(v.min())
+        pad = 0.05 * (hi - lo) if hi > lo else 0.05
+        setter(lo - pad, hi + pad)
+
+
+def plot_pareto(metrics: Sequence[dict[str, float]], feasible: Sequence[bool],
+                xs: Sequence[str], ys: Sequence[str], fronts: dict[tuple[str, str], Any],
+                bounds: dict[str, float], marks: dict[str, dict[str, float]],
+                path: str | Path, title: str = "", absolute: Any = ()) -> Path:
+    """A tuning's trials: each measure in ``ys`` (rows) against each in ``xs`` (columns),
+    feasible and infeasible trials, the non-dominated front of each pair, the bounds and the
+    marked designs (``hand-set``: black diamond, ``best``: red star).
+
+    Parameters
+    ----------
+    metrics : sequence of dict
+        Each completed trial's measures (ratios to the reference, or per-case values).
+    feasible : sequence of bool
+    xs, ys : sequence of str
+        Measures on the horizontal and vertical axes.
+    fronts : dict
+        (y, x) -> indices of the front's trials, in order along x.
+    bounds : dict
+        Measure -> upper bound (a dashed line where it is an x).
+    marks : dict
+        ``hand-set`` / ``best`` -> measures.
+    path : str or Path
+    title : str
+    absolute : collection of str
+        Measures that are not ratios (labelled without "/ reference").
+
+    Returns
+    -------
+    Path
+    """
+    plt = _plt()
+    fig, axes = plt.subplots(len(ys), len(xs), figsize=(4.6 * len(xs), 3.4 * len(ys)),
+                             squeeze=False)
+    ok = np.asarray(feasible, bool)
+    style = {"hand-set": ("D", "k", 6), "best": ("*", "tab:red", 13)}
+    for r, y in enumerate(ys):
+        for c, x in enumerate(xs):
+            ax = axes[r][c]
+            pts = np.array([[m.get(x, math.nan), m.get(y, math.nan)] for m in metrics], float)
+            ax.scatter(pts[~ok, 0], pts[~ok, 1], c="0.7", s=16, label="infeasible")
+            ax.scatter(pts[ok, 0], pts[ok, 1], c="tab:blue", s=16, label="feasible")
+            front = np.asarray(fronts.get((y, x), []), int)
+            if front.size >= 2:
+                ax.plot(pts[front, 0], pts[front, 1], "-", c="tab:orange", lw=1.2,
+                        label="Pareto front")
+            if x in bounds:
+                ax.axvline(bounds[x], ls="--", c="k", lw=0.8, label="bound")
+            for name, m in marks.items():
+                if x in m and y in m:
+                    mk, col, ms = style.get(name, ("o", "tab:green", 7))
+                    ax.plot(m[x], m[y], mk, c=col, ms=ms, label=name)
+            ax.axhline(1.0, c="0.5", lw=0.6)
+            hand = marks.get("hand-set", {})
+            _zoom(ax, pts[np.all(np.isfinite(pts), axis=1)], [hand.get(x), hand.get(y)])
+            ax.set_xlabel(x if x in absolute else f"{x} / reference")
+            ax.set_ylabel(y if y in absolute else f"{y} / reference")
+            ax.grid(alpha=0.3)
+    axes[0][0].legend(fontsize=7)
+    fig.suptitle(title)
+    return _save(fig, path)

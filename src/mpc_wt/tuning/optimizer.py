@@ -23,6 +23,8 @@ from typing import Any, Callable, Mapping, Sequence
 
 from linearize.validate import check_number
 
+from ..errors import TrialFailed
+
 __all__ = ["Parameter", "Constraint", "TrialRecord", "TuneResult", "TrialFailed", "optimize",
            "SAMPLERS"]
 
@@ -30,11 +32,6 @@ log = logging.getLogger(__name__)
 
 #: Samplers by name: TPE (default, constraint-aware), random search, and NSGA-II.
 SAMPLERS = ("tpe", "random", "nsga2")
-
-
-class TrialFailed(RuntimeError):
-    """An evaluation that could not produce metrics (a diverged case, a synthesis error): the
-    trial is recorded as failed with the message, and the study goes on."""
 
 
 @dataclass(frozen=True)

@@ -95,71 +95,31 @@ def _rows(spec: TuneSpec, outcome: TuneOutcome) -> list[str]:
     return lines
 
 
-def _zoom(ax: Any, pts: np.ndarray, extra: list[Any]) -> None:
-    """Axis limits over the trials up to 1.5x their 80th percentile (and the reference and
-    hand-set): a few diverging designs would otherwise squash the front into a corner."""
-    if pts.shape[0] < 3:
-        return
-    for col, setter in ((1, ax.set_xlim), (0, ax.set_ylim)):
-        v = np.concatenate([pts[:, col], [1.0], [e for e in extra[1 - col:2 - col]
-                                                 if e is not None]])
-        hi = min(float(v.max()), 1.5 * float(np.percentile(v, 80)))
-        lo = float(v.min())
-        pad = 0.05 * (hi - lo) if hi > lo else 0.05
-        setter(lo - pad, hi + pad)
-
-
 def _plot_pareto(spec: TuneSpec, outcome: TuneOutcome, path: Path) -> Path | None:
-    """Objective, and each of its measures, against each constraint measure: every completed
-    trial (feasible or not), the non-dominated front of the pair, the bound, hand-set, best."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    """Objective, and each of its measures, against each constraint measure
+    (:func:`mpc_wt.plotting.plot_pareto`)."""
+    from ..plotting import plot_pareto
 
     done = [t for t in outcome.result.trials if t.state == "COMPLETE"]
     if not done:
         return None
     xs = [c.metric for c in spec.constraints] or ["rotor_speed_std", "pitch_travel"]
     ys = list(dict.fromkeys(["objective"] + [m for m, _ in spec.objective]))
-    fig, axes = plt.subplots(len(ys), len(xs), figsize=(4.6 * len(xs), 3.4 * len(ys)),
-                             squeeze=False)
-    ok = np.array([t.feasible for t in done])
-    hand = outcome.tuning.get("hand-set", {})
-    b = outcome.result.best
-    for r, y in enumerate(ys):
-        for c, x in enumerate(xs):
-            ax = axes[r][c]
-            pts = np.array([[t.metrics.get(y, math.nan), t.metrics.get(x, math.nan)]
+    fronts = {}
+    for y in ys:
+        for x in xs:
+            pts = np.array([[t.metrics.get(x, math.nan), t.metrics.get(y, math.nan)]
                             for t in done], float)
-            ax.scatter(pts[~ok, 1], pts[~ok, 0], c="0.7", s=16, label="infeasible")
-            ax.scatter(pts[ok, 1], pts[ok, 0], c="tab:blue", s=16, label="feasible")
-            good = np.all(np.isfinite(pts), axis=1)
-            if good.sum() >= 2:
-                front = np.flatnonzero(good)[pareto_front(pts[good][:, ::-1])]
-                ax.plot(pts[front, 1], pts[front, 0], "-", c="tab:orange", lw=1.2,
-                        label="Pareto front")
-            for con in spec.constraints:
-                if con.metric == x:
-                    ax.axvline(con.upper, ls="--", c="k", lw=0.8, label="bound")
-            if x in hand and y in hand:
-                ax.plot(hand[x], hand[y], "D", c="k", label="hand-set")
-            if b is not None:
-                ax.plot(b.metrics.get(x, math.nan), b.metrics.get(y, math.nan), "*",
-                        c="tab:red", ms=13, label="best")
-            ax.axhline(1.0, c="0.5", lw=0.6)
-            _zoom(ax, pts[good], [hand.get(x), hand.get(y)])
-            ax.set_xlabel(x if x in ("pitch_rate_limit_hits", "pitch_rate_limit_s",
-                                     "pitch_rate_max_degps") else f"{x} / reference")
-            ax.set_ylabel(f"{y} / reference")
-            ax.grid(alpha=0.3)
-    axes[0][0].legend(fontsize=7)
-    fig.suptitle(f"{spec.name}: {len(done)} completed trials (ratios to "
-                 f"{spec.reference['name']})")
-    fig.tight_layout()
-    fig.savefig(path, dpi=100)
-    plt.close(fig)
-    return path
+            good = np.flatnonzero(np.all(np.isfinite(pts), axis=1))
+            fronts[(y, x)] = good[pareto_front(pts[good])] if good.size >= 2 else good[:0]
+    b = outcome.result.best
+    marks = {"hand-set": outcome.tuning.get("hand-set", {}),
+             "best": b.metrics if b is not None else {}}
+    absolute = {"pitch_rate_limit_hits", "pitch_rate_limit_s", "pitch_rate_max_degps"}
+    return plot_pareto([t.metrics for t in done], [t.feasible for t in done], xs, ys, fronts,
+                       {c.metric: c.upper for c in spec.constraints}, marks, path,
+                       title=f"{spec.name}: {len(done)} completed trials (ratios to "
+                             f"{spec.reference['name']})", absolute=absolute)
 
 
 def write_outputs(spec: TuneSpec, outcome: TuneOutcome, out: Path) -> list[Path]:

@@ -30,7 +30,7 @@ from ..campaign.report import absolute_metrics, relative_metrics
 from ..campaign.runner import _dask_import
 from ..errors import CampaignLockedError
 from .optimizer import TrialFailed, TuneResult, optimize
-from .spec import TuneSpec
+from .spec import TuneSpec, load_tune_spec
 
 __all__ = ["tune", "TuneOutcome", "REPORT_METRICS"]
 
@@ -116,15 +116,15 @@ def _ratios(spec: TuneSpec, root: Path, designs: Mapping[str, Mapping[str, float
                                 **absolute_metrics(cspec, rows, name)}) for name in designs}
 
 
-def tune(spec: TuneSpec, out: str | Path, *, engine: str = "dask", workers: int | None = None,
-         scheduler: str | None = None, n_trials: int | None = None,
+def tune(spec: TuneSpec | str | Path, out: str | Path, *, engine: str = "dask",
+         workers: int | None = None, scheduler: str | None = None, n_trials: int | None = None,
          progress: bool = True) -> TuneOutcome:
     """Search the spec's parameters, then assess the best design on the held-out seeds.
 
     Parameters
     ----------
-    spec : TuneSpec
-        :func:`mpc_wt.tuning.spec.load_tune_spec`.
+    spec : TuneSpec, str or Path
+        A validated spec (:func:`mpc_wt.tuning.spec.load_tune_spec`) or a tuning YAML file.
     out : path
         The tuning directory (created; an existing one is continued).
     engine : {"dask", "processes", "serial"}
@@ -147,6 +147,8 @@ def tune(spec: TuneSpec, out: str | Path, *, engine: str = "dask", workers: int 
     CampaignLockedError
         Another tuning runs the directory.
     """
+    if not isinstance(spec, TuneSpec):
+        spec = load_tune_spec(spec)
     out = Path(out)
     t0 = time.perf_counter()
     with _lock(out), _engine(engine, workers, scheduler) as run:
