@@ -261,3 +261,37 @@ def test_actuator_limit_hits_hand_worked() -> None:
     assert m["pitch_rate_limit_s"] == pytest.approx(1.5, abs=1e-9)
     assert m["pitch_rate_max_degps"] == pytest.approx(8.0, rel=1e-9)
     assert actuator_limit_metrics(t, {"rotor_speed": t}, lim, 0.5) == {}
+
+
+def test_relative_and_absolute_metrics_hand_worked() -> None:
+    """Hand-worked ratios: one wind, two seeds. The candidate's tower DELs 2 and 2 MN m against
+    the reference's 1 and 1 (m = 4, equal cycle counts: the bin DEL is the m-power mean) give 2;
+    DELs 1 and 3 against 1 and 1 give ((1 + 81) / 2)^(1/4) = 2.530; power std 3 and 5 kW
+    against 2 and 2 give 2; the per-case limit hits 1 and 4 give 2.5 (no ratio: the reference
+    has none)."""
+    from mpc_wt.campaign import spec_from_dict
+    from mpc_wt.campaign.report import absolute_metrics, relative_metrics
+    from mpc_wt.campaign.store import CaseRow
+
+    spec = spec_from_dict({"name": "h", "winds": [18], "seeds": 2,
+                           "channels": {"tower_base_fa_moment": 4},
+                           "controllers": ["baseline", {"name": "c", "controller": "baseline"}],
+                           "reference": "baseline"})
+
+    def row(ctl: str, seed: int, d: float, p: float, hits: int) -> CaseRow:
+        m = {"channels": {"tower_base_fa_moment": {"del": d * 1e6, "m": 4.0, "n_eq": 600.0}},
+             "power_std_W": p * 1e3, "pitch_rate_limit_hits": hits}
+        return CaseRow(f"{ctl}{seed}", ctl, "baseline", 18.0, seed, "A", "", "", "done", None,
+                       m, None, None, None, None, 1, None, None)
+
+    ref = [row("baseline", 1, 1.0, 2.0, 0), row("baseline", 2, 1.0, 2.0, 0)]
+    got = relative_metrics(spec, ref + [row("c", 1, 2.0, 3.0, 1), row("c", 2, 2.0, 5.0, 4)], "c")
+    assert got["del:tower_base_fa_moment"] == pytest.approx(2.0, rel=1e-12)
+    assert got["power_std"] == pytest.approx(2.0, rel=1e-12)
+    assert "cs1" not in got                                      # neither has it
+    got = relative_metrics(spec, ref + [row("c", 1, 1.0, 2.0, 0), row("c", 2, 3.0, 2.0, 0)], "c")
+    assert got["del:tower_base_fa_moment"] == pytest.approx(41.0 ** 0.25, rel=1e-12)
+    ab = absolute_metrics(spec, ref + [row("c", 1, 2.0, 3.0, 1), row("c", 2, 2.0, 5.0, 4)], "c")
+    assert ab["pitch_rate_limit_hits"] == pytest.approx(2.5, rel=1e-12)
+    with pytest.raises(ValueError, match="share no wind with finished cases"):
+        relative_metrics(spec, [row("c", 1, 2.0, 3.0, 1)], "c")
