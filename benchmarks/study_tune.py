@@ -67,8 +67,12 @@ def _tower_first(spec, r, out: Path) -> list[str]:
     """The feasible trial with the lowest tower DEL, on the tuning and held-out seeds."""
     key = "del:tower_base_fa_moment"
     feas = [t for t in r.trials if t.feasible and key in t.metrics]
+    note = ""
+    if not feas:        # show what the search reached anyway, and say it broke a bound
+        feas = [t for t in r.trials if t.state == "COMPLETE" and key in t.metrics]
+        note = " (no trial met the constraints: the lowest tower DEL of all, infeasible)"
     if not feas:
-        return ["(no feasible trial)"]
+        return ["(no completed trial)"]
     t = min(feas, key=lambda t: t.metrics[key])
     name = spec.candidate_name(t.params)
     cspec = spec.campaign({name: t.params}, seeds=spec.holdout_seeds)
@@ -79,7 +83,8 @@ def _tower_first(spec, r, out: Path) -> list[str]:
 
     held = relative_metrics(cspec, rows, name)
     keys = [key, "cs1", "cs2", "rotor_speed_std", "pitch_travel"]
-    return [f"trial {t.number}: " + ", ".join(f"{k} = {v:.4g}" for k, v in t.params.items()),
+    return [f"trial {t.number}{note}: " + ", ".join(f"{k} = {v:.4g}"
+                                                   for k, v in t.params.items()),
             "", "| seeds | " + " | ".join(keys) + " |", "|---|" + "---|" * len(keys),
             "| tuning | " + " | ".join(_pct(t.metrics.get(k)) for k in keys) + " |",
             "| held-out | " + " | ".join(_pct(held.get(k)) for k in keys) + " |"]

@@ -90,6 +90,7 @@ def test_interrupted_tuning_resumes_without_rerunning(tmp_path: Path) -> None:
     interrupted = [t for t in res.trials if t.state == "FAIL"]
     assert len(interrupted) == 1 and calls[2] == interrupted[0].params["r"]
     assert res.evaluated == 4 and len(res.completed) == 6
+    assert len(set(calls)) == 6                 # the resumed sampler repeats no earlier point
     # a third call with the same target evaluates nothing
     again = optimize(evaluate, space, storage=store, objective="cost", n_trials=6,
                      progress=False)

@@ -245,6 +245,12 @@ def optimize(evaluate: Callable[[dict[str, Any]], Mapping[str, float]],
         storage=f"sqlite:///{path.resolve()}", study_name=study_name, direction="minimize",
         sampler=_sampler(sampler, seed, n_startup=max(5, min(10, n_trials // 4))),
         load_if_exists=True)
+    # a resumed study draws on from a seed of its own: the same seed would replay the first
+    # trials' start-up samples (TPE samples at random for its first n_startup trials)
+    n_before = len(study.trials)
+    if n_before:
+        study.sampler = _sampler(sampler, seed + n_before,
+                                 n_startup=max(5, min(10, n_trials // 4)))
     _recover(study)
     if not study.trials:
         for point in initial:
