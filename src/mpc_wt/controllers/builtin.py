@@ -251,7 +251,13 @@ class MPCWeightOptions(Options):
     gen_torque_ref: Optional[float] = option(None, help="input " + _MW, unit="-", lo=0.0)
 
     def weights(self) -> Any:
-        """The :class:`mpc_wt.MPCWeights` with the set options in place of the defaults."""
+        """The cost weights.
+
+        Returns
+        -------
+        MPCWeights
+            :class:`mpc_wt.MPCWeights` with the set options in place of its defaults.
+        """
         from ..mpc import MPCWeights
 
         w = MPCWeights()
@@ -435,9 +441,19 @@ class LQRPIOOptions(Options):
                             unit="-", lo=0.0, lo_open=True)
 
     def lqr_weights(self, region: str) -> tuple[dict[str, float], dict[str, float]]:
-        """The state weights and input weights of the design in ``region`` ("II", "III"):
-        the region's defaults (:data:`mpc_wt.synthesis.REGION3_WEIGHTS`, ``REGION2_WEIGHTS``)
-        with the options that are set in their place."""
+        """The state weights and input weights of the design in ``region``: the region's
+        defaults (:data:`mpc_wt.synthesis.REGION3_WEIGHTS`, ``REGION2_WEIGHTS``) with the
+        options that are set in their place.
+
+        Parameters
+        ----------
+        region : {"II", "III"}
+
+        Returns
+        -------
+        state_weights, input_weights : dict of str to float
+            For :func:`mpc_wt.synthesis.design_lqr` (zero weights left out).
+        """
         from ..synthesis import REGION2_WEIGHTS, REGION3_WEIGHTS
 
         w = dict(REGION3_WEIGHTS if region == "III" else REGION2_WEIGHTS)

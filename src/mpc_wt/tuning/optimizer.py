@@ -69,7 +69,16 @@ class Parameter:
                              f"{self.low!r}")
 
     def suggest(self, trial: Any) -> float | int:
-        """The trial's value of this parameter."""
+        """The trial's value of this parameter.
+
+        Parameters
+        ----------
+        trial : optuna.Trial
+
+        Returns
+        -------
+        float or int
+        """
         if self.integer:
             return int(trial.suggest_int(self.name, int(self.low), int(self.high), log=self.log))
         return float(trial.suggest_float(self.name, self.low, self.high, log=self.log))
@@ -94,14 +103,39 @@ class Constraint:
         check_number(f"constraint {self.metric!r} upper", self.upper)
 
     def violation(self, metrics: Mapping[str, float]) -> float:
-        """metrics[metric] - upper (<= 0: met); +inf when the measure is missing."""
+        """How far a design is from meeting the bound.
+
+        Parameters
+        ----------
+        metrics : mapping of str to float
+
+        Returns
+        -------
+        float
+            metrics[metric] - upper (<= 0: met); +inf when the measure is missing.
+        """
         v = metrics.get(self.metric)
         return float(v) - self.upper if v is not None and math.isfinite(v) else math.inf
 
 
 @dataclass
 class TrialRecord:
-    """One trial as stored: number, state, parameters, objective, metrics, feasibility."""
+    """One trial as stored.
+
+    Parameters
+    ----------
+    number : int
+    state : str
+        COMPLETE, FAIL, RUNNING, WAITING.
+    params : dict of str to float
+    value : float or None
+        The objective (None unless complete).
+    metrics : dict of str to float
+    feasible : bool
+        Complete and every constraint met.
+    error : str or None
+        Why it failed.
+    """
 
     number: int
     state: str

@@ -123,7 +123,20 @@ def _plot_pareto(spec: TuneSpec, outcome: TuneOutcome, path: Path) -> Path | Non
 
 
 def write_outputs(spec: TuneSpec, outcome: TuneOutcome, out: Path) -> list[Path]:
-    """best.json, trials.csv, pareto.png, report.md and best/ (gain table) in ``out``."""
+    """Write best.json, trials.csv, pareto.png, report.md and best/ (gain table).
+
+    Parameters
+    ----------
+    spec : TuneSpec
+    outcome : TuneOutcome
+    out : Path
+        The tuning directory.
+
+    Returns
+    -------
+    list of Path
+        The files written.
+    """
     res = outcome.result
     files = [write_trials_csv(res, out / "trials.csv")]
     best = res.best

@@ -60,7 +60,17 @@ def _fail(key: str, msg: str) -> SpecError:
 
 
 def nest(flat: Mapping[str, Any]) -> dict[str, Any]:
-    """``{"a.b": 1, "c": 2}`` -> ``{"a": {"b": 1}, "c": 2}`` (nested option names)."""
+    """Dotted option names as nested mappings: ``{"a.b": 1, "c": 2}`` -> ``{"a": {"b": 1},
+    "c": 2}``.
+
+    Parameters
+    ----------
+    flat : mapping of str to object
+
+    Returns
+    -------
+    dict
+    """
     out: dict[str, Any] = {}
     for key, val in flat.items():
         *head, last = key.split(".")
@@ -129,20 +139,52 @@ class TuneSpec:
         return str(self.controller["controller"])
 
     def candidate_name(self, params: Mapping[str, float]) -> str:
-        """A design's controller name in the campaign: ``c-`` + a digest of its parameters,
-        so that the same design always maps to the same (reused) cases."""
+        """A design's controller name in the campaign.
+
+        Parameters
+        ----------
+        params : mapping of str to float
+
+        Returns
+        -------
+        str
+            ``c-`` + a digest of the parameters, so that the same design always maps to the
+            same (reused) cases.
+        """
         blob = json.dumps({k: float(f"{float(v):.9g}") for k, v in sorted(params.items())})
         return "c-" + hashlib.sha1(blob.encode()).hexdigest()[:10]
 
     def options(self, params: Mapping[str, float]) -> dict[str, Any]:
-        """The kind's options of a design: the fixed ones with the parameters in place."""
+        """The kind's options of a design.
+
+        Parameters
+        ----------
+        params : mapping of str to float
+            Dotted names for nested options.
+
+        Returns
+        -------
+        dict
+            The fixed options with the parameters in place.
+        """
         fixed = {k: v for k, v in self.controller.items() if k != "controller"}
         return _merge(fixed, nest(params))
 
     def campaign(self, designs: Mapping[str, Mapping[str, float] | None], *,
                  seeds: Any = None) -> CampaignSpec:
-        """The campaign of the reference and the given designs (name -> parameters; None:
-        the kind's hand-set defaults with the fixed options), on the tuning or other seeds."""
+        """The campaign of the reference and the given designs.
+
+        Parameters
+        ----------
+        designs : mapping of str to (mapping or None)
+            Name -> parameters (None: the kind's hand-set defaults with the fixed options).
+        seeds : sequence of int, optional
+            Other seeds than the tuning set (the held-out ones).
+
+        Returns
+        -------
+        CampaignSpec
+        """
         raw = copy.deepcopy(self.campaign_raw)
         if seeds is not None:
             raw["seeds"] = list(seeds)
@@ -154,7 +196,23 @@ class TuneSpec:
         return spec_from_dict(raw, base=self.base)
 
     def metrics(self, ratios: Mapping[str, float]) -> dict[str, float]:
-        """The ratios with ``objective``, the weighted mean of the objective's ratios."""
+        """The measures with the objective added.
+
+        Parameters
+        ----------
+        ratios : mapping of str to float
+            Ratios to the reference (and per-case measures).
+
+        Returns
+        -------
+        dict of str to float
+            With ``objective``: the weighted mean of the objective's ratios.
+
+        Raises
+        ------
+        ValueError
+            If a measure of the objective is missing (naming it and those there are).
+        """
         missing = [m for m, _ in self.objective if m not in ratios]
         if missing:
             raise ValueError(f"objective measures {missing} missing from the campaign's "
