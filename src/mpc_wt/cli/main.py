@@ -85,7 +85,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     Returns
     -------
     int
-        0 on success, 1 when a campaign finished with failed cases, 2 on a usage or input
+        0 on success, 1 when a campaign finished with failed cases or a tuning found no
+        design that meets its constraints, 2 on a usage or input
         error (the message names the parameter and the value).
     """
     logging.basicConfig(level=logging.WARNING, format="%(levelname)s %(name)s: %(message)s")
