@@ -223,16 +223,34 @@ def _run_pool(todo: list[Any], root: str, n: int, commit: Callable[..., None],
                     commit(futs[f], _failed(futs[f], err))
 
 
+def local_cluster(n: int) -> Any:
+    """A local Dask cluster of ``n`` single-threaded worker processes, one task per worker at
+    a time (the campaigns' engine; a tuning keeps one for all its trials).
+
+    Parameters
+    ----------
+    n : int
+        Worker processes.
+
+    Returns
+    -------
+    distributed.LocalCluster
+        Close it when done.
+    """
+    distributed = _dask_import()
+    import dask
+
+    dask.config.set({"distributed.scheduler.worker-saturation": 1.0})
+    return distributed.LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
+                                    dashboard_address=None, host="127.0.0.1")
+
+
 def _run_dask(todo: list[Any], root: str, n: int, scheduler: str | None,
               commit: Callable[..., None], bar: "_Bar") -> None:
     distributed = _dask_import()
     cluster = None
     if scheduler is None:
-        import dask
-
-        dask.config.set({"distributed.scheduler.worker-saturation": 1.0})
-        cluster = distributed.LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
-                                           dashboard_address=None, host="127.0.0.1")
+        cluster = local_cluster(n)
         client = distributed.Client(cluster)
     else:
         client = distributed.Client(scheduler, timeout="30s")

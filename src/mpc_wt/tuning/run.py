@@ -27,7 +27,6 @@ import numpy as np
 
 from ..campaign import CampaignStore, run_campaign
 from ..campaign.report import absolute_metrics, relative_metrics
-from ..campaign.runner import _dask_import
 from ..errors import CampaignLockedError
 from .optimizer import TrialFailed, TuneResult, optimize
 from .spec import TuneSpec, load_tune_spec
@@ -87,15 +86,9 @@ def _engine(engine: str, workers: int | None, scheduler: str | None
     if engine != "dask" or scheduler is not None:
         yield {"engine": engine, "workers": workers, "scheduler": scheduler}
         return
-    distributed = _dask_import()
-    import dask
+    from ..campaign.runner import _workers, local_cluster
 
-    from ..campaign.runner import _workers
-
-    dask.config.set({"distributed.scheduler.worker-saturation": 1.0})
-    cluster = distributed.LocalCluster(n_workers=_workers(workers), threads_per_worker=1,
-                                       processes=True, dashboard_address=None,
-                                       host="127.0.0.1")
+    cluster = local_cluster(_workers(workers))
     try:
         yield {"engine": "dask", "workers": None, "scheduler": cluster.scheduler_address}
     finally:
