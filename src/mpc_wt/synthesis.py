@@ -371,6 +371,12 @@ class LQRPIOController(ControllerBase):
         III: generator torque held at the operating point (Do's constant-torque region III);
         II: the torque law K_opt Omega_g^2 (eq 7, ``k_opt`` [N m/(rad/s)^2] on generator speed),
         the LQR pitch added around the operating-point pitch.
+    torque_law : BaselineController, optional
+        Region II only: take the generator torque from this baseline's schedule (regions 1.5,
+        2 and 2.5, :meth:`BaselineController.torque`) on the generator speed low-passed at its
+        filter corner, instead of K_opt Omega_g^2 on the raw speed. Do et al.'s PI and FSF share
+        one torque law in region II (sec. 4.2: only the pitch loop differs), so a comparison
+        with our baseline needs ours.
     feedforward : bool
         Add the unknown-input feedforward -K_f f_hat (default True).
     regulated : names of states whose steady deviation the feedforward cancels (least squares;
@@ -380,15 +386,17 @@ class LQRPIOController(ControllerBase):
     def __init__(self, model: linearize.LinearModel, turbine: linearize.Turbine,
                  lqr: LQRDesign, observer: PIObserver, *, dt: float = 1.0 / 80.0,
                  region: str = "III", k_opt: float | None = None, feedforward: bool = True,
-                 regulated: Sequence[str] = ("rotor_speed",)) -> None:
+                 regulated: Sequence[str] = ("rotor_speed",),
+                 torque_law: Any = None) -> None:
         if model.dt is not None:
             raise ValueError("model must be continuous (the observer is discretized here)")
         if lqr.dt is not None:
             raise ValueError("lqr must be designed on the continuous model")
         if region not in ("II", "III"):
             raise ValueError(f"region must be 'II' or 'III', got {region!r}")
-        if region == "II" and not (k_opt and k_opt > 0):
-            raise ValueError("region 'II' needs k_opt > 0 [N m/(rad/s)^2]")
+        if region == "II" and torque_law is None and not (k_opt and k_opt > 0):
+            raise ValueError("region 'II' needs k_opt > 0 [N m/(rad/s)^2] or a torque_law")
+        self.torque_law = torque_law if region == "II" else None
         check_number("dt", dt, lo=0.0, lo_open=True, unit="s")
         self.model, self.turbine, self.lqr, self.obs = model, turbine, lqr, observer
         self.dt, self.region, self.k_opt = float(dt), region, k_opt
@@ -421,6 +429,7 @@ class LQRPIOController(ControllerBase):
     def reset(self) -> None:
         self.xe = np.zeros(self._nx + self._nf)
         self._u_dev = np.zeros(self._nu_all)
+        self._w_filt: float | None = None
         self.signals: dict[str, float] = {}
 
     def step(self, t: float, meas: dict[str, Any]) -> tuple[np.ndarray, float]:
@@ -437,10 +446,7 @@ class LQRPIOController(ControllerBase):
         u_abs[self._iu] += du
         pa = self.turbine.pitch_actuator
         pitch = np.clip(u_abs[:3], pa.min_pitch_rad, pa.max_pitch_rad)
-        if self.region == "III":
-            torque = float(self.model.u0[3])
-        else:
-            torque = float(self.k_opt * meas["gen_speed"] ** 2)
+        torque = self._torque(meas, pitch)
         torque = float(np.clip(torque, self.turbine.generator.min_torque,
                                self.turbine.generator.max_torque))
         ud = np.r_[pitch, torque] - self.model.u0
@@ -449,3 +455,15 @@ class LQRPIOController(ControllerBase):
                         if self._nf >= 3 else float(fh[0]),
                         "pitch_ref_1": float(pitch[0]), "torque_ref": torque}
         return pitch, torque
+
+    def _torque(self, meas: dict[str, Any], pitch: np.ndarray) -> float:
+        """The generator torque demand of the region (see ``region`` and ``torque_law``)."""
+        if self.region == "III":
+            return float(self.model.u0[3])
+        w = float(meas["gen_speed"])
+        if self.torque_law is None:
+            return float(self.k_opt * w ** 2)
+        law = self.torque_law
+        a = math.exp(-law.wc * self.dt)
+        self._w_filt = w if self._w_filt is None else a * self._w_filt + (1 - a) * w
+        return float(law.torque(self._w_filt, float(np.mean(pitch))))

@@ -439,6 +439,10 @@ class LQRPIOOptions(Options):
                                           unit="-", lo=0.0)
     w_pitch: float = option(1.0, help="LQR input weight on each blade's pitch (scale 1 deg)",
                             unit="-", lo=0.0, lo_open=True)
+    region2_torque: str = option("baseline", help="region-II torque: the baseline's schedule "
+                                 "(1.5/2/2.5 on filtered speed, as the PI it is compared with) "
+                                 "or Do's bare K_opt Omega_g^2 on raw speed",
+                                 choices=("baseline", "k_opt"))
 
     def lqr_weights(self, region: str) -> tuple[dict[str, float], dict[str, float]]:
         """The state weights and input weights of the design in ``region``: the region's
@@ -470,7 +474,7 @@ class LQRPIOOptions(Options):
 @register("lqr-pio", LQRPIOOptions, design=_design_lqr, design_name="lqr",
           summary="Do et al.'s LQR with a PI observer at the mean wind (region II or III)")
 def _build_lqr_pio(ctx: BuildContext, opts: LQRPIOOptions) -> Built:
-    from ..baseline import tune_baseline
+    from ..baseline import BaselineController, tune_baseline
     from ..synthesis import (REGION2_SCALES, REGION3_SCALES, LQRPIOController, design_lqr,
                              design_pi_observer)
 
@@ -483,7 +487,9 @@ def _build_lqr_pio(ctx: BuildContext, opts: LQRPIOOptions) -> Built:
     ctl = LQRPIOController(model, turbine, lq, design_pi_observer(model, q=opts.observer_q),
                            region=region,
                            k_opt=tune_baseline(turbine).k_opt if region == "II" else None,
-                           feedforward=region == "III")
+                           feedforward=region == "III",
+                           torque_law=BaselineController(turbine)
+                           if region == "II" and opts.region2_torque == "baseline" else None)
     return Built(ctl, meta={"lqr": {"weights": lq.weights, "observer_q": opts.observer_q,
                                     "region": region}})
 
