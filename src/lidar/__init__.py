@@ -5,13 +5,13 @@ This package imports neither ``linearize`` nor ``mpc_wt``; turbine geometry arri
 from .cw import CWLidar, LidarMeasurement
 from .errors import FieldFileError
 from .field import WindField
-from .preview import (Preview, blade_effective_wind, coherence, coherence_bandwidth, peak_lag,
+from .preview import (Preview, PreviewBuffer, blade_effective_wind, coherence, coherence_bandwidth, peak_lag,
                       preview, preview_series, rms_preview_error, rotor_effective_wind)
 from .turbulence import (TurbulenceSpec, evolution_coherence, evolve_field, generate_field,
                          iec_coherence, iec_sigma, kaimal_spectrum, simley_pao_evolution)
 
 __all__ = ["CWLidar", "LidarMeasurement", "FieldFileError", "WindField", "Preview",
-           "blade_effective_wind", "coherence", "coherence_bandwidth", "peak_lag", "preview",
+           "PreviewBuffer", "blade_effective_wind", "coherence", "coherence_bandwidth", "peak_lag", "preview",
            "preview_series", "rms_preview_error", "rotor_effective_wind", "TurbulenceSpec",
            "evolution_coherence", "evolve_field", "generate_field", "iec_coherence", "iec_sigma",
            "kaimal_spectrum", "simley_pao_evolution"]

@@ -13,7 +13,7 @@ from ._typing import FloatArray
 from .cw import LidarMeasurement
 from .field import WindField
 
-__all__ = ["Preview", "preview", "preview_series", "blade_effective_wind",
+__all__ = ["Preview", "PreviewBuffer", "preview", "preview_series", "blade_effective_wind",
            "rotor_effective_wind", "coherence", "coherence_bandwidth", "rms_preview_error",
            "peak_lag"]
 
@@ -62,6 +62,92 @@ def preview(meas: LidarMeasurement, t_now: float, horizon: int = 15,
     tm = np.clip(np.minimum(tm, t_now), meas.t[0], meas.t[-1])
     blade = np.column_stack([np.interp(tm, meas.t, meas.u_hat[:, i]) for i in range(3)])
     return Preview(t=steps, blade=blade, rotor=blade.mean(axis=1), measured=measured)
+
+
+class PreviewBuffer:
+    """The last measurements of a LIDAR in the loop, in a fixed-size ring buffer, and the
+    per-blade preview from them (the same preview as :func:`preview` on the whole history).
+
+    A preview at t needs the measurements back to t - T_p + dt only (the step t + dt was
+    measured at t + dt - T_p), so the buffer keeps ceil(T_p / dt) + 3 samples at the
+    controller step and a step costs the same at the end of a long run as at its start. Each
+    sample is written twice (at i and i + capacity), so the newest ``capacity`` samples are
+    always one contiguous, ordered view.
+
+    Parameters
+    ----------
+    preview_time : float
+        T_p of the instrument [s] (``LidarMeasurement.preview_time``), > 0.
+    dt : float
+        Interval between pushes (the controller step) [s], > 0.
+    """
+
+    def __init__(self, preview_time: float, dt: float) -> None:
+        if not (math.isfinite(preview_time) and preview_time > 0):
+            raise ValueError(f"preview_time must be > 0 s, got {preview_time!r}")
+        if not (math.isfinite(dt) and dt > 0):
+            raise ValueError(f"dt must be > 0 s, got {dt!r}")
+        self.preview_time, self.dt = float(preview_time), float(dt)
+        self.capacity = int(math.ceil(self.preview_time / self.dt)) + 3
+        self._t = np.empty(2 * self.capacity)
+        self._u = np.empty((3, 2 * self.capacity))
+        self._n = 0                           # samples pushed so far
+        self._last = -math.inf
+
+    def __len__(self) -> int:
+        return min(self._n, self.capacity)
+
+    def push(self, t: float, u_hat: FloatArray) -> None:
+        """Add the measurement of the three beams at ``t`` (later than the last one).
+
+        Parameters
+        ----------
+        t : float
+            Measurement time [s].
+        u_hat : (3,) array
+            Reconstructed longitudinal wind of each beam [m/s].
+        """
+        if not t > self._last:
+            raise ValueError(f"t = {t!r} s must be later than the last measurement "
+                             f"{self._last:g} s")
+        i = self._n % self.capacity
+        self._t[i] = self._t[i + self.capacity] = t
+        self._u[:, i] = self._u[:, i + self.capacity] = u_hat
+        self._n += 1
+        self._last = t
+
+    def history(self) -> tuple[FloatArray, FloatArray]:
+        """The kept samples, oldest first: times (n,) [s] and winds (3, n) [m/s] (views)."""
+        n = len(self)
+        lo = self._n % self.capacity if self._n >= self.capacity else 0
+        return self._t[lo:lo + n], self._u[:, lo:lo + n]
+
+    def preview(self, t_now: float, horizon: int = 15) -> Preview:
+        """The preview of the next ``horizon`` steps at ``t_now`` (eq. of :func:`preview`).
+
+        Parameters
+        ----------
+        t_now : float
+            Controller time, within the kept measurements [s].
+        horizon : int
+            Steps H_p (>= 1).
+
+        Returns
+        -------
+        Preview
+        """
+        tk, uk = self.history()
+        if tk.size == 0 or not tk[0] <= t_now <= tk[-1] + 1e-9:
+            span = f"{tk[0]:g}..{tk[-1]:g} s" if tk.size else "none yet"
+            raise ValueError(f"t_now = {t_now!r} s is outside the kept measurements ({span})")
+        if not isinstance(horizon, (int, np.integer)) or horizon < 1:
+            raise ValueError(f"horizon must be an integer >= 1, got {horizon!r}")
+        steps = t_now + self.dt * np.arange(1, horizon + 1)
+        tm = steps - self.preview_time
+        measured = tm <= t_now + 1e-9
+        tm = np.clip(np.minimum(tm, t_now), tk[0], tk[-1])
+        blade = np.column_stack([np.interp(tm, tk, uk[i]) for i in range(3)])
+        return Preview(t=steps, blade=blade, rotor=blade.mean(axis=1), measured=measured)
 
 
 def preview_series(meas: LidarMeasurement, t_ctrl: FloatArray, horizon: int = 15,

@@ -91,7 +91,9 @@ Controller.step.__doc__ = ControllerBase.step.__doc__
 class LidarPreview:
     """A simulated LIDAR in the loop: measures the wind field at the rotor's current azimuth
     and speed at every controller step and serves the per-blade preview of the next
-    ``horizon`` steps from the measurements taken T_p earlier (:func:`lidar.preview`).
+    ``horizon`` steps from the measurements taken T_p earlier (:func:`lidar.preview`). Only
+    the last T_p of measurements is kept (a fixed-size ring, :class:`lidar.PreviewBuffer`), so
+    a step costs the same at any time of a run.
 
     Parameters
     ----------
@@ -114,9 +116,9 @@ class LidarPreview:
 
     def reset(self) -> None:
         """Forget the measurement history."""
-        self._t: list[float] = []
-        self._u: list[np.ndarray] = []
-        self._az: list[np.ndarray] = []
+        #: the kept measurements (:class:`lidar.PreviewBuffer`, the last T_p), made at the
+        #: first call when the instrument's preview time is known
+        self.buffer: Any = None
 
     def __call__(self, t: float, azimuth_rad: float, rotor_speed_rad_s: float) -> Any:
         """Measure at ``t`` and return the :class:`lidar.Preview` of the next H_p steps."""
@@ -124,14 +126,10 @@ class LidarPreview:
 
         m = self.lidar.measure(self.field, np.array([t]), np.array([azimuth_rad]),
                                rotor_speed_rad_s)
-        self._t.append(t)
-        self._u.append(m.u_hat[0])
-        self._az.append(m.beam_azimuth_rad[0])
-        hist = lidar.LidarMeasurement(t=np.array(self._t), los=np.array(self._u) * 0.0,
-                                      u_hat=np.array(self._u),
-                                      beam_azimuth_rad=np.array(self._az),
-                                      preview_time=m.preview_time, radius=m.radius)
-        return lidar.preview(hist, t, self.horizon, self.dt)
+        if self.buffer is None:
+            self.buffer = lidar.PreviewBuffer(m.preview_time, self.dt)
+        self.buffer.push(t, m.u_hat[0])
+        return self.buffer.preview(t, self.horizon)
 
 
 def _measurements(t: float, x: np.ndarray, z: np.ndarray) -> dict[str, Any]:

@@ -5,6 +5,8 @@ import math
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 from numpy.testing import assert_allclose
 from scipy import integrate
 
@@ -124,6 +126,67 @@ def test_preview_shape_and_times(turbulent: WindField) -> None:
     assert series.shape == (2, 15, 3) and np.allclose(series[0], p.blade)
     with pytest.raises(ValueError, match="horizon must be an integer >= 1"):
         lidar.preview(m, 30.0, horizon=0)
+
+
+def test_ring_buffer_serves_the_true_later_blade_wind(turbulent: WindField) -> None:
+    """Issue 23: the in-loop preview from the fixed-size ring buffer, pushed one step at a
+    time, is the wind each blade meets T_p later (idealized LIDAR, frozen field: exact to
+    1e-6 m/s once a whole T_p is measured), while the buffer never holds more than
+    ceil(T_p / dt) + 3 samples (600 pushes, 33 kept)."""
+    lid = CWLidar(63.0, range_weighting=False, los_error=False)
+    t = np.arange(0.0, 60.0, 0.1)
+    m = lid.measure(turbulent, t, OMEGA * t, OMEGA)
+    buf = lidar.PreviewBuffer(m.preview_time, 0.1)
+    assert buf.capacity == math.ceil(m.preview_time / 0.1) + 3 < 40
+    for k, tk in enumerate(t):
+        buf.push(float(tk), m.u_hat[k])
+        assert len(buf) <= buf.capacity
+        if tk >= m.preview_time and k % 7 == 0:
+            p = buf.preview(float(tk), 15)
+            assert p.measured.all()
+            later = lidar.blade_effective_wind(turbulent, p.t, OMEGA * p.t, lid.radius)
+            assert_allclose(p.blade, later, rtol=0, atol=1e-6)
+    assert len(buf) == buf.capacity and buf.history()[0][0] == pytest.approx(t[-buf.capacity])
+
+
+@settings(max_examples=40, deadline=None)
+@given(tp=st.floats(0.05, 6.0), dt=st.floats(0.01, 0.5), horizon=st.integers(1, 40),
+       n=st.integers(1, 300), seed=st.integers(0, 2**16))
+def test_ring_buffer_preview_equals_the_whole_history(tp, dt, horizon, n, seed) -> None:
+    """Property: at every step the ring buffer's preview equals :func:`lidar.preview` on the
+    whole measurement history (which keeps everything), whatever T_p, dt, horizon and length
+    (held values beyond T_p and the start-up clipping included)."""
+    rng = np.random.default_rng(seed)
+    t = dt * np.arange(n) + 3.0
+    u = 10 + rng.standard_normal((n, 3))
+    buf = lidar.PreviewBuffer(tp, dt)
+    for k in range(n):
+        buf.push(float(t[k]), u[k])
+        if k % max(1, n // 20) == 0 or k == n - 1:
+            hist = lidar.LidarMeasurement(t=t[:k + 1], los=u[:k + 1], u_hat=u[:k + 1],
+                                          beam_azimuth_rad=np.zeros((k + 1, 3)),
+                                          preview_time=tp, radius=45.0)
+            want = lidar.preview(hist, float(t[k]), horizon, dt)
+            got = buf.preview(float(t[k]), horizon)
+            assert_allclose(got.blade, want.blade, rtol=0, atol=1e-12)
+            assert np.array_equal(got.measured, want.measured)
+    assert len(buf) <= math.ceil(tp / dt) + 3
+
+
+def test_ring_buffer_bad_input() -> None:
+    """Bad input names the parameter and what is allowed."""
+    with pytest.raises(ValueError, match="preview_time must be > 0 s"):
+        lidar.PreviewBuffer(0.0, 0.1)
+    with pytest.raises(ValueError, match="dt must be > 0 s"):
+        lidar.PreviewBuffer(3.0, math.nan)
+    buf = lidar.PreviewBuffer(1.0, 0.1)
+    with pytest.raises(ValueError, match="outside the kept measurements .none yet"):
+        buf.preview(0.0)
+    buf.push(1.0, np.ones(3))
+    with pytest.raises(ValueError, match="must be later than the last measurement 1 s"):
+        buf.push(1.0, np.ones(3))
+    with pytest.raises(ValueError, match="horizon must be an integer >= 1"):
+        buf.preview(1.0, 0)
 
 
 def test_focus_outside_field_is_an_error(turbulent: WindField) -> None:

@@ -189,6 +189,9 @@ def test_lidar_preview_reduces_asymmetric_loads(turbine: linearize.Turbine,
                       harmonic_psd(r.channel("flap_moment_1")[late], 80.0, frot, (1,),
                                    nperseg=2048)[1], r.channel("gen_power")[late].std())
         assert r.controller["qp_fallback"].sum() == 0
+    # issue 23: 700 controller steps, the preview keeps only the last T_p (+3 samples)
+    if prev is not None:
+        assert len(prev.buffer) == prev.buffer.capacity < 40
     # measured (2026-11-22): tilt std x0.58, yaw std x0.48, 1P flap x0.16, power std x0.44;
     # bounds about 10 % of the measured ratio above each (the README states both)
     for k, bound in enumerate((0.65, 0.55, 0.25, 0.50)):
