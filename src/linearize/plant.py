@@ -1093,6 +1093,7 @@ class PlantStepper:
         n_r = self._pack.r.size
         self._hint = np.full((4, _N_BLADE, n_r), np.nan)
         self._dphi = np.zeros((_N_BLADE, n_r))
+        self._rk4_entry: Any = None
 
     def step(self, t: float, x: FloatArray, u: FloatArray) -> tuple[FloatArray, FloatArray]:
         """One RK4 step from ``t`` with the inputs held.
@@ -1113,8 +1114,17 @@ class PlantStepper:
         z : (n_z,) ndarray
             Outputs at ``t`` (:data:`OUTPUT_NAMES`).
         """
-        xn, z, self._hint, self._dphi = _rk4(t, x, u, self.dt, self._pack, self._kind,
-                                             self._wpar, self._grid, self._hint, self._dphi)
+        x = np.ascontiguousarray(x, dtype=np.float64)
+        u = np.ascontiguousarray(u, dtype=np.float64)
+        args = (float(t), x, u, self.dt, self._pack, self._kind, self._wpar, self._grid,
+                self._hint, self._dphi)
+        if self._rk4_entry is None:
+            # numba's dispatcher types every argument at every call, and typing the plant's
+            # 64-field parameter tuple costs 5-10 us a step; the arguments' types never change
+            # within a run (the arrays are made C-contiguous float64 above), so the compiled
+            # overload is looked up once and called directly
+            self._rk4_entry = _rk4.compile(tuple(nb.typeof(a) for a in args))
+        xn, z, self._hint, self._dphi = self._rk4_entry(*args)
         return xn, z
 
     def outputs(self, t: float, x: FloatArray, u: FloatArray) -> FloatArray:

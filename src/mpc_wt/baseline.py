@@ -306,6 +306,7 @@ class BaselineController(ControllerBase):
         g = self.gains
         n = turbine.drivetrain.gearbox_ratio
         self.wc = 2 * math.pi * filter_hz
+        self._a_filt = math.exp(-self.wc * self.dt)      # the speed filter's pole at dt
         self.pitch_min = turbine.operation.fine_pitch_rad
         self.pitch_max = turbine.pitch_actuator.max_pitch_rad
         self.rate = turbine.pitch_actuator.max_rate_rad_s
@@ -403,12 +404,13 @@ class BaselineController(ControllerBase):
         w = float(meas["gen_speed"])
         if not math.isfinite(w):
             raise ValueError(f"measurement gen_speed is not finite at t = {t:g} s: {w!r}")
-        pitch_meas = float(np.mean(meas["pitch"]))
+        p1, p2, p3 = meas["pitch"]
+        pitch_meas = float(p1 + p2 + p3) / 3.0
         first = self.w_filt is None
         if first:
             self.w_filt = w
             self.last_pitch = pitch_meas
-        a = math.exp(-self.wc * self.dt)
+        a = self._a_filt
         self.w_filt = a * self.w_filt + (1 - a) * w
         g = self.gains
         p_ref = self._reference(t)
@@ -462,4 +464,4 @@ class BaselineController(ControllerBase):
             self.signals["power_reference"] = p_ref
             self.signals["apc_saturated"] = float(cmd <= self.pitch_min + 1e-9
                                                   and err < 0.0)
-        return np.full(3, cmd), tq
+        return np.array((cmd, cmd, cmd)), tq

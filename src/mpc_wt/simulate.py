@@ -146,12 +146,26 @@ def _measurements(t: float, x: np.ndarray, z: np.ndarray) -> dict[str, Any]:
 
 
 def _hub_wind(wind: Any, hub_height: float) -> Any:
-    """t -> free wind speed at the hub [m/s] (the grid point nearest the hub, linear in t)."""
+    """t -> free wind speed at the hub [m/s] (the grid point nearest the hub, linear in t).
+
+    A uniform time grid (every generated or ``.bts`` field) is read by index, O(1) a call;
+    others by a binary search. The series is copied once, contiguous: ``np.interp`` on a strided
+    column would copy the whole series at every call."""
     if isinstance(wind, linearize.GridWind):
         j = int(np.argmin(np.abs(wind.y)))
         k = int(np.argmin(np.abs(wind.z - hub_height)))
-        series = np.asarray(wind.u[:, j, k], dtype=float)
-        tt = np.asarray(wind.t, dtype=float)
+        series = np.ascontiguousarray(wind.u[:, j, k], dtype=float)
+        tt = np.ascontiguousarray(wind.t, dtype=float)
+        step = (tt[-1] - tt[0]) / (tt.size - 1) if tt.size > 1 else 0.0
+        if step > 0 and np.allclose(np.diff(tt), step, rtol=1e-9, atol=1e-12):
+            t0, last, vals = float(tt[0]), tt.size - 1, series.tolist()
+
+            def uniform(t: float) -> float:
+                s = min(max((t - t0) / step, 0.0), float(last))
+                i = min(int(s), last - 1)
+                a = s - i
+                return (1.0 - a) * vals[i] + a * vals[i + 1]
+            return uniform
         return lambda t: float(np.interp(t, tt, series))
     speed = float(getattr(wind, "speed", math.nan))
     return lambda t: speed
@@ -175,6 +189,9 @@ class _Loop:
         self.clipped = 0
         self.k_done = 0
         self.rate = params.turbine.generator.max_torque_rate * dt
+        pa, gen = params.turbine.pitch_actuator, params.turbine.generator
+        self._p_lo, self._p_hi = pa.min_pitch_rad - 1e-9, pa.max_pitch_rad + 1e-9
+        self._q_lo, self._q_hi = gen.min_torque - 1e-6, gen.max_torque + 1e-6
 
     def command(self, t: float, z: np.ndarray) -> None:
         """Ask the controller for new commands and hold them."""
@@ -185,13 +202,15 @@ class _Loop:
             meas["preview"] = self.preview(t, float(self.x[_IX_AZ]), float(self.x[_IX_ROTOR]))
         pitch, tq = self.controller.step(t, meas)
         pitch = np.asarray(pitch, float)
-        if pitch.shape != (3,) or not np.all(np.isfinite(pitch)) or not math.isfinite(tq):
+        fin = math.isfinite
+        if (pitch.shape != (3,) or not fin(tq)
+                or not (fin(pitch[0]) and fin(pitch[1]) and fin(pitch[2]))):
             raise ValueError(f"controller returned pitch {pitch!r}, torque {tq!r} at "
                              f"t = {t:g} s: need 3 finite pitch angles [rad] and a "
                              f"finite torque [N m]")
-        pa, gen = self.params.turbine.pitch_actuator, self.params.turbine.generator
-        if (pitch.min() < pa.min_pitch_rad - 1e-9 or pitch.max() > pa.max_pitch_rad + 1e-9
-                or not gen.min_torque - 1e-6 <= tq <= gen.max_torque + 1e-6):
+        p1, p2, p3 = pitch.tolist()
+        lo, hi = min(p1, p2, p3), max(p1, p2, p3)
+        if not (self._p_lo <= lo and hi <= self._p_hi and self._q_lo <= tq <= self._q_hi):
             if self.clipped == 0:
                 log.warning("controller command out of the actuator range at t = %g s "
                             "(pitch %s rad, torque %g N m): the plant clips it; the "

@@ -7,6 +7,8 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 from numpy.testing import assert_allclose
 
 import lidar
@@ -270,3 +272,20 @@ def test_a_rotor_driven_backwards_is_reported_as_divergence(turbine: linearize.T
         simulate_closed_loop(params, _Fixed(math.radians(90.0), 43093.55),
                              linearize.SteadyWind(12.0), 120.0, x0=op.x, u0=op.u)
     assert exc.value.partial.x[:, 2].min() > -0.2
+
+
+@settings(max_examples=60, deadline=None)
+@given(dt=st.floats(0.01, 0.5), n=st.integers(2, 400), t0=st.floats(-5.0, 5.0),
+       q=st.lists(st.floats(-10.0, 250.0), min_size=1, max_size=20), seed=st.integers(0, 999))
+def test_hub_wind_reads_the_field_as_linear_interpolation(dt, n, t0, q, seed) -> None:
+    """Issue 23: the hub wind handed to controllers is read by index on a uniform grid; it is
+    numpy's linear interpolation of the hub column (held at the ends) at any time."""
+    from mpc_wt.simulate import _hub_wind
+
+    rng = np.random.default_rng(seed)
+    t = t0 + dt * np.arange(n)
+    y, z = np.linspace(-80, 80, 5), np.linspace(10, 170, 5)
+    u = rng.normal(10, 2, (n, 5, 5))
+    f = _hub_wind(linearize.GridWind(t=t, y=y, z=z, u=u), 90.0)
+    for tq in q:
+        assert f(tq) == pytest.approx(np.interp(tq, t, u[:, 2, 2]), rel=1e-12, abs=1e-12)
