@@ -23,14 +23,19 @@ __all__ = ["WindField", "FieldFileError"]
 SCHEMA_VERSION = 1
 
 
-def _frozen(a: Any, name: str) -> FloatArray:
-    """Read-only float64 copy; an array that is already read-only, contiguous float64 is
-    adopted without copying (it cannot change under us)."""
-    if (isinstance(a, np.ndarray) and a.dtype == np.float64 and not a.flags.writeable
+def _frozen(a: Any, name: str, single: bool = False) -> FloatArray:
+    """Read-only contiguous copy, float64 (or float32 when ``single``: the wind components,
+    whose 7 significant digits are far finer than any measured or generated wind); an array
+    that is already read-only, contiguous and of that type is adopted without copying (it
+    cannot change under us)."""
+    dtype = np.float32 if single else np.float64
+    if (isinstance(a, np.ndarray) and a.dtype == dtype and not a.flags.writeable
             and a.flags.c_contiguous):
         arr = a
     else:
-        arr = np.ascontiguousarray(np.array(a, dtype=float))
+        arr = np.ascontiguousarray(np.asarray(a, dtype=dtype))
+        if arr is a or (isinstance(a, np.ndarray) and np.shares_memory(arr, a)):
+            arr = arr.copy()
     if not np.all(np.isfinite(arr)):
         bad = np.argwhere(~np.isfinite(arr))[0]
         raise ValueError(f"WindField.{name} must be finite; entry {tuple(int(i) for i in bad)} "
@@ -62,7 +67,8 @@ class WindField:
     z : (n_z,) ndarray
         Uniform heights above ground [m].
     u, v, w : (n_t, n_y, n_z) ndarray
-        Longitudinal, lateral and vertical components [m/s].
+        Longitudinal, lateral and vertical components [m/s]; stored as float32 (a 600 s,
+        32 x 32 field at 20 Hz is 150 MB instead of 300 MB).
     mean_speed : float
         Mean hub-height speed, used for Taylor's frozen turbulence [m/s].
     hub_height : float
@@ -83,7 +89,7 @@ class WindField:
 
     def __post_init__(self) -> None:
         for n in ("t", "y", "z", "u", "v", "w"):
-            object.__setattr__(self, n, _frozen(getattr(self, n), n))
+            object.__setattr__(self, n, _frozen(getattr(self, n), n, single=n in ("u", "v", "w")))
         for n in ("t", "y", "z"):
             _uniform(n, getattr(self, n))
         shape = (self.t.size, self.y.size, self.z.size)

@@ -38,7 +38,7 @@ from __future__ import annotations
 import logging
 import math
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, Iterator
 
 import numpy as np
 
@@ -202,19 +202,25 @@ class _CirculantSampler:
         self.chol: dict[int, FloatArray] = {}
         if exact:
             r = _distances(spec)
-            for k in exact:
-                self.chol[k] = _cholesky_factor(float(c[k]), r)
+            for k in exact:         # float32 like the field: 4 MB each on 32 x 32 points
+                self.chol[k] = _cholesky_factor(float(c[k]), r).astype(np.float32)
             log.debug("circulant embedding indefinite at %d frequencies: exact Cholesky used",
                       len(exact))
 
-    def draw(self, rng: np.random.Generator, chunk: int = 512) -> np.ndarray:
-        """Complex Gaussian coefficients (n_f, n_y, n_z), covariance exp(-c_k r) per k."""
+    def draw(self, rng: np.random.Generator, chunk: int = 128,
+             out: np.ndarray | None = None) -> np.ndarray:
+        """Complex Gaussian coefficients (n_f, n_y, n_z), covariance exp(-c_k r) per k
+        (written into ``out``, complex64, when given)."""
         spec = self.spec
         nf = self.root.shape[0]
-        out = np.empty((self.n_f, spec.n_y, spec.n_z), dtype=np.complex64)
-        out[nf:] = rng.standard_normal((self.n_f - nf, spec.n_y, spec.n_z, 2),
-                                       dtype=np.float32).view(np.complex64)[..., 0] \
-            * np.float32(1.0 / math.sqrt(2.0))
+        if out is None:
+            out = np.empty((self.n_f, spec.n_y, spec.n_z), dtype=np.complex64)
+        # the independent frequencies, a block at a time (the same stream as one draw)
+        for s in range(nf, self.n_f, 4 * chunk):
+            e = min(s + 4 * chunk, self.n_f)
+            xi = rng.standard_normal((e - s, spec.n_y, spec.n_z, 2), dtype=np.float32)
+            xi *= np.float32(1.0 / math.sqrt(2.0))
+            out[s:e] = xi.view(np.complex64)[..., 0]
         for s in range(0, nf, chunk):
             root = self.root[s:s + chunk]
             # complex normals as pairs of float32 normals viewed as complex64 (no copy)
@@ -294,6 +300,22 @@ def generate_field(spec: TurbulenceSpec, seed: int | np.random.Generator | None 
                          f"{spec.n_y * spec.n_z} > 400")
     rng = seed if isinstance(seed, np.random.Generator) else np.random.default_rng(seed)
     t, y, z = spec.grid()
+    fields = dict(_components(spec, rng, method, low_frequency, components))
+    meta: dict[str, Any] = {"model": "IEC 61400-1 Kaimal (IECKAI)", "method": method,
+                            "turbulence": spec.turbulence, "sigma": spec.sigma.tolist(),
+                            "shear_exponent": spec.shear_exponent, "low_frequency": low_frequency,
+                            "seed": seed if isinstance(seed, (int, type(None))) else "generator"}
+    return WindField(t=t, y=y, z=z, u=fields["u"], v=fields["v"], w=fields["w"],
+                     mean_speed=spec.mean_speed, hub_height=spec.hub_height, meta=meta)
+
+
+def _components(spec: TurbulenceSpec, rng: np.random.Generator, method: str = "circulant",
+                low_frequency: str = "lump", components: str = "uvw"
+                ) -> Iterator[tuple[str, FloatArray]]:
+    """The field's components u, v, w in turn, each (n_t, n_y, n_z) float32 and read-only,
+    drawn from ``rng`` in that order (one at a time: a caller that needs one component at a
+    time never holds the three)."""
+    t, y, z = spec.grid()
     n_t = t.size
     if n_t < 4:
         raise ValueError(f"duration / dt gives {n_t} samples; need at least 4")
@@ -306,14 +328,15 @@ def generate_field(spec: TurbulenceSpec, seed: int | np.random.Generator | None 
     ls = spec.length_scales
     c = _decay(f, v, ls[3])
     sampler = _CirculantSampler(c, spec) if method == "circulant" else None
-    fields = {}
+    shear = (v * (z / spec.hub_height) ** spec.shear_exponent).astype(np.float32)
     for k, comp in enumerate("uvw"):
         if comp not in components:
-            series = np.zeros((n_t, spec.n_y, spec.n_z))
+            series = np.zeros((n_t, spec.n_y, spec.n_z), dtype=np.float32)
             if comp == "u":
-                series += v * (z / spec.hub_height)[None, None, :] ** spec.shear_exponent
+                series += shear
             series.flags.writeable = False
-            fields[comp] = series
+            yield comp, series
+            del series
             continue
         s = kaimal_spectrum(f, sig[k], ls[k], v)
         var = s * df
@@ -323,26 +346,26 @@ def generate_field(spec: TurbulenceSpec, seed: int | np.random.Generator | None 
             # integral of S from 0 to the lower edge of the first bin (f_1 / 2)
             var = var.copy()
             var[0] += below
-        coeff = (sampler.draw(rng) if sampler is not None
-                 else _coefficients_cholesky(c, spec, rng))
         spec_arr = np.zeros((nf + 1, spec.n_y, spec.n_z), dtype=np.complex64)
-        spec_arr[1:nf] = coeff
-        del coeff
+        if sampler is not None:
+            sampler.draw(rng, out=spec_arr[1:nf])
+        else:
+            spec_arr[1:nf] = _coefficients_cholesky(c, spec, rng)
         spec_arr[1:nf] *= (np.sqrt(2.0 * var) * (n_t / 2.0)).astype(np.float32)[:, None, None]
-        series = np.fft.irfft(spec_arr, n=n_t, axis=0).astype(np.float64)
+        # complex64 in, float32 out (numpy >= 2 transforms in single precision), a few grid
+        # columns at a time: the field is stored as float32 (WindField), and the transform's
+        # own buffers stay small
+        series = np.empty((n_t, spec.n_y, spec.n_z), dtype=np.float32)
+        for j in range(0, spec.n_y, 4):
+            series[:, j:j + 4] = np.fft.irfft(spec_arr[:, j:j + 4], n=n_t, axis=0)
         del spec_arr
         if low_frequency == "scale":
-            series *= sig[k] / max(float(series.std()), 1e-300)
+            series *= np.float32(sig[k] / max(float(series.std(dtype=np.float64)), 1e-300))
         if comp == "u":
-            series += v * (z / spec.hub_height)[None, None, :] ** spec.shear_exponent
+            series += shear
         series.flags.writeable = False
-        fields[comp] = series
-    meta: dict[str, Any] = {"model": "IEC 61400-1 Kaimal (IECKAI)", "method": method,
-                            "turbulence": spec.turbulence, "sigma": sig.tolist(),
-                            "shear_exponent": spec.shear_exponent, "low_frequency": low_frequency,
-                            "seed": seed if isinstance(seed, (int, type(None))) else "generator"}
-    return WindField(t=t, y=y, z=z, u=fields["u"], v=fields["v"], w=fields["w"],
-                     mean_speed=v, hub_height=spec.hub_height, meta=meta)
+        yield comp, series
+        del series                      # the caller may drop it before asking for the next
 
 
 def simley_pao_evolution(mean_speed: float, sigma: Any, length_scale: float
@@ -410,7 +433,7 @@ def _spec_like(field: WindField) -> TurbulenceSpec:
     if not (isinstance(turb, str) and turb.upper() in _I_REF
             or isinstance(turb, (int, float)) and 0 < turb < 1):
         u = field.u[:, field.y.size // 2, field.z.size // 2]
-        turb = float(min(max(u.std() / field.mean_speed, 1e-3), 0.99))
+        turb = float(min(max(u.std(dtype=np.float64) / field.mean_speed, 1e-3), 0.99))
     width = float(field.y[-1] - field.y[0])
     height = float(field.z[-1] - field.z[0])
     return TurbulenceSpec(field.mean_speed, turb, hub_height=float(field.z[0]) + height / 2,
@@ -476,19 +499,31 @@ def evolve_field(field: WindField, distance: float, spec: TurbulenceSpec | None 
     if distance == 0.0:
         return WindField(t=field.t, y=field.y, z=field.z, u=field.u, v=field.v, w=field.w,
                          mean_speed=field.mean_speed, hub_height=field.hub_height, meta=meta)
-    other = generate_field(spec, seed)
+    # u' one component at a time (the same draws as generate_field(spec, seed)), transformed
+    # in single precision: the peak holds the field, one component of u' and two spectra
+    rng = seed if isinstance(seed, np.random.Generator) else np.random.default_rng(seed)
     f = np.fft.rfftfreq(n_t, field.dt)
     g = np.sqrt(evolution_coherence(f, distance, field.mean_speed, a, b))
-    keep, fresh = g[:, None, None], np.sqrt(1.0 - g**2)[:, None, None]
+    keep = g.astype(np.float32)[:, None, None]
+    fresh = np.sqrt(1.0 - g**2).astype(np.float32)[:, None, None]
     out = {}
-    for comp in ("u", "v", "w"):
+    for comp, xo in _components(spec, rng):
         x = getattr(field, comp)
-        xo = getattr(other, comp)
-        mean = x.mean(axis=0, keepdims=True)
-        fx = np.fft.rfft(x - mean, axis=0)
+        mean = x.mean(axis=0, keepdims=True, dtype=np.float64)
+        fx = np.fft.rfft(x - mean.astype(np.float32), axis=0)
         fx *= keep
-        fx += fresh * np.fft.rfft(xo - xo.mean(axis=0, keepdims=True), axis=0)
-        out[comp] = np.fft.irfft(fx, n=n_t, axis=0) + mean
+        fo = np.fft.rfft(xo - xo.mean(axis=0, keepdims=True, dtype=np.float64)
+                         .astype(np.float32), axis=0)
+        del xo
+        fo *= fresh
+        fx += fo
+        del fo
+        series = np.fft.irfft(fx, n=n_t, axis=0)
         del fx
+        # the mean of every point kept to the float32 storage's resolution: the residual mean
+        # of the single-precision transform is taken out with the mean put back
+        series += (mean - series.mean(axis=0, keepdims=True, dtype=np.float64)
+                   ).astype(np.float32)
+        out[comp] = series
     return WindField(t=field.t, y=field.y, z=field.z, u=out["u"], v=out["v"], w=out["w"],
                      mean_speed=field.mean_speed, hub_height=field.hub_height, meta=meta)

@@ -159,7 +159,7 @@ def _raw_jacobians(params: PlantParams, op: OperatingPoint, wake: str, shear: fl
     x0 = op.x.copy()
     x0[16] = psi
     u0 = op.u.copy()
-    w0 = _sample_wind(0.0, psi, pk, 0, np.array([op.wind_mps, shear]), np.zeros((1, 1, 1)))
+    w0 = _sample_wind(0.0, psi, pk, 0, np.array([op.wind_mps, shear]), np.zeros((1, 1, 1), dtype=np.float32))
     bem0 = _eval(x0, u0, w0, pk, np.full((4, 3, pk.r.size), np.nan), MODE_NOLIMITS)[2]
     mode = MODE_NOLIMITS | (MODE_FROZEN if wake == "frozen" else 0)
     if method == "cs":
@@ -623,7 +623,7 @@ def _z0(p: PlantParams, op: OperatingPoint, shear: float, n_azimuth: int = 24) -
     x = op.x.copy()
     for psi in 2 * math.pi * np.arange(n_azimuth) / n_azimuth:
         x[16] = psi
-        w = _sample_wind(0.0, float(psi), pk, 0, wpar, np.zeros((1, 1, 1)))
+        w = _sample_wind(0.0, float(psi), pk, 0, wpar, np.zeros((1, 1, 1), dtype=np.float32))
         z += _eval(x, op.u, w, pk, np.full((4, 3, pk.r.size), np.nan), 0)[1]
     return z / n_azimuth
 

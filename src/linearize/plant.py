@@ -864,7 +864,8 @@ class SteadyWind:
             raise ValueError(f"shear_exponent must be in [-1, 1], got {self.shear_exponent!r}")
 
     def _kernel_args(self) -> tuple[int, FloatArray, FloatArray]:
-        return 0, np.array([float(self.speed), float(self.shear_exponent)]), np.zeros((1, 1, 1))
+        return (0, np.array([float(self.speed), float(self.shear_exponent)]),
+                np.zeros((1, 1, 1), dtype=np.float32))
 
     def check_covers(self, params: PlantParams, t_end: float) -> None:
         """Steady wind covers any rotor and any duration."""
@@ -883,7 +884,8 @@ class GridWind:
     z : (n_z,) ndarray
         Uniformly spaced heights above ground [m].
     u : (n_t, n_y, n_z) ndarray
-        Longitudinal wind speed [m/s], finite and >= 0.
+        Longitudinal wind speed [m/s], finite and >= 0; kept as float32 (a 600 s turbulent
+        field on 32 x 32 points at 20 Hz is 50 MB).
     """
 
     t: FloatArray
@@ -902,10 +904,13 @@ class GridWind:
             a.flags.writeable = False
             object.__setattr__(self, name, a)
         u = check_array("GridWind.u", self.u, (self.t.size, self.y.size, self.z.size),
-                        shape_names="(n_t, n_y, n_z)")
+                        shape_names="(n_t, n_y, n_z)", dtype=np.float32)
         if np.any(u < 0):
             raise ValueError(f"GridWind.u must be >= 0 m/s, got min {u.min()!r}")
-        u = np.ascontiguousarray(u)
+        # adopt a read-only contiguous float32 array (it cannot change under us), else copy
+        if (u is self.u and self.u.flags.writeable) or u.base is not None \
+                or not u.flags.c_contiguous:
+            u = np.array(u, dtype=np.float32, order="C")
         u.flags.writeable = False
         object.__setattr__(self, "u", u)
 

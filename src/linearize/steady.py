@@ -29,7 +29,7 @@ def _avg_eval(x, u, speed, shear, p, n_az, mode=0):  # pragma: no cover - compil
     z_avg = np.zeros(31)
     hint = np.full((4, 3, p.r.size), np.nan)
     wpar = np.array([speed, shear])
-    dummy = np.zeros((1, 1, 1))
+    dummy = np.zeros((1, 1, 1), dtype=np.float32)
     xx = x.copy()
     for k in range(n_az):
         xx[16] = k * _TWO_PI_3 / n_az

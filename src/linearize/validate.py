@@ -89,12 +89,14 @@ def check_range(name: str, value: float, lo: float, hi: float) -> float:
 
 
 def check_array(name: str, value: Any, shape: tuple[int | None, ...], *,
-                shape_names: str | None = None, finite: bool = True) -> FloatArray:
-    """Return ``value`` as a float64 array of the given shape (``None`` = any length).
+                shape_names: str | None = None, finite: bool = True,
+                dtype: Any = np.float64) -> FloatArray:
+    """Return ``value`` as a float64 (or ``dtype``) array of the given shape (``None`` = any
+    length).
 
     ``shape_names`` is the symbolic shape used in the message, e.g. ``"(n_blade, n_r)"``.
     """
-    arr = np.asarray(value, dtype=float)
+    arr = np.asarray(value, dtype=dtype)
     ok = arr.ndim == len(shape) and all(s is None or s == a for s, a in zip(shape, arr.shape))
     if not ok:
         want = tuple("any" if s is None else s for s in shape)

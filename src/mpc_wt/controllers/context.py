@@ -128,7 +128,13 @@ def make_wind(turbine: linearize.Turbine, scenario: Scenario
                                 height=width, n_y=n, n_z=n,
                                 duration=scenario.duration + 20.0, shear_exponent=alpha)
     f = lidar.generate_field(spec, scenario.seed)
-    return linearize.GridWind(t=f.t, y=f.y, z=f.z, u=np.maximum(f.u, 0.0)), f
+    # the plant shares the field's u (read-only float32) unless a gust of a very turbulent
+    # low wind runs backwards: then the clipped copy
+    u = f.u
+    if float(u.min()) < 0.0:
+        u = np.maximum(f.u, np.float32(0.0))
+        u.flags.writeable = False
+    return linearize.GridWind(t=f.t, y=f.y, z=f.z, u=u), f
 
 
 def turbine_key(turbine: linearize.Turbine) -> str:
