@@ -104,6 +104,7 @@ n_z = len(OUTPUT_NAMES)
 _N_BLADE = 3
 
 _IX = {n: i for i, n in enumerate(STATE_NAMES)}
+_DENSE = (8,)                   # the strides of a 1-D C-contiguous float64 array
 
 
 @dataclass(frozen=True)
@@ -743,6 +744,19 @@ def _bad_state(x, lim):  # pragma: no cover - compiled
 
 
 @nb.njit(**_JIT)
+def _rk4_into(t, x, u, h, p, kind, wpar, grid, hint, dphi, lim, x_out, z_out):  # pragma: no cover
+    """:func:`_rk4` with its results written into ``x_out``, ``z_out`` and the warm start
+    (``hint``, ``dphi``) in place; returns the first state outside the envelope ``lim`` (-1:
+    none). Nothing is returned to Python but an int: no arrays to box at every step."""
+    xn, z, ph4, nd = _rk4(t, x, u, h, p, kind, wpar, grid, hint, dphi)
+    x_out[:] = xn
+    z_out[:] = z
+    hint[:] = ph4
+    dphi[:] = nd
+    return _bad_state(xn, lim)
+
+
+@nb.njit(**_JIT)
 def _simulate(x0, u_seq, t0, h, n_steps, p, kind, wpar, grid, lim, rate_tq):  # pragma: no cover
     nx = x0.size
     xs = np.empty((n_steps + 1, nx))
@@ -1099,6 +1113,7 @@ class PlantStepper:
         self._hint = np.full((4, _N_BLADE, n_r), np.nan)
         self._dphi = np.zeros((_N_BLADE, n_r))
         self._rk4_entry: Any = None
+        self._into_entry: Any = None
 
     def step(self, t: float, x: FloatArray, u: FloatArray) -> tuple[FloatArray, FloatArray]:
         """One RK4 step from ``t`` with the inputs held.
@@ -1131,6 +1146,38 @@ class PlantStepper:
             self._rk4_entry = _rk4.compile(tuple(nb.typeof(a) for a in args))
         xn, z, self._hint, self._dphi = self._rk4_entry(*args)
         return xn, z
+
+    def step_into(self, t: float, x: FloatArray, u: FloatArray, x_out: FloatArray,
+                  z_out: FloatArray) -> int:
+        """:meth:`step` writing into given arrays (a closed loop's record rows), and the
+        envelope check of :meth:`outside_envelope` on the new state, in one compiled call.
+
+        Parameters
+        ----------
+        t : float
+            Time at the start of the step [s].
+        x, u : (n_x,), (n_u,) ndarray
+            State at ``t`` and inputs over the step (C-contiguous float64).
+        x_out, z_out : (n_x,), (n_z,) ndarray
+            Written: the state at ``t + dt`` and the outputs at ``t`` (C-contiguous float64,
+            writable; ``x_out`` must not be ``x``).
+
+        Returns
+        -------
+        int
+            Index of the first state of ``x_out`` outside the envelope, or -1.
+        """
+        # the compiled overload is called directly (see step); it reads 1-D arrays as dense
+        # float64, so that is checked at every call (a strided view would be misread)
+        for name, a in (("x", x), ("u", u), ("x_out", x_out), ("z_out", z_out)):
+            if a.strides != _DENSE or a.dtype != np.float64:
+                raise ValueError(f"{name} must be a 1-D C-contiguous float64 array, got "
+                                 f"dtype {a.dtype}, strides {a.strides}")
+        args = (float(t), x, u, self.dt, self._pack, self._kind, self._wpar, self._grid,
+                self._hint, self._dphi, self.limits, x_out, z_out)
+        if self._into_entry is None:
+            self._into_entry = _rk4_into.compile(tuple(nb.typeof(a) for a in args))
+        return self._into_entry(*args)
 
     def outputs(self, t: float, x: FloatArray, u: FloatArray) -> FloatArray:
         """The outputs at ``t`` without stepping, (n_z,) (:data:`OUTPUT_NAMES`)."""

@@ -132,17 +132,22 @@ class LidarPreview:
         return self.buffer.preview(t, self.horizon)
 
 
+_IDX = tuple(_Z[n] for n in (
+    "gen_speed", "rotor_speed", "tower_fa_acceleration", "tower_ss_acceleration", "azimuth",
+    "gen_power", "gen_torque", "aero_power", "lss_torque", "thrust", "tilt_moment",
+    "yaw_moment"))
+
+
 def _measurements(t: float, x: np.ndarray, z: np.ndarray) -> dict[str, Any]:
-    return {"t": t, "gen_speed": z[_Z["gen_speed"]], "rotor_speed": z[_Z["rotor_speed"]],
-            "pitch": z[1:4].copy(), "flap_moment": z[10:13].copy(),
-            "edge_moment": z[13:16].copy(),
-            "tower_fa_acceleration": z[_Z["tower_fa_acceleration"]],
-            "tower_ss_acceleration": z[_Z["tower_ss_acceleration"]],
-            "azimuth": z[_Z["azimuth"]], "gen_power": z[_Z["gen_power"]],
-            "gen_torque": z[_Z["gen_torque"]], "aero_power": z[_Z["aero_power"]],
-            "lss_torque": z[_Z["lss_torque"]], "thrust": z[_Z["thrust"]],
-            "tilt_moment": z[_Z["tilt_moment"]], "yaw_moment": z[_Z["yaw_moment"]],
-            "state": x.copy()}
+    # the scalars as Python floats through one tolist() (indexing the array once per signal
+    # costs more than the whole conversion)
+    v = z.tolist()
+    gs, rs, fa, ss, az, gp, gt, ap, lss, th, tm, ym = _IDX
+    return {"t": t, "gen_speed": v[gs], "rotor_speed": v[rs], "pitch": z[1:4].copy(),
+            "flap_moment": z[10:13].copy(), "edge_moment": z[13:16].copy(),
+            "tower_fa_acceleration": v[fa], "tower_ss_acceleration": v[ss], "azimuth": v[az],
+            "gen_power": v[gp], "gen_torque": v[gt], "aero_power": v[ap], "lss_torque": v[lss],
+            "thrust": v[th], "tilt_moment": v[tm], "yaw_moment": v[ym], "state": x.copy()}
 
 
 def _hub_wind(wind: Any, hub_height: float) -> Any:
@@ -251,15 +256,22 @@ def _check_rates(duration: float, dt: float, controller_dt: float | None
 
 def _run(loop: _Loop, stepper: linearize.PlantStepper, ratio: int, bar: Any) -> None:
     """Advance the loop over all its steps; raises :class:`_Diverged` at the first state
-    outside the envelope (``loop.k_done`` then counts the samples kept)."""
+    outside the envelope (``loop.k_done`` then counts the samples kept).
+
+    The plant writes each new state and the outputs straight into the record rows
+    (:meth:`~linearize.PlantStepper.step_into`), so a step moves no arrays through Python."""
     n, dt = loop.n, loop.dt
+    xs, us, zs = loop.xs, loop.us, loop.zs
+    xs[0] = loop.x
     for k in range(n + 1):
         t = k * dt
+        x, z = xs[k], zs[k]
+        loop.x = x
+        us[k] = loop.u
         if k == n:
-            z = stepper.outputs(t, loop.x, loop.u)
+            z[:] = stepper.outputs(t, x, loop.u)
         else:
-            xn, z = stepper.step(t, loop.x, loop.u)
-        loop.xs[k], loop.us[k], loop.zs[k] = loop.x, loop.u, z
+            bad = stepper.step_into(t, x, loop.u, xs[k + 1], z)
         if k % ratio == 0 and k < n:
             loop.command(t, z)
         loop.record_signals()
@@ -267,10 +279,8 @@ def _run(loop: _Loop, stepper: linearize.PlantStepper, ratio: int, bar: Any) -> 
             break
         loop.apply_torque_rate()
         loop.k_done = k + 1
-        bad = stepper.outside_envelope(xn)
         if bad >= 0:
-            raise _Diverged(k + 1, bad, float(xn[bad]))
-        loop.x = xn
+            raise _Diverged(k + 1, bad, float(xs[k + 1, bad]))
         if k % 800 == 0:
             bar.update(min(800, n - bar.n))
 

@@ -286,6 +286,8 @@ def test_hub_wind_reads_the_field_as_linear_interpolation(dt, n, t0, q, seed) ->
     t = t0 + dt * np.arange(n)
     y, z = np.linspace(-80, 80, 5), np.linspace(10, 170, 5)
     u = rng.normal(10, 2, (n, 5, 5))
-    f = _hub_wind(linearize.GridWind(t=t, y=y, z=z, u=u), 90.0)
+    gw = linearize.GridWind(t=t, y=y, z=z, u=u)
+    f = _hub_wind(gw, 90.0)
+    hub = gw.u[:, 2, 2].astype(float)           # the column as stored (float32, issue 23)
     for tq in q:
-        assert f(tq) == pytest.approx(np.interp(tq, t, u[:, 2, 2]), rel=1e-12, abs=1e-12)
+        assert f(tq) == pytest.approx(np.interp(tq, t, hub), rel=1e-12, abs=1e-12)

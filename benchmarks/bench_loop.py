@@ -1,0 +1,174 @@
+"""Issue 23: closed loops at the plant's speed, the MPC step at the solver's, a run's memory.
+
+Measured side by side in one run, on one 600 s IEC class-A field at 18 m/s (seed 1, 32 x 32
+points, 20 Hz), all DOFs, one core:
+
+- the plant alone: ``linearize.rk4_simulate`` with the trim inputs held (compiled loop), and
+  the same through ``PlantStepper`` one step at a time from Python;
+- the baseline closed loop (80 Hz controller) and Madsen's MPC with the realistic LIDAR's
+  per-blade preview (``mpc-lidar``: range weighting, LOS error, wind evolution; 10 Hz), each as
+  a real-time factor and as a ratio to the plant alone;
+- the MPC-with-LIDAR loop's cost per controller step in its first and its last minute (a loop
+  whose cost grows with elapsed time shows a ratio above 1);
+- the MPC's whole step (state and preview in, commands out), replayed on the recorded
+  measurements with each backend (DAQP, OSQP), median and p99;
+- peak resident memory of ``mpcwt simulate`` for 600 s (baseline and mpc-lidar), every signal
+  kept and written, each in its own process.
+
+Run:  python benchmarks/bench_loop.py [--json] [--repeat 3] [--skip-memory]
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import platform
+import resource
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+import linearize
+from mpc_wt.baseline import BaselineController, tune_baseline
+from mpc_wt.controllers import Scenario, build_controller
+from mpc_wt.simulate import simulate_closed_loop
+
+DURATION = 600.0
+
+
+def _best(fn: Any, repeat: int) -> float:
+    times = []
+    for _ in range(repeat):
+        t0 = time.perf_counter()
+        fn()
+        times.append(time.perf_counter() - t0)
+    return min(times)
+
+
+def _plant(t: Any, wind: Any, op: Any, repeat: int) -> dict[str, float]:
+    p = linearize.plant_params(t)
+    linearize.rk4_simulate(p, op.x, op.u, wind, 1.0)          # compile / load the cache
+    compiled = _best(lambda: linearize.rk4_simulate(p, op.x, op.u, wind, DURATION), repeat)
+
+    def stepped() -> None:
+        st = linearize.PlantStepper(p, wind, 1 / 80, DURATION)
+        x, u = op.x.copy(), op.u.copy()
+        for k in range(int(DURATION * 80)):
+            x, _ = st.step(k / 80, x, u)
+    return {"plant_compiled_s": compiled, "plant_stepper_s": _best(stepped, repeat)}
+
+
+def _baseline(t: Any, wind: Any, op: Any, repeat: int) -> float:
+    p, g = linearize.plant_params(t), tune_baseline(t)
+    simulate_closed_loop(p, BaselineController(t, g), wind, 2.0, x0=op.x, u0=op.u)
+    return _best(lambda: simulate_closed_loop(p, BaselineController(t, g), wind, DURATION,
+                                              x0=op.x, u0=op.u), repeat)
+
+
+def _mpc_lidar(t: Any) -> dict[str, Any]:
+    """One 600 s mpc-lidar loop with the controller's calls time-stamped and their inputs kept."""
+    built, op, wind = build_controller(t, "mpc-lidar", Scenario(18.0, "A", 1, DURATION))
+    ctl = built.controller
+    stamps: list[float] = []
+    rec: list[tuple[float, dict[str, Any]]] = []
+    step0 = ctl.step
+
+    def step(tt: float, meas: dict[str, Any]) -> Any:
+        stamps.append(time.perf_counter())
+        rec.append((tt, {"state": np.array(meas["state"]), "preview": meas.get("preview")}))
+        return step0(tt, meas)
+    ctl.step = step
+    t0 = time.perf_counter()
+    simulate_closed_loop(linearize.plant_params(t), ctl, wind, DURATION, x0=op.x, u0=op.u,
+                         controller_dt=built.controller_dt, preview=built.preview)
+    wall = time.perf_counter() - t0
+    s = np.diff(np.array(stamps))
+    per_min = int(round(60.0 / built.controller_dt))
+    first, last = s[:per_min].mean(), s[-per_min:].mean()
+    return {"mpc_lidar_s": wall, "first_minute_us_per_step": first * 1e6,
+            "last_minute_us_per_step": last * 1e6, "last_over_first": last / first,
+            "rec": rec, "dt": built.controller_dt}
+
+
+def _whole_step(t: Any, rec: list[tuple[float, dict[str, Any]]], backend: str
+                ) -> dict[str, float]:
+    """The MPC's step replayed on the recorded state and preview (its own warm starts)."""
+    built, _, _ = build_controller(t, "mpc-lidar", Scenario(18.0, "A", 1, 10.0),
+                                   {"backend": backend})
+    c = built.controller
+    c.reset()
+    times = []
+    for tt, meas in rec:
+        t0 = time.perf_counter()
+        c.step(tt, meas)
+        times.append(time.perf_counter() - t0)
+    us = np.array(times[10:]) * 1e6
+    return {"median_us": float(np.median(us)), "p99_us": float(np.percentile(us, 99)),
+            "max_us": float(us.max())}
+
+
+def _peak_memory(controller: str) -> float:
+    """Peak resident set of ``mpcwt simulate --controller C --duration 600`` [MB]."""
+    with tempfile.TemporaryDirectory() as tmp:
+        code = ("import resource, subprocess, sys; subprocess.run(sys.argv[1:], check=True); "
+                "print(resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss)")
+        out = subprocess.run([sys.executable, "-c", code, sys.executable, "-m", "mpc_wt.cli",
+                              "simulate", "--controller", controller, "--wind", "18",
+                              "--duration", str(int(DURATION)), "--out",
+                              str(Path(tmp) / "run")],
+                             check=True, capture_output=True, text=True)
+    return int(out.stdout.split()[-1]) / 1024.0
+
+
+def main() -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--json", action="store_true")
+    ap.add_argument("--repeat", type=int, default=3, help="best of N for the timed loops")
+    ap.add_argument("--skip-memory", action="store_true")
+    args = ap.parse_args()
+    res: dict[str, Any] = {"date": time.strftime("%Y-%m-%d %H:%M"),
+                           "machine": f"{platform.node()} {platform.machine()}",
+                           "python": platform.python_version(), "duration_s": DURATION}
+    t = linearize.load_turbine()
+    _, op, wind = build_controller(t, "baseline", Scenario(18.0, "A", 1, DURATION))
+    res.update(_plant(t, wind, op, args.repeat))
+    res["baseline_s"] = _baseline(t, wind, op, args.repeat)
+    m = _mpc_lidar(t)
+    rec = m.pop("rec")
+    m.pop("dt")
+    res.update(m)
+    res["whole_step"] = {b: _whole_step(t, rec, b) for b in ("daqp", "osqp")}
+    for k in ("plant_compiled", "plant_stepper", "baseline", "mpc_lidar"):
+        res[f"{k}_realtime"] = DURATION / res[f"{k}_s"]
+    res["baseline_over_plant"] = res["baseline_s"] / res["plant_compiled_s"]
+    res["mpc_lidar_over_plant"] = res["mpc_lidar_s"] / res["plant_compiled_s"]
+    if not args.skip_memory:
+        res["peak_rss_mb"] = {c: _peak_memory(c) for c in ("baseline", "mpc-lidar")}
+    if args.json:
+        print(json.dumps(res, indent=1))
+        return 0
+    print(f"{res['date']}  {res['machine']}  python {res['python']}  (600 s, 18 m/s class A)")
+    for k, label in (("plant_compiled", "plant alone, compiled loop"),
+                     ("plant_stepper", "plant alone, PlantStepper from Python"),
+                     ("baseline", "baseline closed loop (80 Hz)"),
+                     ("mpc_lidar", "MPC + realistic LIDAR preview (10 Hz)")):
+        print(f"{label:42s} {res[k + '_s']:7.2f} s  {res[k + '_realtime']:6.1f}x real time")
+    print(f"baseline / plant alone {res['baseline_over_plant']:.2f}, "
+          f"mpc-lidar / plant alone {res['mpc_lidar_over_plant']:.2f}")
+    print(f"mpc-lidar loop per controller step: first minute "
+          f"{res['first_minute_us_per_step']:.0f} us, last minute "
+          f"{res['last_minute_us_per_step']:.0f} us (ratio {res['last_over_first']:.2f})")
+    for b, w in res["whole_step"].items():
+        print(f"MPC whole step with preview, {b:5s}: median {w['median_us']:6.1f} us, "
+              f"p99 {w['p99_us']:6.1f} us, max {w['max_us']:6.0f} us")
+    for c, mb in res.get("peak_rss_mb", {}).items():
+        print(f"peak resident memory, mpcwt simulate --controller {c} (600 s): {mb:.0f} MB")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
