@@ -286,3 +286,24 @@ def test_evolution_of_a_field_without_a_class() -> None:
     with pytest.raises(ValueError, match=r"spec grid \(3000, 4, 5\) does not match the field "
                                          r"\(3000, 5, 5\)"):
         lidar.evolve_field(bare, 80.0, other)
+
+
+def test_shared_sampler_changes_no_field() -> None:
+    """Issue 23: consecutive fields of one wind and grid share the circulant sampler (built
+    once); a field drawn with the shared sampler is bit for bit the field drawn with a fresh
+    one, and another wind builds its own."""
+    from lidar import turbulence
+
+    spec = TurbulenceSpec(12.0, "B", width=60, height=60, n_y=6, n_z=6, duration=60, dt=0.1)
+    turbulence._LAST_SAMPLER.clear()
+    generate_field(spec, 1)
+    shared = generate_field(spec, 2)
+    assert len(turbulence._LAST_SAMPLER) == 1
+    turbulence._LAST_SAMPLER.clear()
+    fresh = generate_field(spec, 2)
+    for comp in "uvw":
+        assert np.array_equal(getattr(shared, comp), getattr(fresh, comp))
+    other = TurbulenceSpec(16.0, "B", width=60, height=60, n_y=6, n_z=6, duration=60, dt=0.1)
+    key = next(iter(turbulence._LAST_SAMPLER))
+    generate_field(other, 2)
+    assert next(iter(turbulence._LAST_SAMPLER)) != key and len(turbulence._LAST_SAMPLER) == 1
