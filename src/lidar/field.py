@@ -34,9 +34,7 @@ def _frozen(a: Any, name: str, single: bool = False) -> FloatArray:
             and a.flags.c_contiguous):
         arr = a
     else:
-        arr = np.ascontiguousarray(np.asarray(a, dtype=dtype))
-        if arr is a or (isinstance(a, np.ndarray) and np.shares_memory(arr, a)):
-            arr = arr.copy()
+        arr = np.array(a, dtype=dtype, order="C")
     if not np.all(np.isfinite(arr)):
         bad = np.argwhere(~np.isfinite(arr))[0]
         raise ValueError(f"WindField.{name} must be finite; entry {tuple(int(i) for i in bad)} "

@@ -1112,7 +1112,6 @@ class PlantStepper:
         n_r = self._pack.r.size
         self._hint = np.full((4, _N_BLADE, n_r), np.nan)
         self._dphi = np.zeros((_N_BLADE, n_r))
-        self._rk4_entry: Any = None
         self._into_entry: Any = None
 
     def step(self, t: float, x: FloatArray, u: FloatArray) -> tuple[FloatArray, FloatArray]:
@@ -1134,17 +1133,9 @@ class PlantStepper:
         z : (n_z,) ndarray
             Outputs at ``t`` (:data:`OUTPUT_NAMES`).
         """
-        x = np.ascontiguousarray(x, dtype=np.float64)
-        u = np.ascontiguousarray(u, dtype=np.float64)
-        args = (float(t), x, u, self.dt, self._pack, self._kind, self._wpar, self._grid,
-                self._hint, self._dphi)
-        if self._rk4_entry is None:
-            # numba's dispatcher types every argument at every call, and typing the plant's
-            # 64-field parameter tuple costs 5-10 us a step; the arguments' types never change
-            # within a run (the arrays are made C-contiguous float64 above), so the compiled
-            # overload is looked up once and called directly
-            self._rk4_entry = _rk4.compile(tuple(nb.typeof(a) for a in args))
-        xn, z, self._hint, self._dphi = self._rk4_entry(*args)
+        xn, z = np.empty(n_x), np.empty(n_z)
+        self.step_into(t, np.ascontiguousarray(x, dtype=np.float64),
+                       np.ascontiguousarray(u, dtype=np.float64), xn, z)
         return xn, z
 
     def step_into(self, t: float, x: FloatArray, u: FloatArray, x_out: FloatArray,
@@ -1167,8 +1158,10 @@ class PlantStepper:
         int
             Index of the first state of ``x_out`` outside the envelope, or -1.
         """
-        # the compiled overload is called directly (see step); it reads 1-D arrays as dense
-        # float64, so that is checked at every call (a strided view would be misread)
+        # numba's dispatcher types every argument at every call, and typing the plant's 64-field
+        # parameter tuple costs 5-10 us a step; the compiled overload is looked up once and
+        # called directly. It reads 1-D arrays as dense float64, so that is checked at every
+        # call (a strided view would be misread)
         for name, a in (("x", x), ("u", u), ("x_out", x_out), ("z_out", z_out)):
             if a.strides != _DENSE or a.dtype != np.float64:
                 raise ValueError(f"{name} must be a 1-D C-contiguous float64 array, got "

@@ -398,6 +398,9 @@ class LQRPIOController(ControllerBase):
             raise ValueError("region 'II' needs k_opt > 0 [N m/(rad/s)^2] or a torque_law")
         self.torque_law = torque_law if region == "II" else None
         check_number("dt", dt, lo=0.0, lo_open=True, unit="s")
+        # the torque law's speed filter pole at our period
+        self._a_law = (math.exp(-torque_law.wc * dt) if self.torque_law is not None
+                       else math.nan)
         self.model, self.turbine, self.lqr, self.obs = model, turbine, lqr, observer
         self.dt, self.region, self.k_opt = float(dt), region, k_opt
         nx, nf = model.A.shape[0], observer.L2.shape[0]
@@ -463,7 +466,6 @@ class LQRPIOController(ControllerBase):
         w = float(meas["gen_speed"])
         if self.torque_law is None:
             return float(self.k_opt * w ** 2)
-        law = self.torque_law
-        a = math.exp(-law.wc * self.dt)
+        a = self._a_law
         self._w_filt = w if self._w_filt is None else a * self._w_filt + (1 - a) * w
-        return float(law.torque(self._w_filt, float(np.mean(pitch))))
+        return float(self.torque_law.torque(self._w_filt, float(np.mean(pitch))))
