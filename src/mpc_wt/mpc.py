@@ -36,7 +36,7 @@ import numpy as np
 import linearize
 from linearize.validate import check_number
 
-from .qp import check_backend, default_backend, make_backend
+from .qp import check_backend, daqp_update_solve, default_backend, make_backend
 from .simulate import ControllerBase
 
 __all__ = ["coleman_weight", "MPCWeights", "MPCSettings", "MPC", "ScheduledMPC"]
@@ -123,7 +123,8 @@ class MPCSettings:
         rows (block-banded, grows linearly with the horizon). Both give the same moves.
     solver_options : dict
         Passed to OSQP (defaults: eps_abs = eps_rel = 1e-5, polish off, warm start,
-        termination checked every 2 iterations condensed, 5 sparse).
+        termination checked every 2 iterations condensed, 5 sparse), or to the DAQP adapter
+        (``{"interface": "python"}``: DAQP's Python ``Model`` instead of its C interface).
     max_rotor_speed : float or None
         Soft output constraint [rad/s]: the predicted rotor speed stays below it unless a slack
         variable s_i >= 0 pays for the excess (one slack per predicted step, cost
@@ -212,30 +213,153 @@ class MPCSettings:
 
 _EMPTY = np.zeros(0)
 _EMPTY_I = np.zeros(0, dtype=np.int64)
+_NO_BLADE = np.zeros((0, 3))
+
+
+# The step's data, packed so that a compiled call takes few arguments (a numba call costs
+# about 0.1 us an array argument): integers ``im`` (sizes, then the state index, the bounds'
+# rows of y and the command's columns), constants ``fc`` (x0, d0, the bounds' constants and
+# signs, the input scales, u0) and one work buffer ``fb`` (z, y, lo, hi, v, u, du, slack);
+# MPC._pack builds them and points the MPC's arrays into ``fb``.
+_NZD, _SLACK0, _NX, _ND, _NY, _NB, _NV, _NU, _NZ, _HEAD = range(10)
 
 
 @nb.njit(cache=True, nogil=True)
-def _apply_affine(wt: np.ndarray, z: np.ndarray, ncols: int, state: np.ndarray,
-                  idx: np.ndarray, x0: np.ndarray, up: np.ndarray,
-                  out: np.ndarray) -> None:  # pragma: no cover (compiled)
-    """out = W z over the first ``ncols`` data columns, W stored transposed (``wt``); first
-    z[1:1+n_x] = state[idx] - x0 when ``state`` is given and z's u_prev block = ``up`` when
-    given. One compiled call instead of four numpy calls per step."""
-    nx = idx.shape[0]
+def _step_map(wt: np.ndarray, fb: np.ndarray, fc: np.ndarray, im: np.ndarray, ncols: int,
+              state: np.ndarray, up: np.ndarray,
+              blade: np.ndarray) -> None:  # pragma: no cover (compiled)
+    """The step's QP vectors: y = Y z over the first ``ncols`` data columns (Y stored
+    transposed, ``wt``), then each bound r from one of them, const[r] + sgn[r] y[kmap[r]]
+    (:func:`_bound_map`). Written into z first, each when given (non-empty): the state
+    deviation z[1:1+n_x] = state[idx] - x0, the previous command ``up`` and, from z[nzd] on,
+    the preview deviations from the per-blade preview ``blade`` (rows >= 1, its last row
+    held to the horizon): blade[i] - d0 with three disturbances, the rotor mean - d0 with
+    one."""
+    nzd, nx, nd, ny, nb, nz = im[_NZD], im[_NX], im[_ND], im[_NY], im[_NB], im[_NZ]
+    z = fb[:nz]
     if state.shape[0] > 0:
         for k in range(nx):
-            z[1 + k] = state[idx[k]] - x0[k]
-    if up.shape[0] > 0:
-        for k in range(up.shape[0]):
-            z[1 + nx + k] = up[k]
-    n = out.shape[0]
-    for i in range(n):
-        out[i] = 0.0
+            z[1 + k] = state[im[_HEAD + k]] - fc[k]
+    for k in range(up.shape[0]):
+        z[1 + nx + k] = up[k]
+    rows = blade.shape[0]
+    if rows > 0:
+        for i in range((nz - nzd) // nd):
+            r = min(i, rows - 1)
+            if nd == blade.shape[1]:
+                for j in range(nd):
+                    z[nzd + i * nd + j] = blade[r, j] - fc[nx + j]
+            else:
+                acc = 0.0
+                for j in range(blade.shape[1]):
+                    acc += blade[r, j]
+                z[nzd + i] = acc / blade.shape[1] - fc[nx]
+    y = fb[nz:nz + ny]
+    for i in range(ny):
+        y[i] = 0.0
     for j in range(ncols):
         zj = z[j]
         if zj != 0.0:
-            for i in range(n):
-                out[i] += wt[j, i] * zj
+            for i in range(ny):
+                y[i] += wt[j, i] * zj
+    c0, k0 = nx + nd, _HEAD + nx
+    for r in range(nb):
+        fb[nz + ny + r] = fc[c0 + r] + fc[c0 + nb + r] * y[im[k0 + r]]
+
+
+@nb.njit(cache=True, nogil=True)
+def _step_result(xs: np.ndarray, fb: np.ndarray, fc: np.ndarray,
+                 im: np.ndarray) -> bool:  # pragma: no cover (compiled)
+    """The step's result from the solver's shifted solution xs: v = xs + c; the first
+    command's deviation du = v[:n_u] su[:n_u], the absolute command u = u0 + du[ucol] and
+    the largest scaled slack (0 without slacks), into ``fb``. False when v is not finite
+    (then only v is written)."""
+    nx, nd, ny, nb, nv, nu, nz = im[_NX], im[_ND], im[_NY], im[_NB], im[_NV], im[_NU], im[_NZ]
+    iv = nz + ny + nb
+    total = 0.0
+    for i in range(nv):
+        fb[iv + i] = xs[i] + fb[nz + i]
+        total += fb[iv + i]
+    if not np.isfinite(total):
+        return False
+    isu = nx + nd + 2 * nb
+    iu, idu = iv + nv, iv + nv + 4
+    for k in range(nu):
+        fb[idu + k] = fb[iv + k] * fc[isu + k]
+    icol = _HEAD + nx + nb
+    for k in range(4):
+        fb[iu + k] = fc[isu + nu + 1 + k] + fb[idu + im[icol + k]]
+    s0 = im[_SLACK0]
+    slack = 0.0
+    if s0 < nv:
+        slack = fb[iv + s0]
+        for i in range(s0 + 1, nv):
+            slack = max(slack, fb[iv + i])
+        slack *= fc[isu + nu]
+    fb[idu + nu] = slack
+    return True
+
+
+@nb.njit(cache=True, nogil=True)
+def _step_daqp(wt: np.ndarray, fb: np.ndarray, fc: np.ndarray, im: np.ndarray, ncols: int,
+               state: np.ndarray, up: np.ndarray, blade: np.ndarray, xs: np.ndarray,
+               addr: np.ndarray, res: np.ndarray) -> int:  # pragma: no cover (compiled)
+    """The whole QP step in one compiled call with DAQP's C interface
+    (:func:`mpc_wt.qp.daqp_update_solve`): data, bounds, solve, result. Returns DAQP's flag
+    (1: solved), or 0 for a solution that is not finite."""
+    _step_map(wt, fb, fc, im, ncols, state, up, blade)
+    flag = daqp_update_solve(addr, res)
+    if flag != 1:
+        return flag
+    return 1 if _step_result(xs, fb, fc, im) else 0
+
+
+def _bound_map(w_shift: np.ndarray, nv: int) -> tuple[np.ndarray, ...]:
+    """Factor the step's affine map W (rows: the shift c (n_v), then the lower and the upper
+    bounds) into the rows it really needs. A bound's data part (W's columns 1:) is often that
+    of another row or its negative: a box bound is a constant minus c, and a general row's
+    lower and upper bounds differ by a constant. So Y holds c's rows and one row per distinct
+    data part left (Y's constant column zero there), and every bound is const + sgn y[k]
+    (sgn 0 for a constant bound). For Madsen's MPC this is 120 rows of Y for 300 of W.
+
+    Parameters
+    ----------
+    w_shift : (n_v + 2 n_c, n_z) ndarray
+        The affine map.
+    nv : int
+        Number of variables (rows of c).
+
+    Returns
+    -------
+    yt : (n_z, n_y) ndarray
+        Y transposed.
+    const, sgn : (2 n_c,) ndarray
+        Each bound's constant and sign.
+    kmap : (2 n_c,) int64 ndarray
+        Each bound's row of Y.
+    """
+    rows = [w_shift[i] for i in range(nv)]
+    seen: dict[bytes, int] = {}
+    for i in range(nv):
+        seen.setdefault(w_shift[i, 1:].tobytes(), i)
+    nb = w_shift.shape[0] - nv
+    const, sgn, kmap = np.empty(nb), np.empty(nb), np.zeros(nb, dtype=np.int64)
+    for r in range(nb):
+        row = w_shift[nv + r]
+        data = row[1:] + 0.0                       # -0.0 -> 0.0: one key per value
+        if not data.any():
+            const[r], sgn[r] = row[0], 0.0
+            continue
+        k = seen.get(data.tobytes())
+        s = 1.0
+        if k is None:
+            k, s = seen.get((-data + 0.0).tobytes()), -1.0
+        if k is None:
+            k, s = len(rows), 1.0
+            seen[data.tobytes()] = k
+            rows.append(np.concatenate([[0.0], data]))
+        kmap[r], sgn[r], const[r] = k, s, row[0] - s * rows[k][0]
+    return np.ascontiguousarray(np.array(rows).T), const, sgn, kmap
 
 
 def _group(name: str) -> str:
@@ -302,9 +426,11 @@ class MPC(ControllerBase):
         self._n_full = len(linearize.STATE_NAMES)
         self._x_idx = self._x_idx.astype(np.int64)
         self._build(dict(st.solver_options))
-        # compile (or load from numba's cache) the per-step kernel now, not in the first step
-        _apply_affine(self._wt, self._z.copy(), self._nzd, _EMPTY, self._x_idx, self.model.x0,
-                      _EMPTY, np.empty_like(self._wbuf))
+        self._d0 = np.ascontiguousarray(self.model.d0, dtype=float)
+        self._u0 = np.ascontiguousarray(self.model.u0, dtype=float)
+        self._ucol = np.array([0, 0, 0, 1] if self.collective else [0, 1, 2, 3], np.int64)
+        self._pack()
+        self._warm_kernels()
         self.reset()
 
     @classmethod
@@ -390,7 +516,7 @@ class MPC(ControllerBase):
                                     sw=k.sw, big=k.big, lim=k.lim if k.soft else None), k.opts)
             return
         self.qp_backend = make_backend(self.backend, self.formulation,
-                                       k.opts if self.backend == "osqp" else {})
+                                       k.opts if self.backend == "osqp" else self._daqp_opts)
         self.qp_backend.setup(self._h_s, np.zeros(k.nvv), k.acon_s, self._n_box)
 
     def _prediction(self, k: SimpleNamespace) -> None:
@@ -498,6 +624,7 @@ class MPC(ControllerBase):
                     verbose=False, max_iter=4000,
                     check_termination=2 if self.formulation == "condensed" else 5)
         opts.update(solver_options)
+        self._daqp_opts = dict(solver_options)
         u0 = self.model.u0
         if self.collective:
             lo_u = np.tile([pa.min_pitch_rad - u0[0], gen.min_torque - u0[3]], hu)
@@ -570,13 +697,9 @@ class MPC(ControllerBase):
         self._w_orig = np.ascontiguousarray(w_orig)
         nzd = 1 + nx + nu                     # [1, x, u_prev] columns; the preview follows
         self._nzd = nzd
-        self._wt = np.ascontiguousarray(w_shift.T)
         self._z = np.zeros(w_shift.shape[1])
         self._z[0] = 1.0
-        self._wbuf = np.empty(w_shift.shape[0])
-        self._c = self._wbuf[:nvv]
-        self._lo = self._wbuf[nvv:nvv + ncon]
-        self._hi = self._wbuf[nvv + ncon:]
+        self._set_map(w_shift, nvv, ncon)
         self._slack0 = nvu
         k.nvv = nvv
 
@@ -729,10 +852,7 @@ class MPC(ControllerBase):
         w_shift[nv + len(rs) + nvu + ns:nv + len(rs) + nvu + ns + neq] = 0.0
         nzn = 1 + nx + nu
         self._nzd = nzn
-        self._wt = np.ascontiguousarray(w_shift.T)
-        self._wbuf = np.empty(w_shift.shape[0])
-        self._c, self._lo = self._wbuf[:nv], self._wbuf[nv:nv + len(rs)]
-        self._hi = self._wbuf[nv + len(rs):]
+        self._set_map(w_shift, nv, len(rs))
         self._slack0 = nvu + nxv
         self._sparse_shape = (nv, len(rs))
         self._sparse_nnz = int(np.count_nonzero(np.triu(p_s)) + np.count_nonzero(a_s))
@@ -796,25 +916,84 @@ class MPC(ControllerBase):
         return (None if v is None else (v[:self._nvu] * self._su[:self._nvu]).reshape(hu, nu)), \
             status
 
-    def _solve_z(self, preview: bool, state: np.ndarray = _EMPTY,
-                 up: np.ndarray = _EMPTY) -> tuple[np.ndarray | None, str]:
-        """Solve the QP of the data in ``self._z`` (with the plant state ``state`` and the
-        previous command ``up`` written into it first, when given); the scaled solution (None
-        on failure) and the status."""
-        _apply_affine(self._wt, self._z, len(self._z) if preview else self._nzd, state,
-                      self._x_idx, self.model.x0, up, self._wbuf)
+    def _set_map(self, w_shift: np.ndarray, nv: int, ncon: int) -> None:
+        """The step's affine map, factored (:func:`_bound_map`), and the buffer it writes:
+        [y (c first) | lo | hi]."""
+        self._wt, self._bconst, self._bsgn, self._bk = _bound_map(w_shift, nv)
+        ny = self._wt.shape[1]
+        self._wbuf = np.empty(ny + 2 * ncon)
+        self._c = self._wbuf[:nv]
+        self._lo, self._hi = self._wbuf[ny:ny + ncon], self._wbuf[ny + ncon:]
+
+    def _pack(self) -> None:
+        """Pack the step's data for the compiled kernels (see ``_NZD`` ...) and point the
+        MPC's arrays (z, c, lo, hi, the result) into one work buffer; bind the bounds to DAQP
+        when it runs through its C interface (then the whole QP step is one compiled call,
+        :func:`_step_daqp`)."""
+        nx, nd, nz, nu = len(self._x_idx), len(self._d0), len(self._z), self._nu
+        ny, nb, nv = self._wt.shape[1], len(self._bconst), len(self._c)
+        su = np.asarray(self._su, float)
+        self._im = np.concatenate([[self._nzd, self._slack0, nx, nd, ny, nb, nv, nu, nz],
+                                   self._x_idx, self._bk, self._ucol]).astype(np.int64)
+        self._fc = np.concatenate([self.model.x0, self._d0, self._bconst, self._bsgn, su[:nu],
+                                   su[-1:], self._u0]).astype(float)
+        fb = np.zeros(nz + ny + nb + nv + 4 + nu + 1)
+        fb[:nz] = self._z
+        self._fb, self._z = fb, fb[:nz]
+        self._wbuf = fb[nz:nz + ny + nb]
+        self._c = self._wbuf[:nv]
+        self._lo, self._hi = self._wbuf[ny:ny + nb // 2], self._wbuf[ny + nb // 2:]
+        iv = nz + ny + nb
+        self._vbuf, self._ubuf = fb[iv:iv + nv], fb[iv + nv:iv + nv + 4]
+        self._dubuf = fb[iv + nv + 4:iv + nv + 4 + nu]
+        self._islack = iv + nv + 4 + nu
+        direct = getattr(self.qp_backend, "direct", None)
+        self._daqp: Any = None
+        if direct is not None:
+            direct.bind(self._lo, self._hi)
+            self._daqp = (direct.x, *direct.handles())
+
+    def _warm_kernels(self) -> None:
+        """Compile (or load from numba's cache) the per-step kernels now, not in the first
+        step: the map with and without a float64 or float32 preview, the result and (with
+        DAQP's C interface) the whole step on a scratch copy of the data."""
+        fb = self._fb.copy()
+        for blade in (_NO_BLADE, np.zeros((1, 3)), np.zeros((1, 3), np.float32)):
+            _step_map(self._wt, fb, self._fc, self._im, self._nzd, _EMPTY, _EMPTY, blade)
+        _step_result(np.zeros(len(self._c)), fb, self._fc, self._im)
+        if self._daqp is not None:
+            _step_daqp.compile((*(nb.typeof(a) for a in (self._wt, fb, self._fc, self._im)),
+                                nb.int64, nb.typeof(_EMPTY), nb.typeof(_EMPTY),
+                                nb.typeof(_NO_BLADE), *(nb.typeof(a) for a in self._daqp)))
+
+    def _solve_z(self, preview: bool, state: np.ndarray = _EMPTY, up: np.ndarray = _EMPTY,
+                 blade: np.ndarray = _NO_BLADE) -> tuple[np.ndarray | None, str]:
+        """Solve the QP of the data in ``self._z`` (with the plant state ``state``, the
+        previous command ``up`` and the per-blade preview ``blade`` written into it first,
+        when given); the scaled solution (None on failure) and the status. On success the
+        first command is in ``self._ubuf`` (absolute) and ``self._dubuf`` (deviation)."""
+        ncols = len(self._z) if preview else self._nzd
         self._has_preview = preview
+        if self._daqp is not None:
+            xs, addr, res = self._daqp
+            flag = _step_daqp(self._wt, self._fb, self._fc, self._im, ncols, state, up, blade,
+                              xs, addr, res)
+            if flag == 1:
+                self._last_slack = self._fb[self._islack]
+                return self._vbuf, "solved"
+            if flag == 0:
+                return None, "solved with non-finite solution"
+            return None, self.qp_backend.status(flag)
+        _step_map(self._wt, self._fb, self._fc, self._im, ncols, state, up, blade)
         be = self.qp_backend
         be.update_bounds(self._lo, self._hi)
         xs, status = be.solve()
         if xs is None:
             return None, status
-        v = xs + self._c
-        if not math.isfinite(v.sum()):
+        if not _step_result(xs, self._fb, self._fc, self._im):
             return None, f"{status} with non-finite solution"
-        if self._slack0 < len(v):
-            self._last_slack = float(v[self._slack0:].max() * self._su[-1])
-        return v, status
+        self._last_slack = self._fb[self._islack]
+        return self._vbuf, status
 
     def qp(self) -> dict[str, np.ndarray]:
         """The scaled QP of the last :meth:`solve`, for other solvers and checks:
@@ -875,44 +1054,56 @@ class MPC(ControllerBase):
                 raise ValueError(f"meas['state'] has shape {st.shape}; expected the plant's "
                                  f"({self._n_full},)")
         pv = meas.get("preview")
+        blade = _NO_BLADE
         if self.preview is not None and pv is not None:
-            blade = np.asarray(pv.blade, float)[: self.hp]
-            if blade.shape[0] < self.hp:
-                blade = np.vstack([blade, np.repeat(blade[-1:], self.hp - blade.shape[0], 0)])
-            dprev = blade - self.model.d0 if self._nd == 3 else \
-                blade.mean(axis=1, keepdims=True) - self.model.d0
+            blade = pv.blade
+            if not isinstance(blade, np.ndarray) or blade.dtype not in (np.float64, np.float32):
+                blade = np.asarray(blade, float)
+            if blade.ndim != 2 or blade.shape[0] < 1 or blade.shape[1] != 3:
+                raise ValueError(f"preview.blade has shape {blade.shape}; expected (n >= 1, 3) "
+                                 "per-blade winds")
         elif self.preview == "lidar":
             raise ValueError("this MPC was built with preview='lidar' but the harness gives no "
                              "preview: pass simulate_closed_loop(..., preview=LidarPreview(...))")
-        if dprev is not None:
+        if dprev is not None and blade.shape[0] == 0:          # the estimator's wind, held
             if dprev.shape != (self.hp, self._nd):
                 raise ValueError(f"preview has shape {dprev.shape}; expected (H_p, n_d) = "
                                  f"({self.hp}, {self._nd})")
             z[1 + nx + nu:] = dprev.ravel()
         t_qp = time.perf_counter()
-        v, status = self._solve_z(dprev is not None, st,
-                                  self._up0 if self._u_prev is None else self._u_prev)
+        v, status = self._solve_z(dprev is not None or blade.shape[0] > 0, st,
+                                  self._up0 if self._u_prev is None else self._u_prev, blade)
         qp_ms = 1e3 * (time.perf_counter() - t_qp)
-        fallback = 0.0
         if v is None:
-            if self._plan is not None and len(self._plan) > nu:
-                v = np.concatenate([self._plan[nu:], self._plan[-nu:]])
-                fallback = 1.0
-            else:
-                v = np.zeros(self._nvu)
-                if self._u_prev is not None:
-                    v[:self._nvu] = np.tile(self._u_prev / self._su[:nu], self.hu)
-                fallback = 2.0
-            log.warning("MPC QP %s at t = %g s: fallback %d", status, t, int(fallback))
-        self._plan = v[:self._nvu]
-        du = v[:nu] * self._su[:nu]
-        self._u_prev = du
-        u = self._u_abs(du)
-        self.signals = {"qp_fallback": fallback, "pitch_ref_1": u[0], "torque_ref": u[3],
+            u = self._fallback(t, status)
+        else:
+            self._plan = v[:self._nvu].copy()
+            self._u_prev = self._dubuf          # read by the next step before it is rewritten
+            u = self._ubuf
+        self.signals = {"qp_fallback": self._fallback_level if v is None else 0.0,
+                        "pitch_ref_1": float(u[0]), "torque_ref": float(u[3]),
                         "rotor_speed_slack": self._last_slack, "qp_solve_ms": qp_ms}
         if self.estimator is not None:
             self.signals.update(self.signals_est)
-        return u[:3], float(u[3])
+        return u[:3].copy(), float(u[3])
+
+    def _fallback(self, t: float, status: str) -> np.ndarray:
+        """The command when the QP failed: the rest of the last plan (level 1) or the last
+        command held (level 2, zero deviation at the start); logged."""
+        nu = self._nu
+        if self._plan is not None and len(self._plan) > nu:
+            v = np.concatenate([self._plan[nu:], self._plan[-nu:]])
+            self._fallback_level = 1.0
+        else:
+            v = np.zeros(self._nvu)
+            if self._u_prev is not None:
+                v[:self._nvu] = np.tile(self._u_prev / self._su[:nu], self.hu)
+            self._fallback_level = 2.0
+        log.warning("MPC QP %s at t = %g s: fallback %d", status, t, int(self._fallback_level))
+        self._plan = v[:self._nvu]
+        du = v[:nu] * self._su[:nu]
+        self._u_prev = du
+        return self._u_abs(du)
 
     def hand_over(self, other: "MPC") -> None:
         """Continue from another MPC's last command and estimate (gain scheduling): the

@@ -9,12 +9,19 @@ variables so that a step changes the bounds only).
 """
 from __future__ import annotations
 
+import ctypes
 import importlib
+import importlib.metadata
 import logging
+import weakref
 from typing import Any, ClassVar
 
+import numba as nb
 import numpy as np
 import scipy.sparse as sp
+from llvmlite import ir
+from numba.core import types as nbtypes
+from numba.extending import intrinsic
 
 from .errors import QPSetupError
 
@@ -250,13 +257,239 @@ def _clarabel_solve(h: Any, q: np.ndarray, a: Any, lo: np.ndarray, hi: np.ndarra
     return None, f"clarabel: {name}"
 
 
+class _DAQPProblem(ctypes.Structure):
+    """DAQP's ``DAQPProblem`` (include/types.h, unchanged since v0.8): the problem's sizes and
+    pointers to its data, which stay ours."""
+
+    _fields_ = [("n", ctypes.c_int), ("m", ctypes.c_int), ("ms", ctypes.c_int),
+                ("H", ctypes.c_void_p), ("f", ctypes.c_void_p), ("A", ctypes.c_void_p),
+                ("bupper", ctypes.c_void_p), ("blower", ctypes.c_void_p),
+                ("sense", ctypes.c_void_p), ("break_points", ctypes.c_void_p),
+                ("nh", ctypes.c_int), ("problem_type", ctypes.c_int)]
+
+
+class _DAQPResult(ctypes.Structure):
+    """DAQP's ``DAQPResult`` (include/api.h): pointers to our solution and multiplier
+    buffers, the solver's flag and counts."""
+
+    _fields_ = [("x", ctypes.c_void_p), ("lam", ctypes.c_void_p), ("fval", ctypes.c_double),
+                ("soft_slack", ctypes.c_double), ("exitflag", ctypes.c_int),
+                ("iter", ctypes.c_int), ("nodes", ctypes.c_int),
+                ("solve_time", ctypes.c_double), ("setup_time", ctypes.c_double)]
+
+
+#: DAQP releases whose C interface (struct layouts above, ``daqp_update_ldp``) the direct path
+#: was checked against; others go through DAQP's Python ``Model``.
+_DAQP_C_VERSIONS = ("0.10.", "0.11.")
+_DAQP_UPDATE_D = 8                     # DAQP_UPDATE_d: new bounds (include/constants.h)
+_DAQP_WORKSPACE_BYTES = 1 << 14        # a DAQPWorkspace is < 1 kB; the rest is margin
+
+
+def _daqp_library(module: Any) -> Any:
+    """DAQP's C functions from its Python extension (the wheel exports them), or None when the
+    installed release is not one the direct path knows."""
+    try:
+        version = importlib.metadata.version("daqp")
+    except importlib.metadata.PackageNotFoundError:
+        return None
+    if not version.startswith(_DAQP_C_VERSIONS):
+        return None
+    try:
+        lib = ctypes.CDLL(module.__file__)
+        fns = {n: getattr(lib, n) for n in ("allocate_daqp_settings", "setup_daqp",
+                                            "daqp_update_ldp", "daqp_solve",
+                                            "free_daqp_workspace", "free_daqp_ldp")}
+    except (OSError, AttributeError):
+        return None
+    vp = ctypes.c_void_p
+    for n in ("allocate_daqp_settings", "free_daqp_workspace", "free_daqp_ldp"):
+        fns[n].argtypes, fns[n].restype = [vp], None
+    fns["setup_daqp"].argtypes, fns["setup_daqp"].restype = [vp, vp, vp], ctypes.c_int
+    fns["daqp_update_ldp"].argtypes = [ctypes.c_int, vp, vp]
+    fns["daqp_update_ldp"].restype = ctypes.c_int
+    fns["daqp_solve"].argtypes, fns["daqp_solve"].restype = [vp, vp], None
+    return fns
+
+
+def _free_workspace(fns: dict[str, Any], work: int) -> None:
+    fns["free_daqp_workspace"](work)
+    fns["free_daqp_ldp"](work)
+
+
+class _DAQPDirect:
+    """A DAQP workspace driven through DAQP's C functions (``setup_daqp``, ``daqp_update_ldp``,
+    ``daqp_solve``), the bounds read from the caller's arrays in place and the solution written
+    into a buffer of ours: a step costs two foreign calls instead of the Python wrapper's
+    argument handling, dict and copies (about 9 us of the MPC's step).
+
+    Parameters
+    ----------
+    fns : dict
+        The C functions (:func:`_daqp_library`).
+    h : (n, n) ndarray
+        Hessian.
+    q : (n,) ndarray
+        Linear term.
+    a : (m - ms, n) ndarray
+        General constraint rows.
+    m, ms : int
+        Number of bounds and of simple bounds.
+    """
+
+    def __init__(self, fns: dict[str, Any], h: np.ndarray, q: np.ndarray, a: np.ndarray,
+                 m: int, ms: int) -> None:
+        n = h.shape[0]
+        self._fns = fns
+        self._keep = [np.ascontiguousarray(h, float), np.array(q, float).reshape(n),
+                      np.ascontiguousarray(a, float), np.zeros(m, dtype=np.intc)]
+        self.x, self.lam = np.zeros(n), np.zeros(m)
+        self._lo_arr: Any = None
+        self._hi_arr: Any = None
+        # no linear term: f = NULL, so that DAQP keeps no v and a bounds update is O(m) (with
+        # f given, every update forms M v, about 6 us here, for v = 0)
+        f = self._keep[1].ctypes.data if np.any(self._keep[1]) else None
+        self._prob = _DAQPProblem(n, m, ms, self._keep[0].ctypes.data, f,
+                                  self._keep[2].ctypes.data, None, None,
+                                  self._keep[3].ctypes.data, None, 0, 0)
+        self._res = _DAQPResult(self.x.ctypes.data, self.lam.ctypes.data)
+        self._work_mem = np.zeros(_DAQP_WORKSPACE_BYTES, np.uint8)
+        self._work = self._work_mem.ctypes.data
+        self._prob_p = ctypes.addressof(self._prob)
+        self._res_p = ctypes.addressof(self._res)
+        free = np.full(m, 1e30)
+        self.bind(-free, free)
+        fns["allocate_daqp_settings"](self._work)
+        flag = fns["setup_daqp"](self._prob_p, self._work, None)
+        weakref.finalize(self, _free_workspace, fns, self._work)
+        if flag < 0:
+            raise QPSetupError(f"daqp setup failed with exitflag {flag}")
+        self._update, self._solve = fns["daqp_update_ldp"], fns["daqp_solve"]
+
+    def bind(self, lo: np.ndarray, hi: np.ndarray) -> None:
+        """Point the problem's bounds at ``lo`` and ``hi`` (kept alive here; DAQP reads them
+        at every :meth:`update_bounds` or :func:`daqp_update_solve`).
+
+        Parameters
+        ----------
+        lo, hi : (m,) ndarray
+            Bounds.
+
+        Raises
+        ------
+        ValueError
+            Naming the shapes, when they are not (m,).
+        """
+        m = self._prob.m
+        lo = np.ascontiguousarray(lo, dtype=float)
+        hi = np.ascontiguousarray(hi, dtype=float)
+        if lo.shape != (m,) or hi.shape != (m,):
+            raise ValueError(f"bounds have shapes {lo.shape}, {hi.shape}; expected ({m},)")
+        self._lo_arr, self._hi_arr = lo, hi
+        self._prob.blower, self._prob.bupper = lo.ctypes.data, hi.ctypes.data
+
+    def update_bounds(self, lo: np.ndarray, hi: np.ndarray) -> int:
+        """Point the problem at ``lo``/``hi`` (kept; a caller that passes the same arrays
+        again, rewritten in place, costs no re-binding) and refresh DAQP's internal form.
+
+        Parameters
+        ----------
+        lo, hi : (m,) ndarray
+            Bounds.
+
+        Returns
+        -------
+        int
+            DAQP's update flag (negative on failure).
+        """
+        if lo is not self._lo_arr or hi is not self._hi_arr:
+            self.bind(lo, hi)
+        return int(self._update(_DAQP_UPDATE_D, self._work, self._prob_p))
+
+    def handles(self) -> tuple[np.ndarray, np.ndarray]:
+        """What compiled code needs to update and solve this workspace itself
+        (:func:`daqp_update_solve`).
+
+        Returns
+        -------
+        addresses : (5,) int64 ndarray
+            ``daqp_update_ldp``, ``daqp_solve``, the workspace, the problem, the result.
+        result : (k,) int32 ndarray
+            The result struct's memory as int32 (``exitflag`` at
+            ``_DAQPResult.exitflag.offset // 4``, ``iter`` after it).
+        """
+        addr = [ctypes.cast(self._update, ctypes.c_void_p).value,
+                ctypes.cast(self._solve, ctypes.c_void_p).value, self._work, self._prob_p,
+                self._res_p]
+        words = ctypes.sizeof(_DAQPResult) // 4
+        view = np.ctypeslib.as_array((ctypes.c_int32 * words).from_address(self._res_p))
+        return np.array(addr, dtype=np.int64), view
+
+    def solve(self) -> tuple[int, int]:
+        """Solve; the solution is in :attr:`x` (overwritten by the next solve).
+
+        Returns
+        -------
+        exitflag, iterations : int
+        """
+        self._solve(self._res_p, self._work)
+        return self._res.exitflag, self._res.iter
+
+
+@intrinsic
+def _c_int_call(typingctx: Any, fn: Any, a: Any, p: Any, q: Any) -> Any:  # pragma: no cover
+    """int fn(int a, void *p, void *q) at the address ``fn`` (numba intrinsic)."""
+    sig = nbtypes.int32(nbtypes.int64, nbtypes.int32, nbtypes.int64, nbtypes.int64)
+
+    def codegen(context: Any, builder: Any, signature: Any, args: Any) -> Any:
+        vp = ir.IntType(8).as_pointer()
+        fty = ir.FunctionType(ir.IntType(32), [ir.IntType(32), vp, vp])
+        f = builder.inttoptr(args[0], fty.as_pointer())
+        return builder.call(f, [args[1], builder.inttoptr(args[2], vp),
+                                builder.inttoptr(args[3], vp)])
+    return sig, codegen
+
+
+@intrinsic
+def _c_void_call(typingctx: Any, fn: Any, p: Any, q: Any) -> Any:  # pragma: no cover
+    """void fn(void *p, void *q) at the address ``fn`` (numba intrinsic); returns 0."""
+    sig = nbtypes.int32(nbtypes.int64, nbtypes.int64, nbtypes.int64)
+
+    def codegen(context: Any, builder: Any, signature: Any, args: Any) -> Any:
+        vp = ir.IntType(8).as_pointer()
+        fty = ir.FunctionType(ir.VoidType(), [vp, vp])
+        f = builder.inttoptr(args[0], fty.as_pointer())
+        builder.call(f, [builder.inttoptr(args[1], vp), builder.inttoptr(args[2], vp)])
+        return ir.Constant(ir.IntType(32), 0)
+    return sig, codegen
+
+
+_RES_FLAG = _DAQPResult.exitflag.offset // 4
+
+
+@nb.njit(cache=True, nogil=True)
+def daqp_update_solve(addr: np.ndarray, res: np.ndarray) -> int:  # pragma: no cover
+    """New bounds into a :class:`_DAQPDirect` workspace and solve, from compiled code
+    (``addr``, ``res``: :meth:`_DAQPDirect.handles`). Returns DAQP's update flag when it is
+    negative (bounds infeasible), else its exit flag (1: solved)."""
+    flag = _c_int_call(addr[0], _DAQP_UPDATE_D, addr[2], addr[3])
+    if flag < 0:
+        return flag
+    _c_void_call(addr[1], addr[4], addr[2])
+    return res[_RES_FLAG]
+
+
 class DAQPBackend(QPBackend):
     """DAQP (dual active set; dense problems, exact to its tolerances on these small QPs).
+
+    Through DAQP's C functions on a workspace of ours when the installed release is one whose
+    interface we know (0.10, 0.11: :class:`_DAQPDirect`), else through its Python ``Model``;
+    the two give the same iterates (tested).
 
     Parameters
     ----------
     options : dict, optional
-        Unused (DAQP's defaults are kept).
+        ``{"interface": "python"}`` forces DAQP's Python ``Model``; DAQP's own settings are
+        kept at their defaults.
     """
 
     name, module, extra, dense_only = "daqp", "daqp", "daqp", True
@@ -267,18 +500,66 @@ class DAQPBackend(QPBackend):
     def setup(self, h: Any, q: np.ndarray, a: Any, n_box: int) -> None:
         daqp = self.import_solver()
         a = np.asarray(a.toarray() if sp.issparse(a) else a, float)
-        free = np.full(a.shape[0], 1e30)               # the bounds are set every step
-        self.model = daqp.Model()
-        self.model.setup(np.ascontiguousarray(h), np.asarray(q, float),
-                         np.ascontiguousarray(a[n_box:]), free, -free)
+        interface = self.options.get("interface", "c")
+        if interface not in ("c", "python"):
+            raise QPSetupError(f"daqp option interface must be 'c' or 'python', got "
+                               f"{interface!r}")
+        fns = _daqp_library(daqp) if interface == "c" else None
+        self.direct = None if fns is None else _DAQPDirect(
+            fns, np.asarray(h, float), np.asarray(q, float), a[n_box:], a.shape[0], n_box)
+        self._iter = self._update_flag = 0
+        if self.direct is None:
+            free = np.full(a.shape[0], 1e30)           # the bounds are set every step
+            self.model = daqp.Model()
+            self.model.setup(np.ascontiguousarray(h), np.asarray(q, float),
+                             np.ascontiguousarray(a[n_box:]), free, -free)
 
     def update_bounds(self, lo: np.ndarray, hi: np.ndarray) -> None:
-        self.model.update(bupper=hi, blower=lo)
+        # DAQP checks the bounds here (lo > hi is infeasible at once); its flag is kept, so
+        # that solve() reports it instead of solving the previous problem
+        if self.direct is not None:
+            self._update_flag = self.direct.update_bounds(lo, hi)
+        else:
+            self._update_flag = int(self.model.update(bupper=hi, blower=lo))
+
+    def status(self, flag: int) -> str:
+        """Our status of a DAQP flag.
+
+        Parameters
+        ----------
+        flag : int
+            DAQP's exit (or bounds-update) flag.
+
+        Returns
+        -------
+        str
+            "solved", or the flag and its meaning.
+        """
+        if flag == 1:
+            return "solved"
+        return f"daqp exitflag {flag} ({self.STATUS_MAP.get(flag, 'unknown')})"
 
     def solve(self) -> tuple[np.ndarray | None, str]:
-        xs, _, flag, self.info = self.model.solve()
+        """Solve with the current bounds (the direct path returns its solution buffer,
+        overwritten by the next solve).
+
+        Returns
+        -------
+        x : (n_v,) ndarray or None
+            The solution, None when DAQP did not solve.
+        status : str
+            Our status.
+        """
+        if self._update_flag < 0:
+            flag, self._iter, xs = self._update_flag, 0, None
+        elif self.direct is not None:
+            flag, self._iter = self.direct.solve()
+            xs = self.direct.x
+        else:
+            xs, _, flag, self.info = self.model.solve()
+            self._iter = int(self.info["iterations"])
         if flag != 1:
-            return None, f"daqp exitflag {flag} ({self.STATUS_MAP.get(flag, 'unknown')})"
+            return None, self.status(flag)
         return xs, "solved"
 
     def reset(self) -> None:
@@ -286,7 +567,9 @@ class DAQPBackend(QPBackend):
 
     @property
     def iterations(self) -> int:
-        return int(self.info["iterations"])
+        if self.direct is not None:
+            return int(self.direct._res.iter)
+        return self._iter
 
 
 #: Backend name -> adapter class.

@@ -403,3 +403,109 @@ def test_step_rejects_a_state_of_the_wrong_length(model, turbine) -> None:
     with pytest.raises(ValueError,
                        match=r"meas\['state'\] has shape \(5,\); expected the plant's \(23,\)"):
         MPC(model, turbine, MPCSettings(backend="osqp")).step(0.0, {"state": np.zeros(5)})
+
+
+@settings(max_examples=25, deadline=None)
+@given(seed=st.integers(0, 2**31 - 1), width=st.floats(0.05, 2.0))
+def test_daqp_c_interface_gives_daqps_own_iterates(seed: int, width: float) -> None:
+    """Our direct path into DAQP's C functions (issue 23) against DAQP's own Python ``Model``
+    (the peer) on random strictly convex QPs with box and general rows, warm-started over a
+    sequence of bound updates as in the loop: the same exit flags, iteration counts and
+    solutions (to 1e-12)."""
+    pytest.importorskip("daqp")
+    from mpc_wt.qp import DAQPBackend
+
+    rng = np.random.default_rng(seed)
+    n, mg = 12, 20
+    m = rng.standard_normal((n, n))
+    h = m @ m.T + n * np.eye(n)
+    a = np.vstack([np.eye(n), rng.standard_normal((mg, n))])
+    q = np.zeros(n) if seed % 2 else rng.standard_normal(n)
+    direct, peer = DAQPBackend(), DAQPBackend({"interface": "python"})
+    direct.setup(h, q, a, n)
+    peer.setup(h, q, a, n)
+    assert direct.direct is not None and peer.direct is None
+    lo, hi = np.empty(n + mg), np.empty(n + mg)
+    for _ in range(6):
+        lo[:] = -rng.uniform(0.0, width, n + mg) - 0.01
+        hi[:] = rng.uniform(0.0, width, n + mg) + 0.01
+        direct.update_bounds(lo, hi)                  # the same arrays, rewritten in place
+        peer.update_bounds(lo, hi)
+        (xd, sd), (xp, sp) = direct.solve(), peer.solve()
+        assert sd == sp
+        assert direct.iterations == peer.iterations
+        if xp is not None:
+            assert_allclose(xd, xp, rtol=0, atol=1e-12)
+
+
+def test_daqp_c_interface_bad_input() -> None:
+    pytest.importorskip("daqp")
+    from mpc_wt.errors import QPSetupError
+    from mpc_wt.qp import DAQPBackend
+
+    be = DAQPBackend()
+    be.setup(np.eye(2), np.zeros(2), np.eye(2), 2)
+    with pytest.raises(ValueError, match=r"bounds have shapes \(3,\), \(2,\); expected \(2,\)"):
+        be.update_bounds(np.zeros(3), np.ones(2))
+    for interface in ("c", "python"):                # lo > hi: infeasible, not the old QP
+        be = DAQPBackend({"interface": interface})
+        be.setup(np.eye(2), np.zeros(2), np.eye(2), 2)
+        be.update_bounds(-np.ones(2), np.ones(2))
+        assert be.solve()[1] == "solved"
+        be.update_bounds(np.ones(2), np.zeros(2))
+        x, status = be.solve()
+        assert x is None and "infeasible" in status
+    with pytest.raises(QPSetupError, match="interface must be 'c' or 'python', got 'fortran'"):
+        DAQPBackend({"interface": "fortran"}).setup(np.eye(2), np.zeros(2), np.eye(2), 2)
+
+
+@pytest.mark.parametrize("rows", [15, 4, 1])
+def test_step_with_a_preview_equals_the_qp_of_its_deviations(model, turbine, rows: int) -> None:
+    """The harness step writes the per-blade preview into the QP data in compiled code
+    (issue 23): its command equals :meth:`MPC.solve` given the preview deviations worked out
+    here (a short preview held at its last row to the horizon), for both backends and for
+    DAQP through its C interface (the step one compiled call) and through its Python Model."""
+    pytest.importorskip("daqp")
+    rng = np.random.default_rng(rows)
+    x_full = np.zeros(len(linearize.STATE_NAMES))
+    idx = [linearize.STATE_NAMES.index(nm) for nm in model.states]
+    dx = 0.02 * rng.standard_normal(len(idx))
+    x_full[idx] = model.x0 + dx
+    blade = model.d0 + rng.normal(0.0, 1.5, (rows, 3))
+    held = np.vstack([blade, np.repeat(blade[-1:], 15 - rows, 0)])
+    from lidar import Preview
+
+    pv = Preview(np.arange(rows) * 0.1, blade.astype(np.float32).astype(float),
+                 blade.mean(axis=1), np.ones(rows, bool))
+    for backend, opts in (("daqp", {}), ("daqp", {"interface": "python"}), ("osqp", {})):
+        a = MPC(model, turbine, MPCSettings(backend=backend, solver_options=opts))
+        b = MPC(model, turbine, MPCSettings(backend=backend))
+        pitch, torque = a.step(0.0, {"state": x_full, "preview": pv})
+        plan, status = b.solve(dx, pv.blade[np.minimum(np.arange(15), rows - 1)] - model.d0
+                               if rows < 15 else pv.blade - model.d0)
+        assert status == "solved"
+        u = model.u0 + plan[0]
+        assert_allclose(pitch, u[:3], rtol=0, atol=1e-9)
+        assert torque == pytest.approx(u[3], rel=1e-9)
+        assert np.abs(held - pv.blade[np.minimum(np.arange(15), rows - 1)]).max() < 1e-5
+
+
+@settings(max_examples=20, deadline=None)
+@given(seed=st.integers(0, 2**31 - 1))
+def test_factored_step_map_equals_the_full_map(model, turbine, seed: int) -> None:
+    """The step's affine map is evaluated on the rows it needs (c and one row per distinct
+    bound, issue 23): for random data z the shift and the bounds equal W z from numpy on the
+    full map, condensed and sparse."""
+    from mpc_wt.mpc import _bound_map
+
+    rng = np.random.default_rng(seed)
+    for form in ("condensed", "sparse"):
+        c = MPC(model, turbine, MPCSettings(backend="osqp", formulation=form))
+        nv, nc = len(c._c), len(c._lo)
+        w = c._w_orig                        # W of the unshifted QP; shift it as the MPC does
+        yt, const, sgn, kmap = _bound_map(np.vstack([w[:nv], w[nv:nv + nc], w[nv + nc:]]), nv)
+        assert yt.shape[1] < nv + 2 * nc
+        z = np.concatenate([[1.0], rng.standard_normal(w.shape[1] - 1)])
+        y = yt.T @ z
+        assert_allclose(const + sgn * y[kmap], w[nv:] @ z, rtol=1e-12, atol=1e-9)
+        assert_allclose(y[:nv], w[:nv] @ z, rtol=1e-12, atol=1e-12)
