@@ -8,9 +8,10 @@ from .field import WindField
 from .preview import (Preview, PreviewBuffer, blade_effective_wind, coherence, coherence_bandwidth, peak_lag,
                       preview, preview_series, rms_preview_error, rotor_effective_wind)
 from .turbulence import (TurbulenceSpec, evolution_coherence, evolve_field, generate_field,
-                         iec_coherence, iec_sigma, kaimal_spectrum, simley_pao_evolution)
+                         iec_coherence, iec_sigma, kaimal_spectrum, keep_samplers,
+                         simley_pao_evolution)
 
-__all__ = ["CWLidar", "LidarMeasurement", "FieldFileError", "WindField", "Preview",
+__all__ = ["keep_samplers", "CWLidar", "LidarMeasurement", "FieldFileError", "WindField", "Preview",
            "PreviewBuffer", "blade_effective_wind", "coherence", "coherence_bandwidth", "peak_lag", "preview",
            "preview_series", "rms_preview_error", "rotor_effective_wind", "TurbulenceSpec",
            "evolution_coherence", "evolve_field", "generate_field", "iec_coherence", "iec_sigma",

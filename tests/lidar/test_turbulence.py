@@ -295,15 +295,36 @@ def test_shared_sampler_changes_no_field() -> None:
     from lidar import turbulence
 
     spec = TurbulenceSpec(12.0, "B", width=60, height=60, n_y=6, n_z=6, duration=60, dt=0.1)
-    turbulence._LAST_SAMPLER.clear()
-    generate_field(spec, 1)
-    shared = generate_field(spec, 2)
-    assert len(turbulence._LAST_SAMPLER) == 1
-    turbulence._LAST_SAMPLER.clear()
-    fresh = generate_field(spec, 2)
-    for comp in "uvw":
-        assert np.array_equal(getattr(shared, comp), getattr(fresh, comp))
-    other = TurbulenceSpec(16.0, "B", width=60, height=60, n_y=6, n_z=6, duration=60, dt=0.1)
-    key = next(iter(turbulence._LAST_SAMPLER))
-    generate_field(other, 2)
-    assert next(iter(turbulence._LAST_SAMPLER)) != key and len(turbulence._LAST_SAMPLER) == 1
+    was = lidar.keep_samplers(True)
+    try:
+        generate_field(spec, 1)
+        shared = generate_field(spec, 2)
+        assert len(turbulence._LAST_SAMPLER) == 1
+        turbulence._LAST_SAMPLER.clear()
+        fresh = generate_field(spec, 2)
+        for comp in "uvw":
+            assert np.array_equal(getattr(shared, comp), getattr(fresh, comp))
+        other = TurbulenceSpec(16.0, "B", width=60, height=60, n_y=6, n_z=6, duration=60,
+                               dt=0.1)
+        key = next(iter(turbulence._LAST_SAMPLER))
+        generate_field(other, 2)
+        assert next(iter(turbulence._LAST_SAMPLER)) != key
+        assert len(turbulence._LAST_SAMPLER) == 1
+    finally:
+        lidar.keep_samplers(was)
+    assert len(turbulence._LAST_SAMPLER) == (1 if was else 0)
+    lidar.keep_samplers(False)
+    generate_field(spec, 3)                  # off (the default): nothing held after the field
+    assert not turbulence._LAST_SAMPLER
+    lidar.keep_samplers(was)
+
+
+def test_u_only_field_has_the_full_fields_u() -> None:
+    """Issue 23: runs without a LIDAR generate u alone (v = w = 0); u is drawn first from the
+    seed's stream, so it is the full field's u bit for bit."""
+    spec = TurbulenceSpec(12.0, "B", width=60, height=60, n_y=6, n_z=6, duration=60, dt=0.1)
+    full, only = generate_field(spec, 5), generate_field(spec, 5, components="u")
+    assert np.array_equal(full.u, only.u)
+    assert not only.v.any() and not only.w.any() and full.v.std() > 0.1
+    with pytest.raises(ValueError, match="components must be letters of 'uvw'.*got 'ux'"):
+        generate_field(spec, 5, components="ux")

@@ -185,9 +185,12 @@ def run_case(case: dict[str, Any], root: str) -> dict[str, Any]:
             except ResultFileError:
                 res = None
         if res is None:
+            import lidar
+
             from ..controllers import load_plugins, run_controller
 
             load_plugins(case.get("plugins", ()))
+            lidar.keep_samplers(True)        # a worker's next case is often the next seed
             try:
                 res = run_controller(_turbine(case["turbine"]), case["run_name"],
                                      case["wind_mps"], case["turbulence"], case["seed"],

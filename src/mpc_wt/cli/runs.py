@@ -16,6 +16,7 @@ from typing import Any
 
 import numpy as np
 
+import lidar
 import linearize
 
 from ..errors import UsageError
@@ -269,6 +270,7 @@ def _comparison_runs(turbine: linearize.Turbine, args: argparse.Namespace, out: 
 
     names = [c.strip() for c in args.controllers.split(",") if c.strip()]
     rows, runs = [], []
+    lidar.keep_samplers(True)                # every controller meets the same field
     for name in names:
         res = run_controller(turbine, name, args.wind, args.turbulence, args.seed,
                              args.duration, progress=True)

@@ -93,7 +93,7 @@ def field_grid(turbine: linearize.Turbine) -> tuple[float, int]:
     return width, n
 
 
-def make_wind(turbine: linearize.Turbine, scenario: Scenario
+def make_wind(turbine: linearize.Turbine, scenario: Scenario, components: str = "uvw"
               ) -> tuple[linearize.SteadyWind | linearize.GridWind, lidar.WindField]:
     """The plant's wind for a scenario and the same field for a LIDAR in the loop.
 
@@ -103,6 +103,9 @@ def make_wind(turbine: linearize.Turbine, scenario: Scenario
         For the hub height.
     scenario : Scenario
         The load case; the field is 20 s longer than the run.
+    components : str
+        The turbulent components to generate ("uvw" default; "u": v = w = 0, for runs
+        without a LIDAR; u is the same either way, drawn first from the seed's stream).
 
     Returns
     -------
@@ -127,7 +130,7 @@ def make_wind(turbine: linearize.Turbine, scenario: Scenario
     spec = lidar.TurbulenceSpec(v, scenario.turbulence, hub_height=hub, width=width,
                                 height=width, n_y=n, n_z=n,
                                 duration=scenario.duration + 20.0, shear_exponent=alpha)
-    f = lidar.generate_field(spec, scenario.seed)
+    f = lidar.generate_field(spec, scenario.seed, components=components)
     # the plant shares the field's u (read-only float32) unless a gust of a very turbulent
     # low wind runs backwards: then the clipped copy
     u = f.u

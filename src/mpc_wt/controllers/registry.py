@@ -60,6 +60,10 @@ class ControllerKind:
     group : str
         Words for messages about options this kind shares with its family
         (``the MPC controllers``).
+    field_components : str
+        The wind components its build reads from ``ctx.field`` ("uvw", the default: a LIDAR
+        needs all three; "u": the case's field is generated without v and w, a third of
+        the memory and time; the plant meets only u either way).
     """
 
     name: str
@@ -75,6 +79,7 @@ class ControllerKind:
     design: Callable[..., Any] | None = None
     design_name: str = ""
     group: str = ""
+    field_components: str = "uvw"
 
     @property
     def is_addon(self) -> bool:

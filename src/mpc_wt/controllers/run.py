@@ -60,7 +60,8 @@ def build_controller(turbine: linearize.Turbine, controller: str, scenario: Scen
     sel = resolve(controller)
     opts = sel.options(options, naming)
     op = _operating_point(turbine, sel, opts, scenario)
-    wind, field = make_wind(turbine, scenario)
+    needs = set().union(*(k.field_components for k in (sel.base, *sel.addons)))
+    wind, field = make_wind(turbine, scenario, "".join(c for c in "uvw" if c in needs))
     ctx = BuildContext(turbine=turbine, params=linearize.plant_params(turbine), op=op,
                        scenario=scenario, field=field, cache=cache)
     built = sel.base.build(ctx, opts[0])
