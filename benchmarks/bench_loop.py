@@ -11,7 +11,8 @@ points, 20 Hz), all DOFs, one core:
 - the MPC-with-LIDAR loop's cost per controller step in its first and its last minute (a loop
   whose cost grows with elapsed time shows a ratio above 1);
 - the MPC's whole step (state and preview in, commands out), replayed on the recorded
-  measurements with each backend (DAQP, OSQP), median and p99;
+  measurements with each backend (DAQP, OSQP), median and p99, in this process and in a few
+  fresh ones, against DAQP's solve alone through its own Python interface;
 - peak resident memory of ``mpcwt simulate`` for 600 s (baseline and mpc-lidar), every signal
   kept and written, each in its own process.
 
@@ -21,6 +22,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import pickle
 import platform
 import resource
 import subprocess
@@ -35,6 +37,7 @@ import numpy as np
 import linearize
 from mpc_wt.baseline import BaselineController, tune_baseline
 from mpc_wt.controllers import Scenario, build_controller
+from mpc_wt.mpc import MPC
 from mpc_wt.simulate import simulate_closed_loop
 
 DURATION = 600.0
@@ -96,7 +99,9 @@ def _mpc_lidar(t: Any) -> dict[str, Any]:
 
 def _whole_step(t: Any, rec: list[tuple[float, dict[str, Any]]], backend: str
                 ) -> dict[str, float]:
-    """The MPC's step replayed on the recorded state and preview (its own warm starts)."""
+    """The MPC's step replayed on the recorded state and preview (its own warm starts). With
+    DAQP, also DAQP's solve alone through its own Python ``Model`` on a twin controller (the
+    reference the step is held against: the solver's cost)."""
     built, _, _ = build_controller(t, "mpc-lidar", Scenario(18.0, "A", 1, 10.0),
                                    {"backend": backend})
     c = built.controller
@@ -107,8 +112,43 @@ def _whole_step(t: Any, rec: list[tuple[float, dict[str, Any]]], backend: str
         c.step(tt, meas)
         times.append(time.perf_counter() - t0)
     us = np.array(times[10:]) * 1e6
-    return {"median_us": float(np.median(us)), "p99_us": float(np.percentile(us, 99)),
-            "max_us": float(us.max())}
+    out = {"median_us": float(np.median(us)), "p99_us": float(np.percentile(us, 99)),
+           "max_us": float(us.max())}
+    if backend == "daqp":
+        twin = MPC(c.model, t, c.settings.replace(solver_options={"interface": "python"}))
+        model, solves = twin.qp_backend.model, []
+        solve0 = model.solve
+
+        class _Timed:
+            def __getattr__(self, name: str) -> Any:
+                return getattr(model, name)
+
+            def solve(self) -> Any:
+                t0 = time.perf_counter()
+                r = solve0()
+                solves.append(time.perf_counter() - t0)
+                return r
+        twin.qp_backend.model = _Timed()
+        twin.reset()
+        for tt, meas in rec:
+            twin.step(tt, meas)
+        out["daqp_model_solve_median_us"] = float(np.median(solves[10:]) * 1e6)
+    return out
+
+
+def _whole_step_processes(rec: list[tuple[float, dict[str, Any]]], n: int
+                          ) -> list[dict[str, Any]]:
+    """The replay in ``n`` fresh processes (this VM's speed differs from process to process by
+    up to 1.8x: one process's figure is one draw)."""
+    with tempfile.TemporaryDirectory() as tmp:
+        path = Path(tmp) / "rec.pkl"
+        path.write_bytes(pickle.dumps(rec))
+        runs = []
+        for _ in range(n):
+            out = subprocess.run([sys.executable, __file__, "--replay", str(path)], check=True,
+                                 capture_output=True, text=True)
+            runs.append(json.loads(out.stdout))
+    return runs
 
 
 def _peak_memory(controller: str) -> float:
@@ -129,7 +169,15 @@ def main() -> int:
     ap.add_argument("--json", action="store_true")
     ap.add_argument("--repeat", type=int, default=3, help="best of N for the timed loops")
     ap.add_argument("--skip-memory", action="store_true")
+    ap.add_argument("--step-processes", type=int, default=3,
+                    help="fresh processes for the MPC step replay (default 3)")
+    ap.add_argument("--replay", help=argparse.SUPPRESS)
     args = ap.parse_args()
+    if args.replay:
+        rec = pickle.loads(Path(args.replay).read_bytes())
+        tb = linearize.load_turbine()
+        print(json.dumps({b: _whole_step(tb, rec, b) for b in ("daqp", "osqp")}))
+        return 0
     res: dict[str, Any] = {"date": time.strftime("%Y-%m-%d %H:%M"),
                            "machine": f"{platform.node()} {platform.machine()}",
                            "python": platform.python_version(), "duration_s": DURATION}
@@ -142,6 +190,7 @@ def main() -> int:
     m.pop("dt")
     res.update(m)
     res["whole_step"] = {b: _whole_step(t, rec, b) for b in ("daqp", "osqp")}
+    res["whole_step_processes"] = _whole_step_processes(rec, args.step_processes)
     for k in ("plant_compiled", "plant_stepper", "baseline", "mpc_lidar"):
         res[f"{k}_realtime"] = DURATION / res[f"{k}_s"]
     res["baseline_over_plant"] = res["baseline_s"] / res["plant_compiled_s"]
@@ -164,7 +213,16 @@ def main() -> int:
           f"{res['last_minute_us_per_step']:.0f} us (ratio {res['last_over_first']:.2f})")
     for b, w in res["whole_step"].items():
         print(f"MPC whole step with preview, {b:5s}: median {w['median_us']:6.1f} us, "
-              f"p99 {w['p99_us']:6.1f} us, max {w['max_us']:6.0f} us")
+              f"p99 {w['p99_us']:6.1f} us, max {w['max_us']:6.0f} us (this process)")
+    ref = res["whole_step"]["daqp"]["daqp_model_solve_median_us"]
+    print(f"  DAQP's solve alone through its Python Model: median {ref:.1f} us; whole step / "
+          f"that {res['whole_step']['daqp']['median_us'] / ref:.2f}")
+    for b in ("daqp", "osqp"):
+        med = [r[b]["median_us"] for r in res["whole_step_processes"]]
+        p99 = [r[b]["p99_us"] for r in res["whole_step_processes"]]
+        print(f"  {b} in {len(med)} fresh processes: medians "
+              f"{', '.join(f'{v:.1f}' for v in med)} us; p99 {', '.join(f'{v:.0f}' for v in p99)}"
+              f" us")
     for c, mb in res.get("peak_rss_mb", {}).items():
         print(f"peak resident memory, mpcwt simulate --controller {c} (600 s): {mb:.0f} MB")
     return 0
