@@ -11,7 +11,7 @@ from linearize import OperatingPoint
 
 __all__ = ["plot_cp_surface", "plot_operating_schedule", "plot_lidar_coherence",
            "plot_scan_pattern", "plot_cs_ellipses", "plot_psd_comparison", "plot_design",
-           "assess_plots", "plot_pareto"]
+           "assess_plots", "plot_pareto", "plot_wind_condition"]
 
 
 def _save(fig, path: str | Path) -> Path:  # type: ignore[no-untyped-def]
@@ -469,4 +469,45 @@ def plot_pareto(metrics: Sequence[dict[str, float]], feasible: Sequence[bool],
             ax.grid(alpha=0.3)
     axes[0][0].legend(fontsize=7)
     fig.suptitle(title)
+    return _save(fig, path)
+
+
+def plot_wind_condition(field: Any, path: str | Path) -> Path:
+    """An IEC wind condition over time (:func:`lidar.iec_field`): the speed at the hub and at
+    the top, bottom and lateral edges of the grid, and the direction at the hub.
+
+    Parameters
+    ----------
+    field : lidar.WindField
+        The field.
+    path : str or Path
+        The PNG.
+
+    Returns
+    -------
+    Path
+        The file written.
+    """
+    plt = _plt()
+    j, k = int(np.argmin(np.abs(field.y))), int(np.argmin(np.abs(field.z - field.hub_height)))
+    speed = np.hypot(field.u, field.v)
+    fig, (a1, a2) = plt.subplots(2, 1, figsize=(8, 6), sharex=True)
+    t = np.asarray(field.t, float)
+    yh, zh = np.zeros_like(t), np.full_like(t, field.hub_height)
+    hu, hv = field.sample(t, yh, zh, "u"), field.sample(t, yh, zh, "v")
+    a1.plot(t, np.hypot(hu, hv), label="hub", lw=1.2)
+    for lab, jj, kk in (("top", j, -1), ("bottom", j, 0), ("left (+y)", -1, k),
+                        ("right (-y)", 0, k)):
+        a1.plot(t, speed[:, jj, kk], label=lab, lw=0.8)
+    a1.set_ylabel("speed [m/s]")
+    a1.legend(fontsize=8, ncol=5)
+    m = field.meta
+    a1.set_title(f"IEC 61400-1 {m.get('condition', '').upper()}, class "
+                 f"{m.get('turbine_class', '?')}{m.get('turbulence_class', '')}, "
+                 f"V_hub {field.mean_speed:g} m/s")
+    a2.plot(t, np.degrees(np.arctan2(hv, hu)))
+    a2.set_ylabel("direction at the hub [deg]")
+    a2.set_xlabel("t [s]")
+    for ax in (a1, a2):
+        ax.grid(alpha=0.3)
     return _save(fig, path)

@@ -365,3 +365,28 @@ def test_linearize_at_a_given_operating_point(capsys: pytest.CaptureFixture[str]
     assert main(["linearize", "--wind", "11:12:1", "--rotor-speed-rpm", "11.81",
                  "--pitch-deg", "0"]) == 2
     assert "go together, with a single --wind" in capsys.readouterr().err
+
+
+def test_wind_generate_iec_condition(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """Issue 24: ``mpcwt wind generate --condition eog --mean 13`` writes the deterministic
+    field and its plot; the EOG magnitude printed is eq 16's (class I A, z_hub 90 m, D 126 m:
+    3.3 * 0.16 (0.75 * 13 + 5.6) / 1.3 = 6.2345 m/s); the field loads back with the gust."""
+    import lidar
+
+    out, png = tmp_path / "eog.npz", tmp_path / "eog.png"
+    assert main(["wind", "generate", "--condition", "eog", "--mean", "13", "--cut-in", "3",
+                 "--cut-out", "25", "--n", "8", "--out", str(out), "--plot", str(png)]) == 0
+    assert "gust_mps 6.234" in capsys.readouterr().out
+    assert png.read_bytes()[:4] == b"\x89PNG"
+    f = lidar.WindField.load(out)
+    assert f.meta["condition"] == "eog"
+    hub = f.sample(f.t, np.zeros_like(f.t), np.full_like(f.t, 90.0))
+    assert (hub - hub[0]).max() == pytest.approx(0.74 * 6.2345, abs=5e-4)   # the same at
+    # every height; the grid's hub point is interpolated on the power-law profile
+    assert main(["wind", "generate", "--condition", "eog", "--mean", "26", "--cut-out", "25",
+                 "--out", str(out)]) == 2
+    assert ("--condition eog: mean_speed 26 m/s is above the turbine's cut-out 25 m/s"
+            in capsys.readouterr().err)
+    assert main(["wind", "generate", "--condition", "ecd", "--mean", "13", "--iec-class", "IV",
+                 "--out", str(out)]) == 2
+    assert "turbine_class must be one of ['I', 'II', 'III']" in capsys.readouterr().err

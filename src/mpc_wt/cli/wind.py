@@ -34,6 +34,21 @@ def add_parsers(sub: Any) -> None:
     q.add_argument("--width", type=float, default=150.0, help="grid side [m]")
     q.add_argument("--hub-height", type=float, default=90.0, help="[m]")
     q.add_argument("--shear", type=float, default=0.2, help="power-law exponent")
+    q.add_argument("--condition", default=None,
+                   choices=("ntm", "etm", "nwp", "eog", "edc", "ecd", "ews-v", "ews-h"),
+                   help="an IEC 61400-1 ed. 3 wind condition (default: the NTM field, or --ti)")
+    q.add_argument("--iec-class", default="I", help="wind turbine class I, II or III (for "
+                   "--condition; V_ref 50, 42.5, 37.5 m/s)")
+    q.add_argument("--diameter", type=float, default=126.0, help="rotor diameter [m] (for "
+                   "--condition)")
+    q.add_argument("--cut-in", type=float, default=None, help="[m/s] operating events below "
+                   "it are refused")
+    q.add_argument("--cut-out", type=float, default=None, help="[m/s] operating events above "
+                   "it are refused")
+    q.add_argument("--sign", type=int, default=1, choices=(1, -1),
+                   help="direction of a direction change or shear")
+    q.add_argument("--t-start", type=float, default=30.0, help="start of the transient [s]")
+    q.add_argument("--plot", default=None, help="PNG of the condition over time")
     q.add_argument("--out", required=True, help=".bts (TurbSim) or .npz (native)")
     q.set_defaults(func=_generate)
 
@@ -59,6 +74,8 @@ def _generate(args: argparse.Namespace) -> int:
     from .common import check_suffix
 
     check_suffix(args.out, "--out", (".bts", ".npz"))
+    if args.condition is not None:
+        return _generate_condition(args)
     turb: str | float = args.turbulence_class if args.ti is None else args.ti
     try:
         spec = lidar.TurbulenceSpec(args.mean, turb, hub_height=args.hub_height,
@@ -72,6 +89,36 @@ def _generate(args: argparse.Namespace) -> int:
     u = field.u
     print(f"wrote {out}: {u.shape[0]} steps x {u.shape[1]} x {u.shape[2]} points, "
           f"hub TI {u[:, u.shape[1] // 2, u.shape[2] // 2].std() / args.mean:.3f}")
+    return 0
+
+
+def _generate_condition(args: argparse.Namespace) -> int:
+    """An IEC wind condition (:func:`lidar.iec_field`) written as a field, with its plot."""
+    import lidar
+
+    if args.ti is not None:
+        raise UsageError("--ti does not go with --condition: the condition sets sigma_1 from "
+                         "--class and --iec-class")
+    try:
+        site = lidar.IECSite(args.iec_class, args.turbulence_class, args.hub_height,
+                             args.diameter, args.shear, cut_in=args.cut_in,
+                             cut_out=args.cut_out)
+        turbulent = args.condition in ("ntm", "etm")
+        field = lidar.iec_field(args.condition, args.mean, site, t_start=args.t_start,
+                                duration=args.duration if turbulent else None, dt=args.dt,
+                                width=args.width, n=args.n, sign=args.sign, seed=args.seed)
+    except ValueError as err:
+        raise UsageError(f"--condition {args.condition}: {err}") from None
+    out = field.save(args.out)
+    m = field.meta
+    mags = ", ".join(f"{k} {m[k]:.4g}" for k in ("gust_mps", "direction_change_deg",
+                                                  "shear_amplitude_mps", "sigma_1") if k in m)
+    print(f"wrote {out}: IEC {args.condition.upper()} at {args.mean:g} m/s, class "
+          f"{site.turbine_class}{site.turbulence_class}; {mags}")
+    if args.plot:
+        from ..plotting import plot_wind_condition
+
+        print(f"wrote {plot_wind_condition(field, args.plot)}")
     return 0
 
 
