@@ -15,6 +15,9 @@ rotor: OpenFAST's ``HorWindV``); ``state``, the full plant state
 (:data:`linearize.STATE_NAMES`), for full-state-information designs (Madsen's MPC); and
 ``preview`` when a LIDAR preview is attached. A controller with a ``finalize()`` method gets
 it called once after the run (also after a failed one): a Bladed-style library's last call.
+A controller whose ``grid_connected`` attribute turns False (a grid loss,
+:class:`mpc_wt.supervisor.Supervisor`) gets zero generator torque from the next plant step on,
+without the torque-rate limit.
 """
 from __future__ import annotations
 
@@ -192,6 +195,7 @@ class _Loop:
         self.u = np.asarray(u0, float).copy()
         self.u_tq = float(self.u[3])
         self.clipped = 0
+        self.grid_lost = False
         self.k_done = 0
         self.rate = params.turbine.generator.max_torque_rate * dt
         pa, gen = params.turbine.pitch_actuator, params.turbine.generator
@@ -224,6 +228,9 @@ class _Loop:
             self.clipped += 1
         self.u[:3] = pitch
         self.u_tq = float(tq)
+        if not self.grid_lost and getattr(self.controller, "grid_connected", True) is False:
+            self.grid_lost = True
+            log.info("grid lost at t = %g s: generator torque zero from here", t)
 
     def record_signals(self) -> None:
         """Append the controller's internal signals of this plant step."""
@@ -231,7 +238,11 @@ class _Loop:
             self.sig.setdefault(name, []).append(float(val))
 
     def apply_torque_rate(self) -> None:
-        """Move the applied torque toward the command by at most the generator's rate."""
+        """Move the applied torque toward the command by at most the generator's rate (after
+        a grid loss: zero at once)."""
+        if self.grid_lost:
+            self.u[3] = 0.0
+            return
         self.u[3] += min(max(self.u_tq - self.u[3], -self.rate), self.rate)
 
     def result(self, k: int, meta: dict[str, Any]) -> ClosedLoopResult:
