@@ -122,22 +122,8 @@ class Supervisor(ControllerBase):
         self._torque0 = float(meas["gen_torque"])
 
     def step(self, t: float, meas: dict[str, Any]) -> tuple[np.ndarray, float]:
-        """The wrapped controller's commands while running, the stop sequence after a trip.
-
-        Parameters
-        ----------
-        t : float
-            Time [s].
-        meas : dict
-            The harness's measurements.
-
-        Returns
-        -------
-        pitch_ref : (3,) ndarray
-            Blade pitch commands [rad].
-        gen_torque_ref : float
-            Generator torque command [N m].
-        """
+        # the wrapped controller's commands while running, the stop sequence after a trip
+        # (parameters and returns: ControllerBase.step)
         if self.state == "running":
             self._trip(t, meas)
         if self.state == "running":
