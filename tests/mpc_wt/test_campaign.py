@@ -280,8 +280,25 @@ def test_report_tables_and_plots(tmp_path):
     assert "Pettas fig. 5" in text and "lss_torque" in text
     assert "## Regulation and 1P content" in text
     for f in ("lifetime_del.csv", "short_term_del.csv", "aep.csv", "del_vs_wind.png",
-              "lifetime_del.png", "cs_ellipses.png", "psd.png"):
+              "lifetime_del.png", "cs_ellipses.png", "psd.png", "ultimate.csv"):
         assert (Path(rep).parent / f).is_file(), f
+    # ultimate loads (issue 24): the campaign's largest shaft torque and its case, found here
+    # from the result files themselves; the characteristic value is the larger of the two
+    # winds' seed means of the maxima; the design value 1.35 x that
+    assert "## Ultimate loads" in text
+    ult = {r["controller"]: r for r in agg["ultimate"] if r["channel"] == "lss_torque"}
+    peaks: dict = {}
+    for row in agg["rows"]:
+        if row.controller == "derate80":
+            res = ClosedLoopResult.load(tmp_path / row.file)
+            k = res.t >= res.t[0] + spec.transient
+            peaks[row.case_id] = (row.wind_mps, float(res.channel("lss_torque")[k].max()))
+    top = max(peaks, key=lambda c: peaks[c][1])
+    u = ult["derate80"]
+    assert u["max_case"] == top and u["max"] == pytest.approx(peaks[top][1], rel=1e-12)
+    means = [np.mean([m for w, m in peaks.values() if w == v]) for v in (10.0, 14.0)]
+    assert u["characteristic_max"] == pytest.approx(max(means), rel=1e-12)
+    assert u["design_max"] == pytest.approx(1.35 * max(means), rel=1e-12)
 
 
 def _probs_rayleigh(winds, mean):

@@ -222,6 +222,29 @@ class _Group:
                 prow[f"{name}_change_pct"] = _pct(float(base), float(mine))
         return prow
 
+    def ultimate(self) -> list[dict[str, Any]]:
+        """Ultimate loads of this controller and turbulence (:mod:`.ultimate`; the cases'
+        extremes, seed means per wind, normal-family safety factor 1.35)."""
+        from .ultimate import ultimate_table
+
+        rows = [{"case_id": c.case_id, "dlc": str(self.turb), "wind_mps": v, "seed": c.seed,
+                 "extremes": c.metrics["extremes"]}
+                for v in self.winds for c in self.bins[v] if "extremes" in c.metrics]
+        if not rows:
+            return []
+        chans = [ch for ch in (*self.spec.channels, "rotor_speed")
+                 if all(ch in r["extremes"] for r in rows)]
+        out = []
+        for ch, u in ultimate_table(rows, chans).items():
+            d = u["by_dlc"][str(self.turb)]
+            out.append({**self.key, "channel": ch, "max": u["max"], "max_case": u["max_case"],
+                        "min": u["min"], "min_case": u["min_case"],
+                        "characteristic_max": d["characteristic_max"],
+                        "wind_max": d["wind_max"], "design_max": d["design_max"],
+                        "characteristic_min": d["characteristic_min"],
+                        "design_min": d["design_min"], "safety_factor": d["safety_factor"]})
+        return out
+
     def regulation(self) -> dict[str, Any]:
         """Rotor-speed std, power std and the blade-1 flap 1P and 3P content, weighted over
         the winds like the pitch duty, with their changes against the reference."""
@@ -328,7 +351,8 @@ def aggregate(root: str | Path) -> dict[str, Any]:
     -------
     dict
         ``spec``, ``rows`` (finished cases), ``short_term``, ``per_wind``, ``lifetime``,
-        ``aep``, ``pitch``, ``cs``, ``extension``, ``sweep``, ``incomplete`` and ``outliers``.
+        ``aep``, ``pitch``, ``cs``, ``extension``, ``ultimate``, ``sweep``, ``incomplete``
+        and ``outliers``.
 
     Raises
     ------
@@ -338,7 +362,7 @@ def aggregate(root: str | Path) -> dict[str, Any]:
     spec, rows = _load(Path(root))
     out: dict[str, Any] = {"spec": spec, "rows": rows, "short_term": [], "per_wind": [],
                            "lifetime": [], "aep": [], "pitch": [], "regulation": [], "cs": [],
-                           "extension": [],
+                           "extension": [], "ultimate": [],
                            "sweep": [], "incomplete": [], "outliers": []}
     for g in _groups(spec, rows):
         missing = g.missing_seeds()
@@ -355,6 +379,7 @@ def aggregate(root: str | Path) -> dict[str, Any]:
         out["aep"] += g.aep()
         out["pitch"].append(g.pitch())
         out["regulation"].append(g.regulation())
+        out["ultimate"] += g.ultimate()
     for c in spec.controllers:
         f = c.options.get("apc_frequency")
         if f is not None:
@@ -657,7 +682,7 @@ def make_report(root: str | Path, out: str | Path | None = None) -> Path:
     out = Path(out) if out else root / "report"
     out.mkdir(parents=True, exist_ok=True)
     for name in ("short_term", "per_wind", "lifetime", "aep", "pitch", "cs", "extension",
-                 "sweep", "outliers"):
+                 "sweep", "outliers", "ultimate"):
         if agg[name]:
             fname = {"short_term": "short_term_del", "per_wind": "del_by_wind",
                      "lifetime": "lifetime_del"}.get(name, name)
@@ -751,6 +776,18 @@ def _md_loads(agg: dict[str, Any]) -> list[str]:
 def _md_more(agg: dict[str, Any]) -> list[str]:
     """Lifetime extension, CS1-CS5 and the APC sweep."""
     md: list[str] = []
+    if agg["ultimate"]:
+        md += ["## Ultimate loads", "",
+               "Each case's extremes after the transient; characteristic: the mean over seeds "
+               "of each seed's extreme, the largest over the winds; design: times the partial "
+               "safety factor (IEC 61400-1 ed. 3 table 3, normal 1.35). All rows in "
+               "`ultimate.csv`.", "",
+               _md(agg["ultimate"], ["controller", "turbulence", "channel", "max", "max_case",
+                                     "characteristic_max", "wind_max", "design_max", "min",
+                                     "design_min"],
+                   ["controller", "turbulence", "channel", "max", "its case",
+                    "characteristic max", "at wind [m/s]", "design max", "min",
+                    "design min"]), ""]
     if agg["extension"]:
         md += ["## Lifetime extension (retrofit after 15 years, 5 more at the new rate; "
                "Pettas and Cheng eq 1)", "",

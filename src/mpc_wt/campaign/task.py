@@ -72,7 +72,9 @@ def case_metrics(t: np.ndarray, cols: dict[str, np.ndarray], channels: dict[str,
     Returns
     -------
     dict
-        JSON-safe metrics (:func:`mpc_wt.assess.assess_series` plus rotor-speed statistics).
+        JSON-safe metrics (:func:`mpc_wt.assess.assess_series` plus rotor-speed statistics and
+        ``extremes``: each channel's and the rotor speed's maximum and minimum and their times,
+        :func:`mpc_wt.campaign.ultimate.case_extremes`).
 
     Raises
     ------
@@ -90,6 +92,11 @@ def case_metrics(t: np.ndarray, cols: dict[str, np.ndarray], channels: dict[str,
         if n in sub and not np.all(np.isfinite(sub[n])):
             raise ValueError(f"channel {n!r} holds NaN or inf")
     out = assess_series(t[k], sub, channels, convention=convention)
+    # ultimate loads (issue 24): each channel's extremes and when (campaign.ultimate)
+    from .ultimate import case_extremes
+
+    out["extremes"] = case_extremes(t[k], sub, [n for n in (*channels, "rotor_speed")
+                                                if n in sub])
     if "rotor_speed" in sub:
         out["rotor_speed_mean_rad_s"] = float(sub["rotor_speed"].mean())
         out["rotor_speed_std_rad_s"] = float(sub["rotor_speed"].std())
