@@ -311,7 +311,10 @@ def _daqp_library(module: Any) -> Any:
     return fns
 
 
-def _free_workspace(fns: dict[str, Any], work: int) -> None:
+def _free_workspace(fns: dict[str, Any], work_mem: np.ndarray) -> None:
+    # the finalizer holds the workspace's memory itself, so it is still ours when DAQP frees
+    # what it allocated inside it
+    work = work_mem.ctypes.data
     fns["free_daqp_workspace"](work)
     fns["free_daqp_ldp"](work)
 
@@ -360,7 +363,7 @@ class _DAQPDirect:
         self.bind(-free, free)
         fns["allocate_daqp_settings"](self._work)
         flag = fns["setup_daqp"](self._prob_p, self._work, None)
-        weakref.finalize(self, _free_workspace, fns, self._work)
+        weakref.finalize(self, _free_workspace, fns, self._work_mem)
         if flag < 0:
             raise QPSetupError(f"daqp setup failed with exitflag {flag}")
         self._update, self._solve = fns["daqp_update_ldp"], fns["daqp_solve"]
