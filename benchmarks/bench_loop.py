@@ -36,6 +36,7 @@ import numpy as np
 
 import linearize
 from mpc_wt.baseline import BaselineController, tune_baseline
+from mpc_wt.bench import _Timed  # the solver-call timer of bench_mpc
 from mpc_wt.controllers import Scenario, build_controller
 from mpc_wt.mpc import MPC
 from mpc_wt.simulate import simulate_closed_loop
@@ -116,23 +117,12 @@ def _whole_step(t: Any, rec: list[tuple[float, dict[str, Any]]], backend: str
            "max_us": float(us.max())}
     if backend == "daqp":
         twin = MPC(c.model, t, c.settings.replace(solver_options={"interface": "python"}))
-        model, solves = twin.qp_backend.model, []
-        solve0 = model.solve
-
-        class _Timed:
-            def __getattr__(self, name: str) -> Any:
-                return getattr(model, name)
-
-            def solve(self) -> Any:
-                t0 = time.perf_counter()
-                r = solve0()
-                solves.append(time.perf_counter() - t0)
-                return r
-        twin.qp_backend.model = _Timed()
+        timer = _Timed(twin.qp_backend.model, "solve")
+        twin.qp_backend.model = timer
         twin.reset()
         for tt, meas in rec:
             twin.step(tt, meas)
-        out["daqp_model_solve_median_us"] = float(np.median(solves[10:]) * 1e6)
+        out["daqp_model_solve_median_us"] = float(np.median(timer.times[10:]) * 1e6)
     return out
 
 

@@ -263,11 +263,11 @@ class IECSite:
         return v
 
 
-def _transient(condition: str, site: IECSite, v: float, tau: FloatArray, sign: float
+def _transient(condition: str, mag: dict[str, float], tau: FloatArray, sign: float
                ) -> tuple[FloatArray, FloatArray, FloatArray]:
     """Per time (relative to the event's start): speed added at every point [m/s], direction
     [rad], and the linear shear amplitude across the rotor A(t) [m/s] (multiplied by
-    (z - z_hub) / D or y / D)."""
+    (z - z_hub) / D or y / D); ``mag``: :meth:`IECSite.magnitudes` at the hub speed."""
     T = CONDITIONS[condition]
     inside = (tau >= 0.0) & (tau <= T)
     x = np.where(inside, tau / T if T else 0.0, 0.0)
@@ -275,7 +275,6 @@ def _transient(condition: str, site: IECSite, v: float, tau: FloatArray, sign: f
     gust = np.zeros_like(tau)
     theta = np.zeros_like(tau)
     shear = np.zeros_like(tau)
-    mag = site.magnitudes(v)
     if condition == "eog":
         vg = mag["eog_gust"]
         gust = np.where(inside, -0.37 * vg * np.sin(3 * np.pi * x) * (1 - np.cos(2 * np.pi * x)),
@@ -358,8 +357,9 @@ def iec_field(condition: str, mean_speed: float, site: IECSite, *, t_start: floa
                             "turbulence_class": site.turbulence_class,
                             "hub_height": site.hub_height, "diameter": site.diameter,
                             "shear_exponent": site.shear_exponent}
+    mag = site.magnitudes(v)
     if turbulent:
-        sigma = site.magnitudes(v)["sigma_ntm" if cond == "ntm" else "sigma_etm"]
+        sigma = mag["sigma_ntm" if cond == "ntm" else "sigma_etm"]
         spec = TurbulenceSpec(v, sigma / v, hub_height=site.hub_height, width=width,
                               height=width, n_y=int(n), n_z=int(n), duration=duration, dt=dt,
                               shear_exponent=site.shear_exponent)
@@ -370,7 +370,7 @@ def iec_field(condition: str, mean_speed: float, site: IECSite, *, t_start: floa
     t = np.arange(int(round(duration / dt)) + 1) * dt
     y = np.linspace(-width / 2, width / 2, int(n))
     z = site.hub_height + np.linspace(-width / 2, width / 2, int(n))
-    gust, theta, shear = _transient(cond, site, v, t - t_start, float(sign))
+    gust, theta, shear = _transient(cond, mag, t - t_start, float(sign))
     profile = v * (z / site.hub_height) ** site.shear_exponent            # (n_z,)
     speed = profile[None, None, :] + gust[:, None, None]
     if cond == "ews-v":
@@ -382,7 +382,6 @@ def iec_field(condition: str, mean_speed: float, site: IECSite, *, t_start: floa
     c, s = np.cos(theta)[:, None, None], np.sin(theta)[:, None, None]
     u = (speed * c).astype(np.float32)
     vv = (speed * s).astype(np.float32)
-    mag = site.magnitudes(v)
     named = {"eog": ("gust_mps", mag["eog_gust"]),
              "ecd": ("direction_change_deg", sign * mag["ecd_deg"]),
              "edc": ("direction_change_deg", sign * mag["edc_deg"]),

@@ -699,7 +699,7 @@ class MPC(ControllerBase):
         self._nzd = nzd
         self._z = np.zeros(w_shift.shape[1])
         self._z[0] = 1.0
-        self._set_map(w_shift, nvv, ncon)
+        self._set_map(w_shift, nvv)
         self._slack0 = nvu
         k.nvv = nvv
 
@@ -852,7 +852,7 @@ class MPC(ControllerBase):
         w_shift[nv + len(rs) + nvu + ns:nv + len(rs) + nvu + ns + neq] = 0.0
         nzn = 1 + nx + nu
         self._nzd = nzn
-        self._set_map(w_shift, nv, len(rs))
+        self._set_map(w_shift, nv)
         self._slack0 = nvu + nxv
         self._sparse_shape = (nv, len(rs))
         self._sparse_nnz = int(np.count_nonzero(np.triu(p_s)) + np.count_nonzero(a_s))
@@ -916,14 +916,11 @@ class MPC(ControllerBase):
         return (None if v is None else (v[:self._nvu] * self._su[:self._nvu]).reshape(hu, nu)), \
             status
 
-    def _set_map(self, w_shift: np.ndarray, nv: int, ncon: int) -> None:
-        """The step's affine map, factored (:func:`_bound_map`), and the buffer it writes:
-        [y (c first) | lo | hi]."""
+    def _set_map(self, w_shift: np.ndarray, nv: int) -> None:
+        """The step's affine map, factored (:func:`_bound_map`); its buffers are made by
+        :meth:`_pack`."""
         self._wt, self._bconst, self._bsgn, self._bk = _bound_map(w_shift, nv)
-        ny = self._wt.shape[1]
-        self._wbuf = np.empty(ny + 2 * ncon)
-        self._c = self._wbuf[:nv]
-        self._lo, self._hi = self._wbuf[ny:ny + ncon], self._wbuf[ny + ncon:]
+        self._map_nv = nv
 
     def _pack(self) -> None:
         """Pack the step's data for the compiled kernels (see ``_NZD`` ...) and point the
@@ -931,7 +928,7 @@ class MPC(ControllerBase):
         when it runs through its C interface (then the whole QP step is one compiled call,
         :func:`_step_daqp`)."""
         nx, nd, nz, nu = len(self._x_idx), len(self._d0), len(self._z), self._nu
-        ny, nb, nv = self._wt.shape[1], len(self._bconst), len(self._c)
+        ny, nb, nv = self._wt.shape[1], len(self._bconst), self._map_nv
         su = np.asarray(self._su, float)
         self._im = np.concatenate([[self._nzd, self._slack0, nx, nd, ny, nb, nv, nu, nz],
                                    self._x_idx, self._bk, self._ucol]).astype(np.int64)
@@ -1075,35 +1072,35 @@ class MPC(ControllerBase):
                                   self._up0 if self._u_prev is None else self._u_prev, blade)
         qp_ms = 1e3 * (time.perf_counter() - t_qp)
         if v is None:
-            u = self._fallback(t, status)
+            u, level = self._fallback(t, status)
         else:
             self._plan = v[:self._nvu].copy()
             self._u_prev = self._dubuf          # read by the next step before it is rewritten
-            u = self._ubuf
-        self.signals = {"qp_fallback": self._fallback_level if v is None else 0.0,
+            u, level = self._ubuf, 0.0
+        self.signals = {"qp_fallback": level,
                         "pitch_ref_1": float(u[0]), "torque_ref": float(u[3]),
                         "rotor_speed_slack": self._last_slack, "qp_solve_ms": qp_ms}
         if self.estimator is not None:
             self.signals.update(self.signals_est)
         return u[:3].copy(), float(u[3])
 
-    def _fallback(self, t: float, status: str) -> np.ndarray:
-        """The command when the QP failed: the rest of the last plan (level 1) or the last
-        command held (level 2, zero deviation at the start); logged."""
+    def _fallback(self, t: float, status: str) -> tuple[np.ndarray, float]:
+        """The command when the QP failed and the fallback's level: the rest of the last plan
+        (1) or the last command held (2, zero deviation at the start); logged."""
         nu = self._nu
         if self._plan is not None and len(self._plan) > nu:
             v = np.concatenate([self._plan[nu:], self._plan[-nu:]])
-            self._fallback_level = 1.0
+            level = 1.0
         else:
             v = np.zeros(self._nvu)
             if self._u_prev is not None:
                 v[:self._nvu] = np.tile(self._u_prev / self._su[:nu], self.hu)
-            self._fallback_level = 2.0
-        log.warning("MPC QP %s at t = %g s: fallback %d", status, t, int(self._fallback_level))
+            level = 2.0
+        log.warning("MPC QP %s at t = %g s: fallback %d", status, t, int(level))
         self._plan = v[:self._nvu]
         du = v[:nu] * self._su[:nu]
         self._u_prev = du
-        return self._u_abs(du)
+        return self._u_abs(du), level
 
     def hand_over(self, other: "MPC") -> None:
         """Continue from another MPC's last command and estimate (gain scheduling): the

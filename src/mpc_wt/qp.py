@@ -342,7 +342,6 @@ class _DAQPDirect:
     def __init__(self, fns: dict[str, Any], h: np.ndarray, q: np.ndarray, a: np.ndarray,
                  m: int, ms: int) -> None:
         n = h.shape[0]
-        self._fns = fns
         self._keep = [np.ascontiguousarray(h, float), np.array(q, float).reshape(n),
                       np.ascontiguousarray(a, float), np.zeros(m, dtype=np.intc)]
         self.x, self.lam = np.zeros(n), np.zeros(m)
@@ -427,15 +426,21 @@ class _DAQPDirect:
         view = np.ctypeslib.as_array((ctypes.c_int32 * words).from_address(self._res_p))
         return np.array(addr, dtype=np.int64), view
 
-    def solve(self) -> tuple[int, int]:
+    def solve(self) -> int:
         """Solve; the solution is in :attr:`x` (overwritten by the next solve).
 
         Returns
         -------
-        exitflag, iterations : int
+        int
+            DAQP's exit flag.
         """
         self._solve(self._res_p, self._work)
-        return self._res.exitflag, self._res.iter
+        return self._res.exitflag
+
+    @property
+    def iterations(self) -> int:
+        """Iterations of the last solve (also one run from compiled code)."""
+        return int(self._res.iter)
 
 
 @intrinsic
@@ -556,8 +561,7 @@ class DAQPBackend(QPBackend):
         if self._update_flag < 0:
             flag, self._iter, xs = self._update_flag, 0, None
         elif self.direct is not None:
-            flag, self._iter = self.direct.solve()
-            xs = self.direct.x
+            flag, xs = self.direct.solve(), self.direct.x
         else:
             xs, _, flag, self.info = self.model.solve()
             self._iter = int(self.info["iterations"])
@@ -570,8 +574,8 @@ class DAQPBackend(QPBackend):
 
     @property
     def iterations(self) -> int:
-        if self.direct is not None:
-            return int(self.direct._res.iter)
+        if self.direct is not None and self._update_flag >= 0:
+            return self.direct.iterations
         return self._iter
 
 

@@ -23,6 +23,7 @@ from ..assess import (aep_Wh, cs_measures, lifetime_del, lifetime_extension, pct
                      wind_bin_probabilities)
 from .spec import CampaignSpec, spec_from_dict, turbulence_tag
 from .store import CampaignStore, CaseRow
+from .ultimate import ultimate_table
 
 __all__ = ["aggregate", "make_report", "relative_metrics", "absolute_metrics",
            "RELATIVE_METRICS", "ABSOLUTE_METRICS"]
@@ -225,8 +226,6 @@ class _Group:
     def ultimate(self) -> list[dict[str, Any]]:
         """Ultimate loads of this controller and turbulence (:mod:`.ultimate`; the cases'
         extremes, seed means per wind, normal-family safety factor 1.35)."""
-        from .ultimate import ultimate_table
-
         rows = [{"case_id": c.case_id, "dlc": str(self.turb), "wind_mps": v, "seed": c.seed,
                  "extremes": c.metrics["extremes"]}
                 for v in self.winds for c in self.bins[v] if "extremes" in c.metrics]

@@ -19,6 +19,8 @@ from typing import Any
 
 import numpy as np
 
+from .ultimate import case_extremes
+
 __all__ = ["run_case", "case_metrics", "case_file", "actuator_limit_metrics"]
 
 #: A pitch rate at or above this fraction of the actuator's limit counts as at the limit.
@@ -92,9 +94,7 @@ def case_metrics(t: np.ndarray, cols: dict[str, np.ndarray], channels: dict[str,
         if n in sub and not np.all(np.isfinite(sub[n])):
             raise ValueError(f"channel {n!r} holds NaN or inf")
     out = assess_series(t[k], sub, channels, convention=convention)
-    # ultimate loads (issue 24): each channel's extremes and when (campaign.ultimate)
-    from .ultimate import case_extremes
-
+    # ultimate loads (issue 24): each channel's extremes and when
     out["extremes"] = case_extremes(t[k], sub, [n for n in (*channels, "rotor_speed")
                                                 if n in sub])
     if "rotor_speed" in sub:

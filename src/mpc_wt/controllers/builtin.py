@@ -8,7 +8,6 @@ loop, :mod:`mpc_wt.discon`).
 from __future__ import annotations
 
 import math
-import dataclasses
 from dataclasses import dataclass
 from typing import Any, Optional
 
@@ -18,7 +17,7 @@ import linearize
 
 from .context import BuildContext, Built, Scenario
 from .options import REQUIRED, Options, option
-from .registry import kinds, register, register_kind
+from .registry import register
 
 __all__ = ["BaselineOptions", "DerateOptions", "APCOptions", "IBCOptions", "ColemanIPCOptions",
            "MPCOptions", "MPCWeightOptions", "LidarOptions", "MPCLidarOptions", "LQRPIOOptions", "TSOptions",
@@ -147,13 +146,13 @@ def _design_baseline(turbine: linearize.Turbine, *, omega_n_rad_s: float = 0.6,
     return doc, f"kp {doc['settings']['kp']:.4g} s, ki {doc['settings']['ki']:.4g}"
 
 
-register("baseline", BaselineOptions, design=_design_baseline,
+register("baseline", BaselineOptions, field_components="u", design=_design_baseline,
          summary="tuned PI pitch and torque law, constant power in region III (80 Hz)"
          )(_baseline("constant_power"))
-register("baseline-ct", BaselineOptions,
+register("baseline-ct", BaselineOptions, field_components="u",
          summary="the baseline with constant torque in region III (Do et al.'s PI)"
          )(_baseline("constant_torque"))
-register("derate", DerateOptions, pattern=r"derate(\d+(?:\.\d+)?)",
+register("derate", DerateOptions, field_components="u", pattern=r"derate(\d+(?:\.\d+)?)",
          pattern_options=_derate_preset, pattern_help="derateNN (NN % of rated power)",
          operating_point=_derated_trim,
          summary="the baseline derated to NN % of rated power, PI re-tuned")(
@@ -185,8 +184,8 @@ class IBCOptions(Options):
                                          lo=0.0, lo_open=True, flag="")
 
 
-@register("ibc", IBCOptions, addon_to=("baseline", "derate"), default_base="baseline",
-          design=_design_ibc,
+@register("ibc", IBCOptions, field_components="u", addon_to=("baseline", "derate"),
+          default_base="baseline", design=_design_ibc,
           group="the ibc controllers",
           summary="individual blade control on a baseline (ibc, derateNN+ibc)")
 def _build_ibc(ctx: BuildContext, opts: IBCOptions, base: Built) -> Built:
@@ -216,7 +215,7 @@ class ColemanIPCOptions(Options):
                                              unit="-", lo=0.0, flag="")
 
 
-@register("coleman-ipc", ColemanIPCOptions, addon_to=("baseline", "derate"),
+@register("coleman-ipc", ColemanIPCOptions, field_components="u", addon_to=("baseline", "derate"),
           default_base="baseline", design=_design_coleman,
           summary="tilt/yaw integral IPC on a baseline (coleman-ipc, derateNN+coleman-ipc)")
 def _build_coleman(ctx: BuildContext, opts: ColemanIPCOptions, base: Built) -> Built:
@@ -412,10 +411,10 @@ def _lidar_preview(ctx: BuildContext, opts: LidarOptions, horizon: int, dt: floa
 
 
 _MPC_GROUP = "the MPC controllers"
-register("mpc", MPCOptions, group=_MPC_GROUP,
+register("mpc", MPCOptions, field_components="u", group=_MPC_GROUP,
          summary="Madsen's Coleman-weighted individual-pitch MPC, disturbance held at the mean"
          )(_mpc(False, False))
-register("mpc-collective", MPCOptions, group=_MPC_GROUP,
+register("mpc-collective", MPCOptions, field_components="u", group=_MPC_GROUP,
          summary="the MPC with one collective pitch input")(_mpc(True, False))
 register("mpc-lidar", MPCLidarOptions, group=_MPC_GROUP,
          summary="the individual-pitch MPC with a CW LIDAR's per-blade preview "
@@ -472,7 +471,8 @@ class LQRPIOOptions(Options):
                 {f"pitch_ref_{i}": self.w_pitch for i in (1, 2, 3)})
 
 
-@register("lqr-pio", LQRPIOOptions, design=_design_lqr, design_name="lqr",
+@register("lqr-pio", LQRPIOOptions, field_components="u", design=_design_lqr,
+          design_name="lqr",
           summary="Do et al.'s LQR with a PI observer at the mean wind (region II or III)")
 def _build_lqr_pio(ctx: BuildContext, opts: LQRPIOOptions) -> Built:
     from ..baseline import BaselineController, tune_baseline
@@ -511,7 +511,7 @@ class TSOptions(Options):
                                         lo_open=True, flag="")
 
 
-@register("ts", TSOptions, design=_design_ts,
+@register("ts", TSOptions, field_components="u", design=_design_ts,
           summary="Clemens et al.'s Takagi-Sugeno controller and wind observer (LMI gains)")
 def _build_ts(ctx: BuildContext, opts: TSOptions) -> Built:
     from ..retrofit import apc_reference
@@ -561,7 +561,7 @@ def _apc_trim(turbine: linearize.Turbine, sc: Scenario, opts: APCOptions
     return linearize.trim(turbine, sc.wind_mps, rated * (1.0 - dp(0.0)))
 
 
-@register("apc", APCOptions, operating_point=_apc_trim,
+@register("apc", APCOptions, field_components="u", operating_point=_apc_trim,
           summary="the baseline following P_r (1 - Delta P(t)), PI scheduled on the reference")
 def _build_apc(ctx: BuildContext, opts: APCOptions) -> Built:
     from ..baseline import BaselineController, tune_baseline_schedule
@@ -621,7 +621,7 @@ def _discon_built(ctx: BuildContext, library: Any, discon_in: Any, opts: Any,
                  power_fraction=power_fraction)
 
 
-@register("discon", DisconOptions,
+@register("discon", DisconOptions, field_components="u",
           summary="any Bladed-style controller library (DISCON) with its input file")
 def _build_discon(ctx: BuildContext, opts: DisconOptions) -> Built:
     return _discon_built(ctx, opts.discon_library, opts.discon_in, opts, "discon")
@@ -637,7 +637,7 @@ def _rosco_operating_point(turbine: linearize.Turbine, sc: Scenario, opts: Rosco
     return linearize.trim(turbine, sc.wind_mps)
 
 
-@register("rosco", RoscoOptions, operating_point=_rosco_operating_point,
+@register("rosco", RoscoOptions, field_components="u", operating_point=_rosco_operating_point,
           summary="ROSCO (the rosco package's libdiscon) with a DISCON.IN exported from our "
                   "baseline, ROSCO's own ('shipped') or any file")
 def _build_rosco(ctx: BuildContext, opts: RoscoOptions) -> Built:
@@ -730,9 +730,3 @@ def _build_lidar_ff(ctx: BuildContext, opts: LidarFFOptions, base: Built) -> Bui
     return Built(ctl, base.controller_dt, base.preview, {**base.meta, "lidar_ff": meta},
                  base.power_fraction)
 
-
-# The plant meets only u; only the kinds with a LIDAR read v and w of the case's field, so the
-# others have it generated without them (a 600 s, 32 x 32 field: 50 MB instead of 150 MB).
-for _name in ("baseline", "baseline-ct", "derate", "ibc", "coleman-ipc", "mpc", "mpc-collective",
-              "lqr-pio", "ts", "apc", "discon", "rosco"):
-    register_kind(dataclasses.replace(kinds()[_name], field_components="u"), replace=True)
