@@ -327,18 +327,21 @@ def _solve_phi(vx, vy, r, chord, theta, k_af, table, alpha0, dalpha, nb_, rtip, 
     Without a hint (NaN) the root is found in Ning's (2014) global brackets by Brent's method
     to ``_XTOL`` (1e-13 rad); this always converges and is what trim uses. With a hint (an
     earlier solution nearby, as in time stepping) a secant iteration starts from it with the
-    slope cached at that solve, confined to the hint's Ning region, and stops at the evaluated
-    point whose Newton correction is below ``tol`` (with ``tol <= _XTOL``, as linearization asks,
-    that last correction is applied too, which puts phi at rounding level: finite differences
-    of a 1e7 N m rotor sum then resolve 1e-7 N m); if it does not get there in 8 steps it falls
-    back to the global brackets.
+    slope cached at that solve, confined to (0, pi), and stops at the evaluated point whose
+    Newton correction is below ``tol`` (with ``tol <= _XTOL``, as linearization asks, that last
+    correction is applied too, which puts phi at rounding level: finite differences of a 1e7 N m
+    rotor sum then resolve 1e-7 N m); if it does not get there in 8 steps it falls back to the
+    global brackets.
+
+    A hint in the propeller-brake region (phi < 0) is not used: Ning's procedure takes that
+    region only when (0, pi/2) holds no root, and the residual jumps at phi = 0, where a secant
+    confined to the negative region can "converge" on the jump with a huge slope. Tracking such
+    a hint once kept a tip element at phi = -3e-5 while the root had come back to 0.106 rad, and
+    the next step's loads threw the edgewise rates to 200 m/s (a campaign case that diverged).
     """
     args = (vx, vy, r, chord, theta, k_af, table, alpha0, dalpha, nb_, rtip, rhub, flags)
-    if hint == hint:  # not NaN
-        if hint > 0.0:
-            lo_b, hi_b = _EPS_PHI, _PI - _EPS_PHI
-        else:
-            lo_b, hi_b = -0.25 * _PI, -_EPS_PHI
+    if hint == hint and hint > 0.0:  # not NaN, not in the propeller-brake region
+        lo_b, hi_b = _EPS_PHI, _PI - _EPS_PHI
         if lo_b < hint < hi_b:
             x0 = hint
             f0, oma, opa, cn, ct = _induction(x0, *args)

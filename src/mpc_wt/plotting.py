@@ -511,3 +511,108 @@ def plot_wind_condition(field: Any, path: str | Path) -> Path:
     for ax in (a1, a2):
         ax.grid(alpha=0.3)
     return _save(fig, path)
+
+
+def _grouped_bars(ax: Any, cats: Sequence[str], series: dict[str, list[float | None]]) -> None:
+    """Bars of several series (legend labels) over categories; None leaves a gap."""
+    n = max(1, len(series))
+    w = 0.8 / n
+    x = np.arange(len(cats))
+    for i, (lab, vals) in enumerate(series.items()):
+        v = np.array([np.nan if a is None else a for a in vals], float)
+        ax.bar(x + (i - (n - 1) / 2) * w, v, w, label=lab, color=f"C{i}")
+    ax.set_xticks(x)
+    ax.set_xticklabels(cats, fontsize=7, rotation=30, ha="right")
+    ax.grid(alpha=0.3, axis="y")
+
+
+def plot_ultimate(rows: Sequence[dict[str, Any]], path: str | Path) -> Path:
+    """Design loads per DLC and controller, one panel per channel (maximum above zero, minimum
+    below; :func:`mpc_wt.campaign.signoff.ultimate_rows`).
+
+    Parameters
+    ----------
+    rows : sequence of dict
+        Ultimate rows (``controller``, ``dlc``, ``channel``, ``design_max``, ``design_min``).
+    path : str or Path
+        The PNG.
+
+    Returns
+    -------
+    Path
+        The file written.
+    """
+    plt = _plt()
+    rows = [r for r in rows if r["design_max"] is not None or r["design_min"] is not None]
+    chans = list(dict.fromkeys(r["channel"] for r in rows))
+    ctls = list(dict.fromkeys(r["controller"] for r in rows))
+    dlcs = list(dict.fromkeys(r["dlc"] for r in rows))
+    nc = min(3, len(chans))
+    nr = math.ceil(len(chans) / nc)
+    fig, axs = plt.subplots(nr, nc, figsize=(4.6 * nc, 3.2 * nr), dpi=110, squeeze=False)
+    for ax, ch in zip(axs.flat, chans):
+        sel = [r for r in rows if r["channel"] == ch]
+        big = max(abs(r[k] or 0.0) for r in sel for k in ("design_max", "design_min")) > 1e5
+        scale, unit = (1e-6, " [M]") if big else (1.0, "")
+        for side in ("design_max", "design_min"):
+            _grouped_bars(ax, dlcs, {c: [next((None if r[side] is None else r[side] * scale
+                                               for r in sel if r["controller"] == c
+                                               and r["dlc"] == d), None) for d in dlcs]
+                                     for c in ctls})
+        ax.axhline(0.0, color="k", lw=0.6)
+        ax.set_title(f"{ch}{unit}", fontsize=8)
+        ax.set_xlabel("DLC", fontsize=8)
+    handles, labels = axs.flat[0].get_legend_handles_labels()
+    axs.flat[0].legend(handles[:len(ctls)], labels[:len(ctls)], fontsize=7)
+    for ax in list(axs.flat)[len(chans):]:
+        ax.set_visible(False)
+    fig.suptitle("Design loads per DLC (partial safety factors applied)", fontsize=9)
+    return _save(fig, path)
+
+
+def plot_signoff(signoff: Sequence[dict[str, Any]], governing: Sequence[dict[str, Any]],
+                 path: str | Path) -> Path:
+    """A controller sign-off at a glance: the governing design load per channel against the
+    reference's, the largest rotor speed per DLC against rated (with the overspeed limit) and
+    the largest pitch rate per DLC against the actuator's limit.
+
+    Parameters
+    ----------
+    signoff : sequence of dict
+        :func:`mpc_wt.campaign.signoff.signoff_rows`.
+    governing : sequence of dict
+        :func:`mpc_wt.campaign.signoff.governing_rows`.
+    path : str or Path
+        The PNG.
+
+    Returns
+    -------
+    Path
+        The file written.
+    """
+    plt = _plt()
+    ctls = list(dict.fromkeys(r["controller"] for r in signoff))
+    dlcs = list(dict.fromkeys(r["dlc"] for r in signoff))
+    chans = list(dict.fromkeys(r["channel"] for r in governing))
+    fig, (a1, a2, a3) = plt.subplots(3, 1, figsize=(9, 10), dpi=110)
+
+    def pick(rows: Sequence[dict[str, Any]], key: str, by: str, cats: list[str]
+             ) -> dict[str, list[float | None]]:
+        return {c: [next((r.get(key) for r in rows if r["controller"] == c and r[by] == d),
+                         None) for d in cats] for c in ctls}
+
+    _grouped_bars(a1, chans, pick(governing, "change_pct", "channel", chans))
+    a1.axhline(0.0, color="k", lw=0.6)
+    a1.set_ylabel("governing design load\nchange [%]")
+    a1.legend(fontsize=7, ncol=min(5, len(ctls)))
+    _grouped_bars(a2, dlcs, pick(signoff, "rotor_speed_max_rel", "dlc", dlcs))
+    lims = [r["overspeed_limit_rel"] for r in signoff if r.get("overspeed_limit_rel")]
+    if lims:
+        a2.axhline(min(lims), color="r", ls="--", lw=1, label="overspeed limit")
+    a2.set_ylim(bottom=0.9)
+    a2.set_ylabel("rotor speed max / rated")
+    _grouped_bars(a3, dlcs, pick(signoff, "pitch_rate_max_rel", "dlc", dlcs))
+    a3.axhline(1.0, color="r", ls="--", lw=1)
+    a3.set_ylabel("pitch rate max / limit")
+    a3.set_xlabel("DLC")
+    return _save(fig, path)

@@ -155,3 +155,27 @@ def test_element_loads_finite_for_any_velocity(turbine: linearize.Turbine, vx: f
         n, t, phi = element_loads(turbine, np.full(17, vx), vy * b.r / b.r[-1],
                                   math.radians(pitch_deg))
     assert np.all(np.isfinite(n)) and np.all(np.isfinite(t)) and np.all(np.isfinite(phi))
+
+
+@pytest.mark.parametrize("hint, slope", [(-2.8134e-05, 4.5809e05), (-1e-3, 10.0),
+                                         (-0.1, 50.0), (0.2, math.nan)])
+def test_warm_start_never_keeps_a_propeller_brake_hint(turbine: linearize.Turbine, hint: float,
+                                                       slope: float) -> None:
+    """A time-stepping warm start must give the element the root Ning's global procedure
+    finds. The first hint and slope are what a campaign case (baseline, ETM 13 m/s, seed 1)
+    carried on blade 2's tip element at t = 587.3 s: phi = -2.8e-5 rad at the residual's jump
+    at phi = 0, while the global root was 0.106 rad; tracking it threw the edgewise rates to
+    200 m/s in one step. Here the tip element at 13 m/s, 1.28 rad/s and 3.7 deg pitch."""
+    from linearize.bem import _element, aero_flags, polar_table_of
+
+    b, g = turbine.blade, turbine.geometry
+    tab = polar_table_of(turbine)
+    j = b.r.size - 1
+    args = (11.0, 1.2842 * b.r[j], b.r[j], b.chord[j], b.twist_rad[j] + 0.0653, b.airfoil[j],
+            tab.table, tab.alpha0, tab.dalpha, float(g.number_of_blades), g.tip_radius,
+            g.hub_radius, aero_flags(AeroOptions()), turbine.environment.air_density)
+    cold = _element(*args, math.nan, math.nan, 0.0, 0.0, 0)
+    warm = _element(*args, hint, slope, 0.0, 0.0, 0)
+    assert cold[2] > 0.05                                   # the global root: phi > 0
+    assert warm[2] == pytest.approx(cold[2], abs=1e-8)
+    assert warm[0] == pytest.approx(cold[0], rel=1e-6)      # the element's normal load

@@ -23,7 +23,7 @@ from ..assess import (aep_Wh, cs_measures, lifetime_del, lifetime_extension, pct
                      wind_bin_probabilities)
 from .spec import CampaignSpec, spec_from_dict, turbulence_tag
 from .store import CampaignStore, CaseRow
-from .ultimate import ultimate_table
+from .signoff import governing_rows, signoff_rows, ultimate_rows
 
 __all__ = ["aggregate", "make_report", "relative_metrics", "absolute_metrics",
            "RELATIVE_METRICS", "ABSOLUTE_METRICS"]
@@ -58,17 +58,19 @@ def _pct(a: float | None, b: float | None) -> float | None:
     return v if math.isfinite(v) else None
 
 
-def _load(root: Path) -> tuple[CampaignSpec, list[CaseRow]]:
+def _load(root: Path) -> tuple[CampaignSpec, list[CaseRow], list[CaseRow]]:
     with CampaignStore(root) as st:
         meta = st.meta()
-        rows = [r for r in st.rows() if r.status == "done" and r.metrics]
+        every = st.rows()
+        rows = [r for r in every if r.status == "done" and r.metrics]
+        failed = [r for r in every if r.status == "failed"]
     if "spec_raw" not in meta:
         raise ValueError(f"{root}: the index holds no spec (was the campaign ever run?)")
     spec = spec_from_dict(meta["spec_raw"])
     if not rows:
         raise ValueError(f"{root}: no finished case to report; run the campaign first "
                          f"(mpcwt campaign run SPEC --out {root})")
-    return spec, rows
+    return spec, rows, failed
 
 
 def _probs(spec: CampaignSpec, winds: Sequence[float]) -> np.ndarray:
@@ -223,27 +225,6 @@ class _Group:
                 prow[f"{name}_change_pct"] = _pct(float(base), float(mine))
         return prow
 
-    def ultimate(self) -> list[dict[str, Any]]:
-        """Ultimate loads of this controller and turbulence (:mod:`.ultimate`; the cases'
-        extremes, seed means per wind, normal-family safety factor 1.35)."""
-        rows = [{"case_id": c.case_id, "dlc": str(self.turb), "wind_mps": v, "seed": c.seed,
-                 "extremes": c.metrics["extremes"]}
-                for v in self.winds for c in self.bins[v] if "extremes" in c.metrics]
-        if not rows:
-            return []
-        chans = [ch for ch in (*self.spec.channels, "rotor_speed")
-                 if all(ch in r["extremes"] for r in rows)]
-        out = []
-        for ch, u in ultimate_table(rows, chans).items():
-            d = u["by_dlc"][str(self.turb)]
-            out.append({**self.key, "channel": ch, "max": u["max"], "max_case": u["max_case"],
-                        "min": u["min"], "min_case": u["min_case"],
-                        "characteristic_max": d["characteristic_max"],
-                        "wind_max": d["wind_max"], "design_max": d["design_max"],
-                        "characteristic_min": d["characteristic_min"],
-                        "design_min": d["design_min"], "safety_factor": d["safety_factor"]})
-        return out
-
     def regulation(self) -> dict[str, Any]:
         """Rotor-speed std, power std and the blade-1 flap 1P and 3P content, weighted over
         the winds like the pitch duty, with their changes against the reference."""
@@ -350,20 +331,26 @@ def aggregate(root: str | Path) -> dict[str, Any]:
     -------
     dict
         ``spec``, ``rows`` (finished cases), ``short_term``, ``per_wind``, ``lifetime``,
-        ``aep``, ``pitch``, ``cs``, ``extension``, ``ultimate``, ``sweep``, ``incomplete``
-        and ``outliers``.
+        ``aep``, ``pitch``, ``cs``, ``extension`` (of the fatigue load cases), ``ultimate``,
+        ``governing``, ``signoff`` (:mod:`.signoff`; every load case), ``fatigue_rows``
+        (the finished cases of the fatigue load cases), ``sweep``,
+        ``incomplete`` and ``outliers``.
 
     Raises
     ------
     ValueError
         If no case has finished.
     """
-    spec, rows = _load(Path(root))
+    spec, rows, failed = _load(Path(root))
     out: dict[str, Any] = {"spec": spec, "rows": rows, "short_term": [], "per_wind": [],
                            "lifetime": [], "aep": [], "pitch": [], "regulation": [], "cs": [],
-                           "extension": [], "ultimate": [],
-                           "sweep": [], "incomplete": [], "outliers": []}
-    for g in _groups(spec, rows):
+                           "extension": [], "sweep": [], "incomplete": [], "outliers": []}
+    out["ultimate"] = ultimate_rows(spec, rows)
+    out["governing"] = governing_rows(spec, out["ultimate"])
+    out["signoff"] = signoff_rows(spec, rows, failed) if not spec.load_cases[0].legacy else []
+    fatigue = {c.case_id for c in spec.cases() if c.fatigue}
+    out["fatigue_rows"] = [r for r in rows if r.case_id in fatigue]
+    for g in _groups(spec, out["fatigue_rows"]):
         missing = g.missing_seeds()
         if missing:
             out["incomplete"].append(f"{g.ctl} ({g.turb}): winds {missing} lack seeds")
@@ -378,7 +365,6 @@ def aggregate(root: str | Path) -> dict[str, Any]:
         out["aep"] += g.aep()
         out["pitch"].append(g.pitch())
         out["regulation"].append(g.regulation())
-        out["ultimate"] += g.ultimate()
     for c in spec.controllers:
         f = c.options.get("apc_frequency")
         if f is not None:
@@ -471,9 +457,17 @@ def _md(rows: list[dict[str, Any]], cols: Sequence[str], heads: Sequence[str] | 
 
 def _plots(agg: dict[str, Any], root: Path, out: Path) -> list[str]:
     """Every figure of the report, as PNG in ``out``; returns their paths."""
+    from ..plotting import plot_signoff, plot_ultimate
+
+    made = []
+    if agg["ultimate"] and agg["signoff"]:
+        made += [str(plot_ultimate(agg["ultimate"], out / "ultimate.png")),
+                 str(plot_signoff(agg["signoff"], agg["governing"], out / "signoff.png"))]
     ctls = list(dict.fromkeys(r["controller"] for r in agg["per_wind"]))
     turbs = list(dict.fromkeys(r["turbulence"] for r in agg["per_wind"]))
-    made = [_plot_del_vs_wind(agg, ctls, turbs, out)]
+    if not turbs:           # no fatigue load case finished
+        return made
+    made += [_plot_del_vs_wind(agg, ctls, turbs, out)]
     made += _plot_lifetime_bars(agg, ctls, turbs, out)
     series, cs_w, psd_w = _plot_series(agg, root, turbs[0])
     made += _plot_cs_psd(agg, ctls, series, cs_w, psd_w, turbs[0], out)
@@ -562,7 +556,7 @@ def _plot_series(agg: dict[str, Any], root: Path, turb0: Any
     from ..results import ClosedLoopResult
 
     spec: CampaignSpec = agg["spec"]
-    winds = sorted({r.wind_mps for r in agg["rows"]})
+    winds = sorted({r.wind_mps for r in agg["fatigue_rows"]})
 
     def near(target: float) -> float:
         return min(winds, key=lambda v: abs(v - target))
@@ -571,7 +565,7 @@ def _plot_series(agg: dict[str, Any], root: Path, turb0: Any
     psd_w = near(float(spec.report.get("psd_wind", 18.0)))
     series: dict[tuple[str, float], list[tuple[np.ndarray, dict[str, np.ndarray]]]] = \
         defaultdict(list)
-    for r in agg["rows"]:
+    for r in agg["fatigue_rows"]:
         if r.turbulence == turb0 and r.wind_mps in (cs_w, psd_w) and r.file:
             try:
                 res = ClosedLoopResult.load(root / r.file)
@@ -681,7 +675,7 @@ def make_report(root: str | Path, out: str | Path | None = None) -> Path:
     out = Path(out) if out else root / "report"
     out.mkdir(parents=True, exist_ok=True)
     for name in ("short_term", "per_wind", "lifetime", "aep", "pitch", "cs", "extension",
-                 "sweep", "outliers", "ultimate"):
+                 "sweep", "outliers", "ultimate", "governing", "signoff"):
         if agg[name]:
             fname = {"short_term": "short_term_del", "per_wind": "del_by_wind",
                      "lifetime": "lifetime_del"}.get(name, name)
@@ -690,7 +684,7 @@ def make_report(root: str | Path, out: str | Path | None = None) -> Path:
     paper = _paper_rows(agg)
     if paper:
         _write_csv(out / "paper_comparison.csv", paper)
-    md = _md_head(agg, paper) + _md_loads(agg) + _md_more(agg)
+    md = _md_head(agg, paper) + _md_signoff(agg) + _md_loads(agg) + _md_more(agg)
     md += ["Plots: " + ", ".join(Path(p).name for p in plots), ""]
     path = out / "report.md"
     tmp = path.with_suffix(".md.tmp")
@@ -727,11 +721,22 @@ def _md_head(agg: dict[str, Any], paper: list[dict[str, Any]]) -> list[str]:
         md += [spec.description.strip(), ""]
     md += [f"Generated by `mpcwt campaign report` (mpc-wt {__version__}; cases computed by "
            f"{', '.join(versions)}) from {len(agg['rows'])} finished cases. Turbine "
-           f"{spec.turbine}; {spec.duration:g} s per case after a {spec.transient:g} s "
-           f"transient; turbulence {', '.join(turbulence_tag(t) for t in spec.turbulence)}; "
-           f"shear {spec.shear_exponent:g}; seeds {list(spec.seeds)}; wind distribution "
-           f"{spec.wind_distribution}; lifetime {spec.lifetime_years:g} years; reference "
-           f"controller `{spec.reference}`.", ""]
+           f"{spec.turbine}; " + (
+               f"{spec.duration:g} s per case after a {spec.transient:g} s transient; "
+               f"turbulence {', '.join(turbulence_tag(t) for t in spec.turbulence)}; "
+               f"seeds {list(spec.seeds)}; " if spec.load_cases[0].legacy else
+               f"{spec.transient:g} s of transient before each case; ")
+           + f"shear {spec.shear_exponent:g}; wind distribution {spec.wind_distribution}; "
+           f"lifetime {spec.lifetime_years:g} years; reference controller "
+           f"`{spec.reference}`.", ""]
+    if not spec.load_cases[0].legacy:
+        md += ["Load cases (IEC 61400-1 ed. 3, class "
+               f"{spec.iec_class}; times after each case's transient):", "",
+               _md([_load_case_row(lc) for lc in spec.load_cases],
+                   ["dlc", "condition", "winds", "runs", "family", "fatigue", "length",
+                    "events"],
+                   ["DLC", "wind condition", "winds [m/s]", "seeds / signs", "family",
+                    "fatigue", "length [s]", "supervisor"]), ""]
     if agg["incomplete"]:
         md += ["**Incomplete:** " + "; ".join(agg["incomplete"]) + " (failed or not run; "
                "`mpcwt campaign status` lists them).", ""]
@@ -750,6 +755,19 @@ def _md_head(agg: dict[str, Any], paper: list[dict[str, Any]]) -> list[str]:
     if spec.report.get("notes"):
         md += ["## Where we differ, and why", "", str(spec.report["notes"]).strip(), ""]
     return md
+
+
+def _load_case_row(lc: Any) -> dict[str, Any]:
+    """A load case as a row of the report's head."""
+    runs = (f"signs {', '.join(f'{g:+d}' for g in lc.signs)}" if lc.deterministic
+            else f"{len(lc.seeds)} seeds")
+    return {"dlc": lc.dlc, "condition": f"{lc.condition.upper()} "
+                                         f"({', '.join(map(turbulence_tag, lc.turbulence))})",
+            "winds": ", ".join(f"{v:g}" for v in lc.winds), "runs": runs, "family": lc.family,
+            "fatigue": "yes" if lc.fatigue else "", "length": f"{lc.duration:g}",
+            "events": ", ".join(f"{k} {v:g}" for k, v in lc.supervisor.items()
+                                if v is not None)
+            + (f"; event at {lc.event_at:g} s" if lc.deterministic else "")}
 
 
 def _md_loads(agg: dict[str, Any]) -> list[str]:
@@ -772,21 +790,100 @@ def _md_loads(agg: dict[str, Any]) -> list[str]:
                  "acc std [deg/s^2]", "travel [%]", "rate std [%]", "acc std [%]"]), ""]
 
 
+def _md_signoff(agg: dict[str, Any]) -> list[str]:
+    """Fatigue and ultimate loads side by side with the overspeed margin and the pitch-rate
+    demand, one row per controller (campaigns with load cases)."""
+    spec: CampaignSpec = agg["spec"]
+    if not agg["signoff"]:
+        return []
+    rows = []
+    for c in spec.controllers:
+        so = [r for r in agg["signoff"] if r["controller"] == c.name]
+        if not so:
+            continue
+        row: dict[str, Any] = {"controller": c.name}
+        for ch in spec.channels:
+            life = [r["change_pct"] for r in agg["lifetime"] if r["controller"] == c.name
+                    and r["channel"] == ch]
+            gov = [r for r in agg["governing"] if r["controller"] == c.name
+                   and r["channel"] == ch]
+            row[f"{ch}_del"] = life[0] if life else None
+            row[f"{ch}_ult"] = gov[0]["change_pct"] if gov else None
+            row[f"{ch}_dlc"] = gov[0]["dlc"] if gov else None
+        w = [r for r in so if r.get("rotor_speed_max_rel") is not None]
+        top = max(w, key=lambda r: r["rotor_speed_max_rel"]) if w else None
+        row["speed_max"] = top["rotor_speed_max_rel"] if top else None
+        row["speed_dlc"] = top["dlc"] if top else None
+        margins = [r["overspeed_margin_pct"] for r in so if r["overspeed_margin_pct"] is not None]
+        row["margin"] = min(margins) if margins else None
+        row["stops"] = sum(r["overspeed_stops"] for r in so)
+        rates = [r["pitch_rate_max_rel"] for r in so if r.get("pitch_rate_max_rel") is not None]
+        row["rate"] = max(rates) if rates else None
+        row["failed"] = sum(r["failed"] for r in so)
+        rows.append(row)
+    keys = ["controller", *[f"{ch}_{k}" for ch in spec.channels for k in ("del", "ult", "dlc")],
+            "speed_max", "speed_dlc", "margin", "stops", "rate", "failed"]
+    heads = ["controller", *[f"{ch} {k}" for ch in spec.channels
+                             for k in ("lifetime DEL [%]", "design load [%]", "governing DLC")],
+             "rotor speed max / rated", "in DLC", "overspeed margin [% rated]",
+             "overspeed stops", "pitch rate max / limit", "failed cases"]
+    return ["## Sign-off: fatigue and ultimate loads side by side", "",
+            f"Per controller, against `{spec.reference}`: the change of the lifetime DEL "
+            "(fatigue load cases) and of the governing design load (the largest design load "
+            "over every DLC) per channel, with the DLC that governs; "
+            "the largest rotor speed over every case against rated and the smallest margin to "
+            "the supervisor's overspeed limit (negative: the limit was crossed, in operation "
+            "or during a stop already under way); the cases the overspeed protection stopped; "
+            "the "
+            "largest pitch rate against the actuator's limit; failed cases (diverged; "
+            "`mpcwt campaign status` lists them).", "", _md(rows, keys, heads), "",
+            "![sign-off](signoff.png)", ""]
+
+
+def _md_ultimate(agg: dict[str, Any]) -> list[str]:
+    """The governing design loads, the per-DLC ultimate loads and the overspeed and pitch-rate
+    demand per DLC."""
+    if not agg["ultimate"]:
+        return []
+    md = ["## Ultimate loads", "",
+          "Each case's extremes after its transient; characteristic: per mean wind the mean "
+          "over seeds of each seed's extreme (a deterministic case counts once per sign), the "
+          "largest over the winds; design: times the partial safety factor of the DLC's family "
+          "(IEC 61400-1 ed. 3 table 3: normal 1.35, abnormal 1.1); extrapolated: the 50-year "
+          "load of a DLC's maxima (Gumbel per wind, weighted by the wind distribution; factor "
+          "1.25). Governing: the largest design load in magnitude over the DLCs.", "",
+          _md(agg["governing"], ["controller", "channel", "design", "side", "dlc", "case",
+                                 "change_pct"],
+              ["controller", "channel", "governing design load", "max/min", "DLC",
+               "case of the extreme", "change [%]"]), "",
+          "Per DLC (all columns in `ultimate.csv`):", "",
+          _md(agg["ultimate"], ["controller", "dlc", "family", "channel", "max", "max_case",
+                                "characteristic_max", "wind_max", "design_max", "min",
+                                "design_min", *(["extrapolated_max", "design_extrapolated_max"]
+                                                if any("extrapolated_max" in r for r in
+                                                       agg["ultimate"]) else [])],
+              ["controller", "DLC", "family", "channel", "max", "its case",
+               "characteristic max", "at wind [m/s]", "design max", "min", "design min",
+               *(["extrapolated max (50 y)", "design extrapolated"]
+                 if any("extrapolated_max" in r for r in agg["ultimate"]) else [])]), ""]
+    if agg["signoff"]:
+        md += ["### Overspeed and pitch-rate demand per DLC", "",
+               _md(agg["signoff"], ["controller", "dlc", "cases", "failed",
+                                    "rotor_speed_max_rel", "rotor_speed_max_case",
+                                    "overspeed_margin_pct", "overspeed_stops", "stops",
+                                    "pitch_rate_max_degps", "pitch_rate_max_rel",
+                                    "pitch_rate_limit_s"],
+                   ["controller", "DLC", "cases", "failed", "rotor speed max / rated",
+                    "its case", "overspeed margin [% rated]", "overspeed stops",
+                    "stop sequences", "pitch rate max [deg/s]", "of the limit",
+                    "at the limit [s/case]"]), "", "![ultimate loads](ultimate.png)", ""]
+    return md
+
+
 def _md_more(agg: dict[str, Any]) -> list[str]:
     """Lifetime extension, CS1-CS5 and the APC sweep."""
     md: list[str] = []
-    if agg["ultimate"]:
-        md += ["## Ultimate loads", "",
-               "Each case's extremes after the transient; characteristic: the mean over seeds "
-               "of each seed's extreme, the largest over the winds; design: times the partial "
-               "safety factor (IEC 61400-1 ed. 3 table 3, normal 1.35). All rows in "
-               "`ultimate.csv`.", "",
-               _md(agg["ultimate"], ["controller", "turbulence", "channel", "max", "max_case",
-                                     "characteristic_max", "wind_max", "design_max", "min",
-                                     "design_min"],
-                   ["controller", "turbulence", "channel", "max", "its case",
-                    "characteristic max", "at wind [m/s]", "design max", "min",
-                    "design min"]), ""]
+    md += _md_ultimate(agg)
     if agg["extension"]:
         md += ["## Lifetime extension (retrofit after 15 years, 5 more at the new rate; "
                "Pettas and Cheng eq 1)", "",

@@ -22,16 +22,31 @@ import yaml
 
 from ..errors import SpecError
 
-__all__ = ["SpecError", "CampaignSpec", "ControllerSpec", "Case", "load_spec", "spec_from_dict"]
+__all__ = ["SpecError", "CampaignSpec", "ControllerSpec", "Case", "LoadCase", "DLC_DEFAULTS",
+           "load_spec", "spec_from_dict"]
 
 
 _TOP_KEYS = {"name", "description", "turbine", "duration", "transient", "turbulence",
              "shear_exponent", "winds", "seeds", "lidar", "controllers", "channels",
              "wind_distribution", "lifetime_years", "reference", "report", "plugins",
-             "del_convention"}
+             "del_convention", "load_cases", "iec_class", "supervisor"}
 #: A controller entry's own keys; any other key is an option of the controller's kind.
 _CONTROLLER_KEYS = {"name", "controller", "winds", "seeds", "turbulence", "label", "options",
-                    "mpc_options", "retrofit_options"}
+                    "mpc_options", "retrofit_options", "dlcs"}
+_LOAD_CASE_KEYS = {"dlc", "condition", "winds", "seeds", "signs", "turbulence", "family",
+                   "fatigue", "duration", "transient", "event_at", "supervisor", "extrapolate",
+                   "label"}
+#: IEC 61400-1 ed. 3 table 2: the partial safety factor family of a DLC's ultimate loads
+#: ("N" normal, "A" abnormal) and whether its runs count for fatigue. DLC 1.2's turbulent runs
+#: also give its ultimate loads (the runs of DLC 1.1, normal family).
+DLC_DEFAULTS: dict[str, tuple[str, bool]] = {
+    "1.1": ("N", False), "1.2": ("N", True), "1.3": ("N", False), "1.4": ("N", False),
+    "1.5": ("N", False), "2.1": ("N", False), "2.2": ("A", False), "2.3": ("A", False),
+    "2.4": ("N", True), "3.2": ("N", False), "3.3": ("N", False), "4.2": ("N", False),
+    "5.1": ("N", False)}
+#: The supervisor's settings a spec may give (:class:`mpc_wt.supervisor.Supervisor`); the
+#: times are counted from the end of the case's transient.
+_SUPERVISOR_KEYS = {"overspeed", "shutdown_at", "grid_loss_at", "pitch_rate", "torque_ramp_s"}
 _REPORT_KEYS = {"paper", "notes", "psd_wind", "cs_wind", "sweep", "title"}
 
 
@@ -128,7 +143,11 @@ class ControllerSpec:
         The kind's options as given (checked by the registry when the spec loads), e.g.
         ``apc_frequency`` [Hz], ``horizon``, ``lidar``.
     winds, seeds, turbulence : tuple or None
-        This controller's own grid (default: the campaign's).
+        This controller's own grid (default: the campaign's; not with ``load_cases``).
+    label : str, optional
+        Text for the report.
+    dlcs : tuple of str, optional
+        The load cases this controller runs (default all of the spec's ``load_cases``).
     """
 
     name: str
@@ -138,6 +157,63 @@ class ControllerSpec:
     seeds: tuple[int, ...] | None = None
     turbulence: tuple[str | float, ...] | None = None
     label: str | None = None
+    dlcs: tuple[str, ...] | None = None
+
+
+@dataclass(frozen=True)
+class LoadCase:
+    """One design load case of a campaign (IEC 61400-1 ed. 3 table 2 style).
+
+    Parameters
+    ----------
+    dlc : str
+        Its name, e.g. "1.3" (:data:`DLC_DEFAULTS` gives the family and the fatigue flag of
+        the standard's).
+    condition : str
+        Wind condition (:data:`lidar.CONDITIONS`; "ntm": the turbulence given).
+    winds : tuple of float
+        Mean hub-height winds [m/s].
+    seeds : tuple of int
+        Seeds of a turbulent condition (a deterministic one runs once per sign).
+    signs : tuple of int
+        Directions of a direction change or shear (deterministic conditions).
+    turbulence : tuple
+        Classes or intensities (ntm); the category of the site (other conditions).
+    family : str
+        Partial safety factor family of its ultimate loads: "N", "A" or "T".
+    fatigue : bool
+        Its runs enter the fatigue, AEP and duty tables.
+    duration, transient : float
+        Assessed length and discarded start [s].
+    event_at : float
+        When a transient starts, after the discarded start [s].
+    supervisor : dict
+        :class:`mpc_wt.supervisor.Supervisor` settings, times after the discarded start.
+    extrapolate : bool
+        Extrapolate its maxima statistically to 50 years (turbulent conditions).
+    legacy : bool
+        The grid of a spec without ``load_cases`` (case ids without the DLC).
+    """
+
+    dlc: str
+    condition: str
+    winds: tuple[float, ...]
+    seeds: tuple[int, ...]
+    signs: tuple[int, ...]
+    turbulence: tuple[str | float, ...]
+    family: str
+    fatigue: bool
+    duration: float
+    transient: float
+    event_at: float = 0.0
+    supervisor: dict[str, Any] = field(default_factory=dict)
+    extrapolate: bool = False
+    legacy: bool = False
+
+    @property
+    def deterministic(self) -> bool:
+        """True for a condition without turbulence (one run per wind and sign)."""
+        return self.condition not in ("ntm", "etm") or self.turbulence == ("steady",)
 
 
 @dataclass(frozen=True)
@@ -176,6 +252,19 @@ class Case:
         Modules that register controller kinds, imported by the worker.
     del_convention : str
         The DEL convention of the assessment (:data:`mpc_wt.assess.DEL_CONVENTIONS`).
+    dlc : str
+        Its load case.
+    condition : dict or None
+        The IEC wind condition (``condition``, ``iec_class``, ``sign``, ``event_at`` [s of
+        simulation]) for :func:`mpc_wt.controllers.run_controller`; None: normal turbulence.
+    supervisor : dict or None
+        :class:`mpc_wt.supervisor.Supervisor` settings (times of simulation) or None.
+    family : str
+        Partial safety factor family of the load case.
+    fatigue : bool
+        The case enters the fatigue tables.
+    sign : int
+        Direction of a deterministic condition (1 or -1).
     """
 
     case_id: str
@@ -195,6 +284,12 @@ class Case:
     assess_hash: str
     plugins: tuple[str, ...] = ()
     del_convention: str = "range-1hz"
+    dlc: str = "1.2"
+    condition: dict[str, Any] | None = None
+    supervisor: dict[str, Any] | None = None
+    family: str = "N"
+    fatigue: bool = True
+    sign: int = 1
 
     def to_dict(self) -> dict[str, Any]:
         """Plain data for a worker (pickles and JSON-serialises).
@@ -250,6 +345,11 @@ class CampaignSpec:
     del_convention : str
         The DEL convention (``range-1hz``, default; ``clemens``; ``pcrunch``): DEL per case and
         the lifetime DEL's weights (Clemens eq 18 weights bins by their counted cycles).
+    load_cases : tuple of LoadCase
+        The design load cases (one ``legacy`` DLC 1.2 of ``winds`` x ``seeds`` x
+        ``turbulence`` when the spec gives none).
+    iec_class : str
+        Wind turbine class "I", "II" or "III" of the IEC conditions.
     """
 
     name: str
@@ -273,6 +373,8 @@ class CampaignSpec:
     source: str | None = None
     plugins: tuple[str, ...] = ()
     del_convention: str = "range-1hz"
+    load_cases: tuple[LoadCase, ...] = ()
+    iec_class: str = "I"
 
     @property
     def spec_hash(self) -> str:
@@ -299,7 +401,8 @@ class CampaignSpec:
                        f"{[c.name for c in self.controllers]}")
 
     def cases(self) -> list[Case]:
-        """Every case of the campaign, in a stable order (controller, turbulence, wind, seed).
+        """Every case of the campaign, in a stable order (controller, load case, turbulence,
+        wind, seed or sign).
 
         Returns
         -------
@@ -311,25 +414,60 @@ class CampaignSpec:
         if self.del_convention != "range-1hz":      # the default keeps older hashes valid
             assess["del_convention"] = self.del_convention
         for c in self.controllers:
-            for turb in c.turbulence or self.turbulence:
-                for v in c.winds or self.winds:
-                    for s in c.seeds or self.seeds:
-                        sim = {"turbine": self.turbine_hash, "controller": c.controller,
-                               "options": c.options, "wind_mps": v, "seed": s,
-                               "turbulence": turb, "duration": self.duration + self.transient,
-                               "shear_exponent": self.shear_exponent}
-                        cid = f"{c.name}__{turbulence_tag(turb)}__v{v:g}__s{s}"
-                        out.append(Case(case_id=cid, controller=c.name,
-                                        run_name=c.controller, options=copy.deepcopy(c.options),
-                                        wind_mps=v, seed=s, turbulence=turb,
-                                        duration=self.duration, transient=self.transient,
-                                        shear_exponent=self.shear_exponent,
-                                        turbine=self.turbine, turbine_hash=self.turbine_hash,
-                                        channels=dict(self.channels), case_hash=_digest(sim),
-                                        assess_hash=_digest(assess),
-                                        plugins=self.plugins,
-                                        del_convention=self.del_convention))
+            for lc in self.load_cases:
+                if c.dlcs is None or lc.dlc in c.dlcs:
+                    out += self._load_case(c, lc, assess)
         return out
+
+    def _load_case(self, c: ControllerSpec, lc: LoadCase, assess: dict[str, Any]
+                   ) -> list[Case]:
+        """The cases of one controller in one load case."""
+        if lc.legacy:
+            grid = [(t, v, s, 1) for t in c.turbulence or lc.turbulence
+                    for v in c.winds or lc.winds for s in c.seeds or lc.seeds]
+        elif lc.deterministic:
+            grid = [(t, v, 0, g) for t in lc.turbulence for v in lc.winds for g in lc.signs]
+        else:
+            grid = [(t, v, s, 1) for t in lc.turbulence for v in lc.winds for s in lc.seeds]
+        a = assess if lc.transient == self.transient else {**assess, "transient": lc.transient}
+        sup = ({k: (lc.transient + x if k.endswith("_at") else x)
+                for k, x in lc.supervisor.items()} if lc.supervisor else None)
+        out = []
+        for turb, v, seed, sign in grid:
+            sim = {"turbine": self.turbine_hash, "controller": c.controller,
+                   "options": c.options, "wind_mps": v, "seed": seed, "turbulence": turb,
+                   "duration": lc.duration + lc.transient,
+                   "shear_exponent": self.shear_exponent}
+            cond = None
+            if lc.condition != "ntm":
+                cond = {"condition": lc.condition, "iec_class": self.iec_class,
+                        "sign": sign, "event_at": lc.transient + lc.event_at}
+                sim["condition"] = cond
+            if sup:
+                sim["supervisor"] = sup
+            out.append(Case(
+                case_id=_case_id(c.name, lc, turb, v, seed, sign), controller=c.name,
+                run_name=c.controller, options=copy.deepcopy(c.options), wind_mps=v,
+                seed=seed, turbulence=turb, duration=lc.duration, transient=lc.transient,
+                shear_exponent=self.shear_exponent, turbine=self.turbine,
+                turbine_hash=self.turbine_hash, channels=dict(self.channels),
+                case_hash=_digest(sim), assess_hash=_digest(a), plugins=self.plugins,
+                del_convention=self.del_convention, dlc=lc.dlc, condition=cond,
+                supervisor=copy.deepcopy(sup), family=lc.family, fatigue=lc.fatigue,
+                sign=sign))
+        return out
+
+
+def _case_id(ctl: str, lc: LoadCase, turb: str | float, v: float, seed: int,
+             sign: int) -> str:
+    """``ctl__TURB__vV__sS`` (a spec without load cases), ``ctl__dlcD__[COND-]TURB__vV__sS``
+    (turbulent) or ``ctl__dlcD__COND__vV__pos|neg`` (deterministic)."""
+    if lc.legacy:
+        return f"{ctl}__{turbulence_tag(turb)}__v{v:g}__s{seed}"
+    if lc.deterministic:
+        return f"{ctl}__dlc{lc.dlc}__{lc.condition}__v{v:g}__{'pos' if sign > 0 else 'neg'}"
+    cond = "" if lc.condition == "ntm" else f"{lc.condition}-"
+    return f"{ctl}__dlc{lc.dlc}__{cond}{turbulence_tag(turb)}__v{v:g}__s{seed}"
 
 
 def _digest(obj: Any) -> str:
@@ -415,8 +553,13 @@ def _controller(i: int, raw: Any, lidar: dict[str, Any]) -> ControllerSpec:
                                    f"got {name!r}")
     run_name = str(raw.get("controller", name))
     opts = _controller_options(key, raw, run_name, lidar)
+    dlcs = raw.get("dlcs")
+    if dlcs is not None and (not isinstance(dlcs, list) or not dlcs
+                             or not all(isinstance(d, (str, int, float)) for d in dlcs)):
+        raise _fail(f"{key}.dlcs", f"must be a non-empty list of load case names, got {dlcs!r}")
     return ControllerSpec(
         name=name, controller=run_name, options=opts,
+        dlcs=None if dlcs is None else tuple(str(d) for d in dlcs),
         winds=_winds(f"{key}.winds", raw["winds"]) if "winds" in raw else None,
         seeds=_seeds(f"{key}.seeds", raw["seeds"]) if "seeds" in raw else None,
         turbulence=(_turbulence(f"{key}.turbulence", raw["turbulence"])
@@ -437,6 +580,117 @@ def _lidar(key: str, raw: Any) -> dict[str, Any]:
         return {k: getattr(opts, k) for k in raw}
     except OptionsError as err:
         raise _fail(err.key, str(err)) from err
+
+
+def _keys_of(key: str, raw: Any, allowed: set[str]) -> None:
+    """``raw`` is a mapping whose keys are all ``allowed``, or a :class:`SpecError`."""
+    if not isinstance(raw, Mapping):
+        raise _fail(key, f"must be a mapping, got {raw!r}")
+    extra = set(raw) - allowed
+    if extra:
+        raise _fail(f"{key}.{sorted(extra)[0]}", f"unknown key; allowed: {sorted(allowed)}")
+
+
+def _supervisor(key: str, raw: Any, turbine: str) -> dict[str, Any]:
+    """Supervisor settings (:data:`_SUPERVISOR_KEYS`), checked by
+    :class:`mpc_wt.supervisor.Supervisor` itself on the campaign's turbine."""
+    from ..supervisor import Supervisor
+    from .task import load_case_turbine
+
+    if raw is None:
+        return {}
+    _keys_of(key, raw, _SUPERVISOR_KEYS)
+    try:
+        Supervisor(_NullController(), load_case_turbine(turbine), **dict(raw))
+    except (TypeError, ValueError) as err:
+        raise _fail(key, str(err)) from err
+    return {k: (None if v is None else float(v)) for k, v in raw.items()}
+
+
+class _NullController:
+    """Stands in for a controller while a supervisor's settings are checked."""
+
+    def reset(self) -> None:
+        """Nothing to reset."""
+
+
+def _load_case(i: int, raw: Any, top: Mapping[str, Any]) -> LoadCase:
+    """One entry of ``load_cases``, its defaults from the spec's top level (``top``)."""
+    import lidar
+
+    key = f"load_cases[{i}]"
+    _keys_of(key, raw, _LOAD_CASE_KEYS)
+    dlc = raw.get("dlc")
+    if not isinstance(dlc, (str, int, float)) or not str(dlc).strip():
+        raise _fail(f"{key}.dlc", f"must name the load case, e.g. '1.3', got {dlc!r}")
+    dlc = str(dlc).strip()
+    cond = str(raw.get("condition", "ntm")).lower()
+    if cond not in lidar.CONDITIONS:
+        raise _fail(f"{key}.condition", f"must be one of {sorted(lidar.CONDITIONS)}, got "
+                                        f"{raw.get('condition')!r}")
+    fam0, fat0 = DLC_DEFAULTS.get(dlc, ("N", False))
+    family = raw.get("family", fam0)
+    if family not in ("N", "A", "T"):
+        raise _fail(f"{key}.family", f"must be 'N', 'A' or 'T' (IEC 61400-1 table 3), got "
+                                     f"{family!r}")
+    turb = _turbulence(f"{key}.turbulence", raw.get("turbulence", top["turbulence"]))
+    if cond != "ntm" and not all(t in ("A", "B", "C") for t in turb):
+        raise _fail(f"{key}.turbulence", f"condition {cond!r} needs IEC categories 'A', 'B' "
+                                         f"or 'C', got {list(turb)}")
+    turbulent = cond in ("ntm", "etm") and turb != ("steady",)
+    signs = raw.get("signs", [1])
+    if not isinstance(signs, list) or not signs or any(g not in (1, -1) for g in signs) \
+            or len(set(signs)) != len(signs):
+        raise _fail(f"{key}.signs", f"must be a list of distinct 1 and -1, got {signs!r}")
+    if "winds" not in raw and "winds" not in top:
+        raise _fail(f"{key}.winds", "missing (no top-level winds to default to)")
+    extrapolate = raw.get("extrapolate", False)
+    if not isinstance(extrapolate, bool) or (extrapolate and not turbulent):
+        raise _fail(f"{key}.extrapolate", f"must be true or false, and true only for a "
+                                          f"turbulent condition (ntm, etm), got {extrapolate!r}")
+    fatigue = raw.get("fatigue", fat0 and turbulent)
+    if not isinstance(fatigue, bool):
+        raise _fail(f"{key}.fatigue", f"must be true or false, got {fatigue!r}")
+    sup = {**top["supervisor"], **_supervisor(f"{key}.supervisor", raw.get("supervisor"),
+                                              top["turbine"])}
+    return LoadCase(
+        dlc=dlc, condition=cond, winds=_winds(f"{key}.winds", raw.get("winds", top.get(
+            "winds"))), seeds=_seeds(f"{key}.seeds", raw.get("seeds", top["seeds"])),
+        signs=tuple(int(g) for g in signs), turbulence=turb, family=family, fatigue=fatigue,
+        duration=_number(f"{key}.duration", raw.get(
+            "duration", top["duration"] if turbulent else 60.0), 0.0, lo_open=True),
+        transient=_number(f"{key}.transient", raw.get("transient", top["transient"]), 0.0),
+        event_at=_number(f"{key}.event_at", raw.get("event_at", 10.0), 0.0),
+        supervisor=sup, extrapolate=extrapolate)
+
+
+def _load_cases(raw: Mapping[str, Any], duration: float, transient: float,
+                turbine: str) -> tuple[LoadCase, ...]:
+    """The spec's load cases, or the one legacy DLC 1.2 of a spec without them."""
+    sup = _supervisor("supervisor", raw.get("supervisor"), turbine)
+    top = {"turbulence": raw.get("turbulence", "A"), "seeds": raw.get("seeds", 1),
+           "duration": duration, "transient": transient, "supervisor": sup,
+           "turbine": turbine}
+    if "winds" in raw:
+        top["winds"] = raw["winds"]
+    if "load_cases" not in raw:
+        if "winds" not in raw:
+            raise _fail("winds", "missing (required: name, winds or load_cases, controllers)")
+        return (LoadCase(dlc="1.2", condition="ntm", winds=_winds("winds", raw["winds"]),
+                         seeds=_seeds("seeds", top["seeds"]), signs=(1,),
+                         turbulence=_turbulence("turbulence", top["turbulence"]), family="N",
+                         fatigue=True, duration=duration, transient=transient,
+                         supervisor=sup, legacy=True),)
+    lcs = raw["load_cases"]
+    if not isinstance(lcs, list) or not lcs:
+        raise _fail("load_cases", f"must be a non-empty list, got {lcs!r}")
+    out = tuple(_load_case(i, lc, top) for i, lc in enumerate(lcs))
+    names = [lc.dlc for lc in out]
+    dup = sorted({n for n in names if names.count(n) > 1})
+    if dup:
+        raise _fail("load_cases", f"repeated dlc names {dup}; give each a distinct name "
+                                  f"(e.g. '2.3a')")
+    return out
 
 
 def _distribution(raw: Any) -> dict[str, Any]:
@@ -519,6 +773,25 @@ def _report(report: Any, names: list[str], chans: Mapping[str, float]) -> dict[s
     return dict(report)
 
 
+def _check_controller_grids(ctls: tuple[ControllerSpec, ...],
+                            load_cases: tuple[LoadCase, ...]) -> None:
+    """A controller's own grid only without load cases; its ``dlcs`` must name load cases."""
+    names = [lc.dlc for lc in load_cases]
+    for i, c in enumerate(ctls):
+        if not load_cases[0].legacy:
+            for k in ("winds", "seeds", "turbulence"):
+                if getattr(c, k) is not None:
+                    raise _fail(f"controllers[{i}].{k}", "a controller's own grid is not "
+                                                         "allowed with load_cases; restrict "
+                                                         "it with dlcs")
+        elif c.dlcs is not None:
+            raise _fail(f"controllers[{i}].dlcs", "only with load_cases")
+        for d in c.dlcs or ():
+            if d not in names:
+                raise _fail(f"controllers[{i}].dlcs", f"{d!r} is not a load case; load cases "
+                                                      f"are {names}")
+
+
 def spec_from_dict(raw: Mapping[str, Any], base: Path | None = None,
                    source: str | None = None) -> CampaignSpec:
     """Validate a campaign given as a mapping (the parsed YAML).
@@ -551,10 +824,10 @@ def spec_from_dict(raw: Mapping[str, Any], base: Path | None = None,
     extra = set(raw) - _TOP_KEYS
     if extra:
         raise _fail(sorted(extra)[0], f"unknown key; allowed: {sorted(_TOP_KEYS)}")
-    missing = [k for k in ("name", "winds", "controllers") if k not in raw]
+    missing = [k for k in ("name", "controllers") if k not in raw]
     if missing:
-        raise _fail(missing[0], f"missing (required: name, winds, controllers; missing "
-                                f"{missing})")
+        raise _fail(missing[0], f"missing (required: name, winds or load_cases, "
+                                f"controllers; missing {missing})")
     name = raw["name"]
     if not isinstance(name, str) or not name.strip():
         raise _fail("name", f"must be a non-empty string, got {name!r}")
@@ -567,6 +840,12 @@ def spec_from_dict(raw: Mapping[str, Any], base: Path | None = None,
     if not isinstance(ctl_raw, list) or not ctl_raw:
         raise _fail("controllers", "must be a non-empty list")
     ctls = tuple(_controller(i, c, lidar) for i, c in enumerate(ctl_raw))
+    iec_class = raw.get("iec_class", "I")
+    if iec_class not in ("I", "II", "III"):
+        raise _fail("iec_class", f"must be 'I', 'II' or 'III' (IEC 61400-1 table 1), got "
+                                 f"{iec_class!r}")
+    load_cases = _load_cases(raw, duration, transient, turbine)
+    _check_controller_grids(ctls, load_cases)
     names = [c.name for c in ctls]
     dup = sorted({n for n in names if names.count(n) > 1})
     if dup:
@@ -584,7 +863,9 @@ def spec_from_dict(raw: Mapping[str, Any], base: Path | None = None,
         duration=duration, transient=transient,
         turbulence=_turbulence("turbulence", raw.get("turbulence", "A")),
         shear_exponent=_number("shear_exponent", raw.get("shear_exponent", 0.2), -1.0, 1.0),
-        winds=_winds("winds", raw["winds"]), seeds=_seeds("seeds", raw.get("seeds", 1)),
+        winds=load_cases[0].winds if "winds" not in raw else _winds("winds", raw["winds"]),
+        seeds=_seeds("seeds", raw.get("seeds", 1)), load_cases=load_cases,
+        iec_class=iec_class,
         lidar=lidar, controllers=ctls, channels=chans,
         wind_distribution=_distribution(raw.get("wind_distribution", {})),
         lifetime_years=_number("lifetime_years", raw.get("lifetime_years", 20.0), 0.0,

@@ -21,7 +21,8 @@ import numpy as np
 
 from .ultimate import case_extremes
 
-__all__ = ["run_case", "case_metrics", "case_file", "actuator_limit_metrics"]
+__all__ = ["run_case", "case_metrics", "case_file", "actuator_limit_metrics",
+           "load_case_turbine"]
 
 #: A pitch rate at or above this fraction of the actuator's limit counts as at the limit.
 RATE_LIMIT_FRACTION = 0.98
@@ -44,7 +45,18 @@ def case_file(case_id: str) -> str:
 
 
 @functools.lru_cache(maxsize=8)
-def _turbine(ref: str) -> Any:
+def load_case_turbine(ref: str) -> Any:
+    """A campaign's turbine, loaded once per process.
+
+    Parameters
+    ----------
+    ref : str
+        Packaged name or resolved path (:attr:`Case.turbine`).
+
+    Returns
+    -------
+    linearize.Turbine
+    """
     import linearize
 
     return linearize.load_turbine(ref)
@@ -103,6 +115,11 @@ def case_metrics(t: np.ndarray, cols: dict[str, np.ndarray], channels: dict[str,
         out["rotor_speed_max_rad_s"] = float(sub["rotor_speed"].max())
     if "tower_base_fa_moment" in sub:
         out["tower_base_fa_mean_Nm"] = float(sub["tower_base_fa_moment"].mean())
+    if "supervisor_state" in sub:       # the stop sequence (mpc_wt.supervisor.STATES codes)
+        state = np.asarray(sub["supervisor_state"])
+        out["supervisor_state"] = int(state.max())
+        tripped = np.flatnonzero(state > 0)
+        out["supervisor_trip_s"] = float(t[k][tripped[0]]) if tripped.size else None
     for key in ("power_ref",):
         if key in sub:
             out[f"{key}_mean_W"] = float(np.mean(sub[key]))
@@ -199,11 +216,12 @@ def run_case(case: dict[str, Any], root: str) -> dict[str, Any]:
             load_plugins(case.get("plugins", ()))
             lidar.keep_samplers(True)        # a worker's next case is often the next seed
             try:
-                res = run_controller(_turbine(case["turbine"]), case["run_name"],
+                res = run_controller(load_case_turbine(case["turbine"]), case["run_name"],
                                      case["wind_mps"], case["turbulence"], case["seed"],
                                      duration=case["duration"] + case["transient"],
                                      shear_exponent=case["shear_exponent"],
-                                     options=case["options"])
+                                     options=case["options"], condition=case.get("condition"),
+                                     supervisor=case.get("supervisor"))
             except SimulationDivergedError as err:
                 if getattr(err, "partial", None) is not None:
                     err.partial.meta["campaign_case"] = {"case_id": case["case_id"],
@@ -219,7 +237,7 @@ def run_case(case: dict[str, Any], root: str) -> dict[str, Any]:
         metrics = case_metrics(res.t, cols, case["channels"], case["transient"],
                                case.get("del_convention", "range-1hz"))
         metrics.update(_plain(actuator_limit_metrics(
-            res.t, cols, _turbine(case["turbine"]).pitch_actuator.max_rate_rad_s,
+            res.t, cols, load_case_turbine(case["turbine"]).pitch_actuator.max_rate_rad_s,
             case["transient"])))
         return {**base, "status": "done", "file": rel, "metrics": metrics, "reused": reused,
                 "wall_s": time.perf_counter() - t0}

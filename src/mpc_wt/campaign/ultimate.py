@@ -10,19 +10,108 @@ Per case and channel the extremes are the largest and the smallest value and the
   winds;
 * the design load is the characteristic load times the partial safety factor for loads of the
   DLC's family (table 3: normal 1.35, abnormal 1.1, transport and erection 1.5).
+
+Optionally (:func:`extrapolate_maxima`) a turbulent DLC's per-seed maxima are extrapolated to
+the load with a 50-year return period, the standard's approach for DLC 1.1 (7.6.2.1 and annex
+F; partial safety factor 1.25): a Gumbel distribution per mean wind (method of moments, 10-min
+maxima), weighted by the wind distribution's bin probabilities, solved for the exceedance
+probability of one run in 50 years.
 """
 from __future__ import annotations
 
 import math
 from collections import defaultdict
-from typing import Any, Iterable, Mapping
+from typing import Any, Iterable, Mapping, Sequence
 
 import numpy as np
 
-__all__ = ["SAFETY_FACTORS", "case_extremes", "ultimate_table"]
+__all__ = ["SAFETY_FACTORS", "EXTRAPOLATED_SAFETY_FACTOR", "case_extremes", "ultimate_table",
+           "extrapolate_maxima"]
 
 #: Partial safety factors for loads, IEC 61400-1 ed. 3 table 3 (unfavourable loads).
 SAFETY_FACTORS = {"N": 1.35, "A": 1.1, "T": 1.5}
+#: Partial safety factor of a load extrapolated to 50 years (DLC 1.1, IEC 61400-1 ed. 3
+#: 7.6.2.1).
+EXTRAPOLATED_SAFETY_FACTOR = 1.25
+_EULER_GAMMA = 0.5772156649015329
+_YEAR_S = 365.25 * 24 * 3600.0
+
+
+def extrapolate_maxima(maxima: Mapping[float, Sequence[float]],
+                       probabilities: Mapping[float, float], *, run_s: float = 600.0,
+                       return_years: float = 50.0) -> dict[str, Any]:
+    """The load whose exceedance in one run has the probability of once in ``return_years``.
+
+    Per mean wind v the run maxima are taken as Gumbel distributed with the method-of-moments
+    parameters beta_v = s_v sqrt(6) / pi and mu_v = mean_v - 0.5772 beta_v (s_v: sample
+    standard deviation, ddof 1); the long-term exceedance of a load l is
+    P(l) = sum_v p_v (1 - exp(-exp(-(l - mu_v) / beta_v))), and the extrapolated load solves
+    P(l) = run_s / (return_years * 1 year) (IEC 61400-1 ed. 3 annex F's procedure).
+
+    Parameters
+    ----------
+    maxima : mapping
+        Mean wind [m/s] -> the maxima of its runs (at least 3 per wind).
+    probabilities : mapping
+        Mean wind -> probability of the wind bin (the time share of the bin; the rest of the
+        time, outside these winds, produces no load).
+    run_s : float
+        Length of one run [s].
+    return_years : float
+        Return period [years].
+
+    Returns
+    -------
+    dict
+        ``load`` (the extrapolated load), ``exceedance`` (the target probability per run),
+        ``gumbel`` (wind -> (mu, beta)), ``max_observed``.
+
+    Raises
+    ------
+    ValueError
+        A wind with fewer than 3 maxima, non-finite maxima, a wind without a probability,
+        probabilities outside [0, 1] or summing above 1, non-positive run length or period.
+    """
+    from scipy.optimize import brentq
+
+    if not (math.isfinite(run_s) and run_s > 0 and math.isfinite(return_years)
+            and return_years > 0):
+        raise ValueError(f"run_s and return_years must be > 0, got {run_s!r}, "
+                         f"{return_years!r}")
+    if not maxima:
+        raise ValueError("extrapolate_maxima needs the maxima of at least one wind")
+    gum: dict[float, tuple[float, float]] = {}
+    p = []
+    for v, xs in sorted(maxima.items()):
+        x = np.asarray(xs, float)
+        if x.size < 3 or not np.all(np.isfinite(x)):
+            raise ValueError(f"wind {v:g} m/s: needs at least 3 finite maxima, got "
+                             f"{list(map(float, x))}")
+        if v not in probabilities or not 0.0 <= probabilities[v] <= 1.0:
+            raise ValueError(f"wind {v:g} m/s: probability must be in [0, 1], got "
+                             f"{probabilities.get(v)!r}")
+        beta = max(float(np.std(x, ddof=1)) * math.sqrt(6.0) / math.pi,
+                   1e-12 * max(1.0, float(np.abs(x).max())))
+        gum[v] = (float(x.mean()) - _EULER_GAMMA * beta, beta)
+        p.append(float(probabilities[v]))
+    if sum(p) > 1.0 + 1e-9 or sum(p) <= 0.0:
+        raise ValueError(f"wind probabilities must sum to (0, 1], got {sum(p):g}")
+    target = run_s / (return_years * _YEAR_S)
+    mu = np.array([g[0] for g in gum.values()])
+    beta = np.array([g[1] for g in gum.values()])
+    pw = np.asarray(p)
+
+    def excess(load: float) -> float:
+        return float(np.sum(pw * -np.expm1(-np.exp(-(load - mu) / beta)))) - target
+
+    lo = float(np.min(mu))
+    hi = float(np.max(mu + beta * 60.0))
+    if excess(lo) <= 0.0:       # the bins' total probability is below the target itself
+        raise ValueError(f"the winds' probabilities ({sum(p):g}) are below the target "
+                         f"exceedance {target:.3g}: no load reaches it")
+    load = float(brentq(excess, lo, hi, xtol=1e-12 * max(1.0, abs(hi)), maxiter=200))
+    return {"load": load, "exceedance": target, "gumbel": gum,
+            "max_observed": max(float(np.max(x)) for x in maxima.values())}
 
 
 def case_extremes(t: np.ndarray, cols: Mapping[str, np.ndarray],
@@ -93,7 +182,9 @@ def ultimate_table(rows: Iterable[Mapping[str, Any]], channels: Iterable[str], *
         Channel -> {"max", "max_case", "min", "min_case" (the campaign's extremes and their
         cases), "by_dlc": {dlc: {"characteristic_max", "characteristic_min" (the largest
         and smallest seed-mean extreme over the DLC's winds), "wind_max", "wind_min",
-        "family", "safety_factor", "design_max", "design_min", "seeds"}}}.
+        "family", "safety_factor", "design_max", "design_min" (the characteristic loads times
+        the safety factor: None for a maximum <= 0 or a minimum >= 0, which the factor would
+        make less unfavourable), "seeds"}}}.
 
     Raises
     ------
@@ -133,8 +224,13 @@ def ultimate_table(rows: Iterable[Mapping[str, Any]], channels: Iterable[str], *
         for dlc, d in by_dlc.items():
             fam = _family(dlc, families)
             gf = SAFETY_FACTORS[fam]
-            d.update(family=fam, safety_factor=gf, design_max=gf * d["characteristic_max"],
-                     design_min=gf * d["characteristic_min"])
+            # the factor makes a load more unfavourable: a maximum above zero larger, a
+            # minimum below zero more negative; the other sides have no design value
+            d.update(family=fam, safety_factor=gf,
+                     design_max=(gf * d["characteristic_max"] if d["characteristic_max"] > 0
+                                 else None),
+                     design_min=(gf * d["characteristic_min"] if d["characteristic_min"] < 0
+                                 else None))
         out[ch] = {"max": best["max"][0], "max_case": best["max"][1],
                    "min": best["min"][0], "min_case": best["min"][1], "by_dlc": by_dlc}
     return out

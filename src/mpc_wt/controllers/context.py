@@ -16,12 +16,13 @@ import linearize
 from linearize.validate import check_finite_scalar, check_positive, check_range
 
 __all__ = ["Scenario", "BuildContext", "Built", "DesignCache", "make_wind", "field_grid",
-           "turbine_key"]
+           "turbine_key", "iec_site"]
 
 
 @dataclass(frozen=True)
 class Scenario:
-    """One load case: mean wind, turbulence, seed, length and shear.
+    """One load case: mean wind, turbulence, seed, length and shear, and optionally an IEC
+    61400-1 wind condition (:func:`lidar.iec_field`).
 
     Parameters
     ----------
@@ -35,6 +36,17 @@ class Scenario:
         Simulated time [s], > 0.
     shear_exponent : float
         Power-law shear exponent [-], in [-1, 1].
+    condition : str
+        IEC 61400-1 ed. 3 wind condition (:data:`lidar.CONDITIONS`): "ntm" (default: the
+        turbulence given), "etm" (the extreme turbulence model's sigma_1 for the category
+        ``turbulence``), "nwp" (steady) or a deterministic transient ("eog", "edc", "ecd",
+        "ews-v", "ews-h") for the class ``iec_class`` and the category ``turbulence``.
+    iec_class : str
+        Wind turbine class "I", "II" or "III" (V_ref of the EOG and ECD).
+    sign : {1, -1}
+        Direction of a direction change or a shear.
+    event_at : float
+        When a transient starts [s] (simulation time).
     """
 
     wind_mps: float
@@ -42,6 +54,10 @@ class Scenario:
     seed: int = 1
     duration: float = 600.0
     shear_exponent: float = 0.2
+    condition: str = "ntm"
+    iec_class: str = "I"
+    sign: int = 1
+    event_at: float = 0.0
 
     def __post_init__(self) -> None:
         check_positive("wind_mps", self.wind_mps)
@@ -56,6 +72,20 @@ class Scenario:
         if isinstance(self.seed, bool) or not isinstance(self.seed, (int, np.integer)) \
                 or self.seed < 0:
             raise ValueError(f"seed must be an integer >= 0, got {self.seed!r}")
+        if self.condition not in lidar.CONDITIONS:
+            raise ValueError(f"condition must be one of {sorted(lidar.CONDITIONS)}, got "
+                             f"{self.condition!r}")
+        if self.condition not in ("ntm", "nwp") and self.turbulence not in ("A", "B", "C"):
+            raise ValueError(f"condition {self.condition!r} needs an IEC turbulence category "
+                             f"'A', 'B' or 'C' as turbulence, got {self.turbulence!r}")
+        if self.sign not in (1, -1):
+            raise ValueError(f"sign must be 1 or -1, got {self.sign!r}")
+        check_range("event_at", self.event_at, 0.0, math.inf)
+
+    @property
+    def deterministic(self) -> bool:
+        """True for a wind without turbulence: steady, NWP or an IEC transient."""
+        return self.turbulence == "steady" or self.condition not in ("ntm", "etm")
 
     def meta(self) -> dict[str, Any]:
         """The case as plain data for a result's ``meta``.
@@ -64,10 +94,15 @@ class Scenario:
         -------
         dict
             ``wind_mps``, ``turbulence``, ``seed``, ``duration_s``, ``shear_exponent`` (the I/O keys
-            carry units).
+            carry units); with an IEC condition also ``condition``, ``iec_class``, ``sign``,
+            ``event_at_s``.
         """
-        return {"wind_mps": self.wind_mps, "turbulence": self.turbulence, "seed": self.seed,
-                "duration_s": self.duration, "shear_exponent": self.shear_exponent}
+        out = {"wind_mps": self.wind_mps, "turbulence": self.turbulence, "seed": self.seed,
+               "duration_s": self.duration, "shear_exponent": self.shear_exponent}
+        if self.condition != "ntm":
+            out.update(condition=self.condition, iec_class=self.iec_class, sign=self.sign,
+                       event_at_s=self.event_at)
+        return out
 
 
 def field_grid(turbine: linearize.Turbine) -> tuple[float, int]:
@@ -117,7 +152,13 @@ def make_wind(turbine: linearize.Turbine, scenario: Scenario, components: str = 
     hub = turbine.geometry.hub_height
     v, alpha = scenario.wind_mps, scenario.shear_exponent
     width, n = field_grid(turbine)
-    if scenario.turbulence == "steady":
+    turb = scenario.turbulence
+    if scenario.condition not in ("ntm", "nwp"):
+        site = iec_site(turbine, scenario)
+        if scenario.condition != "etm":
+            return _iec_wind(scenario, site, width, n)
+        turb = site.magnitudes(site.check_speed("etm", v))["sigma_etm"] / v
+    if scenario.turbulence == "steady" or scenario.condition == "nwp":
         spec = lidar.TurbulenceSpec(v, 0.01, hub_height=hub, duration=scenario.duration + 20.0,
                                     dt=1.0, n_y=8, n_z=8, width=width, height=width,
                                     shear_exponent=alpha)
@@ -127,17 +168,59 @@ def make_wind(turbine: linearize.Turbine, scenario: Scenario, components: str = 
         f = lidar.WindField(t=t, y=y, z=z, u=u, v=zero, w=zero, mean_speed=v, hub_height=hub,
                             meta={"model": "steady power law"})
         return linearize.SteadyWind(v, alpha), f
-    spec = lidar.TurbulenceSpec(v, scenario.turbulence, hub_height=hub, width=width,
+    spec = lidar.TurbulenceSpec(v, turb, hub_height=hub, width=width,
                                 height=width, n_y=n, n_z=n,
                                 duration=scenario.duration + 20.0, shear_exponent=alpha)
     f = lidar.generate_field(spec, scenario.seed, components=components)
-    # the plant shares the field's u (read-only float32) unless a gust of a very turbulent
-    # low wind runs backwards: then the clipped copy
+    if scenario.condition == "etm":
+        f = dataclasses.replace(f, meta={**f.meta, "condition": "etm",
+                                         "iec_class": scenario.iec_class,
+                                         "turbulence_class": scenario.turbulence})
+    return _grid_wind(f), f
+
+
+def _grid_wind(f: lidar.WindField) -> linearize.GridWind:
+    """The plant's wind: the field's u (read-only float32) unless a gust of a very turbulent
+    low wind (or a direction change beyond 90 deg) runs backwards: then the clipped copy."""
     u = f.u
     if float(u.min()) < 0.0:
         u = np.maximum(f.u, np.float32(0.0))
         u.flags.writeable = False
-    return linearize.GridWind(t=f.t, y=f.y, z=f.z, u=u), f
+    return linearize.GridWind(t=f.t, y=f.y, z=f.z, u=u)
+
+
+def iec_site(turbine: linearize.Turbine, scenario: Scenario) -> lidar.IECSite:
+    """The turbine's IEC 61400-1 site for a scenario: its class and category, hub height,
+    rotor diameter, the scenario's shear and the turbine's operating range.
+
+    Parameters
+    ----------
+    turbine : Turbine
+        For the hub height, the rotor and cut-in / cut-out.
+    scenario : Scenario
+        For ``iec_class``, the category (``turbulence``) and the shear.
+
+    Returns
+    -------
+    lidar.IECSite
+    """
+    op = turbine.operation
+    return lidar.IECSite(scenario.iec_class, str(scenario.turbulence),
+                         hub_height=turbine.geometry.hub_height,
+                         diameter=2.0 * turbine.geometry.tip_radius,
+                         shear_exponent=scenario.shear_exponent, cut_in=op.cut_in_wind,
+                         cut_out=op.cut_out_wind)
+
+
+def _iec_wind(scenario: Scenario, site: lidar.IECSite, width: float, n: int
+              ) -> tuple[linearize.GridWind, lidar.WindField]:
+    """A deterministic IEC transient on the turbulence grid, 20 s longer than the run. The
+    plant meets the rotor-normal component u = V cos(theta) of a direction change (no skewed
+    inflow model); a LIDAR in the loop sees u and v."""
+    f = lidar.iec_field(scenario.condition, scenario.wind_mps, site,
+                        t_start=scenario.event_at, duration=scenario.duration + 20.0,
+                        dt=0.05, width=width, n=n, sign=scenario.sign)
+    return _grid_wind(f), f
 
 
 def turbine_key(turbine: linearize.Turbine) -> str:
@@ -284,7 +367,7 @@ class BuildContext:
         -------
         lidar.WindField
         """
-        if distance == 0.0 or self.scenario.turbulence == "steady":
+        if distance == 0.0 or self.scenario.deterministic:
             return self.field
         seed = np.random.default_rng([self.scenario.seed, _EVOLUTION_STREAM])
         return lidar.evolve_field(self.field, distance, seed=seed)

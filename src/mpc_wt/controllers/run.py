@@ -21,6 +21,19 @@ def _operating_point(turbine: linearize.Turbine, sel: Selection, opts: Sequence[
     return linearize.trim(turbine, scenario.wind_mps)
 
 
+_CONDITION_KEYS = ("condition", "iec_class", "sign", "event_at")
+
+
+def _condition(raw: Mapping[str, Any] | None) -> dict[str, Any]:
+    if raw is None:
+        return {}
+    extra = set(raw) - set(_CONDITION_KEYS)
+    if extra:
+        raise ValueError(f"condition: unknown key {sorted(extra)[0]!r}; allowed: "
+                         f"{list(_CONDITION_KEYS)}")
+    return dict(raw)
+
+
 def build_controller(turbine: linearize.Turbine, controller: str, scenario: Scenario,
                      options: Mapping[str, Any] | None = None, *,
                      cache: DesignCache = DEFAULT_CACHE, naming: Naming = API_NAMING
@@ -75,7 +88,9 @@ def run_controller(turbine: linearize.Turbine, controller: str, wind_mps: float,
                    progress: bool = False, shear_exponent: float = 0.2,
                    options: Mapping[str, Any] | None = None, *,
                    cache: DesignCache = DEFAULT_CACHE,
-                   naming: Naming = API_NAMING) -> ClosedLoopResult:
+                   naming: Naming = API_NAMING,
+                   condition: Mapping[str, Any] | None = None,
+                   supervisor: Mapping[str, Any] | None = None) -> ClosedLoopResult:
     """Trim, build the controller, generate the wind and simulate.
 
     Parameters
@@ -106,6 +121,15 @@ def run_controller(turbine: linearize.Turbine, controller: str, wind_mps: float,
         For designs that cost seconds (the TS LMIs), keyed on the turbine's content.
     naming : Naming
         How error messages name options.
+    condition : mapping, optional
+        An IEC 61400-1 wind condition instead of normal turbulence: ``condition`` ("etm",
+        "eog", "edc", "ecd", "ews-v", "ews-h", "nwp"), ``iec_class`` ("I"), ``sign`` (1),
+        ``event_at`` (when the transient starts [s]); ``turbulence`` is then the category
+        (:class:`~mpc_wt.controllers.context.Scenario`).
+    supervisor : mapping, optional
+        Runs the controller under :class:`mpc_wt.supervisor.Supervisor` with these settings
+        (``overspeed``, ``shutdown_at``, ``grid_loss_at`` [s], ``pitch_rate``,
+        ``torque_ramp_s``).
 
     Returns
     -------
@@ -120,11 +144,18 @@ def run_controller(turbine: linearize.Turbine, controller: str, wind_mps: float,
     SimulationDivergedError
         If the run leaves the physical envelope (``.partial`` keeps what was simulated).
     """
-    scenario = Scenario(wind_mps, turbulence, seed, duration, shear_exponent)
+    scenario = Scenario(wind_mps, turbulence, seed, duration, shear_exponent,
+                        **_condition(condition))
     built, op, wind = build_controller(turbine, controller, scenario, options, cache=cache,
                                        naming=naming)
     meta = {"controller": controller, **scenario.meta(), "turbine": turbine.name,
             **built.meta}
-    return simulate_closed_loop(linearize.plant_params(turbine), built.controller, wind,
+    ctl = built.controller
+    if supervisor is not None:
+        from ..supervisor import Supervisor
+
+        ctl = Supervisor(ctl, turbine, **dict(supervisor))
+        meta["supervisor"] = {k: v for k, v in dict(supervisor).items() if v is not None}
+    return simulate_closed_loop(linearize.plant_params(turbine), ctl, wind,
                                 duration, x0=op.x, u0=op.u, controller_dt=built.controller_dt,
                                 preview=built.preview, progress=progress, meta=meta)

@@ -1,0 +1,238 @@
+"""Ultimate loads per design load case and the sign-off summary of a campaign (issue 24).
+
+A campaign with ``load_cases`` (IEC 61400-1 ed. 3 table 2 style: DLC 1.2 fatigue, 1.3 ETM,
+1.4 ECD, 1.5 EWS, 2.x faults, 4.2 shutdown in a gust, 5.1 emergency stop) is reported per
+controller and DLC:
+
+* :func:`ultimate_rows`: per channel the DLC's extremes and their cases, its characteristic
+  loads (seed means of the per-case extremes, largest over the winds), its design loads (times
+  the family's partial safety factor, :data:`~.ultimate.SAFETY_FACTORS`) and, for a DLC marked
+  ``extrapolate``, the 50-year load (:func:`~.ultimate.extrapolate_maxima`, factor 1.25);
+* :func:`governing_rows`: per controller and channel the largest design load over the DLCs and
+  the DLC that sets it, against the reference controller's (the extrapolated loads are shown
+  beside, not taken: with a few seeds per wind their Gumbel fits are indicative);
+* :func:`signoff_rows`: per controller and DLC the largest rotor speed against rated and the
+  margin to the supervisor's overspeed limit, the stops that tripped, the largest pitch rate
+  against the actuator's limit, the time at that limit, and the failed cases.
+"""
+from __future__ import annotations
+
+import math
+from collections import defaultdict
+from typing import Any, Mapping, Sequence
+
+import numpy as np
+
+from ..assess import pct_change, wind_bin_probabilities
+from .spec import Case, CampaignSpec, turbulence_tag
+from .store import CaseRow
+from .task import load_case_turbine
+from .ultimate import EXTRAPOLATED_SAFETY_FACTOR, extrapolate_maxima, ultimate_table
+
+__all__ = ["dlc_label", "ultimate_rows", "governing_rows", "signoff_rows"]
+
+
+def dlc_label(spec: CampaignSpec, case: Case | None, row: CaseRow) -> str:
+    """The DLC a finished case belongs to ("1.2" for a spec without load cases; with several
+    turbulences "1.2-A", "1.2-ti12").
+
+    Parameters
+    ----------
+    spec : CampaignSpec
+        The campaign.
+    case : Case or None
+        The case of the row (None: no longer in the spec).
+    row : CaseRow
+        The finished case.
+
+    Returns
+    -------
+    str
+    """
+    if case is not None and spec.load_cases and not spec.load_cases[0].legacy:
+        return case.dlc
+    turbs = spec.load_cases[0].turbulence if spec.load_cases else spec.turbulence
+    return "1.2" if len(turbs) == 1 else f"1.2-{turbulence_tag(row.turbulence_value)}"
+
+
+def _by_controller_dlc(spec: CampaignSpec, rows: Sequence[CaseRow]
+                       ) -> dict[tuple[str, str], list[tuple[CaseRow, Case | None]]]:
+    cases = {c.case_id: c for c in spec.cases()}
+    out: dict[tuple[str, str], list[tuple[CaseRow, Case | None]]] = defaultdict(list)
+    for r in rows:
+        c = cases.get(r.case_id)
+        out[(r.controller, dlc_label(spec, c, r))].append((r, c))
+    order = [c.name for c in spec.controllers]
+    dlcs = [lc.dlc for lc in spec.load_cases]
+    return dict(sorted(out.items(), key=lambda kv: (
+        order.index(kv[0][0]) if kv[0][0] in order else 99,
+        dlcs.index(kv[0][1]) if kv[0][1] in dlcs else 99, kv[0][1])))
+
+
+def _load_case(spec: CampaignSpec, dlc: str) -> Any:
+    return next((lc for lc in spec.load_cases if lc.dlc == dlc), None)
+
+
+def _extrapolated(spec: CampaignSpec, items: list[tuple[CaseRow, Case | None]], ch: str,
+                  side: str) -> float | None:
+    """The 50-year load of a channel's maxima (``side`` "max") or minima ("min", as the
+    negated maxima of -x); None with fewer than 3 seeds at some wind."""
+    by: dict[float, list[float]] = defaultdict(list)
+    for r, _ in items:
+        x = r.metrics["extremes"][ch][side]
+        by[r.wind_mps].append(x if side == "max" else -x)
+    d = spec.wind_distribution
+    winds = np.array(sorted(by))
+    p = (wind_bin_probabilities(winds, "rayleigh", mean=d["mean"]) if d["kind"] == "rayleigh"
+         else wind_bin_probabilities(winds, "weibull", shape=d["shape"], scale=d["scale"]))
+    if min(len(v) for v in by.values()) < 3:
+        return None
+    lc = _load_case(spec, items[0][1].dlc) if items[0][1] is not None else None
+    run = (lc.duration if lc is not None else spec.duration)
+    val = extrapolate_maxima(by, dict(zip(winds.tolist(), p.tolist())), run_s=run)["load"]
+    return val if side == "max" else -val
+
+
+def ultimate_rows(spec: CampaignSpec, rows: Sequence[CaseRow]) -> list[dict[str, Any]]:
+    """Ultimate loads per controller, DLC and channel (module docstring).
+
+    Parameters
+    ----------
+    spec : CampaignSpec
+        The campaign.
+    rows : sequence of CaseRow
+        Its finished cases (with ``extremes`` in their metrics).
+
+    Returns
+    -------
+    list of dict
+        ``controller``, ``dlc``, ``family``, ``channel``, ``max``/``max_case``,
+        ``min``/``min_case`` (the DLC's extremes), ``characteristic_max``, ``wind_max``,
+        ``design_max``, ``characteristic_min``, ``design_min``, ``safety_factor``, ``seeds``,
+        ``cases`` and, for an ``extrapolate`` DLC, ``extrapolated_max``/``_min`` and
+        ``design_extrapolated_max``/``_min`` (factor 1.25).
+    """
+    out = []
+    for (ctl, dlc), items in _by_controller_dlc(spec, rows).items():
+        items = [(r, c) for r, c in items if r.metrics and "extremes" in r.metrics]
+        if not items:
+            continue
+        lc = _load_case(spec, dlc)
+        fam = lc.family if lc is not None and not lc.legacy else "N"
+        urows = [{"case_id": r.case_id, "dlc": dlc, "wind_mps": r.wind_mps, "seed": r.seed,
+                  "extremes": r.metrics["extremes"]} for r, _ in items]
+        chans = [ch for ch in (*spec.channels, "rotor_speed")
+                 if all(ch in u["extremes"] for u in urows)]
+        for ch, u in ultimate_table(urows, chans, families={dlc: fam}).items():
+            d = u["by_dlc"][dlc]
+            row = {"controller": ctl, "dlc": dlc, "family": fam, "channel": ch,
+                   "max": u["max"], "max_case": u["max_case"], "min": u["min"],
+                   "min_case": u["min_case"], **{k: d[k] for k in (
+                       "characteristic_max", "wind_max", "design_max", "characteristic_min",
+                       "wind_min", "design_min", "safety_factor", "seeds")},
+                   "cases": len(urows)}
+            if ch not in spec.channels:        # the rotor speed: extremes, not a load
+                row.update(design_max=None, design_min=None, safety_factor=None)
+            elif lc is not None and lc.extrapolate:
+                for side in ("max", "min"):
+                    x = _extrapolated(spec, items, ch, side)
+                    row[f"extrapolated_{side}"] = x
+                    row[f"design_extrapolated_{side}"] = (
+                        None if x is None else EXTRAPOLATED_SAFETY_FACTOR * x)
+            out.append(row)
+    return out
+
+
+def governing_rows(spec: CampaignSpec, ult: Sequence[Mapping[str, Any]]
+                   ) -> list[dict[str, Any]]:
+    """The largest design load (in magnitude) per controller and channel over its DLCs, the
+    DLC that sets it, and its change against the reference controller's governing load
+    (seed-mean characteristic loads times the safety factors; not the extrapolated ones).
+
+    Parameters
+    ----------
+    spec : CampaignSpec
+        For the reference controller.
+    ult : sequence of dict
+        :func:`ultimate_rows`.
+
+    Returns
+    -------
+    list of dict
+        ``controller``, ``channel``, ``design`` (signed: the governing design max or min),
+        ``side``, ``dlc``, ``case`` (the case of that DLC's extreme), ``change_pct``.
+    """
+    best: dict[tuple[str, str], dict[str, Any]] = {}
+    for u in ult:
+        for side in ("max", "min"):
+            val = u[f"design_{side}"]
+            if val is None:
+                continue
+            key = (u["controller"], u["channel"])
+            if key not in best or abs(val) > abs(best[key]["design"]):
+                best[key] = {"controller": u["controller"], "channel": u["channel"],
+                             "design": val, "side": side, "dlc": u["dlc"],
+                             "case": u[f"{side}_case"]}
+    out = list(best.values())
+    for b in out:
+        ref = best.get((spec.reference, b["channel"]))
+        b["change_pct"] = None
+        if ref is not None and ref["design"] != 0:
+            v = pct_change(abs(ref["design"]), abs(b["design"]))
+            b["change_pct"] = v if math.isfinite(v) else None
+    return out
+
+
+def signoff_rows(spec: CampaignSpec, rows: Sequence[CaseRow],
+                 failed: Sequence[CaseRow] = ()) -> list[dict[str, Any]]:
+    """Rotor overspeed, stops and pitch-rate demand per controller and DLC.
+
+    Parameters
+    ----------
+    spec : CampaignSpec
+        The campaign (its turbine gives rated rotor speed and the pitch rate limit).
+    rows : sequence of CaseRow
+        Finished cases.
+    failed : sequence of CaseRow
+        Failed cases (counted per controller and DLC).
+
+    Returns
+    -------
+    list of dict
+        ``controller``, ``dlc``, ``cases``, ``failed``, ``rotor_speed_max_rel`` (largest rotor
+        speed / rated), ``rotor_speed_max_case``, ``overspeed_limit_rel`` (the supervisor's,
+        None without protection), ``overspeed_margin_pct`` (limit minus largest, in % of
+        rated), ``overspeed_stops`` (cases stopped by the protection), ``stops`` (cases in
+        which any stop sequence ran), ``pitch_rate_max_degps``, ``pitch_rate_max_rel`` (of the
+        actuator's limit), ``pitch_rate_limit_s`` (mean time per case at the limit).
+    """
+    tb = load_case_turbine(spec.turbine)
+    rated = tb.operation.rated_rotor_speed_rad_s
+    lim_rate = math.degrees(tb.pitch_actuator.max_rate_rad_s)
+    groups = _by_controller_dlc(spec, [*rows, *failed])
+    out = []
+    for (ctl, dlc), items in groups.items():
+        done = [(r, c) for r, c in items if r.status == "done" and r.metrics]
+        row: dict[str, Any] = {"controller": ctl, "dlc": dlc, "cases": len(done),
+                               "failed": len(items) - len(done)}
+        ex = [(r.metrics["extremes"]["rotor_speed"]["max"], r.case_id) for r, _ in done
+              if "rotor_speed" in r.metrics.get("extremes", {})]
+        if ex:
+            w, case = max(ex)
+            row.update(rotor_speed_max_rel=w / rated, rotor_speed_max_case=case)
+        lims = {(c.supervisor or {}).get("overspeed") for _, c in done if c is not None}
+        lim = min((x for x in lims if x is not None), default=None)
+        row["overspeed_limit_rel"] = lim
+        row["overspeed_margin_pct"] = (100.0 * (lim - row["rotor_speed_max_rel"])
+                                       if lim is not None and ex else None)
+        states = [r.metrics.get("supervisor_state") or 0 for r, _ in done]
+        row["overspeed_stops"] = sum(1 for s in states if s == 2)
+        row["stops"] = sum(1 for s in states if s > 0)
+        rates = [r.metrics["pitch_rate_max_degps"] for r, _ in done
+                 if r.metrics.get("pitch_rate_max_degps") is not None]
+        if rates:
+            row.update(pitch_rate_max_degps=max(rates), pitch_rate_max_rel=max(rates) / lim_rate)
+        at = [r.metrics.get("pitch_rate_limit_s") or 0.0 for r, _ in done]
+        row["pitch_rate_limit_s"] = float(np.mean(at)) if at else None
+        out.append(row)
+    return out
