@@ -418,16 +418,6 @@ def _components(spec: TurbulenceSpec, rng: np.random.Generator, method: str = "c
         del series                      # the caller may drop it before asking for the next
 
 
-def _rfft_time(x: np.ndarray) -> np.ndarray:
-    """rfft along time (axis 0) of a float32 (n_t, n_y, n_z) field, complex64, four grid
-    columns at a time: numpy's transform of the whole array along its first axis holds about
-    five times the output in temporaries (280 MB for a 600 s 32 x 32 component)."""
-    out = np.empty((x.shape[0] // 2 + 1, *x.shape[1:]), dtype=np.complex64)
-    for j in range(0, x.shape[1], 4):
-        out[:, j:j + 4] = np.fft.rfft(x[:, j:j + 4], axis=0)
-    return out
-
-
 def simley_pao_evolution(mean_speed: float, sigma: Any, length_scale: float
                          ) -> tuple[float, float]:
     """Parameters (a [-], b [1/m]) of Simley and Pao's wind-evolution coherence.
@@ -560,8 +550,9 @@ def evolve_field(field: WindField, distance: float, spec: TurbulenceSpec | None 
         return WindField(t=field.t, y=field.y, z=field.z, u=field.u, v=field.v, w=field.w,
                          mean_speed=field.mean_speed, hub_height=field.hub_height, meta=meta)
     # u' one component at a time (the same draws as generate_field(spec, seed)), transformed
-    # in single precision; each mean leaves as the zero-frequency bin, and u' is transformed
-    # and dropped before the field's component: the peak holds the two fields and two spectra
+    # in single precision four grid columns at a time (every column's series is independent:
+    # the spectra never exist whole); each mean leaves as the zero-frequency bin. The peak holds
+    # the two fields and one independent component
     rng = seed if isinstance(seed, np.random.Generator) else np.random.default_rng(seed)
     f = np.fft.rfftfreq(n_t, field.dt)
     g = np.sqrt(evolution_coherence(f, distance, field.mean_speed, a, b))
@@ -569,21 +560,19 @@ def evolve_field(field: WindField, distance: float, spec: TurbulenceSpec | None 
     fresh = np.sqrt(1.0 - g**2).astype(np.float32)[:, None, None]
     out = {}
     for comp, xo in _components(spec, rng):
-        fo = _rfft_time(xo)
-        del xo
-        fo[0] = 0.0
-        fo *= fresh
         x = getattr(field, comp)
         mean = x.mean(axis=0, keepdims=True, dtype=np.float64)
-        fx = _rfft_time(x)
-        fx[0] = 0.0
-        fx *= keep
-        fx += fo
-        del fo
         series = np.empty(x.shape, dtype=np.float32)
         for j in range(0, x.shape[1], 4):
-            series[:, j:j + 4] = np.fft.irfft(fx[:, j:j + 4], n=n_t, axis=0)
-        del fx
+            fo = np.fft.rfft(xo[:, j:j + 4], axis=0).astype(np.complex64, copy=False)
+            fo[0] = 0.0
+            fo *= fresh
+            fx = np.fft.rfft(x[:, j:j + 4], axis=0).astype(np.complex64, copy=False)
+            fx[0] = 0.0
+            fx *= keep
+            fx += fo
+            series[:, j:j + 4] = np.fft.irfft(fx, n=n_t, axis=0)
+        del xo
         # the mean of every point kept to the float32 storage's resolution: the residual mean
         # of the single-precision transform is taken out with the mean put back
         series += (mean - series.mean(axis=0, keepdims=True, dtype=np.float64)

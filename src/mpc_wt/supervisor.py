@@ -93,6 +93,26 @@ class Supervisor(ControllerBase):
         self.feather = pa.max_pitch_rad
         self.reset()
 
+    @classmethod
+    def check_settings(cls, turbine: linearize.Turbine, **settings: Any) -> None:
+        """Check supervisor settings without a controller (a spec or the command line).
+
+        Parameters
+        ----------
+        turbine : linearize.Turbine
+            For rated rotor speed and the pitch actuator's limits.
+        **settings
+            The keyword arguments of :class:`Supervisor` but the controller.
+
+        Raises
+        ------
+        ValueError
+            Naming the setting, its value and what is allowed.
+        TypeError
+            An unknown setting.
+        """
+        cls(_Idle(), turbine, **settings)
+
     def reset(self) -> None:
         """Back to running; reset the wrapped controller."""
         self.controller.reset()
@@ -148,3 +168,10 @@ class Supervisor(ControllerBase):
         fin = getattr(self.controller, "finalize", None)
         if callable(fin):
             fin()
+
+
+class _Idle:
+    """Stands in for the controller while settings are checked."""
+
+    def reset(self) -> None:
+        """Nothing to reset."""

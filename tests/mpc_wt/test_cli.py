@@ -390,3 +390,33 @@ def test_wind_generate_iec_condition(tmp_path: Path, capsys: pytest.CaptureFixtu
     assert main(["wind", "generate", "--condition", "ecd", "--mean", "13", "--iec-class", "IV",
                  "--out", str(out)]) == 2
     assert "turbine_class must be one of ['I', 'II', 'III']" in capsys.readouterr().err
+
+
+def test_simulate_iec_event_with_supervisor(tmp_path: Path,
+                                            capsys: pytest.CaptureFixture[str]) -> None:
+    """Issue 24: ``mpcwt simulate --condition eog --grid-loss-at`` runs a gust with a grid loss
+    under the supervisor: the result records the condition, the trip (state 3, grid loss) at
+    the first controller step from 40 s, and zero generator torque after it."""
+    from mpc_wt.simulate import ClosedLoopResult
+
+    out = tmp_path / "eog.nc"
+    assert main(["simulate", "--wind", "13.4", "--condition", "eog", "--event-at", "35",
+                 "--duration", "50", "--overspeed", "1.25", "--grid-loss-at", "40",
+                 "--out", str(out)]) == 0
+    res = ClosedLoopResult.load(out)
+    assert res.meta["condition"] == "eog" and res.meta["event_at_s"] == 35.0
+    state = res.channel("supervisor_state")
+    trip = res.t[np.flatnonzero(state > 0)[0]]
+    assert state.max() == 3 and 40.0 - 1e-9 <= trip <= 40.1 + 1e-9
+    assert np.all(res.channel("gen_torque")[res.t > trip + 0.05] == 0.0)
+    capsys.readouterr()
+    assert main(["simulate", "--wind", "26", "--condition", "eog", "--out", str(out)]) == 2
+    assert ("--condition eog: mean_speed 26 m/s is above the turbine's cut-out 25 m/s"
+            in capsys.readouterr().err)
+    assert main(["simulate", "--wind", "13", "--condition", "eog", "--turbulence", "steady",
+                 "--out", str(out)]) == 2
+    assert "needs an IEC turbulence category" in capsys.readouterr().err
+    assert main(["simulate", "--wind", "13", "--overspeed", "0.8", "--out", str(out)]) == 2
+    assert "--overspeed: overspeed must be a fraction of rated" in capsys.readouterr().err
+    assert main(["simulate", "--wind", "13", "--shutdown-at", "-1", "--out", str(out)]) == 2
+    assert "--shutdown-at: shutdown_at must be a finite time >= 0 s" in capsys.readouterr().err

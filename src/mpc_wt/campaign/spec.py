@@ -601,17 +601,10 @@ def _supervisor(key: str, raw: Any, turbine: str) -> dict[str, Any]:
         return {}
     _keys_of(key, raw, _SUPERVISOR_KEYS)
     try:
-        Supervisor(_NullController(), load_case_turbine(turbine), **dict(raw))
+        Supervisor.check_settings(load_case_turbine(turbine), **dict(raw))
     except (TypeError, ValueError) as err:
         raise _fail(key, str(err)) from err
     return {k: (None if v is None else float(v)) for k, v in raw.items()}
-
-
-class _NullController:
-    """Stands in for a controller while a supervisor's settings are checked."""
-
-    def reset(self) -> None:
-        """Nothing to reset."""
 
 
 def _load_case(i: int, raw: Any, top: Mapping[str, Any]) -> LoadCase:

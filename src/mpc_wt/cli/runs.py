@@ -72,6 +72,21 @@ def _add_simulate(sub: Any) -> None:
     p.add_argument("--out", required=True, help="result file (netCDF, .nc)")
     p.add_argument("--option", action="append", metavar="NAME=VALUE",
                    help="any option of the controller kind (repeatable; YAML values)")
+    e = p.add_argument_group("IEC 61400-1 wind condition and supervisor events (issue 24)")
+    e.add_argument("--condition", choices=sorted(lidar.CONDITIONS), default="ntm",
+                   help="wind condition (default ntm: --turbulence as given; the others take "
+                        "--turbulence as the category A, B or C)")
+    e.add_argument("--iec-class", choices=("I", "II", "III"), default="I")
+    e.add_argument("--sign", type=int, choices=(1, -1), default=1,
+                   help="direction of a direction change or shear")
+    e.add_argument("--event-at", type=float, default=30.0,
+                   help="when the condition's transient starts [s]")
+    e.add_argument("--overspeed", type=float, default=None,
+                   help="emergency stop above this fraction of rated rotor speed (e.g. 1.25)")
+    e.add_argument("--shutdown-at", type=float, default=None, help="normal shutdown [s]")
+    e.add_argument("--grid-loss-at", type=float, default=None, help="grid loss [s]")
+    e.add_argument("--torque-ramp", type=float, default=None,
+                   help="a shutdown's generator torque ramp to zero [s] (default 5)")
     g = p.add_argument_group("controller options (each applies to the kinds that take it)")
     for name, meta in cli_flags().items():
         _add_option_flag(g, name, meta)
@@ -125,8 +140,10 @@ def _simulate(args: argparse.Namespace) -> int:
         prefix = "" if hasattr(err, "key") else "--controller: "
         raise UsageError(f"{prefix}{err}") from None
     turbine = linearize.load_turbine(args.turbine)
+    cond, sup = _events(args, turbine)
     res = run_controller(turbine, args.controller, args.wind, args.turbulence, args.seed,
-                         args.duration, progress=True, options=opts, naming=naming)
+                         args.duration, progress=True, options=opts, naming=naming,
+                         condition=cond, supervisor=sup)
     out = Path(args.out)
     if out.suffix == "":
         out = out.with_suffix(".nc")
@@ -135,6 +152,37 @@ def _simulate(args: argparse.Namespace) -> int:
     print(f"wrote {out}: {res.t.size} samples; mean power {p.mean() / 1e6:.3f} MW, "
           f"gen speed std {res.channel('gen_speed').std():.3f} rad/s")
     return 0
+
+
+def _events(args: argparse.Namespace, turbine: linearize.Turbine
+            ) -> tuple[dict[str, Any] | None, dict[str, Any] | None]:
+    """The wind condition and the supervisor settings of ``simulate``, checked here so that
+    an error names the flag."""
+    from ..controllers.context import Scenario, iec_site
+    from ..supervisor import Supervisor
+
+    cond = None
+    if args.condition != "ntm":
+        cond = {"condition": args.condition, "iec_class": args.iec_class, "sign": args.sign,
+                "event_at": args.event_at}
+        try:
+            sc = Scenario(args.wind, args.turbulence, args.seed, args.duration, **cond)
+            iec_site(turbine, sc).check_speed(args.condition, args.wind)
+        except ValueError as err:
+            raise UsageError(f"--condition {args.condition}: {err}") from None
+    sup = {k: v for k, v in (("overspeed", args.overspeed), ("shutdown_at", args.shutdown_at),
+                             ("grid_loss_at", args.grid_loss_at),
+                             ("torque_ramp_s", args.torque_ramp)) if v is not None}
+    if not sup:
+        return cond, None
+    try:
+        Supervisor.check_settings(turbine, **sup)
+    except ValueError as err:
+        flag = {"overspeed": "--overspeed", "shutdown_at": "--shutdown-at",
+                "grid_loss_at": "--grid-loss-at", "torque_ramp_s": "--torque-ramp"}
+        name = next((f for k, f in flag.items() if str(err).startswith(k)), "--overspeed")
+        raise UsageError(f"{name}: {err}") from None
+    return cond, sup
 
 
 def _controllers(args: argparse.Namespace) -> int:
