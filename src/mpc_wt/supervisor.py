@@ -30,7 +30,7 @@ import linearize
 
 from .simulate import ControllerBase
 
-__all__ = ["Supervisor", "STATES"]
+__all__ = ["Supervisor", "STATES", "TorqueLawGuard"]
 
 #: Supervisor states and their codes in the signal ``supervisor_state``.
 STATES = {"running": 0, "shutdown": 1, "overspeed": 2, "grid_loss": 3}
@@ -175,3 +175,65 @@ class _Idle:
 
     def reset(self) -> None:
         """Nothing to reset."""
+
+
+class TorqueLawGuard(ControllerBase):
+    """Caps a controller's generator torque at the baseline's torque-speed law in a lull: at
+    fine pitch below rated speed (the ``+torque-law`` add-on of the MPC kinds).
+
+    An above-rated design that regulates power and speed with pitch and torque together (Madsen
+    et al.'s MPC, linearized at the case's mean wind) has, in a lull that brings the pitch to
+    fine, only the torque left; holding power with it is the unstable constant-power law below
+    rated: the torque rises as the rotor slows, and the rotor stalls (the sign-off campaign:
+    13 of 65 MPC cases, from 9 to 17 m/s). With the guard, while the measured collective pitch
+    is within ``fine_band`` of fine and the generator speed below the law's rated speed, the
+    torque is at most the baseline's law at that speed (K omega^2 in region 2, the region 2.5
+    line up to rated torque: :meth:`mpc_wt.baseline.BaselineController.torque`); otherwise the
+    guarded controller's torque passes unchanged.
+
+    Parameters
+    ----------
+    controller : Controller
+        The controller guarded.
+    turbine : linearize.Turbine
+        For the torque law and fine pitch.
+    fine_band : float
+        Pitch above fine within which the guard acts [rad] (default 1 deg, the baseline's own
+        switch to region 3).
+    """
+
+    def __init__(self, controller: Any, turbine: linearize.Turbine, *,
+                 fine_band: float = math.radians(1.0)) -> None:
+        from .baseline import BaselineController
+
+        band = float(fine_band)
+        if not (math.isfinite(band) and band >= 0.0):
+            raise ValueError(f"fine_band must be a finite pitch >= 0 rad, got {fine_band!r}")
+        self.controller = controller
+        self.law = BaselineController(turbine)
+        self.fine = turbine.operation.fine_pitch_rad + band
+        self.reset()
+
+    def reset(self) -> None:
+        """Reset the guarded controller."""
+        self.controller.reset()
+        self.signals: dict[str, float] = {"torque_law_active": 0.0}
+
+    def step(self, t: float, meas: dict[str, Any]) -> tuple[np.ndarray, float]:
+        # the guarded controller's commands, the torque capped in a lull (parameters and
+        # returns: ControllerBase.step)
+        pitch, tq = self.controller.step(t, meas)
+        w, p = float(meas["gen_speed"]), meas["pitch"]
+        active = 0.0
+        if w < self.law.w_rated and float(p[0] + p[1] + p[2]) / 3.0 <= self.fine:
+            cap = self.law.torque(w, 0.0)
+            if tq > cap:
+                tq, active = cap, 1.0
+        self.signals = {**getattr(self.controller, "signals", {}), "torque_law_active": active}
+        return pitch, tq
+
+    def finalize(self) -> None:
+        """Pass the harness's last call on to the guarded controller."""
+        fin = getattr(self.controller, "finalize", None)
+        if callable(fin):
+            fin()

@@ -23,7 +23,7 @@ from mpc_wt.controllers.registry import _KINDS
 from mpc_wt.errors import OptionsError
 
 BUILTIN = ["baseline", "baseline-ct", "derate", "ibc", "coleman-ipc", "mpc", "mpc-collective",
-           "mpc-lidar", "lqr-pio", "ts", "apc"]
+           "mpc-lidar", "torque-law", "lqr-pio", "ts", "apc"]
 
 # The README's example of a user-defined kind, verbatim (ten lines of code).
 PLUGIN = textwrap.dedent('''

@@ -96,3 +96,43 @@ def test_grid_loss_drops_the_torque_at_once(turbine, steady18) -> None:
 def test_bad_settings_are_named(turbine, kwargs, match) -> None:
     with pytest.raises(ValueError, match=match):
         Supervisor(BaselineController(turbine), turbine, **kwargs)
+
+
+class _MaxTorque:
+    """Commands fine pitch and the generator's largest torque, whatever it measures."""
+
+    def __init__(self, turbine):
+        self.tq = turbine.generator.max_torque
+        self.signals = {"inner": 1.0}
+
+    def reset(self):
+        pass
+
+    def step(self, t, meas):
+        return np.zeros(3), self.tq
+
+
+def test_torque_law_guard_caps_only_in_a_lull() -> None:
+    """At fine pitch below rated speed the torque is the baseline's law (region 2: K omega^2
+    with K from its design; region 2.5 between); above rated speed, or with the pitch beyond
+    the band, the guarded torque passes unchanged."""
+    from mpc_wt.baseline import tune_baseline
+    from mpc_wt.supervisor import TorqueLawGuard
+
+    tb = linearize.load_turbine("nrel5mw")
+    g = TorqueLawGuard(_MaxTorque(tb), tb)
+    k = tune_baseline(tb).k_opt
+    w2 = 100.0                                  # rad/s on the generator: region 2 (K w^2)
+    _, tq = g.step(0.0, {"gen_speed": w2, "pitch": np.zeros(3)})
+    assert tq == pytest.approx(k * w2**2, rel=1e-12) and g.signals["torque_law_active"] == 1.0
+    assert g.signals["inner"] == 1.0
+    rated = tb.operation.rated_rotor_speed_rad_s * tb.drivetrain.gearbox_ratio
+    _, tq = g.step(0.1, {"gen_speed": 1.01 * rated, "pitch": np.zeros(3)})
+    assert tq == tb.generator.max_torque and g.signals["torque_law_active"] == 0.0
+    _, tq = g.step(0.2, {"gen_speed": w2, "pitch": np.full(3, np.radians(1.5))})
+    assert tq == tb.generator.max_torque                         # pitch beyond the 1 deg band
+    wide = TorqueLawGuard(_MaxTorque(tb), tb, fine_band=np.radians(2.0))
+    _, tq = wide.step(0.0, {"gen_speed": w2, "pitch": np.full(3, np.radians(1.5))})
+    assert tq == pytest.approx(k * w2**2, rel=1e-12)
+    with pytest.raises(ValueError, match=r"fine_band must be a finite pitch >= 0 rad, got -1"):
+        TorqueLawGuard(_MaxTorque(tb), tb, fine_band=-1)

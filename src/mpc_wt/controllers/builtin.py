@@ -421,6 +421,28 @@ register("mpc-lidar", MPCLidarOptions, group=_MPC_GROUP,
                  "(range weighting, LOS error and wind evolution on)")(_mpc(False, True))
 
 
+@dataclass(frozen=True)
+class TorqueLawOptions(Options):
+    """The torque-law guard in lulls (:class:`mpc_wt.supervisor.TorqueLawGuard`)."""
+
+    fine_band_deg: float = option(1.0, help="pitch above fine within which the guard acts",
+                                  unit="deg", lo=0.0, flag="")
+
+
+@register("torque-law", TorqueLawOptions, field_components="u",
+          addon_to=("mpc", "mpc-lidar", "mpc-collective"), default_base="mpc",
+          group=_MPC_GROUP, summary="caps the MPC's torque at the baseline's torque-speed law "
+                                    "at fine pitch below rated speed (mpc+torque-law, "
+                                    "mpc-lidar+torque-law)")
+def _build_torque_law(ctx: BuildContext, opts: TorqueLawOptions, base: Built) -> Built:
+    from ..supervisor import TorqueLawGuard
+
+    ctl = TorqueLawGuard(base.controller, ctx.turbine,
+                         fine_band=math.radians(opts.fine_band_deg))
+    return Built(ctl, base.controller_dt, base.preview,
+                 {**base.meta, "torque_law": opts.to_dict()}, base.power_fraction)
+
+
 # -- LQR + PI observer ------------------------------------------------------------------------
 @dataclass(frozen=True)
 class LQRPIOOptions(Options):
