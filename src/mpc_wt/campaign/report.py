@@ -834,8 +834,8 @@ def _md_signoff(agg: dict[str, Any]) -> list[str]:
             "the largest rotor speed over every case against rated and the smallest margin to "
             "the supervisor's overspeed limit (negative: the limit was crossed, in operation "
             "or during a stop already under way); the cases the overspeed protection stopped; "
-            "the "
-            "largest pitch rate against the actuator's limit; failed cases (diverged; "
+            "the largest pitch rate of the cases without a stop (a stop pitches at the maximum "
+            "rate by design) against the actuator's limit; failed cases (diverged; "
             "`mpcwt campaign status` lists them).", "", _md(rows, keys, heads), "",
             "![sign-off](signoff.png)", ""]
 

@@ -13,7 +13,8 @@ controller and DLC:
   beside, not taken: with a few seeds per wind their Gumbel fits are indicative);
 * :func:`signoff_rows`: per controller and DLC the largest rotor speed against rated and the
   margin to the supervisor's overspeed limit, the stops that tripped, the largest pitch rate
-  against the actuator's limit, the time at that limit, and the failed cases.
+  against the actuator's limit and the time at that limit in the cases that ran without a stop
+  (a stop pitches at the maximum rate by design), and the failed cases.
 """
 from __future__ import annotations
 
@@ -204,7 +205,8 @@ def signoff_rows(spec: CampaignSpec, rows: Sequence[CaseRow],
         None without protection), ``overspeed_margin_pct`` (limit minus largest, in % of
         rated), ``overspeed_stops`` (cases stopped by the protection), ``stops`` (cases in
         which any stop sequence ran), ``pitch_rate_max_degps``, ``pitch_rate_max_rel`` (of the
-        actuator's limit), ``pitch_rate_limit_s`` (mean time per case at the limit).
+        actuator's limit), ``pitch_rate_limit_s`` (mean time per case at the limit): these
+        three over the cases without a stop (None if every case stopped).
     """
     tb = load_case_turbine(spec.turbine)
     rated = tb.operation.rated_rotor_speed_rad_s
@@ -228,11 +230,14 @@ def signoff_rows(spec: CampaignSpec, rows: Sequence[CaseRow],
         states = [r.metrics.get("supervisor_state") or 0 for r, _ in done]
         row["overspeed_stops"] = sum(1 for s in states if s == 2)
         row["stops"] = sum(1 for s in states if s > 0)
-        rates = [r.metrics["pitch_rate_max_degps"] for r, _ in done
+        # the controller's demand: cases in operation only (a stop pitches at the actuator's
+        # maximum rate by design)
+        run = [r for r, _ in done if not r.metrics.get("supervisor_state")]
+        rates = [r.metrics["pitch_rate_max_degps"] for r in run
                  if r.metrics.get("pitch_rate_max_degps") is not None]
-        if rates:
-            row.update(pitch_rate_max_degps=max(rates), pitch_rate_max_rel=max(rates) / lim_rate)
-        at = [r.metrics.get("pitch_rate_limit_s") or 0.0 for r, _ in done]
+        row.update(pitch_rate_max_degps=max(rates) if rates else None,
+                   pitch_rate_max_rel=max(rates) / lim_rate if rates else None)
+        at = [r.metrics.get("pitch_rate_limit_s") or 0.0 for r in run]
         row["pitch_rate_limit_s"] = float(np.mean(at)) if at else None
         out.append(row)
     return out

@@ -88,7 +88,9 @@ def case_metrics(t: np.ndarray, cols: dict[str, np.ndarray], channels: dict[str,
     dict
         JSON-safe metrics (:func:`mpc_wt.assess.assess_series` plus rotor-speed statistics and
         ``extremes``: each channel's and the rotor speed's maximum and minimum and their times,
-        :func:`mpc_wt.campaign.ultimate.case_extremes`).
+        :func:`mpc_wt.campaign.ultimate.case_extremes`); with a supervisor in the loop
+        ``supervisor_state`` (the largest :data:`mpc_wt.supervisor.STATES` code after the
+        transient) and ``supervisor_trip_s`` (when it tripped, even within the transient).
 
     Raises
     ------
@@ -116,10 +118,10 @@ def case_metrics(t: np.ndarray, cols: dict[str, np.ndarray], channels: dict[str,
     if "tower_base_fa_moment" in sub:
         out["tower_base_fa_mean_Nm"] = float(sub["tower_base_fa_moment"].mean())
     if "supervisor_state" in sub:       # the stop sequence (mpc_wt.supervisor.STATES codes)
-        state = np.asarray(sub["supervisor_state"])
-        out["supervisor_state"] = int(state.max())
-        tripped = np.flatnonzero(state > 0)
-        out["supervisor_trip_s"] = float(t[k][tripped[0]]) if tripped.size else None
+        out["supervisor_state"] = int(np.max(sub["supervisor_state"]))
+        # when it tripped, also if that was in the discarded transient (the signal holds it)
+        trip = float(np.asarray(cols.get("supervisor_trip_time", [math.nan]))[-1])
+        out["supervisor_trip_s"] = trip if math.isfinite(trip) else None
     for key in ("power_ref",):
         if key in sub:
             out[f"{key}_mean_W"] = float(np.mean(sub[key]))
