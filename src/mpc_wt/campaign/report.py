@@ -127,9 +127,16 @@ class _Group:
     def missing_seeds(self) -> list[float]:
         cs = self.spec.controller(self.ctl) if self.ctl in {c.name for c in
                                                             self.spec.controllers} else None
-        want = set(cs.winds if cs and cs.winds else self.spec.winds)
+        if not self.spec.load_cases[0].legacy:      # the fatigue load cases' grid
+            want: dict[float, int] = {}
+            for lc in self.spec.load_cases:
+                if lc.fatigue and (cs is None or cs.dlcs is None or lc.dlc in cs.dlcs):
+                    for v in lc.winds:
+                        want[v] = want.get(v, 0) + len(lc.seeds)
+            return sorted(v for v, n in want.items() if len(self.bins.get(v, [])) < n)
+        winds = set(cs.winds if cs and cs.winds else self.spec.winds)
         n_seed = len(cs.seeds if cs and cs.seeds else self.spec.seeds)
-        return sorted(v for v in want if len(self.bins.get(v, [])) < n_seed)
+        return sorted(v for v in winds if len(self.bins.get(v, [])) < n_seed)
 
     def outliers(self) -> list[dict[str, Any]]:
         out = []
