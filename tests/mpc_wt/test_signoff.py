@@ -238,3 +238,15 @@ def test_signoff_campaign_end_to_end(tmp_path) -> None:
         assert head in text, head
     for f in ("signoff.png", "ultimate.png", "governing.csv", "signoff.csv"):
         assert (rep.parent / f).is_file(), f
+
+
+def test_incomplete_fatigue_bins_counted_against_the_load_cases_seeds() -> None:
+    """DLC 1.2 runs 2 seeds at 13 m/s: a bin with one finished seed is incomplete, with two it
+    is not (the spec's top-level seeds, 1 by default, do not apply to load cases)."""
+    from mpc_wt.campaign.report import _Group
+
+    spec = _spec()
+    one = _Group(spec, "baseline", "A", {13.0: ["s1"]}, {})
+    assert one.missing_seeds() == [13.0]
+    two = _Group(spec, "baseline", "A", {13.0: ["s1", "s2"]}, {})
+    assert two.missing_seeds() == []
