@@ -248,6 +248,13 @@ def _groups(spec: CampaignSpec, rows: list[CaseRow]) -> list[_Group]:
             for ctl, turb in keys]
 
 
+def _fatigue_done(spec: CampaignSpec, rows: Sequence[CaseRow]) -> list[CaseRow]:
+    """The finished cases but those of the spec's non-fatigue load cases (all of a spec without
+    load cases; a row the spec does not know is kept)."""
+    other = {c.case_id for c in spec.cases() if not c.fatigue}
+    return [r for r in rows if r.status == "done" and r.metrics and r.case_id not in other]
+
+
 def relative_metrics(spec: CampaignSpec, rows: Sequence[CaseRow], controller: str
                      ) -> dict[str, float]:
     """A controller's measures as ratios to the spec's reference over the winds both ran (1:
@@ -276,7 +283,7 @@ def relative_metrics(spec: CampaignSpec, rows: Sequence[CaseRow], controller: st
     ValueError
         If the controller and the reference share no wind with finished cases.
     """
-    done = [r for r in rows if r.status == "done" and r.metrics]
+    done = _fatigue_done(spec, rows)
     groups = [g for g in _groups(spec, done) if g.ctl == controller and g.common]
     if not groups:
         raise ValueError(f"controller {controller!r} and the reference {spec.reference!r} "
@@ -316,7 +323,7 @@ def absolute_metrics(spec: CampaignSpec, rows: Sequence[CaseRow], controller: st
     dict of str to float
         Name -> value; a measure some wind lacks is left out.
     """
-    done = [r for r in rows if r.status == "done" and r.metrics]
+    done = _fatigue_done(spec, rows)
     acc: dict[str, list[float]] = defaultdict(list)
     for g in (g for g in _groups(spec, done) if g.ctl == controller):
         for name, key in ABSOLUTE_METRICS.items():
@@ -355,8 +362,7 @@ def aggregate(root: str | Path) -> dict[str, Any]:
     out["ultimate"] = ultimate_rows(spec, rows)
     out["governing"] = governing_rows(spec, out["ultimate"])
     out["signoff"] = signoff_rows(spec, rows, failed) if not spec.load_cases[0].legacy else []
-    fatigue = {c.case_id for c in spec.cases() if c.fatigue}
-    out["fatigue_rows"] = [r for r in rows if r.case_id in fatigue]
+    out["fatigue_rows"] = _fatigue_done(spec, rows)
     for g in _groups(spec, out["fatigue_rows"]):
         missing = g.missing_seeds()
         if missing:
