@@ -19,8 +19,7 @@ from typing import Any, Sequence
 
 import numpy as np
 
-from ..assess import (aep_Wh, cs_measures, lifetime_del, lifetime_extension, pct_change, psd,
-                     wind_bin_probabilities)
+from ..assess import aep_Wh, cs_measures, lifetime_del, lifetime_extension, pct_change, psd
 from .spec import CampaignSpec, spec_from_dict, turbulence_tag
 from .store import CampaignStore, CaseRow
 from .signoff import governing_rows, signoff_rows, ultimate_rows
@@ -73,14 +72,6 @@ def _load(root: Path) -> tuple[CampaignSpec, list[CaseRow], list[CaseRow]]:
     return spec, rows, failed
 
 
-def _probs(spec: CampaignSpec, winds: Sequence[float]) -> np.ndarray:
-    d = spec.wind_distribution
-    if d["kind"] == "rayleigh":
-        return wind_bin_probabilities(np.asarray(winds, float), "rayleigh", mean=d["mean"])
-    return wind_bin_probabilities(np.asarray(winds, float), "weibull", shape=d["shape"],
-                                  scale=d["scale"])
-
-
 def _bin_del(cases: list[CaseRow], ch: str, m: float) -> float | None:
     """The DEL of a wind bin over its seeds: their cycles taken together, i.e. the m-power mean
     of the seeds' DELs weighted by their equivalent cycle counts (equal for ``range-1hz``)."""
@@ -120,8 +111,8 @@ class _Group:
         self.spec, self.ctl, self.turb, self.bins, self.rbins = spec, ctl, turb, bins, rbins
         self.winds = sorted(bins)
         self.common = [v for v in self.winds if v in rbins]
-        self.p_all = _probs(spec, self.winds)
-        self.p_com = _probs(spec, self.common) if self.common else None
+        self.p_all = spec.bin_probabilities(self.winds)
+        self.p_com = spec.bin_probabilities(self.common) if self.common else None
         self.key = {"controller": ctl, "turbulence": turb}
 
     def missing_seeds(self) -> list[float]:

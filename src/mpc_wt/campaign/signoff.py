@@ -24,7 +24,7 @@ from typing import Any, Mapping, Sequence
 
 import numpy as np
 
-from ..assess import pct_change, wind_bin_probabilities
+from ..assess import pct_change
 from .spec import Case, CampaignSpec, turbulence_tag
 from .store import CaseRow
 from .task import load_case_turbine
@@ -74,23 +74,19 @@ def _load_case(spec: CampaignSpec, dlc: str) -> Any:
     return next((lc for lc in spec.load_cases if lc.dlc == dlc), None)
 
 
-def _extrapolated(spec: CampaignSpec, items: list[tuple[CaseRow, Case | None]], ch: str,
-                  side: str) -> float | None:
+def _extrapolated(spec: CampaignSpec, lc: Any, items: list[tuple[CaseRow, Case | None]],
+                  ch: str, side: str) -> float | None:
     """The 50-year load of a channel's maxima (``side`` "max") or minima ("min", as the
-    negated maxima of -x); None with fewer than 3 seeds at some wind."""
+    negated maxima of -x) in load case ``lc``; None with fewer than 3 seeds at some wind."""
     by: dict[float, list[float]] = defaultdict(list)
     for r, _ in items:
         x = r.metrics["extremes"][ch][side]
         by[r.wind_mps].append(x if side == "max" else -x)
-    d = spec.wind_distribution
-    winds = np.array(sorted(by))
-    p = (wind_bin_probabilities(winds, "rayleigh", mean=d["mean"]) if d["kind"] == "rayleigh"
-         else wind_bin_probabilities(winds, "weibull", shape=d["shape"], scale=d["scale"]))
     if min(len(v) for v in by.values()) < 3:
         return None
-    lc = _load_case(spec, items[0][1].dlc) if items[0][1] is not None else None
-    run = (lc.duration if lc is not None else spec.duration)
-    val = extrapolate_maxima(by, dict(zip(winds.tolist(), p.tolist())), run_s=run)["load"]
+    winds = sorted(by)
+    p = dict(zip(winds, spec.bin_probabilities(winds).tolist()))
+    val = extrapolate_maxima(by, p, run_s=lc.duration)["load"]
     return val if side == "max" else -val
 
 
@@ -136,7 +132,7 @@ def ultimate_rows(spec: CampaignSpec, rows: Sequence[CaseRow]) -> list[dict[str,
                 row.update(design_max=None, design_min=None, safety_factor=None)
             elif lc is not None and lc.extrapolate:
                 for side in ("max", "min"):
-                    x = _extrapolated(spec, items, ch, side)
+                    x = _extrapolated(spec, lc, items, ch, side)
                     row[f"extrapolated_{side}"] = x
                     row[f"design_extrapolated_{side}"] = (
                         None if x is None else EXTRAPOLATED_SAFETY_FACTOR * x)

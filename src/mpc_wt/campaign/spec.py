@@ -18,6 +18,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Mapping
 
+import numpy as np
 import yaml
 
 from ..errors import SpecError
@@ -213,7 +214,12 @@ class LoadCase:
     @property
     def deterministic(self) -> bool:
         """True for a condition without turbulence (one run per wind and sign)."""
-        return self.condition not in ("ntm", "etm") or self.turbulence == ("steady",)
+        return not _turbulent(self.condition, self.turbulence)
+
+
+def _turbulent(condition: str, turbulence: tuple[str | float, ...]) -> bool:
+    """A load case whose runs are turbulent (seeds), not deterministic (signs)."""
+    return condition in ("ntm", "etm") and turbulence != ("steady",)
 
 
 @dataclass(frozen=True)
@@ -380,6 +386,27 @@ class CampaignSpec:
     def spec_hash(self) -> str:
         """SHA-256 of the canonical spec (with the turbine files' hash)."""
         return _digest({"spec": self.raw, "turbine": self.turbine_hash})
+
+    def bin_probabilities(self, winds: Any) -> np.ndarray:
+        """The wind distribution's probability of each mean-wind bin
+        (:func:`mpc_wt.assess.wind_bin_probabilities`).
+
+        Parameters
+        ----------
+        winds : array_like
+            Bin centres [m/s], ascending.
+
+        Returns
+        -------
+        ndarray
+            One probability per bin.
+        """
+        from ..assess import wind_bin_probabilities
+
+        d, w = self.wind_distribution, np.asarray(winds, float)
+        if d["kind"] == "rayleigh":
+            return wind_bin_probabilities(w, "rayleigh", mean=d["mean"])
+        return wind_bin_probabilities(w, "weibull", shape=d["shape"], scale=d["scale"])
 
     def controller(self, name: str) -> ControllerSpec:
         """The controller labelled ``name``.
@@ -630,7 +657,7 @@ def _load_case(i: int, raw: Any, top: Mapping[str, Any]) -> LoadCase:
     if cond != "ntm" and not all(t in ("A", "B", "C") for t in turb):
         raise _fail(f"{key}.turbulence", f"condition {cond!r} needs IEC categories 'A', 'B' "
                                          f"or 'C', got {list(turb)}")
-    turbulent = cond in ("ntm", "etm") and turb != ("steady",)
+    turbulent = _turbulent(cond, turb)
     signs = raw.get("signs", [1])
     if not isinstance(signs, list) or not signs or any(g not in (1, -1) for g in signs) \
             or len(set(signs)) != len(signs):
