@@ -8,7 +8,7 @@ from .field import WindField
 from .iec import CONDITIONS, IEC_REFERENCE_SPEED, IEC_TURBULENCE, IECSite, event_duration, iec_field
 from .preview import (Preview, PreviewBuffer, blade_effective_wind, coherence, coherence_bandwidth, peak_lag,
                       preview, preview_series, rms_preview_error, rotor_effective_wind)
-from .turbulence import (TurbulenceSpec, evolution_coherence, evolve_field, generate_field,
+from .turbulence import (TurbulenceSpec, evolution_coherence, evolve_field, generate_evolved_field, generate_field,
                          iec_coherence, iec_sigma, kaimal_spectrum, keep_samplers,
                          simley_pao_evolution)
 
@@ -16,5 +16,5 @@ __all__ = ["IECSite", "iec_field", "event_duration", "CONDITIONS", "IEC_REFERENC
            "IEC_TURBULENCE", "keep_samplers", "CWLidar", "LidarMeasurement", "FieldFileError", "WindField", "Preview",
            "PreviewBuffer", "blade_effective_wind", "coherence", "coherence_bandwidth", "peak_lag", "preview",
            "preview_series", "rms_preview_error", "rotor_effective_wind", "TurbulenceSpec",
-           "evolution_coherence", "evolve_field", "generate_field", "iec_coherence", "iec_sigma",
+           "evolution_coherence", "evolve_field", "generate_evolved_field", "generate_field", "iec_coherence", "iec_sigma",
            "kaimal_spectrum", "simley_pao_evolution"]

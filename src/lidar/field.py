@@ -27,15 +27,19 @@ SCHEMA_VERSION = 1
 def _frozen(a: Any, name: str, single: bool = False) -> FloatArray:
     """Read-only contiguous copy, float64 (or float32 when ``single``: the wind components,
     whose 7 significant digits are far finer than any measured or generated wind); an array
-    that is already read-only, contiguous and of that type is adopted without copying (it
-    cannot change under us)."""
+    that is already read-only and of that type is adopted without copying (it cannot change
+    under us), strided or not (an evolved field is stored point-major:
+    :func:`lidar.generate_evolved_field`)."""
     dtype = np.float32 if single else np.float64
-    if (isinstance(a, np.ndarray) and a.dtype == dtype and not a.flags.writeable
-            and a.flags.c_contiguous):
+    if isinstance(a, np.ndarray) and a.dtype == dtype and not a.flags.writeable:
         arr = a
     else:
         arr = np.array(a, dtype=dtype, order="C")
-    if not np.all(np.isfinite(arr)):
+    # a float32 array's sum in double is finite exactly when every entry is (float32
+    # magnitudes cannot overflow it): no array of flags the field's size
+    finite = (math.isfinite(float(arr.sum(dtype=np.float64))) if single
+              else bool(np.all(np.isfinite(arr))))
+    if not finite:
         bad = np.argwhere(~np.isfinite(arr))[0]
         raise ValueError(f"WindField.{name} must be finite; entry {tuple(int(i) for i in bad)} "
                          f"is {arr[tuple(bad)]!r}")

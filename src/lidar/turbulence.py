@@ -35,6 +35,7 @@ user's guide, NREL/TP-500-46198.
 """
 from __future__ import annotations
 
+import dataclasses
 import hashlib
 import logging
 import math
@@ -47,7 +48,8 @@ from ._typing import FloatArray
 from .field import WindField
 
 __all__ = ["TurbulenceSpec", "iec_sigma", "kaimal_spectrum", "iec_coherence", "generate_field",
-           "evolve_field", "evolution_coherence", "simley_pao_evolution", "keep_samplers"]
+           "evolve_field", "generate_evolved_field", "evolution_coherence",
+           "simley_pao_evolution", "keep_samplers"]
 
 log = logging.getLogger(__name__)
 
@@ -177,13 +179,21 @@ class _CirculantSampler:
     """Square roots of the circulant-embedding eigenvalues of exp(-c_k r) for every frequency,
     computed once per field and shared by the three components.
 
+    The kernel is even in both lags, so its eigenvalues are too: one quadrant,
+    (n_y + 1) x (n_z + 1) of the (2 n_y) x (2 n_z), is stored (a quarter of the memory, 13 MB
+    for a 600 s field on 32 x 32 points) and mirrored a chunk at a time when drawing.
+
     Frequencies whose minimal (2 n_y x 2 n_z) embedding is not non-negative definite (the
     lowest few, where the coherence length exceeds the grid) are drawn through the exact
     Cholesky factor of the coherence matrix instead, so every frequency is exact in
-    distribution.
+    distribution. The factors (4 MB each on 32 x 32 points, some 80 MB for a 600 s field) are
+    kept only by a sampler built with ``keep_factors`` (one shared between fields, see
+    :func:`keep_samplers`); otherwise each is formed when drawn (38 ms on 32 x 32 points) and
+    only the last is held, which is what two streams drawn side by side need.
     """
 
-    def __init__(self, c: FloatArray, spec: TurbulenceSpec, chunk: int = 512) -> None:
+    def __init__(self, c: FloatArray, spec: TurbulenceSpec, chunk: int = 64,
+                 keep_factors: bool = True) -> None:
         self.spec = spec
         self.my, self.mz = 2 * spec.n_y, 2 * spec.n_z
         # above this frequency index the coherence of the nearest grid neighbours,
@@ -191,51 +201,97 @@ class _CirculantSampler:
         dmin = min(spec.width / (spec.n_y - 1), spec.height / (spec.n_z - 1))
         self.n_corr = int(np.searchsorted(c * dmin, 16.0))
         self.n_f = c.size
-        c = c[:self.n_corr]
-        self.root = np.empty((c.size, self.my, self.mz), dtype=np.float32)
+        self.c = c[:self.n_corr].copy()
+        # lag index -> quadrant index (the eigenvalues are even in both wavenumbers)
+        self._iy = np.minimum(np.arange(self.my), self.my - np.arange(self.my))
+        self._iz = np.minimum(np.arange(self.mz), self.mz - np.arange(self.mz))
+        self.root = np.empty((self.n_corr, spec.n_y + 1, spec.n_z + 1), dtype=np.float32)
         exact = []
-        for s in range(0, c.size, chunk):
-            lam = _circulant_eigs(c[s:s + chunk], spec, 2)
+        for s in range(0, self.n_corr, chunk):
+            lam = _circulant_eigs(self.c[s:s + chunk], spec, 2)
             bad = lam.min(axis=(1, 2)) < -1e-9 * lam.max(axis=(1, 2))
             exact += [s + int(i) for i in np.flatnonzero(bad)]
             # the 1/sqrt(2) of a unit complex normal is folded in here
-            self.root[s:s + chunk] = np.sqrt(np.clip(lam, 0.0, None) / (2 * self.my * self.mz))
+            self.root[s:s + chunk] = np.sqrt(np.clip(lam[:, :spec.n_y + 1, :spec.n_z + 1], 0.0,
+                                                     None) / (2 * self.my * self.mz))
+        self.exact = tuple(exact)
+        self.keep_factors = keep_factors
         self.chol: dict[int, FloatArray] = {}
+        self._last: tuple[int, FloatArray] | None = None
+        self._r: FloatArray | None = None
         if exact:
-            r = _distances(spec)
-            for k in exact:         # float32 like the field: 4 MB each on 32 x 32 points
-                self.chol[k] = _cholesky_factor(float(c[k]), r).astype(np.float32)
             log.debug("circulant embedding indefinite at %d frequencies: exact Cholesky used",
                       len(exact))
+            if keep_factors:
+                for k in exact:
+                    self.factor(k)
+                self._r = None
 
-    def draw(self, rng: np.random.Generator, chunk: int = 128,
-             out: np.ndarray | None = None) -> np.ndarray:
-        """Complex Gaussian coefficients (n_f, n_y, n_z), covariance exp(-c_k r) per k
-        (written into ``out``, complex64, when given)."""
+    def full_root(self, start: int, stop: int | None = None) -> FloatArray:
+        """The square roots of the eigenvalues of frequencies ``start:stop`` on the whole
+        (2 n_y) x (2 n_z) torus, float32 (stop default: start + 1)."""
+        stop = start + 1 if stop is None else stop
+        return self.root[start:stop][:, self._iy][:, :, self._iz]
+
+    def factor(self, k: int) -> FloatArray:
+        """The float32 lower Cholesky factor of the coherence matrix at frequency ``k`` (one of
+        ``exact``), kept or formed as the sampler was built to."""
+        low = self.chol.get(k)
+        if low is None:
+            if self._last is not None and self._last[0] == k:
+                return self._last[1]
+            if self._r is None:
+                self._r = _distances(self.spec)
+            low = _cholesky_factor(float(self.c[k]), self._r).astype(np.float32)
+            if self.keep_factors:
+                self.chol[k] = low
+            else:
+                self._last = (k, low)
+        return low
+
+    def chunks(self, rng: np.random.Generator, chunk: int = 32
+               ) -> Iterator[tuple[int, int, np.ndarray]]:
+        """The complex Gaussian coefficients of one component, covariance exp(-c_k r) at each
+        frequency k, as (start, stop, (stop - start, n_y, n_z) array) in the stream's order: the
+        independent frequencies a block at a time, the correlated ones a chunk at a time, then
+        the exactly drawn ones, which replace what their chunk gave."""
         spec = self.spec
-        nf = self.root.shape[0]
-        if out is None:
-            out = np.empty((self.n_f, spec.n_y, spec.n_z), dtype=np.complex64)
-        # the independent frequencies, a block at a time (the same stream as one draw)
+        nf = self.n_corr
         for s in range(nf, self.n_f, 4 * chunk):
             e = min(s + 4 * chunk, self.n_f)
             xi = rng.standard_normal((e - s, spec.n_y, spec.n_z, 2), dtype=np.float32)
             xi *= np.float32(1.0 / math.sqrt(2.0))
-            out[s:e] = xi.view(np.complex64)[..., 0]
+            yield s, e, xi.view(np.complex64)[..., 0]
         for s in range(0, nf, chunk):
-            root = self.root[s:s + chunk]
+            root = self.full_root(s, min(s + chunk, nf))
             # complex normals as pairs of float32 normals viewed as complex64 (no copy)
             xi = rng.standard_normal(root.shape + (2,), dtype=np.float32).view(np.complex64)
             xi = xi[..., 0] * root
             # 2-D FFT of which only the first n_y x n_z block is needed: z first, keep n_z
             # columns, then y on those
             part = np.fft.fft(xi, axis=2)[:, :, :spec.n_z]
-            out[s:min(s + chunk, nf)] = np.fft.fft(part, axis=1)[:, :spec.n_y, :]
-        for k, low in self.chol.items():
-            n = low.shape[0]
+            yield s, min(s + chunk, nf), np.fft.fft(part, axis=1)[:, :spec.n_y, :]
+        n = spec.n_y * spec.n_z
+        for k in self.exact:
             xi = (rng.standard_normal(n) + 1j * rng.standard_normal(n)) / math.sqrt(2)
-            out[k] = (low @ xi).reshape(spec.n_y, spec.n_z)
+            yield k, k + 1, (self.factor(k) @ xi).reshape(1, spec.n_y, spec.n_z)
+
+    def draw(self, rng: np.random.Generator, chunk: int = 32,
+             out: np.ndarray | None = None) -> np.ndarray:
+        """Complex Gaussian coefficients (n_f, n_y, n_z), covariance exp(-c_k r) per k
+        (written into ``out``, complex64, when given)."""
+        if out is None:
+            out = np.empty((self.n_f, self.spec.n_y, self.spec.n_z), dtype=np.complex64)
+        for s, e, x in self.chunks(rng, chunk):
+            out[s:e] = x
+        self.release()
         return out
+
+    def release(self) -> None:
+        """Drop what drawing formed and did not keep (the last factor, the distances)."""
+        self._last = None
+        if not self.keep_factors:
+            self._r = None
 
 
 #: the last circulant sampler built, by its grid and decay rates: the seeds of one wind (a
@@ -277,7 +333,7 @@ def _shared_sampler(c: FloatArray, spec: TurbulenceSpec) -> _CirculantSampler:
     hit = _LAST_SAMPLER.get(key)
     if hit is None:
         _LAST_SAMPLER.clear()                 # one at a time: release the last before building
-        hit = _CirculantSampler(c, spec)
+        hit = _CirculantSampler(c, spec, keep_factors=_KEEP["sampler"])
         if _KEEP["sampler"]:
             _LAST_SAMPLER[key] = hit
     return hit
@@ -286,14 +342,23 @@ def _shared_sampler(c: FloatArray, spec: TurbulenceSpec) -> _CirculantSampler:
 def _distances(spec: TurbulenceSpec) -> FloatArray:
     """Distances between all grid points, (n_y n_z, n_y n_z) [m] (y-major order)."""
     _, y, z = spec.grid()
-    yy, zz = np.meshgrid(y, z, indexing="ij")
-    pts = np.column_stack([yy.ravel(), zz.ravel()])
-    return np.sqrt(((pts[:, None, :] - pts[None, :, :]) ** 2).sum(-1))
+    yy, zz = (a.ravel() for a in np.meshgrid(y, z, indexing="ij"))
+    d = yy[:, None] - yy[None, :]
+    d *= d
+    dz = zz[:, None] - zz[None, :]
+    dz *= dz
+    d += dz
+    del dz
+    return np.sqrt(d, out=d)
 
 
 def _cholesky_factor(ck: float, r: FloatArray) -> FloatArray:
-    """Exact reference: lower Cholesky factor of the coherence matrix exp(-c r)."""
-    return np.linalg.cholesky(np.exp(-ck * r) + 1e-12 * np.eye(r.shape[0]))
+    """Exact reference: lower Cholesky factor of the coherence matrix exp(-c r) (+ 1e-12 on
+    the diagonal), formed in place (a 32 x 32 grid's matrix is 8 MB)."""
+    m = np.multiply(r, -ck)
+    np.exp(m, out=m)
+    m[np.diag_indices(r.shape[0])] += 1e-12
+    return np.linalg.cholesky(m)
 
 
 def _coefficients_cholesky(c: FloatArray, spec: TurbulenceSpec,
@@ -359,43 +424,51 @@ def generate_field(spec: TurbulenceSpec, seed: int | np.random.Generator | None 
                      mean_speed=spec.mean_speed, hub_height=spec.hub_height, meta=meta)
 
 
+def _frequencies(spec: TurbulenceSpec) -> tuple[int, int, FloatArray, FloatArray]:
+    """n_t, nf (bins 1..nf-1 carry turbulence; the Nyquist bin nf is left at zero), the
+    frequencies of bins 1..nf-1 [Hz] and their coherence decay rates (eq. of :func:`_decay`)."""
+    n_t = spec.grid()[0].size
+    if n_t < 4:
+        raise ValueError(f"duration / dt gives {n_t} samples; need at least 4")
+    nf = n_t // 2
+    f = np.arange(1, nf) / (n_t * spec.dt)
+    return n_t, nf, f, _decay(f, spec.mean_speed, spec.length_scales[3])
+
+
+def _bin_variance(spec: TurbulenceSpec, k: int, f: FloatArray, low_frequency: str = "lump"
+                  ) -> FloatArray:
+    """The Kaimal variance of component k in each frequency bin [m^2/s^2], with the variance
+    below the first bin added to it when ``low_frequency`` is "lump"."""
+    v, sig, ls = spec.mean_speed, spec.sigma, spec.length_scales
+    df = f[0]
+    var = kaimal_spectrum(f, sig[k], ls[k], v) * df
+    if low_frequency == "lump":
+        lv = ls[k] / v
+        # integral of S from 0 to the lower edge of the first bin (f_1 / 2)
+        var[0] += sig[k] ** 2 * (1.0 - (1.0 + 6.0 * f[0] / 2 * lv) ** (-2.0 / 3.0))
+    return var
+
+
 def _components(spec: TurbulenceSpec, rng: np.random.Generator, method: str = "circulant",
                 low_frequency: str = "lump", components: str = "uvw"
                 ) -> Iterator[tuple[str, FloatArray]]:
     """The field's components u, v, w in turn, each (n_t, n_y, n_z) float32 and read-only,
     drawn from ``rng`` in that order (one at a time: a caller that needs one component at a
     time never holds the three)."""
-    t, y, z = spec.grid()
-    n_t = t.size
-    if n_t < 4:
-        raise ValueError(f"duration / dt gives {n_t} samples; need at least 4")
-    period = n_t * spec.dt
-    nf = n_t // 2                                   # bins 1..nf-1 (Nyquist left at zero)
-    f = np.arange(1, nf) / period
-    df = 1.0 / period
-    v = spec.mean_speed
-    sig = spec.sigma
-    ls = spec.length_scales
-    c = _decay(f, v, ls[3])
+    n_t, nf, f, c = _frequencies(spec)
+    _, _, z = spec.grid()
     sampler = _shared_sampler(c, spec) if method == "circulant" else None
-    shear = (v * (z / spec.hub_height) ** spec.shear_exponent).astype(np.float32)
+    shear = (spec.mean_speed * (z / spec.hub_height) ** spec.shear_exponent).astype(np.float32)
     for k, comp in enumerate("uvw"):
         if comp not in components:
-            series = np.zeros((n_t, spec.n_y, spec.n_z), dtype=np.float32)
-            if comp == "u":
-                series += shear
-            series.flags.writeable = False
+            # no turbulence: one row (the shear profile or zeros) broadcast over the grid and
+            # time, a read-only view that holds no memory
+            series = np.broadcast_to(shear if comp == "u" else np.float32(0.0),
+                                     (n_t, spec.n_y, spec.n_z))
             yield comp, series
             del series
             continue
-        s = kaimal_spectrum(f, sig[k], ls[k], v)
-        var = s * df
-        if low_frequency == "lump":
-            lv = ls[k] / v
-            below = sig[k] ** 2 * (1.0 - (1.0 + 6.0 * f[0] / 2 * lv) ** (-2.0 / 3.0))
-            # integral of S from 0 to the lower edge of the first bin (f_1 / 2)
-            var = var.copy()
-            var[0] += below
+        var = _bin_variance(spec, k, f, low_frequency)
         spec_arr = np.zeros((nf + 1, spec.n_y, spec.n_z), dtype=np.complex64)
         if sampler is not None:
             sampler.draw(rng, out=spec_arr[1:nf])
@@ -410,7 +483,7 @@ def _components(spec: TurbulenceSpec, rng: np.random.Generator, method: str = "c
             series[:, j:j + 4] = np.fft.irfft(spec_arr[:, j:j + 4], n=n_t, axis=0)
         del spec_arr
         if low_frequency == "scale":
-            series *= np.float32(sig[k] / max(float(series.std(dtype=np.float64)), 1e-300))
+            series *= np.float32(spec.sigma[k] / max(float(series.std(dtype=np.float64)), 1e-300))
         if comp == "u":
             series += shear
         series.flags.writeable = False
@@ -530,17 +603,7 @@ def evolve_field(field: WindField, distance: float, spec: TurbulenceSpec | None 
         field's.
     """
     spec = _spec_like(field) if spec is None else spec
-    model = "given"
-    if a is None or b is None:
-        lam = 0.7 * field.hub_height if field.hub_height <= 60.0 else 42.0
-        sa, sb = simley_pao_evolution(field.mean_speed, spec.sigma, 8.1 * lam)
-        a = sa if a is None else a
-        b = sb if b is None else b
-        model = "Simley and Pao (2015)"
-    for name, val in (("distance", distance), ("a", a), ("b", b)):
-        if not (math.isfinite(val) and val >= 0):
-            raise ValueError(f"{name} must be finite and >= 0, got {val!r}")
-    n_t = field.t.size
+    a, b, model = _evolution_parameters(spec, field.hub_height, distance, a, b)
     t, y, z = spec.grid()
     if (t.size, y.size, z.size) != field.u.shape:
         raise ValueError(f"spec grid {(t.size, y.size, z.size)} does not match the field "
@@ -549,34 +612,162 @@ def evolve_field(field: WindField, distance: float, spec: TurbulenceSpec | None 
     if distance == 0.0:
         return WindField(t=field.t, y=field.y, z=field.z, u=field.u, v=field.v, w=field.w,
                          mean_speed=field.mean_speed, hub_height=field.hub_height, meta=meta)
-    # u' one component at a time (the same draws as generate_field(spec, seed)), transformed
-    # in single precision four grid columns at a time (every column's series is independent:
-    # the spectra never exist whole); each mean leaves as the zero-frequency bin. The peak holds
-    # the two fields and one independent component
+    # u' one component at a time (the same draws as generate_field(spec, seed)), its Fourier
+    # coefficients straight from the sampler into a point-major buffer; the field's own
+    # coefficients are added a few grid points at a time and each point's series is written
+    # back over its coefficients (_series_in_place): per component the peak holds one buffer
     rng = seed if isinstance(seed, np.random.Generator) else np.random.default_rng(seed)
-    f = np.fft.rfftfreq(n_t, field.dt)
-    g = np.sqrt(evolution_coherence(f, distance, field.mean_speed, a, b))
-    keep = g.astype(np.float32)[:, None, None]
-    fresh = np.sqrt(1.0 - g**2).astype(np.float32)[:, None, None]
+    n_t, nf, f, c = _frequencies(spec)
+    sampler = _shared_sampler(c, spec)
+    keep, fresh = _evolution_gains(n_t, spec.dt, distance, field.mean_speed, a, b)
+    n_p = spec.n_y * spec.n_z
     out = {}
-    for comp, xo in _components(spec, rng):
-        x = getattr(field, comp)
-        mean = x.mean(axis=0, keepdims=True, dtype=np.float64)
-        series = np.empty(x.shape, dtype=np.float32)
-        for j in range(0, x.shape[1], 4):
-            fo = np.fft.rfft(xo[:, j:j + 4], axis=0).astype(np.complex64, copy=False)
-            fo[0] = 0.0
-            fo *= fresh
-            fx = np.fft.rfft(x[:, j:j + 4], axis=0).astype(np.complex64, copy=False)
-            fx[0] = 0.0
-            fx *= keep
-            fx += fo
-            series[:, j:j + 4] = np.fft.irfft(fx, n=n_t, axis=0)
-        del xo
-        # the mean of every point kept to the float32 storage's resolution: the residual mean
-        # of the single-precision transform is taken out with the mean put back
-        series += (mean - series.mean(axis=0, keepdims=True, dtype=np.float64)
-                   ).astype(np.float32)
+    for k, comp in enumerate("uvw"):
+        gain = fresh[1:nf] * _bin_scale(spec, k, f, n_t)
+        buf = np.zeros((n_p, nf + 1), dtype=np.complex64)
+        for s, e, xo in sampler.chunks(rng):
+            buf[:, 1 + s:1 + e] = (xo * gain[s:e, None, None]).reshape(e - s, n_p).T
+        sampler.release()
+        x = getattr(field, comp).reshape(n_t, n_p)
+        mean = x.mean(axis=0, dtype=np.float64)
+
+        def add_field(r: int, part: np.ndarray, x: np.ndarray = x) -> None:
+            fx = np.fft.rfft(x[:, r:r + part.shape[0]], axis=0)
+            fx[0] = 0.0                      # the mean leaves as the zero-frequency bin
+            part += (fx * keep[:, None]).T
+
+        series = _series_in_place(buf, n_t, spec, add_field)
+        # the mean of every point put back, to the float32 storage's resolution: the residual
+        # mean of the single-precision transform is taken out with it
+        series += (mean.reshape(spec.n_y, spec.n_z)
+                   - series.mean(axis=0, dtype=np.float64)).astype(np.float32)
+        series.flags.writeable = False
         out[comp] = series
     return WindField(t=field.t, y=field.y, z=field.z, u=out["u"], v=out["v"], w=out["w"],
                      mean_speed=field.mean_speed, hub_height=field.hub_height, meta=meta)
+
+
+def generate_evolved_field(spec: TurbulenceSpec, seed: int | np.random.Generator | None,
+                           distance: float,
+                           evolution_seed: int | np.random.Generator | None = None, *,
+                           a: float | None = None, b: float | None = None) -> WindField:
+    """The field ``distance`` upstream of ``generate_field(spec, seed)``, with wind evolution,
+    without that field: ``evolve_field(generate_field(spec, seed), distance, spec,
+    evolution_seed)`` to single-precision rounding.
+
+    A LIDAR in the loop needs the upstream field's three components but the rotor (whose field
+    this does not make) only u. Each Fourier coefficient of the upstream field is
+    gamma X + sqrt(1 - gamma^2) X' (:func:`evolve_field`), with X drawn from ``seed``'s stream
+    as :func:`generate_field` draws it and X' from ``evolution_seed``'s; here both are drawn
+    side by side a frequency chunk at a time and combined at once, so neither the rotor's
+    field nor the independent one ever exists: a 600 s field on 32 x 32 points peaks at its
+    own 150 MB and a few MB, where ``evolve_field`` of a generated field holds the generated
+    one beside it.
+
+    Parameters
+    ----------
+    spec : TurbulenceSpec
+        The rotor's field (and of the independent part).
+    seed : int or Generator
+        The rotor's field's seed, as given to :func:`generate_field`.
+    distance : float
+        Upstream distance d [m], >= 0 (0: ``generate_field(spec, seed)`` itself).
+    evolution_seed : int or Generator, optional
+        Of the independent part, as given to :func:`evolve_field`.
+    a, b : float, optional
+        Coherence parameters (default: :func:`simley_pao_evolution` of the spec).
+
+    Returns
+    -------
+    WindField
+        With ``meta["evolution"]`` = {distance, a, b, model}; its components are stored
+        point-major (strided (n_t, n_y, n_z) views).
+
+    Raises
+    ------
+    ValueError
+        If the distance or parameters are negative or not finite.
+    """
+    a, b, model = _evolution_parameters(spec, spec.hub_height, distance, a, b)
+    evo = {"distance": distance, "a": a, "b": b, "model": model}
+    if distance == 0.0:
+        f0 = generate_field(spec, seed)
+        return dataclasses.replace(f0, meta={**f0.meta, "evolution": evo})
+    rng = seed if isinstance(seed, np.random.Generator) else np.random.default_rng(seed)
+    rng_o = (evolution_seed if isinstance(evolution_seed, np.random.Generator)
+             else np.random.default_rng(evolution_seed))
+    n_t, nf, f, c = _frequencies(spec)
+    t, y, z = spec.grid()
+    sampler = _shared_sampler(c, spec)
+    keep, fresh = _evolution_gains(n_t, spec.dt, distance, spec.mean_speed, a, b)
+    n_p = spec.n_y * spec.n_z
+    out = {}
+    for k, comp in enumerate("uvw"):
+        scale = _bin_scale(spec, k, f, n_t)
+        gx = (keep[1:nf] * scale)[:, None, None]
+        go = (fresh[1:nf] * scale)[:, None, None]
+        buf = np.zeros((n_p, nf + 1), dtype=np.complex64)
+        for (s, e, x), (_, _, xo) in zip(sampler.chunks(rng), sampler.chunks(rng_o)):
+            buf[:, 1 + s:1 + e] = (x * gx[s:e] + xo * go[s:e]).reshape(e - s, n_p).T
+        sampler.release()
+        series = _series_in_place(buf, n_t, spec)
+        if comp == "u":
+            series += (spec.mean_speed * (z / spec.hub_height) ** spec.shear_exponent
+                       ).astype(np.float32)
+        series.flags.writeable = False
+        out[comp] = series
+    meta: dict[str, Any] = {"model": "IEC 61400-1 Kaimal (IECKAI)", "method": "circulant",
+                            "turbulence": spec.turbulence, "sigma": spec.sigma.tolist(),
+                            "shear_exponent": spec.shear_exponent, "low_frequency": "lump",
+                            "components": "uvw",
+                            "seed": seed if isinstance(seed, (int, type(None))) else "generator",
+                            "evolution": evo}
+    return WindField(t=t, y=y, z=z, u=out["u"], v=out["v"], w=out["w"],
+                     mean_speed=spec.mean_speed, hub_height=spec.hub_height, meta=meta)
+
+
+def _evolution_parameters(spec: TurbulenceSpec, hub_height: float, distance: float,
+                          a: float | None, b: float | None) -> tuple[float, float, str]:
+    """(a, b, model) of the evolution coherence: the given ones, else Simley and Pao's of the
+    spec's sigma and the hub height's length scale; checked finite and >= 0 with the
+    distance."""
+    model = "given"
+    if a is None or b is None:
+        lam = 0.7 * hub_height if hub_height <= 60.0 else 42.0
+        sa, sb = simley_pao_evolution(spec.mean_speed, spec.sigma, 8.1 * lam)
+        a = sa if a is None else a
+        b = sb if b is None else b
+        model = "Simley and Pao (2015)"
+    for name, val in (("distance", distance), ("a", a), ("b", b)):
+        if not (math.isfinite(val) and val >= 0):
+            raise ValueError(f"{name} must be finite and >= 0, got {val!r}")
+    return float(a), float(b), model
+
+
+def _evolution_gains(n_t: int, dt: float, distance: float, mean_speed: float, a: float,
+                     b: float) -> tuple[FloatArray, FloatArray]:
+    """gamma and sqrt(1 - gamma^2) of every rfft bin (0..n_t // 2), float32."""
+    g = np.sqrt(evolution_coherence(np.fft.rfftfreq(n_t, dt), distance, mean_speed, a, b))
+    return g.astype(np.float32), np.sqrt(1.0 - g**2).astype(np.float32)
+
+
+def _bin_scale(spec: TurbulenceSpec, k: int, f: FloatArray, n_t: int) -> FloatArray:
+    """Unit complex normals times this give component k's rfft coefficients in bins
+    1..nf-1 (the IEC default "lump" of the low-frequency variance), float32."""
+    return (np.sqrt(2.0 * _bin_variance(spec, k, f)) * (n_t / 2.0)).astype(np.float32)
+
+
+def _series_in_place(buf: np.ndarray, n_t: int, spec: TurbulenceSpec,
+                     before: Any = None, rows: int = 32) -> np.ndarray:
+    """The real series of point-major rfft coefficients ``buf`` (n_y n_z, nf + 1) complex64,
+    written over them: a point's n_t float32 samples take no more bytes than its nf + 1
+    coefficients, so each block of points is transformed and written back into its own rows
+    (``before(r, block)`` may change a block's coefficients first). Returns the
+    (n_t, n_y, n_z) strided view of ``buf``'s memory."""
+    flat = buf.view(np.float32)
+    for r in range(0, buf.shape[0], rows):
+        block = buf[r:r + rows]
+        if before is not None:
+            before(r, block)
+        flat[r:r + rows, :n_t] = np.fft.irfft(block, n=n_t, axis=1)
+    return flat[:, :n_t].reshape(spec.n_y, spec.n_z, n_t).transpose(2, 0, 1)

@@ -18,7 +18,7 @@ from mpc_wt import controllers
 from mpc_wt.cli import main
 from mpc_wt.controllers import (DesignCache, IBCOptions, MPCOptions, Options, Scenario,
                                 build_controller, option, resolve,
-                                turbine_key)
+                                make_wind, turbine_key)
 from mpc_wt.controllers.registry import _KINDS
 from mpc_wt.errors import OptionsError
 
@@ -268,3 +268,38 @@ def test_lqr_pio_region2_shares_the_baselines_torque_law() -> None:
              for law, r in runs.items()}
     assert diffs["baseline"] < 0.005 * q_rated
     assert diffs["k_opt"] > 0.02 * q_rated
+
+
+def test_lidar_field_is_made_from_the_seed_not_beside_the_case_field() -> None:
+    """Issue 23 (memory): the built-in kinds have the case's field made with the plant's u
+    only; a LIDAR's field is made from the case's spec and seed. Evolved, it is
+    lidar.evolve_field of the whole case field with the context's evolution stream (the
+    path before) to single-precision rounding, 2e-5 m/s; frozen (distance 0), the whole
+    field, whose u is the case's. A u-only field whose u runs backwards holds the plant's
+    clipped u itself, not a second copy."""
+    import lidar
+    from mpc_wt.controllers.context import _EVOLUTION_STREAM, BuildContext, field_spec
+
+    tb = linearize.load_turbine()
+    for name in ("mpc-lidar", "baseline+lidar-ff"):
+        sel = controllers.resolve(name)
+        assert set().union(*(k.field_components for k in (sel.base, *sel.addons))) == {"u"}
+    sc = Scenario(18.0, "A", 4, 20.0, 0.2)
+    wind, field = make_wind(tb, sc, "u")
+    assert not field.v.any() and not field.w.any()
+    whole = lidar.generate_field(field_spec(tb, sc), 4)
+    assert np.array_equal(field.u, whole.u)
+    ctx = BuildContext(turbine=tb, params=None, op=None, scenario=sc, field=field)
+    seen = ctx.lidar_field(54.0)
+    ref = lidar.evolve_field(whole, 54.0, seed=np.random.default_rng([4, _EVOLUTION_STREAM]))
+    for comp in "uvw":
+        np.testing.assert_allclose(getattr(seen, comp), getattr(ref, comp), rtol=0, atol=2e-5)
+    frozen = ctx.lidar_field(0.0)
+    assert np.array_equal(frozen.u, whole.u) and np.array_equal(frozen.w, whole.w)
+    low = Scenario(4.0, 0.9, 1, 20.0, 0.2)           # 90 % intensity at 4 m/s: u < 0 somewhere
+    wind, field = make_wind(tb, low, "u")
+    assert lidar.generate_field(field_spec(tb, low), 1).u.min() < 0.0
+    assert wind.u is field.u and field.u.min() == 0.0 and field.meta["u_clipped_at_zero"]
+    with pytest.raises(ValueError, match="scenario 'eog' with turbulence 'A' has no "
+                                         "turbulent field"):
+        field_spec(tb, Scenario(18.0, "A", 1, 20.0, 0.2, condition="eog"))

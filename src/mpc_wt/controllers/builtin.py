@@ -380,6 +380,10 @@ def _mpc(collective: bool, with_lidar: bool) -> Any:
         from ..mpc import MPC
 
         settings = _mpc_settings(opts, collective)
+        # the LIDAR's field first: its making is the run's peak of memory, lower before the
+        # MPC's design is held
+        lidar_opts = opts.lidar if with_lidar else None  # type: ignore[attr-defined]
+        seen = lidar_opts.lidar(ctx) if lidar_opts is not None else None
         if opts.scheduled:
             if not with_lidar and settings.estimator is None:
                 settings = settings.replace(estimator="kalman")
@@ -395,19 +399,13 @@ def _mpc(collective: bool, with_lidar: bool) -> Any:
             "formulation": settings.formulation, "estimator": str(settings.estimator),
             "scheduled": bool(opts.scheduled)}}
         preview = None
-        if with_lidar:
-            preview = _lidar_preview(ctx, opts.lidar, settings.horizon, cdt)  # type: ignore
-            meta["lidar"] = {**opts.lidar.given(),  # type: ignore[attr-defined]
-                             "evolution": opts.lidar.evolution}  # type: ignore[attr-defined]
+        if lidar_opts is not None and seen is not None:
+            from ..simulate import LidarPreview
+
+            preview = LidarPreview(*seen, settings.horizon, cdt)
+            meta["lidar"] = {**lidar_opts.given(), "evolution": lidar_opts.evolution}
         return Built(ctl, cdt, preview, meta)
     return build
-
-
-def _lidar_preview(ctx: BuildContext, opts: LidarOptions, horizon: int, dt: float) -> Any:
-    from ..simulate import LidarPreview
-
-    cw, seen = opts.lidar(ctx)
-    return LidarPreview(cw, seen, horizon, dt)
 
 
 _MPC_GROUP = "the MPC controllers"
@@ -416,7 +414,7 @@ register("mpc", MPCOptions, field_components="u", group=_MPC_GROUP,
          )(_mpc(False, False))
 register("mpc-collective", MPCOptions, field_components="u", group=_MPC_GROUP,
          summary="the MPC with one collective pitch input")(_mpc(True, False))
-register("mpc-lidar", MPCLidarOptions, group=_MPC_GROUP,
+register("mpc-lidar", MPCLidarOptions, field_components="u", group=_MPC_GROUP,
          summary="the individual-pitch MPC with a CW LIDAR's per-blade preview "
                  "(range weighting, LOS error and wind evolution on)")(_mpc(False, True))
 
@@ -717,7 +715,7 @@ class LidarFFOptions(Options):
 
 
 @register("lidar-ff", LidarFFOptions, addon_to=("baseline", "derate"), default_base="baseline",
-          group="the lidar feedforward",
+          field_components="u", group="the lidar feedforward",
           summary="collective pitch feedforward from the CW LIDAR on a baseline "
                   "(baseline+lidar-ff, derate80+lidar-ff)")
 def _build_lidar_ff(ctx: BuildContext, opts: LidarFFOptions, base: Built) -> Built:

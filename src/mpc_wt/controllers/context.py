@@ -15,8 +15,8 @@ import lidar
 import linearize
 from linearize.validate import check_finite_scalar, check_positive, check_range
 
-__all__ = ["Scenario", "BuildContext", "Built", "DesignCache", "make_wind", "field_grid",
-           "turbine_key", "iec_site"]
+__all__ = ["Scenario", "BuildContext", "Built", "DesignCache", "make_wind", "field_spec",
+           "field_grid", "turbine_key", "iec_site"]
 
 
 @dataclass(frozen=True)
@@ -151,14 +151,11 @@ def make_wind(turbine: linearize.Turbine, scenario: Scenario, components: str = 
     """
     hub = turbine.geometry.hub_height
     v, alpha = scenario.wind_mps, scenario.shear_exponent
-    width, n = field_grid(turbine)
-    turb = scenario.turbulence
-    if scenario.condition not in ("ntm", "nwp"):
-        site = iec_site(turbine, scenario)
-        if scenario.condition != "etm":
-            return _iec_wind(scenario, site, width, n)
-        turb = site.magnitudes(site.check_speed("etm", v))["sigma_etm"] / v
+    if scenario.condition not in ("ntm", "nwp", "etm"):
+        width, n = field_grid(turbine)
+        return _iec_wind(scenario, iec_site(turbine, scenario), width, n)
     if scenario.turbulence == "steady" or scenario.condition == "nwp":
+        width, _ = field_grid(turbine)
         spec = lidar.TurbulenceSpec(v, 0.01, hub_height=hub, duration=scenario.duration + 20.0,
                                     dt=1.0, n_y=8, n_z=8, width=width, height=width,
                                     shear_exponent=alpha)
@@ -168,25 +165,63 @@ def make_wind(turbine: linearize.Turbine, scenario: Scenario, components: str = 
         f = lidar.WindField(t=t, y=y, z=z, u=u, v=zero, w=zero, mean_speed=v, hub_height=hub,
                             meta={"model": "steady power law"})
         return linearize.SteadyWind(v, alpha), f
-    spec = lidar.TurbulenceSpec(v, turb, hub_height=hub, width=width,
-                                height=width, n_y=n, n_z=n,
-                                duration=scenario.duration + 20.0, shear_exponent=alpha)
+    spec = field_spec(turbine, scenario)
     f = lidar.generate_field(spec, scenario.seed, components=components)
     if scenario.condition == "etm":
         f = dataclasses.replace(f, meta={**f.meta, "condition": "etm",
                                          "iec_class": scenario.iec_class,
                                          "turbulence_class": scenario.turbulence})
-    return _grid_wind(f), f
+    return _grid_wind(f)
 
 
-def _grid_wind(f: lidar.WindField) -> linearize.GridWind:
+def field_spec(turbine: linearize.Turbine, scenario: Scenario) -> lidar.TurbulenceSpec:
+    """The turbulence of a turbulent scenario's field: the NTM of its class or intensity, or
+    the ETM's sigma (IEC 61400-1 eq. 19) for its IEC class, on :func:`field_grid`'s grid, 20 s
+    longer than the run.
+
+    Parameters
+    ----------
+    turbine : Turbine
+        For the hub height and the grid.
+    scenario : Scenario
+        A turbulent load case (condition ``ntm`` or ``etm``, turbulence not ``steady``).
+
+    Returns
+    -------
+    lidar.TurbulenceSpec
+
+    Raises
+    ------
+    ValueError
+        For a deterministic scenario (steady, NWP or an IEC transient), naming it.
+    """
+    if scenario.deterministic:
+        raise ValueError(f"scenario {scenario.condition!r} with turbulence "
+                         f"{scenario.turbulence!r} has no turbulent field")
+    v = scenario.wind_mps
+    width, n = field_grid(turbine)
+    turb = scenario.turbulence
+    if scenario.condition == "etm":
+        site = iec_site(turbine, scenario)
+        turb = site.magnitudes(site.check_speed("etm", v))["sigma_etm"] / v
+    return lidar.TurbulenceSpec(v, turb, hub_height=turbine.geometry.hub_height, width=width,
+                                height=width, n_y=n, n_z=n, duration=scenario.duration + 20.0,
+                                shear_exponent=scenario.shear_exponent)
+
+
+def _grid_wind(f: lidar.WindField) -> tuple[linearize.GridWind, lidar.WindField]:
     """The plant's wind: the field's u (read-only float32) unless a gust of a very turbulent
-    low wind (or a direction change beyond 90 deg) runs backwards: then the clipped copy."""
+    low wind (or a direction change beyond 90 deg) runs backwards: then the clipped copy. A
+    field made for the plant alone (u only) then holds the clipped u itself instead of
+    beside it (50 MB for a 600 s field on 32 x 32 points), with ``meta["u_clipped_at_zero"]``;
+    a LIDAR never measures it (:meth:`BuildContext.lidar_field` makes its own field)."""
     u = f.u
     if float(u.min()) < 0.0:
         u = np.maximum(f.u, np.float32(0.0))
         u.flags.writeable = False
-    return linearize.GridWind(t=f.t, y=f.y, z=f.z, u=u)
+        if f.meta.get("components") == "u":
+            f = dataclasses.replace(f, u=u, meta={**f.meta, "u_clipped_at_zero": True})
+    return linearize.GridWind(t=f.t, y=f.y, z=f.z, u=u), f
 
 
 def iec_site(turbine: linearize.Turbine, scenario: Scenario) -> lidar.IECSite:
@@ -220,7 +255,7 @@ def _iec_wind(scenario: Scenario, site: lidar.IECSite, width: float, n: int
     f = lidar.iec_field(scenario.condition, scenario.wind_mps, site,
                         t_start=scenario.event_at, duration=scenario.duration + 20.0,
                         dt=0.05, width=width, n=n, sign=scenario.sign)
-    return _grid_wind(f), f
+    return _grid_wind(f)
 
 
 def turbine_key(turbine: linearize.Turbine) -> str:
@@ -358,6 +393,12 @@ class BuildContext:
         over that distance with Simley and Pao's coherence (:func:`lidar.evolve_field`; its
         independent part seeded from the case's seed, so every kind sees the same wind).
 
+        A turbulent case's evolved field is made from the case's spec and seed
+        (:func:`lidar.generate_evolved_field`), not from ``field``: so the case's field needs
+        only the plant's u (``field_components="u"``), and the two are never held side by side
+        with the case's v and w (a 600 s mpc-lidar run peaks some 300 MB lower). With frozen
+        turbulence (distance 0) a u-only case field is made whole again from its seed.
+
         Parameters
         ----------
         distance : float
@@ -367,10 +408,22 @@ class BuildContext:
         -------
         lidar.WindField
         """
-        if distance == 0.0 or self.scenario.deterministic:
+        if self.scenario.deterministic:
             return self.field
+        spec = field_spec(self.turbine, self.scenario)
+        if distance == 0.0:
+            if set(self.field.meta.get("components", "uvw")) >= set("uvw"):
+                return self.field
+            # the case's field was made with u only (the plant's): the whole field, whose u
+            # is the same
+            return dataclasses.replace(lidar.generate_field(spec, self.scenario.seed),
+                                       meta=self.field.meta | {"components": "uvw"})
+        # made without the case's field: it is generate_evolved_field(spec, seed, ...), the
+        # evolution of generate_field(spec, seed) to single-precision rounding
         seed = np.random.default_rng([self.scenario.seed, _EVOLUTION_STREAM])
-        return lidar.evolve_field(self.field, distance, seed=seed)
+        seen = lidar.generate_evolved_field(spec, self.scenario.seed, distance, seed)
+        return dataclasses.replace(seen, meta={**self.field.meta, **seen.meta,
+                                               "components": "uvw"})
 
 
 @dataclass

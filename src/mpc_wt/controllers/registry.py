@@ -61,9 +61,11 @@ class ControllerKind:
         Words for messages about options this kind shares with its family
         (``the MPC controllers``).
     field_components : str
-        The wind components its build reads from ``ctx.field`` ("uvw", the default: a LIDAR
-        needs all three; "u": the case's field is generated without v and w, a third of
-        the memory and time; the plant meets only u either way).
+        The wind components its build reads from ``ctx.field`` ("uvw", the default; "u": the
+        case's field is generated without v and w, a third of the memory and time; the plant
+        meets only u either way). A LIDAR that takes its field from
+        ``ctx.lidar_field`` (all the built-in ones) needs only "u": that field is made whole
+        from the case's seed.
     """
 
     name: str
