@@ -5,9 +5,10 @@ points, 20 Hz), all DOFs, one core:
 
 - the plant alone: ``linearize.rk4_simulate`` with the trim inputs held (compiled loop), and
   the same through ``PlantStepper`` one step at a time from Python;
-- the baseline closed loop (80 Hz controller) and Madsen's MPC with the realistic LIDAR's
-  per-blade preview (``mpc-lidar``: range weighting, LOS error, wind evolution; 10 Hz), each as
-  a real-time factor and as a ratio to the plant alone;
+- the baseline closed loop (80 Hz controller; compiled with the plant, the default, and the
+  Python loop, ``compiled=False``) and Madsen's MPC with the realistic LIDAR's per-blade
+  preview (``mpc-lidar``: range weighting, LOS error, wind evolution; 10 Hz), each as a
+  real-time factor and as a ratio to the plant alone;
 - the MPC-with-LIDAR loop's cost per controller step in its first and its last minute (a loop
   whose cost grows with elapsed time shows a ratio above 1);
 - the MPC's whole step (state and preview in, commands out), replayed on the recorded
@@ -66,11 +67,12 @@ def _plant(t: Any, wind: Any, op: Any, repeat: int) -> dict[str, float]:
     return {"plant_compiled_s": compiled, "plant_stepper_s": _best(stepped, repeat)}
 
 
-def _baseline(t: Any, wind: Any, op: Any, repeat: int) -> float:
+def _baseline(t: Any, wind: Any, op: Any, repeat: int, compiled: bool = True) -> float:
     p, g = linearize.plant_params(t), tune_baseline(t)
-    simulate_closed_loop(p, BaselineController(t, g), wind, 2.0, x0=op.x, u0=op.u)
+    simulate_closed_loop(p, BaselineController(t, g), wind, 2.0, x0=op.x, u0=op.u,
+                         compiled=compiled)
     return _best(lambda: simulate_closed_loop(p, BaselineController(t, g), wind, DURATION,
-                                              x0=op.x, u0=op.u), repeat)
+                                              x0=op.x, u0=op.u, compiled=compiled), repeat)
 
 
 def _mpc_lidar(t: Any) -> dict[str, Any]:
@@ -175,15 +177,17 @@ def main() -> int:
     _, op, wind = build_controller(t, "baseline", Scenario(18.0, "A", 1, DURATION))
     res.update(_plant(t, wind, op, args.repeat))
     res["baseline_s"] = _baseline(t, wind, op, args.repeat)
+    res["baseline_python_s"] = _baseline(t, wind, op, args.repeat, compiled=False)
     m = _mpc_lidar(t)
     rec = m.pop("rec")
     m.pop("dt")
     res.update(m)
     res["whole_step"] = {b: _whole_step(t, rec, b) for b in ("daqp", "osqp")}
     res["whole_step_processes"] = _whole_step_processes(rec, args.step_processes)
-    for k in ("plant_compiled", "plant_stepper", "baseline", "mpc_lidar"):
+    for k in ("plant_compiled", "plant_stepper", "baseline", "baseline_python", "mpc_lidar"):
         res[f"{k}_realtime"] = DURATION / res[f"{k}_s"]
     res["baseline_over_plant"] = res["baseline_s"] / res["plant_compiled_s"]
+    res["baseline_python_over_plant"] = res["baseline_python_s"] / res["plant_compiled_s"]
     res["mpc_lidar_over_plant"] = res["mpc_lidar_s"] / res["plant_compiled_s"]
     if not args.skip_memory:
         res["peak_rss_mb"] = {c: _peak_memory(c) for c in ("baseline", "mpc-lidar")}
@@ -193,10 +197,12 @@ def main() -> int:
     print(f"{res['date']}  {res['machine']}  python {res['python']}  (600 s, 18 m/s class A)")
     for k, label in (("plant_compiled", "plant alone, compiled loop"),
                      ("plant_stepper", "plant alone, PlantStepper from Python"),
-                     ("baseline", "baseline closed loop (80 Hz)"),
+                     ("baseline", "baseline closed loop (80 Hz), compiled"),
+                     ("baseline_python", "the same, Python loop (compiled=False)"),
                      ("mpc_lidar", "MPC + realistic LIDAR preview (10 Hz)")):
         print(f"{label:42s} {res[k + '_s']:7.2f} s  {res[k + '_realtime']:6.1f}x real time")
-    print(f"baseline / plant alone {res['baseline_over_plant']:.2f}, "
+    print(f"baseline / plant alone {res['baseline_over_plant']:.2f} (Python loop "
+          f"{res['baseline_python_over_plant']:.2f}), "
           f"mpc-lidar / plant alone {res['mpc_lidar_over_plant']:.2f}")
     print(f"mpc-lidar loop per controller step: first minute "
           f"{res['first_minute_us_per_step']:.0f} us, last minute "

@@ -67,7 +67,8 @@ __all__ = [
     "DOF_NAMES", "STATE_NAMES", "STATE_UNITS", "INPUT_NAMES", "INPUT_UNITS", "OUTPUT_NAMES",
     "OUTPUT_UNITS", "MADSEN_OUTPUTS", "PlantConfig", "PlantParams", "plant_params", "plant_rhs",
     "plant_outputs", "element_wind", "SteadyWind", "GridWind", "SimulationResult",
-    "SimulationDivergedError", "rk4_simulate", "PlantStepper", "structural_frequencies", "n_x", "n_u", "n_z",
+    "SimulationDivergedError", "rk4_simulate", "PlantStepper", "step_kernel",
+    "structural_frequencies", "n_x", "n_u", "n_z",
 ]
 
 DOF_NAMES = ("tower_fa", "tower_ss", "drivetrain", "generator", "blade_flap", "pitch_actuator",
@@ -756,6 +757,13 @@ def _rk4_into(t, x, u, h, p, kind, wpar, grid, hint, dphi, lim, x_out, z_out):  
     return _bad_state(xn, lim)
 
 
+#: The compiled RK4 step of :meth:`PlantStepper.step_into`, for closed loops compiled with their
+#: controller: ``step_kernel(t, x, u, *stepper.kernel_args(), x_out, z_out)`` in nopython code
+#: advances the plant and the stepper's warm start and returns the first state outside the
+#: envelope (-1: none).
+step_kernel = _rk4_into
+
+
 @nb.njit(**_JIT)
 def _simulate(x0, u_seq, t0, h, n_steps, p, kind, wpar, grid, lim, rate_tq):  # pragma: no cover
     nx = x0.size
@@ -1171,6 +1179,19 @@ class PlantStepper:
         if self._into_entry is None:
             self._into_entry = _rk4_into.compile(tuple(nb.typeof(a) for a in args))
         return self._into_entry(*args)
+
+    def kernel_args(self) -> tuple[Any, ...]:
+        """What :data:`step_kernel` takes between the inputs and the outputs: (dt, the packed
+        parameters, the wind's kind, parameters and grid, the BEM warm start (hint, dphi; updated
+        in place), the state envelope).
+
+        Returns
+        -------
+        tuple
+            For ``step_kernel(t, x, u, *kernel_args(), x_out, z_out)``.
+        """
+        return (self.dt, self._pack, self._kind, self._wpar, self._grid, self._hint,
+                self._dphi, self.limits)
 
     def outputs(self, t: float, x: FloatArray, u: FloatArray) -> FloatArray:
         """The outputs at ``t`` without stepping, (n_z,) (:data:`OUTPUT_NAMES`)."""

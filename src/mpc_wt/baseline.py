@@ -345,6 +345,48 @@ class BaselineController(ControllerBase):
         self.last_torque: float | None = None
         self.signals: dict[str, float] = {}
 
+    def compiled_law(self, gen_speed_index: int) -> tuple[np.ndarray, np.ndarray] | None:
+        """The law's state and parameters for the closed loop compiled with the plant
+        (:mod:`mpc_wt.compiled_loop`), or None where it does not apply: a power reference, a
+        gain schedule, an add-on's feedforward, a subclass or a ``step`` replaced on the
+        instance (a wrapper that times or records the calls): those run through :meth:`step`.
+
+        Parameters
+        ----------
+        gen_speed_index : int
+            Index of the generator speed in the plant's outputs.
+
+        Returns
+        -------
+        (state, params) or None
+        """
+        if (type(self) is not BaselineController or "step" in vars(self)
+                or self.power_reference is not None or self._sched_f is not None
+                or self.pitch_feedforward is not None):
+            return None
+        from .compiled_loop import law_arrays
+
+        return law_arrays(self, gen_speed_index)
+
+    def adopt_compiled_state(self, state: np.ndarray, signals: np.ndarray) -> None:
+        """Take the state a compiled run left (:meth:`compiled_law`'s layout) and its last
+        signals, so the controller reads as if :meth:`step` had run.
+
+        Parameters
+        ----------
+        state : (5,) ndarray
+            Filtered speed, integral, last pitch, last torque, started (0 / 1).
+        signals : (6,) ndarray
+            The last step's signals (:data:`mpc_wt.compiled_loop.SIGNALS`).
+        """
+        from .compiled_loop import SIGNALS
+
+        if state[4] == 0.0:                 # never stepped
+            return
+        self.w_filt, self.integral, self.last_pitch, self.last_torque = (
+            float(v) for v in state[:4])
+        self.signals = {k: float(v) for k, v in zip(SIGNALS, signals)}
+
     def torque(self, w: float, pitch: float, power: float | None = None) -> float:
         """Generator torque demand for a filtered generator speed and the collective pitch;
         ``power`` replaces rated power in region 3 (active power control) [W].
