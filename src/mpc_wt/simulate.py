@@ -391,7 +391,7 @@ def simulate_closed_loop(params: linearize.PlantParams, controller: Any,
         Configuration stored with the result.
     compiled : bool
         Run a controller with a compiled law (the plain baseline, :mod:`mpc_wt.compiled_loop`)
-        compiled with the plant (default: the same loop, 1.4x faster); False: in Python.
+        compiled with the plant (default: the same loop, 1.35x faster); False: in Python.
 
     Returns
     -------
