@@ -176,7 +176,8 @@ def _tie_cache_to_sources(dispatcher: Any, paths: tuple[str, ...]) -> None:
     """numba keys a kernel's disk cache on its own file's source only; :func:`_loop` compiles
     the plant's kernels into itself, so their sources enter the key too: an edit of
     linearize's plant or BEM recompiles the loop instead of loading a stale one. Through
-    numba's cache attributes (0.5x-0.6x); without them, numba's own key and a debug log."""
+    numba's cache object (its attributes as of numba 0.68); without them, numba's own key
+    and a debug log."""
     try:
         cache_file = dispatcher._cache._cache_file
         h = hashlib.sha256(repr(cache_file._source_stamp).encode())
