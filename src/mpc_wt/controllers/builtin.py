@@ -383,7 +383,7 @@ def _mpc(collective: bool, with_lidar: bool) -> Any:
         # the LIDAR's field first: its making is the run's peak of memory, lower before the
         # MPC's design is held
         lidar_opts = opts.lidar if with_lidar else None  # type: ignore[attr-defined]
-        seen = lidar_opts.lidar(ctx) if lidar_opts is not None else None
+        instrument = lidar_opts.lidar(ctx) if lidar_opts is not None else None   # (cw, field)
         if opts.scheduled:
             if not with_lidar and settings.estimator is None:
                 settings = settings.replace(estimator="kalman")
@@ -399,10 +399,10 @@ def _mpc(collective: bool, with_lidar: bool) -> Any:
             "formulation": settings.formulation, "estimator": str(settings.estimator),
             "scheduled": bool(opts.scheduled)}}
         preview = None
-        if lidar_opts is not None and seen is not None:
+        if lidar_opts is not None and instrument is not None:
             from ..simulate import LidarPreview
 
-            preview = LidarPreview(*seen, settings.horizon, cdt)
+            preview = LidarPreview(*instrument, settings.horizon, cdt)
             meta["lidar"] = {**lidar_opts.given(), "evolution": lidar_opts.evolution}
         return Built(ctl, cdt, preview, meta)
     return build
