@@ -415,16 +415,28 @@ def generate_field(spec: TurbulenceSpec, seed: int | np.random.Generator | None 
     if method == "cholesky" and spec.n_y * spec.n_z > 400:
         raise ValueError(f"method='cholesky' is the small-grid reference: n_y * n_z = "
                          f"{spec.n_y * spec.n_z} > 400")
-    rng = seed if isinstance(seed, np.random.Generator) else np.random.default_rng(seed)
+    rng = np.random.default_rng(seed)            # a Generator is returned as it is
     t, y, z = spec.grid()
     fields = dict(_components(spec, rng, method, low_frequency, components))
-    meta: dict[str, Any] = {"model": "IEC 61400-1 Kaimal (IECKAI)", "method": method,
-                            "turbulence": spec.turbulence, "sigma": spec.sigma.tolist(),
-                            "shear_exponent": spec.shear_exponent, "low_frequency": low_frequency,
-                            "components": components,
-                            "seed": seed if isinstance(seed, (int, type(None))) else "generator"}
+    meta = _field_meta(spec, seed, method, low_frequency, components)
     return WindField(t=t, y=y, z=z, u=fields["u"], v=fields["v"], w=fields["w"],
                      mean_speed=spec.mean_speed, hub_height=spec.hub_height, meta=meta)
+
+
+def _field_meta(spec: TurbulenceSpec, seed: Any, method: str, low_frequency: str,
+                components: str) -> dict[str, Any]:
+    """A generated field's ``meta``: how it was made."""
+    return {"model": "IEC 61400-1 Kaimal (IECKAI)", "method": method,
+            "turbulence": spec.turbulence, "sigma": spec.sigma.tolist(),
+            "shear_exponent": spec.shear_exponent, "low_frequency": low_frequency,
+            "components": components,
+            "seed": seed if isinstance(seed, (int, type(None))) else "generator"}
+
+
+def _shear_profile(spec: TurbulenceSpec) -> np.ndarray:
+    """The mean power-law profile of u over the grid's heights, (n_z,) float32 [m/s]."""
+    z = spec.grid()[2]
+    return (spec.mean_speed * (z / spec.hub_height) ** spec.shear_exponent).astype(np.float32)
 
 
 def _frequencies(spec: TurbulenceSpec) -> tuple[int, int, FloatArray, FloatArray]:
@@ -459,9 +471,8 @@ def _components(spec: TurbulenceSpec, rng: np.random.Generator, method: str = "c
     drawn from ``rng`` in that order (one at a time: a caller that needs one component at a
     time never holds the three)."""
     n_t, nf, f, c = _frequencies(spec)
-    _, _, z = spec.grid()
     sampler = _shared_sampler(c, spec) if method == "circulant" else None
-    shear = (spec.mean_speed * (z / spec.hub_height) ** spec.shear_exponent).astype(np.float32)
+    shear = _shear_profile(spec)
     for k, comp in enumerate("uvw"):
         if comp not in components:
             # no turbulence: one row (the shear profile or zeros) broadcast over the grid and
@@ -619,7 +630,7 @@ def evolve_field(field: WindField, distance: float, spec: TurbulenceSpec | None 
     # coefficients straight from the sampler into a point-major buffer; the field's own
     # coefficients are added a few grid points at a time and each point's series is written
     # back over its coefficients (_series_in_place): per component the peak holds one buffer
-    rng = seed if isinstance(seed, np.random.Generator) else np.random.default_rng(seed)
+    rng = np.random.default_rng(seed)            # a Generator is returned as it is
     n_t, nf, f, c = _frequencies(spec)
     sampler = _shared_sampler(c, spec)
     keep, fresh = _evolution_gains(n_t, spec.dt, distance, field.mean_speed, a, b)
@@ -697,9 +708,8 @@ def generate_evolved_field(spec: TurbulenceSpec, seed: int | np.random.Generator
     if distance == 0.0:
         f0 = generate_field(spec, seed)
         return dataclasses.replace(f0, meta={**f0.meta, "evolution": evo})
-    rng = seed if isinstance(seed, np.random.Generator) else np.random.default_rng(seed)
-    rng_o = (evolution_seed if isinstance(evolution_seed, np.random.Generator)
-             else np.random.default_rng(evolution_seed))
+    # default_rng returns a Generator given as it is
+    rng, rng_o = np.random.default_rng(seed), np.random.default_rng(evolution_seed)
     n_t, nf, f, c = _frequencies(spec)
     t, y, z = spec.grid()
     sampler = _shared_sampler(c, spec)
@@ -716,16 +726,10 @@ def generate_evolved_field(spec: TurbulenceSpec, seed: int | np.random.Generator
         sampler.release()
         series = _series_in_place(buf, n_t, spec)
         if comp == "u":
-            series += (spec.mean_speed * (z / spec.hub_height) ** spec.shear_exponent
-                       ).astype(np.float32)
+            series += _shear_profile(spec)
         series.flags.writeable = False
         out[comp] = series
-    meta: dict[str, Any] = {"model": "IEC 61400-1 Kaimal (IECKAI)", "method": "circulant",
-                            "turbulence": spec.turbulence, "sigma": spec.sigma.tolist(),
-                            "shear_exponent": spec.shear_exponent, "low_frequency": "lump",
-                            "components": "uvw",
-                            "seed": seed if isinstance(seed, (int, type(None))) else "generator",
-                            "evolution": evo}
+    meta = {**_field_meta(spec, seed, "circulant", "lump", "uvw"), "evolution": evo}
     return WindField(t=t, y=y, z=z, u=out["u"], v=out["v"], w=out["w"],
                      mean_speed=spec.mean_speed, hub_height=spec.hub_height, meta=meta)
 

@@ -849,6 +849,7 @@ def _md_ultimate(agg: dict[str, Any]) -> list[str]:
     demand per DLC."""
     if not agg["ultimate"]:
         return []
+    extra = any("extrapolated_max" in r for r in agg["ultimate"])
     md = ["## Ultimate loads", "",
           "Each case's extremes after its transient; characteristic: per mean wind the mean "
           "over seeds of each seed's extreme (a deterministic case counts once per sign), the "
@@ -864,12 +865,10 @@ def _md_ultimate(agg: dict[str, Any]) -> list[str]:
           _md(agg["ultimate"], ["controller", "dlc", "family", "channel", "max", "max_case",
                                 "characteristic_max", "wind_max", "design_max", "min",
                                 "design_min", *(["extrapolated_max", "design_extrapolated_max"]
-                                                if any("extrapolated_max" in r for r in
-                                                       agg["ultimate"]) else [])],
+                                                if extra else [])],
               ["controller", "DLC", "family", "channel", "max", "its case",
                "characteristic max", "at wind [m/s]", "design max", "min", "design min",
-               *(["extrapolated max (50 y)", "design extrapolated"]
-                 if any("extrapolated_max" in r for r in agg["ultimate"]) else [])]), ""]
+               *(["extrapolated max (50 y)", "design extrapolated"] if extra else [])]), ""]
     if agg["signoff"]:
         md += ["### Overspeed and pitch-rate demand per DLC", "",
                _md(agg["signoff"], ["controller", "dlc", "cases", "failed",

@@ -443,11 +443,11 @@ class CampaignSpec:
         for c in self.controllers:
             for lc in self.load_cases:
                 if c.dlcs is None or lc.dlc in c.dlcs:
-                    out += self._load_case(c, lc, assess)
+                    out += self._cases_of(c, lc, assess)
         return out
 
-    def _load_case(self, c: ControllerSpec, lc: LoadCase, assess: dict[str, Any]
-                   ) -> list[Case]:
+    def _cases_of(self, c: ControllerSpec, lc: LoadCase, assess: dict[str, Any]
+                  ) -> list[Case]:
         """The cases of one controller in one load case."""
         if lc.legacy:
             grid = [(t, v, s, 1) for t in c.turbulence or lc.turbulence
