@@ -15,9 +15,9 @@ import numpy as np
 
 import lidar
 import linearize
-from mpc_wt.assess import damage_equivalent_load
-from mpc_wt.baseline import BaselineController, tune_baseline
-from mpc_wt.simulate import simulate_closed_loop
+from mpc_wt.assessment.fatigue import damage_equivalent_load
+from mpc_wt.controllers.baseline import BaselineController, tune_baseline
+from mpc_wt.simulation.loop import simulate_closed_loop
 
 
 def main() -> int:

@@ -18,8 +18,9 @@ import time
 import timeit
 
 import linearize
-from mpc_wt.controllers import Scenario, build_controller
-from mpc_wt.simulate import simulate_closed_loop
+from mpc_wt.run import build_controller
+from mpc_wt.simulation.loop import simulate_closed_loop
+from mpc_wt.simulation.scenario import Scenario
 
 
 def main() -> int:

@@ -36,11 +36,12 @@ from typing import Any
 import numpy as np
 
 import linearize
-from mpc_wt.baseline import BaselineController, tune_baseline
-from mpc_wt.bench import _Timed  # the solver-call timer of bench_mpc
-from mpc_wt.controllers import Scenario, build_controller
-from mpc_wt.mpc import MPC
-from mpc_wt.simulate import simulate_closed_loop
+from mpc_wt.controllers.baseline import BaselineController, tune_baseline
+from mpc_wt.controllers.mpc import MPC
+from mpc_wt.run import build_controller
+from mpc_wt.simulation.loop import simulate_closed_loop
+from mpc_wt.simulation.scenario import Scenario
+from mpc_wt.simulation.solver_timing import _Timed
 
 DURATION = 600.0
 

@@ -25,7 +25,7 @@ import numpy as np
 import rosco
 
 from linearize import load_openfast, read_lin, read_lin_set
-from mpc_wt.openfast_output import read_openfast_output, write_openfast_output
+from mpc_wt.io.openfast_output import read_openfast_output, write_openfast_output
 
 CASES = Path(rosco.__file__).parents[1] / "Examples" / "Test_Cases"
 DECKS = {"NREL-5MW": "NREL-5MW/NREL-5MW.fst",

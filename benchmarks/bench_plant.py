@@ -30,7 +30,7 @@ import numba as nb
 import numpy as np
 
 import linearize
-from linearize.plant import _eval
+from linearize.plant import evaluate_plant
 from linearize.steady import _avg_eval
 
 
@@ -38,7 +38,7 @@ from linearize.steady import _avg_eval
 def _loop_rhs(x, u, w, pk, hint, n):  # pragma: no cover - compiled
     acc = 0.0
     for _ in range(n):
-        dx, z, ph = _eval(x, u, w, pk, hint, 0)
+        dx, z, ph = evaluate_plant(x, u, w, pk, hint, 0)
         hint = ph
         acc += dx[2]
     return acc

@@ -21,7 +21,7 @@ import numpy as np
 from tqdm import tqdm
 
 import linearize
-from mpc_wt.controllers import run_controller
+from mpc_wt.run import run_controller
 
 BOUNDS = {"speed_std": 0.15, "power_mean": 0.005, "pitch_travel": 0.20}
 

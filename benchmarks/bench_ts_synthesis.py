@@ -16,8 +16,12 @@ import platform
 import time
 
 import linearize
-from mpc_wt.synthesis import SynthesisError
-from mpc_wt.ts import build_ts_model, design_ts_controller, design_ts_observer
+from mpc_wt.controllers.takagi_sugeno import (
+    build_ts_model,
+    design_ts_controller,
+    design_ts_observer,
+)
+from mpc_wt.errors import SynthesisError
 
 GRIDS = {"8 vertices": ((12.0, 16.0, 20.0, 25.0), (0.0, 0.8)),
          "18 vertices": ((12.0, 14.0, 16.0, 19.0, 22.0, 25.0), (0.0, 0.4, 0.8))}

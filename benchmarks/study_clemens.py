@@ -7,7 +7,7 @@ for the PI baseline on the same wind for context; wind estimate RMS error agains
 of the field and its coherence (Welch). Per f_r at 15 m/s (the paper's Fig. 3 case): amplitude
 ratio and phase of electrical power against the reference (least-squares sine fit at f_r after
 the transient). Eq 11 as printed asks for 175 % of rated at its troughs; we use
-Delta P = 3/8 (1 + sin 2 pi f_r t) (peak reduction 3/4, as printed) -- see mpc_wt.ts.apc_reference.
+Delta P = 3/8 (1 + sin 2 pi f_r t) (peak reduction 3/4, as printed) -- see mpc_wt.controllers.takagi_sugeno.apc_reference.
 
 Run:  python benchmarks/study_clemens.py [--duration 600] [--out study-clemens]
 """
@@ -18,17 +18,21 @@ import json
 import time
 
 import numpy as np
+from _study import study_args
 
 import lidar
 import linearize
-from mpc_wt.assess import tracking_response
 from mpc_wt import run_controller
-from mpc_wt.controllers import Scenario, make_wind
-from mpc_wt.simulate import simulate_closed_loop
-from mpc_wt.retrofit import apc_reference
-from mpc_wt.ts import TSController, build_ts_model, design_ts_controller, design_ts_observer
-
-from _study import study_args
+from mpc_wt.assessment.performance import tracking_response
+from mpc_wt.controllers.apc import apc_reference
+from mpc_wt.controllers.takagi_sugeno import (
+    TSController,
+    build_ts_model,
+    design_ts_controller,
+    design_ts_observer,
+)
+from mpc_wt.simulation.loop import simulate_closed_loop
+from mpc_wt.simulation.scenario import Scenario, make_wind
 
 
 def main() -> int:

@@ -16,16 +16,21 @@ import json
 import time
 
 import numpy as np
+from _study import study_args
 
 import linearize
-from mpc_wt.assess import cs_measures, damage_equivalent_load
-from mpc_wt.baseline import BaselineController, tune_baseline
-from mpc_wt.controllers import Scenario, make_wind
 from mpc_wt import SimulationDivergedError, simulate_closed_loop
-from mpc_wt.synthesis import (REGION3_SCALES, REGION3_WEIGHTS, LQRPIOController, design_lqr,
-                              design_pi_observer)
-
-from _study import study_args
+from mpc_wt.assessment.fatigue import damage_equivalent_load
+from mpc_wt.assessment.performance import cs_measures
+from mpc_wt.controllers.baseline import BaselineController, tune_baseline
+from mpc_wt.controllers.lqr import (
+    REGION3_SCALES,
+    REGION3_WEIGHTS,
+    LQRPIOController,
+    design_lqr,
+    design_pi_observer,
+)
+from mpc_wt.simulation.scenario import Scenario, make_wind
 
 PAPER = {"cs1_change_pct": -27.0, "cs2_change_pct": -79.0, "tower_del_change_pct": -29.0,
          "table4": {"5-10": [0.144, 149.9], "5-15": [0.122, 102.8], "5-20": [0.134, 102.7]}}

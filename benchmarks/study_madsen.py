@@ -18,13 +18,13 @@ import sys
 import time
 
 import numpy as np
+from _study import study_args
 
 import linearize
-from mpc_wt.assess import damage_equivalent_load, harmonic_psd, psd
-from mpc_wt.plotting import plot_psd_comparison
 from mpc_wt import run_controller
-
-from _study import study_args
+from mpc_wt.assessment.fatigue import damage_equivalent_load
+from mpc_wt.assessment.performance import harmonic_psd, psd
+from mpc_wt.plotting import plot_psd_comparison
 
 PAPER = {"power_std_pct_lidar": 0.29, "power_std_pct_no_lidar": 0.36,
          "flap_1P_reduction_pct": 60.0, "shaft_1P_reduction_pct": 85.0,

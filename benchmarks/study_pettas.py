@@ -26,15 +26,14 @@ import time
 from concurrent.futures import ProcessPoolExecutor
 
 import numpy as np
+from _study import study_args
 
 import linearize
-from mpc_wt.assess import tracking_response, wind_bin_probabilities
-from mpc_wt.assess import lifetime_comparison
-from mpc_wt.retrofit import aep_change
 from mpc_wt import run_controller
-from mpc_wt.assess import assess_series
-
-from _study import study_args
+from mpc_wt.assessment.fatigue import wind_bin_probabilities
+from mpc_wt.assessment.performance import tracking_response
+from mpc_wt.assessment.series import assess_series, lifetime_comparison
+from mpc_wt.controllers.derating import aep_change
 
 PAPER = {"aep_change_pct": {"derate90": -6.5, "derate80": -13.5},
          "lss_del_change_pct": {"derate90": -14.0, "derate80": -11.0},

@@ -38,9 +38,13 @@ def test_checker_catches_a_forbidden_edge(tmp_path: Path) -> None:
 
 
 def test_init_files_have_no_logic() -> None:
+    """Re-exports and ``__all__`` only; a module ``__getattr__`` may serve names lazily (the
+    controllers package serves the registry's plugin API that way)."""
     for init in SRC.rglob("__init__.py"):
         tree = ast.parse(init.read_text())
         for node in tree.body:
+            if isinstance(node, ast.FunctionDef) and node.name == "__getattr__":
+                continue
             assert isinstance(node, (ast.Expr, ast.Import, ast.ImportFrom, ast.Assign,
                                      ast.AnnAssign, ast.Try)), \
                 f"{init}: only re-exports and __all__ allowed, found {type(node).__name__}"
@@ -120,10 +124,10 @@ def test_runs_module_is_gone_and_one_simulation_diverged_error() -> None:
     assert not (SRC / "mpc_wt" / "runs.py").exists()
     import linearize
     import mpc_wt
-    from mpc_wt import simulate
+    from mpc_wt.simulation import loop
 
     assert mpc_wt.SimulationDivergedError is linearize.SimulationDivergedError
-    assert simulate.SimulationDivergedError is linearize.SimulationDivergedError
+    assert loop.SimulationDivergedError is linearize.SimulationDivergedError
     for pkg in ("linearize", "lidar", "mpc_wt"):
         tree = ast.parse((SRC / pkg / "errors.py").read_text())
         classes = [n.name for n in tree.body if isinstance(n, ast.ClassDef)]

@@ -2,15 +2,41 @@
 
 This package imports neither ``linearize`` nor ``mpc_wt``; turbine geometry arrives as numbers.
 """
-from .cw import CWLidar, LidarMeasurement
-from .errors import FieldFileError
-from .field import WindField
-from .iec import CONDITIONS, IEC_REFERENCE_SPEED, IEC_TURBULENCE, IECSite, event_duration, iec_field
-from .preview import (Preview, PreviewBuffer, blade_effective_wind, coherence, coherence_bandwidth, peak_lag,
-                      preview, preview_series, rms_preview_error, rotor_effective_wind)
-from .turbulence import (TurbulenceSpec, evolution_coherence, evolve_field, generate_evolved_field, generate_field,
-                         iec_coherence, iec_sigma, kaimal_spectrum, keep_samplers,
-                         simley_pao_evolution)
+from lidar.cw import CWLidar, LidarMeasurement
+from lidar.errors import FieldFileError
+from lidar.field import WindField
+from lidar.iec import (
+           CONDITIONS,
+           IEC_REFERENCE_SPEED,
+           IEC_TURBULENCE,
+           IECSite,
+           event_duration,
+           iec_field,
+)
+from lidar.preview import (
+           Preview,
+           PreviewBuffer,
+           blade_effective_wind,
+           coherence,
+           coherence_bandwidth,
+           peak_lag,
+           preview,
+           preview_series,
+           rms_preview_error,
+           rotor_effective_wind,
+)
+from lidar.turbulence import (
+           TurbulenceSpec,
+           evolution_coherence,
+           evolve_field,
+           generate_evolved_field,
+           generate_field,
+           iec_coherence,
+           iec_sigma,
+           kaimal_spectrum,
+           keep_samplers,
+           simley_pao_evolution,
+)
 
 __all__ = ["IECSite", "iec_field", "event_duration", "CONDITIONS", "IEC_REFERENCE_SPEED",
            "IEC_TURBULENCE", "keep_samplers", "CWLidar", "LidarMeasurement", "FieldFileError", "WindField", "Preview",

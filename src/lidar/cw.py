@@ -26,8 +26,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ._typing import FloatArray
-from .field import WindField
+from lidar._typing import FloatArray
+from lidar.field import WindField
 
 __all__ = ["CWLidar", "LidarMeasurement"]
 

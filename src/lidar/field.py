@@ -16,8 +16,8 @@ from typing import Any
 import numba as nb
 import numpy as np
 
-from ._typing import FloatArray
-from .errors import FieldFileError
+from lidar._typing import FloatArray
+from lidar.errors import FieldFileError
 
 __all__ = ["WindField", "FieldFileError"]
 

@@ -39,8 +39,8 @@ from typing import Any
 
 import numpy as np
 
-from ._typing import FloatArray
-from .field import WindField
+from lidar._typing import FloatArray
+from lidar.field import WindField
 
 __all__ = ["IEC_REFERENCE_SPEED", "IEC_TURBULENCE", "CONDITIONS", "IECSite", "iec_field",
            "event_duration"]
@@ -332,7 +332,7 @@ def iec_field(condition: str, mean_speed: float, site: IECSite, *, t_start: floa
         An unknown condition, a speed outside what the standard allows (:meth:`IECSite.
         check_speed`), a bad sign, time step or grid.
     """
-    from .turbulence import TurbulenceSpec, generate_field
+    from lidar.turbulence import TurbulenceSpec, generate_field
 
     cond = str(condition).lower()
     T = event_duration(cond)

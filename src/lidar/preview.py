@@ -9,9 +9,9 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import signal
 
-from ._typing import FloatArray
-from .cw import LidarMeasurement
-from .field import WindField
+from lidar._typing import FloatArray
+from lidar.cw import LidarMeasurement
+from lidar.field import WindField
 
 __all__ = ["Preview", "PreviewBuffer", "preview", "preview_series", "blade_effective_wind",
            "rotor_effective_wind", "coherence", "coherence_bandwidth", "rms_preview_error",

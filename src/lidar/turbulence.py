@@ -44,8 +44,8 @@ from typing import Any, Iterator
 
 import numpy as np
 
-from ._typing import FloatArray
-from .field import WindField
+from lidar._typing import FloatArray
+from lidar.field import WindField
 
 __all__ = ["TurbulenceSpec", "iec_sigma", "kaimal_spectrum", "iec_coherence", "generate_field",
            "evolve_field", "generate_evolved_field", "evolution_coherence",

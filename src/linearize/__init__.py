@@ -2,24 +2,64 @@
 
 This package never imports ``mpc_wt`` or ``lidar``.
 """
-from .bem import AeroOptions, element_induction, element_loads
-from .errors import (LinearizationError, LinFileError, SimulationDivergedError, TrimError,
-                     TurbineFileError)
-from .linear import (LinearModel, LinearModelFamily, augment_actuator,
-                     jacobian_check, linearize, linearize_family, sensitivities,
-                     with_power_input)
-from .plant import (DOF_NAMES, INPUT_NAMES, INPUT_UNITS, MADSEN_OUTPUTS, OUTPUT_NAMES,
-                    OUTPUT_UNITS, STATE_NAMES, STATE_UNITS, GridWind, PlantConfig, PlantParams,
-                    PlantStepper, SimulationResult, SteadyWind, element_wind,
-                    plant_outputs, plant_params, plant_rhs, rk4_simulate, structural_frequencies)
-from .openfast import load_openfast
-from .openfast_lin import read_lin, read_lin_set, write_lin
-from .performance import (RotorPerformance, read_rotor_performance, rotor_performance,
-                          write_rotor_performance)
-from .steady import optimal_tsr, rotor_average, steady_coefficients
-from .trim import (OperatingPoint, operating_point, operating_schedule, rated_wind_speed,
-                   trim)
-from .turbine import LoadReport, Turbine, available_turbines, load_turbine
+from linearize.bem import AeroOptions, element_induction, element_loads
+from linearize.errors import (
+    LinearizationError,
+    LinFileError,
+    SimulationDivergedError,
+    TrimError,
+    TurbineFileError,
+)
+from linearize.linear import (
+    LinearModel,
+    LinearModelFamily,
+    augment_actuator,
+    jacobian_check,
+    linearize,
+    linearize_family,
+    sensitivities,
+    with_power_input,
+)
+from linearize.load import load_turbine
+from linearize.openfast import load_openfast
+from linearize.openfast_lin import read_lin, read_lin_set, write_lin
+from linearize.performance import (
+    RotorPerformance,
+    read_rotor_performance,
+    rotor_performance,
+    write_rotor_performance,
+)
+from linearize.plant import (
+    DOF_NAMES,
+    INPUT_NAMES,
+    INPUT_UNITS,
+    MADSEN_OUTPUTS,
+    OUTPUT_NAMES,
+    OUTPUT_UNITS,
+    STATE_NAMES,
+    STATE_UNITS,
+    GridWind,
+    PlantConfig,
+    PlantParams,
+    PlantStepper,
+    SimulationResult,
+    SteadyWind,
+    element_wind,
+    plant_outputs,
+    plant_params,
+    plant_rhs,
+    rk4_simulate,
+    structural_frequencies,
+)
+from linearize.steady import optimal_tsr, rotor_average, steady_coefficients
+from linearize.trim import (
+    OperatingPoint,
+    operating_point,
+    operating_schedule,
+    rated_wind_speed,
+    trim,
+)
+from linearize.turbine import LoadReport, Turbine, available_turbines
 
 __all__ = [
     "AeroOptions", "element_induction", "element_loads", "DOF_NAMES", "INPUT_NAMES", "INPUT_UNITS", "MADSEN_OUTPUTS",

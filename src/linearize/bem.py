@@ -32,9 +32,9 @@ import numba as nb
 import numpy as np
 from scipy.interpolate import Akima1DInterpolator
 
-from ._typing import FloatArray
-from .validate import check_array
-from .turbine import Polar, Turbine
+from linearize._typing import FloatArray
+from linearize.turbine import Polar, Turbine
+from linearize.validate import check_array
 
 __all__ = ["AeroOptions", "PolarTable", "build_polar_table", "element_induction", "element_loads",
            "polar_table_of"]
@@ -124,7 +124,7 @@ def build_polar_table(polars: tuple[Polar, ...], n_alpha: int = _N_ALPHA) -> Pol
 # --------------------------------------------------------------------------------------------
 _JIT = dict(cache=True, error_model="numpy", fastmath=False)
 
-# Mode bits of _element (and of the plant kernel that passes them on).
+# Mode bits of element_kernel (and of the plant kernel that passes them on).
 MODE_FROZEN = 1    # frozen wake: induced velocities given, no solve
 MODE_CS = 2        # complex step: implicit-function step around a tight real root
 MODE_TIGHT = 4     # warm-started solves run to _XTOL instead of _XTOL_WARM
@@ -135,7 +135,7 @@ MODE_NOLIMITS = 8  # plant: no actuator position/rate clipping (linearization)
 
 
 @nb.njit(**_JIT)
-def _locate_cell(x, n):  # pragma: no cover - compiled
+def locate_cell(x, n):  # pragma: no cover - compiled
     """Cell of a uniform grid with n nodes holding the fractional index x: (i, x - i), i in
     [0, n - 2] (clamped, so points outside extrapolate the end cells)."""
     i = int(math.floor(x.real))
@@ -161,7 +161,7 @@ def _atan2(y, x):  # pragma: no cover - compiled
 def _polar_lookup(table, k, alpha, alpha0, dalpha):  # pragma: no cover - compiled
     """cl, cd of airfoil k at alpha [rad], alpha wrapped into [-pi, pi)."""
     a = alpha - 2.0 * _PI * math.floor((alpha.real + _PI) / (2.0 * _PI))
-    i, t = _locate_cell((a - alpha0) / dalpha, table.shape[2])
+    i, t = locate_cell((a - alpha0) / dalpha, table.shape[2])
     t2 = t * t
     t3 = t2 * t
     h00 = 2.0 * t3 - 3.0 * t2 + 1.0
@@ -445,7 +445,7 @@ def _element_cs(vx, vy, r, chord, theta, k_af, table, alpha0, dalpha, nb_, rtip,
 
 
 @nb.njit(**_JIT)
-def _element(vx, vy, r, chord, theta, k_af, table, alpha0, dalpha, nb_, rtip, rhub, flags, rho,
+def element_kernel(vx, vy, r, chord, theta, k_af, table, alpha0, dalpha, nb_, rtip, rhub, flags, rho,
              hint, hint_slope, frozen_u, frozen_v, mode):  # pragma: no cover - compiled
     """Loads per unit length on one element: (N', T', phi, dR/dphi, u_ind, v_ind), the last two
     the axial and tangential induced velocities V_x a and V_y a' [m/s].
@@ -535,7 +535,7 @@ def element_loads(turbine: Turbine, vx: FloatArray, vy: FloatArray, pitch_rad: f
     flags = aero_flags(opts)
     out = np.empty((6, n))
     for j in range(n):
-        out[:, j] = _element(vx[j], vy[j], b.r[j], b.chord[j], b.twist_rad[j] + pitch_rad,
+        out[:, j] = element_kernel(vx[j], vy[j], b.r[j], b.chord[j], b.twist_rad[j] + pitch_rad,
                              b.airfoil[j], tab.table, tab.alpha0, tab.dalpha,
                              float(g.number_of_blades), g.tip_radius, g.hub_radius, flags,
                              turbine.environment.air_density, math.nan, math.nan, 0.0, 0.0, 0)
@@ -576,7 +576,7 @@ def element_induction(turbine: Turbine, vx: FloatArray, vy: FloatArray, pitch_ra
     flags = aero_flags(opts)
     out = np.empty((2, n))
     for j in range(n):
-        out[:, j] = _element(vx[j], vy[j], b.r[j], b.chord[j], b.twist_rad[j] + pitch_rad,
+        out[:, j] = element_kernel(vx[j], vy[j], b.r[j], b.chord[j], b.twist_rad[j] + pitch_rad,
                              b.airfoil[j], tab.table, tab.alpha0, tab.dalpha,
                              float(g.number_of_blades), g.tip_radius, g.hub_radius, flags,
                              turbine.environment.air_density, math.nan, math.nan, 0.0, 0.0,

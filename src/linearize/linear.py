@@ -27,9 +27,9 @@ Wake assumption (``wake``):
   equations written out). Use it for the report's gain schedule and for fast pitch action
   (IPC, load control), where the wake has no time to respond within a control period; it
   predicts stronger immediate sensitivities (dP/dpitch 30 % and dT/dV 19 % above the
-  quasi-steady ones at 18 m/s). Before issue 18 the induction *factors* were held, which made
-  the induced velocities scale with V and Omega: dT/dV, dQ/dV 27-88 % off and a dQ/dOmega of the
-  wrong sign near rated.
+  quasi-steady ones at 18 m/s). The induced *velocities* are held, not the induction factors:
+  held factors would make the induced velocities scale with V and Omega (dT/dV, dQ/dV 27-88 %
+  off and a dQ/dOmega of the wrong sign near rated).
 
 With tilt, cone, gravity or shear on, the plant is periodic in azimuth; the models are averaged
 over azimuth in blade coordinates (Madsen's azimuth-independent models), or in multi-blade
@@ -55,15 +55,27 @@ import numba as nb
 import numpy as np
 import scipy.linalg
 
-from ._typing import FloatArray
-from .errors import LinearizationError
-from .validate import check_finite_scalar, check_positive
-from .bem import MODE_CS, MODE_FROZEN, MODE_NOLIMITS, MODE_TIGHT
-from .plant import (INPUT_NAMES, INPUT_UNITS, OUTPUT_NAMES, OUTPUT_UNITS, STATE_NAMES,
-                    STATE_UNITS, PlantConfig, PlantParams, _eval, _sample_wind, n_x, n_z,
-                    plant_params)
-from .trim import OperatingPoint, trim
-from .turbine import Turbine
+from linearize._typing import FloatArray
+from linearize.bem import MODE_CS, MODE_FROZEN, MODE_NOLIMITS, MODE_TIGHT
+from linearize.errors import LinearizationError
+from linearize.plant import (
+    INPUT_NAMES,
+    INPUT_UNITS,
+    OUTPUT_NAMES,
+    OUTPUT_UNITS,
+    STATE_NAMES,
+    STATE_UNITS,
+    PlantConfig,
+    PlantParams,
+    evaluate_plant,
+    n_x,
+    n_z,
+    plant_params,
+    sample_wind,
+)
+from linearize.trim import OperatingPoint, trim
+from linearize.turbine import Turbine
+from linearize.validate import check_finite_scalar, check_positive
 
 __all__ = ["LinearModel", "LinearModelFamily", "LinearizationError", "linearize",
            "linearize_family", "jacobian_check", "augment_actuator", "with_power_input",
@@ -114,8 +126,8 @@ def _jac_fd(x0, u0, w0, p, bem0, mode, h):  # pragma: no cover - compiled
     for j in range(n_x + 7):
         xp, up, wp = _perturbed(x0, u0, w0, j, h[j])
         xm, um, wm = _perturbed(x0, u0, w0, j, -h[j])
-        fp, zp, _ = _eval(xp, up, wp, p, bem0, mode)
-        fm, zm, _ = _eval(xm, um, wm, p, bem0, mode)
+        fp, zp, _ = evaluate_plant(xp, up, wp, p, bem0, mode)
+        fm, zm, _ = evaluate_plant(xm, um, wm, p, bem0, mode)
         jf[:, j] = (fp - fm) / (2 * h[j])
         jz[:, j] = (zp - zm) / (2 * h[j])
     return jf, jz
@@ -129,7 +141,7 @@ def _jac_cs(x0, u0, w0, p, bem0, mode):  # pragma: no cover - compiled
     jz = np.zeros((n_z, n_x + 7))
     for j in range(n_x + 7):
         x, u, w = _perturbed(x0 + 0j, u0 + 0j, w0 + 0j, j, 1j * h)
-        f, z, _ = _eval(x, u, w, p, bem0, mode)
+        f, z, _ = evaluate_plant(x, u, w, p, bem0, mode)
         jf[:, j] = f.imag / h
         jz[:, j] = z.imag / h
     return jf, jz
@@ -159,8 +171,8 @@ def _raw_jacobians(params: PlantParams, op: OperatingPoint, wake: str, shear: fl
     x0 = op.x.copy()
     x0[16] = psi
     u0 = op.u.copy()
-    w0 = _sample_wind(0.0, psi, pk, 0, np.array([op.wind_mps, shear]), np.zeros((1, 1, 1), dtype=np.float32))
-    bem0 = _eval(x0, u0, w0, pk, np.full((4, 3, pk.r.size), np.nan), MODE_NOLIMITS)[2]
+    w0 = sample_wind(0.0, psi, pk, 0, np.array([op.wind_mps, shear]), np.zeros((1, 1, 1), dtype=np.float32))
+    bem0 = evaluate_plant(x0, u0, w0, pk, np.full((4, 3, pk.r.size), np.nan), MODE_NOLIMITS)[2]
     mode = MODE_NOLIMITS | (MODE_FROZEN if wake == "frozen" else 0)
     if method == "cs":
         mode |= 0 if wake == "frozen" else MODE_CS
@@ -320,7 +332,7 @@ class LinearModel:
     def modes(self) -> list[dict[str, Any]]:
         """Oscillatory modes: frequency [Hz], damping ratio [-] and a name from participation.
 
-        The name is the state group with the largest participation factor |phi_k psi_k|
+        The name is the state group with the largest participation factor abs(phi_k psi_k)
         (right and left eigenvectors): tower fore-aft, tower side-side, drivetrain torsion,
         blade flap or blade edge (collective or asymmetric), rotor, pitch actuator.
         """
@@ -405,7 +417,7 @@ def _check_options(wake: str, disturbance: str, coordinates: str) -> None:
         raise ValueError(f"coordinates must be 'blade' or 'mbc', got {coordinates!r}")
 
 
-def _mbc_matrices(psi: float, omega: float) -> tuple[FloatArray, FloatArray, FloatArray,
+def mbc_matrices(psi: float, omega: float) -> tuple[FloatArray, FloatArray, FloatArray,
                                                       FloatArray]:
     """T(psi) with rows [1, cos psi_i, sin psi_i], its inverse, dT/dpsi, d2T/dpsi2."""
     ang = psi + 2 * math.pi * np.arange(3) / 3
@@ -433,7 +445,7 @@ def _assemble(jx: FloatArray, ju: FloatArray, jd: FloatArray, hx: FloatArray, hu
     dd = hd[_OUT_IDX]
     if coordinates == "blade":
         return a, b, bd, c, du, dd
-    t, tinv, tdot, tddot = _mbc_matrices(psi, omega)
+    t, tinv, tdot, tddot = mbc_matrices(psi, omega)
     names = [STATE_NAMES[i] for i in si]
     n = len(si)
     tx = np.eye(n)          # x_blade = tx x_nr
@@ -584,7 +596,7 @@ def _model(p: PlantParams, op: OperatingPoint, jac: tuple[FloatArray, ...], wake
         outputs = _rename(outputs, _BLADE_GROUPS_Z)
         inputs = _rename(inputs, (INPUT_NAMES[:3],))
         dists = _rename(dists, (dists,))
-        t, tinv, _, _ = _mbc_matrices(0.0, 0.0)
+        t, tinv, _, _ = mbc_matrices(0.0, 0.0)
         x0 = _to_mbc_values(states, x0)
         u0 = np.concatenate([tinv @ u0[:3], u0[3:]])
         d0 = tinv @ d0
@@ -623,8 +635,8 @@ def _z0(p: PlantParams, op: OperatingPoint, shear: float, n_azimuth: int = 24) -
     x = op.x.copy()
     for psi in 2 * math.pi * np.arange(n_azimuth) / n_azimuth:
         x[16] = psi
-        w = _sample_wind(0.0, float(psi), pk, 0, wpar, np.zeros((1, 1, 1), dtype=np.float32))
-        z += _eval(x, op.u, w, pk, np.full((4, 3, pk.r.size), np.nan), 0)[1]
+        w = sample_wind(0.0, float(psi), pk, 0, wpar, np.zeros((1, 1, 1), dtype=np.float32))
+        z += evaluate_plant(x, op.u, w, pk, np.full((4, 3, pk.r.size), np.nan), 0)[1]
     return z / n_azimuth
 
 

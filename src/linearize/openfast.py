@@ -34,11 +34,27 @@ from typing import Sequence
 
 import numpy as np
 
-from ._typing import FloatArray
-from .errors import TurbineFileError
-from .turbine import (BladeAero, BladeStructure, Damping, Drivetrain, Environment, Generator,
-                      Geometry, LoadReport, ModeShapes, Nacelle, Operation, PitchActuator, Polar,
-                      ReportEntry, RotorMass, TowerStructure, Turbine)
+from linearize._typing import FloatArray
+from linearize.errors import TurbineFileError
+from linearize.turbine import (
+    BladeAero,
+    BladeStructure,
+    Damping,
+    Drivetrain,
+    Environment,
+    Generator,
+    Geometry,
+    LoadReport,
+    ModeShapes,
+    Nacelle,
+    Operation,
+    PitchActuator,
+    Polar,
+    ReportEntry,
+    RotorMass,
+    TowerStructure,
+    Turbine,
+)
 
 __all__ = ["load_openfast", "OpenFASTFile", "read_airfoil_polar"]
 

@@ -28,10 +28,10 @@ from typing import Sequence
 
 import numpy as np
 
-from ._typing import FloatArray
-from .errors import LinearizationError, LinFileError
-from .linear import LinearModel, _mbc_matrices
-from .openfast_channels import SI_UNIT, resolve_channels, unit_key
+from linearize._typing import FloatArray
+from linearize.errors import LinearizationError, LinFileError
+from linearize.linear import LinearModel, mbc_matrices
+from linearize.openfast_channels import SI_UNIT, resolve_channels, unit_key
 
 __all__ = ["read_lin", "read_lin_set", "write_lin", "compare_with_openfast", "LinFileError"]
 
@@ -457,7 +457,7 @@ def read_lin_set(paths: Sequence[str | Path]) -> LinearModel:
 
 def _mbc(lin: _Lin, xs: list[list[int]], us: list[list[int]], ys: list[list[int]],
          pairs: list[tuple[list[int], list[int]]]) -> tuple[FloatArray, ...]:
-    t, tinv, tdot, tddot = _mbc_matrices(lin.azimuth, lin.rotor_speed)
+    t, tinv, tdot, tddot = mbc_matrices(lin.azimuth, lin.rotor_speed)
     n_x, n_u, n_y = lin.A.shape[0], lin.B.shape[1], lin.C.shape[0]
     tx, txdot = np.eye(n_x), np.zeros((n_x, n_x))
     for g in xs:
@@ -656,9 +656,9 @@ def compare_with_openfast(turbine: object, openfast: LinearModel) -> dict[str, o
     LinFileError
         If the model has no finite wind speed or no pitch operating point.
     """
-    from .linear import linearize
-    from .plant import PlantConfig
-    from .trim import operating_point
+    from linearize.linear import linearize
+    from linearize.plant import PlantConfig
+    from linearize.trim import operating_point
 
     v = openfast.wind_mps
     if not math.isfinite(v):

@@ -15,10 +15,10 @@ from pathlib import Path
 
 import numpy as np
 
-from ._typing import FloatArray
-from .bem import AeroOptions
-from .errors import TurbineFileError
-from .validate import frozen_array
+from linearize._typing import FloatArray
+from linearize.bem import AeroOptions
+from linearize.errors import TurbineFileError
+from linearize.validate import frozen_array
 
 __all__ = ["RotorPerformance", "read_rotor_performance", "write_rotor_performance",
            "rotor_performance"]
@@ -108,7 +108,7 @@ def rotor_performance(turbine: object, tsr: FloatArray, pitch_deg: FloatArray, *
     -------
     RotorPerformance
     """
-    from .steady import steady_coefficients
+    from linearize.steady import steady_coefficients
 
     lam = np.asarray(tsr, dtype=float)
     beta = np.asarray(pitch_deg, dtype=float)

@@ -56,12 +56,18 @@ from typing import Any
 import numba as nb
 import numpy as np
 
-from ._typing import FloatArray
-from .errors import SimulationDivergedError
-from .validate import check_array, check_positive
-from .bem import (MODE_NOLIMITS, AeroOptions, _element, _locate_cell, aero_flags,
-                  polar_table_of)
-from .turbine import Turbine, mode_shape
+from linearize._typing import FloatArray
+from linearize.bem import (
+    MODE_NOLIMITS,
+    AeroOptions,
+    aero_flags,
+    element_kernel,
+    locate_cell,
+    polar_table_of,
+)
+from linearize.errors import SimulationDivergedError
+from linearize.turbine import Turbine, mode_shape
+from linearize.validate import check_array, check_positive
 
 __all__ = [
     "DOF_NAMES", "STATE_NAMES", "STATE_UNITS", "INPUT_NAMES", "INPUT_UNITS", "OUTPUT_NAMES",
@@ -432,7 +438,7 @@ def _clip(v, lo, hi):  # pragma: no cover - compiled
 
 
 @nb.njit(**_JIT)
-def _eval(x, u, wind, p, hint, mode):  # pragma: no cover - compiled
+def evaluate_plant(x, u, wind, p, hint, mode):  # pragma: no cover - compiled
     """Derivatives, outputs and BEM state at one instant (generic over float and complex).
 
     ``wind``: (3, n_r) [m/s]. ``hint``: (4, 3, n_r) BEM state of a nearby earlier solve --
@@ -499,7 +505,7 @@ def _eval(x, u, wind, p, hint, mode):  # pragma: no cover - compiled
             vrel = wind[i, j] - vhub_x - nod * rj * cc * cp
             vx = vrel * (ct * cc + st * sc * cp) - qd * p.phi_flap[j]
             vy = (wr + roll) * rj * cc + vrel * st * sp - vhub_y * cp + ed * p.phi_edge[j]
-            npr, tpr, ph, sl, u_ind, v_ind = _element(
+            npr, tpr, ph, sl, u_ind, v_ind = element_kernel(
                 vx, vy, rj, p.chord[j], p.twist[j] + pitch[i], p.af[j], p.table, p.alpha0,
                 p.dalpha, p.nb, p.rtip, p.rhub, p.flags, p.rho, hint[0, i, j].real,
                 hint[1, i, j].real, hint[2, i, j].real, hint[3, i, j].real, mode)
@@ -670,7 +676,7 @@ def _element_positions(psi, p):  # pragma: no cover - compiled
 
 
 @nb.njit(**_JIT)
-def _sample_wind(t, psi, p, kind, wpar, grid):  # pragma: no cover - compiled
+def sample_wind(t, psi, p, kind, wpar, grid):  # pragma: no cover - compiled
     ys, zs = _element_positions(psi, p)
     nr = p.r.size
     out = np.empty((3, nr))
@@ -687,11 +693,11 @@ def _sample_wind(t, psi, p, kind, wpar, grid):  # pragma: no cover - compiled
     if nt == 1:
         it, at = 0, 0.0
     else:
-        it, at = _locate_cell((t - t0) / dt, nt)
+        it, at = locate_cell((t - t0) / dt, nt)
     for i in range(3):
         for j in range(nr):
-            iy, ay = _locate_cell((ys[i, j] - y0) / dy, ny)
-            iz, az = _locate_cell((zs[i, j] - z0) / dz, nz)
+            iy, ay = locate_cell((ys[i, j] - y0) / dy, ny)
+            iz, az = locate_cell((zs[i, j] - z0) / dz, nz)
             acc = 0.0
             for kt in range(2):
                 if nt == 1 and kt == 1:
@@ -713,19 +719,19 @@ def _rk4(t, x, u, h, p, kind, wpar, grid, hint, dphi):  # pragma: no cover - com
 
     Returns the new state, the outputs at t, the stage-4 BEM state and the new ``dphi``.
     """
-    w1 = _sample_wind(t, x[16], p, kind, wpar, grid)
-    k1, z, ph1 = _eval(x, u, w1, p, hint, 0)
+    w1 = sample_wind(t, x[16], p, kind, wpar, grid)
+    k1, z, ph1 = evaluate_plant(x, u, w1, p, hint, 0)
     x2 = x + 0.5 * h * k1
     hint2 = ph1.copy()
     hint2[0] += 0.5 * dphi
-    k2, _, ph2 = _eval(x2, u, _sample_wind(t + 0.5 * h, x2[16], p, kind, wpar, grid), p, hint2,
+    k2, _, ph2 = evaluate_plant(x2, u, sample_wind(t + 0.5 * h, x2[16], p, kind, wpar, grid), p, hint2,
                        0)
     x3 = x + 0.5 * h * k2
-    k3, _, ph3 = _eval(x3, u, _sample_wind(t + 0.5 * h, x3[16], p, kind, wpar, grid), p, ph2, 0)
+    k3, _, ph3 = evaluate_plant(x3, u, sample_wind(t + 0.5 * h, x3[16], p, kind, wpar, grid), p, ph2, 0)
     x4 = x + h * k3
     hint4 = ph3.copy()
     hint4[0] += 0.5 * dphi
-    k4, _, ph4 = _eval(x4, u, _sample_wind(t + h, x4[16], p, kind, wpar, grid), p, hint4, 0)
+    k4, _, ph4 = evaluate_plant(x4, u, sample_wind(t + h, x4[16], p, kind, wpar, grid), p, hint4, 0)
     xn = x + h / 6.0 * (k1 + 2.0 * k2 + 2.0 * k3 + k4)
     new_dphi = ph4[0] - ph1[0]
     for i in range(new_dphi.shape[0]):
@@ -786,8 +792,8 @@ def _simulate(x0, u_seq, t0, h, n_steps, p, kind, wpar, grid, lim, rate_tq):  # 
         us[k] = u
         t = t0 + k * h
         if k == n_steps:
-            w = _sample_wind(t, x[16], p, kind, wpar, grid)
-            _, z, _ = _eval(x, u, w, p, hint, 0)
+            w = sample_wind(t, x[16], p, kind, wpar, grid)
+            _, z, _ = evaluate_plant(x, u, w, p, hint, 0)
             zs[k] = z
             break
         xn, z, hint, dphi = _rk4(t, x, u, h, p, kind, wpar, grid, hint, dphi)
@@ -841,7 +847,7 @@ def plant_rhs(t: float, x: FloatArray, u: FloatArray, d: FloatArray,
     """
     x, u, d = _check_xud(x, u, d, params.pack.r.size)
     hint = np.full((4, _N_BLADE, params.pack.r.size), np.nan)
-    dx, _, _ = _eval(x, u, d, params.pack, hint, 0)
+    dx, _, _ = evaluate_plant(x, u, d, params.pack, hint, 0)
     return dx
 
 
@@ -850,7 +856,7 @@ def plant_outputs(t: float, x: FloatArray, u: FloatArray, d: FloatArray,
     """Performance outputs z (Madsen eq 17 first, then :data:`OUTPUT_NAMES`), (n_z,) ndarray."""
     x, u, d = _check_xud(x, u, d, params.pack.r.size)
     hint = np.full((4, _N_BLADE, params.pack.r.size), np.nan)
-    _, z, _ = _eval(x, u, d, params.pack, hint, 0)
+    _, z, _ = evaluate_plant(x, u, d, params.pack, hint, 0)
     return z
 
 
@@ -859,7 +865,7 @@ def element_wind(params: PlantParams, azimuth_rad: float, hub_speed: float,
     """Free wind at each element from a steady power-law profile, (n_blade, n_r) [m/s]."""
     ws = SteadyWind(hub_speed, shear_exponent)
     kind, wpar, grid = ws._kernel_args()
-    return _sample_wind(0.0, float(azimuth_rad), params.pack, kind, wpar, grid)
+    return sample_wind(0.0, float(azimuth_rad), params.pack, kind, wpar, grid)
 
 
 @dataclass(frozen=True)
@@ -1195,8 +1201,8 @@ class PlantStepper:
 
     def outputs(self, t: float, x: FloatArray, u: FloatArray) -> FloatArray:
         """The outputs at ``t`` without stepping, (n_z,) (:data:`OUTPUT_NAMES`)."""
-        w = _sample_wind(t, x[16], self._pack, self._kind, self._wpar, self._grid)
-        return _eval(x, u, w, self._pack, self._hint, 0)[1]
+        w = sample_wind(t, x[16], self._pack, self._kind, self._wpar, self._grid)
+        return evaluate_plant(x, u, w, self._pack, self._hint, 0)[1]
 
     def outside_envelope(self, x: FloatArray) -> int:
         """Index of the first state outside the physical envelope (or non-finite), else -1.

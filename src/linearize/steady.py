@@ -7,14 +7,15 @@ the loads azimuth-dependent (one third of a revolution suffices for three equal 
 from __future__ import annotations
 
 import math
+
 import numba as nb
 import numpy as np
 from scipy.optimize import minimize_scalar
 
-from ._typing import FloatArray
-from .bem import MODE_NOLIMITS, AeroOptions
-from .plant import PlantConfig, PlantParams, _eval, _sample_wind, n_x, plant_params
-from .turbine import Turbine
+from linearize._typing import FloatArray
+from linearize.bem import MODE_NOLIMITS, AeroOptions
+from linearize.plant import PlantConfig, PlantParams, evaluate_plant, n_x, plant_params, sample_wind
+from linearize.turbine import Turbine
 
 __all__ = ["steady_coefficients", "optimal_tsr", "rotor_average"]
 
@@ -33,8 +34,8 @@ def _avg_eval(x, u, speed, shear, p, n_az, mode=0):  # pragma: no cover - compil
     xx = x.copy()
     for k in range(n_az):
         xx[16] = k * _TWO_PI_3 / n_az
-        w = _sample_wind(0.0, xx[16], p, 0, wpar, dummy)
-        dx, z, phis = _eval(xx, u, w, p, hint, mode)
+        w = sample_wind(0.0, xx[16], p, 0, wpar, dummy)
+        dx, z, phis = evaluate_plant(xx, u, w, p, hint, mode)
         hint = phis
         dx_avg += dx
         z_avg += z

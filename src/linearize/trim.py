@@ -27,12 +27,12 @@ from typing import Any
 import numpy as np
 from scipy.optimize import brentq, minimize_scalar
 
-from ._typing import FloatArray
-from .errors import TrimError
-from .validate import check_finite_scalar
-from .plant import STATE_NAMES, PlantConfig, PlantParams, n_x, plant_params
-from .steady import optimal_tsr, rotor_average
-from .turbine import Turbine
+from linearize._typing import FloatArray
+from linearize.errors import TrimError
+from linearize.plant import STATE_NAMES, PlantConfig, PlantParams, n_x, plant_params
+from linearize.steady import optimal_tsr, rotor_average
+from linearize.turbine import Turbine
+from linearize.validate import check_finite_scalar
 
 __all__ = ["TrimError", "OperatingPoint", "trim", "operating_point", "operating_schedule",
            "rated_wind_speed"]

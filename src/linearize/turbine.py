@@ -17,14 +17,14 @@ from typing import Any, Callable
 import numpy as np
 import yaml
 
-from ._typing import FloatArray, IntArray
-from .errors import TurbineFileError
-from .validate import frozen_array
+from linearize._typing import FloatArray, IntArray
+from linearize.errors import TurbineFileError
+from linearize.validate import frozen_array
 
 __all__ = [
     "TurbineFileError", "Geometry", "Operation", "Environment", "RotorMass", "Nacelle",
     "Drivetrain", "Generator", "PitchActuator", "Damping", "BladeAero", "Polar",
-    "BladeStructure", "TowerStructure", "ModeShapes", "Turbine", "load_turbine",
+    "BladeStructure", "TowerStructure", "ModeShapes", "Turbine",
     "available_turbines", "LoadReport", "ReportEntry",
 ]
 
@@ -557,15 +557,42 @@ def available_turbines() -> list[str]:
     return sorted(p.name for p in root.iterdir() if (p / "turbine.yaml").is_file())
 
 
-def load_turbine(name_or_path: str | Path = "nrel5mw") -> Turbine:
-    """Load a turbine shipped with mpc-wt (by name), a turbine file or an OpenFAST deck.
+def read_turbine_mapping(path: Path) -> dict[str, Any]:
+    """The top-level mapping of a ``turbine.yaml`` file.
 
     Parameters
     ----------
-    name_or_path : str or Path
-        A packaged name (see :func:`available_turbines`, default ``"nrel5mw"``), a path to a
-        ``turbine.yaml`` file or a directory holding one, or an OpenFAST ``.fst`` deck (read by
-        :func:`linearize.load_openfast`, whose report is ``Turbine.report``).
+    path : Path
+        The file.
+
+    Returns
+    -------
+    dict
+        Its parsed YAML.
+
+    Raises
+    ------
+    TurbineFileError
+        If the file is not YAML or its top level is not a mapping.
+    """
+    try:
+        raw = yaml.safe_load(path.read_text())
+    except yaml.YAMLError as err:
+        raise TurbineFileError(f"{path}: not valid YAML: {err}") from err
+    if not isinstance(raw, dict):
+        raise TurbineFileError(f"{path}: top level must be a mapping, got {type(raw).__name__}")
+    return raw
+
+
+def turbine_from_mapping(path: Path, raw: dict[str, Any]) -> Turbine:
+    """A turbine from the mapping of a native ``turbine.yaml`` and the files it names.
+
+    Parameters
+    ----------
+    path : Path
+        The file (its folder holds the files the mapping names).
+    raw : dict
+        Its parsed YAML (:func:`read_turbine_mapping`).
 
     Returns
     -------
@@ -574,48 +601,15 @@ def load_turbine(name_or_path: str | Path = "nrel5mw") -> Turbine:
     Raises
     ------
     TurbineFileError
-        Naming the file, the field and the allowed range: unknown or missing keys, values out of
-        range, non-monotonic span, polars not covering -180..180 deg, non-positive masses or
-        stiffnesses, elements outside the rotor; for decks, the file and key.
-    FileNotFoundError
-        If neither a packaged name nor an existing path.
+        Naming the file, the field and the allowed range.
     """
-    text = str(name_or_path)
-    if isinstance(name_or_path, str) and text in available_turbines():
-        ref = resources.files("linearize") / "data" / text / "turbine.yaml"
-        with resources.as_file(ref) as p:
-            return _load_path(Path(p))
-    path = Path(name_or_path)
-    if path.is_dir():
-        path = path / "turbine.yaml"
-    if not path.is_file():
-        raise FileNotFoundError(
-            f"turbine {text!r} is neither a packaged turbine {available_turbines()} "
-            f"nor an existing turbine file or OpenFAST .fst deck")
-    if path.suffix.lower() == ".fst":
-        from .openfast import load_openfast
-        return load_openfast(path)
-    return _load_path(path)
-
-
-def _load_path(path: Path) -> Turbine:
-    try:
-        raw = yaml.safe_load(path.read_text())
-    except yaml.YAMLError as err:
-        raise TurbineFileError(f"{path}: not valid YAML: {err}") from err
-    if not isinstance(raw, dict):
-        raise TurbineFileError(f"{path}: top level must be a mapping, got {type(raw).__name__}")
-    if "openfast_deck" in raw:
-        return _load_deck_pointer(path, raw)
-    _check_keys(path, "top level", raw, _TOP_KEYS)
-    if raw["schema_version"] != SCHEMA_VERSION:
-        raise TurbineFileError(f"{path}: schema_version must be {SCHEMA_VERSION}, got "
-                               f"{raw['schema_version']!r}")
+    check_keys(path, "top level", raw, _TOP_KEYS)
+    check_schema_version(path, raw)
     sections = {}
     for sec, cls in _SECTIONS.items():
         sections[sec] = _build_section(path, sec, raw[sec], cls)
     files = raw["files"]
-    _check_keys(path, "files", files, _FILE_KEYS)
+    check_keys(path, "files", files, _FILE_KEYS)
     base = path.parent
     scale = sections["rotor"].blade_mass_scale
     try:
@@ -637,18 +631,45 @@ def _load_path(path: Path) -> Turbine:
         raise TurbineFileError(f"{path}: {err}") from err
 
 
-def _load_deck_pointer(path: Path, raw: dict[str, Any]) -> Turbine:
-    """A ``turbine.yaml`` that names an OpenFAST deck: ``schema_version``, ``name`` and
-    ``openfast_deck`` (path relative to the YAML file)."""
-    _check_keys(path, "top level", raw, {"schema_version", "name", "openfast_deck"})
+def check_schema_version(path: Path, raw: dict[str, Any]) -> None:
+    """Raise unless a turbine file's ``schema_version`` is the one this release reads.
+
+    Parameters
+    ----------
+    path : Path
+        The file, for the message.
+    raw : dict
+        Its parsed YAML.
+
+    Raises
+    ------
+    TurbineFileError
+        Naming the version found and the one expected.
+    """
     if raw["schema_version"] != SCHEMA_VERSION:
         raise TurbineFileError(f"{path}: schema_version must be {SCHEMA_VERSION}, got "
                                f"{raw['schema_version']!r}")
-    from .openfast import load_openfast
-    return load_openfast(path.parent / str(raw["openfast_deck"]), name=str(raw["name"]))
 
 
-def _check_keys(path: Path, where: str, d: Any, allowed: set[str]) -> None:
+def check_keys(path: Path, where: str, d: Any, allowed: set[str]) -> None:
+    """Raise naming the unknown and the missing keys of a section.
+
+    Parameters
+    ----------
+    path : Path
+        The file, for the message.
+    where : str
+        The section, for the message.
+    d : Any
+        The section's value (must be a mapping).
+    allowed : set of str
+        Its keys, all required.
+
+    Raises
+    ------
+    TurbineFileError
+        If ``d`` is not a mapping, or has unknown or missing keys.
+    """
     if not isinstance(d, dict):
         raise TurbineFileError(f"{path}: section {where!r} must be a mapping")
     unknown = sorted(set(d) - allowed)
@@ -667,7 +688,7 @@ def _build_section(path: Path, sec: str, d: Any, cls: type) -> Any:
     optional = {k for k, f in meta.items() if f.metadata.get("optional")}
     if isinstance(d, dict):
         d = {**{k: meta[k].default for k in optional if k not in d}, **d}
-    _check_keys(path, sec, d, set(meta))
+    check_keys(path, sec, d, set(meta))
     kwargs = {}
     for key, f in meta.items():
         v = d[key]

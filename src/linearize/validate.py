@@ -9,7 +9,7 @@ from typing import Any
 
 import numpy as np
 
-from ._typing import FloatArray
+from linearize._typing import FloatArray
 
 
 def check_positive(name: str, value: float, *, allow_zero: bool = False) -> float:

@@ -1,43 +1,63 @@
 """mpc-wt: model-based wind-turbine control design.
 
-Controllers and their synthesis, closed-loop simulation, assessment, campaigns, export and the
-``mpcwt`` command line. Builds on ``linearize`` (the plant) and ``lidar`` (wind fields and
-preview). Controller kinds are registered objects: ``mpc_wt.controllers.kinds()`` lists them,
-``mpc_wt.controllers.register`` adds one, :func:`run_controller` runs any of them.
+Controllers and their synthesis (:mod:`mpc_wt.controllers`), the registry of controller kinds
+(:mod:`mpc_wt.registry`), closed-loop simulation (:mod:`mpc_wt.simulation`), assessment
+(:mod:`mpc_wt.assessment`), files in and out (:mod:`mpc_wt.io`), load-case campaigns
+(:mod:`mpc_wt.campaign`), tuning (:mod:`mpc_wt.tuning`) and the ``mpcwt`` command line
+(:mod:`mpc_wt.cli`). Builds on :mod:`linearize` (the plant) and :mod:`lidar` (wind fields and
+preview). :func:`run_controller` runs any registered kind on a scenario.
 """
-from importlib.metadata import PackageNotFoundError, version
+from mpc_wt import controllers, registry
+from mpc_wt._version import __version__
+from mpc_wt.assessment.fatigue import damage_equivalent_load, lifetime_del
+from mpc_wt.assessment.performance import cs_measures
+from mpc_wt.assessment.series import DEFAULT_CHANNELS, assess_series, reductions
+from mpc_wt.controllers.apc import apc_reference
+from mpc_wt.controllers.baseline import (
+                                         BaselineController,
+                                         BaselineGains,
+                                         tune_baseline,
+                                         tune_baseline_schedule,
+)
+from mpc_wt.controllers.estimator import KalmanEstimator
+from mpc_wt.controllers.ipc import ColemanIPCController, IBCController, tune_coleman_ipc, tune_ibc
+from mpc_wt.controllers.lqr import (
+                                         LQRPIOController,
+                                         design_lqr,
+                                         design_lqr_family,
+                                         design_pi_observer,
+)
+from mpc_wt.controllers.mpc import MPC, MPCSettings, MPCWeights, ScheduledMPC
+from mpc_wt.controllers.qp import BACKENDS, default_backend
+from mpc_wt.controllers.takagi_sugeno import (
+                                         TSController,
+                                         build_ts_model,
+                                         design_ts_controller,
+                                         design_ts_observer,
+)
+from mpc_wt.errors import (
+                                         OptionsError,
+                                         ResultFileError,
+                                         SimulationDivergedError,
+                                         SpecError,
+                                         SynthesisError,
+)
+from mpc_wt.registry.registry import register
+from mpc_wt.run import build_controller, run_controller
+from mpc_wt.simulation.loop import simulate_closed_loop
+from mpc_wt.simulation.preview import LidarPreview
+from mpc_wt.simulation.results import ClosedLoopResult, load_series
+from mpc_wt.simulation.scenario import Scenario
+from mpc_wt.tuning.run import tune
 
-try:
-    __version__ = version("mpc-wt")
-except PackageNotFoundError:  # pragma: no cover - running from a source tree
-    __version__ = "0+unknown"
-
-from . import controllers
-from .assess import (DEFAULT_CHANNELS, assess_series, cs_measures, damage_equivalent_load,
-                     lifetime_del, reductions)
-from .baseline import BaselineController, BaselineGains, tune_baseline, tune_baseline_schedule
-from .controllers import Scenario, register, run_controller
-from .errors import (OptionsError, ResultFileError, SimulationDivergedError, SpecError,
-                     SynthesisError)
-from .estimator import KalmanEstimator
-from .mpc import MPC, MPCSettings, MPCWeights, ScheduledMPC
-from .qp import BACKENDS, default_backend
-from .results import ClosedLoopResult, load_series
-from .retrofit import (ColemanIPCController, IBCController, apc_reference, tune_coleman_ipc,
-                       tune_ibc)
-from .simulate import LidarPreview, simulate_closed_loop
-from .synthesis import LQRPIOController, design_lqr, design_lqr_family, design_pi_observer
-from .ts import (TSController, build_ts_model, design_ts_controller, design_ts_observer)
-from .tuning.run import tune
-
-__all__ = ["__version__", "controllers", "DEFAULT_CHANNELS", "assess_series", "cs_measures",
-           "damage_equivalent_load", "lifetime_del", "reductions", "BaselineController",
-           "BaselineGains", "tune_baseline", "tune_baseline_schedule", "Scenario", "register",
-           "run_controller", "OptionsError", "ResultFileError", "SimulationDivergedError",
-           "SpecError", "SynthesisError", "KalmanEstimator", "MPC", "MPCSettings", "MPCWeights",
-           "ScheduledMPC", "BACKENDS", "default_backend", "ClosedLoopResult", "load_series",
-           "ColemanIPCController", "IBCController", "apc_reference", "tune_coleman_ipc",
-           "tune_ibc", "LidarPreview", "simulate_closed_loop", "LQRPIOController", "design_lqr",
-           "design_lqr_family", "design_pi_observer", "TSController", "build_ts_model",
-           "design_ts_controller", "design_ts_observer", "tune"]
-
+__all__ = ["__version__", "controllers", "registry", "DEFAULT_CHANNELS", "assess_series",
+           "cs_measures", "damage_equivalent_load", "lifetime_del", "reductions",
+           "BaselineController", "BaselineGains", "tune_baseline", "tune_baseline_schedule",
+           "Scenario", "register", "run_controller", "build_controller", "OptionsError",
+           "ResultFileError", "SimulationDivergedError", "SpecError", "SynthesisError",
+           "KalmanEstimator", "MPC", "MPCSettings", "MPCWeights", "ScheduledMPC", "BACKENDS",
+           "default_backend", "ClosedLoopResult", "load_series", "ColemanIPCController",
+           "IBCController", "apc_reference", "tune_coleman_ipc", "tune_ibc", "LidarPreview",
+           "simulate_closed_loop", "LQRPIOController", "design_lqr", "design_lqr_family",
+           "design_pi_observer", "TSController", "build_ts_model", "design_ts_controller",
+           "design_ts_observer", "tune"]

@@ -9,12 +9,12 @@ import numpy as np
 
 from linearize import OperatingPoint
 
-__all__ = ["plot_cp_surface", "plot_operating_schedule", "plot_lidar_coherence",
+__all__ = ["plot_lidar_evaluation", "plot_cp_surface", "plot_operating_schedule", "plot_lidar_coherence",
            "plot_scan_pattern", "plot_cs_ellipses", "plot_psd_comparison", "plot_design",
            "assess_plots", "plot_pareto", "plot_wind_condition"]
 
 
-def _save(fig, path: str | Path) -> Path:  # type: ignore[no-untyped-def]
+def save_figure(fig, path: str | Path) -> Path:  # type: ignore[no-untyped-def]
     """Lay out, write the PNG and release the figure."""
     import matplotlib.pyplot as plt
 
@@ -25,7 +25,7 @@ def _save(fig, path: str | Path) -> Path:  # type: ignore[no-untyped-def]
     return out
 
 
-def _plt():  # type: ignore[no-untyped-def]
+def pyplot():  # type: ignore[no-untyped-def]
     import matplotlib
 
     matplotlib.use("Agg")
@@ -57,7 +57,7 @@ def plot_cp_surface(tsr: np.ndarray, pitch_deg: np.ndarray, cp: np.ndarray, path
     Path
         The PNG file.
     """
-    plt = _plt()
+    plt = pyplot()
     fig, ax = plt.subplots(figsize=(7.5, 5.0), dpi=120)
     shown = np.clip(cp, 0.0, None)
     levels = np.linspace(0.0, max(float(shown.max()), 1e-3), 25)
@@ -72,7 +72,7 @@ def plot_cp_surface(tsr: np.ndarray, pitch_deg: np.ndarray, cp: np.ndarray, path
     ax.set_ylabel("collective pitch [deg]")
     ax.set_title(title or "Power coefficient C_P(lambda, pitch)")
     ax.legend(loc="upper right", fontsize=8)
-    return _save(fig, path)
+    return save_figure(fig, path)
 
 
 def plot_operating_schedule(points: Sequence[OperatingPoint], path: str | Path,
@@ -93,7 +93,7 @@ def plot_operating_schedule(points: Sequence[OperatingPoint], path: str | Path,
     Path
         The PNG file.
     """
-    plt = _plt()
+    plt = pyplot()
     v = np.array([p.wind_mps for p in points])
     fig, axs = plt.subplots(2, 2, figsize=(9.0, 6.5), dpi=120, sharex=True)
     axs[0, 0].plot(v, [p.power / 1e6 for p in points], "o-", ms=3, label="electrical")
@@ -120,7 +120,7 @@ def plot_operating_schedule(points: Sequence[OperatingPoint], path: str | Path,
                 ax.axvline(p.wind_mps, color="0.6", lw=0.8, ls=":")
             break
     fig.suptitle(title or "Steady operating schedule")
-    return _save(fig, path)
+    return save_figure(fig, path)
 
 
 def plot_lidar_coherence(f: np.ndarray, gamma2: np.ndarray, bandwidth_hz: float,
@@ -139,7 +139,7 @@ def plot_lidar_coherence(f: np.ndarray, gamma2: np.ndarray, bandwidth_hz: float,
     Path
         The PNG file.
     """
-    plt = _plt()
+    plt = pyplot()
     fig, ax = plt.subplots(figsize=(7.0, 4.2), dpi=120)
     for i in range(gamma2.shape[1]):
         ax.semilogx(f[1:], gamma2[1:, i], lw=1.0, label=f"blade {i + 1}")
@@ -153,7 +153,7 @@ def plot_lidar_coherence(f: np.ndarray, gamma2: np.ndarray, bandwidth_hz: float,
     ax.set_title("LIDAR preview vs wind at the blade (75 % span)")
     ax.legend(fontsize=8)
     ax.grid(alpha=0.3, which="both")
-    return _save(fig, path)
+    return save_figure(fig, path)
 
 
 def plot_scan_pattern(beam_azimuth_rad: np.ndarray, blade_azimuth_rad: np.ndarray,
@@ -172,7 +172,7 @@ def plot_scan_pattern(beam_azimuth_rad: np.ndarray, blade_azimuth_rad: np.ndarra
     Path
         The PNG file.
     """
-    plt = _plt()
+    plt = pyplot()
     fig, ax = plt.subplots(figsize=(5.5, 5.5), dpi=120)
     th = np.linspace(0, 2 * np.pi, 200)
     ax.plot(rotor_radius * np.sin(th), rotor_radius * np.cos(th), color="0.6", lw=0.8)
@@ -192,7 +192,7 @@ def plot_scan_pattern(beam_azimuth_rad: np.ndarray, blade_azimuth_rad: np.ndarra
     ax.set_ylabel("vertical from hub [m]")
     ax.set_title("CW LIDAR scan: foci lead their blades by omega T_p")
     ax.legend(fontsize=8, loc="lower right")
-    return _save(fig, path)
+    return save_figure(fig, path)
 
 
 def plot_cs_ellipses(items: list[tuple[str, Any, np.ndarray, np.ndarray]], path: str | Path,
@@ -215,7 +215,7 @@ def plot_cs_ellipses(items: list[tuple[str, Any, np.ndarray, np.ndarray]], path:
     Path
         The PNG file.
     """
-    plt = _plt()
+    plt = pyplot()
     fig, ax = plt.subplots(figsize=(7.0, 5.0), dpi=120)
     for k, (label, cs, x, y) in enumerate(items):
         step = max(1, len(x) // 3000)
@@ -231,7 +231,7 @@ def plot_cs_ellipses(items: list[tuple[str, Any, np.ndarray, np.ndarray]], path:
     ax.set_title("Covariance ellipses (95 %, s = 5.99), Do et al. 2020")
     ax.legend(fontsize=7)
     ax.grid(alpha=0.3)
-    return _save(fig, path)
+    return save_figure(fig, path)
 
 
 def plot_psd_comparison(items: list[tuple[str, np.ndarray, np.ndarray]], rotor_hz: float,
@@ -254,7 +254,7 @@ def plot_psd_comparison(items: list[tuple[str, np.ndarray, np.ndarray]], rotor_h
     Path
         The PNG file.
     """
-    plt = _plt()
+    plt = pyplot()
     fig, ax = plt.subplots(figsize=(7.0, 4.2), dpi=120)
     for label, f, p in items:
         ax.loglog(f[1:], p[1:], lw=1.0, label=label)
@@ -265,7 +265,7 @@ def plot_psd_comparison(items: list[tuple[str, np.ndarray, np.ndarray]], rotor_h
     ax.set_ylabel(ylabel)
     ax.legend(fontsize=8)
     ax.grid(alpha=0.3, which="both")
-    return _save(fig, path)
+    return save_figure(fig, path)
 
 
 def assess_plots(runs: Sequence[tuple[str, np.ndarray, dict[str, np.ndarray]]],
@@ -284,7 +284,7 @@ def assess_plots(runs: Sequence[tuple[str, np.ndarray, dict[str, np.ndarray]]],
     list of str
         The files written.
     """
-    from .assess import cs_measures, psd
+    from mpc_wt.assessment.performance import cs_measures, psd
 
     d = Path(out_dir)
     d.mkdir(parents=True, exist_ok=True)
@@ -315,7 +315,7 @@ def plot_design(doc: dict[str, Any], path: str | Path) -> Path:
     Parameters
     ----------
     doc : dict
-        A gain-table document (:mod:`mpc_wt.export`).
+        A gain-table document (:mod:`mpc_wt.io.gain_tables`).
     path : str or Path
         The PNG file.
 
@@ -324,7 +324,7 @@ def plot_design(doc: dict[str, Any], path: str | Path) -> Path:
     Path
         ``path``.
     """
-    plt = _plt()
+    plt = pyplot()
     s = doc["schedule"]
     rows = np.asarray(s["rows"], dtype=float)
     x = rows[:, 0]
@@ -352,7 +352,7 @@ def plot_design(doc: dict[str, Any], path: str | Path) -> Path:
     ax.set_title(f"{doc['kind']} gains, {doc['turbine']}")
     ax.grid(True, alpha=0.3)
     ax.legend(fontsize=7)
-    return _save(fig, path)
+    return save_figure(fig, path)
 
 
 def plot_comparison(runs: Sequence[tuple[str, np.ndarray, dict[str, np.ndarray]]],
@@ -440,7 +440,7 @@ def plot_pareto(metrics: Sequence[dict[str, float]], feasible: Sequence[bool],
     -------
     Path
     """
-    plt = _plt()
+    plt = pyplot()
     fig, axes = plt.subplots(len(ys), len(xs), figsize=(4.6 * len(xs), 3.4 * len(ys)),
                              squeeze=False)
     ok = np.asarray(feasible, bool)
@@ -469,7 +469,7 @@ def plot_pareto(metrics: Sequence[dict[str, float]], feasible: Sequence[bool],
             ax.grid(alpha=0.3)
     axes[0][0].legend(fontsize=7)
     fig.suptitle(title)
-    return _save(fig, path)
+    return save_figure(fig, path)
 
 
 def plot_wind_condition(field: Any, path: str | Path) -> Path:
@@ -488,7 +488,7 @@ def plot_wind_condition(field: Any, path: str | Path) -> Path:
     Path
         The file written.
     """
-    plt = _plt()
+    plt = pyplot()
     j, k = int(np.argmin(np.abs(field.y))), int(np.argmin(np.abs(field.z - field.hub_height)))
     speed = np.hypot(field.u, field.v)
     fig, (a1, a2) = plt.subplots(2, 1, figsize=(8, 6), sharex=True)
@@ -510,7 +510,7 @@ def plot_wind_condition(field: Any, path: str | Path) -> Path:
     a2.set_xlabel("t [s]")
     for ax in (a1, a2):
         ax.grid(alpha=0.3)
-    return _save(fig, path)
+    return save_figure(fig, path)
 
 
 def _grouped_bars(ax: Any, cats: Sequence[str], series: dict[str, list[float | None]]) -> None:
@@ -542,7 +542,7 @@ def plot_ultimate(rows: Sequence[dict[str, Any]], path: str | Path) -> Path:
     Path
         The file written.
     """
-    plt = _plt()
+    plt = pyplot()
     rows = [r for r in rows if r["design_max"] is not None or r["design_min"] is not None]
     chans = list(dict.fromkeys(r["channel"] for r in rows))
     ctls = list(dict.fromkeys(r["controller"] for r in rows))
@@ -567,7 +567,7 @@ def plot_ultimate(rows: Sequence[dict[str, Any]], path: str | Path) -> Path:
     for ax in list(axs.flat)[len(chans):]:
         ax.set_visible(False)
     fig.suptitle("Design loads per DLC (partial safety factors applied)", fontsize=9)
-    return _save(fig, path)
+    return save_figure(fig, path)
 
 
 def plot_signoff(signoff: Sequence[dict[str, Any]], governing: Sequence[dict[str, Any]],
@@ -590,7 +590,7 @@ def plot_signoff(signoff: Sequence[dict[str, Any]], governing: Sequence[dict[str
     Path
         The file written.
     """
-    plt = _plt()
+    plt = pyplot()
     ctls = list(dict.fromkeys(r["controller"] for r in signoff))
     dlcs = list(dict.fromkeys(r["dlc"] for r in signoff))
     chans = list(dict.fromkeys(r["channel"] for r in governing))
@@ -615,4 +615,34 @@ def plot_signoff(signoff: Sequence[dict[str, Any]], governing: Sequence[dict[str
     a3.axhline(1.0, color="r", ls="--", lw=1)
     a3.set_ylabel("pitch rate max / limit")
     a3.set_xlabel("DLC")
-    return _save(fig, path)
+    return save_figure(fig, path)
+
+
+def plot_lidar_evaluation(summary: dict[str, Any], curves: dict[str, Any], tip_radius: float,
+                          folder: str | Path) -> list[str]:
+    """The LIDAR-rotor coherence and the scan pattern of one revolution, as
+    ``lidar_coherence.png`` and ``lidar_scan.png`` in ``folder``.
+
+    Parameters
+    ----------
+    summary, curves : dict
+        What :func:`mpc_wt.assessment.lidar.lidar_evaluation` returns.
+    tip_radius : float
+        Rotor tip radius [m].
+    folder : str or Path
+        Where the plots go (made if missing).
+
+    Returns
+    -------
+    list of str
+        The files written.
+    """
+    d = Path(folder)
+    d.mkdir(parents=True, exist_ok=True)
+    plot_lidar_coherence(curves["frequency_hz"], curves["coherence"],
+                         summary["coherence_bandwidth_Hz"], summary["mean_speed_mps"],
+                         d / "lidar_coherence.png")
+    plot_scan_pattern(curves["beam_azimuth_rad"], curves["blade_azimuth_rad"],
+                      curves["lidar_radius"], tip_radius, d / "lidar_scan.png")
+    return [str(d / "lidar_coherence.png"), str(d / "lidar_scan.png")]
+

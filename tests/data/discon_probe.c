@@ -1,4 +1,4 @@
-/* A Bladed-style test controller for tests/mpc_wt/test_discon.py: it appends every record it
+/* A Bladed-style test controller for tests/mpc_wt/controllers/test_discon.py: it appends every record it
  * receives (1..130) to <OUTNAME>.swap.csv, counts its calls in a global (one count per loaded
  * copy), answers fixed demands, and stops the run (aviFAIL = -1) at t >= 0.5 s when its input
  * file is named PROBE_STOP.IN. */

@@ -166,7 +166,7 @@ def test_warm_start_never_keeps_a_propeller_brake_hint(turbine: linearize.Turbin
     carried on blade 2's tip element at t = 587.3 s: phi = -2.8e-5 rad at the residual's jump
     at phi = 0, while the global root was 0.106 rad; tracking it threw the edgewise rates to
     200 m/s in one step. Here the tip element at 13 m/s, 1.28 rad/s and 3.7 deg pitch."""
-    from linearize.bem import _element, aero_flags, polar_table_of
+    from linearize.bem import aero_flags, element_kernel, polar_table_of
 
     b, g = turbine.blade, turbine.geometry
     tab = polar_table_of(turbine)
@@ -174,8 +174,8 @@ def test_warm_start_never_keeps_a_propeller_brake_hint(turbine: linearize.Turbin
     args = (11.0, 1.2842 * b.r[j], b.r[j], b.chord[j], b.twist_rad[j] + 0.0653, b.airfoil[j],
             tab.table, tab.alpha0, tab.dalpha, float(g.number_of_blades), g.tip_radius,
             g.hub_radius, aero_flags(AeroOptions()), turbine.environment.air_density)
-    cold = _element(*args, math.nan, math.nan, 0.0, 0.0, 0)
-    warm = _element(*args, hint, slope, 0.0, 0.0, 0)
+    cold = element_kernel(*args, math.nan, math.nan, 0.0, 0.0, 0)
+    warm = element_kernel(*args, hint, slope, 0.0, 0.0, 0)
     assert cold[2] > 0.05                                   # the global root: phi > 0
     assert warm[2] == pytest.approx(cold[2], abs=1e-8)
     assert warm[0] == pytest.approx(cold[0], rel=1e-6)      # the element's normal load

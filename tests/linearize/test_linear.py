@@ -10,9 +10,17 @@ import pytest
 from numpy.testing import assert_allclose
 
 import linearize
-from linearize import (LinearizationError, LinearModelFamily, PlantConfig, TrimError,
-                       augment_actuator, jacobian_check, linearize_family, sensitivities,
-                       with_power_input)
+from linearize import (
+    LinearizationError,
+    LinearModelFamily,
+    PlantConfig,
+    TrimError,
+    augment_actuator,
+    jacobian_check,
+    linearize_family,
+    sensitivities,
+    with_power_input,
+)
 from linearize import linearize as lin
 from linearize.linear import _D_SCALE, _U_SCALE, _X_SCALE
 

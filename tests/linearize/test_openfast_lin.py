@@ -94,8 +94,8 @@ def test_written_lin_is_read_by_openfast_io(our_set) -> None:
 def test_our_model_through_lin_drives_mpc_and_lqr(our_set, turbine) -> None:
     """A model read back from .lin files is used where our own are: model.modes(), the LQR
     and the MPC (which needs Madsen's outputs: they are there under our names)."""
-    from mpc_wt.mpc import MPC
-    from mpc_wt.synthesis import design_lqr
+    from mpc_wt.controllers.lqr import design_lqr
+    from mpc_wt.controllers.mpc import MPC
 
     paths, _, original = our_set
     m = read_lin(paths[0])

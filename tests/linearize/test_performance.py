@@ -10,8 +10,12 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import linearize
-from linearize import (RotorPerformance, TurbineFileError, read_rotor_performance,
-                       write_rotor_performance)
+from linearize import (
+    RotorPerformance,
+    TurbineFileError,
+    read_rotor_performance,
+    write_rotor_performance,
+)
 
 ROSCO_TABLE = Path(__file__).parents[1] / "data" / "Cp_Ct_Cq.NREL5MW.txt"
 

@@ -11,9 +11,19 @@ from hypothesis import strategies as st
 from numpy.testing import assert_allclose
 
 import linearize
-from linearize import (OUTPUT_NAMES, STATE_NAMES, GridWind, PlantConfig, SimulationDivergedError,
-                       SteadyWind, plant_outputs, plant_rhs, rk4_simulate, structural_frequencies,
-                       trim)
+from linearize import (
+    OUTPUT_NAMES,
+    STATE_NAMES,
+    GridWind,
+    PlantConfig,
+    SimulationDivergedError,
+    SteadyWind,
+    plant_outputs,
+    plant_rhs,
+    rk4_simulate,
+    structural_frequencies,
+    trim,
+)
 
 # published: Jonkman et al. (2009) Table 9-1, FAST full-system natural frequencies
 # (report values, not re-read): 1st tower fore-aft 0.3240 Hz, 1st tower side-to-side 0.3120 Hz,

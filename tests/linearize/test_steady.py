@@ -16,6 +16,7 @@ import pytest
 
 import linearize
 
+
 @pytest.fixture(scope="module")
 def turbine() -> linearize.Turbine:
     return linearize.load_turbine()

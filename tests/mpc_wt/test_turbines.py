@@ -3,7 +3,6 @@ and a closed loop, OpenFAST decks on the command line, ROSCO tables written by t
 from __future__ import annotations
 
 import json
-import math
 from pathlib import Path
 
 import numpy as np
@@ -12,7 +11,7 @@ import rosco  # in the test extras
 
 import linearize
 from mpc_wt.cli import main
-from mpc_wt.controllers import run_controller
+from mpc_wt.run import run_controller
 
 CASES = Path(rosco.__file__).parents[1] / "Examples" / "Test_Cases"
 

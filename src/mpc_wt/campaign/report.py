@@ -2,7 +2,7 @@
 
 Per controller, turbulence and channel: short-term DELs per wind bin and seed; the DEL per bin
 over seeds (m-power mean of equal-length runs); the lifetime DEL, the m-power mean weighted by
-the wind distribution (Clemens et al. eq 18, :func:`mpc_wt.assess.lifetime_del`); AEP from the
+the wind distribution (Clemens et al. eq 18, :func:`mpc_wt.assessment.series.lifetime_del`); AEP from the
 mean power per bin; pitch duty weighted the same way (Pettas and Cheng sec. 4); CS1-CS5 per bin
 (Do et al. eqs 21-26); lifetime extension for a retrofit after 15 of 20 years (Pettas and Cheng
 eq 1). Every comparison with the reference controller is made over the winds both ran.
@@ -19,10 +19,11 @@ from typing import Any, Sequence
 
 import numpy as np
 
-from ..assess import aep_Wh, cs_measures, lifetime_del, lifetime_extension, pct_change, psd
-from .spec import CampaignSpec, spec_from_dict, turbulence_tag
-from .store import CampaignStore, CaseRow
-from .signoff import governing_rows, signoff_rows, ultimate_rows
+from mpc_wt.assessment.fatigue import lifetime_del, lifetime_extension
+from mpc_wt.assessment.performance import aep_Wh, cs_measures, pct_change, psd
+from mpc_wt.campaign.signoff import governing_rows, signoff_rows, ultimate_rows
+from mpc_wt.campaign.spec import CampaignSpec, spec_from_dict, turbulence_tag
+from mpc_wt.campaign.store import CampaignStore, CaseRow
 
 __all__ = ["aggregate", "make_report", "relative_metrics", "absolute_metrics",
            "RELATIVE_METRICS", "ABSOLUTE_METRICS"]
@@ -50,7 +51,7 @@ ABSOLUTE_METRICS: dict[str, tuple[str, ...]] = {
 
 
 def _pct(a: float | None, b: float | None) -> float | None:
-    """:func:`mpc_wt.assess.pct_change`, None where it states no change (JSON/CSV cells)."""
+    """:func:`mpc_wt.assessment.series.pct_change`, None where it states no change (JSON/CSV cells)."""
     if a is None or b is None:
         return None
     v = pct_change(a, b)
@@ -461,7 +462,7 @@ def _md(rows: list[dict[str, Any]], cols: Sequence[str], heads: Sequence[str] | 
 
 def _plots(agg: dict[str, Any], root: Path, out: Path) -> list[str]:
     """Every figure of the report, as PNG in ``out``; returns their paths."""
-    from ..plotting import plot_signoff, plot_ultimate
+    from mpc_wt.plotting import plot_signoff, plot_ultimate
 
     made = []
     if agg["ultimate"] and agg["signoff"]:
@@ -481,9 +482,9 @@ def _plots(agg: dict[str, Any], root: Path, out: Path) -> list[str]:
 
 def _plot_del_vs_wind(agg: dict[str, Any], ctls: list[str], turbs: list[Any], out: Path) -> str:
     """DEL vs mean wind per controller (Clemens fig. 6 / Pettas fig. 4 layout)."""
-    from ..plotting import _plt, _save
+    from mpc_wt.plotting import pyplot, save_figure
 
-    plt = _plt()
+    plt = pyplot()
     spec: CampaignSpec = agg["spec"]
     chans = list(spec.channels)
     nc = min(3, len(chans))
@@ -513,15 +514,15 @@ def _plot_del_vs_wind(agg: dict[str, Any], ctls: list[str], turbs: list[Any], ou
     for ax in list(axs.flat)[len(chans):]:
         ax.axis("off")
     axs.flat[0].legend(fontsize=6)
-    return str(_save(fig, out / "del_vs_wind.png"))
+    return str(save_figure(fig, out / "del_vs_wind.png"))
 
 
 def _plot_lifetime_bars(agg: dict[str, Any], ctls: list[str], turbs: list[Any],
                         out: Path) -> list[str]:
     """Lifetime DEL change bars (Pettas fig. 5 / Clemens fig. 7 layout)."""
-    from ..plotting import _plt, _save
+    from mpc_wt.plotting import pyplot, save_figure
 
-    plt = _plt()
+    plt = pyplot()
     spec: CampaignSpec = agg["spec"]
     chans = list(spec.channels)
     made: list[str] = []
@@ -550,14 +551,14 @@ def _plot_lifetime_bars(agg: dict[str, Any], ctls: list[str], turbs: list[Any],
         ax.set_ylabel(f"lifetime DEL change vs {spec.reference} [%]")
         ax.legend(fontsize=7)
         ax.grid(alpha=0.3, axis="y")
-        made.append(str(_save(fig, out / "lifetime_del.png")))
+        made.append(str(save_figure(fig, out / "lifetime_del.png")))
     return made
 
 
 def _plot_series(agg: dict[str, Any], root: Path, turb0: Any
                  ) -> tuple[dict[tuple[str, float], list[Any]], float, float]:
     """The stored time series at the CS and PSD winds (Do fig. 4 / Madsen fig. 8)."""
-    from ..results import ClosedLoopResult
+    from mpc_wt.simulation.results import ClosedLoopResult
 
     spec: CampaignSpec = agg["spec"]
     winds = sorted({r.wind_mps for r in agg["fatigue_rows"]})
@@ -585,9 +586,9 @@ def _plot_series(agg: dict[str, Any], root: Path, turb0: Any
 def _plot_cs_psd(agg: dict[str, Any], ctls: list[str], series: dict[tuple[str, float], Any],
                  cs_w: float, psd_w: float, turb0: Any, out: Path) -> list[str]:
     """CS ellipses and PSDs at one wind, mean over seeds."""
-    from ..plotting import _plt, _save, plot_cs_ellipses
+    from mpc_wt.plotting import plot_cs_ellipses, pyplot, save_figure
 
-    plt = _plt()
+    plt = pyplot()
     made = []
     items = []
     for ctl in ctls:
@@ -621,15 +622,15 @@ def _plot_cs_psd(agg: dict[str, Any], ctls: list[str], series: dict[tuple[str, f
         ax.set_ylabel("PSD [(N m)^2/Hz]")
         ax.grid(alpha=0.3, which="both")
         ax.legend(fontsize=7)
-    made.append(str(_save(fig, out / "psd.png")))
+    made.append(str(save_figure(fig, out / "psd.png")))
     return made
 
 
 def _plot_sweep(agg: dict[str, Any], turb0: Any, out: Path) -> list[str]:
     """Lifetime DEL against APC frequency (Clemens fig. 8 layout)."""
-    from ..plotting import _plt, _save
+    from mpc_wt.plotting import pyplot, save_figure
 
-    plt = _plt()
+    plt = pyplot()
     spec: CampaignSpec = agg["spec"]
     chans = list(spec.channels)
     made: list[str] = []
@@ -648,7 +649,7 @@ def _plot_sweep(agg: dict[str, Any], turb0: Any, out: Path) -> list[str]:
         ax.set_title("Lifetime DEL against APC frequency (Clemens fig. 8 layout)", fontsize=9)
         ax.legend(fontsize=6, ncol=2)
         ax.grid(alpha=0.3)
-        made.append(str(_save(fig, out / "apc_sweep.png")))
+        made.append(str(save_figure(fig, out / "apc_sweep.png")))
     return made
 
 
@@ -716,7 +717,7 @@ def _paper_rows(agg: dict[str, Any]) -> list[dict[str, Any]]:
 
 def _md_head(agg: dict[str, Any], paper: list[dict[str, Any]]) -> list[str]:
     """Title, the campaign's settings, incomplete cases, the paper table, suspect cases."""
-    from .. import __version__
+    from mpc_wt._version import __version__
 
     spec: CampaignSpec = agg["spec"]
     versions = sorted({r.software_version for r in agg["rows"] if r.software_version})

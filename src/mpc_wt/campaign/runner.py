@@ -23,9 +23,9 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Callable
 
-from .spec import CampaignSpec
-from .store import CampaignStore
-from .task import run_case
+from mpc_wt.campaign.spec import CampaignSpec
+from mpc_wt.campaign.store import CampaignStore
+from mpc_wt.campaign.task import run_case
 
 __all__ = ["run_campaign", "RunSummary", "ENGINES"]
 
@@ -75,7 +75,7 @@ class RunSummary:
         return 60.0 * n / self.wall_s if self.wall_s > 0 else 0.0
 
 
-def _workers(workers: int | None) -> int:
+def worker_count(workers: int | None) -> int:
     if workers is None:
         return max(1, len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity")
                    else (os.cpu_count() or 1))
@@ -183,12 +183,12 @@ def _check_engine(engine: str, scheduler: str | None, workers: int | None) -> in
     if scheduler is not None and not str(scheduler).startswith(("tcp://", "tls://",
                                                                 "inproc://", "ws://")):
         raise ValueError(f"scheduler must be an address like tcp://HOST:PORT, got {scheduler!r}")
-    return 1 if engine == "serial" else _workers(workers)
+    return 1 if engine == "serial" else worker_count(workers)
 
 
 def _write_spec(spec: CampaignSpec, out: Path, store: CampaignStore) -> None:
     """Keep the spec in the directory (its file, or the validated mapping) and in the index."""
-    from .. import __version__
+    from mpc_wt._version import __version__
 
     if spec.source and Path(spec.source).is_file():
         (out / "spec.yaml").write_text(Path(spec.source).read_text())
@@ -240,7 +240,7 @@ def local_cluster(n: int) -> Any:
     distributed = _dask_import()
     import dask
 
-    # issue 23: cases ran 12-18 % slower in Dask's workers than in a process pool. Dask's nanny
+    # cases ran 12-18 % slower in Dask's workers than in a process pool. Dask's nanny
     # sets MALLOC_TRIM_THRESHOLD_=65536 in its workers, which fixes glibc's trim threshold so
     # that freed arrays go back to the OS and come back as page faults (a 300 s case: +4..11 %
     # measured); None unsets it. The worker's statistical profiler samples the task thread's
@@ -315,9 +315,9 @@ class _Bar:
         self.run = 0
         self.bar = None
         if enabled:
-            from tqdm import tqdm
-
             import sys
+
+            from tqdm import tqdm
 
             # a terminal redraws twice a second; a log file gets a line every 30 s at most
             self.bar = tqdm(total=total, desc=f"campaign {name}", unit="case", smoothing=0.1,

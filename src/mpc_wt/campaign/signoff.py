@@ -1,4 +1,4 @@
-"""Ultimate loads per design load case and the sign-off summary of a campaign (issue 24).
+"""Ultimate loads per design load case and the sign-off summary of a campaign.
 
 A campaign with ``load_cases`` (IEC 61400-1 ed. 3 table 2 style: DLC 1.2 fatigue, 1.3 ETM,
 1.4 ECD, 1.5 EWS, 2.x faults, 4.2 shutdown in a gust, 5.1 emergency stop) is reported per
@@ -24,11 +24,15 @@ from typing import Any, Mapping, Sequence
 
 import numpy as np
 
-from ..assess import pct_change
-from .spec import Case, CampaignSpec, turbulence_tag
-from .store import CaseRow
-from .task import load_case_turbine
-from .ultimate import EXTRAPOLATED_SAFETY_FACTOR, extrapolate_maxima, ultimate_table
+from mpc_wt.assessment.performance import pct_change
+from mpc_wt.assessment.ultimate import (
+    EXTRAPOLATED_SAFETY_FACTOR,
+    extrapolate_maxima,
+    ultimate_table,
+)
+from mpc_wt.campaign.spec import CampaignSpec, Case, turbulence_tag
+from mpc_wt.campaign.store import CaseRow
+from mpc_wt.campaign.task import load_case_turbine
 
 __all__ = ["dlc_label", "ultimate_rows", "governing_rows", "signoff_rows"]
 

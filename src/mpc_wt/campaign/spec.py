@@ -21,7 +21,7 @@ from typing import Any, Mapping
 import numpy as np
 import yaml
 
-from ..errors import SpecError
+from mpc_wt.errors import SpecError
 
 __all__ = ["SpecError", "CampaignSpec", "ControllerSpec", "Case", "LoadCase", "DLC_DEFAULTS",
            "load_spec", "spec_from_dict"]
@@ -45,7 +45,7 @@ DLC_DEFAULTS: dict[str, tuple[str, bool]] = {
     "1.5": ("N", False), "2.1": ("N", False), "2.2": ("A", False), "2.3": ("A", False),
     "2.4": ("N", True), "3.2": ("N", False), "3.3": ("N", False), "4.2": ("N", False),
     "5.1": ("N", False)}
-#: The supervisor's settings a spec may give (:class:`mpc_wt.supervisor.Supervisor`); the
+#: The supervisor's settings a spec may give (:class:`mpc_wt.controllers.supervisor.Supervisor`); the
 #: times are counted from the end of the case's transient.
 _SUPERVISOR_KEYS = {"overspeed", "shutdown_at", "grid_loss_at", "pitch_rate", "torque_ramp_s"}
 _REPORT_KEYS = {"paper", "notes", "psd_wind", "cs_wind", "sweep", "title"}
@@ -189,7 +189,7 @@ class LoadCase:
     event_at : float
         When a transient starts, after the discarded start [s].
     supervisor : dict
-        :class:`mpc_wt.supervisor.Supervisor` settings, times after the discarded start.
+        :class:`mpc_wt.controllers.supervisor.Supervisor` settings, times after the discarded start.
     extrapolate : bool
         Extrapolate its maxima statistically to 50 years (turbulent conditions).
     legacy : bool
@@ -257,14 +257,14 @@ class Case:
     plugins : tuple of str
         Modules that register controller kinds, imported by the worker.
     del_convention : str
-        The DEL convention of the assessment (:data:`mpc_wt.assess.DEL_CONVENTIONS`).
+        The DEL convention of the assessment (:data:`mpc_wt.assessment.series.DEL_CONVENTIONS`).
     dlc : str
         Its load case.
     condition : dict or None
         The IEC wind condition (``condition``, ``iec_class``, ``sign``, ``event_at`` [s of
         simulation]) for :func:`mpc_wt.controllers.run_controller`; None: normal turbulence.
     supervisor : dict or None
-        :class:`mpc_wt.supervisor.Supervisor` settings (times of simulation) or None.
+        :class:`mpc_wt.controllers.supervisor.Supervisor` settings (times of simulation) or None.
     family : str
         Partial safety factor family of the load case.
     fatigue : bool
@@ -389,7 +389,7 @@ class CampaignSpec:
 
     def bin_probabilities(self, winds: Any) -> np.ndarray:
         """The wind distribution's probability of each mean-wind bin
-        (:func:`mpc_wt.assess.wind_bin_probabilities`).
+        (:func:`mpc_wt.assessment.series.wind_bin_probabilities`).
 
         Parameters
         ----------
@@ -401,7 +401,7 @@ class CampaignSpec:
         ndarray
             One probability per bin.
         """
-        from ..assess import wind_bin_probabilities
+        from mpc_wt.assessment.fatigue import wind_bin_probabilities
 
         d, w = self.wind_distribution, np.asarray(winds, float)
         if d["kind"] == "rayleigh":
@@ -526,7 +526,7 @@ def turbine_files_hash(turbine: str, base: Path | None = None) -> tuple[str, str
         except Exception as err:  # noqa: BLE001 - any loader error is reported with the key
             raise _fail("turbine", f"{turbine!r} does not load: {err}") from err
         if p.suffix.lower() == ".fst":      # a deck reads files outside its folder: hash what
-            from ..controllers.context import turbine_key   # was read, not the folder
+            from mpc_wt.registry.context import turbine_key
             return ref, turbine_key(loaded)
     h = hashlib.sha256()
     for f in sorted(folder.rglob("*")):
@@ -542,8 +542,8 @@ def _controller_options(key: str, raw: Mapping[str, Any], run_name: str,
     the campaign's own (name, grid, label) is an option of the kind; ``options:`` holds them
     too, and the groups ``mpc_options`` / ``retrofit_options`` of older specs are flattened.
     The campaign's ``lidar`` settings are the defaults of a kind that takes ``lidar``."""
-    from ..controllers import resolve
-    from ..errors import OptionsError
+    from mpc_wt.errors import OptionsError
+    from mpc_wt.registry.registry import resolve
 
     opts: dict[str, Any] = {}
     for group in ("options", "mpc_options", "retrofit_options"):
@@ -597,8 +597,8 @@ def _controller(i: int, raw: Any, lidar: dict[str, Any]) -> ControllerSpec:
 def _lidar(key: str, raw: Any) -> dict[str, Any]:
     """The campaign's LIDAR settings (defaults of the kinds that take ``lidar``), checked by
     :class:`mpc_wt.controllers.LidarOptions`."""
-    from ..controllers import LidarOptions
-    from ..errors import OptionsError
+    from mpc_wt.errors import OptionsError
+    from mpc_wt.registry.builtin import LidarOptions
 
     if not isinstance(raw, Mapping):
         raise _fail(key, f"must be a mapping, got {raw!r}")
@@ -620,9 +620,9 @@ def _keys_of(key: str, raw: Any, allowed: set[str]) -> None:
 
 def _supervisor(key: str, raw: Any, turbine: str) -> dict[str, Any]:
     """Supervisor settings (:data:`_SUPERVISOR_KEYS`), checked by
-    :class:`mpc_wt.supervisor.Supervisor` itself on the campaign's turbine."""
-    from ..supervisor import Supervisor
-    from .task import load_case_turbine
+    :class:`mpc_wt.controllers.supervisor.Supervisor` itself on the campaign's turbine."""
+    from mpc_wt.campaign.task import load_case_turbine
+    from mpc_wt.controllers.supervisor import Supervisor
 
     if raw is None:
         return {}
@@ -738,7 +738,7 @@ def _distribution(raw: Any) -> dict[str, Any]:
 
 
 def _convention(raw: Any) -> str:
-    from ..assess import DEL_CONVENTIONS
+    from mpc_wt.assessment.fatigue import DEL_CONVENTIONS
 
     if raw not in DEL_CONVENTIONS:
         raise _fail("del_convention", f"must be one of {list(DEL_CONVENTIONS)}, got {raw!r}")
@@ -747,7 +747,7 @@ def _convention(raw: Any) -> str:
 
 def _plugins(raw: Any) -> tuple[str, ...]:
     """Modules that register controller kinds, imported here and in every worker."""
-    from ..controllers import load_plugins
+    from mpc_wt.registry.registry import load_plugins
 
     if not isinstance(raw, list) or not all(isinstance(m, str) and m for m in raw):
         raise _fail("plugins", f"must be a list of module names, got {raw!r}")
@@ -759,10 +759,9 @@ def _plugins(raw: Any) -> tuple[str, ...]:
 
 
 def _channels(raw: Any) -> dict[str, float]:
-    """Channel -> Woehler exponent (default :data:`mpc_wt.assess.DEFAULT_CHANNELS`)."""
+    """Channel -> Woehler exponent (default :data:`mpc_wt.assessment.series.DEFAULT_CHANNELS`)."""
     import linearize
-
-    from ..assess import DEFAULT_CHANNELS
+    from mpc_wt.assessment.series import DEFAULT_CHANNELS
 
     chans_raw = DEFAULT_CHANNELS if raw is None else raw
     if not isinstance(chans_raw, Mapping) or not chans_raw:

@@ -23,8 +23,8 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Iterable
 
-from ..errors import CampaignLockedError
-from .spec import Case, CampaignSpec
+from mpc_wt.campaign.spec import CampaignSpec, Case
+from mpc_wt.errors import CampaignLockedError
 
 __all__ = ["CampaignStore", "CampaignLockedError", "CaseRow", "STATUSES"]
 

@@ -19,7 +19,7 @@ from typing import Any
 
 import numpy as np
 
-from .ultimate import case_extremes
+from mpc_wt.assessment.ultimate import case_extremes
 
 __all__ = ["run_case", "case_metrics", "case_file", "actuator_limit_metrics",
            "load_case_turbine"]
@@ -81,15 +81,15 @@ def case_metrics(t: np.ndarray, cols: dict[str, np.ndarray], channels: dict[str,
     transient : float
         Discarded start [s].
     convention : str
-        The DEL convention (:data:`mpc_wt.assess.DEL_CONVENTIONS`).
+        The DEL convention (:data:`mpc_wt.assessment.series.DEL_CONVENTIONS`).
 
     Returns
     -------
     dict
-        JSON-safe metrics (:func:`mpc_wt.assess.assess_series` plus rotor-speed statistics and
+        JSON-safe metrics (:func:`mpc_wt.assessment.series.assess_series` plus rotor-speed statistics and
         ``extremes``: each channel's and the rotor speed's maximum and minimum and their times,
-        :func:`mpc_wt.campaign.ultimate.case_extremes`); with a supervisor in the loop
-        ``supervisor_state`` (the largest :data:`mpc_wt.supervisor.STATES` code after the
+        :func:`mpc_wt.assessment.ultimate.case_extremes`); with a supervisor in the loop
+        ``supervisor_state`` (the largest :data:`mpc_wt.controllers.supervisor.STATES` code after the
         transient) and ``supervisor_trip_s`` (when it tripped, even within the transient).
 
     Raises
@@ -97,7 +97,7 @@ def case_metrics(t: np.ndarray, cols: dict[str, np.ndarray], channels: dict[str,
     ValueError
         If less than 10 s remain after the transient, or a series holds NaN.
     """
-    from ..assess import assess_series
+    from mpc_wt.assessment.series import assess_series
 
     k = t >= t[0] + transient
     if np.count_nonzero(k) < 2 or t[k][-1] - t[k][0] < 10.0:
@@ -108,7 +108,7 @@ def case_metrics(t: np.ndarray, cols: dict[str, np.ndarray], channels: dict[str,
         if n in sub and not np.all(np.isfinite(sub[n])):
             raise ValueError(f"channel {n!r} holds NaN or inf")
     out = assess_series(t[k], sub, channels, convention=convention)
-    # ultimate loads (issue 24): each channel's extremes and when
+    # ultimate loads: each channel's extremes and when
     out["extremes"] = case_extremes(t[k], sub, [n for n in (*channels, "rotor_speed")
                                                 if n in sub])
     if "rotor_speed" in sub:
@@ -117,7 +117,7 @@ def case_metrics(t: np.ndarray, cols: dict[str, np.ndarray], channels: dict[str,
         out["rotor_speed_max_rad_s"] = float(sub["rotor_speed"].max())
     if "tower_base_fa_moment" in sub:
         out["tower_base_fa_mean_Nm"] = float(sub["tower_base_fa_moment"].mean())
-    if "supervisor_state" in sub:       # the stop sequence (mpc_wt.supervisor.STATES codes)
+    if "supervisor_state" in sub:       # the stop sequence (mpc_wt.controllers.supervisor.STATES codes)
         out["supervisor_state"] = int(np.max(sub["supervisor_state"]))
         # when it tripped, also if that was in the discarded transient (the signal holds it)
         trip = float(np.asarray(cols.get("supervisor_trip_time", [math.nan]))[-1])
@@ -192,8 +192,10 @@ def run_case(case: dict[str, Any], root: str) -> dict[str, Any]:
         held this case's simulation: only the assessment ran), or "failed" with ``error`` and
         ``traceback``; both with ``wall_s``, ``worker`` (host:pid) and ``software_version``.
     """
-    from .. import __version__
-    from ..simulate import ClosedLoopResult, ResultFileError, SimulationDivergedError
+    from mpc_wt._version import __version__
+    from mpc_wt.errors import ResultFileError
+    from mpc_wt.simulation.loop import SimulationDivergedError
+    from mpc_wt.simulation.results import ClosedLoopResult
 
     t0 = time.perf_counter()
     base = {"case_id": case["case_id"], "worker": f"{socket.gethostname()}:{os.getpid()}",
@@ -212,8 +214,8 @@ def run_case(case: dict[str, Any], root: str) -> dict[str, Any]:
                 res = None
         if res is None:
             import lidar
-
-            from ..controllers import load_plugins, run_controller
+            from mpc_wt.registry.registry import load_plugins
+            from mpc_wt.run import run_controller
 
             load_plugins(case.get("plugins", ()))
             lidar.keep_samplers(True)        # a worker's next case is often the next seed

@@ -1,6 +1,6 @@
 """``python -m mpc_wt.cli``: the ``mpcwt`` command."""
 import sys
 
-from .main import main
+from mpc_wt.cli.main import main
 
 sys.exit(main())

@@ -8,7 +8,7 @@ import logging
 from pathlib import Path
 from typing import Any
 
-from ..errors import UsageError
+from mpc_wt.errors import UsageError
 
 __all__ = ["add_parsers"]
 
@@ -73,7 +73,11 @@ def add_parsers(sub: Any) -> None:
 
 
 def _bench_mpc(args: argparse.Namespace) -> int:
-    from ..bench import format_table, plot_solver_times, run_solver_benchmark
+    from mpc_wt.simulation.solver_timing import (
+        format_table,
+        plot_solver_times,
+        run_solver_benchmark,
+    )
 
     if args.steps < 10:
         raise UsageError(f"--steps must be >= 10, got {args.steps}")
@@ -85,7 +89,8 @@ def _bench_mpc(args: argparse.Namespace) -> int:
 
 
 def _run(args: argparse.Namespace) -> int:
-    from ..campaign import load_spec, run_campaign
+    from mpc_wt.campaign.runner import run_campaign
+    from mpc_wt.campaign.spec import load_spec
 
     if args.scheduler and args.workers:
         raise UsageError("give --workers (local cluster) or --scheduler (running cluster), "
@@ -108,7 +113,7 @@ def _run(args: argparse.Namespace) -> int:
         print(f"  tracebacks: mpcwt campaign status {out} --failed; rerun the same command "
               f"to retry failed cases")
     if args.report and not s.failed:
-        from ..campaign.report import make_report
+        from mpc_wt.campaign.report import make_report
 
         rep = make_report(out)
         print(f"  report {rep}")
@@ -116,7 +121,7 @@ def _run(args: argparse.Namespace) -> int:
 
 
 def _status(args: argparse.Namespace) -> int:
-    from ..campaign.store import CampaignStore
+    from mpc_wt.campaign.store import CampaignStore
 
     with CampaignStore(args.dir) as st:
         meta = st.meta()
@@ -158,7 +163,7 @@ def _status(args: argparse.Namespace) -> int:
 
 
 def _report(args: argparse.Namespace) -> int:
-    from ..campaign.report import make_report
+    from mpc_wt.campaign.report import make_report
 
     rep = make_report(args.dir, out=args.out)
     print(f"report {rep}")
@@ -176,8 +181,8 @@ def _quiet_dask() -> None:
 
 
 def _tune(args: argparse.Namespace) -> int:
-    from ..tuning.run import tune
-    from ..tuning.spec import load_tune_spec
+    from mpc_wt.tuning.run import tune
+    from mpc_wt.tuning.spec import load_tune_spec
 
     if args.scheduler and args.workers:
         raise UsageError("give --workers (local cluster) or --scheduler (running cluster), "

@@ -12,8 +12,7 @@ import numpy as np
 
 import linearize
 from linearize import OperatingPoint
-
-from ..errors import UsageError
+from mpc_wt.errors import UsageError
 
 __all__ = ["parse_range", "add_turbine", "schedule", "format_table", "write_points_csv",
            "cp_surface", "write_surface_csv", "pairs", "floats", "check_suffix"]

@@ -8,9 +8,8 @@ from pathlib import Path
 from typing import Any
 
 import linearize
-
-from ..errors import GainTableError, UsageError
-from .common import add_turbine, floats, number_pairs, parse_range
+from mpc_wt.cli.common import add_turbine, floats, number_pairs, parse_range
+from mpc_wt.errors import GainTableError, UsageError
 
 __all__ = ["add_parsers"]
 
@@ -23,7 +22,7 @@ def add_parsers(sub: Any) -> None:
     sub : argparse subparsers action
         Of the top-level parser.
     """
-    from ..controllers.registry import designs
+    from mpc_wt.registry.registry import designs
 
     p = sub.add_parser("design", help="gain synthesis: baseline PI, LQR family, TS by LMIs, "
                                       "IBC, Coleman IPC")
@@ -71,7 +70,7 @@ def _positive(name: str, value: float, allow_zero: bool = False) -> float:
 
 def _design_args(args: argparse.Namespace) -> dict[str, Any]:
     """Every design argument, checked before any work (names the flag)."""
-    from ..baseline import check_power_fraction
+    from mpc_wt.controllers.baseline import check_power_fraction
 
     try:
         frac = check_power_fraction(args.power_fraction, "--power-fraction")
@@ -90,9 +89,9 @@ def _design_args(args: argparse.Namespace) -> dict[str, Any]:
 
 
 def _design(args: argparse.Namespace) -> int:
-    from ..controllers.registry import designs
-    from ..export import save_design
-    from ..plotting import plot_design
+    from mpc_wt.io.gain_tables import save_design
+    from mpc_wt.plotting import plot_design
+    from mpc_wt.registry.registry import designs
 
     kind = designs()[args.kind]
     every = _design_args(args)
@@ -106,7 +105,7 @@ def _design(args: argparse.Namespace) -> int:
 
 
 def _export(args: argparse.Namespace) -> int:
-    from ..export import export
+    from mpc_wt.io.gain_tables import export
 
     turbine = linearize.load_turbine(args.turbine) if args.turbine else None
     try:

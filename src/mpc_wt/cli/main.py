@@ -32,9 +32,8 @@ import sys
 from typing import Sequence
 
 import linearize
-
-from ..errors import CampaignLockedError, ControllerLibraryError, UsageError
-from . import campaign, design, runs, steady, wind
+from mpc_wt.cli import campaign, design, runs, steady, wind
+from mpc_wt.errors import CampaignLockedError, ControllerLibraryError, UsageError
 
 __all__ = ["main", "build_parser"]
 
@@ -92,7 +91,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     logging.basicConfig(level=logging.WARNING, format="%(levelname)s %(name)s: %(message)s")
     argv = list(sys.argv[1:] if argv is None else argv)
     try:
-        from ..controllers import load_plugins
+        from mpc_wt.registry.registry import load_plugins
 
         load_plugins(_plugins(argv))
     except ImportError as err:

@@ -18,10 +18,16 @@ import numpy as np
 
 import lidar
 import linearize
-
-from ..errors import UsageError
-from .common import (add_turbine, cp_surface, format_table, pairs, schedule, write_points_csv,
-                     write_surface_csv)
+from mpc_wt.cli.common import (
+    add_turbine,
+    cp_surface,
+    format_table,
+    pairs,
+    schedule,
+    write_points_csv,
+    write_surface_csv,
+)
+from mpc_wt.errors import UsageError
 
 __all__ = ["add_parsers", "controller_options"]
 
@@ -56,8 +62,7 @@ def add_parsers(sub: Any) -> None:
 
 
 def _add_simulate(sub: Any) -> None:
-    from ..controllers import kinds
-    from ..controllers.registry import cli_flags
+    from mpc_wt.registry.registry import cli_flags, kinds
 
     names = [k.pattern_help or k.name for k in kinds().values()]
     p = sub.add_parser("simulate", help="closed-loop simulation on the plant")
@@ -72,7 +77,7 @@ def _add_simulate(sub: Any) -> None:
     p.add_argument("--out", required=True, help="result file (netCDF, .nc)")
     p.add_argument("--option", action="append", metavar="NAME=VALUE",
                    help="any option of the controller kind (repeatable; YAML values)")
-    e = p.add_argument_group("IEC 61400-1 wind condition and supervisor events (issue 24)")
+    e = p.add_argument_group("IEC 61400-1 wind condition and supervisor events")
     e.add_argument("--condition", choices=sorted(lidar.CONDITIONS), default="ntm",
                    help="wind condition (default ntm: --turbulence as given; the others take "
                         "--turbulence as the category A, B or C)")
@@ -129,8 +134,8 @@ def controller_options(args: argparse.Namespace) -> dict[str, Any]:
 
 
 def _simulate(args: argparse.Namespace) -> int:
-    from ..controllers import cli_naming, resolve, run_controller
-    from ..controllers.registry import cli_flags
+    from mpc_wt.registry.registry import cli_flags, cli_naming, resolve
+    from mpc_wt.run import run_controller
 
     naming = cli_naming({k: m["flag"] for k, m in cli_flags().items()})
     opts = controller_options(args)
@@ -158,8 +163,8 @@ def _events(args: argparse.Namespace, turbine: linearize.Turbine
             ) -> tuple[dict[str, Any] | None, dict[str, Any] | None]:
     """The wind condition and the supervisor settings of ``simulate``, checked here so that
     an error names the flag."""
-    from ..controllers.context import Scenario, iec_site
-    from ..supervisor import Supervisor
+    from mpc_wt.controllers.supervisor import Supervisor
+    from mpc_wt.simulation.scenario import Scenario, iec_site
 
     cond = None
     if args.condition != "ntm":
@@ -186,7 +191,7 @@ def _events(args: argparse.Namespace, turbine: linearize.Turbine
 
 
 def _controllers(args: argparse.Namespace) -> int:
-    from ..controllers import describe
+    from mpc_wt.registry.registry import describe
 
     rows = describe()
     if args.json:
@@ -222,9 +227,9 @@ def _add_assess(sub: Any) -> None:
 
 
 def _assess(args: argparse.Namespace) -> int:
-    from ..assess import DEFAULT_CHANNELS, assess_series, reductions
-    from ..plotting import assess_plots
-    from ..results import load_series
+    from mpc_wt.assessment.series import DEFAULT_CHANNELS, assess_series, reductions
+    from mpc_wt.plotting import assess_plots
+    from mpc_wt.simulation.results import load_series
 
     chans = None
     if args.channels:
@@ -278,8 +283,8 @@ def _run(args: argparse.Namespace) -> int:
 
 def _design_outputs(turbine: linearize.Turbine, out: Path) -> None:
     """The linear model family and the baseline's gain tables (CSV, JSON, ROSCO)."""
-    from ..baseline import tune_baseline
-    from ..export import baseline_table, export
+    from mpc_wt.controllers.baseline import tune_baseline
+    from mpc_wt.io.gain_tables import baseline_table, export
 
     fam = linearize.linearize_family(turbine, progress=True)
     fam.save(out / "linear_models.mat")
@@ -312,9 +317,9 @@ def _comparison_row(name: str, a: dict[str, Any], cols: dict[str, np.ndarray],
 
 def _comparison_runs(turbine: linearize.Turbine, args: argparse.Namespace, out: Path) -> None:
     """The controllers on one field, assessed and compared in one table and plots."""
-    from ..assess import assess_series
-    from ..controllers import run_controller
-    from ..plotting import assess_plots, plot_comparison
+    from mpc_wt.assessment.series import assess_series
+    from mpc_wt.plotting import assess_plots, plot_comparison
+    from mpc_wt.run import run_controller
 
     names = [c.strip() for c in args.controllers.split(",") if c.strip()]
     rows, runs = [], []
@@ -352,7 +357,7 @@ def _comparison_runs(turbine: linearize.Turbine, args: argparse.Namespace, out: 
 
 def _steady_outputs(turbine: linearize.Turbine, out: Path) -> None:
     """The main job's steady part: operating table, C_P surface and their plots."""
-    from ..plotting import plot_cp_surface, plot_operating_schedule
+    from mpc_wt.plotting import plot_cp_surface, plot_operating_schedule
 
     op = turbine.operation
     winds = np.arange(op.cut_in_wind, op.cut_out_wind + 1e-9, 1.0)

@@ -11,10 +11,15 @@ from typing import Any
 import numpy as np
 
 import linearize
-
-from ..errors import UsageError
-from .common import (add_turbine, check_suffix, format_table, parse_range, schedule,
-                     write_surface_csv)
+from mpc_wt.cli.common import (
+    add_turbine,
+    check_suffix,
+    format_table,
+    parse_range,
+    schedule,
+    write_surface_csv,
+)
+from mpc_wt.errors import UsageError
 
 __all__ = ["add_parsers"]
 
@@ -117,7 +122,7 @@ def _cp_surface(args: argparse.Namespace) -> int:
             write_surface_csv(tsr, pitch, cp, Path(args.out))
             print(f"wrote {args.out}")
     if args.plot:
-        from ..plotting import plot_cp_surface
+        from mpc_wt.plotting import plot_cp_surface
 
         plot_cp_surface(tsr, pitch, cp, args.plot, title=f"{turbine.name}: C_P")
         print(f"wrote {args.plot}")

@@ -6,9 +6,8 @@ import json
 from typing import Any
 
 import linearize
-
-from ..errors import UsageError
-from .common import add_turbine
+from mpc_wt.cli.common import add_turbine
+from mpc_wt.errors import UsageError
 
 __all__ = ["add_parsers"]
 
@@ -70,8 +69,7 @@ def add_parsers(sub: Any) -> None:
 
 def _generate(args: argparse.Namespace) -> int:
     import lidar
-
-    from .common import check_suffix
+    from mpc_wt.cli.common import check_suffix
 
     check_suffix(args.out, "--out", (".bts", ".npz"))
     if args.condition is not None:
@@ -116,7 +114,7 @@ def _generate_condition(args: argparse.Namespace) -> int:
     print(f"wrote {out}: IEC {args.condition.upper()} at {args.mean:g} m/s, class "
           f"{site.turbine_class}{site.turbulence_class}; {mags}")
     if args.plot:
-        from ..plotting import plot_wind_condition
+        from mpc_wt.plotting import plot_wind_condition
 
         print(f"wrote {plot_wind_condition(field, args.plot)}")
     return 0
@@ -124,14 +122,19 @@ def _generate_condition(args: argparse.Namespace) -> int:
 
 def _evaluate(args: argparse.Namespace) -> int:
     import lidar
-
-    from ..lidar_eval import evaluate_lidar
+    from mpc_wt.assessment.lidar import lidar_evaluation
 
     field = lidar.WindField.load(args.field)
     turbine = linearize.load_turbine(args.turbine)
-    res = evaluate_lidar(field, turbine, focus_distance=args.focus, plots=args.plots,
-                         range_weighting=not args.point, los_error=not args.no_los_error,
-                         noise_std=args.noise, evolution=args.evolution)
+    res, curves = lidar_evaluation(field, turbine, focus_distance=args.focus,
+                                   range_weighting=not args.point,
+                                   los_error=not args.no_los_error, noise_std=args.noise,
+                                   evolution=args.evolution)
+    if args.plots:
+        from mpc_wt.plotting import plot_lidar_evaluation
+
+        res["plots"] = plot_lidar_evaluation(res, curves, turbine.geometry.tip_radius,
+                                             args.plots)
     if args.json:
         print(json.dumps(res, indent=1))
     else:

@@ -1,21 +1,71 @@
-"""Controllers as registered kinds: the registry, typed options, and one run from a name.
+"""Controllers: the laws that run in the closed loop, and their synthesis.
 
-``kinds()`` lists every kind (``describe()`` with its options); ``register`` adds one;
-``run_controller`` trims, builds, makes the wind and simulates. The kinds mpc-wt ships are
-registered by importing :mod:`mpc_wt.controllers.builtin`, which this package does.
+Each module holds one kind of controller with its design functions: the tuned baseline PI and
+torque law (:mod:`.baseline`, its law compiled in :mod:`.baseline_law`), Madsen's MPC
+(:mod:`.mpc` on the QP backends of :mod:`.qp`, the Kalman estimator of :mod:`.estimator`), Do
+et al.'s LQR with a PI observer (:mod:`.lqr`), Clemens et al.'s Takagi-Sugeno controller and
+wind observer (:mod:`.takagi_sugeno`), individual blade control and Coleman IPC (:mod:`.ipc`),
+active power control (:mod:`.apc`), down-regulation (:mod:`.derating`), LIDAR collective pitch
+feedforward (:mod:`.lidar_feedforward`), the supervisor (:mod:`.supervisor`) and Bladed-style
+DISCON libraries in the loop (:mod:`.discon`). Every controller offers ``reset()`` and
+``step(t, measurements)`` (:class:`~mpc_wt.controllers.base.Controller`).
+
+The plugin API (``register``, ``Options``, ``option``, ``Built``, ``BuildContext``, ``kinds``,
+``describe`` ...) lives in :mod:`mpc_wt.registry`; it is re-exported here, where plugin authors
+import it from (``from mpc_wt.controllers import register``), without importing the registry
+when this package is imported.
 """
-from . import builtin
-from .builtin import (APCOptions, BaselineOptions, ColemanIPCOptions, DerateOptions, IBCOptions,
-                      LidarOptions, LQRPIOOptions, MPCLidarOptions, MPCOptions, TSOptions)
-from .context import BuildContext, Built, DesignCache, Scenario, make_wind, turbine_key
-from .options import REQUIRED, Options, option
-from .registry import (API_NAMING, ControllerKind, Naming, Selection, cli_naming, describe,
-                       get_kind, kinds, load_plugins, register, register_kind, resolve)
-from .run import build_controller, run_controller
+from mpc_wt.controllers.apc import apc_reference
+from mpc_wt.controllers.base import Controller, ControllerBase
+from mpc_wt.controllers.baseline import (
+    BaselineController,
+    BaselineGains,
+    tune_baseline,
+    tune_baseline_schedule,
+)
+from mpc_wt.controllers.discon import DisconController
+from mpc_wt.controllers.estimator import KalmanEstimator
+from mpc_wt.controllers.ipc import ColemanIPCController, IBCController, tune_coleman_ipc, tune_ibc
+from mpc_wt.controllers.lidar_feedforward import LidarFeedforward
+from mpc_wt.controllers.lqr import (
+    LQRPIOController,
+    design_lqr,
+    design_lqr_family,
+    design_pi_observer,
+)
+from mpc_wt.controllers.mpc import MPC, MPCSettings, MPCWeights, ScheduledMPC
+from mpc_wt.controllers.qp import BACKENDS, default_backend
+from mpc_wt.controllers.supervisor import Supervisor, TorqueLawGuard
+from mpc_wt.controllers.takagi_sugeno import (
+    TSController,
+    build_ts_model,
+    design_ts_controller,
+    design_ts_observer,
+)
 
-__all__ = ["builtin", "APCOptions", "BaselineOptions", "ColemanIPCOptions", "DerateOptions",
-           "IBCOptions", "LidarOptions", "LQRPIOOptions", "MPCLidarOptions", "MPCOptions",
-           "TSOptions", "BuildContext", "Built", "DesignCache", "Scenario", "make_wind",
-           "turbine_key", "REQUIRED", "Options", "option", "API_NAMING", "ControllerKind",
-           "Naming", "Selection", "cli_naming", "describe", "get_kind", "kinds", "load_plugins",
-           "register", "register_kind", "resolve", "build_controller", "run_controller"]
+#: names of :mod:`mpc_wt.registry` served from this package (the plugin API's former home)
+REGISTRY_NAMES = ("register", "register_kind", "kinds", "describe", "get_kind", "resolve",
+                  "load_plugins", "designs", "cli_naming", "API_NAMING", "ControllerKind",
+                  "Naming", "Selection", "Options", "option", "REQUIRED", "Built",
+                  "BuildContext", "DesignCache", "turbine_key", "APCOptions", "BaselineOptions",
+                  "ColemanIPCOptions", "DerateOptions", "IBCOptions", "LidarOptions",
+                  "LQRPIOOptions", "MPCLidarOptions", "MPCOptions", "TSOptions")
+
+
+def __getattr__(name: str):  # type: ignore[no-untyped-def]
+    """Serve the registry's plugin API (:data:`REGISTRY_NAMES`) from :mod:`mpc_wt.registry`."""
+    if name in REGISTRY_NAMES:
+        import mpc_wt.registry
+
+        return getattr(mpc_wt.registry, name)
+    raise AttributeError(f"module 'mpc_wt.controllers' has no attribute {name!r}")
+
+
+__all__ = ["apc_reference", "Controller", "ControllerBase", "BaselineController",
+           "BaselineGains", "tune_baseline", "tune_baseline_schedule", "DisconController",
+           "KalmanEstimator", "ColemanIPCController", "IBCController", "tune_coleman_ipc",
+           "tune_ibc", "LidarFeedforward", "LQRPIOController", "design_lqr",
+           "design_lqr_family", "design_pi_observer", "MPC", "MPCSettings", "MPCWeights",
+           "ScheduledMPC", "BACKENDS", "default_backend", "Supervisor", "TorqueLawGuard",
+           "TSController", "build_ts_model", "design_ts_controller", "design_ts_observer",
+           "REGISTRY_NAMES", *REGISTRY_NAMES]

@@ -22,8 +22,7 @@ from pathlib import Path
 from typing import Any, Callable, Mapping, Sequence
 
 from linearize.validate import check_number
-
-from ..errors import TrialFailed
+from mpc_wt.errors import TrialFailed
 
 __all__ = ["Parameter", "Constraint", "TrialRecord", "TuneResult", "TrialFailed", "optimize",
            "SAMPLERS"]

@@ -10,8 +10,8 @@ from typing import Any, Mapping
 
 import numpy as np
 
-from .run import REPORT_METRICS, TuneOutcome, pareto_front, write_trials_csv
-from .spec import TuneSpec
+from mpc_wt.tuning.outcome import REPORT_METRICS, TuneOutcome, pareto_front, write_trials_csv
+from mpc_wt.tuning.spec import TuneSpec
 
 __all__ = ["write_outputs", "export_design"]
 
@@ -21,8 +21,7 @@ log = logging.getLogger(__name__)
 def _design_kwargs(spec: TuneSpec, params: Mapping[str, float]) -> tuple[Any, dict] | None:
     """The kind's gain synthesis and its arguments for a design (None: the kind has none)."""
     import linearize
-
-    from ..controllers import resolve
+    from mpc_wt.registry.registry import resolve
 
     sel = resolve(spec.kind)
     fn = sel.base.design
@@ -59,8 +58,7 @@ def export_design(spec: TuneSpec, params: Mapping[str, float], out: Path) -> lis
     list of Path
     """
     import linearize
-
-    from ..export import export, save_design
+    from mpc_wt.io.gain_tables import export, save_design
 
     got = _design_kwargs(spec, params)
     if got is None:
@@ -98,7 +96,7 @@ def _rows(spec: TuneSpec, outcome: TuneOutcome) -> list[str]:
 def _plot_pareto(spec: TuneSpec, outcome: TuneOutcome, path: Path) -> Path | None:
     """Objective, and each of its measures, against each constraint measure
     (:func:`mpc_wt.plotting.plot_pareto`)."""
-    from ..plotting import plot_pareto
+    from mpc_wt.plotting import plot_pareto
 
     done = [t for t in outcome.result.trials if t.state == "COMPLETE"]
     if not done:

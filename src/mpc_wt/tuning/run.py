@@ -13,54 +13,24 @@ CSV, JSON, and ROSCO's DISCON.IN for a baseline).
 from __future__ import annotations
 
 import contextlib
-import csv
 import fcntl
 import json
 import logging
-import math
 import time
-from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Iterator, Mapping
 
-import numpy as np
+from mpc_wt.campaign.report import absolute_metrics, relative_metrics
+from mpc_wt.campaign.runner import run_campaign
+from mpc_wt.campaign.store import CampaignStore
+from mpc_wt.errors import CampaignLockedError, TrialFailed
+from mpc_wt.tuning.optimizer import optimize
+from mpc_wt.tuning.outcome import TuneOutcome
+from mpc_wt.tuning.spec import TuneSpec, load_tune_spec
 
-from ..campaign import CampaignStore, run_campaign
-from ..campaign.report import absolute_metrics, relative_metrics
-from ..errors import CampaignLockedError
-from .optimizer import TrialFailed, TuneResult, optimize
-from .spec import TuneSpec, load_tune_spec
-
-__all__ = ["tune", "TuneOutcome", "REPORT_METRICS"]
+__all__ = ['tune']
 
 log = logging.getLogger(__name__)
-
-#: Measures the report always shows (besides the objective's and the constraints').
-REPORT_METRICS = ("rotor_speed_std", "power_std", "pitch_travel", "cs1", "cs2")
-
-
-@dataclass
-class TuneOutcome:
-    """What :func:`tune` found and wrote.
-
-    Parameters
-    ----------
-    result : TuneResult
-        The search (best trial, every trial).
-    tuning : dict
-        Ratios to the reference on the tuning seeds: ``tuned`` and ``hand-set``.
-    holdout : dict
-        The same on the held-out seeds (empty without ``holdout_seeds``).
-    files : list of Path
-        What was written.
-    wall_s : float
-    """
-
-    result: TuneResult
-    tuning: dict[str, dict[str, float]] = field(default_factory=dict)
-    holdout: dict[str, dict[str, float]] = field(default_factory=dict)
-    files: list[Path] = field(default_factory=list)
-    wall_s: float = 0.0
 
 
 @contextlib.contextmanager
@@ -86,9 +56,9 @@ def _engine(engine: str, workers: int | None, scheduler: str | None
     if engine != "dask" or scheduler is not None:
         yield {"engine": engine, "workers": workers, "scheduler": scheduler}
         return
-    from ..campaign.runner import _workers, local_cluster
+    from mpc_wt.campaign.runner import local_cluster, worker_count
 
-    cluster = local_cluster(_workers(workers))
+    cluster = local_cluster(worker_count(workers))
     try:
         yield {"engine": "dask", "workers": None, "scheduler": cluster.scheduler_address}
     finally:
@@ -173,41 +143,9 @@ def tune(spec: TuneSpec | str | Path, out: str | Path, *, engine: str = "dask",
             target.update({("hand-set" if k == "hand-set" else "tuned"): v
                            for k, v in got.items()})
     outcome.wall_s = time.perf_counter() - t0
-    from .report import write_outputs
+    from mpc_wt.tuning.report import write_outputs
 
     outcome.files = write_outputs(spec, outcome, out)
     return outcome
 
 
-def trials_table(result: TuneResult) -> list[dict[str, Any]]:
-    """One row per trial: number, state, feasible, objective, parameters, measures, error."""
-    keys = sorted({k for t in result.trials for k in t.metrics} - {"objective"})
-    pnames = sorted({k for t in result.trials for k in t.params})
-    return [{"trial": t.number, "state": t.state, "feasible": t.feasible, "objective": t.value,
-             **{f"param:{k}": t.params.get(k) for k in pnames},
-             **{k: t.metrics.get(k) for k in keys}, "error": t.error or ""}
-            for t in result.trials]
-
-
-def write_trials_csv(result: TuneResult, path: Path) -> Path:
-    """``trials.csv`` of :func:`trials_table`."""
-    rows = trials_table(result)
-    with open(path, "w", newline="") as f:
-        if rows:
-            w = csv.DictWriter(f, fieldnames=list(rows[0]))
-            w.writeheader()
-            for r in rows:
-                w.writerow({k: ("" if v is None else f"{v:.6g}" if isinstance(v, float)
-                                and math.isfinite(v) else v) for k, v in r.items()})
-    return path
-
-
-def pareto_front(points: np.ndarray) -> np.ndarray:
-    """Indices of the non-dominated rows of ``points`` (every column minimized), in order of
-    the first column."""
-    idx = []
-    for i, p in enumerate(points):
-        dominated = np.any(np.all(points <= p, axis=1) & np.any(points < p, axis=1))
-        if not dominated:
-            idx.append(i)
-    return np.array(sorted(idx, key=lambda i: points[i, 0]), dtype=int)

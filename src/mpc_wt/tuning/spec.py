@@ -39,10 +39,10 @@ from typing import Any, Mapping
 
 import yaml
 
-from ..campaign.report import ABSOLUTE_METRICS, RELATIVE_METRICS
-from ..campaign.spec import CampaignSpec, spec_from_dict
-from ..errors import SpecError
-from .optimizer import SAMPLERS, Constraint, Parameter
+from mpc_wt.campaign.report import ABSOLUTE_METRICS, RELATIVE_METRICS
+from mpc_wt.campaign.spec import CampaignSpec, spec_from_dict
+from mpc_wt.errors import SpecError
+from mpc_wt.tuning.optimizer import SAMPLERS, Constraint, Parameter
 
 __all__ = ["TuneSpec", "load_tune_spec", "tune_spec_from_dict", "nest"]
 
@@ -380,8 +380,8 @@ def tune_spec_from_dict(raw: Mapping[str, Any], base: Path | None = None) -> Tun
 
 def _check_parameters(spec: TuneSpec) -> None:
     """Every parameter is an option of the kind and both ends of its range are allowed."""
-    from ..controllers import resolve
-    from ..errors import OptionsError
+    from mpc_wt.errors import OptionsError
+    from mpc_wt.registry.registry import resolve
 
     try:
         sel = resolve(spec.kind)

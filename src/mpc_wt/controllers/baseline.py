@@ -1,0 +1,508 @@
+"""The baseline controller: NREL 5-MW style variable-speed, variable-pitch control, tuned by
+mpc-wt from its own linear models.
+
+* Generator torque (Jonkman et al. 2009, sec. 7.3): region 1 (no torque), 1.5 (linear from
+  cut-in speed), 2 (K omega_g^2 with K from the optimal C_P), 2.5 (straight line to rated
+  torque at rated speed with a slip), 3 (constant power, or constant torque), on the filtered
+  generator speed; torque rate limited.
+* Collective pitch: PI on the filtered generator-speed error, gain-scheduled
+  GK(theta) = 1 / (1 + theta / theta_K), with anti-windup (the integral is held so that the
+  command stays within the pitch limits), rate-limited command.
+* Tuning (report sec. 7.4; Do et al. 2020 eq 8, the method of Wright and Fingersh): the rotor as
+  one rigid inertia J (rotor plus generator on the low-speed shaft) with the aerodynamic power
+  sensitivity dP/dtheta, linear in pitch: dP/dtheta = (dP/dtheta)_0 (1 + theta / theta_K).
+  Placing the closed-loop poles at omega_n, zeta (aerodynamic damping neglected, as the report
+  does) gives KP = 2 J Omega_0 zeta omega_n / (N (-dP/dtheta)_0) and
+  KI = J Omega_0 omega_n^2 / (N (-dP/dtheta)_0), on the generator speed.
+* Down-regulation (Pettas and Cheng 2018, sec. 3.2): ``power_fraction`` f < 1 lowers the rated
+  power to f P_r by the generator torque (rated torque f T_r at the same rated speed) and
+  re-tunes the PI on the derated operating points (trim to the power reference).
+* Active power control (Clemens et al. sec. 3.2, eq 11): a power reference P_ref(t) replaces
+  rated power in the constant-power torque law, and the PI gains are interpolated between
+  designs at several power fractions (the pitch loop scheduled on the power reference).
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Any, Callable, Sequence
+
+import numpy as np
+
+import linearize
+from mpc_wt.controllers.base import ControllerBase
+
+__all__ = ["BaselineGains", "tune_baseline", "tune_baseline_schedule", "BaselineController",
+           "check_power_fraction", "effective_pi_gains"]
+
+
+def check_power_fraction(value: Any, name: str = "power_fraction") -> float:
+    """A derating fraction of rated power: finite and in (0, 1].
+
+    Parameters
+    ----------
+    value : float
+        The fraction [-].
+    name : str
+        The argument's name, for the message.
+
+    Returns
+    -------
+    float
+        The fraction.
+
+    Raises
+    ------
+    ValueError
+        Naming the argument and the value.
+    """
+    f = float(value)
+    if not (math.isfinite(f) and 0.0 < f <= 1.0):
+        raise ValueError(f"{name} must be in (0, 1] (a fraction of rated power), got {value!r}")
+    return f
+
+
+def effective_pi_gains(kp: float, ki: float, theta_k_rad: float, pitch_rad: Any
+                       ) -> tuple[np.ndarray, np.ndarray]:
+    """Small-signal PI gains of the DISCON-form pitch loop at collective pitch theta.
+
+    :class:`BaselineController` (as Jonkman's DISCON, report sec. 7.4) commands
+    theta_k = GK(theta_{k-1}) (kp e_k + ki sum e dt), GK(theta) = 1 / (1 + theta / theta_K),
+    with GK taken at the previous command and the integral of the raw speed error. Holding
+    theta = GK(theta) X with X = kp e + ki int e makes a small change obey
+    d theta (1 + theta GK / theta_K) = GK dX, i.e. d theta = dX / (1 + 2 theta / theta_K) in the
+    control band. The loop therefore acts with kp / (1 + 2 theta / theta_K) and
+    ki / (1 + 2 theta / theta_K), not with kp GK(theta): 0.62x of it at 0.15 rad for the
+    NREL 5-MW. A PI that holds its integral in pitch units and applies its table's gains
+    directly (ROSCO) regulates as ours with these gains.
+
+    Parameters
+    ----------
+    kp, ki : float
+        The design's gains at zero pitch [s], [-].
+    theta_k_rad : float
+        Gain-schedule corner [rad].
+    pitch_rad : array_like
+        Collective pitch [rad].
+
+    Returns
+    -------
+    kp_eff, ki_eff : ndarray
+        Effective proportional [s] and integral [-] gains at each pitch.
+    """
+    f = 1.0 / (1.0 + 2.0 * np.asarray(pitch_rad, float) / theta_k_rad)
+    return kp * f, ki * f
+
+
+@dataclass(frozen=True)
+class BaselineGains:
+    """Gains and set points of the baseline controller (high-speed-shaft quantities).
+
+    Parameters
+    ----------
+    kp : float
+        Proportional gain at zero pitch [rad pitch / (rad/s generator speed)] (= [s]).
+    ki : float
+        Integral gain at zero pitch [rad pitch / rad generator-speed integral] (= [-]).
+    theta_k_rad : float
+        Pitch at which the pitch sensitivity doubles (gain-schedule corner) [rad].
+    k_opt : float
+        Region-2 torque gain [N m / (rad/s)^2].
+    rated_gen_speed_rad_s, rated_torque, rated_power : float
+        Set points [rad/s, N m, W (electrical)].
+    dpdtheta_0 : float
+        Aerodynamic power sensitivity extrapolated to zero pitch [W/rad].
+    omega_n_rad_s, zeta : float
+        Design natural frequency [rad/s] and damping ratio [-].
+    power_fraction : float
+        Fraction of the turbine's rated power this design was tuned for (1: normal operation;
+        < 1: derated, ``rated_power`` and ``rated_torque`` already lowered) [-].
+    """
+
+    kp: float
+    ki: float
+    theta_k_rad: float
+    k_opt: float
+    rated_gen_speed_rad_s: float
+    rated_torque: float
+    rated_power: float
+    dpdtheta_0: float
+    omega_n_rad_s: float = 0.6
+    zeta: float = 0.7
+    power_fraction: float = 1.0
+    info: dict[str, Any] = field(default_factory=dict, compare=False)
+
+
+def tune_baseline(turbine: linearize.Turbine, *, omega_n_rad_s: float = 0.6, zeta: float = 0.7,
+                  wake: str = "frozen", winds: Any = None,
+                  inertia: float | None = None, power_fraction: float = 1.0) -> BaselineGains:
+    """Tune the baseline from the turbine's own linear models.
+
+    With ``power_fraction`` f < 1 (down-regulation, Pettas and Cheng sec. 3.2) the pitch
+    sensitivities come from the operating points trimmed to f P_r at rated rotor speed, and the
+    set points become f P_r and f T_r (the same rated speed, so the same tip-speed ratio).
+
+    Parameters
+    ----------
+    omega_n_rad_s, zeta : float
+        Closed-loop natural frequency [rad/s] and damping ratio (report: 0.6 rad/s, 0.7).
+    wake : {"frozen", "quasi-steady"}
+        Wake assumption of the pitch sensitivities (the report's are frozen-wake).
+    winds : array_like, optional
+        Wind speeds for the linear fit of dP/dtheta against pitch; default rated (zero pitch),
+        then 12-25 m/s, the range of the report's fit (its Table 7-2 starts at 11.4 m/s).
+    inertia : float, optional
+        Drivetrain inertia on the low-speed shaft [kg m^2]; default rotor (from the blade data)
+        plus N^2 times the generator inertia.
+    power_fraction : float
+        Derating fraction in (0, 1] [-].
+
+
+    Returns
+    -------
+    BaselineGains
+        KP, KI, the gain-scheduling angle theta_K, the torque constant and the set points.
+
+    Raises
+    ------
+    ValueError
+        If ``power_fraction`` is outside (0, 1] or a gain parameter is not positive.
+    """
+    frac = check_power_fraction(power_fraction)
+    if not (omega_n_rad_s > 0 and zeta > 0):
+        raise ValueError(f"omega_n_rad_s and zeta must be > 0, got {omega_n_rad_s!r}, {zeta!r}")
+    if winds is None:
+        v_rated = linearize.rated_wind_speed(turbine)
+        v = np.r_[v_rated + 1e-6, np.arange(12.0, 25.5, 1.0)]
+    else:
+        v = np.asarray(winds, float)
+    params = linearize.plant_params(turbine)
+    p_w = None if frac == 1.0 else frac * turbine.operation.rated_power
+    fam = linearize.linearize_family(turbine, v, wake=wake, params=params, power_W=p_w)
+    theta = np.array([m.info["pitch_deg"] for m in fam.models]) * math.pi / 180
+    dpdt = np.array([linearize.sensitivities(m)["dP_dpitch_W_per_rad"] for m in fam.models])
+    slope, intercept = np.polyfit(theta, dpdt, 1)
+    theta_k = intercept / slope
+    n = turbine.drivetrain.gearbox_ratio
+    j = (params.rotor_inertia + n**2 * turbine.drivetrain.generator_inertia
+         if inertia is None else float(inertia))
+    om0 = turbine.operation.rated_rotor_speed_rad_s
+    kp = 2 * j * om0 * zeta * omega_n_rad_s / (n * -intercept)
+    ki = j * om0 * omega_n_rad_s**2 / (n * -intercept)
+    lam, cp = linearize.optimal_tsr(turbine, math.degrees(turbine.operation.fine_pitch_rad))
+    r = turbine.geometry.tip_radius * math.cos(turbine.geometry.precone_rad)
+    rho = turbine.environment.air_density
+    k_opt = 0.5 * rho * math.pi * r**5 * cp / lam**3 / n**3
+    return BaselineGains(kp=kp, ki=ki, theta_k_rad=theta_k, k_opt=k_opt,
+                         rated_gen_speed_rad_s=turbine.rated_generator_speed_rad_s,
+                         rated_torque=frac * turbine.rated_generator_torque,
+                         rated_power=frac * turbine.operation.rated_power, dpdtheta_0=intercept,
+                         omega_n_rad_s=omega_n_rad_s, zeta=zeta, power_fraction=frac,
+                         info={"wake": wake, "inertia_lss": j, "tsr_opt": lam, "cp_max": cp,
+                               "fit_winds": v.tolist()})
+
+
+def tune_baseline_schedule(turbine: linearize.Turbine,
+                           fractions: Sequence[float] = (1.0, 0.75, 0.5, 0.25),
+                           **kwargs: Any) -> tuple[BaselineGains, ...]:
+    """PI designs at several power fractions, for a pitch loop scheduled on the power reference
+    (active power control). ``kwargs`` go to :func:`tune_baseline`; sorted by fraction.
+
+    Parameters
+    ----------
+    turbine : Turbine
+        The turbine.
+    fractions : sequence of float
+        Power fractions in (0, 1].
+    **kwargs
+        Passed to :func:`tune_baseline`.
+
+    Returns
+    -------
+    tuple of BaselineGains
+        One design per fraction, by increasing fraction.
+    """
+    fr = sorted({check_power_fraction(f, "fractions") for f in fractions})
+    if len(fr) < 1:
+        raise ValueError("fractions must hold at least one power fraction")
+    return tuple(tune_baseline(turbine, power_fraction=f, **kwargs) for f in fr)
+
+
+class BaselineController(ControllerBase):
+    """NREL 5-MW style baseline (torque law + gain-scheduled PI pitch) as a harness controller.
+
+    ``step(t, meas)`` takes a measurement dict with at least ``gen_speed`` [rad/s] and
+    ``pitch`` (3,) [rad] and returns (pitch_ref (3,), gen_torque_ref) and stores its internal
+    signals in ``.signals``. Call at the plant rate (``dt``).
+
+    Derated gains (``gains.power_fraction`` < 1) cap the torque law at the derated rated torque
+    at rated speed. Region 2.5 is the NREL line from the synchronous speed to (rated speed,
+    rated torque); when K omega^2 meets no such line below rated speed (deep derating), the
+    region-2 torque is capped at the rated torque instead (a constant-torque region 2.5 in which
+    the rotor speeds up to rated, as in Pettas and Cheng fig. 5).
+
+    Active power control: ``power_reference(t)`` [W] replaces rated power in region 3, and with
+    ``gain_schedule`` (designs at several power fractions, :func:`tune_baseline_schedule`) the
+    effective gains KP GK(theta), KI GK(theta) of the designs are interpolated on P_ref / P_r
+    (integral kept in pitch units, so a gain change moves no command), and with ``feedforward``
+    each change of the reference moves the pitch by dP_ref / (eta dP/dtheta), dP/dtheta from the
+    same designs at the present pitch (the pitch loop then only corrects). A reference outside
+    (0, rated power] raises ``ValueError``; while the rotor is below rated speed at fine pitch
+    the wind cannot give the reference (signal ``apc_saturated`` = 1).
+
+    Parameters
+    ----------
+    turbine : Turbine
+        The turbine.
+    gains : BaselineGains, optional
+        The design (default :func:`tune_baseline`).
+    dt : float
+        Controller period [s] (default the plant's 1/80 s).
+    region3 : {"constant_power", "constant_torque"}
+        Torque law above rated.
+    filter_hz : float
+        Corner of the generator-speed low-pass [Hz].
+    slip_pct : float
+        Region 2.5 width, in percent of rated generator speed.
+    power_reference : callable, optional
+        t [s] -> power reference [W] (active power control).
+    gain_schedule : sequence of BaselineGains, optional
+        Designs at several power fractions, interpolated on the reference.
+    feedforward : bool
+        Pitch feedforward on changes of the power reference.
+    """
+
+    def __init__(self, turbine: linearize.Turbine, gains: BaselineGains | None = None, *,
+                 dt: float = 1.0 / 80.0, region3: str = "constant_power",
+                 filter_hz: float = 0.25, slip_pct: float = 10.0,
+                 power_reference: Callable[[float], float] | None = None,
+                 gain_schedule: Sequence[BaselineGains] | None = None,
+                 feedforward: bool = True) -> None:
+        if region3 not in ("constant_power", "constant_torque"):
+            raise ValueError(f"region3 must be 'constant_power' or 'constant_torque', got "
+                             f"{region3!r}")
+        if not dt > 0:
+            raise ValueError(f"dt must be > 0 s, got {dt!r}")
+        if not 0 < filter_hz < 0.5 / dt:
+            raise ValueError(f"filter_hz must be in (0, Nyquist = {0.5 / dt:g} Hz) at dt = "
+                             f"{dt:g} s, got {filter_hz!r}")
+        self.turbine = turbine
+        self.power_reference = power_reference
+        self.feedforward = bool(feedforward)
+        if gain_schedule is not None:
+            sched = sorted(gain_schedule, key=lambda g: g.power_fraction)
+            if not sched:
+                raise ValueError("gain_schedule must hold at least one BaselineGains")
+            self._sched_f: np.ndarray | None = np.array([g.power_fraction for g in sched])
+            self._sched = np.array([[g.kp, g.ki, g.theta_k_rad, g.dpdtheta_0] for g in sched])
+            if gains is None:
+                gains = sched[-1]
+        else:
+            self._sched_f = None
+        self.gains = gains or tune_baseline(turbine)
+        self.dt = float(dt)
+        self.region3 = region3
+        g = self.gains
+        n = turbine.drivetrain.gearbox_ratio
+        self.wc = 2 * math.pi * filter_hz
+        self._a_filt = math.exp(-self.wc * self.dt)      # the speed filter's pole at dt
+        self.pitch_min = turbine.operation.fine_pitch_rad
+        self.pitch_max = turbine.pitch_actuator.max_pitch_rad
+        self.rate = turbine.pitch_actuator.max_rate_rad_s
+        self.tq_rate = turbine.generator.max_torque_rate
+        self.tq_max = turbine.generator.max_torque
+        # torque-law breakpoints (report sec. 7.3, DISCON): rated speed 99 % of the set point
+        # region 1.5 runs from the minimum rotor speed to 30 % above it on the generator (the
+        # NREL 5-MW's 670 and 871 rpm)
+        self.w_cutin = turbine.operation.min_rotor_speed_rad_s * n
+        self.w_rgn2 = 1.3 * self.w_cutin
+        self.w_rated = 0.99 * g.rated_gen_speed_rad_s
+        self.w_sync = self.w_rated / (1.0 + 0.01 * slip_pct)
+        self.slope25 = g.rated_power / turbine.drivetrain.generator_efficiency / self.w_rated \
+            / (self.w_rated - self.w_sync)
+        self.slope15 = g.k_opt * self.w_rgn2**2 / (self.w_rgn2 - self.w_cutin)
+        # region 2 -> 2.5 where K w^2 meets the 2.5 line (DISCON's VS_TrGnSp), so the torque is
+        # continuous; without an intersection the line starts at the synchronous speed
+        disc = self.slope25**2 - 4.0 * g.k_opt * self.slope25 * self.w_sync
+        self.w_trans = ((self.slope25 - math.sqrt(disc)) / (2.0 * g.k_opt) if disc >= 0
+                        else math.inf)
+        # no crossing below rated speed: region 2 runs up to rated, capped at rated torque
+        self.tq_cap = g.rated_power / turbine.drivetrain.generator_efficiency / self.w_rated
+        if self.w_trans > self.w_rated:
+            self.w_trans = self.w_rated
+        self.reset()
+
+    def reset(self) -> None:
+        """Forget the filter, integral and last commands."""
+        self.w_filt: float | None = None
+        self.integral = 0.0
+        #: an add-on's feedforward pitch [rad], set before each step (None: none); its change
+        #: from step to step enters the integral, so the PI stays consistent with it
+        self.pitch_feedforward: float | None = None
+        self._ff_last: float | None = None
+        self.last_pitch: float | None = None
+        self.last_torque: float | None = None
+        self.signals: dict[str, float] = {}
+
+    def compiled_law(self, gen_speed_index: int) -> tuple[np.ndarray, np.ndarray] | None:
+        """The law's state and parameters for the closed loop compiled with the plant
+        (:mod:`mpc_wt.simulation.compiled`), or None where it does not apply: a power reference, a
+        gain schedule, an add-on's feedforward, a subclass or a ``step`` replaced on the
+        instance (a wrapper that times or records the calls): those run through :meth:`step`.
+
+        Parameters
+        ----------
+        gen_speed_index : int
+            Index of the generator speed in the plant's outputs.
+
+        Returns
+        -------
+        (state, params) or None
+        """
+        if (type(self) is not BaselineController or "step" in vars(self)
+                or self.power_reference is not None or self._sched_f is not None
+                or self.pitch_feedforward is not None):
+            return None
+        from mpc_wt.controllers.baseline_law import law_arrays
+
+        return law_arrays(self, gen_speed_index)
+
+    def adopt_compiled_state(self, state: np.ndarray, signals: np.ndarray) -> None:
+        """Take the state a compiled run left (:meth:`compiled_law`'s layout) and its last
+        signals, so the controller reads as if :meth:`step` had run.
+
+        Parameters
+        ----------
+        state : (5,) ndarray
+            Filtered speed, integral, last pitch, last torque, started (0 / 1).
+        signals : (6,) ndarray
+            The last step's signals (:data:`mpc_wt.simulation.compiled.SIGNALS`).
+        """
+        from mpc_wt.controllers.baseline_law import SIGNALS
+
+        if state[4] == 0.0:                 # never stepped
+            return
+        self.w_filt, self.integral, self.last_pitch, self.last_torque = (
+            float(v) for v in state[:4])
+        self.signals = {k: float(v) for k, v in zip(SIGNALS, signals)}
+
+    def torque(self, w: float, pitch: float, power: float | None = None) -> float:
+        """Generator torque demand for a filtered generator speed and the collective pitch;
+        ``power`` replaces rated power in region 3 (active power control) [W].
+
+        Parameters
+        ----------
+        w : float
+            Filtered generator speed [rad/s].
+        pitch : float
+            Collective pitch [rad].
+        power : float, optional
+            Power reference [W] (default rated).
+
+        Returns
+        -------
+        float
+            Generator torque demand [N m].
+        """
+        g = self.gains
+        eta = self.turbine.drivetrain.generator_efficiency
+        p3 = g.rated_power if power is None else power
+        if w >= self.w_rated or pitch >= math.radians(1.0):
+            if self.region3 == "constant_power":
+                return p3 / eta / max(w, 1e-6)
+            return g.rated_torque * p3 / g.rated_power
+        if w <= self.w_cutin:
+            return 0.0
+        if w < self.w_rgn2:
+            tq = self.slope15 * (w - self.w_cutin)
+        elif w < self.w_trans:
+            tq = g.k_opt * w * w
+        else:
+            tq = self.slope25 * (w - self.w_sync)
+        return min(tq, self.tq_cap, p3 / eta / max(w, 1e-6))
+
+    def _ff_step(self) -> float:
+        """The feedforward pitch's change since the last step [rad]."""
+        ff = self.pitch_feedforward
+        if ff is None:
+            self._ff_last = None
+            return 0.0
+        d = 0.0 if self._ff_last is None else ff - self._ff_last
+        self._ff_last = ff
+        return d
+
+    def _reference(self, t: float) -> float | None:
+        if self.power_reference is None:
+            return None
+        p = float(self.power_reference(t))
+        if not (math.isfinite(p) and 0.0 < p <= self.gains.rated_power * (1 + 1e-9)):
+            raise ValueError(f"power_reference({t:g} s) = {p!r} W must be in (0, rated power "
+                             f"{self.gains.rated_power:g} W]")
+        return p
+
+    def step(self, t: float, meas: dict[str, Any]) -> tuple[np.ndarray, float]:
+        # One control step; returns (pitch_ref (3,) [rad], gen_torque_ref [N m]).
+        w = float(meas["gen_speed"])
+        if not math.isfinite(w):
+            raise ValueError(f"measurement gen_speed is not finite at t = {t:g} s: {w!r}")
+        p1, p2, p3 = meas["pitch"]
+        pitch_meas = float(p1 + p2 + p3) / 3.0
+        first = self.w_filt is None
+        if first:
+            self.w_filt = w
+            self.last_pitch = pitch_meas
+        a = self._a_filt
+        self.w_filt = a * self.w_filt + (1 - a) * w
+        g = self.gains
+        p_ref = self._reference(t)
+        err = self.w_filt - g.rated_gen_speed_rad_s
+        if self._sched_f is None:
+            # DISCON form: the integral of the speed error, scaled by GK with the P part
+            gk = 1.0 / (1.0 + self.last_pitch / g.theta_k_rad)
+            if first:                       # bumpless start at the measured pitch
+                self.integral = (pitch_meas / gk - g.kp * err) / g.ki
+            self.integral += err * self.dt + self._ff_step() / (gk * g.ki)
+            # anti-windup: keep the integral term within the pitch limits
+            lo, hi = self.pitch_min / (gk * g.ki), self.pitch_max / (gk * g.ki)
+            self.integral = min(max(self.integral, lo), hi)
+            cmd = gk * (g.kp * err + g.ki * self.integral)
+        else:
+            # scheduled on P_ref / P_r and pitch: the integral is kept in pitch units (ROSCO
+            # form) so that a gain change moves no command
+            frac = p_ref / (g.rated_power / g.power_fraction) if p_ref is not None \
+                else g.power_fraction
+            gks = 1.0 / (1.0 + self.last_pitch / self._sched[:, 2])
+            kp = float(np.interp(frac, self._sched_f, self._sched[:, 0] * gks))
+            ki = float(np.interp(frac, self._sched_f, self._sched[:, 1] * gks))
+            gk = kp / g.kp
+            if first:
+                self.integral = pitch_meas - kp * err
+                self._p_ref_last = p_ref
+            ff = 0.0
+            if self.feedforward and p_ref is not None:
+                # pitch that sheds the reference change at this operating point:
+                # d theta = d P_aero / (dP/dtheta), dP/dtheta = (dP/dtheta)_0 / GK
+                dpdt = float(np.interp(frac, self._sched_f, self._sched[:, 3] / gks))
+                eta = self.turbine.drivetrain.generator_efficiency
+                ff = (p_ref - self._p_ref_last) / eta / dpdt
+                self._p_ref_last = p_ref
+            self.integral = min(max(self.integral + ki * err * self.dt + ff + self._ff_step(),
+                                    self.pitch_min), self.pitch_max)
+            cmd = kp * err + self.integral
+        cmd = min(max(cmd, self.pitch_min), self.pitch_max)
+        step = self.rate * self.dt
+        cmd = min(max(cmd, self.last_pitch - step), self.last_pitch + step)
+        self.last_pitch = cmd
+        tq = min(self.torque(self.w_filt, cmd, p_ref), self.tq_max)
+        if self.last_torque is not None:
+            d = self.tq_rate * self.dt
+            tq = min(max(tq, self.last_torque - d), self.last_torque + d)
+        self.last_torque = tq
+        self.signals = {"gen_speed_filtered": self.w_filt, "speed_error": err,
+                        "pitch_integral": self.integral, "gain_schedule": gk,
+                        "pitch_command": cmd, "torque_command": tq}
+        if p_ref is not None:
+            self.signals["power_reference"] = p_ref
+            self.signals["apc_saturated"] = float(cmd <= self.pitch_min + 1e-9
+                                                  and err < 0.0)
+        return np.array((cmd, cmd, cmd)), tq

@@ -1,0 +1,430 @@
+"""A host for Bladed-style controller libraries (``DISCON``), ROSCO's included, through ctypes.
+
+The interface is the one OpenFAST's ServoDyn and Bladed call: ``DISCON(avrSWAP, aviFAIL,
+accINFILE, avcOUTNAME, avcMSG)`` with a float32 swap array whose records the host fills with
+measurements and settings before each call and from which it reads the demands after it
+(Bladed User Manual, appendix A; the records as ServoDyn fills them, :data:`SWAP_RECORDS`).
+``avrSWAP(1)`` is the status: 0 on the first call, 1 on every later one, -1 on the last.
+
+Each :class:`DisconController` loads its own copy of the library (copied to a private temporary
+folder): libraries keep their state in globals (ROSCO refuses a second initialization of one
+loaded copy, "This ROSCO dynamic library has already been loaded"), so two controllers, or two
+runs in one process, must not share one.
+"""
+from __future__ import annotations
+
+import ctypes
+import logging
+import math
+import os
+import shutil
+import sys
+import tempfile
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from mpc_wt.controllers.base import ControllerBase
+from mpc_wt.errors import ControllerLibraryError
+
+__all__ = ["DisconController", "SWAP_RECORDS", "SWAP_SIZE", "rosco_library", "rosco_discon"]
+
+log = logging.getLogger(__name__)
+
+#: Length of the swap array: the Bladed records, ROSCO's extended block from 1001, and room for
+#: the logging channels a library may return.
+SWAP_SIZE = 3300
+_MSG_LEN = 1025
+_OUT_LEN = 4097
+#: Records the host writes (1-based, as the interface numbers them) -> what they hold.
+SWAP_RECORDS = {
+    1: "status: 0 first call, 1 running, -1 last call",
+    2: "current time [s]", 3: "communication interval [s]",
+    4: "blade 1 pitch angle [rad]", 5: "below-rated pitch set-point (fine pitch) [rad]",
+    6: "minimum pitch [rad]", 7: "maximum pitch [rad]", 8: "minimum pitch rate [rad/s]",
+    9: "maximum pitch rate [rad/s]", 10: "0 = pitch position actuator",
+    11: "current demanded pitch [rad]", 13: "demanded power [W]",
+    14: "measured shaft power [W]", 15: "measured electrical power [W]",
+    17: "minimum generator speed [rad/s]", 18: "optimal-mode maximum speed [rad/s]",
+    19: "demanded generator speed above rated [rad/s]",
+    20: "measured generator speed [rad/s]", 21: "measured rotor speed [rad/s]",
+    22: "demanded generator torque above rated [N m]",
+    23: "measured generator torque [N m]", 24: "measured yaw error [rad]",
+    27: "hub wind speed [m/s]", 28: "pitch control: 0 collective, 1 individual",
+    29: "yaw control: 0 rate", 30: "blade 1 root out-of-plane moment [N m]",
+    31: "blade 2 root out-of-plane moment [N m]", 32: "blade 3 root out-of-plane moment [N m]",
+    33: "blade 2 pitch angle [rad]", 34: "blade 3 pitch angle [rad]",
+    35: "generator contactor (the library's last value, first 1)",
+    37: "nacelle yaw from North [rad]", 49: "length of the message buffer",
+    50: "length of INFILE incl. NUL", 51: "length of OUTNAME incl. NUL",
+    53: "tower-top fore-aft acceleration [m/s^2]",
+    54: "tower-top side-side acceleration [m/s^2]", 60: "rotor azimuth [rad]",
+    61: "number of blades", 62: "maximum logging channels", 63: "start of logging records",
+    64: "length of the OUTNAME buffer", 66: "start of the platform-motion block (1001)",
+    69: "blade 1 root in-plane moment [N m]", 70: "blade 2 root in-plane moment [N m]",
+    71: "blade 3 root in-plane moment [N m]", 75: "fixed-frame hub tilt moment [N m]",
+    76: "fixed-frame hub yaw moment [N m]", 95: "air density [kg/m^3]",
+    109: "low-speed-shaft torque [N m]", 110: "rotor thrust [N]", 129: "swap array length",
+}
+_LOG_START = 165
+
+
+def rosco_library() -> Path:
+    """The compiled ROSCO controller of the ``rosco`` package (``pip install mpc-wt[rosco]``).
+
+    Returns
+    -------
+    Path
+
+    Raises
+    ------
+    ControllerLibraryError
+        If the package or its library is not installed.
+    """
+    try:
+        import rosco
+    except ImportError:
+        raise ControllerLibraryError("the rosco package is not installed; pip install "
+                                     "'mpc-wt[rosco]' (it ships ROSCO's libdiscon)") from None
+    lib_dir = Path(rosco.__file__).parent / "lib"
+    names = {"linux": "libdiscon.so", "darwin": "libdiscon.dylib", "win32": "libdiscon.dll"}
+    path = lib_dir / names.get(sys.platform, "libdiscon.so")
+    if not path.is_file():
+        raise ControllerLibraryError(f"{path}: ROSCO's library is not in the rosco package "
+                                     f"(found {sorted(p.name for p in lib_dir.glob('*'))})")
+    return path
+
+
+def rosco_discon(turbine_name: str = "NREL-5MW") -> Path:
+    """A ``DISCON.IN`` shipped with the ``rosco`` package's examples.
+
+    Parameters
+    ----------
+    turbine_name : str
+        ``"NREL-5MW"`` (default) or ``"IEA-15-240-RWT"``.
+
+    Returns
+    -------
+    Path
+    """
+    cases = rosco_library().parents[2] / "Examples" / "Test_Cases"
+    files = {"NREL-5MW": cases / "NREL-5MW" / "DISCON.IN",
+             "IEA-15-240-RWT": cases / "IEA-15-240-RWT" / "IEA-15-240-RWT-Monopile"
+             / "IEA-15-240-RWT-Monopile_DISCON.IN"}
+    if turbine_name not in files:
+        raise ValueError(f"turbine_name must be one of {sorted(files)}, got {turbine_name!r}")
+    return files[turbine_name]
+
+
+def _check_library(path: Path) -> None:
+    if not path.is_file():
+        raise ControllerLibraryError(f"controller library {path}: file not found")
+    with path.open("rb") as fh:
+        head = fh.read(20)
+    magic = {"linux": b"\x7fELF", "darwin": (b"\xcf\xfa\xed\xfe", b"\xca\xfe\xba\xbe"),
+             "win32": b"MZ"}.get(sys.platform, b"\x7fELF")
+    magics = magic if isinstance(magic, tuple) else (magic,)
+    if not any(head.startswith(m) for m in magics):
+        raise ControllerLibraryError(
+            f"controller library {path}: not a shared library for this platform "
+            f"({sys.platform}); its first bytes are {head[:4]!r}, expected {magics[0]!r}")
+    if sys.platform == "linux" and len(head) >= 20:
+        machine = int.from_bytes(head[18:20], "little")
+        want = {"x86_64": 62, "aarch64": 183, "i686": 3, "i386": 3}.get(os.uname().machine)
+        if want is not None and machine != want:
+            raise ControllerLibraryError(
+                f"controller library {path}: built for ELF machine {machine}, this machine is "
+                f"{os.uname().machine} (ELF machine {want})")
+
+
+_PRELOADED: set[str] = set()
+
+
+def _preload_dependencies(original: Path) -> None:
+    """Load the libraries a wheel bundles beside ``original`` ($ORIGIN-relative RPATH, e.g.
+    ROSCO's ``rosco.libs/libgfortran-*.so``) once, globally, so that a copy of ``original`` in
+    another folder finds them by their sonames. Only these runtime dependencies are shared
+    between copies; the controller's own globals are not."""
+    import re
+
+    # unbuffered Fortran units, so that a quiet controller's redirect catches what is printed
+    os.environ.setdefault("GFORTRAN_UNBUFFERED_PRECONNECTED", "y")
+    data = original.read_bytes()
+    dirs = []
+    for m in re.finditer(rb"\$(?:ORIGIN|\{ORIGIN\})([^\x00:]*)", data):
+        rest = m.group(1).decode(errors="ignore").lstrip("/")
+        d = (original.parent / rest).resolve()
+        if d.is_dir() and d != original.parent.resolve():
+            dirs.append(d)
+    libs = [f for d in dirs for f in sorted(d.iterdir())
+            if ".so" in f.name and str(f) not in _PRELOADED]
+    for _ in range(3):                       # dependencies among them: retry in passes
+        left = []
+        for f in libs:
+            try:
+                ctypes.CDLL(str(f), mode=getattr(ctypes, "RTLD_GLOBAL", 0))
+                _PRELOADED.add(str(f))
+            except OSError:
+                left.append(f)
+        if not left or len(left) == len(libs):
+            break
+        libs = left
+
+
+class DisconController(ControllerBase):
+    """Run a Bladed-style controller library in mpc-wt's closed loop.
+
+    Parameters
+    ----------
+    library : str or Path
+        The shared library exporting ``DISCON``.
+    discon_in : str or Path
+        Its input file (passed as ``accINFILE``; ROSCO's ``DISCON.IN``).
+    turbine : Turbine
+        For the settings records (pitch and speed limits, rated values, air density).
+    dt : float
+        Communication interval [s] (``avrSWAP(3)``); the harness must call at this period.
+    pitch_control : {"individual", "collective"}
+        ``avrSWAP(28)``: individual (read records 42-44; ROSCO needs it for IPC) or collective
+        (record 45 for all blades).
+    workdir : str or Path, optional
+        Where the library may write its own files (``.dbg``, ...); its ``OUTNAME`` is
+        ``workdir/root_name``. Default: a temporary folder removed by :meth:`finalize`.
+    root_name : str
+        The simulation root name given to the library.
+    quiet : bool
+        Send what the library prints on the process's standard output (ROSCO's banner and
+        status lines) to the null device during its calls (default); its ``aviFAIL`` messages
+        are kept either way.
+
+    Raises
+    ------
+    ControllerLibraryError
+        If the library or input file does not exist, is not a library for this machine, or has
+        no ``DISCON`` symbol.
+    """
+
+    def __init__(self, library: str | Path, discon_in: str | Path, turbine: Any, *,
+                 dt: float = 1.0 / 80.0, pitch_control: str = "individual",
+                 workdir: str | Path | None = None, root_name: str = "mpcwt_discon",
+                 quiet: bool = True) -> None:
+        self.library = Path(library).resolve()
+        self.discon_in = Path(discon_in).resolve()
+        _check_library(self.library)
+        if not self.discon_in.is_file():
+            raise ControllerLibraryError(f"controller input file {self.discon_in}: file not "
+                                         f"found")
+        if pitch_control not in ("individual", "collective"):
+            raise ValueError(f"pitch_control must be 'individual' or 'collective', got "
+                             f"{pitch_control!r}")
+        if not (math.isfinite(dt) and dt > 0):
+            raise ValueError(f"dt must be finite and > 0 s, got {dt!r}")
+        self.turbine, self.dt, self.pitch_control = turbine, float(dt), pitch_control
+        self._own_workdir = workdir is None
+        self.workdir = Path(workdir) if workdir is not None else None
+        self.root_name = root_name
+        self.quiet = quiet
+        self._fds: tuple[int, int] | None = None
+        self._lib: Any = None
+        self._copy_dir: str | None = None
+        self._swap = (ctypes.c_float * SWAP_SIZE)()
+        self._view = np.frombuffer(self._swap, dtype=np.float32)
+        self.signals: dict[str, float] = {}
+        self.messages: list[str] = []
+        self._status = 0
+        self._load()                         # fail early on a bad library
+
+    # -- library lifetime --------------------------------------------------------------------
+    def _load(self) -> None:
+        self._unload()
+        self._copy_dir = tempfile.mkdtemp(prefix="mpcwt_discon_")
+        copy = Path(self._copy_dir) / self.library.name
+        shutil.copy2(self.library, copy)
+        _preload_dependencies(self.library)
+        try:
+            lib = ctypes.CDLL(str(copy), mode=getattr(ctypes, "RTLD_LOCAL", 0))
+        except OSError as err:
+            self._unload()
+            raise ControllerLibraryError(f"controller library {self.library}: cannot be "
+                                         f"loaded: {err}") from err
+        try:
+            fn = lib.DISCON
+        except AttributeError:
+            self._unload()
+            raise ControllerLibraryError(f"controller library {self.library}: no symbol "
+                                         f"'DISCON' (not a Bladed-style controller)") from None
+        fn.restype = None
+        fn.argtypes = [ctypes.POINTER(ctypes.c_float), ctypes.POINTER(ctypes.c_int),
+                       ctypes.c_char_p, ctypes.c_char_p, ctypes.c_char_p]
+        self._lib, self._fn = lib, fn
+
+    def _unload(self) -> None:
+        if self._lib is not None:
+            handle = self._lib._handle
+            self._lib = None
+            try:
+                import _ctypes
+                (getattr(_ctypes, "dlclose", None) or getattr(_ctypes, "FreeLibrary"))(handle)
+            except (OSError, AttributeError):
+                pass
+        if self._copy_dir is not None:
+            shutil.rmtree(self._copy_dir, ignore_errors=True)
+            self._copy_dir = None
+
+    def reset(self) -> None:
+        """A fresh copy of the library (its globals start over) and the first-call status."""
+        if self._lib is None or self._status != 0:
+            self._load()
+        if self._own_workdir:
+            self.workdir = Path(tempfile.mkdtemp(prefix="mpcwt_discon_run_"))
+        assert self.workdir is not None
+        self.workdir.mkdir(parents=True, exist_ok=True)
+        self._view[:] = 0.0
+        self._view[34] = 1.0                 # record 35: generator contactor on
+        self._status = 0
+        self._last_pitch = np.full(3, self.turbine.operation.fine_pitch_rad)
+        self._last_torque = 0.0
+        self._settings()
+        self.messages = []
+        self.signals = {}
+
+    def finalize(self) -> None:
+        """The library's last call (status -1), then unload it; its files stay in
+        ``workdir`` when one was given."""
+        if self._lib is not None and self._status == 1:
+            self._view[0] = -1.0
+            try:
+                self._call(float(self._view[1]))
+            except ControllerLibraryError as err:    # the run is over: report, do not raise
+                self.messages.append(str(err))
+                log.warning("%s", err)
+        self._status = -1
+        self._unload()
+        if self._fds is not None:
+            for fd in self._fds:
+                os.close(fd)
+            self._fds = None
+        if self._own_workdir and self.workdir is not None:
+            shutil.rmtree(self.workdir, ignore_errors=True)
+
+    def __del__(self) -> None:  # pragma: no cover - interpreter shutdown order varies
+        try:
+            self._unload()
+        except Exception:  # noqa: BLE001
+            pass
+
+    # -- one call ----------------------------------------------------------------------------
+    def _settings(self) -> None:
+        """The records that do not change during a run, and the string buffers."""
+        tb = self.turbine
+        op, pa, dr = tb.operation, tb.pitch_actuator, tb.drivetrain
+        n = dr.gearbox_ratio
+        assert self.workdir is not None
+        self._infile = str(self.discon_in).encode()
+        self._outname = str(self.workdir / self.root_name).encode()
+        fixed = {3: self.dt, 5: op.fine_pitch_rad, 6: pa.min_pitch_rad, 7: pa.max_pitch_rad,
+                 8: -pa.max_rate_rad_s, 9: pa.max_rate_rad_s, 10: 0.0, 13: op.rated_power,
+                 17: op.min_rotor_speed_rad_s * n, 18: op.rated_rotor_speed_rad_s * n,
+                 19: op.rated_rotor_speed_rad_s * n, 22: tb.rated_generator_torque, 24: 0.0,
+                 28: 1.0 if self.pitch_control == "individual" else 0.0, 29: 0.0, 37: 0.0,
+                 49: float(_MSG_LEN), 50: float(len(self._infile) + 1),
+                 51: float(len(self._outname) + 1), 61: 3.0, 62: 0.0, 63: float(_LOG_START),
+                 64: float(_OUT_LEN), 66: 1001.0, 95: tb.environment.air_density,
+                 129: float(SWAP_SIZE)}
+        self._view[np.array(list(fixed)) - 1] = np.array(list(fixed.values()), np.float32)
+        self._msg = ctypes.create_string_buffer(_MSG_LEN)
+        self._out = ctypes.create_string_buffer(_OUT_LEN)
+
+    #: records filled from the measurements at each call, in the order of ``_fill``'s list
+    _DYNAMIC = np.array([1, 2, 4, 33, 34, 11, 14, 15, 20, 21, 23, 27, 30, 31, 32, 69, 70, 71,
+                         53, 54, 60, 75, 76, 109, 110]) - 1
+
+    def _fill(self, t: float, meas: dict[str, Any]) -> None:
+        g = meas.get
+        p, f, e = meas["pitch"], meas["flap_moment"], meas["edge_moment"]
+        self._view[self._DYNAMIC] = (
+            self._status, t, p[0], p[1], p[2], self._last_pitch[0], g("aero_power", 0.0),
+            g("gen_power", 0.0), meas["gen_speed"], meas["rotor_speed"],
+            g("gen_torque", self._last_torque), g("hub_wind_speed", 0.0), f[0], f[1], f[2],
+            e[0], e[1], e[2], g("tower_fa_acceleration", 0.0), g("tower_ss_acceleration", 0.0),
+            g("azimuth", 0.0), g("tilt_moment", 0.0), g("yaw_moment", 0.0),
+            g("lss_torque", 0.0), g("thrust", 0.0))
+
+    def _call(self, t: float) -> None:
+        fail = ctypes.c_int(0)
+        self._msg[0] = b"\0"
+        ctypes.memmove(self._out, self._outname + b"\0", len(self._outname) + 1)
+        if self.quiet:
+            if self._fds is None:
+                sys.stdout.flush()
+                self._fds = (os.open(os.devnull, os.O_WRONLY), os.dup(1))
+            os.dup2(self._fds[0], 1)
+            try:
+                self._fn(self._swap, ctypes.byref(fail), self._infile, self._out, self._msg)
+            finally:
+                os.dup2(self._fds[1], 1)
+        else:
+            self._fn(self._swap, ctypes.byref(fail), self._infile, self._out, self._msg)
+        if fail.value == 0:
+            return
+        text = self._msg.value.decode(errors="replace").strip()
+        if fail.value < 0:
+            raise ControllerLibraryError(
+                f"controller library {self.library.name} stopped the run at t = {t:g} s "
+                f"(aviFAIL = {fail.value}): {text or '(no message)'}")
+        if text:
+            self.messages.append(f"t = {t:g} s: {text}")
+            log.warning("%s at t = %g s: %s", self.library.name, t, text)
+
+    def step(self, t: float, meas: dict[str, Any]) -> tuple[np.ndarray, float]:
+        """Fill the swap array, call the library, read its demands.
+
+        Parameters
+        ----------
+        t : float
+            Time of the call, written to record 2 [s].
+        meas : dict
+            The harness's measurements, written to the records of :data:`SWAP_RECORDS`.
+
+        Returns
+        -------
+        pitch_ref : (3,) ndarray
+            Records 42-44 (individual) or 45 (collective) [rad].
+        gen_torque_ref : float
+            Record 47 [N m]; zero while the library opens the generator contactor (record 35).
+
+        Raises
+        ------
+        ControllerLibraryError
+            If the library sets ``aviFAIL < 0``; the message is the library's.
+        """
+        if self._lib is None:
+            raise ControllerLibraryError(f"controller library {self.library.name}: step() "
+                                         f"before reset() or after finalize()")
+        self._fill(t, meas)
+        self._call(t)
+        self._status = 1
+        v = self._view
+        if self.pitch_control == "individual":
+            pitch = v[41:44].astype(float)
+        else:
+            pitch = np.full(3, float(v[44]))
+        contactor = float(v[34])
+        torque = float(v[46]) if contactor != 0.0 else 0.0
+        # the swap array is float32: a demand at a limit may sit one rounding step beyond it
+        hi = self.turbine.generator.max_torque
+        if hi < torque <= hi * (1 + 1e-6):
+            torque = hi
+        lo_p, hi_p = self.turbine.pitch_actuator.min_pitch_rad, \
+            self.turbine.pitch_actuator.max_pitch_rad
+        pitch = np.where((pitch < lo_p) & (pitch >= lo_p - 1e-6), lo_p, pitch)
+        pitch = np.where((pitch > hi_p) & (pitch <= hi_p + 1e-6), hi_p, pitch)
+        if not (math.isfinite(pitch[0] + pitch[1] + pitch[2]) and math.isfinite(torque)):
+            raise ControllerLibraryError(
+                f"controller library {self.library.name} returned pitch {pitch} rad, torque "
+                f"{torque} N m at t = {t:g} s")
+        self._last_pitch, self._last_torque = pitch, torque
+        self.signals = {"pitch_command": (pitch[0] + pitch[1] + pitch[2]) / 3.0,
+                        "torque_command": torque, "generator_contactor": contactor}
+        return pitch, torque

@@ -1,0 +1,638 @@
+"""Retrofit control strategies: individual blade control, Coleman-frame IPC, down-regulation,
+active power control, and the metrics that judge them.
+
+Individual blade control (Pettas and Cheng 2018, sec. 3.1, fig. 3): three decoupled
+proportional loops, one per blade, on the blade-root flap moment M_i. A high-pass filter on the
+input keeps the loops out of the collective pitch controller's band, band-stop (notch) filters
+on the output keep them out of 3P (and any further harmonics given), and the gain is scheduled
+on the mean pitch. The IBC pitch is weighted by a factor rising linearly from 0 to 1 with the
+electrical power between two fractions of rated (partial to full load):
+
+    theta_i = theta_CPC + w(P) BS(K(theta_mean) HP(M_i)),     i = 1, 2, 3.
+
+The paper tunes K on identified blade models; here K comes from our linear models: at each
+region-III wind, the single-blade loop L = K F(z) (-G(z)) (G: pitch_ref_1 -> flap_moment_1 of
+the blade-coordinate model discretized at the controller rate, F: the filters) gets the loop
+gain ``loop_gain_1p`` at 1P, lowered if needed so that the gain margin is at least
+``min_gain_margin`` (python-control's stability margins), and the closed loop is checked
+stable.
+
+Coleman-frame IPC (Bossanyi 2003, the scheme ROSCO's IPC implements): the tilt and yaw
+components M_cs = 2/3 sum_i M_i [cos psi_i, sin psi_i] are driven to zero by integral control,
+theta_cs = -K_I R(-phi) int M_cs dt, and returned to the blades by the inverse transform. K_I
+and the azimuth offset phi come from the static gain of the MBC linear model (the 2x2 map
+pitch_ref_cos/sin -> flap_moment_cos/sin is close to a gain times a rotation R(phi)): K_I sets
+the crossover ``crossover_rad_s`` and phi cancels the rotation.
+
+Down-regulation (Pettas and Cheng sec. 3.2) is :func:`mpc_wt.controllers.baseline.tune_baseline` with
+``power_fraction``; :func:`steady_power_curve` and :func:`aep_change` give the steady power
+curve of a torque law and the Weibull/Rayleigh-weighted AEP loss.
+
+Active power control (Clemens et al. sec. 3.2, eq 11): :func:`apc_reference` is the test
+signal; :class:`mpc_wt.controllers.baseline.BaselineController` follows it with ``power_reference`` and a
+pitch loop scheduled on the reference.
+
+Metrics (Pettas and Cheng sec. 4, eq 1): :func:`lifetime_comparison`.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Any, Sequence
+
+import numpy as np
+from scipy import signal
+
+import linearize
+from linearize.validate import check_number
+from mpc_wt.controllers.apc import check_weight_range, power_weight
+from mpc_wt.controllers.base import ControllerBase
+from mpc_wt.controllers.baseline import BaselineController, check_power_fraction
+from mpc_wt.controllers.filters import SOSFilterBank, filter_sos
+
+__all__ = ['IBCGains', 'tune_ibc', 'IBCController', 'ColemanIPCGains', 'tune_coleman_ipc', 'ColemanIPCController']
+
+def _region3_winds(turbine: linearize.Turbine, step: float = 2.0) -> np.ndarray:
+    lo = float(np.floor(linearize.rated_wind_speed(turbine))) + 1.0
+    hi = min(25.0, turbine.operation.cut_out_wind)
+    return np.unique(np.r_[np.arange(lo, hi, step), hi])
+
+
+def _freq_resp(a: np.ndarray, b: np.ndarray, c: np.ndarray, d: np.ndarray,
+               z: complex) -> np.ndarray:
+    """C (z I - A)^-1 B + D of a discrete model."""
+    return c @ np.linalg.solve(z * np.eye(a.shape[0]) - a, b) + d
+
+
+# --------------------------------------------------------------------------------------------
+# Individual blade control
+# --------------------------------------------------------------------------------------------
+@dataclass(frozen=True)
+class IBCGains:
+    """Gain schedule and filters of the individual blade controller.
+
+    Parameters
+    ----------
+    pitch_rad : (n_op,) ndarray
+        Mean-pitch breakpoints of the schedule (trim pitch at ``wind_mps``) [rad].
+    gain : (n_op,) ndarray
+        Proportional gain per breakpoint [rad/(N m)]: pitch per unit flap moment.
+    wind_mps : (n_op,) ndarray
+        Wind speeds of the operating points [m/s].
+    gain_margin : (n_op,) ndarray
+        Gain margin of the single-blade loop at each point [-] (inf: none).
+    loop_gain_1p : (n_op,) ndarray
+        Achieved loop gain abs(L) at 1P [-].
+    dt : float
+        Controller period the filters are designed for [s].
+    rotor_speed_rad_s : float
+        Rotor speed of the filter frequencies (rated) [rad/s].
+    highpass_hz : float
+        Input high-pass corner [Hz].
+    notch_harmonics : tuple of int
+        Output band-stop filters at these multiples of 1P.
+    notch_q : float
+        Quality factor of the band-stop filters [-].
+    weight_range : (float, float)
+        Power fractions of rated between which the IBC output rises from 0 to 1 [-].
+    rated_power : float
+        The rated (or derated) power the weight refers to [W].
+    power_fraction : float
+        Derating fraction the gains were tuned at [-].
+    lowpass_hz : float or None
+        Corner of a second-order Butterworth low-pass on the output [Hz] (None: none).
+    """
+
+    pitch_rad: np.ndarray
+    gain: np.ndarray
+    wind_mps: np.ndarray
+    gain_margin: np.ndarray
+    loop_gain_1p: np.ndarray
+    dt: float
+    rotor_speed_rad_s: float
+    highpass_hz: float
+    notch_harmonics: tuple[float, ...]
+    notch_q: float
+    weight_range: tuple[float, float]
+    rated_power: float
+    power_fraction: float = 1.0
+    lowpass_hz: float | None = None
+    info: dict[str, Any] = field(default_factory=dict, compare=False)
+
+    def __post_init__(self) -> None:
+        for n in ("pitch_rad", "gain", "wind_mps", "gain_margin", "loop_gain_1p"):
+            arr = np.array(getattr(self, n), dtype=float)
+            arr.flags.writeable = False
+            object.__setattr__(self, n, arr)
+        if not (self.pitch_rad.shape == self.gain.shape == self.wind_mps.shape
+                and self.pitch_rad.ndim == 1 and self.pitch_rad.size >= 1):
+            raise ValueError(f"pitch_rad {self.pitch_rad.shape}, gain {self.gain.shape} and "
+                             f"wind_mps {self.wind_mps.shape} must be 1-D of equal length")
+        if np.any(np.diff(self.pitch_rad) <= 0):
+            raise ValueError("pitch_rad must be strictly increasing")
+
+    @property
+    def fs(self) -> float:
+        """Controller rate [Hz]."""
+        return 1.0 / self.dt
+
+    @property
+    def one_p_hz(self) -> float:
+        """Rotor frequency of the filters [Hz]."""
+        return self.rotor_speed_rad_s / (2 * math.pi)
+
+    def input_sos(self) -> np.ndarray:
+        """Second-order sections of the input (high-pass) filter.
+
+        Returns
+        -------
+        (n_sections, 6) ndarray
+            The sections.
+        """
+        return _ibc_sos(self.fs, self.one_p_hz, self.highpass_hz, self.notch_harmonics,
+                        self.notch_q, self.lowpass_hz)[0]
+
+    def output_sos(self) -> np.ndarray:
+        """Second-order sections of the output (band-stop, optional low-pass) filters.
+
+        Returns
+        -------
+        (n_sections, 6) ndarray
+            The sections.
+        """
+        return _ibc_sos(self.fs, self.one_p_hz, self.highpass_hz, self.notch_harmonics,
+                        self.notch_q, self.lowpass_hz)[1]
+
+    def gain_at(self, pitch_rad: float) -> float:
+        """Scheduled gain at a mean pitch (held at the ends of the table) [rad/(N m)].
+
+        Parameters
+        ----------
+        pitch_rad : float
+            Mean pitch [rad].
+
+        Returns
+        -------
+        float
+            Gain [rad/(N m)].
+        """
+        return float(np.interp(pitch_rad, self.pitch_rad, self.gain))
+
+
+def _ibc_sos(fs: float, one_p_hz: float, highpass_hz: float, harmonics: Sequence[float],
+             notch_q: float, lowpass_hz: float | None) -> tuple[np.ndarray, np.ndarray]:
+    """(input, output) second-order sections of the IBC filters."""
+    return (filter_sos(fs, highpass_hz=highpass_hz),
+            filter_sos(fs, notch_hz=[h * one_p_hz for h in harmonics], notch_q=notch_q,
+                       lowpass_hz=lowpass_hz))
+
+
+def _blade_model(turbine: linearize.Turbine, v: float, p_w: float | None,
+                 params: linearize.PlantParams, coordinates: str = "blade"
+                 ) -> linearize.LinearModel:
+    return linearize.linearize(turbine, v, params=params, power_W=p_w, coordinates=coordinates)
+
+
+def tune_ibc(turbine: linearize.Turbine, *, winds: Any = None, dt: float = 1.0 / 80.0,
+             loop_gain_1p: float = 1.0, min_gain_margin: float = 2.0,
+             highpass_hz: float | None = None, notch_harmonics: Sequence[int] = (3,),
+             notch_q: float = 1.0, weight_range: tuple[float, float] = (0.8, 0.95),
+             power_fraction: float = 1.0, lowpass_hz: float | None = None) -> IBCGains:
+    """Tune the individual blade controller on our linear models (Pettas and Cheng sec. 3.1).
+
+    Parameters
+    ----------
+    winds : array_like, optional
+        Region-III wind speeds of the schedule [m/s]; default every 2 m/s from the first whole
+        m/s above rated to cut-out.
+    dt : float
+        Controller period [s] (the harness runs the baseline at the plant rate, 1/80 s).
+    loop_gain_1p : float
+        Target loop gain abs(L(1P)) of each blade loop [-].
+    min_gain_margin : float
+        Smallest gain margin allowed (the gain is lowered to meet it) [-] (2 = 6 dB).
+    highpass_hz : float, optional
+        Input high-pass corner [Hz]; default half the rated 1P frequency.
+    notch_harmonics : sequence of int
+        Output band-stop filters at these multiples of rated 1P (paper: 3P).
+    notch_q : float
+        Quality factor of the band-stop filters [-].
+    weight_range : (float, float)
+        Power fractions between which the IBC fades in [-].
+    power_fraction : float
+        Tune on the operating points derated to this fraction of rated power [-].
+    lowpass_hz : float, optional
+        Second-order low-pass corner on the output [Hz] (not in the paper; it limits the pitch
+        acceleration the loops ask for above 3P).
+
+    Returns
+    -------
+    IBCGains
+        The gain schedule over pitch with the filters, margins and the reached 1P loop gain.
+
+    Raises
+    ------
+    ValueError
+        For a filter corner at or above Nyquist, a derating fraction outside (0, 1], or
+        non-positive targets.
+    RuntimeError
+        If a blade loop is unstable even at the smallest gain tried.
+    """
+    frac = check_power_fraction(power_fraction)
+    harm = _check_ibc_args(dt, loop_gain_1p, min_gain_margin, notch_harmonics)
+    wr = check_weight_range(weight_range)
+    om = turbine.operation.rated_rotor_speed_rad_s
+    f1p = om / (2 * math.pi)
+    fs = 1.0 / dt
+    hp = 0.5 * f1p if highpass_hz is None else highpass_hz
+    v = _region3_winds(turbine) if winds is None else np.asarray(winds, float)
+    p_rated = frac * turbine.operation.rated_power
+    p_w = None if frac == 1.0 else p_rated
+    filt = np.vstack(_ibc_sos(fs, f1p, hp, harm, notch_q, lowpass_hz))
+    f_sys = _sos_ss(filt, dt)
+    zf = np.exp(1j * om * dt)
+    f1 = complex(signal.sosfreqz(filt, worN=[f1p], fs=fs)[1][0])
+    params = linearize.plant_params(turbine)
+    pitch, k_out, gm_out, l1p = [], [], [], []
+    for w in v:
+        m = _blade_model(turbine, float(w), p_w, params)
+        k, gm, lg = _ibc_gain(m, dt, zf, f1, f_sys, loop_gain_1p, min_gain_margin)
+        pitch.append(m.info["pitch_deg"] * math.pi / 180)
+        k_out.append(k)
+        gm_out.append(gm)
+        l1p.append(lg)
+    order = np.argsort(pitch)
+    return IBCGains(pitch_rad=np.asarray(pitch)[order], gain=np.asarray(k_out)[order],
+                    wind_mps=v[order], gain_margin=np.asarray(gm_out)[order],
+                    loop_gain_1p=np.asarray(l1p)[order], dt=dt, rotor_speed_rad_s=om,
+                    highpass_hz=hp, notch_harmonics=harm, notch_q=notch_q,
+                    weight_range=wr, rated_power=p_rated, power_fraction=frac,
+                    lowpass_hz=lowpass_hz, info={"target_loop_gain_1p": loop_gain_1p,
+                          "min_gain_margin": min_gain_margin})
+
+
+def _check_ibc_args(dt: float, loop_gain_1p: float, min_gain_margin: float,
+                    notch_harmonics: Sequence[int]) -> tuple[float, ...]:
+    """Check tune_ibc's numbers; the notch harmonics as floats."""
+    check_number("dt", dt, lo=0.0, lo_open=True, unit="s")
+    if not (loop_gain_1p > 0 and min_gain_margin > 1):
+        raise ValueError(f"loop_gain_1p must be > 0 and min_gain_margin > 1, got "
+                         f"{loop_gain_1p!r}, {min_gain_margin!r}")
+    harm = tuple(float(h) for h in notch_harmonics)
+    if any(not h > 0 for h in harm):
+        raise ValueError(f"notch_harmonics must be positive multiples of 1P, got "
+                         f"{notch_harmonics!r}")
+    return harm
+
+
+def _ibc_gain(m: linearize.LinearModel, dt: float, zf: complex, f1: complex, f_sys: Any,
+              loop_gain_1p: float, min_gain_margin: float) -> tuple[float, float, float]:
+    """One blade loop's gain at one operating point: abs(k F G) = target at 1P, lowered until the
+    gain margin is met; returns (gain, gain margin, loop gain at 1P)."""
+    import control
+
+    s = m.select(inputs=["pitch_ref_1"], outputs=["flap_moment_1"]).discretize(dt)
+    g1 = complex(_freq_resp(s.A, s.B_u, s.C_z, s.D_u, zf)[0, 0])
+    k = loop_gain_1p / abs(f1 * g1)
+    plant = control.ss(s.A, s.B_u, -s.C_z, -s.D_u, dt)     # -G: pitch up lowers the moment
+    loop = plant * f_sys
+    gm = _gain_margin(loop, k)
+    if gm < min_gain_margin:
+        k *= gm / min_gain_margin
+        gm = _gain_margin(loop, k)
+    if not gm > 1.0:
+        raise RuntimeError(f"IBC blade loop at {m.wind_mps:g} m/s is unstable at gain {k:g} "
+                           f"rad/(N m); check the filters")
+    return k, gm, k * abs(f1 * g1)
+
+
+def _sos_ss(sos: np.ndarray, dt: float) -> Any:
+    """A discrete filter in second-order sections as a python-control state-space system (a
+    cascade of the sections' state-space forms: no high-order polynomial in between)."""
+    import control
+
+    sys = control.ss([], [], [], [[1.0]], dt)
+    for sec in np.atleast_2d(sos):
+        a, b, c, d = signal.tf2ss(sec[:3], sec[3:])
+        sys = control.ss(a, b, c, d, dt) * sys if a.size else sys * float(d[0, 0])
+    return sys
+
+
+def _gain_margin(loop: Any, k: float) -> float:
+    """Gain margin of the negative-feedback loop k * loop (discrete): the factor by which k can
+    grow before the closed loop turns unstable, found on the closed-loop poles (exact, unlike a
+    margin read off a frequency grid); inf if none up to 1e3."""
+    import control
+
+    def stable(kk: float) -> bool:
+        cl = control.feedback(kk * loop, 1)
+        return bool(np.all(np.abs(control.poles(cl)) < 1.0 - 1e-9))
+
+    if not stable(k):
+        lo, hi = 0.0, 1.0
+        for _ in range(40):
+            mid = 0.5 * (lo + hi)
+            lo, hi = (mid, hi) if stable(mid * k) else (lo, mid)
+        return lo
+    lo, hi = 1.0, 2.0
+    while stable(hi * k):
+        lo, hi = hi, hi * 2
+        if hi > 1e3:
+            return math.inf
+    for _ in range(30):
+        mid = 0.5 * (lo + hi)
+        lo, hi = (mid, hi) if stable(mid * k) else (lo, mid)
+    return lo
+
+
+class _PitchAddOn(ControllerBase):
+    """What IBC and Coleman IPC share: the collective controller underneath, the power
+    fade-in weight (power filtered over ``power_tau`` = 1 s), and pitch limits and rate on the
+    summed command. Subclasses reset their own state in ``_reset_own``."""
+
+    power_tau = 1.0
+
+    def __init__(self, collective: BaselineController, gains: Any) -> None:
+        self.collective = collective
+        self.gains = gains
+        self.dt = collective.dt
+        pa = collective.turbine.pitch_actuator
+        self.pitch_min, self.pitch_max = collective.pitch_min, pa.max_pitch_rad
+        self.step_max = pa.max_rate_rad_s * self.dt
+        self.reset()
+
+    def _reset_own(self) -> None:
+        pass
+
+    def reset(self) -> None:
+        """Forget filters, integrals, power filter and last commands (and reset the
+        collective)."""
+        self.collective.reset()
+        self._p_filt: float | None = None
+        self._last: np.ndarray | None = None
+        self.signals: dict[str, float] = {}
+        self._reset_own()
+
+    def _limit(self, cmd: np.ndarray, meas: dict[str, Any]) -> np.ndarray:
+        cmd = np.clip(cmd, self.pitch_min, self.pitch_max)
+        last = np.asarray(meas["pitch"], float) if self._last is None else self._last
+        cmd = np.clip(cmd, last - self.step_max, last + self.step_max)
+        self._last = cmd
+        return cmd
+
+    def _weight(self, meas: dict[str, Any]) -> float:
+        p = float(meas["gen_power"])
+        a = math.exp(-self.dt / self.power_tau)
+        self._p_filt = p if self._p_filt is None else a * self._p_filt + (1 - a) * p
+        return power_weight(self._p_filt, self.gains.rated_power, self.gains.weight_range)
+
+
+class IBCController(_PitchAddOn):
+    """Individual blade control on top of a collective controller (Pettas and Cheng fig. 3).
+
+    ``collective`` is the baseline (or derated baseline) that regulates rotor speed and power;
+    this class adds the per-blade pitch w(P) BS(K(theta_mean) HP(M_i)) (less its mean over the
+    blades, see below) to its collective command and enforces the pitch limits and rate on the
+    sum. Signals: the collective's, plus ``ibc_weight``, ``ibc_gain`` and ``ibc_pitch_1..3``
+    [rad].
+
+    ``remove_collective=True`` (default) subtracts the blades' mean IBC pitch: the loops act on
+    the cyclic content only and leave thrust and torque to the collective controller. The
+    paper's fully independent loops (False) rely on the high-pass alone to stay out of the
+    collective loop's way; on our plant at 18 m/s (600 s, shear 0.2) that raised the flap DEL
+    by 3 %, the tower fore-aft DEL by 21 % and the shaft-torque DEL by 28 %, while the mean
+    removal gave -21 %, +0.6 % and -0.1 % for the same 1P reduction (benchmarks/RESULTS.md).
+
+    Parameters
+    ----------
+    collective : BaselineController
+        The collective controller.
+    gains : IBCGains
+        From :func:`tune_ibc` at the collective's dt.
+    remove_collective : bool
+        Subtract the blades' mean IBC pitch (cyclic action only).
+    """
+
+    def __init__(self, collective: BaselineController, gains: IBCGains, *,
+                 remove_collective: bool = True) -> None:
+        self.remove_collective = bool(remove_collective)
+        if abs(collective.dt - gains.dt) > 1e-12:
+            raise ValueError(f"IBC gains were designed for dt = {gains.dt:g} s, the collective "
+                             f"controller runs at {collective.dt:g} s")
+        self._hp = SOSFilterBank(gains.input_sos(), 3)
+        self._bs = SOSFilterBank(gains.output_sos(), 3)
+        super().__init__(collective, gains)
+
+    def _reset_own(self) -> None:
+        self._hp.reset()
+        self._bs.reset()
+
+    def step(self, t: float, meas: dict[str, Any]) -> tuple[np.ndarray, float]:
+        # One control step; returns (pitch_ref (3,) [rad], gen_torque_ref [N m]).
+        pc, tq = self.collective.step(t, meas)
+        m = np.asarray(meas["flap_moment"], float)
+        if m.shape != (3,) or not np.all(np.isfinite(m)):
+            raise ValueError(f"measurement flap_moment must be 3 finite moments [N m] at "
+                             f"t = {t:g} s, got {meas['flap_moment']!r}")
+        w = self._weight(meas)
+        k = self.gains.gain_at(float(np.mean(pc)))
+        u = w * self._bs.step(k * self._hp.step(m))
+        if self.remove_collective:
+            u = u - u.mean()
+        cmd = self._limit(pc + u, meas)
+        self.signals = {**self.collective.signals, "ibc_weight": w, "ibc_gain": k,
+                        **{f"ibc_pitch_{i + 1}": float(u[i]) for i in range(3)}}
+        return cmd, tq
+
+
+# --------------------------------------------------------------------------------------------
+# Coleman-frame IPC
+# --------------------------------------------------------------------------------------------
+@dataclass(frozen=True)
+class ColemanIPCGains:
+    """Gain schedule of the Coleman-frame (tilt/yaw) integral IPC.
+
+    Parameters
+    ----------
+    pitch_rad : (n_op,) ndarray
+        Mean-pitch breakpoints [rad].
+    ki : (n_op,) ndarray
+        Integral gain [rad/(N m s)].
+    azimuth_offset_rad : (n_op,) ndarray
+        Rotation phi that decouples tilt and yaw [rad].
+    wind_mps : (n_op,) ndarray
+        [m/s]
+    gain_margin : (n_op,) ndarray
+        Factor on K_I at which the MBC closed loop turns unstable [-].
+    crossover_rad_s : float
+        Design crossover of the tilt and yaw loops [rad/s].
+    max_amplitude_rad : float
+        Limit of the cyclic pitch amplitude (anti-windup) [rad].
+    weight_range : (float, float)
+        Power fractions of the fade-in [-].
+    rated_power : float
+        [W]
+    power_fraction : float
+        [-]
+    """
+
+    pitch_rad: np.ndarray
+    ki: np.ndarray
+    azimuth_offset_rad: np.ndarray
+    wind_mps: np.ndarray
+    gain_margin: np.ndarray
+    crossover_rad_s: float
+    max_amplitude_rad: float
+    weight_range: tuple[float, float]
+    rated_power: float
+    power_fraction: float = 1.0
+
+    def __post_init__(self) -> None:
+        for n in ("pitch_rad", "ki", "azimuth_offset_rad", "wind_mps", "gain_margin"):
+            arr = np.array(getattr(self, n), dtype=float)
+            arr.flags.writeable = False
+            object.__setattr__(self, n, arr)
+        if np.any(np.diff(self.pitch_rad) <= 0):
+            raise ValueError("pitch_rad must be strictly increasing")
+
+    def at(self, pitch_rad: float) -> tuple[float, float]:
+        """(K_I, phi) at a mean pitch.
+
+        Parameters
+        ----------
+        pitch_rad : float
+            Mean pitch [rad].
+
+        Returns
+        -------
+        ki : float
+            Integral gain [rad/(N m s)].
+        phi : float
+            Azimuth offset [rad].
+        """
+        return (float(np.interp(pitch_rad, self.pitch_rad, self.ki)),
+                float(np.interp(pitch_rad, self.pitch_rad, self.azimuth_offset_rad)))
+
+
+def _rot(phi: float) -> np.ndarray:
+    c, s = math.cos(phi), math.sin(phi)
+    return np.array([[c, -s], [s, c]])
+
+
+def tune_coleman_ipc(turbine: linearize.Turbine, *, winds: Any = None,
+                     crossover_rad_s: float = 0.2, max_amplitude_deg: float = 5.0,
+                     weight_range: tuple[float, float] = (0.8, 0.95),
+                     power_fraction: float = 1.0) -> ColemanIPCGains:
+    """Tune the Coleman-frame integral IPC on the MBC linear models.
+
+    At each wind the static MBC gain G0 (pitch_ref_cos/sin -> flap_moment_cos/sin) is fitted as
+    g R(phi); K_I = crossover / g makes both loops integrators crossing over at
+    ``crossover_rad_s``, and phi is the azimuth offset. The 2x2 closed loop of the MBC model
+    with the integral controller is checked stable and its gain margin reported.
+
+    Parameters
+    ----------
+    turbine : Turbine
+        The turbine.
+    winds : array_like, optional
+        Region-III winds of the schedule [m/s] (default every 2 m/s above rated).
+    crossover_rad_s : float
+        Crossover of the integral loops [rad/s].
+    max_amplitude_deg : float
+        Largest cyclic pitch amplitude [deg].
+    weight_range : (float, float)
+        Power fractions of the fade-in [-].
+    power_fraction : float
+        Tune on the operating points derated to this fraction [-].
+
+    Returns
+    -------
+    ColemanIPCGains
+        K_I and the azimuth offset over pitch, with the gain margins.
+    """
+    frac = check_power_fraction(power_fraction)
+    if not crossover_rad_s > 0:
+        raise ValueError(f"crossover_rad_s must be > 0, got {crossover_rad_s!r}")
+    if not 0 < max_amplitude_deg <= 20:
+        raise ValueError(f"max_amplitude_deg must be in (0, 20] deg, got {max_amplitude_deg!r}")
+    wr = check_weight_range(weight_range)
+    v = _region3_winds(turbine) if winds is None else np.asarray(winds, float)
+    p_rated = frac * turbine.operation.rated_power
+    p_w = None if frac == 1.0 else p_rated
+    params = linearize.plant_params(turbine)
+    rows = []
+    for w in v:
+        m = _blade_model(turbine, float(w), p_w, params, coordinates="mbc")
+        s = m.select(inputs=["pitch_ref_cos", "pitch_ref_sin"],
+                     outputs=["flap_moment_cos", "flap_moment_sin"])
+        g0 = s.D_u - s.C_z @ np.linalg.solve(s.A, s.B_u)
+        a, b = 0.5 * (g0[0, 0] + g0[1, 1]), 0.5 * (g0[1, 0] - g0[0, 1])
+        g, phi = math.hypot(a, b), math.atan2(b, a)
+        ki = crossover_rad_s / g
+
+        def stable(kk: float) -> bool:
+            # x' = A x + B theta, e' = C x + D theta, theta = -kk R(-phi) e
+            kc = -kk * _rot(-phi)
+            n = s.A.shape[0]
+            acl = np.block([[s.A, s.B_u @ kc], [s.C_z, s.D_u @ kc]])
+            return bool(np.max(np.linalg.eigvals(acl).real) < -1e-9) and n > 0
+
+        if not stable(ki):
+            raise RuntimeError(f"Coleman IPC at {w:g} m/s is unstable at K_I = {ki:g}; lower "
+                               f"crossover_rad_s")
+        lo, hi = 1.0, 2.0
+        while stable(hi * ki) and hi < 1e3:
+            lo, hi = hi, 2 * hi
+        for _ in range(30):
+            mid = 0.5 * (lo + hi)
+            lo, hi = (mid, hi) if stable(mid * ki) else (lo, mid)
+        rows.append((m.info["pitch_deg"] * math.pi / 180, ki, phi, float(w), lo))
+    rows.sort()
+    arr = np.array(rows)
+    return ColemanIPCGains(pitch_rad=arr[:, 0], ki=arr[:, 1], azimuth_offset_rad=arr[:, 2],
+                           wind_mps=arr[:, 3], gain_margin=arr[:, 4],
+                           crossover_rad_s=crossover_rad_s,
+                           max_amplitude_rad=math.radians(max_amplitude_deg), weight_range=wr,
+                           rated_power=p_rated, power_fraction=frac)
+
+
+class ColemanIPCController(_PitchAddOn):
+    """Coleman-frame integral IPC (tilt and yaw to zero) on top of a collective controller.
+
+    Signals: the collective's, plus ``ipc_weight``, ``ipc_tilt_moment``, ``ipc_yaw_moment``
+    [N m] and ``ipc_pitch_cos``, ``ipc_pitch_sin`` [rad].
+
+    Parameters
+    ----------
+    collective : BaselineController
+        The collective controller.
+    gains : ColemanIPCGains
+        From :func:`tune_coleman_ipc`.
+    """
+
+    def _reset_own(self) -> None:
+        self._theta_cs = np.zeros(2)
+
+    def step(self, t: float, meas: dict[str, Any]) -> tuple[np.ndarray, float]:
+        # One control step; returns (pitch_ref (3,) [rad], gen_torque_ref [N m]).
+        pc, tq = self.collective.step(t, meas)
+        m = np.asarray(meas["flap_moment"], float)
+        psi = float(meas["azimuth"])
+        if m.shape != (3,) or not np.all(np.isfinite(m)) or not math.isfinite(psi):
+            raise ValueError(f"measurements flap_moment (3,) and azimuth must be finite at "
+                             f"t = {t:g} s, got {meas['flap_moment']!r}, {meas['azimuth']!r}")
+        ang = psi + 2 * math.pi * np.arange(3) / 3
+        m_cs = 2.0 / 3.0 * np.array([np.sum(m * np.cos(ang)), np.sum(m * np.sin(ang))])
+        w = self._weight(meas)
+        ki, phi = self.gains.at(float(np.mean(pc)))
+        self._theta_cs += -w * ki * (_rot(-phi) @ m_cs) * self.dt
+        amp = float(np.hypot(*self._theta_cs))
+        if amp > self.gains.max_amplitude_rad:            # anti-windup: clamp the amplitude
+            self._theta_cs *= self.gains.max_amplitude_rad / amp
+        th = w * self._theta_cs
+        u = th[0] * np.cos(ang) + th[1] * np.sin(ang)
+        cmd = self._limit(pc + u, meas)
+        self.signals = {**self.collective.signals, "ipc_weight": w,
+                        "ipc_tilt_moment": float(m_cs[0]), "ipc_yaw_moment": float(m_cs[1]),
+                        "ipc_pitch_cos": float(th[0]), "ipc_pitch_sin": float(th[1])}
+        return cmd, tq

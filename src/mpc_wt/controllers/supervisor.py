@@ -1,0 +1,238 @@
+"""The supervisory layer: a normal shutdown and emergency stops around any controller.
+
+IEC 61400-1 ed. 3's load cases 2.x (a fault or a loss of the electrical network while
+producing), 4.x (normal shutdown) and 5.1 (emergency shutdown) need the turbine's protection
+and shutdown sequence in the loop. :class:`Supervisor` wraps any controller (``reset``/
+``step``) and, once an event has tripped, replaces its commands for the rest of the run:
+
+* **normal shutdown** at ``shutdown_at``: every blade pitches from where it is towards feather
+  (the actuator's maximum pitch) at ``pitch_rate`` (default the actuator's maximum rate), and
+  the generator torque ramps from its value at the trip to zero over ``torque_ramp_s``;
+* **emergency stop on overspeed**: the same sequence, started at the first controller step at
+  which the measured rotor speed exceeds ``overspeed`` times rated (the protection system's
+  limit);
+* **grid loss** at ``grid_loss_at``: the generator torque drops to zero at once (the harness
+  applies no torque-rate limit to it: :attr:`grid_connected` is False) and the blades pitch to
+  feather at ``pitch_rate``.
+
+The state and the trip time are recorded (signals ``supervisor_state``: 0 running, 1
+shutdown, 2 overspeed stop, 3 grid loss; ``supervisor_trip_time``); the wrapped controller's
+signals are held at their last values after the trip.
+"""
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+
+import linearize
+from mpc_wt.controllers.base import ControllerBase
+
+__all__ = ["Supervisor", "STATES", "TorqueLawGuard"]
+
+#: Supervisor states and their codes in the signal ``supervisor_state``.
+STATES = {"running": 0, "shutdown": 1, "overspeed": 2, "grid_loss": 3}
+
+
+def _opt_time(name: str, value: Any) -> float | None:
+    if value is None:
+        return None
+    v = float(value)
+    if not (math.isfinite(v) and v >= 0.0):
+        raise ValueError(f"{name} must be a finite time >= 0 s (or None: never), got "
+                         f"{value!r}")
+    return v
+
+
+class Supervisor(ControllerBase):
+    """Shutdown and emergency stops around a controller (module docstring).
+
+    Parameters
+    ----------
+    controller : Controller
+        The operating controller.
+    turbine : linearize.Turbine
+        For rated rotor speed and the pitch actuator's limits.
+    overspeed : float, optional
+        Emergency stop when the rotor speed exceeds this fraction of rated (e.g. 1.2; None:
+        no overspeed protection) [-].
+    shutdown_at, grid_loss_at : float, optional
+        Times of a normal shutdown and of a grid loss [s] (None: none).
+    pitch_rate : float, optional
+        Pitch rate towards feather [rad/s] (default the actuator's maximum).
+    torque_ramp_s : float
+        Time in which a shutdown ramps the generator torque to zero [s].
+    """
+
+    def __init__(self, controller: Any, turbine: linearize.Turbine, *,
+                 overspeed: float | None = None, shutdown_at: float | None = None,
+                 grid_loss_at: float | None = None, pitch_rate: float | None = None,
+                 torque_ramp_s: float = 5.0) -> None:
+        self.controller = controller
+        pa = turbine.pitch_actuator
+        if overspeed is not None and not (math.isfinite(float(overspeed))
+                                          and float(overspeed) > 1.0):
+            raise ValueError(f"overspeed must be a fraction of rated rotor speed > 1 (e.g. "
+                             f"1.2), got {overspeed!r}")
+        self.overspeed = None if overspeed is None else float(overspeed)
+        self.limit = (math.inf if overspeed is None
+                      else float(overspeed) * turbine.operation.rated_rotor_speed_rad_s)
+        self.shutdown_at = _opt_time("shutdown_at", shutdown_at)
+        self.grid_loss_at = _opt_time("grid_loss_at", grid_loss_at)
+        rate = pa.max_rate_rad_s if pitch_rate is None else float(pitch_rate)
+        if not (math.isfinite(rate) and 0.0 < rate <= pa.max_rate_rad_s * (1 + 1e-9)):
+            raise ValueError(f"pitch_rate must be in (0, {pa.max_rate_rad_s:g}] rad/s (the "
+                             f"actuator's maximum), got {pitch_rate!r}")
+        self.pitch_rate = rate
+        ramp = float(torque_ramp_s)
+        if not (math.isfinite(ramp) and ramp > 0.0):
+            raise ValueError(f"torque_ramp_s must be > 0 s, got {torque_ramp_s!r}")
+        self.torque_ramp_s = ramp
+        self.feather = pa.max_pitch_rad
+        self.reset()
+
+    @classmethod
+    def check_settings(cls, turbine: linearize.Turbine, **settings: Any) -> None:
+        """Check supervisor settings without a controller (a spec or the command line).
+
+        Parameters
+        ----------
+        turbine : linearize.Turbine
+            For rated rotor speed and the pitch actuator's limits.
+        **settings
+            The keyword arguments of :class:`Supervisor` but the controller.
+
+        Raises
+        ------
+        ValueError
+            Naming the setting, its value and what is allowed.
+        TypeError
+            An unknown setting.
+        """
+        cls(_Idle(), turbine, **settings)
+
+    def reset(self) -> None:
+        """Back to running; reset the wrapped controller."""
+        self.controller.reset()
+        self.state = "running"
+        self.trip_time: float | None = None
+        #: False after a grid loss: the harness then applies zero generator torque at once
+        self.grid_connected = True
+        self._pitch0 = np.zeros(3)
+        self._torque0 = 0.0
+        self._inner: dict[str, float] = {}
+        self.signals: dict[str, float] = {"supervisor_state": 0.0,
+                                          "supervisor_trip_time": math.nan}
+
+    def _trip(self, t: float, meas: dict[str, Any]) -> None:
+        """Latch the first event due at ``t``."""
+        if self.grid_loss_at is not None and t >= self.grid_loss_at:
+            self.state = "grid_loss"
+            self.grid_connected = False
+        elif float(meas["rotor_speed"]) > self.limit:
+            self.state = "overspeed"
+        elif self.shutdown_at is not None and t >= self.shutdown_at:
+            self.state = "shutdown"
+        else:
+            return
+        self.trip_time = t
+        self._pitch0 = np.asarray(meas["pitch"], float).copy()
+        self._torque0 = float(meas["gen_torque"])
+
+    def step(self, t: float, meas: dict[str, Any]) -> tuple[np.ndarray, float]:
+        # the wrapped controller's commands while running, the stop sequence after a trip
+        # (parameters and returns: ControllerBase.step)
+        if self.state == "running":
+            self._trip(t, meas)
+        if self.state == "running":
+            pitch, tq = self.controller.step(t, meas)
+            self._inner = dict(getattr(self.controller, "signals", {}))
+            self.signals = {**self._inner, "supervisor_state": 0.0,
+                            "supervisor_trip_time": math.nan}
+            return pitch, tq
+        assert self.trip_time is not None
+        el = t - self.trip_time
+        pitch = np.minimum(self._pitch0 + self.pitch_rate * el, self.feather)
+        pitch = np.maximum(pitch, self._pitch0)
+        tq = 0.0 if self.state == "grid_loss" else \
+            self._torque0 * max(0.0, 1.0 - el / self.torque_ramp_s)
+        self.signals = {**self._inner,                       # held at their last values
+                        "supervisor_state": float(STATES[self.state]),
+                        "supervisor_trip_time": self.trip_time}
+        return pitch, tq
+
+    def finalize(self) -> None:
+        """Pass the harness's last call on to the wrapped controller."""
+        fin = getattr(self.controller, "finalize", None)
+        if callable(fin):
+            fin()
+
+
+class _Idle:
+    """Stands in for the controller while settings are checked."""
+
+    def reset(self) -> None:
+        """Nothing to reset."""
+
+
+class TorqueLawGuard(ControllerBase):
+    """Caps a controller's generator torque at the baseline's torque-speed law in a lull: at
+    fine pitch below rated speed (the ``+torque-law`` add-on of the MPC kinds).
+
+    An above-rated design that regulates power and speed with pitch and torque together (Madsen
+    et al.'s MPC, linearized at the case's mean wind) has, in a lull that brings the pitch to
+    fine, only the torque left; holding power with it is the unstable constant-power law below
+    rated: the torque rises as the rotor slows, and the rotor stalls (the sign-off campaign:
+    13 of 65 MPC cases, from 9 to 17 m/s). With the guard, while the measured collective pitch
+    is within ``fine_band`` of fine and the generator speed below the law's rated speed, the
+    torque is at most the baseline's law at that speed (K omega^2 in region 2, the region 2.5
+    line up to rated torque: :meth:`mpc_wt.controllers.baseline.BaselineController.torque`); otherwise the
+    guarded controller's torque passes unchanged.
+
+    Parameters
+    ----------
+    controller : Controller
+        The controller guarded.
+    turbine : linearize.Turbine
+        For the torque law and fine pitch.
+    fine_band : float
+        Pitch above fine within which the guard acts [rad] (default 1 deg, the baseline's own
+        switch to region 3).
+    """
+
+    def __init__(self, controller: Any, turbine: linearize.Turbine, *,
+                 fine_band: float = math.radians(1.0)) -> None:
+        from mpc_wt.controllers.baseline import BaselineController
+
+        band = float(fine_band)
+        if not (math.isfinite(band) and band >= 0.0):
+            raise ValueError(f"fine_band must be a finite pitch >= 0 rad, got {fine_band!r}")
+        self.controller = controller
+        self.law = BaselineController(turbine)
+        self.fine = turbine.operation.fine_pitch_rad + band
+        self.reset()
+
+    def reset(self) -> None:
+        """Reset the guarded controller."""
+        self.controller.reset()
+        self.signals: dict[str, float] = {"torque_law_active": 0.0}
+
+    def step(self, t: float, meas: dict[str, Any]) -> tuple[np.ndarray, float]:
+        # the guarded controller's commands, the torque capped in a lull (parameters and
+        # returns: ControllerBase.step)
+        pitch, tq = self.controller.step(t, meas)
+        w, p = float(meas["gen_speed"]), meas["pitch"]
+        active = 0.0
+        if w < self.law.w_rated and float(p[0] + p[1] + p[2]) / 3.0 <= self.fine:
+            cap = self.law.torque(w, 0.0)
+            if tq > cap:
+                tq, active = cap, 1.0
+        self.signals = {**getattr(self.controller, "signals", {}), "torque_law_active": active}
+        return pitch, tq
+
+    def finalize(self) -> None:
+        """Pass the harness's last call on to the guarded controller."""
+        fin = getattr(self.controller, "finalize", None)
+        if callable(fin):
+            fin()

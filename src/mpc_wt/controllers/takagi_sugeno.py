@@ -1,0 +1,1079 @@
+"""Takagi-Sugeno (TS) model, LMI-designed controller and wind observer (Clemens et al.).
+
+TS model (Clemens et al. eqs 1-3): sub-models (A_i, B_i, B_d,i) and equilibria (x_0,i, u_0,i,
+v_0,i) from our numerical linearization at the vertices of a rectangular grid of the premise
+z = [v, Delta P] (eq 2: rotor-effective wind speed, power reduction), blended by memberships
+h_i(z) = h_a(v) h_b(Delta P): products of one-dimensional hat functions, so h_i >= 0 and
+sum_i h_i(z) = 1 for every z in the grid (eq 3). The state is Clemens' eq 4 (tower side-side and
+fore-aft, rotor and generator speed, drivetrain torsion, ``linearize.PlantConfig.clemens()``),
+the inputs eq 5 (collective pitch, generator torque); a vertex with Delta P > 0 is trimmed to
+the electrical power (1 - Delta P) P_rated.
+
+Controller (eq 7): parallel distributed compensation u = sum_i h_i (u_0,i - K_i (x_hat - x_0,i)),
+gains from LMIs in X = P^-1 and Y_i = K_i X with a common quadratic Lyapunov function
+(Tanaka & Wang's relaxed conditions; pairs only between vertices of one grid cell, the only ones
+active together)::
+
+    G_ij = A_i X - B_i Y_j,   H_ij = G_ij + G_ij' + 2 alpha X,
+    H_ii < 0,   H_ij + H_ji <= 0,                                  (decay rate alpha)
+    [[-r X, G_ij + G_ji], [*, -r X]] < 0 ... (for a disk abs(lambda) < r, D-stability)
+    [[1, s_k'], [s_k, X]] >= 0   (the ellipsoid x' P x <= 1 holds the typical deviations s_k)
+    [[X, Y_i' e_j], [e_j' Y_i, mu_j^2]] >= 0   (abs(u_j - u_0,j) <= mu_j on that ellipsoid)
+
+minimising sum_j mu_j^2 (least effort for the required decay), or with mu_j fixed.
+
+Observer (eqs 8-10): the state augmented by the rotor-effective wind with the inflow model
+dv/dt = -(v - v_0,i) / tau_v (eq 9, tau_v = 4 s), xi = [x; v], gains L_i from
+A~_i' P + P A~_i - C~' N_i' - N_i C~ + 2 alpha_o P < 0, L_i = P^-1 N_i (C~ common to the
+vertices), with an optional disk abs(lambda) < r_o and the gains' norm minimised.
+
+After every solve the certificate is checked with numpy alone (:func:`verify_controller`,
+:func:`verify_observer`): every LMI at the returned P and gains holds with the stated margin, and
+the closed loop sum_ij h_i h_j (A_i - B_i K_j) on a fine grid of the premise (vertices and
+interpolated points) is Hurwitz with the decay rate and decreases x' P x at rate 2 alpha.
+The LMIs are solved in scaled coordinates (states, inputs and outputs divided by typical
+magnitudes) so that the SDP is well conditioned; the gains are returned in SI units.
+"""
+from __future__ import annotations
+
+import itertools
+import logging
+import math
+import time
+import warnings
+from dataclasses import dataclass, field
+from typing import Any, Callable, Mapping, Sequence
+
+import numpy as np
+import scipy.linalg
+
+import linearize
+from linearize.validate import check_number
+from mpc_wt.controllers.base import ControllerBase
+from mpc_wt.controllers.estimator import read_signals
+from mpc_wt.errors import PremiseError, SynthesisError
+
+__all__ = ["TSModel", "build_ts_model", "TSControllerDesign", "TSObserverDesign",
+           "Certificate", "design_ts_controller", "design_ts_observer", "verify_controller",
+           "verify_observer", "TSController", "PremiseError", "CLEMENS_MEASURED"]
+
+log = logging.getLogger(__name__)
+
+#: Clemens et al. eq 6: tower side-side and fore-aft displacement, rotor and generator speed.
+CLEMENS_MEASURED = ("tower_ss_displacement", "tower_fa_displacement", "rotor_speed", "gen_speed")
+
+#: Typical magnitudes of the TS model's variables (scaling of the LMIs; SI units).
+DEFAULT_SCALES = {"tower_fa_displacement": 0.1, "tower_fa_velocity": 0.1, "rotor_speed": 0.1,
+                  "gen_speed": 0.1 * 97.0, "shaft_torsion": 1e-3, "tower_ss_displacement": 0.02,
+                  "tower_ss_velocity": 0.02, "pitch_ref_coll": math.radians(1.0),
+                  "gen_torque_ref": 4e3, "wind": 1.0}
+
+
+def _hats(grid: np.ndarray, s: float) -> np.ndarray:
+    """One-dimensional hat memberships of ``s`` on ``grid`` (sum to 1 inside the grid)."""
+    w = np.zeros(grid.size)
+    if grid.size == 1:
+        w[0] = 1.0
+        return w
+    k = int(np.clip(np.searchsorted(grid, s) - 1, 0, grid.size - 2))
+    f = (s - grid[k]) / (grid[k + 1] - grid[k])
+    w[k], w[k + 1] = 1.0 - f, f
+    return w
+
+
+@dataclass(frozen=True)
+class TSModel:
+    """Takagi-Sugeno model over the premise z = [v, Delta P] (Clemens et al. eqs 1-3).
+
+    Vertex i = (a, b) of the grid ``wind_grid`` x ``reduction_grid`` (row-major: wind index
+    outer) carries A[i] (n_x, n_x), B[i] (n_x, n_u), B_d[i] (n_x,) and the equilibrium
+    x0[i], u0[i], v0[i] (v0 = the vertex wind [m/s]).
+
+    Parameters
+    ----------
+    wind_grid : (n_a,) ndarray
+        Vertex wind speeds [m/s], strictly increasing.
+    reduction_grid : (n_b,) ndarray
+        Vertex power reductions Delta P [-] in [0, 1), strictly increasing.
+    A, B, B_d, x0, u0, v0 : ndarray
+        Stacked over the N = n_a n_b vertices.
+    states, inputs : names
+    C : (n_y, n_x) ndarray
+        Measured rows (``measured`` names).
+    rated_power : float
+        Electrical power at Delta P = 0 [W].
+    """
+
+    wind_grid: np.ndarray
+    reduction_grid: np.ndarray
+    A: np.ndarray
+    B: np.ndarray
+    B_d: np.ndarray
+    x0: np.ndarray
+    u0: np.ndarray
+    v0: np.ndarray
+    states: tuple[str, ...]
+    inputs: tuple[str, ...]
+    measured: tuple[str, ...]
+    C: np.ndarray
+    rated_power: float
+    info: dict[str, Any] = field(default_factory=dict, compare=False)
+
+    def __post_init__(self) -> None:
+        for n in ("wind_grid", "reduction_grid", "A", "B", "B_d", "x0", "u0", "v0", "C"):
+            a = np.array(getattr(self, n), dtype=float)
+            a.flags.writeable = False
+            object.__setattr__(self, n, a)
+        for n, g in (("wind_grid", self.wind_grid), ("reduction_grid", self.reduction_grid)):
+            if g.ndim != 1 or g.size < 1 or np.any(np.diff(g) <= 0) or not np.all(np.isfinite(g)):
+                raise ValueError(f"{n} must be finite and strictly increasing, got {g}")
+        nv = self.wind_grid.size * self.reduction_grid.size
+        nx, nu = len(self.states), len(self.inputs)
+        want = {"A": (nv, nx, nx), "B": (nv, nx, nu), "B_d": (nv, nx), "x0": (nv, nx),
+                "u0": (nv, nu), "v0": (nv,), "C": (len(self.measured), nx)}
+        for n, shp in want.items():
+            if getattr(self, n).shape != shp:
+                raise ValueError(f"TSModel.{n} has shape {getattr(self, n).shape}; expected "
+                                 f"{shp}")
+
+    @property
+    def n_vertices(self) -> int:
+        return self.A.shape[0]
+
+    @property
+    def vertices(self) -> np.ndarray:
+        """(N, 2) premise values [v, Delta P] of the vertices."""
+        return np.array(list(itertools.product(self.wind_grid, self.reduction_grid)))
+
+    def cells(self) -> list[tuple[int, ...]]:
+        """Vertex indices of each grid cell (the vertices that can be active together).
+
+        Returns
+        -------
+        list of tuple of int
+            Vertex indices per cell.
+        """
+        na, nb = self.wind_grid.size, self.reduction_grid.size
+        out = []
+        for a in range(max(na - 1, 1)):
+            for b in range(max(nb - 1, 1)):
+                ia = [a] if na == 1 else [a, a + 1]
+                ib = [b] if nb == 1 else [b, b + 1]
+                out.append(tuple(i * nb + j for i in ia for j in ib))
+        return out
+
+    def check_premise(self, wind: float, reduction: float) -> None:
+        """Raise :class:`PremiseError` unless [wind, reduction] lies in the vertex grid.
+
+        Parameters
+        ----------
+        wind : float
+            Premise wind [m/s].
+        reduction : float
+            Premise power reduction [-].
+        """
+        for name, s, g, unit in (("wind speed", wind, self.wind_grid, " m/s"),
+                                 ("power reduction", reduction, self.reduction_grid, "")):
+            tol = 1e-9 * max(1.0, abs(g[-1]))
+            if not (math.isfinite(s) and g[0] - tol <= s <= g[-1] + tol):
+                raise PremiseError(f"premise {name} = {s!r}{unit} is outside the TS model's "
+                                   f"vertices {g[0]:g}..{g[-1]:g}{unit}; add vertices or clip")
+
+    def membership(self, wind: float, reduction: float = 0.0) -> np.ndarray:
+        """h_i(z) for z = [wind, reduction] (N,): >= 0, summing to 1 (eq 3).
+
+
+        Parameters
+        ----------
+        wind : float
+            Premise wind [m/s].
+        reduction : float
+            Premise power reduction [-].
+
+        Returns
+        -------
+        (N,) ndarray
+            Memberships h_i [-].
+
+        Raises
+        ------
+        PremiseError
+            If z is outside the vertex grid (or not finite).
+        """
+        self.check_premise(wind, reduction)
+        return np.kron(_hats(self.wind_grid, wind), _hats(self.reduction_grid, reduction))
+
+    def blend(self, h: np.ndarray) -> dict[str, np.ndarray]:
+        """The model's matrices and equilibria weighted by memberships ``h``.
+
+        Parameters
+        ----------
+        h : (N,) ndarray
+            Memberships.
+
+        Returns
+        -------
+        dict of str to ndarray
+            ``A``, ``B``, ``B_d``, ``x0``, ``u0``, ``v0`` weighted by ``h``.
+        """
+        return {n: np.tensordot(h, getattr(self, n), axes=1)
+                for n in ("A", "B", "B_d", "x0", "u0", "v0")}
+
+    def rhs(self, x: np.ndarray, u: np.ndarray, v: float, reduction: float = 0.0) -> np.ndarray:
+        """dx/dt of eq 1 with premise [v, reduction] [state units / s].
+
+        Parameters
+        ----------
+        x : (n_x,) ndarray
+            State.
+        u : (n_u,) ndarray
+            Inputs.
+        v : float
+            Wind [m/s] (the premise and the disturbance).
+        reduction : float
+            Premise power reduction [-].
+
+        Returns
+        -------
+        (n_x,) ndarray
+            dx/dt.
+        """
+        h = self.membership(v, reduction)
+        x, u = np.asarray(x, dtype=float), np.asarray(u, dtype=float)
+        return sum(h[i] * (self.A[i] @ (x - self.x0[i]) + self.B[i] @ (u - self.u0[i])
+                           + self.B_d[i] * (v - self.v0[i]))
+                   for i in np.nonzero(h)[0])
+
+    def to_dict(self) -> dict[str, Any]:
+        """Plain data for JSON.
+
+        Returns
+        -------
+        dict
+            Grids, names and the vertex matrices as lists.
+        """
+        return {"wind_grid": self.wind_grid.tolist(), "reduction_grid":
+                self.reduction_grid.tolist(), "states": list(self.states),
+                "inputs": list(self.inputs), "measured": list(self.measured),
+                "rated_power": self.rated_power, "A": self.A.tolist(), "B": self.B.tolist(),
+                "B_d": self.B_d.tolist(), "x0": self.x0.tolist(), "u0": self.u0.tolist(),
+                "v0": self.v0.tolist(), "C": self.C.tolist()}
+
+
+def build_ts_model(turbine: linearize.Turbine,
+                   wind_grid: Sequence[float] = (12.0, 14.0, 16.0, 19.0, 22.0, 25.0),
+                   reduction_grid: Sequence[float] = (0.0, 0.4, 0.8), *,
+                   measured: Sequence[str] = CLEMENS_MEASURED,
+                   progress: bool = False) -> TSModel:
+    """The TS model of ``turbine`` at the vertices wind_grid x reduction_grid.
+
+    Each vertex is a :func:`linearize.linearize` of the Clemens 7-state configuration with one
+    rotor-effective wind disturbance, in multi-blade coordinates (collective pitch input), at
+    the trim for electrical power (1 - Delta P) P_rated (full load: rated rotor speed).
+
+
+    Returns
+    -------
+    TSModel
+        Vertex matrices, equilibria and memberships over the grid.
+
+
+    Parameters
+    ----------
+    turbine : Turbine
+        The turbine.
+    wind_grid : sequence of float
+        Vertex winds [m/s], increasing.
+    reduction_grid : sequence of float
+        Vertex power reductions Delta P in [0, 1) [-].
+    measured : sequence of str
+        The measured outputs.
+    progress : bool
+        Show a progress bar.
+
+    Raises
+    ------
+    ValueError
+        A grid not strictly increasing, a reduction outside [0, 1), an unknown measured name.
+    linearize.TrimError
+        A vertex that cannot be trimmed (wind outside cut-in..cut-out, power not available).
+    """
+    from tqdm import tqdm
+
+    va = np.asarray(wind_grid, dtype=float)
+    vb = np.asarray(reduction_grid, dtype=float)
+    if vb.size and (vb.min() < 0 or vb.max() >= 1):
+        raise ValueError(f"reduction_grid values must be in [0, 1), got {vb}")
+    rated = turbine.operation.rated_power
+    cfg = linearize.PlantConfig.clemens()
+    params = linearize.plant_params(turbine, cfg)
+    mats: dict[str, list[np.ndarray]] = {k: [] for k in ("A", "B", "B_d", "x0", "u0", "v0")}
+    model = None
+    for v, dp in tqdm(list(itertools.product(va, vb)), desc="TS vertices", unit="vertex",
+                      disable=not progress):
+        m = linearize.linearize(turbine, float(v), params=params, disturbance="rotor",
+                                coordinates="mbc",
+                                power_W=None if dp == 0 else rated * (1.0 - float(dp)))
+        model = m.select(inputs=("pitch_ref_coll", "gen_torque_ref"))
+        mats["A"].append(model.A)
+        mats["B"].append(model.B_u)
+        mats["B_d"].append(model.B_d[:, 0])
+        mats["x0"].append(model.x0)
+        mats["u0"].append(model.u0)
+        mats["v0"].append(np.asarray(v))
+    assert model is not None
+    bad = [n for n in measured if n not in model.states]
+    if bad:
+        raise ValueError(f"measured {bad} are not states of the TS model {list(model.states)}")
+    c = np.array([np.eye(len(model.states))[model.states.index(n)] for n in measured])
+    return TSModel(wind_grid=va, reduction_grid=vb, states=model.states, inputs=model.inputs,
+                   measured=tuple(measured), C=c, rated_power=float(rated),
+                   info={"turbine": turbine.name, "config": "clemens"},
+                   **{k: np.array(v) for k, v in mats.items()})
+
+
+# --------------------------------------------------------------------------------------------
+# LMI synthesis
+# --------------------------------------------------------------------------------------------
+@dataclass
+class Certificate:
+    """The result of checking an LMI design with numpy alone.
+
+    Parameters
+    ----------
+    ok : bool
+    worst_lmi : float
+        Largest eigenvalue over the strict LMIs (scaled coordinates), must be
+        <= -margin.
+    worst_decay : float
+        Largest real part of the closed-loop eigenvalues over the premise grid plus the
+        required decay rate: must be <= 0.
+    worst_lyapunov : float
+        Largest eigenvalue of Acl' P + P Acl + 2 alpha P (normalised) over the premise grid.
+    n_grid : int
+        Premise points checked.
+    failures : list of str
+    """
+
+    ok: bool
+    worst_lmi: float
+    worst_decay: float
+    worst_lyapunov: float
+    n_grid: int
+    failures: list[str]
+
+
+@dataclass
+class TSControllerDesign:
+    """PDC gains K_i [SI] on x - x0_i with common Lyapunov matrix P (in scaled coordinates).
+
+    Parameters
+    ----------
+    K : (N, n_u, n_x [+ 1]) ndarray
+        The last column acts on the integral of ``integral_of``'s deviation [unit s] when set.
+    P : (n_x [+ 1], n_x [+ 1]) ndarray   P = X^-1 of the scaled problem.
+    decay_rate : float [1/s]
+    disk_radius : float or None [1/s]
+    input_bounds : (n_u,) ndarray  mu_j [SI input units] on the ellipsoid.
+    solver, solve_time_s, certificate
+    """
+
+    K: np.ndarray
+    P: np.ndarray
+    scale_x: np.ndarray
+    scale_u: np.ndarray
+    decay_rate: float
+    disk_radius: float | None
+    input_bounds: np.ndarray
+    integral_of: str | None
+    solver: str
+    solve_time_s: float
+    certificate: Certificate
+    margin: float
+
+
+@dataclass
+class TSObserverDesign:
+    """TS observer gains L_i [SI] for xi = [x; v] (Clemens eq 10) from the measured outputs.
+
+    Parameters
+    ----------
+    L : (N, n_xi, n_y) ndarray
+        Observer gains per vertex [SI].
+    P : ndarray
+        Common Lyapunov matrix (scaled coordinates).
+    A_aug, B_aug, C_aug : ndarray
+        The augmented model of eq 10.
+    scale_xi, scale_y : ndarray
+        Scales of the augmented state and the outputs.
+    tau_v : float
+        Wind time constant of the augmentation [s].
+    decay_rate : float
+        Guaranteed decay rate [1/s].
+    disk_radius : float or None
+        Pole disk radius [1/s].
+    solver : str
+        The SDP solver used.
+    solve_time_s : float
+        Solve time [s].
+    certificate : Certificate
+        The numpy check.
+    margin : float
+        LMI margin.
+    """
+
+    L: np.ndarray
+    P: np.ndarray
+    A_aug: np.ndarray
+    B_aug: np.ndarray
+    C_aug: np.ndarray
+    scale_xi: np.ndarray
+    scale_y: np.ndarray
+    tau_v: float
+    decay_rate: float
+    disk_radius: float | None
+    solver: str
+    solve_time_s: float
+    certificate: Certificate
+    margin: float
+
+
+def _scales(names: Sequence[str], scales: Mapping[str, float] | None) -> np.ndarray:
+    s = dict(DEFAULT_SCALES)
+    s.update(scales or {})
+    out = []
+    for n in names:
+        out.append(check_number(f"scale {n!r}", s.get(n, 1.0), lo=0.0, lo_open=True))
+    return np.array(out)
+
+
+def _check_rate(name: str, v: Any, allow_none: bool = False) -> float | None:
+    if v is None and allow_none:
+        return None
+    return check_number(name, v, lo=0.0, unit="[1/s]")
+
+
+def _solve(prob: Any, solver: str | None) -> tuple[str, str]:
+    """Solve with ``solver`` or the first installed of MOSEK, Clarabel, SCS that returns a
+    status; a solver that fails numerically is logged and the next one tried. Returns the
+    solver's name and the status, "solver_error" when none gave one (treated as infeasible by
+    the callers, who then say what to relax)."""
+    import cvxpy as cp
+
+    installed = cp.installed_solvers()
+    if solver and solver not in installed:
+        raise ValueError(f"solver {solver!r} is not installed; installed: {installed}")
+    names = [solver] if solver else [s for s in ("MOSEK", "CLARABEL", "SCS") if s in installed]
+    for s in names:
+        try:
+            with warnings.catch_warnings():
+                # "optimal_inaccurate" is kept: the numpy certificate decides, not the status
+                warnings.filterwarnings("ignore", message="Solution may be inaccurate")
+                prob.solve(solver=s)
+        except (KeyboardInterrupt, SystemExit):
+            raise
+        except BaseException as err:  # cvxpy.SolverError; Clarabel's Rust panics are
+            log.warning("SDP solver %s failed (%s); trying the next", s, err)
+            continue
+        if prob.status in ("optimal", "optimal_inaccurate", "infeasible",
+                           "infeasible_inaccurate"):
+            return s, prob.status
+    return (names[-1] if names else "none"), "solver_error"
+
+
+def _sym(m: Any) -> Any:
+    return 0.5 * (m + m.T)
+
+
+def _controller_mats(ts: TSModel, integral_of: str | None, sx: np.ndarray, su: np.ndarray
+                     ) -> tuple[np.ndarray, np.ndarray]:
+    """Scaled A_i, B_i of the controller design, augmented by the integral of a state's
+    deviation from its vertex value (dq/dt = x_k - x_0,i,k) when ``integral_of`` is set."""
+    a, b = ts.A, ts.B
+    if integral_of is not None:
+        k = ts.states.index(integral_of)
+        nv, nx = a.shape[:2]
+        aa = np.zeros((nv, nx + 1, nx + 1))
+        aa[:, :nx, :nx] = a
+        aa[:, nx, k] = 1.0
+        a = aa
+        b = np.concatenate([b, np.zeros((nv, 1, b.shape[2]))], axis=1)
+    return (np.array([np.diag(1 / sx) @ ai @ np.diag(sx) for ai in a]),
+            np.array([np.diag(1 / sx) @ bi @ np.diag(su) for bi in b]))
+
+
+def _controller_problem(a: np.ndarray, b: np.ndarray, cells: list[tuple[int, ...]],
+                        alpha: float, radius: float | None, mu: np.ndarray | None,
+                        eps: float, use_bound: bool = True) -> tuple[Any, Any, list[Any], Any]:
+    import cvxpy as cp
+
+    nv, nx, nu = b.shape
+    x = cp.Variable((nx, nx), symmetric=True)
+    y = [cp.Variable((nu, nx)) for _ in range(nv)]
+    cons: list[Any] = []
+    ix = np.eye(nx)
+
+    def g(i: int, j: int) -> Any:
+        return a[i] @ x - b[i] @ y[j]
+
+    pairs = sorted({(i, j) for c in cells for i in c for j in c if i < j})
+    for i in range(nv):
+        cons.append(_sym(g(i, i) + g(i, i).T + 2 * alpha * x) << -eps * ix)
+    for i, j in pairs:
+        s = g(i, j) + g(j, i)
+        cons.append(_sym(s + s.T + 4 * alpha * x) << 0)
+    if radius is not None:
+        for i in range(nv):
+            gi = g(i, i)
+            cons.append(_sym(cp.bmat([[-radius * x, gi], [gi.T, -radius * x]]))
+                        << -eps * np.eye(2 * nx))
+        for i, j in pairs:
+            s = g(i, j) + g(j, i)
+            cons.append(_sym(cp.bmat([[-2 * radius * x, s], [s.T, -2 * radius * x]])) << 0)
+    for k in range(nx):
+        e = ix[:, k:k + 1]
+        cons.append(_sym(cp.bmat([[np.ones((1, 1)), e.T], [e, x]])) >> 0)
+    t = cp.Variable(nu)
+    if use_bound:
+        for i in range(nv):
+            for j in range(nu):
+                row = y[i][j:j + 1, :]
+                tj = cp.reshape(t[j], (1, 1), order="C")
+                cons.append(_sym(cp.bmat([[x, row.T], [row, tj]])) >> 0)
+        if mu is not None:
+            for j in np.nonzero(np.isfinite(mu))[0]:
+                cons.append(t[j] <= mu[j] ** 2)
+    obj = cp.Minimize(cp.sum(t)) if use_bound else cp.Minimize(cp.trace(x))
+    return cp.Problem(obj, cons), x, y, t
+
+
+def design_ts_controller(ts: TSModel, *, decay_rate: float = 0.2,
+                         disk_radius: float | None = None,
+                         input_bounds: Mapping[str, float] | None = None,
+                         scales: Mapping[str, float] | None = None, margin: float = 1e-4,
+                         integral_of: str | None = "rotor_speed",
+                         solver: str | None = None, grid_points: int = 6) -> TSControllerDesign:
+    """PDC gains K_i for the TS model by LMIs (Clemens et al. eq 7); certificate checked.
+
+    Parameters
+    ----------
+    decay_rate : float
+        alpha [1/s]: every trajectory decays at least as exp(-alpha t) (Re lambda <= -alpha).
+    disk_radius : float or None
+        D-stability: closed-loop eigenvalues within abs(lambda) < r [1/s] (keeps the gains from
+        outrunning the controller rate and the unmodelled dynamics); None drops it.
+    input_bounds : dict of input name to bound, optional
+        abs(u_j - u_0,j) <= mu_j [SI] for states in the Lyapunov ellipsoid that holds the typical
+        deviations (``scales``). Default: the bounds are minimised instead.
+    scales : dict of name to typical magnitude [SI]
+        Scaling of states and inputs (default :data:`DEFAULT_SCALES`).
+    margin : float
+        Strictness of the LMIs in scaled units (verified to half of it).
+    integral_of : str or None
+        Add integral action on this state's deviation from its equilibrium (default rotor
+        speed: removes the steady speed offset that model mismatch leaves with eq 7 alone;
+        None gives Clemens' eq 7 exactly). Its scale is that of the state times 1 s.
+
+
+    Returns
+    -------
+    TSControllerDesign
+        Gains K_i, P, scales, the solver and the certificate.
+
+    Raises
+    ------
+    SynthesisError
+        LMIs infeasible: the message says which constraint to relax (the input bound, the
+        disk, or the decay rate, with the largest feasible decay rate found).
+    """
+
+    alpha = _check_rate("decay_rate", decay_rate)
+    radius = _check_rate("disk_radius", disk_radius, allow_none=True)
+    if radius is not None and radius <= alpha:
+        raise ValueError(f"disk_radius ({radius:g} 1/s) must exceed decay_rate ({alpha:g} 1/s)")
+    if integral_of is not None and integral_of not in ts.states:
+        raise ValueError(f"integral_of must be a state of the TS model {list(ts.states)}, got "
+                         f"{integral_of!r}")
+    sx, su = _scales(ts.states, scales), _scales(ts.inputs, scales)
+    if integral_of is not None:
+        sx = np.append(sx, sx[ts.states.index(integral_of)] * 1.0)
+    mu = _input_bounds(ts, input_bounds, su)
+    a, b = _controller_mats(ts, integral_of, sx, su)
+    cells = ts.cells()
+    t0 = time.perf_counter()
+    prob, xv, yv, tv = _controller_problem(a, b, cells, alpha, radius, mu, margin)
+    used, status = _solve(prob, solver)
+    dt = time.perf_counter() - t0
+    if status not in ("optimal", "optimal_inaccurate"):
+        raise SynthesisError(_diagnose_controller(a, b, cells, alpha, radius, mu, margin, used))
+    xs = 0.5 * (xv.value + xv.value.T)
+    ks = np.array([y.value @ np.linalg.inv(xs) for y in yv])
+    k = np.array([np.diag(su) @ ki @ np.diag(1 / sx) for ki in ks])
+    p = np.linalg.inv(xs)
+    cert = verify_controller(ts, k, p, sx, su, alpha, radius, margin=0.5 * margin,
+                             grid_points=grid_points, integral_of=integral_of)
+    if not cert.ok:
+        raise SynthesisError(f"the solver ({used}, status {status}) returned gains whose "
+                             f"certificate fails: {'; '.join(cert.failures[:3])}; tighten the "
+                             f"solver tolerance or scale the model")
+    bounds = np.sqrt(np.maximum(tv.value, 0)) * su if tv.value is not None else \
+        np.full(len(ts.inputs), np.nan)
+    return TSControllerDesign(K=k, P=p, scale_x=sx, scale_u=su, decay_rate=alpha,
+                              disk_radius=radius, input_bounds=bounds, integral_of=integral_of,
+                              solver=used, solve_time_s=dt, certificate=cert, margin=margin)
+
+
+def _input_bounds(ts: TSModel, input_bounds: Mapping[str, float] | None, su: np.ndarray
+                  ) -> np.ndarray | None:
+    """Scaled input bounds mu_j on the ellipsoid, or None."""
+    if not input_bounds:
+        return None
+    unknown = set(input_bounds) - set(ts.inputs)
+    if unknown:
+        raise ValueError(f"input_bounds: unknown inputs {sorted(unknown)}; inputs are "
+                         f"{list(ts.inputs)}")
+    mu = np.array([float(input_bounds.get(n, np.inf)) for n in ts.inputs]) / su
+    if np.any(~(mu > 0)):
+        raise ValueError(f"input_bounds must be > 0, got {dict(input_bounds)}")
+    return mu
+
+
+def _diagnose_controller(a, b, cells, alpha, radius, mu, margin, solver) -> str:
+    """Find which constraint makes the controller LMIs infeasible."""
+    what = []
+    if mu is not None:
+        p, *_ = _controller_problem(a, b, cells, alpha, radius, None, margin)
+        if _solve(p, solver)[1] in ("optimal", "optimal_inaccurate"):
+            return ("the controller LMIs are infeasible with the input bounds given: relax "
+                    "input_bounds (feasible without them)")
+        what.append("input_bounds")
+    if radius is not None:
+        p, *_ = _controller_problem(a, b, cells, alpha, None, None, margin, use_bound=False)
+        if _solve(p, solver)[1] in ("optimal", "optimal_inaccurate"):
+            return (f"the controller LMIs are infeasible with disk_radius = {radius:g} 1/s: "
+                    f"relax (increase) disk_radius")
+    lo, hi = 0.0, alpha
+    for _ in range(8):
+        mid = 0.5 * (lo + hi)
+        p, *_ = _controller_problem(a, b, cells, mid, None, None, margin, use_bound=False)
+        if _solve(p, solver)[1] in ("optimal", "optimal_inaccurate"):
+            lo = mid
+        else:
+            hi = mid
+    return (f"the controller LMIs are infeasible at decay_rate = {alpha:g} 1/s even without "
+            f"the disk and input bounds: relax (lower) decay_rate; the largest feasible found is "
+            f"about {lo:.4g} 1/s" if lo > 0 else
+            "the controller LMIs are infeasible at any decay rate: the TS model is not "
+            "stabilizable with a common Lyapunov function; add inputs or split the premise grid")
+
+
+def _premise_grid(ts: TSModel, n: int) -> list[tuple[float, float]]:
+    def fine(g: np.ndarray) -> np.ndarray:
+        if g.size == 1:
+            return g
+        return np.unique(np.concatenate([np.linspace(g[k], g[k + 1], n + 1)
+                                         for k in range(g.size - 1)]))
+    return list(itertools.product(fine(ts.wind_grid), fine(ts.reduction_grid)))
+
+
+def verify_controller(ts: TSModel, K: np.ndarray, P: np.ndarray, scale_x: np.ndarray,
+                      scale_u: np.ndarray, decay_rate: float, disk_radius: float | None = None,
+                      *, margin: float = 5e-5, grid_points: int = 6,
+                      integral_of: str | None = None) -> Certificate:
+    """Check a PDC design with numpy: the LMIs at X = P^-1, Y_i = K_i X hold with ``margin``
+    (scaled units, normalised by ||X||), and on a premise grid with ``grid_points`` intervals
+    per cell edge the closed loop sum_ij h_i h_j (A_i - B_i K_j) has Re lambda <= -alpha and
+    Acl' P + P Acl + 2 alpha P <= 0 (all in the scaled coordinates of the design).
+
+    Parameters
+    ----------
+    ts : TSModel
+        The model.
+    K : ndarray
+        Gains per vertex.
+    P : ndarray
+        Lyapunov matrix (scaled).
+    scale_x, scale_u : ndarray
+        Scales of states and inputs.
+    decay_rate : float
+        Required decay rate [1/s].
+    disk_radius : float, optional
+        Pole disk radius [1/s].
+    margin : float
+        LMI margin.
+    grid_points : int
+        Premise grid intervals per cell edge.
+    integral_of : str, optional
+        The integrated state.
+
+    Returns
+    -------
+    Certificate
+        Whether every check holds, the worst margins and the failures.
+    """
+    sx, su = np.asarray(scale_x, float), np.asarray(scale_u, float)
+    a, b = _controller_mats(ts, integral_of, sx, su)
+    k = np.array([np.diag(1 / su) @ ki @ np.diag(sx) for ki in np.asarray(K, float)])
+    p = 0.5 * (np.asarray(P, float) + np.asarray(P, float).T)
+    fails: list[str] = []
+    lam_p = np.linalg.eigvalsh(p)
+    if lam_p[0] <= 0:
+        fails.append(f"P is not positive definite (smallest eigenvalue {lam_p[0]:g})")
+    x = np.linalg.inv(p)
+    nrm = np.linalg.norm(x, 2)
+    alpha = float(decay_rate)
+    worst = -np.inf
+
+    def g(i: int, j: int) -> np.ndarray:
+        return a[i] @ x - b[i] @ (k[j] @ x)
+
+    pairs = sorted({(i, j) for c in ts.cells() for i in c for j in c if i < j})
+    for i in range(len(a)):
+        h = g(i, i)
+        e = np.linalg.eigvalsh(h + h.T + 2 * alpha * x).max()
+        worst = max(worst, e)
+        if e > -margin:
+            fails.append(f"decay LMI of vertex {i} has eigenvalue {e:.3g} > -{margin:g}")
+        if disk_radius is not None:
+            m = np.block([[-disk_radius * x, h], [h.T, -disk_radius * x]])
+            e = np.linalg.eigvalsh(m).max()
+            worst = max(worst, e)
+            if e > -margin:
+                fails.append(f"disk LMI of vertex {i} has eigenvalue {e:.3g} > -{margin:g}")
+    for i, j in pairs:
+        s = g(i, j) + g(j, i)
+        e = np.linalg.eigvalsh(s + s.T + 4 * alpha * x).max()
+        if e > 1e-8 * nrm:
+            fails.append(f"decay LMI of the pair ({i}, {j}) has eigenvalue {e:.3g} > 0")
+    pts = _premise_grid(ts, grid_points)
+    worst_decay, worst_lyap = _check_grid(ts, pts, a, b, k, p, alpha, fails)
+    return Certificate(ok=not fails, worst_lmi=float(worst), worst_decay=float(worst_decay),
+                       worst_lyapunov=float(worst_lyap), n_grid=len(pts), failures=fails)
+
+
+def _check_grid(ts: TSModel, pts: list[tuple[float, float]], a: np.ndarray, b: np.ndarray,
+                k: np.ndarray, p: np.ndarray, alpha: float, fails: list[str]
+                ) -> tuple[float, float]:
+    """Closed loop sum_ij h_i h_j (A_i - B_i K_j) on the premise grid: Re lambda <= -alpha and
+    a decreasing Lyapunov function; failures appended to ``fails``; the worst of each."""
+    worst_decay, worst_lyap = -np.inf, -np.inf
+    for v, dp in pts:
+        h = ts.membership(v, dp)
+        act = np.nonzero(h)[0]
+        acl = sum(h[i] * h[j] * (a[i] - b[i] @ k[j]) for i in act for j in act)
+        ev = np.linalg.eigvals(acl)
+        d = ev.real.max() + alpha
+        ly = np.linalg.eigvalsh(acl.T @ p + p @ acl + 2 * alpha * p).max() / np.linalg.norm(p, 2)
+        worst_decay, worst_lyap = max(worst_decay, d), max(worst_lyap, ly)
+        if d > 1e-9 * max(1.0, alpha):
+            fails.append(f"closed loop at v = {v:g} m/s, dP = {dp:g} has Re lambda = "
+                         f"{ev.real.max():.4g} > -alpha = {-alpha:g}")
+        if ly > 1e-9:
+            fails.append(f"Lyapunov decrease fails at v = {v:g} m/s, dP = {dp:g} ({ly:.3g})")
+    return worst_decay, worst_lyap
+
+
+def _augmented(ts: TSModel, tau_v: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """A~_i, B~_i (eq 9 appended) and C~ of xi = [x; v]."""
+    nv, nx = ts.A.shape[:2]
+    aa = np.zeros((nv, nx + 1, nx + 1))
+    aa[:, :nx, :nx] = ts.A
+    aa[:, :nx, nx] = ts.B_d
+    aa[:, nx, nx] = -1.0 / tau_v
+    bb = np.concatenate([ts.B, np.zeros((nv, 1, ts.B.shape[2]))], axis=1)
+    cc = np.hstack([ts.C, np.zeros((ts.C.shape[0], 1))])
+    return aa, bb, cc
+
+
+def _observer_mats(ts: TSModel, tau_v: float, sxi: np.ndarray, sy: np.ndarray
+                   ) -> tuple[np.ndarray, np.ndarray]:
+    """Scaled A~_i and C~ of the observer design (states and wind by ``sxi``, outputs by ``sy``)."""
+    aa, _, cc = _augmented(ts, tau_v)
+    return (np.array([np.diag(1 / sxi) @ ai @ np.diag(sxi) for ai in aa]),
+            np.diag(1 / sy) @ cc @ np.diag(sxi))
+
+
+def design_ts_observer(ts: TSModel, *, tau_v: float = 4.0, decay_rate: float = 1.0,
+                       disk_radius: float | None = 60.0,
+                       scales: Mapping[str, float] | None = None, margin: float = 1e-4,
+                       solver: str | None = None, grid_points: int = 6) -> TSObserverDesign:
+    """TS state and wind observer gains L_i (Clemens et al. eqs 8-10) by LMIs; certified.
+
+    Parameters
+    ----------
+    tau_v : float
+        Time constant of the inflow model of eq 9 [s] (Clemens: 4 s).
+    decay_rate : float
+        alpha_o [1/s] of the estimation error.
+    disk_radius : float or None
+        Error eigenvalues within abs(lambda) < r_o [1/s].
+
+
+    Returns
+    -------
+    TSObserverDesign
+        Gains L_i, P, the augmented model, the solver and the certificate.
+
+    Raises
+    ------
+    SynthesisError
+        The pair (A~_i, C~) not detectable at a vertex, or the LMIs infeasible (the message says
+        what to relax).
+    """
+    check_number("tau_v", tau_v, lo=0.0, lo_open=True, unit="s")
+    alpha = _check_rate("decay_rate", decay_rate)
+    radius = _check_rate("disk_radius", disk_radius, allow_none=True)
+    if radius is not None and radius <= alpha:
+        raise ValueError(f"disk_radius ({radius:g} 1/s) must exceed decay_rate ({alpha:g} 1/s)")
+    aa, bb, cc = _augmented(ts, float(tau_v))
+    sxi = _scales(ts.states + ("wind",), scales)
+    sy = _scales(ts.measured, scales)
+    a, c = _observer_mats(ts, float(tau_v), sxi, sy)
+    _check_detectable(ts, a, c, alpha)
+    prob, pv, nvar = _observer_problem(a, c, alpha, radius, margin)
+    t0 = time.perf_counter()
+    used, status = _solve(prob, solver)
+    dt = time.perf_counter() - t0
+    if status not in ("optimal", "optimal_inaccurate"):
+        hint = ("relax (increase) disk_radius or lower decay_rate" if radius is not None
+                else "lower decay_rate")
+        raise SynthesisError(f"the observer LMIs are infeasible at decay_rate = {alpha:g} 1/s"
+                             f"{'' if radius is None else f', disk_radius = {radius:g} 1/s'}: "
+                             f"{hint}")
+    p = 0.5 * (pv.value + pv.value.T)
+    ls = np.array([np.linalg.solve(p, ni.value) for ni in nvar])
+    lmat = np.array([np.diag(sxi) @ li @ np.diag(1 / sy) for li in ls])
+    cert = verify_observer(ts, lmat, p, sxi, sy, alpha, radius, tau_v=float(tau_v),
+                           margin=0.5 * margin)
+    if not cert.ok:
+        raise SynthesisError(f"the observer certificate fails: {'; '.join(cert.failures[:3])}")
+    return TSObserverDesign(L=lmat, P=p, A_aug=aa, B_aug=bb, C_aug=cc, scale_xi=sxi,
+                            scale_y=sy, tau_v=float(tau_v), decay_rate=alpha,
+                            disk_radius=radius, solver=used, solve_time_s=dt,
+                            certificate=cert, margin=margin)
+
+
+def _check_detectable(ts: TSModel, a: np.ndarray, c: np.ndarray, alpha: float) -> None:
+    """Modes slower than the required decay must be observable (PBH on A~ + alpha I)."""
+    from mpc_wt.controllers.lqr import uncontrollable_modes
+
+    for i, ai in enumerate(a):
+        modes = uncontrollable_modes(ai.T + alpha * np.eye(ai.shape[0]), c.T, discrete=False)
+        if modes:
+            raise SynthesisError(
+                f"(A~, C~) is not detectable with decay rate {alpha:g} 1/s at vertex {i} "
+                f"(v = {ts.vertices[i, 0]:g} m/s, dP = {ts.vertices[i, 1]:g}) from "
+                f"{list(ts.measured)}: the modes "
+                f"{', '.join(f'{m.real - alpha:.4g}{m.imag:+.4g}j' for m in modes)} are not "
+                f"seen; measure more signals or lower decay_rate")
+
+
+def _observer_problem(a: np.ndarray, c: np.ndarray, alpha: float, radius: float | None,
+                      margin: float) -> tuple[Any, Any, list[Any]]:
+    """The observer LMIs (Clemens eq 10) with the decay rate and the optional pole disk; the
+    objective bounds the gains' norm."""
+    import cvxpy as cp
+
+    nv, n = a.shape[:2]
+    ny = c.shape[0]
+    pv = cp.Variable((n, n), symmetric=True)
+    nvar = [cp.Variable((n, ny)) for _ in range(nv)]
+    t = cp.Variable()
+    cons = [pv >> np.eye(n)]
+    for i in range(nv):
+        m = a[i].T @ pv + pv @ a[i] - c.T @ nvar[i].T - nvar[i] @ c + 2 * alpha * pv
+        cons.append(_sym(m) << -margin * np.eye(n))
+        if radius is not None:
+            g = pv @ a[i] - nvar[i] @ c
+            cons.append(_sym(cp.bmat([[-radius * pv, g], [g.T, -radius * pv]]))
+                        << -margin * np.eye(2 * n))
+        cons.append(_sym(cp.bmat([[t * np.eye(n), nvar[i]], [nvar[i].T, t * np.eye(ny)]])) >> 0)
+    return cp.Problem(cp.Minimize(t), cons), pv, nvar
+
+
+def verify_observer(ts: TSModel, L: np.ndarray, P: np.ndarray, scale_xi: np.ndarray,
+                    scale_y: np.ndarray, decay_rate: float, disk_radius: float | None = None,
+                    *, tau_v: float = 4.0, margin: float = 5e-5,
+                    grid_points: int = 6) -> Certificate:
+    """Check TS observer gains with numpy: vertex LMIs at P with ``margin`` and, on a premise
+    grid, sum_i h_i (A~_i - L_i C~) Hurwitz with the decay rate and decreasing e' P e.
+
+    Parameters
+    ----------
+    ts : TSModel
+        The model.
+    L : ndarray
+        Gains per vertex.
+    P : ndarray
+        Lyapunov matrix (scaled).
+    scale_xi, scale_y : ndarray
+        Scales of the augmented state and outputs.
+    decay_rate : float
+        Required decay rate [1/s].
+    disk_radius : float, optional
+        Pole disk radius [1/s].
+    tau_v : float
+        Wind time constant [s].
+    margin : float
+        LMI margin.
+    grid_points : int
+        Premise grid intervals per cell edge.
+
+    Returns
+    -------
+    Certificate
+        Whether every check holds, the worst margins and the failures.
+    """
+    sxi, sy = np.asarray(scale_xi, float), np.asarray(scale_y, float)
+    a, c = _observer_mats(ts, tau_v, sxi, sy)
+    ls = np.array([np.diag(1 / sxi) @ li @ np.diag(sy) for li in np.asarray(L, float)])
+    p = 0.5 * (np.asarray(P, float) + np.asarray(P, float).T)
+    fails: list[str] = []
+    if np.linalg.eigvalsh(p)[0] <= 0:
+        fails.append("P is not positive definite")
+    alpha = float(decay_rate)
+    nrm = np.linalg.norm(p, 2)
+    worst = -np.inf
+    for i in range(len(a)):
+        f = a[i] - ls[i] @ c
+        e = np.linalg.eigvalsh(f.T @ p + p @ f + 2 * alpha * p).max()
+        worst = max(worst, e)
+        if e > -margin:
+            fails.append(f"observer decay LMI of vertex {i} has eigenvalue {e:.3g} > -{margin:g}")
+        if disk_radius is not None:
+            g = p @ f
+            e = np.linalg.eigvalsh(np.block([[-disk_radius * p, g], [g.T, -disk_radius * p]])
+                                   ).max()
+            worst = max(worst, e)
+            if e > -margin:
+                fails.append(f"observer disk LMI of vertex {i} has eigenvalue {e:.3g}")
+    wd, wl = -np.inf, -np.inf
+    pts = _premise_grid(ts, grid_points)
+    for v, dp in pts:
+        h = ts.membership(v, dp)
+        f = np.tensordot(h, a, axes=1) - np.tensordot(h, ls, axes=1) @ c
+        d = np.linalg.eigvals(f).real.max() + alpha
+        ly = np.linalg.eigvalsh(f.T @ p + p @ f + 2 * alpha * p).max() / nrm
+        wd, wl = max(wd, d), max(wl, ly)
+        if d > 1e-9 * max(1.0, alpha) or ly > 1e-9:
+            fails.append(f"observer error at v = {v:g} m/s, dP = {dp:g}: decay margin {d:.3g}, "
+                         f"Lyapunov {ly:.3g}")
+    return Certificate(ok=not fails, worst_lmi=float(worst), worst_decay=float(wd),
+                       worst_lyapunov=float(wl), n_grid=len(pts), failures=fails)
+
+
+# --------------------------------------------------------------------------------------------
+# Controller in the harness
+# --------------------------------------------------------------------------------------------
+class TSController(ControllerBase):
+    """TS controller (eq 7) on TS observer estimates (eq 10) for the simulation harness.
+
+    The observer is integrated exactly (zero-order hold on u and y) per vertex at the controller
+    period and the vertex maps are blended with the memberships of the current premise: for
+    slowly varying premises this is the discretization of eq 10. The premise is the estimated
+    wind v_hat and the power reduction Delta P(t) of ``power_reduction``; a premise outside the
+    vertex grid is clipped to it (logged once per run, counted in ``premise_clipped``).
+
+    Parameters
+    ----------
+    ts, controller, observer : the model and the two designs
+    turbine : Turbine (actuator limits)
+    dt : controller period [s]
+    power_reduction : callable t -> Delta P [-], optional (active power control, eq 11)
+    initial_wind_mps : float, optional
+        Initial wind estimate [m/s] (default the middle of the grid).
+
+    Signals recorded: ``wind_est`` [m/s], ``power_reduction`` [-], ``power_ref`` [W],
+    ``premise_clipped`` (0/1).
+    """
+
+    def __init__(self, ts: TSModel, controller: TSControllerDesign,
+                 observer: TSObserverDesign, turbine: linearize.Turbine, *,
+                 dt: float = 1.0 / 80.0,
+                 power_reduction: Callable[[float], float] | None = None,
+                 initial_wind_mps: float | None = None) -> None:
+        check_number("dt", dt, lo=0.0, lo_open=True, unit="s")
+        self.ts, self.ctl, self.obs, self.turbine = ts, controller, observer, turbine
+        self.dt = float(dt)
+        self.power_reduction = power_reduction
+        v_init = float(np.mean(ts.wind_grid) if initial_wind_mps is None else initial_wind_mps)
+        ts.check_premise(v_init, float(ts.reduction_grid[0]))
+        self._v_init = v_init
+        aa, bb, cc = observer.A_aug, observer.B_aug, observer.C_aug
+        nv, n = aa.shape[:2]
+        nu, ny = bb.shape[2], cc.shape[0]
+        ki = controller.integral_of
+        self._ki = None if ki is None else ts.states.index(ki)
+        self._int_src = ts.measured.index(ki) if ki in ts.measured else None
+        self._phi = np.empty((nv, n, n))
+        self._gam = np.empty((nv, n, nu + ny + 1))
+        xi0 = np.hstack([ts.x0, ts.v0[:, None]])
+        for i in range(nv):
+            f = aa[i] - observer.L[i] @ cc
+            const = -aa[i] @ xi0[i] - bb[i] @ ts.u0[i]
+            g = np.hstack([bb[i], observer.L[i], const[:, None]])
+            m = np.zeros((n + g.shape[1], n + g.shape[1]))
+            m[:n, :n], m[:n, n:] = f, g
+            e = scipy.linalg.expm(m * dt)
+            self._phi[i], self._gam[i] = e[:n, :n], e[:n, n:]
+        self.reset()
+
+    def reset(self) -> None:
+        h = self.ts.membership(self._v_init, float(self.ts.reduction_grid[0]))
+        m = self.ts.blend(h)
+        self.xi = np.concatenate([m["x0"], [self._v_init]])
+        self._u = m["u0"].copy()
+        self.signals: dict[str, float] = {}
+        self.premise_clipped = 0
+        self._warned = False
+        self._q = 0.0
+
+    def _premise(self, v: float, dp: float) -> tuple[float, float, bool]:
+        g1, g2 = self.ts.wind_grid, self.ts.reduction_grid
+        vc, dc = float(np.clip(v, g1[0], g1[-1])), float(np.clip(dp, g2[0], g2[-1]))
+        clipped = (vc != v) or (dc != dp)
+        if clipped:
+            self.premise_clipped += 1
+            if not self._warned:
+                log.warning("TS premise (v = %.3g m/s, dP = %.3g) outside the vertex grid; "
+                            "clipped to it (further clips are counted in premise_clipped)",
+                            v, dp)
+                self._warned = True
+        return vc, dc, clipped
+
+    def step(self, t: float, meas: dict[str, Any]) -> tuple[np.ndarray, float]:
+        # Observer update, memberships, PDC control law (Clemens eqs 5-10).
+        y = read_signals(meas, self.ts.measured)
+        if not np.all(np.isfinite(y)):
+            raise ValueError(f"non-finite measurement at t = {t:g} s: "
+                             f"{dict(zip(self.ts.measured, y))}")
+        dp_raw = float(self.power_reduction(t)) if self.power_reduction else 0.0
+        if not math.isfinite(dp_raw):
+            raise ValueError(f"power_reduction({t:g}) returned {dp_raw!r}")
+        v, dp, clipped = self._premise(float(self.xi[-1]), dp_raw)
+        h = self.ts.membership(v, dp)
+        act = np.nonzero(h)[0]
+        w = np.concatenate([self._u, y, [1.0]])
+        self.xi = sum(h[i] * (self._phi[i] @ self.xi + self._gam[i] @ w) for i in act)
+        v, dp, clipped2 = self._premise(float(self.xi[-1]), dp_raw)
+        h = self.ts.membership(v, dp)
+        act = np.nonzero(h)[0]
+        xh = self.xi[:-1]
+        q_prev = self._q
+        if self._ki is not None:
+            src = self._int_src
+            err = (y[src] if src is not None else xh[self._ki]) - h @ self.ts.x0[:, self._ki]
+            self._q = q_prev + err * self.dt
+        u = sum(h[i] * (self.ts.u0[i] - self.ctl.K[i] @ (
+            np.append(xh - self.ts.x0[i], self._q) if self._ki is not None
+            else xh - self.ts.x0[i])) for i in act)
+        pa, gen = self.turbine.pitch_actuator, self.turbine.generator
+        pitch = float(np.clip(u[0], pa.min_pitch_rad, pa.max_pitch_rad))
+        torque = float(np.clip(u[1], gen.min_torque, gen.max_torque))
+        if pitch != u[0] or torque != u[1]:
+            self._q = q_prev  # anti-windup: no integration while an input saturates
+        self._u = np.array([pitch, torque])
+        self.signals = {"wind_est": float(self.xi[-1]), "power_reduction": dp,
+                        "power_ref": self.ts.rated_power * (1.0 - dp),
+                        "premise_clipped": float(clipped or clipped2)}
+        return np.full(3, pitch), torque

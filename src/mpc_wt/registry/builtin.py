@@ -1,0 +1,775 @@
+"""The controller kinds mpc-wt ships, each one registration.
+
+baseline, baseline-ct, derateNN, apc (Jonkman's baseline and its retrofits, Pettas and Cheng),
+ibc and coleman-ipc (add-ons on a baseline), mpc, mpc-collective, mpc-lidar (Madsen et al.),
+lqr-pio (Do et al.), ts (Clemens et al.); rosco and discon (Bladed-style libraries in the
+loop, :mod:`mpc_wt.controllers.discon`).
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any, Optional
+
+import numpy as np
+
+import linearize
+from mpc_wt.registry.context import BuildContext, Built
+from mpc_wt.registry.options import REQUIRED, Options, option
+from mpc_wt.registry.registry import register
+from mpc_wt.simulation.scenario import Scenario
+
+__all__ = ["BaselineOptions", "DerateOptions", "APCOptions", "IBCOptions", "ColemanIPCOptions",
+           "MPCOptions", "MPCWeightOptions", "LidarOptions", "MPCLidarOptions", "LQRPIOOptions", "TSOptions",
+           "DisconOptions", "RoscoOptions"]
+
+
+# -- designs behind `mpcwt design` ------------------------------------------------------------
+def _design_ibc(turbine: linearize.Turbine, *, power_fraction: float = 1.0,
+                loop_gain: float = 1.0) -> tuple[dict, str]:
+    from mpc_wt.controllers.ipc import tune_ibc
+    from mpc_wt.io.gain_tables import ibc_table
+
+    g = tune_ibc(turbine, power_fraction=power_fraction, loop_gain_1p=loop_gain)
+    return ibc_table(turbine, g), (f"{g.gain.size} points, gain margin >= "
+                                   f"{g.gain_margin.min():.3g}, high-pass {g.highpass_hz:.3g} Hz")
+
+
+def _design_coleman(turbine: linearize.Turbine, *, power_fraction: float = 1.0
+                    ) -> tuple[dict, str]:
+    from mpc_wt.controllers.ipc import tune_coleman_ipc
+    from mpc_wt.io.gain_tables import coleman_ipc_table
+
+    g = tune_coleman_ipc(turbine, power_fraction=power_fraction)
+    return coleman_ipc_table(turbine, g), (f"{g.ki.size} points, gain margin >= "
+                                           f"{g.gain_margin.min():.3g}")
+
+
+def _design_lqr(turbine: linearize.Turbine, *, winds: Any = None,
+                weights: dict[str, float] | None = None, scales: dict[str, float] | None = None,
+                observer_q: float = 1e3, input_weights: dict[str, float] | None = None
+                ) -> tuple[dict, str]:
+    from mpc_wt.controllers.lqr import (
+        REGION2_SCALES,
+        REGION3_SCALES,
+        REGION3_WEIGHTS,
+        design_lqr_family,
+        design_pi_observer,
+    )
+    from mpc_wt.io.gain_tables import lqr_table
+
+    winds = np.arange(12.0, 25.5, 1.0) if winds is None else np.asarray(winds, float)
+    fam = linearize.linearize_family(turbine, winds, config=linearize.PlantConfig.do(),
+                                     progress=True)
+    weights = dict(weights or REGION3_WEIGHTS)
+    scales = {**REGION2_SCALES, **REGION3_SCALES, **(scales or {})}
+    sw = {k: v for k, v in weights.items() if k in fam.models[0].states}
+    ow = {k: v for k, v in weights.items() if k not in sw}
+    designs = design_lqr_family(fam, state_weights=sw, output_weights=ow, scales=scales,
+                                input_weights=input_weights)
+    obs = [design_pi_observer(m, q=observer_q) for m in fam.models] if observer_q > 0 else None
+    note = f"{len(designs)} operating points"
+    if obs:
+        note += (f", PIO ||L2||/||L1|| {min(o.gain_ratio for o in obs):.3g}.."
+                 f"{max(o.gain_ratio for o in obs):.3g}")
+    return lqr_table(turbine, designs, obs), note
+
+
+def _design_ts(turbine: linearize.Turbine, *, winds: Any = None,
+               reductions: Any = (0.0, 0.4, 0.8), decay_rate: float = 0.2,
+               observer_decay_rate: float = 1.0) -> tuple[dict, str]:
+    from mpc_wt.controllers.takagi_sugeno import (
+        build_ts_model,
+        design_ts_controller,
+        design_ts_observer,
+    )
+    from mpc_wt.io.gain_tables import ts_table
+
+    grid = (12.0, 14.0, 16.0, 19.0, 22.0, 25.0) if winds is None else winds
+    ts = build_ts_model(turbine, [float(v) for v in grid], list(reductions), progress=True)
+    ctl = design_ts_controller(ts, decay_rate=decay_rate)
+    obs = design_ts_observer(ts, decay_rate=observer_decay_rate)
+    return ts_table(turbine, ts, ctl, obs), (
+        f"{ts.n_vertices} vertices, {ctl.solver} {ctl.solve_time_s:.1f} s + "
+        f"{obs.solve_time_s:.1f} s, certificates ok")
+
+
+# -- baseline family ---------------------------------------------------------------------------
+@dataclass(frozen=True)
+class BaselineOptions(Options):
+    """The baseline PI's design (Jonkman et al. 2009, sec. 7.2)."""
+
+    omega_n_rad_s: float = option(0.6, help="PI closed-loop natural frequency", unit="rad/s",
+                                  lo=0.0, lo_open=True, flag="")
+    zeta: float = option(0.7, help="PI closed-loop damping ratio", unit="-", lo=0.0,
+                         lo_open=True, flag="")
+
+
+@dataclass(frozen=True)
+class DerateOptions(BaselineOptions):
+    """The baseline derated to a fraction of rated power (Pettas and Cheng sec. 3.2)."""
+
+    power_fraction: float = option(REQUIRED, help="fraction of rated power, in (0, 1]",
+                                   unit="-", lo=0.0, lo_open=True, hi=1.0, flag="")
+
+
+def _baseline(region3: str) -> Any:
+    def build(ctx: BuildContext, opts: BaselineOptions) -> Built:
+        from mpc_wt.controllers.baseline import BaselineController, tune_baseline
+
+        frac = getattr(opts, "power_fraction", 1.0)
+        gains = tune_baseline(ctx.turbine, omega_n_rad_s=opts.omega_n_rad_s, zeta=opts.zeta,
+                              power_fraction=frac)
+        ctl = BaselineController(ctx.turbine, gains, region3=region3)
+        meta = {"gains": {"kp": gains.kp, "ki": gains.ki, "theta_k_rad": gains.theta_k_rad,
+                          "k_opt": gains.k_opt, "power_fraction": frac, "region3": region3}}
+        return Built(ctl, meta=meta, power_fraction=frac)
+    return build
+
+
+def _derated_trim(turbine: linearize.Turbine, sc: Scenario, opts: DerateOptions
+                  ) -> linearize.OperatingPoint:
+    """Trim at the derated power; below it (low wind) at the turbine's own optimum."""
+    try:
+        return linearize.trim(turbine, sc.wind_mps, opts.power_fraction
+                              * turbine.operation.rated_power)
+    except linearize.TrimError:
+        return linearize.trim(turbine, sc.wind_mps)
+
+
+def _derate_preset(mt: Any) -> dict[str, Any]:
+    pct = float(mt.group(1))
+    if not 0.0 < pct <= 100.0:
+        raise ValueError(f"derating in {mt.group(0)!r} is {pct:g} % of rated power; allowed: "
+                         f"(0, 100] %")
+    return {"power_fraction": pct / 100.0}
+
+
+def _design_baseline(turbine: linearize.Turbine, *, omega_n_rad_s: float = 0.6,
+                     zeta: float = 0.7, power_fraction: float = 1.0) -> tuple[dict, str]:
+    from mpc_wt.controllers.baseline import tune_baseline
+    from mpc_wt.io.gain_tables import baseline_table
+
+    doc = baseline_table(turbine, tune_baseline(turbine, omega_n_rad_s=omega_n_rad_s, zeta=zeta,
+                                                power_fraction=power_fraction))
+    return doc, f"kp {doc['settings']['kp']:.4g} s, ki {doc['settings']['ki']:.4g}"
+
+
+register("baseline", BaselineOptions, field_components="u", design=_design_baseline,
+         summary="tuned PI pitch and torque law, constant power in region III (80 Hz)"
+         )(_baseline("constant_power"))
+register("baseline-ct", BaselineOptions, field_components="u",
+         summary="the baseline with constant torque in region III (Do et al.'s PI)"
+         )(_baseline("constant_torque"))
+register("derate", DerateOptions, field_components="u", pattern=r"derate(\d+(?:\.\d+)?)",
+         pattern_options=_derate_preset, pattern_help="derateNN (NN % of rated power)",
+         operating_point=_derated_trim,
+         summary="the baseline derated to NN % of rated power, PI re-tuned")(
+    _baseline("constant_power"))
+
+
+# -- add-ons: IBC and Coleman IPC -----------------------------------------------------------
+@dataclass(frozen=True)
+class IBCOptions(Options):
+    """Individual blade control (Pettas and Cheng sec. 3.1; :func:`mpc_wt.controllers.ipc.tune_ibc`)."""
+
+    loop_gain_1p: float = option(1.0, help="loop gain at 1P of each blade loop", unit="-",
+                                 lo=0.0, lo_open=True, flag="--loop-gain")
+    remove_collective: bool = option(True, help="subtract the blades' mean IBC pitch (cyclic "
+                                     "action only); --keep-collective keeps it",
+                                     flag="--keep-collective", flag_value=False)
+    min_gain_margin: float = option(2.0, help="smallest gain margin allowed", unit="-",
+                                    lo=1.0, lo_open=True, flag="")
+    highpass_hz: Optional[float] = option(None, help="input high-pass corner (default half "
+                                          "the rated 1P)", unit="Hz", lo=0.0, lo_open=True,
+                                          flag="")
+    notch_harmonics: tuple[int, ...] = option((3,), help="output band-stops at these "
+                                              "multiples of rated 1P", lo=1, flag="")
+    notch_q: float = option(1.0, help="band-stop quality factor", unit="-", lo=0.0,
+                            lo_open=True, flag="")
+    weight_range: tuple[float, ...] = option((0.8, 0.95), help="power fractions of the fade-in",
+                                             unit="-", lo=0.0, flag="")
+    lowpass_hz: Optional[float] = option(None, help="output low-pass corner", unit="Hz",
+                                         lo=0.0, lo_open=True, flag="")
+
+
+@register("ibc", IBCOptions, field_components="u", addon_to=("baseline", "derate"),
+          default_base="baseline", design=_design_ibc,
+          group="the ibc controllers",
+          summary="individual blade control on a baseline (ibc, derateNN+ibc)")
+def _build_ibc(ctx: BuildContext, opts: IBCOptions, base: Built) -> Built:
+    from mpc_wt.controllers.ipc import IBCController, tune_ibc
+
+    tune = {k: v for k, v in opts.to_dict().items() if k != "remove_collective"}
+    tune["notch_harmonics"] = tuple(opts.notch_harmonics)
+    tune["weight_range"] = tuple(opts.weight_range)
+    g = tune_ibc(ctx.turbine, power_fraction=base.power_fraction, dt=base.controller.dt, **tune)
+    ctl = IBCController(base.controller, g, remove_collective=opts.remove_collective)
+    meta = {"gain": g.gain.tolist(), "pitch_rad": g.pitch_rad.tolist(),
+            "highpass_hz": g.highpass_hz, "notch_harmonics": list(g.notch_harmonics),
+            **opts.to_dict()}
+    return Built(ctl, base.controller_dt, base.preview, {**base.meta, "ibc": meta},
+                 base.power_fraction)
+
+
+@dataclass(frozen=True)
+class ColemanIPCOptions(Options):
+    """Tilt/yaw integral IPC in the Coleman frame (:func:`mpc_wt.controllers.ipc.tune_coleman_ipc`)."""
+
+    crossover_rad_s: float = option(0.2, help="crossover of the integral loops", unit="rad/s",
+                                    lo=0.0, lo_open=True, flag="")
+    max_amplitude_deg: float = option(5.0, help="largest cyclic pitch amplitude", unit="deg",
+                                      lo=0.0, lo_open=True, flag="")
+    weight_range: tuple[float, ...] = option((0.8, 0.95), help="power fractions of the fade-in",
+                                             unit="-", lo=0.0, flag="")
+
+
+@register("coleman-ipc", ColemanIPCOptions, field_components="u", addon_to=("baseline", "derate"),
+          default_base="baseline", design=_design_coleman,
+          summary="tilt/yaw integral IPC on a baseline (coleman-ipc, derateNN+coleman-ipc)")
+def _build_coleman(ctx: BuildContext, opts: ColemanIPCOptions, base: Built) -> Built:
+    from mpc_wt.controllers.ipc import ColemanIPCController, tune_coleman_ipc
+
+    d = opts.to_dict()
+    d["weight_range"] = tuple(opts.weight_range)
+    g = tune_coleman_ipc(ctx.turbine, power_fraction=base.power_fraction, **d)
+    meta = {"ki": g.ki.tolist(), "pitch_rad": g.pitch_rad.tolist(),
+            "azimuth_offset_rad": g.azimuth_offset_rad.tolist(), **opts.to_dict()}
+    return Built(ColemanIPCController(base.controller, g), base.controller_dt, base.preview,
+                 {**base.meta, "coleman_ipc": meta}, base.power_fraction)
+
+
+# -- MPC -----------------------------------------------------------------------------------
+_MW = "weight of the MPC cost on the scaled signal (unset: mpc_wt.MPCWeights' default)"
+
+
+@dataclass(frozen=True)
+class MPCWeightOptions(Options):
+    """Weights of Madsen's MPC cost (:class:`mpc_wt.MPCWeights`); unset ones keep the default.
+    Outputs are divided by their scales (0.5 MW, 1 deg/s, 0.1 m/s, 0.05 rad/s, 1 mrad, 1 MN m)
+    and inputs by theirs (1 deg, 4 kN m) before weighting."""
+
+    gen_power: Optional[float] = option(None, help=_MW, unit="-", lo=0.0)
+    pitch_rate: Optional[float] = option(None, help=_MW, unit="-", lo=0.0)
+    tower_fa_velocity: Optional[float] = option(None, help=_MW, unit="-", lo=0.0)
+    rotor_speed: Optional[float] = option(None, help=_MW, unit="-", lo=0.0)
+    shaft_torsion: Optional[float] = option(None, help=_MW, unit="-", lo=0.0)
+    flap_moment: Optional[float] = option(None, help=_MW + "; Coleman-weighted", unit="-",
+                                          lo=0.0)
+    pitch_ref: Optional[float] = option(None, help="input " + _MW, unit="-", lo=0.0)
+    gen_torque_ref: Optional[float] = option(None, help="input " + _MW, unit="-", lo=0.0)
+
+    def weights(self) -> Any:
+        """The cost weights.
+
+        Returns
+        -------
+        MPCWeights
+            :class:`mpc_wt.MPCWeights` with the set options in place of its defaults.
+        """
+        from mpc_wt.controllers.mpc import MPCWeights
+
+        w = MPCWeights()
+        given = {k: v for k, v in self.to_dict().items() if v is not None}
+        ins = {k: given.pop(k) for k in ("pitch_ref", "gen_torque_ref") if k in given}
+        return MPCWeights(outputs={**w.outputs, **given}, inputs={**w.inputs, **ins},
+                          rate=dict(w.rate), scales=dict(w.scales))
+
+
+@dataclass(frozen=True)
+class MPCOptions(Options):
+    """Madsen et al.'s MPC at 10 Hz (:class:`mpc_wt.MPCSettings` holds the full set)."""
+
+    backend: Optional[str] = option(None, help="QP solver (default DAQP when installed, else "
+                                    "OSQP)", choices=(None, "osqp", "daqp"))
+    formulation: str = option("condensed", help="QP formulation (sparse: OSQP only)",
+                              choices=("condensed", "sparse"))
+    horizon: int = option(15, help="H_p = H_u", lo=1)
+    estimator: Optional[str] = option(None, help="kalman: states and blade winds estimated "
+                                      "from measured signals; none: full-state information",
+                                      choices=(None, "kalman"))
+    scheduled: bool = option(False, help="scheduled over a model family above rated on the "
+                             "estimated wind (or the preview with mpc-lidar)", flag_value=True)
+    weights: MPCWeightOptions = option(MPCWeightOptions(), help="cost weights (gen_power, "
+                                       "flap_moment, rotor_speed, ...)", flag="")
+
+
+_CW = "lidar.CWLidar setting (unset: its default)"
+
+
+@dataclass(frozen=True)
+class LidarOptions(Options):
+    """Settings of the CW LIDAR (:class:`lidar.CWLidar`); unset ones keep its defaults."""
+
+    focus_distance: Optional[float] = option(None, help=_CW, unit="m", lo=0.0, lo_open=True)
+    span_fraction: Optional[float] = option(None, help=_CW, unit="-", lo=0.0, lo_open=True)
+    wavelength: Optional[float] = option(None, help=_CW, unit="m", lo=0.0, lo_open=True)
+    beam_radius: Optional[float] = option(None, help=_CW, unit="m", lo=0.0, lo_open=True)
+    sample_rate: Optional[float] = option(None, help=_CW, unit="Hz", lo=0.0, lo_open=True)
+    noise_std: Optional[float] = option(None, help=_CW, unit="m/s", lo=0.0)
+    misalignment_rad: Optional[float] = option(None, help=_CW, unit="rad")
+    perfect_alignment: Optional[bool] = option(None, help=_CW)
+    los_error: Optional[bool] = option(None, help=_CW)
+    range_weighting: Optional[bool] = option(None, help=_CW)
+    n_range: Optional[int] = option(None, help=_CW, lo=1)
+    evolution: bool = option(True, help="wind evolution between the focus and the rotor "
+                             "(Simley and Pao's coherence, lidar.evolve_field); false: frozen "
+                             "turbulence, Madsen's assumption")
+
+    def given(self) -> dict[str, Any]:
+        """The :class:`lidar.CWLidar` settings that were set.
+
+        Returns
+        -------
+        dict
+            Name -> value of the CWLidar options that are not None (``evolution`` is not one:
+            it acts on the field the LIDAR sees, :meth:`BuildContext.lidar_field`).
+        """
+        return {k: v for k, v in self.to_dict().items() if v is not None and k != "evolution"}
+
+    def lidar(self, ctx: BuildContext) -> tuple[Any, Any]:
+        """The CW LIDAR and the field it measures for a build.
+
+        Parameters
+        ----------
+        ctx : BuildContext
+            The build's turbine and wind.
+
+        Returns
+        -------
+        cw : lidar.CWLidar
+        field : lidar.WindField
+            The case's field, evolved over the focus distance unless ``evolution`` is off.
+
+        Raises
+        ------
+        ValueError
+            A setting CWLidar refuses, prefixed "lidar options:".
+        """
+        import lidar
+
+        try:
+            cw = lidar.CWLidar(ctx.turbine.geometry.tip_radius, **self.given())
+        except (TypeError, ValueError) as err:
+            raise ValueError(f"lidar options: {err}") from err
+        return cw, ctx.lidar_field(cw.focus_distance if self.evolution else 0.0)
+
+
+@dataclass(frozen=True)
+class MPCLidarOptions(MPCOptions):
+    """The MPC with a CW LIDAR's per-blade preview."""
+
+    lidar: LidarOptions = option(LidarOptions(), help="CW LIDAR settings (focus_distance, "
+                                 "noise_std, ...)", flag="")
+
+
+def _mpc_settings(opts: MPCOptions, collective: bool) -> Any:
+    from mpc_wt.controllers.mpc import MPCSettings
+
+    return MPCSettings(horizon=opts.horizon, backend=opts.backend,
+                       formulation=opts.formulation, estimator=opts.estimator,
+                       collective=collective, weights=opts.weights.weights())
+
+
+def _scheduled(ctx: BuildContext, settings: Any, source: str) -> Any:
+    from mpc_wt.controllers.mpc import ScheduledMPC
+
+    turbine, v = ctx.turbine, ctx.scenario.wind_mps
+    lo = float(np.floor(linearize.rated_wind_speed(turbine))) + 1.0
+    winds = np.arange(lo, min(25.0, turbine.operation.cut_out_wind) + 0.5, 1.0)
+    if not winds[0] <= v <= winds[-1]:
+        raise ValueError(f"scheduled MPC covers {winds[0]:g}..{winds[-1]:g} m/s; the wind "
+                         f"{v:g} m/s is outside")
+    fam = linearize.linearize_family(turbine, winds, config=linearize.PlantConfig.madsen())
+    return ScheduledMPC(fam, turbine, settings, wind_source=source, initial_wind_mps=v)
+
+
+def _mpc(collective: bool, with_lidar: bool) -> Any:
+    def build(ctx: BuildContext, opts: MPCOptions) -> Built:
+        from mpc_wt.controllers.mpc import MPC
+
+        settings = _mpc_settings(opts, collective)
+        # the LIDAR's field first: its making is the run's peak of memory, lower before the
+        # MPC's design is held
+        lidar_opts = opts.lidar if with_lidar else None  # type: ignore[attr-defined]
+        instrument = lidar_opts.lidar(ctx) if lidar_opts is not None else None   # (cw, field)
+        if opts.scheduled:
+            if not with_lidar and settings.estimator is None:
+                settings = settings.replace(estimator="kalman")
+            ctl = _scheduled(ctx, settings, "preview" if with_lidar else "estimator")
+            cdt = ctl.controller(ctl.active).dt
+        else:
+            model = linearize.linearize(ctx.turbine, ctx.scenario.wind_mps,
+                                        config=linearize.PlantConfig.madsen())
+            ctl = MPC(model, ctx.turbine, settings)
+            cdt = ctl.dt
+        meta: dict[str, Any] = {"mpc": {
+            "horizon": settings.horizon, "backend": settings.resolved_backend, "dt": cdt,
+            "formulation": settings.formulation, "estimator": str(settings.estimator),
+            "scheduled": bool(opts.scheduled)}}
+        preview = None
+        if lidar_opts is not None and instrument is not None:
+            from mpc_wt.simulation.preview import LidarPreview
+
+            preview = LidarPreview(*instrument, settings.horizon, cdt)
+            meta["lidar"] = {**lidar_opts.given(), "evolution": lidar_opts.evolution}
+        return Built(ctl, cdt, preview, meta)
+    return build
+
+
+_MPC_GROUP = "the MPC controllers"
+register("mpc", MPCOptions, field_components="u", group=_MPC_GROUP,
+         summary="Madsen's Coleman-weighted individual-pitch MPC, disturbance held at the mean"
+         )(_mpc(False, False))
+register("mpc-collective", MPCOptions, field_components="u", group=_MPC_GROUP,
+         summary="the MPC with one collective pitch input")(_mpc(True, False))
+register("mpc-lidar", MPCLidarOptions, field_components="u", group=_MPC_GROUP,
+         summary="the individual-pitch MPC with a CW LIDAR's per-blade preview "
+                 "(range weighting, LOS error and wind evolution on)")(_mpc(False, True))
+
+
+@dataclass(frozen=True)
+class TorqueLawOptions(Options):
+    """The torque-law guard in lulls (:class:`mpc_wt.controllers.supervisor.TorqueLawGuard`)."""
+
+    fine_band_deg: float = option(1.0, help="pitch above fine within which the guard acts",
+                                  unit="deg", lo=0.0, flag="")
+
+
+@register("torque-law", TorqueLawOptions, field_components="u",
+          addon_to=("mpc", "mpc-lidar", "mpc-collective"), default_base="mpc",
+          group=_MPC_GROUP, summary="caps the MPC's torque at the baseline's torque-speed law "
+                                    "at fine pitch below rated speed (mpc+torque-law, "
+                                    "mpc-lidar+torque-law)")
+def _build_torque_law(ctx: BuildContext, opts: TorqueLawOptions, base: Built) -> Built:
+    from mpc_wt.controllers.supervisor import TorqueLawGuard
+
+    ctl = TorqueLawGuard(base.controller, ctx.turbine,
+                         fine_band=math.radians(opts.fine_band_deg))
+    return Built(ctl, base.controller_dt, base.preview,
+                 {**base.meta, "torque_law": opts.to_dict()}, base.power_fraction)
+
+
+# -- LQR + PI observer ------------------------------------------------------------------------
+@dataclass(frozen=True)
+class LQRPIOOptions(Options):
+    """Do et al.'s LQR on PI-observer estimates."""
+
+    observer_q: float = option(1e3, help="PI observer q of Q_obs = diag(I, q I)", unit="-",
+                               lo=0.0, lo_open=True, flag="")
+    w_rotor_speed: Optional[float] = option(None, help="LQR weight on the rotor speed (scale "
+                                            "0.05 rad/s; default 5 in region III, 0 in II)",
+                                            unit="-", lo=0.0)
+    w_tower_fa_velocity: Optional[float] = option(None, help="LQR weight on the tower-top "
+                                                  "fore-aft velocity (scale 0.1 m/s; default 1)",
+                                                  unit="-", lo=0.0)
+    w_flap_rate: Optional[float] = option(None, help="LQR weight on each blade's flap tip rate "
+                                          "(scale 1 m/s; default 0 in region III, 0.2 in II)",
+                                          unit="-", lo=0.0)
+    w_pitch: float = option(1.0, help="LQR input weight on each blade's pitch (scale 1 deg)",
+                            unit="-", lo=0.0, lo_open=True)
+    region2_torque: str = option("baseline", help="region-II torque: the baseline's schedule "
+                                 "(1.5/2/2.5 on filtered speed, as the PI it is compared with) "
+                                 "or Do's bare K_opt Omega_g^2 on raw speed",
+                                 choices=("baseline", "k_opt"))
+
+    def lqr_weights(self, region: str) -> tuple[dict[str, float], dict[str, float]]:
+        """The state weights and input weights of the design in ``region``: the region's
+        defaults (:data:`mpc_wt.controllers.lqr.REGION3_WEIGHTS`, ``REGION2_WEIGHTS``) with the
+        options that are set in their place.
+
+        Parameters
+        ----------
+        region : {"II", "III"}
+
+        Returns
+        -------
+        state_weights, input_weights : dict of str to float
+            For :func:`mpc_wt.controllers.lqr.design_lqr` (zero weights left out).
+        """
+        from mpc_wt.controllers.lqr import REGION2_WEIGHTS, REGION3_WEIGHTS
+
+        w = dict(REGION3_WEIGHTS if region == "III" else REGION2_WEIGHTS)
+        for name, val in (("rotor_speed", self.w_rotor_speed),
+                          ("tower_fa_velocity", self.w_tower_fa_velocity)):
+            if val is not None:
+                w[name] = val
+        if self.w_flap_rate is not None:
+            w.update({f"flap_rate_{i}": self.w_flap_rate for i in (1, 2, 3)})
+        return ({k: v for k, v in w.items() if v > 0},
+                {f"pitch_ref_{i}": self.w_pitch for i in (1, 2, 3)})
+
+
+@register("lqr-pio", LQRPIOOptions, field_components="u", design=_design_lqr,
+          design_name="lqr",
+          summary="Do et al.'s LQR with a PI observer at the mean wind (region II or III)")
+def _build_lqr_pio(ctx: BuildContext, opts: LQRPIOOptions) -> Built:
+    from mpc_wt.controllers.baseline import BaselineController, tune_baseline
+    from mpc_wt.controllers.lqr import (
+        REGION2_SCALES,
+        REGION3_SCALES,
+        LQRPIOController,
+        design_lqr,
+        design_pi_observer,
+    )
+
+    turbine, v = ctx.turbine, ctx.scenario.wind_mps
+    model = linearize.linearize(turbine, v, config=linearize.PlantConfig.do())
+    region = "II" if v < linearize.rated_wind_speed(turbine) else "III"
+    w, iw = opts.lqr_weights(region)
+    lq = design_lqr(model, state_weights=w, input_weights=iw,
+                    scales={**REGION2_SCALES, **REGION3_SCALES})
+    ctl = LQRPIOController(model, turbine, lq, design_pi_observer(model, q=opts.observer_q),
+                           region=region,
+                           k_opt=tune_baseline(turbine).k_opt if region == "II" else None,
+                           feedforward=region == "III",
+                           torque_law=BaselineController(turbine)
+                           if region == "II" and opts.region2_torque == "baseline" else None)
+    return Built(ctl, meta={"lqr": {"weights": lq.weights, "observer_q": opts.observer_q,
+                                    "region": region}})
+
+
+# -- Takagi-Sugeno ------------------------------------------------------------------------------
+@dataclass(frozen=True)
+class TSOptions(Options):
+    """Clemens et al.'s TS controller and wind observer, LMI-designed on the default grid."""
+
+    apc_frequency: Optional[float] = option(None, help="sinusoidal power reduction of eq 11 "
+                                            "at this f_r", unit="Hz", lo=0.0, hi=5.0)
+    apc_amplitude: float = option(0.375, help="amplitude of Delta P (fraction of rated)",
+                                  unit="-", lo=0.0, hi=1.0)
+    apc_offset: float = option(0.375, help="mean of Delta P", unit="-", lo=0.0, hi=1.0)
+    decay_rate: float = option(0.2, help="controller decay rate", unit="1/s", lo=0.0,
+                               lo_open=True, flag="")
+    observer_decay_rate: float = option(1.0, help="observer decay rate", unit="1/s", lo=0.0,
+                                        lo_open=True, flag="")
+
+
+@register("ts", TSOptions, field_components="u", design=_design_ts,
+          summary="Clemens et al.'s Takagi-Sugeno controller and wind observer (LMI gains)")
+def _build_ts(ctx: BuildContext, opts: TSOptions) -> Built:
+    from mpc_wt.controllers.apc import apc_reference
+    from mpc_wt.controllers.takagi_sugeno import (
+        TSController,
+        build_ts_model,
+        design_ts_controller,
+        design_ts_observer,
+    )
+
+    def make() -> tuple[Any, Any, Any]:
+        ts0 = build_ts_model(ctx.turbine)
+        return (ts0, design_ts_controller(ts0, decay_rate=opts.decay_rate),
+                design_ts_observer(ts0, decay_rate=opts.observer_decay_rate))
+
+    ts, c, o = ctx.cache.get(ctx.turbine, ("ts", opts.decay_rate, opts.observer_decay_rate),
+                             make)
+    dp = None if opts.apc_frequency is None else apc_reference(
+        opts.apc_frequency, amplitude=opts.apc_amplitude, offset=opts.apc_offset)
+    w0 = float(np.clip(ctx.scenario.wind_mps, ts.wind_grid[0], ts.wind_grid[-1]))
+    ctl = TSController(ts, c, o, ctx.turbine, initial_wind_mps=w0, power_reduction=dp)
+    return Built(ctl, meta={"ts": {"vertices": ts.n_vertices, "decay_rate": c.decay_rate,
+                                   "observer_decay_rate": o.decay_rate,
+                                   "apc_frequency_Hz": opts.apc_frequency}})
+
+
+# -- active power control -----------------------------------------------------------------
+@dataclass(frozen=True)
+class APCOptions(Options):
+    """Sinusoidal power reduction of Clemens et al. eq 11."""
+
+    apc_frequency: float = option(REQUIRED, help="F [Hz] (0: constant reduction at the offset)",
+                                  unit="Hz", lo=0.0, hi=5.0)
+    apc_amplitude: float = option(0.375, help="amplitude of Delta P (fraction of rated)",
+                                  unit="-", lo=0.0, hi=1.0)
+    apc_offset: float = option(0.375, help="mean of Delta P (0.375: Delta P in [0, 0.75])",
+                               unit="-", lo=0.0, hi=1.0)
+
+
+def _apc_trim(turbine: linearize.Turbine, sc: Scenario, opts: APCOptions
+              ) -> linearize.OperatingPoint:
+    from mpc_wt.controllers.apc import apc_reference
+
+    dp = apc_reference(opts.apc_frequency, amplitude=opts.apc_amplitude, offset=opts.apc_offset)
+    rated = turbine.operation.rated_power
+    p_peak = rated * (1.0 - opts.apc_offset + opts.apc_amplitude)
+    try:    # the reference peaks at P_r (1 - offset + amplitude): the mean wind must give it
+        linearize.trim(turbine, sc.wind_mps, min(p_peak, rated))
+    except linearize.TrimError as err:
+        raise ValueError(f"apc: the power reference peaks at {p_peak:g} W, above the power "
+                         f"available at the mean wind {sc.wind_mps:g} m/s ({err})") from err
+    return linearize.trim(turbine, sc.wind_mps, rated * (1.0 - dp(0.0)))
+
+
+@register("apc", APCOptions, field_components="u", operating_point=_apc_trim,
+          summary="the baseline following P_r (1 - Delta P(t)), PI scheduled on the reference")
+def _build_apc(ctx: BuildContext, opts: APCOptions) -> Built:
+    from mpc_wt.controllers.apc import apc_reference
+    from mpc_wt.controllers.baseline import BaselineController, tune_baseline_schedule
+
+    dp = apc_reference(opts.apc_frequency, amplitude=opts.apc_amplitude, offset=opts.apc_offset)
+    rated = ctx.turbine.operation.rated_power
+    sched = tune_baseline_schedule(ctx.turbine)
+    ctl = BaselineController(ctx.turbine, gain_schedule=sched,
+                             power_reference=lambda t: rated * (1.0 - dp(t)))
+    return Built(ctl, meta={"apc": {"frequency_Hz": opts.apc_frequency,
+                                    "amplitude": opts.apc_amplitude, "offset": opts.apc_offset,
+                                    "schedule_fractions": [g.power_fraction for g in sched]}})
+
+
+# -- Bladed-style libraries: ROSCO and any DISCON ---------------------------------------------
+@dataclass(frozen=True)
+class DisconOptions(Options):
+    """Any Bladed-style controller library (``DISCON``) in the loop (:mod:`mpc_wt.controllers.discon`)."""
+
+    discon_library: str = option(REQUIRED, help="the shared library exporting DISCON")
+    discon_in: str = option(REQUIRED, help="its input file (accINFILE, e.g. DISCON.IN)")
+    pitch_control: str = option("individual", help="avrSWAP(28): read records 42-44 "
+                                "(individual) or 45 (collective)",
+                                choices=("individual", "collective"))
+    discon_dt: float = option(1.0 / 80.0, help="communication interval, a multiple of the "
+                              "plant step", unit="s", lo=0.0, lo_open=True, hi=1.0)
+
+
+@dataclass(frozen=True)
+class RoscoOptions(Options):
+    """ROSCO, the rosco package's compiled controller, in the loop."""
+
+    discon_in: Optional[str] = option(None, help="ROSCO input file; 'shipped' for the DISCON.IN "
+                                      "ROSCO ships for the turbine (nrel5mw, iea15mw); default: "
+                                      "one exported from our baseline design")
+    power_fraction: float = option(1.0, help="with the exported design: derate to this "
+                                   "fraction of rated power", unit="-", lo=0.0, lo_open=True,
+                                   hi=1.0, flag="--rosco-power-fraction")
+    pitch_control: str = option("individual", help="avrSWAP(28): read records 42-44 "
+                                "(individual) or 45 (collective)",
+                                choices=("individual", "collective"))
+    discon_dt: float = option(1.0 / 80.0, help="communication interval, a multiple of the "
+                              "plant step", unit="s", lo=0.0, lo_open=True, hi=1.0)
+
+
+def _discon_built(ctx: BuildContext, library: Any, discon_in: Any, opts: Any,
+                  kind: str, power_fraction: float = 1.0, **meta: Any) -> Built:
+    from mpc_wt.controllers.discon import DisconController
+
+    ctl = DisconController(library, discon_in, ctx.turbine, dt=opts.discon_dt,
+                           pitch_control=opts.pitch_control)
+    return Built(ctl, controller_dt=opts.discon_dt,
+                 meta={kind: {"library": str(ctl.library), "discon_in": str(ctl.discon_in),
+                              "pitch_control": opts.pitch_control, "dt": opts.discon_dt,
+                              **meta}},
+                 power_fraction=power_fraction)
+
+
+@register("discon", DisconOptions, field_components="u",
+          summary="any Bladed-style controller library (DISCON) with its input file")
+def _build_discon(ctx: BuildContext, opts: DisconOptions) -> Built:
+    return _discon_built(ctx, opts.discon_library, opts.discon_in, opts, "discon")
+
+
+_ROSCO_FILES = {"NREL 5-MW": "NREL-5MW", "IEA-15-240-RWT": "IEA-15-240-RWT"}
+
+
+def _rosco_operating_point(turbine: linearize.Turbine, sc: Scenario, opts: RoscoOptions
+                           ) -> linearize.OperatingPoint:
+    if opts.discon_in is None and opts.power_fraction < 1.0:
+        return _derated_trim(turbine, sc, opts)     # type: ignore[arg-type]
+    return linearize.trim(turbine, sc.wind_mps)
+
+
+@register("rosco", RoscoOptions, field_components="u", operating_point=_rosco_operating_point,
+          summary="ROSCO (the rosco package's libdiscon) with a DISCON.IN exported from our "
+                  "baseline, ROSCO's own ('shipped') or any file")
+def _build_rosco(ctx: BuildContext, opts: RoscoOptions) -> Built:
+    from mpc_wt.controllers.discon import rosco_discon, rosco_library
+
+    discon_in = opts.discon_in
+    if discon_in == "shipped":
+        name = next((v for k, v in _ROSCO_FILES.items() if ctx.turbine.name.startswith(k)),
+                    None)
+        if name is None:
+            raise ValueError(f"rosco: no DISCON.IN shipped for turbine {ctx.turbine.name!r}; "
+                             f"give discon_in (--discon-in FILE)")
+        discon_in = str(rosco_discon(name))
+    elif discon_in is None:
+        discon_in = ctx.cache.get(ctx.turbine, ("rosco-export", opts.power_fraction),
+                                  lambda: _export_rosco(ctx.turbine, opts.power_fraction))
+    ours = opts.discon_in is None
+    return _discon_built(ctx, rosco_library(), discon_in, opts, "rosco",
+                         power_fraction=opts.power_fraction if ours else 1.0,
+                         design=("ours" if ours else
+                                 "shipped" if opts.discon_in == "shipped" else "file"))
+
+
+def _export_rosco(turbine: linearize.Turbine, power_fraction: float) -> str:
+    """Our baseline design as a ROSCO DISCON.IN in a folder kept for the process."""
+    import tempfile
+
+    from mpc_wt.controllers.baseline import tune_baseline
+    from mpc_wt.io.gain_tables import baseline_table
+    from mpc_wt.io.rosco import write_rosco_discon
+
+    out = tempfile.mkdtemp(prefix="mpcwt_rosco_export_")
+    doc = baseline_table(turbine, tune_baseline(turbine, power_fraction=power_fraction))
+    return str(write_rosco_discon(turbine, doc, out)[0])
+
+
+# -- LIDAR collective pitch feedforward -------------------------------------------------------
+@dataclass(frozen=True)
+class LidarFFOptions(Options):
+    """Collective pitch feedforward from the CW LIDAR (:class:`mpc_wt.controllers.lidar_feedforward.LidarFeedforward`)."""
+
+    lidar: LidarOptions = option(LidarOptions(), help="CW LIDAR settings (focus_distance, "
+                                 "range_weighting, los_error, ...)", flag="")
+    filter_corner_hz: Optional[float] = option(None, help="low-pass corner of the wind estimate "
+                                               "(default: where the coherence of the LIDAR's "
+                                               "and the rotor's effective wind falls to 0.5 on "
+                                               "the run's field, raised if its delay would not "
+                                               "fit the preview)", unit="Hz",
+                                               lo=0.0, lo_open=True, flag="--ff-corner-hz")
+    lead_time: Optional[float] = option(None, help="lead of the pitch over the wind's arrival "
+                                        "(default: actuator time constant + the filter's "
+                                        "delay)", unit="s", lo=0.0, flag="--ff-lead-time")
+    filter_order: int = option(2, help="order of the low-pass (2: damping 0.7)",
+                               choices=(1, 2), flag="--ff-filter-order")
+
+
+@register("lidar-ff", LidarFFOptions, addon_to=("baseline", "derate"), default_base="baseline",
+          field_components="u", group="the lidar feedforward",
+          summary="collective pitch feedforward from the CW LIDAR on a baseline "
+                  "(baseline+lidar-ff, derate80+lidar-ff)")
+def _build_lidar_ff(ctx: BuildContext, opts: LidarFFOptions, base: Built) -> Built:
+    from mpc_wt.controllers.lidar_feedforward import (
+        LidarFeedforward,
+        corner_within_preview,
+        rews_coherence_corner,
+    )
+
+    cw, seen = opts.lidar.lidar(ctx)
+    v = ctx.scenario.wind_mps
+    coherence_corner, raised = None, False
+    if opts.filter_corner_hz is None:
+        # keyed on the whole scenario: the estimate depends on the field's length too
+        key = (*sorted(opts.lidar.given().items()), ("evolution", opts.lidar.evolution))
+        corner = coherence_corner = ctx.cache.get(
+            ctx.turbine, ("lidar-ff-corner", ctx.scenario, key),
+            lambda: rews_coherence_corner(cw, ctx.field, ctx.turbine, v, seen=seen))
+        if opts.lead_time is None:
+            corner, raised = corner_within_preview(
+                corner, cw.preview_time(v), ctx.turbine.pitch_actuator.time_constant,
+                opts.filter_order)
+    else:
+        corner = 2.0 * math.pi * opts.filter_corner_hz
+    frac = base.power_fraction
+    ctl = LidarFeedforward(base.controller, cw, seen, ctx.turbine, mean_wind_mps=v,
+                           corner_rad_s=corner, lead_s=opts.lead_time,
+                           filter_order=opts.filter_order,
+                           power_W=None if frac == 1.0
+                           else frac * ctx.turbine.operation.rated_power)
+    meta = {"corner_rad_s": corner, "corner_raised": raised,
+            **({} if coherence_corner is None else {"coherence_corner_rad_s": coherence_corner}),
+            "lead_s": ctl.lead, "preview_time_s": ctl.preview_time,
+            "filter_order": opts.filter_order,
+            "focus_distance_m": cw.focus_distance, "evolution": opts.lidar.evolution}
+    return Built(ctl, base.controller_dt, base.preview, {**base.meta, "lidar_ff": meta},
+                 base.power_fraction)
+

@@ -1,0 +1,161 @@
+"""One closed-loop run from a controller name: trim, build, wind, simulate (STYLE rule 12)."""
+from __future__ import annotations
+
+from typing import Any, Mapping, Sequence
+
+import linearize
+from mpc_wt.registry.context import DEFAULT_CACHE, BuildContext, Built, DesignCache
+from mpc_wt.registry.options import Options
+from mpc_wt.registry.registry import API_NAMING, Naming, Selection, resolve
+from mpc_wt.simulation.loop import simulate_closed_loop
+from mpc_wt.simulation.results import ClosedLoopResult
+from mpc_wt.simulation.scenario import Scenario, make_wind
+
+__all__ = ["run_controller", "build_controller"]
+
+
+def _operating_point(turbine: linearize.Turbine, sel: Selection, opts: Sequence[Options],
+                     scenario: Scenario) -> linearize.OperatingPoint:
+    if sel.base.operating_point is not None:
+        return sel.base.operating_point(turbine, scenario, opts[0])
+    return linearize.trim(turbine, scenario.wind_mps)
+
+
+_CONDITION_KEYS = ("condition", "iec_class", "sign", "event_at")
+
+
+def _condition(raw: Mapping[str, Any] | None) -> dict[str, Any]:
+    if raw is None:
+        return {}
+    extra = set(raw) - set(_CONDITION_KEYS)
+    if extra:
+        raise ValueError(f"condition: unknown key {sorted(extra)[0]!r}; allowed: "
+                         f"{list(_CONDITION_KEYS)}")
+    return dict(raw)
+
+
+def build_controller(turbine: linearize.Turbine, controller: str, scenario: Scenario,
+                     options: Mapping[str, Any] | None = None, *,
+                     cache: DesignCache = DEFAULT_CACHE, naming: Naming = API_NAMING
+                     ) -> tuple[Built, linearize.OperatingPoint, Any]:
+    """Resolve, check, trim and build a controller for one scenario (no simulation).
+
+    Parameters
+    ----------
+    turbine : Turbine
+        The turbine.
+    controller : str
+        A registered name (``mpc_wt.controllers.kinds()``), with a pattern or add-ons
+        (``derate80+ibc``).
+    scenario : Scenario
+        The load case.
+    options : mapping, optional
+        Flat option name -> value, split over the base and its add-ons.
+    cache : DesignCache
+        For designs that cost seconds.
+    naming : Naming
+        How error messages name options (keys, or command-line flags).
+
+    Returns
+    -------
+    built : Built
+        Controller, its period, LIDAR preview and design metadata.
+    op : OperatingPoint
+        The trim point the run starts from.
+    wind : SteadyWind or GridWind
+        The plant's wind.
+
+    Raises
+    ------
+    ValueError
+        An unknown name (listing the kinds); :class:`~mpc_wt.errors.OptionsError` for options.
+    """
+    sel = resolve(controller)
+    opts = sel.options(options, naming)
+    op = _operating_point(turbine, sel, opts, scenario)
+    needs = set().union(*(k.field_components for k in (sel.base, *sel.addons)))
+    wind, field = make_wind(turbine, scenario, "".join(c for c in "uvw" if c in needs))
+    ctx = BuildContext(turbine=turbine, params=linearize.plant_params(turbine), op=op,
+                       scenario=scenario, field=field, cache=cache)
+    built = sel.base.build(ctx, opts[0])
+    for kind, o in zip(sel.addons, opts[1:]):
+        built = kind.build(ctx, o, built)
+    return built, op, wind
+
+
+def run_controller(turbine: linearize.Turbine, controller: str, wind_mps: float,
+                   turbulence: str | float = "A", seed: int = 1, duration: float = 600.0,
+                   progress: bool = False, shear_exponent: float = 0.2,
+                   options: Mapping[str, Any] | None = None, *,
+                   cache: DesignCache = DEFAULT_CACHE,
+                   naming: Naming = API_NAMING,
+                   condition: Mapping[str, Any] | None = None,
+                   supervisor: Mapping[str, Any] | None = None) -> ClosedLoopResult:
+    """Trim, build the controller, generate the wind and simulate.
+
+    Parameters
+    ----------
+    turbine : Turbine
+        The turbine (:func:`linearize.load_turbine`).
+    controller : str
+        A registered kind (``mpc_wt.controllers.kinds()`` lists them with their options):
+        ``baseline``, ``baseline-ct``, ``derateNN``, ``apc``, ``ibc``, ``coleman-ipc``,
+        ``derateNN+ibc``, ``mpc``, ``mpc-collective``, ``mpc-lidar``, ``lqr-pio``, ``ts``, or a
+        user-registered one.
+    wind_mps : float
+        Mean hub-height wind [m/s].
+    turbulence : str or float
+        IEC class "A", "B", "C", "steady", or an intensity [-].
+    seed : int
+        Seed of the turbulent field.
+    duration : float
+        [s]
+    progress : bool
+        Show a progress bar.
+    shear_exponent : float
+        Power-law shear [-].
+    options : mapping, optional
+        The kind's options by name, e.g. ``{"apc_frequency": 0.1}`` for ``apc`` or
+        ``{"horizon": 10, "lidar": {"focus_distance": 80}}`` for ``mpc-lidar``.
+    cache : DesignCache
+        For designs that cost seconds (the TS LMIs), keyed on the turbine's content.
+    naming : Naming
+        How error messages name options.
+    condition : mapping, optional
+        An IEC 61400-1 wind condition instead of normal turbulence: ``condition`` ("etm",
+        "eog", "edc", "ecd", "ews-v", "ews-h", "nwp"), ``iec_class`` ("I"), ``sign`` (1),
+        ``event_at`` (when the transient starts [s]); ``turbulence`` is then the category
+        (:class:`~mpc_wt.simulation.scenario.Scenario`).
+    supervisor : mapping, optional
+        Runs the controller under :class:`mpc_wt.controllers.supervisor.Supervisor` with these settings
+        (``overspeed``, ``shutdown_at``, ``grid_loss_at`` [s], ``pitch_rate``,
+        ``torque_ramp_s``).
+
+    Returns
+    -------
+    ClosedLoopResult
+        With ``meta["controller"]`` and the case and design data in ``meta``.
+
+    Raises
+    ------
+    ValueError
+        Unknown controller or bad options (naming the option and what is allowed), or a wind at
+        which the kind cannot operate.
+    SimulationDivergedError
+        If the run leaves the physical envelope (``.partial`` keeps what was simulated).
+    """
+    scenario = Scenario(wind_mps, turbulence, seed, duration, shear_exponent,
+                        **_condition(condition))
+    built, op, wind = build_controller(turbine, controller, scenario, options, cache=cache,
+                                       naming=naming)
+    meta = {"controller": controller, **scenario.meta(), "turbine": turbine.name,
+            **built.meta}
+    ctl = built.controller
+    if supervisor is not None:
+        from mpc_wt.controllers.supervisor import Supervisor
+
+        ctl = Supervisor(ctl, turbine, **dict(supervisor))
+        meta["supervisor"] = {k: v for k, v in dict(supervisor).items() if v is not None}
+    return simulate_closed_loop(linearize.plant_params(turbine), ctl, wind,
+                                duration, x0=op.x, u0=op.u, controller_dt=built.controller_dt,
+                                preview=built.preview, progress=progress, meta=meta)

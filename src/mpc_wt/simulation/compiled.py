@@ -1,0 +1,120 @@
+"""The baseline's closed loop compiled with the plant.
+
+A closed loop in Python pays some 30 µs a plant step around an ~80 µs plant step: the
+measurement dict, the controller's call, the command checks, the signals. For the baseline PI
+and torque law at the plant's rate that is more than the law itself. This module runs the whole
+loop (RK4 step, the law, the command checks, the generator's torque-rate limit, the signals and
+the envelope check) in one compiled call per block of steps.
+
+It is the same loop as :func:`mpc_wt.simulation.loop.simulate_closed_loop`'s Python path, operation for
+operation: :class:`~mpc_wt.controllers.baseline.BaselineController`'s ``step`` (DISCON form: the speed
+low-pass, the PI on the filtered speed error with the gain schedule GK = 1 / (1 + theta /
+theta_K) and its anti-windup, the pitch-rate limit, the torque law of regions 1.5, 2, 2.5 and 3
+and its rate limit), in the same floating-point order, so the two paths agree to rounding (the
+test compares them over turbulent runs in regions 2 and 3). It applies only where the law is
+exactly that: no power reference, gain schedule or add-on feedforward
+(:meth:`~mpc_wt.controllers.baseline.BaselineController.compiled_law` says None otherwise), and no LIDAR.
+"""
+from __future__ import annotations
+
+import hashlib
+import logging
+import math
+from pathlib import Path
+from typing import Any
+
+import numba as nb
+import numpy as np
+
+import linearize
+from linearize.plant import step_kernel
+from mpc_wt.controllers.baseline_law import law
+
+__all__ = ['run_steps']
+
+log = logging.getLogger(__name__)
+
+
+_JIT = dict(cache=True, error_model="numpy")
+
+
+@nb.njit(**_JIT)
+def _loop(k0, k1, ratio, h, pk, kind, wpar, grid, hint, dphi, lim, xs, us, zs, u, held, st,
+          par, sigs, act, counts):  # pragma: no cover - compiled
+    """Plant steps k0..k1-1 of the closed loop (simulate._run's order). ``u`` holds the
+    applied inputs, ``held`` the commanded torque, ``act`` the torque step per plant step and
+    the actuator ranges (pitch lo, hi, torque lo, hi), ``counts`` the commands out of range
+    and the first step with one. Returns (steps done, -1 | the state leaving the envelope |
+    -2 for a non-finite generator speed | -3 for a non-finite command)."""
+    cmd = np.empty(4)
+    for k in range(k0, k1):
+        t = k * h
+        us[k] = u
+        bad = step_kernel(t, xs[k], u, h, pk, kind, wpar, grid, hint, dphi, lim, xs[k + 1],
+                          zs[k])
+        if k % ratio == 0:
+            if law(zs[k], st, par, cmd, sigs[k]) != 0:
+                return k, -2
+            if not (math.isfinite(cmd[0]) and math.isfinite(cmd[3])):
+                return k, -3
+            lo, hi = min(min(cmd[0], cmd[1]), cmd[2]), max(max(cmd[0], cmd[1]), cmd[2])
+            if not (act[1] <= lo and hi <= act[2] and act[3] <= cmd[3] <= act[4]):
+                if counts[0] == 0:
+                    counts[1] = k
+                counts[0] += 1
+            u[0], u[1], u[2] = cmd[0], cmd[1], cmd[2]
+            held[0] = cmd[3]
+        else:
+            sigs[k] = sigs[k - 1]
+        u[3] += min(max(held[0] - u[3], -act[0]), act[0])
+        if bad >= 0:
+            return k + 1, bad
+    return k1, -1
+
+
+def _tie_cache_to_sources(dispatcher: Any, paths: tuple[str, ...]) -> None:
+    """numba keys a kernel's disk cache on its own file's source only; :func:`_loop` compiles
+    the plant's kernels into itself, so their sources enter the key too: an edit of
+    linearize's plant or BEM recompiles the loop instead of loading a stale one. Through
+    numba's cache object (its attributes as of numba 0.68); without them, numba's own key
+    and a debug log."""
+    try:
+        cache_file = dispatcher._cache._cache_file
+        h = hashlib.sha256(repr(cache_file._source_stamp).encode())
+        for path in paths:
+            h.update(Path(path).read_bytes())
+        cache_file._source_stamp = h.hexdigest()
+    except (AttributeError, OSError) as err:      # pragma: no cover - another numba
+        log.debug("compiled loop's cache keyed on its own source only: %s", err)
+
+
+_tie_cache_to_sources(_loop, (linearize.plant.__file__, linearize.bem.__file__))
+
+
+def run_steps(k0: int, k1: int, ratio: int, stepper: Any, arrays: tuple[np.ndarray, ...]
+              ) -> tuple[int, int]:
+    """Run plant steps ``k0`` to ``k1 - 1`` of a compiled closed loop.
+
+    Parameters
+    ----------
+    k0, k1 : int
+        The block of steps.
+    ratio : int
+        Plant steps per controller step.
+    stepper : linearize.PlantStepper
+        The plant and its BEM warm start (advanced in place).
+    arrays : tuple of ndarray
+        (xs, us, zs, u, held, state, params, signals, actuator, counts), see :func:`_loop`;
+        written in place.
+
+    Returns
+    -------
+    done : int
+        Steps done (k1, or the step after a divergence).
+    flag : int
+        -1, the index of the state that left its envelope, -2 for a non-finite generator
+        speed or -3 for a non-finite command (both at step ``done``).
+    """
+    h, pk, kind, wpar, grid, hint, dphi, lim = stepper.kernel_args()
+    done, flag = _loop(k0, k1, ratio, h, pk, kind, wpar, grid, hint, dphi, lim, *arrays)
+    return int(done), int(flag)

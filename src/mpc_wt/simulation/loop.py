@@ -1,0 +1,356 @@
+"""Closed-loop simulation: plant + wind + controller, with results that keep everything.
+
+The plant (:mod:`linearize`) is integrated with fixed-step RK4 at its rate (default 80 Hz,
+:class:`linearize.PlantStepper`); the controller runs at its own rate and its commands are held
+between its steps (zero-order hold). A controller is any object with ``reset()`` and
+``step(t, measurements) -> (pitch_ref (3,), gen_torque_ref)``; it may expose a dict ``signals``
+of internal signals, recorded every step.
+
+Measurements given to the controller: ``t``, ``gen_speed``, ``rotor_speed``, ``pitch`` (3,),
+``flap_moment`` (3,), ``edge_moment`` (3,), ``tower_fa_acceleration``,
+``tower_ss_acceleration``, ``azimuth``, ``gen_power``, ``gen_torque`` (applied),
+``aero_power``, ``lss_torque``, ``thrust``, ``tilt_moment``, ``yaw_moment``,
+``hub_wind_speed`` (the free wind at the hub, as a nacelle anemometer would see it without the
+rotor: OpenFAST's ``HorWindV``); ``state``, the full plant state
+(:data:`linearize.STATE_NAMES`), for full-state-information designs (Madsen's MPC); and
+``preview`` when a LIDAR preview is attached. A controller with a ``finalize()`` method gets
+it called once after the run (also after a failed one): a Bladed-style library's last call.
+A controller whose ``grid_connected`` attribute turns False (a grid loss,
+:class:`mpc_wt.controllers.supervisor.Supervisor`) gets zero generator torque from the next plant step on,
+without the torque-rate limit.
+"""
+from __future__ import annotations
+
+import logging
+import math
+from typing import Any
+
+import numpy as np
+from tqdm import tqdm
+
+import linearize
+from mpc_wt._version import __version__
+from mpc_wt.errors import ControllerLibraryError, SimulationDivergedError
+from mpc_wt.simulation.preview import LidarPreview
+from mpc_wt.simulation.results import ClosedLoopResult
+
+__all__ = ['simulate_closed_loop']
+
+log = logging.getLogger(__name__)
+
+
+_Z = {n: i for i, n in enumerate(linearize.OUTPUT_NAMES)}
+
+
+_IX_ROTOR = linearize.STATE_NAMES.index("rotor_speed")
+
+
+_IX_AZ = linearize.STATE_NAMES.index("azimuth")
+
+
+_IDX = tuple(_Z[n] for n in (
+    "gen_speed", "rotor_speed", "tower_fa_acceleration", "tower_ss_acceleration", "azimuth",
+    "gen_power", "gen_torque", "aero_power", "lss_torque", "thrust", "tilt_moment",
+    "yaw_moment"))
+
+
+def _measurements(t: float, x: np.ndarray, z: np.ndarray) -> dict[str, Any]:
+    # the scalars as Python floats through one tolist() (indexing the array once per signal
+    # costs more than the whole conversion)
+    v = z.tolist()
+    gs, rs, fa, ss, az, gp, gt, ap, lss, th, tm, ym = _IDX
+    return {"t": t, "gen_speed": v[gs], "rotor_speed": v[rs], "pitch": z[1:4].copy(),
+            "flap_moment": z[10:13].copy(), "edge_moment": z[13:16].copy(),
+            "tower_fa_acceleration": v[fa], "tower_ss_acceleration": v[ss], "azimuth": v[az],
+            "gen_power": v[gp], "gen_torque": v[gt], "aero_power": v[ap], "lss_torque": v[lss],
+            "thrust": v[th], "tilt_moment": v[tm], "yaw_moment": v[ym], "state": x.copy()}
+
+
+def _hub_wind(wind: Any, hub_height: float) -> Any:
+    """t -> free wind speed at the hub [m/s] (the grid point nearest the hub, linear in t).
+
+    A uniform time grid (every generated or ``.bts`` field) is read by index, O(1) a call;
+    others by a binary search. The series is copied once, contiguous: ``np.interp`` on a strided
+    column would copy the whole series at every call."""
+    if isinstance(wind, linearize.GridWind):
+        j = int(np.argmin(np.abs(wind.y)))
+        k = int(np.argmin(np.abs(wind.z - hub_height)))
+        series = np.ascontiguousarray(wind.u[:, j, k], dtype=float)
+        tt = np.ascontiguousarray(wind.t, dtype=float)
+        step = (tt[-1] - tt[0]) / (tt.size - 1) if tt.size > 1 else 0.0
+        if step > 0 and np.allclose(np.diff(tt), step, rtol=1e-9, atol=1e-12):
+            t0, last, vals = float(tt[0]), tt.size - 1, series.tolist()
+
+            def uniform(t: float) -> float:
+                s = min(max((t - t0) / step, 0.0), float(last))
+                i = min(int(s), last - 1)
+                a = s - i
+                return (1.0 - a) * vals[i] + a * vals[i + 1]
+            return uniform
+        return lambda t: float(np.interp(t, tt, series))
+    speed = float(getattr(wind, "speed", math.nan))
+    return lambda t: speed
+
+
+class _Loop:
+    """The state of one closed-loop run: the recorded arrays, the held commands and the
+    controller's signals. Private: :func:`simulate_closed_loop` is the interface."""
+
+    def __init__(self, params: linearize.PlantParams, controller: Any, n: int, dt: float,
+                 x0: np.ndarray, u0: np.ndarray, preview: Any, hub_wind: Any = None) -> None:
+        self.params, self.controller, self.preview = params, controller, preview
+        self.hub_wind = hub_wind
+        self.n, self.dt = n, dt
+        self.xs, self.us = np.empty((n + 1, len(linearize.STATE_NAMES))), np.empty((n + 1, 4))
+        self.zs = np.empty((n + 1, 31))
+        self.sig: dict[str, list[float]] = {}
+        self.x = np.asarray(x0, float).copy()
+        self.u = np.asarray(u0, float).copy()
+        self.u_tq = float(self.u[3])
+        self.clipped = 0
+        self.grid_lost = False
+        self.k_done = 0
+        self.rate = params.turbine.generator.max_torque_rate * dt
+        pa, gen = params.turbine.pitch_actuator, params.turbine.generator
+        self._p_lo, self._p_hi = pa.min_pitch_rad - 1e-9, pa.max_pitch_rad + 1e-9
+        self._q_lo, self._q_hi = gen.min_torque - 1e-6, gen.max_torque + 1e-6
+
+    def command(self, t: float, z: np.ndarray) -> None:
+        """Ask the controller for new commands and hold them."""
+        meas = _measurements(t, self.x, z)
+        if self.hub_wind is not None:
+            meas["hub_wind_speed"] = self.hub_wind(t)
+        if self.preview is not None:
+            meas["preview"] = self.preview(t, float(self.x[_IX_AZ]), float(self.x[_IX_ROTOR]))
+        pitch, tq = self.controller.step(t, meas)
+        pitch = np.asarray(pitch, float)
+        fin = math.isfinite
+        if (pitch.shape != (3,) or not fin(tq)
+                or not (fin(pitch[0]) and fin(pitch[1]) and fin(pitch[2]))):
+            raise ValueError(f"controller returned pitch {pitch!r}, torque {tq!r} at "
+                             f"t = {t:g} s: need 3 finite pitch angles [rad] and a "
+                             f"finite torque [N m]")
+        p1, p2, p3 = pitch.tolist()
+        lo, hi = min(p1, p2, p3), max(p1, p2, p3)
+        if not (self._p_lo <= lo and hi <= self._p_hi and self._q_lo <= tq <= self._q_hi):
+            if self.clipped == 0:
+                log.warning("controller command out of the actuator range at t = %g s "
+                            "(pitch %s rad, torque %g N m): the plant clips it; the "
+                            "count is in result.meta['commands_clipped']", t,
+                            np.round(pitch, 4), tq)
+            self.clipped += 1
+        self.u[:3] = pitch
+        self.u_tq = float(tq)
+        if not self.grid_lost and getattr(self.controller, "grid_connected", True) is False:
+            self.grid_lost = True
+            log.info("grid lost at t = %g s: generator torque zero from here", t)
+
+    def record_signals(self) -> None:
+        """Append the controller's internal signals of this plant step."""
+        for name, val in getattr(self.controller, "signals", {}).items():
+            self.sig.setdefault(name, []).append(float(val))
+
+    def apply_torque_rate(self) -> None:
+        """Move the applied torque toward the command by at most the generator's rate (after
+        a grid loss: zero at once)."""
+        if self.grid_lost:
+            self.u[3] = 0.0
+            return
+        self.u[3] += min(max(self.u_tq - self.u[3], -self.rate), self.rate)
+
+    def result(self, k: int, meta: dict[str, Any]) -> ClosedLoopResult:
+        """The first ``k`` samples as a result."""
+        return ClosedLoopResult(t=self.dt * np.arange(k), x=self.xs[:k], u=self.us[:k],
+                                z=self.zs[:k],
+                                controller={s: np.array(v[:k]) for s, v in self.sig.items()},
+                                meta=meta)
+
+
+def _check_rates(duration: float, dt: float, controller_dt: float | None
+                 ) -> tuple[int, int, float]:
+    n = int(round(duration / dt))
+    if n < 1:
+        raise ValueError(f"duration ({duration!r} s) must be at least one step dt = {dt!r} s")
+    cdt = dt if controller_dt is None else controller_dt
+    ratio = int(round(cdt / dt))
+    if ratio < 1 or abs(ratio * dt - cdt) > 1e-9:
+        raise ValueError(f"controller_dt = {cdt!r} s must be a whole multiple of dt = {dt!r} s")
+    return n, ratio, cdt
+
+
+def _compiled_law(loop: _Loop, compiled: bool) -> Any:
+    """The controller's compiled law (state, parameters) when the loop can run compiled: a
+    controller that offers one (the plain baseline) and no LIDAR; else None."""
+    offer = getattr(loop.controller, "compiled_law", None)
+    if not compiled or loop.preview is not None or not callable(offer):
+        return None
+    return offer(_IDX[0])
+
+
+def _run_compiled(loop: _Loop, stepper: linearize.PlantStepper, ratio: int, bar: Any,
+                  law: tuple[np.ndarray, np.ndarray]) -> None:
+    """:func:`_run` for a controller with a compiled law (:mod:`mpc_wt.simulation.compiled`): the
+    same steps in blocks of 800 compiled steps; the same errors, counts and signals."""
+    from mpc_wt.controllers.baseline_law import SIGNALS
+    from mpc_wt.simulation.compiled import run_steps
+
+    n, dt = loop.n, loop.dt
+    loop.xs[0] = loop.x
+    sigs = np.zeros((n + 1, len(SIGNALS)))
+    held, counts = np.array([loop.u_tq]), np.zeros(2, dtype=np.int64)
+    act = np.array([loop.rate, loop._p_lo, loop._p_hi, loop._q_lo, loop._q_hi])
+    arrays = (loop.xs, loop.us, loop.zs, loop.u, held, *law, sigs, act, counts)
+    loop.sig = {name: sigs[:, i] for i, name in enumerate(SIGNALS)}
+    try:
+        for k in range(0, n, 800):
+            done, flag = run_steps(k, min(k + 800, n), ratio, stepper, arrays)
+            loop.k_done = done
+            if flag in (-2, -3):
+                what = (f"measurement gen_speed is not finite at t = {done * dt:g} s: "
+                        f"{float(loop.zs[done, _IDX[0]])!r}" if flag == -2 else
+                        f"controller returned pitch {sigs[done, 4]!r}, torque "
+                        f"{sigs[done, 5]!r} at t = {done * dt:g} s: need 3 finite pitch "
+                        f"angles [rad] and a finite torque [N m]")
+                raise ValueError(what)
+            if flag >= 0:
+                raise _Diverged(done, flag, float(loop.xs[done, flag]))
+            bar.update(min(k + 800, n) - k)
+        loop.us[n] = loop.u
+        loop.zs[n] = stepper.outputs(n * dt, loop.xs[n], loop.u)
+        sigs[n] = sigs[n - 1]
+    finally:
+        loop.clipped, loop.u_tq = int(counts[0]), float(held[0])
+        loop.controller.adopt_compiled_state(law[0], sigs[max(loop.k_done - 1, 0)])
+        if counts[0]:
+            log.warning("controller command out of the actuator range at t = %g s: the plant "
+                        "clips it; the count is in result.meta['commands_clipped']",
+                        counts[1] * dt)
+
+
+def _advance(loop: _Loop, stepper: linearize.PlantStepper, ratio: int, bar: Any,
+             compiled: bool) -> None:
+    """The whole run: compiled where the controller offers a law (:func:`_run_compiled`), else
+    in Python (:func:`_run`)."""
+    law = _compiled_law(loop, compiled)
+    if law is not None:
+        _run_compiled(loop, stepper, ratio, bar, law)
+    else:
+        _run(loop, stepper, ratio, bar)
+
+
+def _run(loop: _Loop, stepper: linearize.PlantStepper, ratio: int, bar: Any) -> None:
+    """Advance the loop over all its steps; raises :class:`_Diverged` at the first state
+    outside the envelope (``loop.k_done`` then counts the samples kept).
+
+    The plant writes each new state and the outputs straight into the record rows
+    (:meth:`~linearize.PlantStepper.step_into`), so a step moves no arrays through Python."""
+    n, dt = loop.n, loop.dt
+    xs, us, zs = loop.xs, loop.us, loop.zs
+    xs[0] = loop.x
+    for k in range(n + 1):
+        t = k * dt
+        x, z = xs[k], zs[k]
+        loop.x = x
+        us[k] = loop.u
+        if k == n:
+            z[:] = stepper.outputs(t, x, loop.u)
+        else:
+            bad = stepper.step_into(t, x, loop.u, xs[k + 1], z)
+        if k % ratio == 0 and k < n:
+            loop.command(t, z)
+        loop.record_signals()
+        if k == n:
+            break
+        loop.apply_torque_rate()
+        loop.k_done = k + 1
+        if bad >= 0:
+            raise _Diverged(k + 1, bad, float(xs[k + 1, bad]))
+        if k % 800 == 0:
+            bar.update(min(800, n - bar.n))
+
+
+def simulate_closed_loop(params: linearize.PlantParams, controller: Any,
+                         wind: linearize.SteadyWind | linearize.GridWind, duration: float, *,
+                         x0: np.ndarray, u0: np.ndarray, dt: float = 1.0 / 80.0,
+                         controller_dt: float | None = None, progress: bool = False,
+                         preview: LidarPreview | None = None,
+                         meta: dict[str, Any] | None = None,
+                         compiled: bool = True) -> ClosedLoopResult:
+    """Run plant, wind and controller together.
+
+    Parameters
+    ----------
+    params : PlantParams
+        The plant (:func:`linearize.plant_params`).
+    controller : Controller
+        Anything with ``reset()`` and ``step(t, meas)``.
+    wind : SteadyWind or GridWind
+        The free wind; it must cover the rotor and the run.
+    duration : float
+        [s]
+    x0 : (n_x,) ndarray
+        Initial state (e.g. a trim point's).
+    u0 : (n_u,) ndarray
+        Initial inputs.
+    dt : float
+        Plant step [s] (default 1/80).
+    controller_dt : float, optional
+        Controller period [s], a multiple of ``dt`` (default ``dt``).
+    progress : bool
+        Show a progress bar.
+    preview : LidarPreview, optional
+        A simulated LIDAR; its preview is passed to the controller as ``meas["preview"]``
+        (a :class:`lidar.Preview`).
+    meta : dict, optional
+        Configuration stored with the result.
+    compiled : bool
+        Run a controller with a compiled law (the plain baseline, :mod:`mpc_wt.simulation.compiled`)
+        compiled with the plant (default: the same loop, 1.35x faster); False: in Python.
+
+    Returns
+    -------
+    ClosedLoopResult
+        ``round(duration / dt) + 1`` samples; ``meta`` gains ``dt``, ``controller_dt``,
+        ``commands_clipped`` and ``software_version``.
+
+    Raises
+    ------
+    SimulationDivergedError
+        If a state leaves the physical envelope; names the time and the state and keeps the
+        samples before in ``.partial``.
+    ValueError
+        If the controller returns a non-finite or wrongly shaped command (names the time).
+    """
+    n, ratio, cdt = _check_rates(duration, dt, controller_dt)
+    stepper = linearize.PlantStepper(params, wind, dt, n * dt)
+    controller.reset()
+    if preview is not None:
+        preview.reset()
+    loop = _Loop(params, controller, n, dt, x0, u0, preview,
+                 _hub_wind(wind, params.turbine.geometry.hub_height))
+    bar = tqdm(total=n, desc="simulate", unit="step", disable=not progress, mininterval=0.5)
+    try:
+        _advance(loop, stepper, ratio, bar, compiled)
+    except _Diverged as d:
+        raise SimulationDivergedError(
+            f"simulation diverged at t = {d.k * dt:.4f} s: state "
+            f"{linearize.STATE_NAMES[d.state]!r} = {d.value!r} "
+            f"{linearize.STATE_UNITS[d.state]} left its envelope; the {loop.k_done} samples "
+            f"before are kept in .partial", loop.result(loop.k_done, meta or {})) from None
+    except ControllerLibraryError as err:
+        raise ControllerLibraryError(f"{err} ({loop.k_done} samples before are kept in "
+                                     f".partial)", loop.result(loop.k_done, meta or {})) from None
+    finally:
+        bar.close()
+        finalize = getattr(controller, "finalize", None)
+        if callable(finalize):
+            finalize()
+    return loop.result(n + 1, {**(meta or {}), "dt": dt,
+                               "controller_dt": cdt, "commands_clipped": loop.clipped,
+                               "software_version": __version__})
+
+
+class _Diverged(Exception):
+    def __init__(self, k: int, state: int, value: float) -> None:
+        super().__init__(k, state, value)
+        self.k, self.state, self.value = k, state, value

@@ -1,0 +1,270 @@
+"""Results of closed-loop runs and their files: :class:`ClosedLoopResult` (netCDF, written and
+read by mpc-wt, openable without it) and :func:`load_series`, which reads a run -- ours, or
+any CSV with a time column -- as time and named channels for assessment."""
+from __future__ import annotations
+
+import csv
+import json
+import os
+import uuid
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+import linearize
+from mpc_wt._version import __version__
+from mpc_wt.errors import ResultFileError
+
+__all__ = ["ClosedLoopResult", "load_series", "SCHEMA_VERSION"]
+
+SCHEMA_VERSION = 1
+_Z = {n: i for i, n in enumerate(linearize.OUTPUT_NAMES)}
+
+
+@dataclass(frozen=True)
+class ClosedLoopResult:
+    """Everything a closed-loop run produced.
+
+    Parameters
+    ----------
+    t : (n_t,) ndarray
+        [s]
+    x : (n_t, n_x) ndarray
+        Plant states (:data:`linearize.STATE_NAMES`).
+    u : (n_t, n_u) ndarray
+        Applied inputs (after the plant's torque rate limit).
+    z : (n_t, n_z) ndarray
+        Plant outputs (:data:`linearize.OUTPUT_NAMES`).
+    controller : dict of str to (n_t,) ndarray
+        The controller's internal signals.
+    meta : dict
+        Configuration and software version.
+    """
+
+    t: np.ndarray
+    x: np.ndarray
+    u: np.ndarray
+    z: np.ndarray
+    controller: dict[str, np.ndarray] = field(default_factory=dict)
+    meta: dict[str, Any] = field(default_factory=dict)
+
+    def channel(self, name: str) -> np.ndarray:
+        """A time series by name: output, state, input, controller signal, or the derived
+        ``shaft_bending_blade1``: the rotating low-speed-shaft bending moment in the direction
+        of blade 1 from the blades' flap moments, M_1 - (M_2 + M_3) / 2 [N m] (rotor weight
+        and hub inertia left out).
+
+        Parameters
+        ----------
+        name : str
+            A name of :meth:`channels`.
+
+        Returns
+        -------
+        (n_t,) ndarray
+            The series (SI units of the name's table).
+
+        Raises
+        ------
+        KeyError
+            Naming the channel and listing the channels.
+        """
+        if name == "shaft_bending_blade1":
+            f = self.z[:, _Z["flap_moment_1"]:_Z["flap_moment_3"] + 1]
+            return f[:, 0] - 0.5 * (f[:, 1] + f[:, 2])
+        if name in _Z:
+            return self.z[:, _Z[name]]
+        if name in linearize.STATE_NAMES:
+            return self.x[:, linearize.STATE_NAMES.index(name)]
+        if name in linearize.INPUT_NAMES:
+            return self.u[:, linearize.INPUT_NAMES.index(name)]
+        if name in self.controller:
+            return self.controller[name]
+        raise KeyError(f"no channel {name!r}; channels are {self.channels()}")
+
+    def channels(self) -> list[str]:
+        """All channel names.
+
+        Returns
+        -------
+        list of str
+            Outputs, states, inputs, derived channels and controller signals.
+        """
+        return (list(linearize.OUTPUT_NAMES) + [n for n in linearize.STATE_NAMES
+                                                if n not in _Z]
+                + list(linearize.INPUT_NAMES) + ["shaft_bending_blade1"]
+                + list(self.controller))
+
+    def save(self, path: str | Path) -> Path:
+        """Write a self-describing netCDF file (xarray; openable without mpc-wt) with units,
+        the configuration and the software version; written to a temporary file, then renamed.
+
+        Parameters
+        ----------
+        path : str or Path
+            The netCDF file.
+
+        Returns
+        -------
+        Path
+            ``path``.
+        """
+        import xarray as xr
+
+        path = Path(path)
+        data = {}
+        units = dict(zip(linearize.OUTPUT_NAMES, linearize.OUTPUT_UNITS))
+        units.update(zip(linearize.STATE_NAMES, linearize.STATE_UNITS))
+        units.update(zip(linearize.INPUT_NAMES, linearize.INPUT_UNITS))
+        for n in self.channels():
+            key = n if n not in data else f"{n}_state"
+            data[key] = xr.Variable("time", self.channel(n),
+                                    {"units": units.get(n, ""),
+                                     "source": "controller" if n in self.controller else "plant"})
+        ds = xr.Dataset(data, coords={"time": ("time", self.t, {"units": "s"})},
+                        attrs={"schema_version": SCHEMA_VERSION, "software": "mpc-wt",
+                               "software_version": __version__,
+                               "meta_json": json.dumps(self.meta)})
+        # a name of this writer's own: two writers of one case (a retried task) never share it
+        tmp = path.with_name(f".{path.name}.{os.getpid()}.{uuid.uuid4().hex[:8]}.tmp")
+        try:
+            ds.to_netcdf(tmp, engine="scipy")
+            tmp.replace(path)
+        finally:
+            tmp.unlink(missing_ok=True)
+        return path
+
+    @classmethod
+    def load(cls, path: str | Path) -> "ClosedLoopResult":
+        """Read a result written by :meth:`save`.
+
+        Raises
+        ------
+        ResultFileError
+            If the file is missing, truncated, of another schema or misses plant channels.
+        """
+        import xarray as xr
+
+        path = Path(path)
+        if not path.is_file():
+            raise ResultFileError(f"{path}: file not found")
+        try:
+            with xr.open_dataset(path, engine="scipy") as ds:
+                ds = ds.load()
+        except Exception as err:  # noqa: BLE001 - any reader failure means a broken file
+            raise ResultFileError(f"{path}: not a readable result file ({err})") from err
+        ver = ds.attrs.get("schema_version")
+        if isinstance(ver, (np.integer, int)):
+            ver = int(ver)
+        if ver != SCHEMA_VERSION:
+            raise ResultFileError(f"{path}: schema_version must be {SCHEMA_VERSION}, got {ver!r} "
+                                  f"(written by {ds.attrs.get('software_version', '?')})")
+        missing = [n for n in linearize.OUTPUT_NAMES if n not in ds]
+        if missing:
+            raise ResultFileError(f"{path}: missing channels {missing}")
+        z = np.column_stack([ds[n].values for n in linearize.OUTPUT_NAMES])
+        x = np.column_stack([ds[n if n not in _Z else n].values for n in linearize.STATE_NAMES])
+        u = np.column_stack([ds[n].values for n in linearize.INPUT_NAMES])
+        ctrl = {n: ds[n].values for n in ds.data_vars
+                if ds[n].attrs.get("source") == "controller"}
+        return cls(t=ds["time"].values, x=x, u=u, z=z, controller=ctrl,
+                   meta=json.loads(ds.attrs.get("meta_json", "{}")))
+
+
+
+def load_series(path: str | Path, time_column: str = "time") -> tuple[np.ndarray,
+                                                                       dict[str, np.ndarray]]:
+    """Time and channels of a run: ours (netCDF), an OpenFAST output (``.out``, ``.outb``) or a
+    CSV with a time column.
+
+    OpenFAST channels (also as CSV headers, ``RootMyb1``, ``RootMyb1_[kN-m]`` or ``RootMyb1
+    (kN-m)``; a bare name is taken in OpenFAST's unit) are mapped to ours in SI by
+    :data:`mpc_wt.io.openfast_output.CHANNEL_MAP`; the notes on unmapped channels are logged.
+
+    Parameters
+    ----------
+    path : str or Path
+        A result file (.nc), an OpenFAST output (.out, .outb) or a CSV with a header row.
+    time_column : str
+        The CSV's time column (``Time`` is also taken when ``time`` is absent).
+
+    Returns
+    -------
+    t : (n_t,) ndarray
+        Time [s].
+    cols : dict of str to (n_t,) ndarray
+        The other columns by name.
+
+    Raises
+    ------
+    ResultFileError
+        If the file cannot be read, has no time column, non-numeric cells, an OpenFAST channel
+        with a unit it cannot have, or a suffix other than .nc, .out, .outb, .csv.
+    """
+    import logging
+
+    from mpc_wt.io.openfast_output import read_openfast_output, to_mpcwt_channels
+
+    log = logging.getLogger("mpc_wt.simulation.results")
+    path = Path(path)
+    suffix = path.suffix.lower()
+    if suffix in (".out", ".outb"):
+        series = read_openfast_output(path)
+        cols, notes = to_mpcwt_channels(series, str(path))
+        for n in notes:
+            log.info("%s: %s", path, n)
+        return series.t, cols
+    if suffix == ".csv":
+        return _load_csv(path, time_column, log)
+    if suffix != ".nc":
+        raise ResultFileError(f"{path}: suffix {path.suffix!r} is not a run file mpc-wt reads; "
+                              f"allowed .nc (ours), .out / .outb (OpenFAST), .csv")
+    res = ClosedLoopResult.load(path)
+    return res.t, {n: res.channel(n) for n in res.channels()}
+
+
+def _load_csv(path: Path, time_column: str, log: Any) -> tuple[np.ndarray,
+                                                               dict[str, np.ndarray]]:
+    """A CSV run; columns with OpenFAST channel names are mapped to ours in SI."""
+    from mpc_wt.io.openfast_output import (
+        CHANNEL_MAP,
+        DEFAULT_UNITS,
+        OpenFASTSeries,
+        split_csv_header,
+        to_mpcwt_channels,
+    )
+
+    if not path.is_file():
+        raise ResultFileError(f"{path}: file not found")
+    with path.open(newline="") as fh:
+        rows = list(csv.reader(fh))
+    if not rows:
+        raise ResultFileError(f"{path}: empty file")
+    head = [h.strip() for h in rows[0]]
+    split = [split_csv_header(h) for h in head]
+    bare = [n for n, _ in split]
+    if time_column not in head and time_column == "time" and "Time" in bare:
+        time_column = head[bare.index("Time")]
+    if time_column not in head:
+        raise ResultFileError(f"{path}: no time column {time_column!r}; columns {head}")
+    try:
+        data = np.array([[float(c) for c in r] for r in rows[1:] if r], dtype=float)
+    except ValueError as err:
+        raise ResultFileError(f"{path}: non-numeric cell ({err})") from err
+    if data.ndim != 2 or data.shape[1] != len(head):
+        raise ResultFileError(f"{path}: ragged rows")
+    it = head.index(time_column)
+    if any(n in CHANNEL_MAP for n in bare):
+        names = tuple(n for k, n in enumerate(bare) if k != it)
+        units = tuple((u if u is not None else DEFAULT_UNITS.get(n, "-"))
+                      for k, (n, u) in enumerate(split) if k != it)
+        series = OpenFASTSeries(t=data[:, it], names=names, units=units,
+                                data=np.delete(data, it, axis=1))
+        cols, notes = to_mpcwt_channels(series, str(path))
+        for n in notes:
+            log.info("%s: %s", path, n)
+        return series.t, cols
+    cols = {h: data[:, i] for i, h in enumerate(head)}
+    return cols.pop(time_column), cols

@@ -1,0 +1,255 @@
+"""What a controller kind builds from: the load case (:class:`Scenario`), its wind, the
+operating point, and a cache for designs that cost seconds (:class:`DesignCache`).
+"""
+from __future__ import annotations
+
+import dataclasses
+import math
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+import lidar
+import linearize
+from linearize.validate import check_finite_scalar, check_positive, check_range
+
+__all__ = ['Scenario', 'field_grid', 'make_wind', 'field_spec', 'iec_site']
+
+@dataclass(frozen=True)
+class Scenario:
+    """One load case: mean wind, turbulence, seed, length and shear, and optionally an IEC
+    61400-1 wind condition (:func:`lidar.iec_field`).
+
+    Parameters
+    ----------
+    wind_mps : float
+        Mean hub-height wind [m/s], > 0.
+    turbulence : str or float
+        IEC class "A", "B", "C", "steady", or a turbulence intensity in (0, 1) [-].
+    seed : int
+        Seed of the turbulent field, >= 0.
+    duration : float
+        Simulated time [s], > 0.
+    shear_exponent : float
+        Power-law shear exponent [-], in [-1, 1].
+    condition : str
+        IEC 61400-1 ed. 3 wind condition (:data:`lidar.CONDITIONS`): "ntm" (default: the
+        turbulence given), "etm" (the extreme turbulence model's sigma_1 for the category
+        ``turbulence``), "nwp" (steady) or a deterministic transient ("eog", "edc", "ecd",
+        "ews-v", "ews-h") for the class ``iec_class`` and the category ``turbulence``.
+    iec_class : str
+        Wind turbine class "I", "II" or "III" (V_ref of the EOG and ECD).
+    sign : {1, -1}
+        Direction of a direction change or a shear.
+    event_at : float
+        When a transient starts [s] (simulation time).
+    """
+
+    wind_mps: float
+    turbulence: str | float = "A"
+    seed: int = 1
+    duration: float = 600.0
+    shear_exponent: float = 0.2
+    condition: str = "ntm"
+    iec_class: str = "I"
+    sign: int = 1
+    event_at: float = 0.0
+
+    def __post_init__(self) -> None:
+        check_positive("wind_mps", self.wind_mps)
+        check_positive("duration", self.duration)
+        check_range("shear_exponent", self.shear_exponent, -1.0, 1.0)
+        if isinstance(self.turbulence, str):
+            if self.turbulence not in ("A", "B", "C", "steady"):
+                raise ValueError(f"turbulence must be 'A', 'B', 'C', 'steady' or an intensity "
+                                 f"in (0, 1), got {self.turbulence!r}")
+        elif not 0.0 < check_finite_scalar("turbulence", self.turbulence) < 1.0:
+            raise ValueError(f"turbulence intensity must be in (0, 1), got {self.turbulence!r}")
+        if isinstance(self.seed, bool) or not isinstance(self.seed, (int, np.integer)) \
+                or self.seed < 0:
+            raise ValueError(f"seed must be an integer >= 0, got {self.seed!r}")
+        if self.condition not in lidar.CONDITIONS:
+            raise ValueError(f"condition must be one of {sorted(lidar.CONDITIONS)}, got "
+                             f"{self.condition!r}")
+        if self.condition not in ("ntm", "nwp") and self.turbulence not in ("A", "B", "C"):
+            raise ValueError(f"condition {self.condition!r} needs an IEC turbulence category "
+                             f"'A', 'B' or 'C' as turbulence, got {self.turbulence!r}")
+        if self.sign not in (1, -1):
+            raise ValueError(f"sign must be 1 or -1, got {self.sign!r}")
+        check_range("event_at", self.event_at, 0.0, math.inf)
+
+    @property
+    def deterministic(self) -> bool:
+        """True for a wind without turbulence: steady, NWP or an IEC transient."""
+        return self.turbulence == "steady" or self.condition not in ("ntm", "etm")
+
+    def meta(self) -> dict[str, Any]:
+        """The case as plain data for a result's ``meta``.
+
+        Returns
+        -------
+        dict
+            ``wind_mps``, ``turbulence``, ``seed``, ``duration_s``, ``shear_exponent`` (the I/O keys
+            carry units); with an IEC condition also ``condition``, ``iec_class``, ``sign``,
+            ``event_at_s``.
+        """
+        out = {"wind_mps": self.wind_mps, "turbulence": self.turbulence, "seed": self.seed,
+               "duration_s": self.duration, "shear_exponent": self.shear_exponent}
+        if self.condition != "ntm":
+            out.update(condition=self.condition, iec_class=self.iec_class, sign=self.sign,
+                       event_at_s=self.event_at)
+        return out
+
+
+def field_grid(turbine: linearize.Turbine) -> tuple[float, int]:
+    """Side [m] and points per side of a square turbulence grid that covers the rotor.
+
+    150 m and 32 points (4.8 m spacing) for rotors up to 63 m; larger rotors get 12 m of margin
+    on each side of the tip and the same spacing (the IEA-15-240-RWT: 266 m, 56 points).
+
+    Parameters
+    ----------
+    turbine : Turbine
+        For the tip radius.
+
+    Returns
+    -------
+    width : float
+        [m].
+    n : int
+        Even number of points per side.
+    """
+    width = max(150.0, 2.0 * turbine.geometry.tip_radius + 24.0)
+    n = max(32, 2 * math.ceil(width / 150.0 * 16))
+    return width, n
+
+
+def make_wind(turbine: linearize.Turbine, scenario: Scenario, components: str = "uvw"
+              ) -> tuple[linearize.SteadyWind | linearize.GridWind, lidar.WindField]:
+    """The plant's wind for a scenario and the same field for a LIDAR in the loop.
+
+    Parameters
+    ----------
+    turbine : Turbine
+        For the hub height.
+    scenario : Scenario
+        The load case; the field is 20 s longer than the run.
+    components : str
+        The turbulent components to generate ("uvw" default; "u": v = w = 0, for runs
+        without a LIDAR; u is the same either way, drawn first from the seed's stream).
+
+    Returns
+    -------
+    wind : SteadyWind or GridWind
+        What the plant meets (negative speeds of a turbulent field clipped at 0).
+    field : lidar.WindField
+        The same field.
+    """
+    hub = turbine.geometry.hub_height
+    v, alpha = scenario.wind_mps, scenario.shear_exponent
+    if scenario.condition not in ("ntm", "nwp", "etm"):
+        width, n = field_grid(turbine)
+        return _iec_wind(scenario, iec_site(turbine, scenario), width, n)
+    if scenario.turbulence == "steady" or scenario.condition == "nwp":
+        width, _ = field_grid(turbine)
+        spec = lidar.TurbulenceSpec(v, 0.01, hub_height=hub, duration=scenario.duration + 20.0,
+                                    dt=1.0, n_y=8, n_z=8, width=width, height=width,
+                                    shear_exponent=alpha)
+        t, y, z = spec.grid()
+        u = np.broadcast_to(v * (z / hub) ** alpha, (t.size, y.size, z.size))
+        zero = np.zeros(u.shape)
+        f = lidar.WindField(t=t, y=y, z=z, u=u, v=zero, w=zero, mean_speed=v, hub_height=hub,
+                            meta={"model": "steady power law"})
+        return linearize.SteadyWind(v, alpha), f
+    spec = field_spec(turbine, scenario)
+    f = lidar.generate_field(spec, scenario.seed, components=components)
+    if scenario.condition == "etm":
+        f = dataclasses.replace(f, meta={**f.meta, "condition": "etm",
+                                         "iec_class": scenario.iec_class,
+                                         "turbulence_class": scenario.turbulence})
+    return _grid_wind(f)
+
+
+def field_spec(turbine: linearize.Turbine, scenario: Scenario) -> lidar.TurbulenceSpec:
+    """The turbulence of a turbulent scenario's field: the NTM of its class or intensity, or
+    the ETM's sigma (IEC 61400-1 eq. 19) for its IEC class, on :func:`field_grid`'s grid, 20 s
+    longer than the run.
+
+    Parameters
+    ----------
+    turbine : Turbine
+        For the hub height and the grid.
+    scenario : Scenario
+        A turbulent load case (condition ``ntm`` or ``etm``, turbulence not ``steady``).
+
+    Returns
+    -------
+    lidar.TurbulenceSpec
+
+    Raises
+    ------
+    ValueError
+        For a deterministic scenario (steady, NWP or an IEC transient), naming it.
+    """
+    if scenario.deterministic:
+        raise ValueError(f"scenario {scenario.condition!r} with turbulence "
+                         f"{scenario.turbulence!r} has no turbulent field")
+    v = scenario.wind_mps
+    width, n = field_grid(turbine)
+    turb = scenario.turbulence
+    if scenario.condition == "etm":
+        site = iec_site(turbine, scenario)
+        turb = site.magnitudes(site.check_speed("etm", v))["sigma_etm"] / v
+    return lidar.TurbulenceSpec(v, turb, hub_height=turbine.geometry.hub_height, width=width,
+                                height=width, n_y=n, n_z=n, duration=scenario.duration + 20.0,
+                                shear_exponent=scenario.shear_exponent)
+
+
+def _grid_wind(f: lidar.WindField) -> tuple[linearize.GridWind, lidar.WindField]:
+    """The plant's wind: the field's u (read-only float32) unless a gust of a very turbulent
+    low wind (or a direction change beyond 90 deg) runs backwards: then the clipped copy. A
+    field made for the plant alone (u only) then holds the clipped u itself instead of
+    beside it (50 MB for a 600 s field on 32 x 32 points), with ``meta["u_clipped_at_zero"]``;
+    a LIDAR never measures it (:meth:`BuildContext.lidar_field` makes its own field)."""
+    u = f.u
+    if float(u.min()) < 0.0:
+        u = np.maximum(f.u, np.float32(0.0))
+        u.flags.writeable = False
+        if f.meta.get("components") == "u":
+            f = dataclasses.replace(f, u=u, meta={**f.meta, "u_clipped_at_zero": True})
+    return linearize.GridWind(t=f.t, y=f.y, z=f.z, u=u), f
+
+
+def iec_site(turbine: linearize.Turbine, scenario: Scenario) -> lidar.IECSite:
+    """The turbine's IEC 61400-1 site for a scenario: its class and category, hub height,
+    rotor diameter, the scenario's shear and the turbine's operating range.
+
+    Parameters
+    ----------
+    turbine : Turbine
+        For the hub height, the rotor and cut-in / cut-out.
+    scenario : Scenario
+        For ``iec_class``, the category (``turbulence``) and the shear.
+
+    Returns
+    -------
+    lidar.IECSite
+    """
+    op = turbine.operation
+    return lidar.IECSite(scenario.iec_class, str(scenario.turbulence),
+                         hub_height=turbine.geometry.hub_height,
+                         diameter=2.0 * turbine.geometry.tip_radius,
+                         shear_exponent=scenario.shear_exponent, cut_in=op.cut_in_wind,
+                         cut_out=op.cut_out_wind)
+
+
+def _iec_wind(scenario: Scenario, site: lidar.IECSite, width: float, n: int
+              ) -> tuple[linearize.GridWind, lidar.WindField]:
+    """A deterministic IEC transient on the turbulence grid, 20 s longer than the run. The
+    plant meets the rotor-normal component u = V cos(theta) of a direction change (no skewed
+    inflow model); a LIDAR in the loop sees u and v."""
+    f = lidar.iec_field(scenario.condition, scenario.wind_mps, site,
+                        t_start=scenario.event_at, duration=scenario.duration + 20.0,
+                        dt=0.05, width=width, n=n, sign=scenario.sign)
+    return _grid_wind(f)

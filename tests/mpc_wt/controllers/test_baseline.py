@@ -1,0 +1,99 @@
+"""Baseline controller: tuning against the published gains and its closed-loop behaviour on the
+plant."""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numpy.testing import assert_allclose
+
+import lidar
+import linearize
+from mpc_wt.controllers.baseline import BaselineController
+from mpc_wt.simulation.loop import ClosedLoopResult, simulate_closed_loop
+
+
+def _field(v: float, turb, seed: int) -> tuple[linearize.GridWind, lidar.WindField]:
+    f = lidar.generate_field(lidar.TurbulenceSpec(v, turb, duration=610.0), seed)
+    return linearize.GridWind(t=f.t, y=f.y, z=f.z, u=np.maximum(f.u, 0.0)), f
+
+
+def test_gains_match_the_published_baseline(gains) -> None:
+    # published: DISCON.F90 (Jonkman's baseline, report sec. 7.4): PC_KP = 0.01882681 s,
+    # PC_KI = 0.008068634, PC_KK = 0.1099965 rad (6.302336 deg), dP/dtheta at zero pitch
+    # -25.52e6 W/rad, VS_Rgn2K = 2.332287 N m/(rad/s)^2. Issue 5 asked for 20 %; measured:
+    # KP and KI +4.6 %, theta_K -9.7 %, dP/dtheta_0 -5.0 %, K_opt -2.5 % (our frozen-wake
+    # sensitivities are within 8.3 % of the report's, the fit's points differ, and the rotor
+    # inertia from the blade table is 0.6 % below the report's). Bounds: the measured value
+    # plus about 1.5 points (the README states both).
+    assert_allclose(gains.kp, 0.01882681, rtol=0.06)
+    assert_allclose(gains.ki, 0.008068634, rtol=0.06)
+    assert_allclose(gains.theta_k_rad, math.radians(6.302336), rtol=0.11)
+    assert_allclose(gains.dpdtheta_0, -25.52e6, rtol=0.065)
+    assert_allclose(gains.k_opt, 2.332287, rtol=0.035)
+
+
+def test_pole_placement_formula() -> None:
+    # analytic: with the report's own numbers (J = 43,784,725 kg m^2, dP/dtheta = -25.52e6,
+    # Omega = 12.1 rpm, N = 97, 0.6 rad/s, 0.7) the formulas give DISCON's KP and KI
+    j, om = 43784725.0, 12.1 * math.pi / 30
+    kp = 2 * j * om * 0.7 * 0.6 / (97 * 25.52e6)
+    ki = j * om * 0.36 / (97 * 25.52e6)
+    assert_allclose([kp, ki], [0.01882681, 0.008068634], rtol=2e-4)
+
+
+def test_region3_closed_loop(run18: ClosedLoopResult) -> None:
+    # issue 5: 18 m/s, turbulent (class A): rated power held, generator speed std below 5 %
+    # of rated (first 60 s of start-up transient left out). Measured: mean power 0.005 % off
+    # 5 MW, speed std 3.5 %; bounds 0.05 % and 4 % (the README states both).
+    late = run18.t > 60.0
+    assert_allclose(run18.channel("gen_power")[late].mean(), 5e6, rtol=5e-4)
+    assert run18.channel("gen_speed")[late].std() < 0.04 * 122.9096
+
+
+def test_no_actuator_limit_violated(run18: ClosedLoopResult, turbine: linearize.Turbine) -> None:
+    pitch = run18.x[:, 5:8]
+    dt = run18.t[1] - run18.t[0]
+    pa = turbine.pitch_actuator
+    assert pitch.min() >= pa.min_pitch_rad - 1e-9 and pitch.max() <= pa.max_pitch_rad + 1e-9
+    assert np.abs(np.diff(pitch, axis=0)).max() / dt <= pa.max_rate_rad_s * (1 + 1e-6)
+    tq = run18.channel("gen_torque")
+    g = turbine.generator
+    assert tq.max() <= g.max_torque + 1e-6 and tq.min() >= g.min_torque - 1e-6
+    assert np.abs(np.diff(tq)).max() / dt <= g.max_torque_rate * (1 + 1e-9)
+
+
+def test_region2_tracks_optimal_tsr(turbine: linearize.Turbine, params: linearize.PlantParams,
+                                    gains) -> None:
+    # issue 5: at 8 m/s the turbine tracks the optimal tip-speed ratio (mean within 3 %),
+    # here in Do et al.'s region-II turbulence (12 %); the tip-speed ratio uses the rotor-
+    # averaged wind. (In class A, 23 % at 8 m/s, the mean is 10 % above optimal: lulls hold the
+    # rotor at its minimum speed and gusts are not followed.)
+    gw, f = _field(8.0, 0.12, 3)
+    op = linearize.trim(turbine, 8.0)
+    r = simulate_closed_loop(params, BaselineController(turbine, gains), gw, 600.0,
+                             x0=op.x, u0=op.u)
+    late = r.t > 60.0
+    rews = np.interp(r.t[late], f.t, lidar.rotor_effective_wind(f, 63.0))
+    tsr = r.channel("rotor_speed")[late].mean() * 63.0 * math.cos(math.radians(2.5)) / rews.mean()
+    # measured 1.4 % above optimal; bound 2 % (issue 5 asked for 3 %; the README states both)
+    assert_allclose(tsr, gains.info["tsr_opt"], rtol=0.02)
+
+
+
+
+
+
+
+
+def test_torque_law_is_continuous_and_monotone(turbine: linearize.Turbine, gains) -> None:
+    # regions 1.5 -> 2 -> 2.5 -> 3 meet without jumps below rated (the 2 -> 2.5 switch is where
+    # K w^2 meets the 2.5 line, as DISCON's VS_TrGnSp), and the torque rises with speed
+    c = BaselineController(turbine, gains)
+    w = np.linspace(60.0, c.w_rated - 1e-6, 20001)
+    tq = np.array([c.torque(x, 0.0) for x in w])
+    assert np.all(np.diff(tq) >= -1e-9)
+    # no jump: every step is bounded by the steepest segment's slope (region 2.5) times the step
+    steep = max(c.slope25, c.slope15, 2 * gains.k_opt * c.w_rated)
+    assert np.max(np.abs(np.diff(tq))) <= steep * (w[1] - w[0]) * (1 + 1e-9)
+    assert_allclose(c.torque(c.w_trans, 0.0), gains.k_opt * c.w_trans**2, rtol=1e-9)

@@ -1,0 +1,214 @@
+"""Gain synthesis (issue 7, first part): LQR against closed forms and python-control, the PI
+observer of Do et al. (eqs 13-16), LQR+PIO in the loop, bad input."""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+import linearize
+from mpc_wt import SimulationDivergedError
+from mpc_wt.controllers.lqr import (
+    REGION3_SCALES,
+    REGION3_WEIGHTS,
+    LQRPIOController,
+    design_lqr,
+    design_lqr_family,
+    design_pi_observer,
+)
+from mpc_wt.errors import SynthesisError
+
+
+def _scalar_model(a: float, b: float, dt: float | None = None) -> linearize.LinearModel:
+    base = linearize.linearize(linearize.load_turbine(), 18.0,
+                               config=linearize.PlantConfig.madsen())
+    m = base.select(outputs=["rotor_speed"])
+    import dataclasses
+
+    return dataclasses.replace(
+        m, A=np.array([[a]]), B_u=np.array([[b]]), B_d=np.zeros((1, 1)),
+        C_z=np.array([[1.0]]), D_u=np.zeros((1, 1)), D_d=np.zeros((1, 1)),
+        states=("rotor_speed",), inputs=("pitch_ref_1",), disturbances=("wind_1",),
+        outputs=("rotor_speed",), state_units=("rad/s",), input_units=("rad",),
+        disturbance_units=("m/s",), output_units=("rad/s",), x0=np.zeros(1), u0=np.zeros(1),
+        d0=np.zeros(1), z0=np.zeros(1), dt=dt)
+
+
+@settings(max_examples=40, deadline=None)
+@given(a=st.floats(-3, 3), b=st.floats(0.1, 5) | st.floats(-5, -0.1), q=st.floats(0.01, 100),
+       r=st.floats(0.01, 100))
+def test_scalar_lqr_matches_the_closed_form(a: float, b: float, q: float, r: float) -> None:
+    # analytic: 2 a p - p^2 b^2 / r + q = 0, p = r (a + sqrt(a^2 + b^2 q / r)) / b^2, k = b p / r
+    d = design_lqr(_scalar_model(a, b), state_weights={"rotor_speed": q},
+                   input_weights={"pitch_ref_1": r}, inputs=("pitch_ref_1",))
+    p = r * (a + math.sqrt(a * a + b * b * q / r)) / (b * b)
+    assert d.P[0, 0] == pytest.approx(p, rel=1e-8)
+    assert d.K[0, 0] == pytest.approx(b * p / r, rel=1e-8)
+    assert d.closed_loop_eigs.real.max() < 0
+
+
+def test_scalar_discrete_lqr_matches_the_closed_form() -> None:
+    # analytic DARE for x+ = a x + b u: p = q + a^2 p - a^2 b^2 p^2 / (r + b^2 p)
+    a, b, q, r = 1.2, 0.5, 2.0, 0.7
+    d = design_lqr(_scalar_model(a, b, dt=0.1), state_weights={"rotor_speed": q},
+                   input_weights={"pitch_ref_1": r}, inputs=("pitch_ref_1",))
+    # b^2 p^2 + (r - a^2 r - q b^2) p - q r = 0
+    cc = r - a * a * r - q * b * b
+    p = (-cc + math.sqrt(cc * cc + 4 * b * b * q * r)) / (2 * b * b)
+    assert d.P[0, 0] == pytest.approx(p, rel=1e-9)
+    assert d.K[0, 0] == pytest.approx(a * b * p / (r + b * b * p), rel=1e-9)
+
+
+@pytest.fixture(scope="module")
+def do_model(turbine: linearize.Turbine) -> linearize.LinearModel:
+    return linearize.linearize(turbine, 18.0, config=linearize.PlantConfig.do())
+
+
+def test_lqr_on_the_turbine_solves_the_riccati_equation(do_model) -> None:
+    """Independent of the solver it wraps: with the weights built by hand (state and output
+    weights, R = I), K = R^-1 B' P where P solves A'P + PA - PBR^-1B'P + Q = 0 (Do et al. eq 10)
+    to the Riccati residual's rounding, P is symmetric positive semidefinite and A - BK is
+    Hurwitz."""
+    w = {"rotor_speed": 5.0, "tower_fa_velocity": 1.0, "flap_rate_1": 1.0}
+    d = design_lqr(do_model, state_weights=w, output_weights={"flap_moment_2": 1e-12})
+    nx = do_model.A.shape[0]
+    q = np.zeros((nx, nx))
+    for n, v in w.items():
+        i = do_model.states.index(n)
+        q[i, i] = v
+    c = do_model.C_z[do_model.outputs.index("flap_moment_2")]
+    q += 1e-12 * np.outer(c, c)
+    a, b, p = do_model.A, do_model.B_u[:, :3], d.P
+    res = a.T @ p + p @ a - p @ b @ b.T @ p + q
+    scale = np.abs(a.T @ p).max() + np.abs(q).max()
+    assert np.abs(res).max() < 1e-8 * scale
+    np.testing.assert_allclose(d.K, b.T @ p, rtol=1e-9, atol=1e-12 * np.abs(d.K).max())
+    np.testing.assert_allclose(p, p.T, atol=1e-9 * np.abs(p).max())
+    assert np.linalg.eigvalsh(0.5 * (p + p.T)).min() > -1e-9 * np.abs(p).max()
+    assert np.linalg.eigvals(a - b @ d.K).real.max() < 0
+
+
+def test_lqr_family_gives_one_gain_per_wind(turbine) -> None:
+    fam = linearize.linearize_family(turbine, [14.0, 18.0, 22.0],
+                                     config=linearize.PlantConfig.do())
+    gains = design_lqr_family(fam, state_weights={"rotor_speed": 1.0})
+    assert [g.wind_mps for g in gains] == [14.0, 18.0, 22.0]
+    # the pitch sensitivity grows with wind, so the speed gain needed falls
+    ks = [abs(g.K[0, g.states.index("rotor_speed")]) for g in gains]
+    assert ks[0] > ks[1] > ks[2]
+
+
+def test_pi_observer_is_stable_and_integral_gain_grows_with_q(do_model) -> None:
+    # Do et al. eqs 15-16: A_e - L C_e stable; q >> 1 raises ||L2||_F / ||L1||_F
+    ratios = []
+    for q in (1e3, 1e5, 1e7):
+        ob = design_pi_observer(do_model, q=q)
+        assert ob.error_eigs.real.max() < 0
+        ratios.append(ob.gain_ratio)
+    assert ratios[0] < ratios[1] < ratios[2]
+
+
+def test_pi_observer_recovers_a_constant_unknown_input(do_model) -> None:
+    # on its own (linear) model, a step of blade wind is estimated exactly in steady state
+    ob = design_pi_observer(do_model, q=1e5)
+    nx = do_model.A.shape[0]
+    f = np.array([1.0, -0.5, 0.25])
+    # the plant's steady state under the step, stabilized by an LQR (the open loop drifts)
+    lq = design_lqr(do_model)
+    acl = do_model.A - do_model.B_u[:, :3] @ lq.K
+    x_ss = -np.linalg.solve(acl, do_model.B_d @ f)
+    y = ob.C_e[:, :nx] @ x_ss
+    # observer steady state with u = -K x_ss: 0 = (Ae - L Ce) xe + Be u + L y
+    u = np.zeros(4)
+    u[:3] = -lq.K @ x_ss
+    ao = ob.A_e - ob.L @ ob.C_e
+    xe = -np.linalg.solve(ao, ob.B_e @ u + ob.L @ y)
+    np.testing.assert_allclose(xe[nx:], f, rtol=1e-6, atol=1e-9)
+    np.testing.assert_allclose(xe[:nx], x_ss, rtol=1e-6, atol=1e-9)
+
+
+@pytest.mark.parametrize("kwargs, match", [
+    ({"state_weights": {"rotor_speed": -1.0}}, "weight 'rotor_speed' must be finite and >= 0"),
+    ({"state_weights": {"rotor_sped": 1.0}}, "unknown state 'rotor_sped'"),
+    ({"input_weights": {"pitch_ref_1": 0.0}}, "must be finite and > 0"),
+    ({"inputs": ("yaw",)}, "not among the model's inputs"),
+    ({"scales": {"rotor_speed": 0.0}}, "scale 'rotor_speed' must be finite and > 0"),
+])
+def test_lqr_bad_weights(do_model, kwargs, match: str) -> None:
+    with pytest.raises(ValueError, match=match):
+        design_lqr(do_model, **kwargs)
+
+
+def test_uncontrollable_pair_is_named() -> None:
+    # an unstable mode the input cannot reach
+    m = _scalar_model(1.0, 0.0)
+    with pytest.raises(SynthesisError, match="not stabilizable.*1\\+0j"):
+        design_lqr(m, inputs=("pitch_ref_1",))
+
+
+def test_unobservable_pair_is_named(do_model) -> None:
+    # measuring only the tower cannot see the blade-wind integrators in full
+    with pytest.raises(SynthesisError, match="not detectable from \\['tower_fa_displacement'\\]"):
+        design_pi_observer(do_model, measured=("tower_fa_displacement",))
+
+
+def test_observer_bad_input(do_model) -> None:
+    with pytest.raises(ValueError, match="q must be finite and > 0"):
+        design_pi_observer(do_model, q=-1.0)
+    with pytest.raises(ValueError, match="neither outputs nor states"):
+        design_pi_observer(do_model, measured=("lidar",))
+    with pytest.raises(ValueError, match="continuous model"):
+        design_pi_observer(do_model.discretize(0.1))
+
+
+def test_lqr_pio_regulates_speed_in_turbulence(turbine, params, do_model) -> None:
+    # in the loop on the nonlinear plant, 18 m/s class A, 60 s: the rotor stays near rated
+    from mpc_wt.simulation.loop import simulate_closed_loop
+    from mpc_wt.simulation.scenario import Scenario, make_wind
+
+    lq = design_lqr(do_model, state_weights={"rotor_speed": 5.0, "tower_fa_velocity": 1.0},
+                    scales={"rotor_speed": 0.05, "tower_fa_velocity": 0.1,
+                            **{f"pitch_ref_{i}": math.radians(1) for i in (1, 2, 3)}})
+    # q = 1e3: with q = 1e5 and the feedforward the loop diverges on the nonlinear plant (the
+    # high-gain observer takes the plant's 1P gravity/shear flap content for wind)
+    ctl = LQRPIOController(do_model, turbine, lq, design_pi_observer(do_model, q=1e3))
+    wind, _ = make_wind(turbine, Scenario(18.0, "A", 1, 60.0, 0.2))
+    op = linearize.trim(turbine, 18.0)
+    r = simulate_closed_loop(params, ctl, wind, 60.0, x0=op.x, u0=op.u)
+    keep = r.t > 10
+    speed = r.x[keep, 2]
+    assert abs(speed.mean() / 1.2671 - 1) < 0.03
+    assert speed.std() < 0.05
+    est = np.asarray(r.controller["wind_est"])
+    assert abs(np.mean(est[len(est) // 6:]) - 18.0) < 2.0
+
+
+def test_high_gain_pi_observer_diverges_in_turbulence_on_our_plant(turbine, params,
+                                                                   do_model) -> None:
+    """Issue 17, defect 5: Do et al. (sec. 2.4) ask for ||L2||_F >> ||L1||_F. On our plant the
+    condition cannot be met in the loop: in steady wind every q holds the rotor, but in class-A
+    turbulence at 18 m/s the loop with the unknown-input feedforward diverges from q = 1e4
+    (ratio 0.69) on; at q = 1e7 (ratio 1.98) it diverges within 30 s, and without the
+    feedforward it survives but regulates 3x worse (rotor-speed std 7.4 % against 2.6 %). The
+    observer takes the turbulence's fast blade-wind content (and the plant's 1P gravity and
+    shear flap content) for unknown inputs and the feedforward -K_f f_hat feeds it back. So
+    the default q = 1e3 (ratio 0.28) is the highest gain that keeps the loop; the README says so.
+    """
+    from mpc_wt.simulation.loop import simulate_closed_loop
+    from mpc_wt.simulation.scenario import Scenario, make_wind
+
+    lq = design_lqr(do_model, state_weights=REGION3_WEIGHTS, scales=REGION3_SCALES)
+    default, high = design_pi_observer(do_model), design_pi_observer(do_model, q=1e7)
+    # the ratio of the default and of the paper's "high gain" direction (Do et al. sec. 2.4)
+    assert default.q == 1e3 and default.gain_ratio < 0.3 and high.gain_ratio > 1.9
+    wind, _ = make_wind(turbine, Scenario(18.0, "A", 1, 40.0, 0.2))
+    op = linearize.trim(turbine, 18.0)
+    with pytest.raises(SimulationDivergedError):
+        simulate_closed_loop(params, LQRPIOController(do_model, turbine, lq, high), wind, 40.0,
+                             x0=op.x, u0=op.u)
+    r = simulate_closed_loop(params, LQRPIOController(do_model, turbine, lq, default), wind,
+                             40.0, x0=op.x, u0=op.u)
+    assert r.x[r.t > 10, 2].std() < 0.05

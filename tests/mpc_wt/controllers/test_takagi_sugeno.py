@@ -1,0 +1,181 @@
+"""Takagi-Sugeno model, LMI synthesis with its certificate, TS controller + wind observer in the
+loop (Clemens et al. eqs 1-11; issue 7)."""
+from __future__ import annotations
+
+import dataclasses
+import math
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+import lidar
+import linearize
+from mpc_wt.controllers.apc import apc_reference
+from mpc_wt.controllers.takagi_sugeno import (
+    TSController,
+    build_ts_model,
+    design_ts_controller,
+    design_ts_observer,
+    verify_controller,
+    verify_observer,
+)
+from mpc_wt.errors import PremiseError, SynthesisError
+from mpc_wt.simulation.loop import simulate_closed_loop
+from mpc_wt.simulation.scenario import Scenario, make_wind
+
+
+@pytest.fixture(scope="module")
+def ts(turbine: linearize.Turbine):
+    return build_ts_model(turbine, wind_grid=(12.0, 16.0, 20.0, 25.0),
+                          reduction_grid=(0.0, 0.8))
+
+
+@pytest.fixture(scope="module")
+def designs(ts):
+    return design_ts_controller(ts), design_ts_observer(ts)
+
+
+def test_vertices_are_the_linearization(turbine: linearize.Turbine, ts) -> None:
+    # vertex (16 m/s, dP 0.8) is the linear model trimmed to 20 % of rated power
+    i = 1 * 2 + 1
+    assert tuple(ts.vertices[i]) == (16.0, 0.8)
+    m = linearize.linearize(turbine, 16.0, config=linearize.PlantConfig.clemens(),
+                            disturbance="rotor", coordinates="mbc",
+                            power_W=0.2 * turbine.operation.rated_power)
+    np.testing.assert_allclose(ts.A[i], m.A, rtol=1e-9, atol=1e-12)
+    np.testing.assert_allclose(ts.u0[i], m.u0[[0, 3]], rtol=1e-12)
+    # full-load trim: rated rotor speed at every vertex, torque (1 - dP) of rated
+    k = ts.states.index("rotor_speed")
+    assert np.allclose(ts.x0[:, k], turbine.operation.rated_rotor_speed_rad_s, rtol=1e-9)
+    tq = ts.u0[:, 1].reshape(4, 2)
+    assert tq[:, 1] / tq[:, 0] == pytest.approx(np.full(4, 0.2), rel=1e-9)
+    # eq 1 at a vertex equilibrium: no motion; its Jacobian there is A_i
+    assert np.allclose(ts.rhs(ts.x0[i], ts.u0[i], 16.0, 0.8), 0.0)
+    dx = np.zeros(len(ts.states))
+    dx[k] = 1e-3
+    np.testing.assert_allclose((ts.rhs(ts.x0[i] + dx, ts.u0[i], 16.0, 0.8)) / 1e-3,
+                               ts.A[i][:, k], rtol=1e-9, atol=1e-12)
+
+
+@settings(max_examples=200, deadline=None)
+@given(v=st.floats(12.0, 25.0), dp=st.floats(0.0, 0.8))
+def test_memberships_are_a_convex_sum(ts, v: float, dp: float) -> None:
+    h = ts.membership(v, dp)
+    assert np.all(h >= 0) and math.isclose(h.sum(), 1.0, rel_tol=1e-12)
+    # linear memberships reproduce the premise itself: sum h_i z_i = z
+    np.testing.assert_allclose(h @ ts.vertices, [v, dp], rtol=1e-12, atol=1e-12)
+    assert np.count_nonzero(h) <= 4
+
+
+@pytest.mark.parametrize("v, dp", [(11.9, 0.2), (25.5, 0.2), (15.0, -0.1), (15.0, 0.9),
+                                   (math.nan, 0.0)])
+def test_premise_outside_the_vertices_is_refused(ts, v: float, dp: float) -> None:
+    with pytest.raises(PremiseError, match="outside the TS model's vertices"):
+        ts.membership(v, dp)
+
+
+def test_controller_certificate_holds_and_can_fail(ts, designs) -> None:
+    ctl, _ = designs
+    assert ctl.certificate.ok, ctl.certificate.failures
+    assert ctl.certificate.worst_decay <= 0 and ctl.certificate.n_grid >= 100
+    # independent of the certificate: each vertex's closed loop (integrator included) decays
+    # at least at the required rate
+    nx = len(ts.states)
+    k_rot = ts.states.index("rotor_speed")
+    for i in range(ts.n_vertices):
+        a = np.zeros((nx + 1, nx + 1))
+        a[:nx, :nx], a[nx, k_rot] = ts.A[i], 1.0
+        b = np.vstack([ts.B[i], np.zeros((1, 2))])
+        assert np.linalg.eigvals(a - b @ ctl.K[i]).real.max() <= -ctl.decay_rate + 1e-9
+    # a perturbed gain: the check must fail
+    bad = ctl.K.copy()
+    bad[2] = 0.0
+    cert = verify_controller(ts, bad, ctl.P, ctl.scale_x, ctl.scale_u, ctl.decay_rate,
+                             integral_of="rotor_speed")
+    assert not cert.ok and any("vertex 2" in f for f in cert.failures)
+    bad = ctl.K * 1.5
+    assert not verify_controller(ts, bad, ctl.P, ctl.scale_x, ctl.scale_u, ctl.decay_rate,
+                                 integral_of="rotor_speed").ok
+
+
+def test_observer_certificate_holds_and_can_fail(ts, designs) -> None:
+    _, obs = designs
+    assert obs.certificate.ok, obs.certificate.failures
+    for i in range(ts.n_vertices):
+        f = obs.A_aug[i] - obs.L[i] @ obs.C_aug
+        assert np.linalg.eigvals(f).real.max() <= -obs.decay_rate + 1e-9
+    bad = obs.L.copy()
+    bad[0] *= 0.0
+    assert not verify_observer(ts, bad, obs.P, obs.scale_xi, obs.scale_y,
+                               obs.decay_rate, obs.disk_radius).ok
+
+
+def test_infeasible_lmis_say_what_to_relax(ts) -> None:
+    with pytest.raises(SynthesisError, match=r"relax \(lower\) decay_rate; the largest "
+                                             r"feasible found is about"):
+        design_ts_controller(ts, decay_rate=40.0, disk_radius=None)
+    with pytest.raises(SynthesisError, match="relax input_bounds"):
+        design_ts_controller(ts, input_bounds={"pitch_ref_coll": 1e-5, "gen_torque_ref": 1.0})
+    with pytest.raises(SynthesisError, match="observer LMIs are infeasible"):
+        design_ts_observer(ts, decay_rate=50.0, disk_radius=55.0)
+
+
+def test_bad_design_input(ts) -> None:
+    with pytest.raises(ValueError, match="decay_rate must be finite and >= 0"):
+        design_ts_controller(ts, decay_rate=-1.0)
+    with pytest.raises(ValueError, match="disk_radius"):
+        design_ts_controller(ts, decay_rate=1.0, disk_radius=0.5)
+    with pytest.raises(ValueError, match="input_bounds: unknown inputs"):
+        design_ts_controller(ts, input_bounds={"yaw": 1.0})
+    with pytest.raises(ValueError, match="tau_v must be finite and > 0"):
+        design_ts_observer(ts, tau_v=0.0)
+    with pytest.raises(ValueError, match="reduction_grid values must be in"):
+        build_ts_model(linearize.load_turbine(), (14.0, 16.0), (0.0, 1.0))
+
+
+def test_unobservable_wind_is_refused(ts) -> None:
+    # a sensor that sees nothing (every mode unobservable)
+    blind = dataclasses.replace(ts, measured=("tower_ss_displacement",),
+                                C=np.zeros((1, len(ts.states))))
+    with pytest.raises(SynthesisError, match="not detectable"):
+        design_ts_observer(blind)
+
+
+def test_ts_controller_regulates_and_tracks_power(turbine, params, ts, designs) -> None:
+    ctl, obs = designs
+    v, dur, f = 16.0, 120.0, 0.1
+    wind, field = make_wind(turbine, Scenario(v, "A", 3, dur, 0.2))
+    op = linearize.trim(turbine, v)
+    c = TSController(ts, ctl, obs, turbine, initial_wind_mps=v)
+    r = simulate_closed_loop(params, c, wind, dur, x0=op.x, u0=op.u)
+    w = r.channel("rotor_speed")[r.t > 20]
+    rated = turbine.operation.rated_rotor_speed_rad_s
+    assert abs(w.mean() / rated - 1) < 0.01 and w.std() / rated < 0.04
+    # wind estimate against the rotor-disk mean of the field
+    truth = np.interp(r.t, field.t,
+                      lidar.rotor_effective_wind(field, turbine.geometry.tip_radius))
+    err = (r.channel("wind_est") - truth)[r.t > 20]
+    assert np.sqrt(np.mean(err**2)) < 0.5 * truth[r.t > 20].std() + 0.3
+    # active power control: the sinusoidal reduction of eq 11 at 0.1 Hz
+    c = TSController(ts, ctl, obs, turbine, initial_wind_mps=v, power_reduction=apc_reference(f))
+    r = simulate_closed_loop(params, c, wind, dur, x0=op.x, u0=op.u)
+    sel = r.t > 20
+    t = r.t[sel]
+    basis = np.c_[np.sin(2 * np.pi * f * t), np.cos(2 * np.pi * f * t), np.ones_like(t)]
+    ref = np.linalg.lstsq(basis, r.channel("power_ref")[sel], rcond=None)[0]
+    got = np.linalg.lstsq(basis, r.channel("gen_power")[sel], rcond=None)[0]
+    gain = complex(got[0], got[1]) / complex(ref[0], ref[1])
+    assert 0.85 < abs(gain) < 1.15 and abs(math.degrees(np.angle(gain))) < 30
+
+
+def test_ts_controller_bad_input(turbine, ts, designs) -> None:
+    ctl, obs = designs
+    with pytest.raises(PremiseError):
+        TSController(ts, ctl, obs, turbine, initial_wind_mps=30.0)
+    c = TSController(ts, ctl, obs, turbine, initial_wind_mps=16.0)
+    meas = {"gen_speed": math.nan, "rotor_speed": 1.2,
+            "state": np.zeros(len(linearize.STATE_NAMES))}
+    with pytest.raises(ValueError, match="non-finite measurement"):
+        c.step(0.0, meas)

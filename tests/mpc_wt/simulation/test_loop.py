@@ -1,0 +1,155 @@
+"""The closed loop: bad controllers and commands, divergence, controller periods, the LIDAR in
+the loop and the wind the harness reads.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from numpy.testing import assert_allclose
+
+import lidar
+import linearize
+from mpc_wt.simulation.loop import SimulationDivergedError, simulate_closed_loop
+
+
+class _NaNController:
+    signals: dict = {}
+
+    def reset(self) -> None:
+        pass
+
+    def step(self, t, meas):
+        return (np.array([0.1, 0.1, np.nan]), 40000.0) if t > 0.5 else (np.zeros(3), 40000.0)
+
+
+class _Fixed:
+    """A controller that always commands the same pitch [rad] and generator torque [N m]."""
+
+    signals: dict = {}
+
+    def __init__(self, pitch: float = 0.0, torque: float = 0.0) -> None:
+        self.pitch, self.torque = pitch, torque
+
+    def reset(self) -> None:
+        pass
+
+    def step(self, t, meas):
+        return np.full(3, self.pitch), self.torque
+
+
+class _PreviewProbe:
+    def __init__(self) -> None:
+        self.signals: dict = {}
+        self.seen: list = []
+
+    def reset(self) -> None:
+        self.seen = []
+
+    def step(self, t, meas):
+        self.seen.append((t, meas["preview"]))
+        return np.full(3, 0.26), 43093.55
+
+
+
+def test_controller_returning_nan(turbine: linearize.Turbine,
+                                  params: linearize.PlantParams) -> None:
+    op = linearize.trim(turbine, 12.0)
+    with pytest.raises(ValueError, match=r"controller returned pitch .* at t = 0.5125 s"):
+        simulate_closed_loop(params, _NaNController(), linearize.SteadyWind(12.0), 2.0,
+                             x0=op.x, u0=op.u)
+
+
+def test_diverging_closed_loop_keeps_the_partial_result(turbine: linearize.Turbine,
+                                                        params: linearize.PlantParams) -> None:
+    op = linearize.trim(turbine, 25.0)
+    x0 = op.x.copy()
+    x0[5:8] = 0.0
+    with pytest.raises(SimulationDivergedError, match=r"state '(rotor|gen)_speed'") as exc:
+        simulate_closed_loop(params, _Fixed(), linearize.SteadyWind(25.0), 300.0,
+                             x0=x0, u0=op.u)
+    assert exc.value.partial.t.size > 100 and np.all(np.isfinite(exc.value.partial.z))
+
+
+def test_controller_period_must_divide(turbine: linearize.Turbine,
+                                      params: linearize.PlantParams) -> None:
+    op = linearize.trim(turbine, 12.0)
+    with pytest.raises(ValueError, match="whole multiple of dt"):
+        simulate_closed_loop(params, _Fixed(), linearize.SteadyWind(12.0), 1.0, x0=op.x,
+                             u0=op.u, controller_dt=0.03)
+
+
+def test_out_of_range_commands_are_recorded(turbine: linearize.Turbine,
+                                            params: linearize.PlantParams,
+                                            caplog: pytest.LogCaptureFixture) -> None:
+    op = linearize.trim(turbine, 14.0)
+    with caplog.at_level("WARNING"):
+        r = simulate_closed_loop(params, _Fixed(math.radians(120.0), 40000.0),
+                                 linearize.SteadyWind(14.0), 1.0, x0=op.x, u0=op.u)
+    assert r.meta["commands_clipped"] == 80
+    assert "out of the actuator range" in caplog.text
+    assert r.x[:, 5].max() <= math.radians(90.0) + 1e-9
+
+
+def test_lidar_preview_in_the_loop(turbine: linearize.Turbine,
+                                   params: linearize.PlantParams) -> None:
+    # the controller receives a (15, 3) per-blade preview from a simulated LIDAR measuring the
+    # field the plant meets; idealized LIDAR + frozen field: it is the wind each blade meets
+    from mpc_wt.simulation.preview import LidarPreview
+
+    f = lidar.generate_field(lidar.TurbulenceSpec(18.0, "A", duration=40.0), 5)
+    gw = linearize.GridWind(t=f.t, y=f.y, z=f.z, u=np.maximum(f.u, 0.0))
+    op = linearize.trim(turbine, 18.0)
+    probe = _PreviewProbe()
+    lid = lidar.CWLidar(63.0, range_weighting=False, los_error=False)
+    r = simulate_closed_loop(params, probe, gw, 20.0, x0=op.x, u0=op.u, controller_dt=0.1,
+                             preview=LidarPreview(lid, f, 15, 0.1))
+    t, p = next((tt, pp) for tt, pp in probe.seen if tt >= 15.0)   # steps inside the run
+    assert p.blade.shape == (15, 3) and p.measured.all()
+    # exact plumbing: each step's preview is the wind at the position predicted when it was
+    # measured (t_m = t - T_p): azimuth psi(t_m) + omega(t_m) T_p, at 75 % span, at time t
+    tp = 54.0 / 18.0
+    tm = p.t - tp
+    psi_m = np.interp(tm, r.t, r.x[:, 16])
+    om_m = np.interp(tm, r.t, r.x[:, 2])
+    predicted = lidar.blade_effective_wind(f, p.t, psi_m + om_m * tp, lid.radius)
+    assert_allclose(p.blade, predicted, rtol=0, atol=1e-9)
+    # the blade actually arrives where the rotor turned to; with fixed pitch and torque its
+    # speed drifts over T_p, so the preview is only as good as that prediction (here < 2 m/s)
+    truth = lidar.blade_effective_wind(f, p.t, np.interp(p.t, r.t, r.x[:, 16]), lid.radius)
+    assert np.abs(p.blade - truth).max() < 2.5
+
+
+def test_a_rotor_driven_backwards_is_reported_as_divergence(turbine: linearize.Turbine,
+                                                            params: linearize.PlantParams) -> None:
+    # feathered blades and full generator torque stop the rotor and drive it backwards: the
+    # envelope allows at most -10 % of rated speed (found when an unstable observer loop ran at
+    # -0.26 rad/s unreported)
+    op = linearize.trim(turbine, 12.0)
+    with pytest.raises(SimulationDivergedError,
+                       match=r"state '(rotor|gen)_speed' = -\d") as exc:
+        simulate_closed_loop(params, _Fixed(math.radians(90.0), 43093.55),
+                             linearize.SteadyWind(12.0), 120.0, x0=op.x, u0=op.u)
+    assert exc.value.partial.x[:, 2].min() > -0.2
+
+
+@settings(max_examples=60, deadline=None)
+@given(dt=st.floats(0.01, 0.5), n=st.integers(2, 400), t0=st.floats(-5.0, 5.0),
+       q=st.lists(st.floats(-10.0, 250.0), min_size=1, max_size=20), seed=st.integers(0, 999))
+def test_hub_wind_reads_the_field_as_linear_interpolation(dt, n, t0, q, seed) -> None:
+    """Issue 23: the hub wind handed to controllers is read by index on a uniform grid; it is
+    numpy's linear interpolation of the hub column (held at the ends) at any time."""
+    from mpc_wt.simulation.loop import _hub_wind
+
+    rng = np.random.default_rng(seed)
+    t = t0 + dt * np.arange(n)
+    y, z = np.linspace(-80, 80, 5), np.linspace(10, 170, 5)
+    u = rng.normal(10, 2, (n, 5, 5))
+    gw = linearize.GridWind(t=t, y=y, z=z, u=u)
+    f = _hub_wind(gw, 90.0)
+    hub = gw.u[:, 2, 2].astype(float)           # the column as stored (float32, issue 23)
+    for tq in q:
+        assert f(tq) == pytest.approx(np.interp(tq, t, hub), rel=1e-12, abs=1e-12)
