@@ -110,11 +110,33 @@ class CWLidar:
         return self.wavelength * self.focus_range**2 / (math.pi * self.beam_radius**2)
 
     def preview_time(self, mean_speed: float) -> float:
-        """T_p = D / V [s]."""
+        """T_p = D / V [s].
+
+        Parameters
+        ----------
+        mean_speed : float
+            Mean wind speed [m/s].
+
+        Returns
+        -------
+        float
+            Preview time T_p [s].
+        """
         return self.focus_distance / mean_speed
 
     def weighting(self, s: FloatArray) -> FloatArray:
-        """Range-weighting function W(s) along the beam, normalized on s in (0, inf) [1/m]."""
+        """Range-weighting function W(s) along the beam, normalized on s in (0, inf) [1/m].
+
+        Parameters
+        ----------
+        s : (n_s,) ndarray
+            Ranges along the beam [m].
+
+        Returns
+        -------
+        (n_s,) ndarray
+            W(s) [1/m].
+        """
         g = self.half_width
         f = self.focus_range
         norm = 0.5 + math.atan(f / g) / math.pi
@@ -125,6 +147,18 @@ class CWLidar:
 
         Uniform in theta = atan((s - F) / Gamma), where the Lorentzian is uniform; the weight of
         (s_max, inf) stays on the last point, so the weights always sum to exactly 1.
+
+        Parameters
+        ----------
+        s_max : float
+            Largest range integrated [m] (default: the whole beam).
+
+        Returns
+        -------
+        s : (n_s,) ndarray
+            Ranges [m].
+        w : (n_s,) ndarray
+            Weights, summing to 1 [-].
         """
         if not self.range_weighting:
             return np.array([self.focus_range]), np.array([1.0])
@@ -140,7 +174,22 @@ class CWLidar:
 
     def beam_azimuths(self, blade_azimuth_rad: FloatArray, rotor_speed_rad_s: FloatArray,
                       mean_speed: float) -> FloatArray:
-        """Azimuth of each beam, (n_t, 3): blade azimuth + (i - 1) 2 pi / 3 + omega_r T_p."""
+        """Azimuth of each beam, (n_t, 3): blade azimuth + (i - 1) 2 pi / 3 + omega_r T_p.
+
+        Parameters
+        ----------
+        blade_azimuth_rad : (n_t,) ndarray
+            Azimuth of blade 1 [rad].
+        rotor_speed_rad_s : (n_t,) ndarray or float
+            Rotor speed [rad/s].
+        mean_speed : float
+            Mean wind speed that sets the preview time [m/s].
+
+        Returns
+        -------
+        (n_t, 3) ndarray
+            Azimuth of each beam [rad].
+        """
         psi = np.asarray(blade_azimuth_rad, float)[:, None] + 2 * math.pi * np.arange(3) / 3
         lead = np.asarray(rotor_speed_rad_s, float)[:, None] * self.preview_time(mean_speed)
         return psi + lead

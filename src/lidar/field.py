@@ -147,6 +147,18 @@ class WindField:
     def sample(self, t: Any, y: Any, z: Any, component: str = "u") -> FloatArray:
         """Trilinear interpolation of one component at points (t, y, z), broadcast together.
 
+        Parameters
+        ----------
+        t, y, z : array_like
+            Times [s] and lateral and vertical positions [m], broadcast together.
+        component : {"u", "v", "w"}
+            The wind component.
+
+        Returns
+        -------
+        ndarray
+            The component at the points, in their broadcast shape [m/s].
+
         Raises
         ------
         ValueError
@@ -175,7 +187,18 @@ class WindField:
     # I/O
     # ---------------------------------------------------------------------------------------
     def save(self, path: str | Path) -> Path:
-        """Write ``.npz`` (native, with metadata) or ``.bts`` (TurbSim binary) by suffix."""
+        """Write ``.npz`` (native, with metadata) or ``.bts`` (TurbSim binary) by suffix.
+
+        Parameters
+        ----------
+        path : str or Path
+            ``.npz`` or ``.bts``.
+
+        Returns
+        -------
+        Path
+            The file written.
+        """
         path = Path(path)
         if path.suffix.lower() == ".bts":
             _write_bts(self, path)

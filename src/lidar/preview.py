@@ -44,6 +44,22 @@ def preview(meas: LidarMeasurement, t_now: float, horizon: int = 15,
             dt: float = 0.1) -> Preview:
     """The preview at controller time ``t_now``: measurement taken at t - T_p for each step t.
 
+    Parameters
+    ----------
+    meas : LidarMeasurement
+        The LIDAR's measurements.
+    t_now : float
+        Controller time [s].
+    horizon : int
+        Preview steps H_p.
+    dt : float
+        Controller step [s].
+
+    Returns
+    -------
+    Preview
+        The per-blade wind over the next ``horizon`` steps.
+
     Raises
     ------
     ValueError
@@ -117,7 +133,15 @@ class PreviewBuffer:
         self._last = t
 
     def history(self) -> tuple[FloatArray, FloatArray]:
-        """The kept samples, oldest first: times (n,) [s] and winds (3, n) [m/s] (views)."""
+        """The kept samples, oldest first: times (n,) [s] and winds (3, n) [m/s] (views).
+
+        Returns
+        -------
+        t : (n,) ndarray
+            Times [s].
+        u : (3, n) ndarray
+            Each beam's wind estimate [m/s].
+        """
         n = len(self)
         lo = self._n % self.capacity if self._n >= self.capacity else 0
         return self._t[lo:lo + n], self._u[:, lo:lo + n]
@@ -152,7 +176,24 @@ class PreviewBuffer:
 
 def preview_series(meas: LidarMeasurement, t_ctrl: FloatArray, horizon: int = 15,
                    dt: float = 0.1) -> FloatArray:
-    """Previews for a sequence of controller times, (n_k, horizon, 3) [m/s] (vectorized)."""
+    """Previews for a sequence of controller times, (n_k, horizon, 3) [m/s] (vectorized).
+
+    Parameters
+    ----------
+    meas : LidarMeasurement
+        The LIDAR's measurements.
+    t_ctrl : (n_k,) ndarray
+        Controller times [s].
+    horizon : int
+        Preview steps H_p.
+    dt : float
+        Controller step [s].
+
+    Returns
+    -------
+    (n_k, horizon, 3) ndarray
+        The previews [m/s].
+    """
     t_ctrl = np.asarray(t_ctrl, float)
     steps = t_ctrl[:, None] + dt * np.arange(1, horizon + 1)[None, :]
     tm = np.clip(np.minimum(steps - meas.preview_time, t_ctrl[:, None]), meas.t[0], meas.t[-1])
@@ -161,7 +202,24 @@ def preview_series(meas: LidarMeasurement, t_ctrl: FloatArray, horizon: int = 15
 
 def blade_effective_wind(field: WindField, t: FloatArray, blade_azimuth_rad: FloatArray,
                          radius: float) -> FloatArray:
-    """Longitudinal wind at each blade's point at ``radius`` (75 % span), (n_t, 3) [m/s]."""
+    """Longitudinal wind at each blade's point at ``radius`` (75 % span), (n_t, 3) [m/s].
+
+    Parameters
+    ----------
+    field : WindField
+        The wind field.
+    t : (n_t,) ndarray
+        Times [s].
+    blade_azimuth_rad : (n_t,) ndarray
+        Azimuth of blade 1 [rad].
+    radius : float
+        Radius of the point on each blade [m].
+
+    Returns
+    -------
+    (n_t, 3) ndarray
+        Longitudinal wind at each blade's point [m/s].
+    """
     t = np.asarray(t, float)
     ang = np.asarray(blade_azimuth_rad, float)[:, None] + 2 * math.pi * np.arange(3) / 3
     y = -radius * np.sin(ang)
@@ -175,6 +233,20 @@ def rotor_effective_wind(field: WindField, rotor_radius: float, method: str = "m
 
     ``"mean"``: the disc average of u (grid points inside the rotor disc); ``"cube"``: the
     cube root of the disc average of u^3 (the power-equivalent speed of IEC 61400-12-1).
+
+    Parameters
+    ----------
+    field : WindField
+        The wind field.
+    rotor_radius : float
+        Rotor radius [m].
+    method : {"mean", "cube"}
+        Disc average of u, or the cube root of the disc average of u^3.
+
+    Returns
+    -------
+    (n_t,) ndarray
+        Rotor-effective wind speed [m/s].
     """
     yy, zz = np.meshgrid(field.y, field.z - field.hub_height, indexing="ij")
     inside = yy**2 + zz**2 <= rotor_radius**2
@@ -191,6 +263,15 @@ def rotor_effective_wind(field: WindField, rotor_radius: float, method: str = "m
 def coherence(estimate: FloatArray, truth: FloatArray, fs: float,
               nperseg: int = 256) -> tuple[FloatArray, FloatArray]:
     """Magnitude-squared coherence (Welch) between an estimate and the truth.
+
+    Parameters
+    ----------
+    estimate, truth : (n_t,) ndarray
+        The two series, sampled together.
+    fs : float
+        Sample rate [Hz].
+    nperseg : int
+        Welch segment length [samples].
 
     Returns
     -------
@@ -211,6 +292,22 @@ def coherence_bandwidth(f: FloatArray, gamma2: FloatArray, level: float = 0.5,
     first-crossing on the raw curve), so the coherence is first averaged in logarithmic bands
     (``bands_per_decade``; 0 uses the raw bins). Returns the interpolated crossing, or the
     highest frequency if the coherence never falls below the level.
+
+    Parameters
+    ----------
+    f : (n_f,) ndarray
+        Frequencies [Hz].
+    gamma2 : (n_f,) ndarray
+        Magnitude-squared coherence [-].
+    level : float
+        The coherence that marks the bandwidth [-].
+    bands_per_decade : int
+        Logarithmic bands the coherence is averaged in (0: raw bins).
+
+    Returns
+    -------
+    float
+        The bandwidth [Hz].
     """
     f = np.asarray(f, float)
     g = np.asarray(gamma2, float)
@@ -237,14 +334,42 @@ def coherence_bandwidth(f: FloatArray, gamma2: FloatArray, level: float = 0.5,
 
 
 def rms_preview_error(previews: FloatArray, truth: FloatArray) -> float:
-    """RMS of preview minus truth over all steps and blades [m/s]."""
+    """RMS of preview minus truth over all steps and blades [m/s].
+
+    Parameters
+    ----------
+    previews : (n_k, n_h, 3) ndarray
+        Previews [m/s].
+    truth : (n_k, n_h, 3) ndarray
+        The wind each blade meets at the same steps [m/s].
+
+    Returns
+    -------
+    float
+        The RMS error [m/s].
+    """
     d = np.asarray(previews, float) - np.asarray(truth, float)
     return float(np.sqrt(np.mean(d**2)))
 
 
 def peak_lag(estimate: FloatArray, later: FloatArray, dt: float, max_lag: float) -> float:
     """Lag [s] that maximizes the cross-correlation of ``later`` against ``estimate``
-    (positive: ``later`` follows ``estimate``), refined by a parabola through the peak."""
+    (positive: ``later`` follows ``estimate``), refined by a parabola through the peak.
+
+    Parameters
+    ----------
+    estimate, later : (n_t,) ndarray
+        The two series, sampled together.
+    dt : float
+        Sample time [s].
+    max_lag : float
+        Largest lag searched [s].
+
+    Returns
+    -------
+    float
+        The lag [s].
+    """
     a = np.asarray(estimate, float) - np.mean(estimate)
     b = np.asarray(later, float) - np.mean(later)
     n = len(a)

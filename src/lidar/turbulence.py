@@ -126,7 +126,15 @@ class TurbulenceSpec:
         return np.array([8.1 * lam, 2.7 * lam, 0.66 * lam, 8.1 * lam])
 
     def grid(self) -> tuple[FloatArray, FloatArray, FloatArray]:
-        """Time, y and z axes."""
+        """Time, y and z axes.
+
+        Returns
+        -------
+        t : (n_t,) ndarray
+            Times [s].
+        y, z : (n_y,), (n_z,) ndarray
+            Lateral and vertical grid positions [m].
+        """
         n_t = int(round(self.duration / self.dt))
         t = np.arange(n_t) * self.dt
         y = np.linspace(-self.width / 2, self.width / 2, self.n_y)
@@ -135,7 +143,20 @@ class TurbulenceSpec:
 
 
 def iec_sigma(mean_speed: float, turbulence: str | float) -> FloatArray:
-    """IEC 61400-1 ed. 3 normal turbulence model: (sigma_1, 0.8 sigma_1, 0.5 sigma_1) [m/s]."""
+    """IEC 61400-1 ed. 3 normal turbulence model: (sigma_1, 0.8 sigma_1, 0.5 sigma_1) [m/s].
+
+    Parameters
+    ----------
+    mean_speed : float
+        Hub-height mean wind speed [m/s].
+    turbulence : str or float
+        IEC class "A", "B" or "C", or a turbulence intensity [-].
+
+    Returns
+    -------
+    (3,) ndarray
+        Standard deviations of u, v, w [m/s].
+    """
     if isinstance(turbulence, str):
         s1 = _I_REF[turbulence.upper()] * (0.75 * mean_speed + 5.6)
     else:
@@ -144,14 +165,48 @@ def iec_sigma(mean_speed: float, turbulence: str | float) -> FloatArray:
 
 
 def kaimal_spectrum(f: FloatArray, sigma: float, length: float, mean_speed: float) -> FloatArray:
-    """One-sided Kaimal spectrum S(f) = 4 sigma^2 (L/V) / (1 + 6 f L / V)^(5/3) [m^2/s]."""
+    """One-sided Kaimal spectrum S(f) = 4 sigma^2 (L/V) / (1 + 6 f L / V)^(5/3) [m^2/s].
+
+    Parameters
+    ----------
+    f : ndarray
+        Frequencies [Hz].
+    sigma : float
+        Standard deviation [m/s].
+    length : float
+        Integral length scale [m].
+    mean_speed : float
+        Mean wind speed [m/s].
+
+    Returns
+    -------
+    ndarray
+        S(f) [m^2/s].
+    """
     f = np.asarray(f, dtype=float)
     lv = length / mean_speed
     return 4.0 * sigma**2 * lv / (1.0 + 6.0 * f * lv) ** (5.0 / 3.0)
 
 
 def iec_coherence(r: FloatArray, f: FloatArray, mean_speed: float, lc: float) -> FloatArray:
-    """IEC exponential coherence exp(-12 sqrt((f r / V)^2 + (0.12 r / L_c)^2)) [-]."""
+    """IEC exponential coherence exp(-12 sqrt((f r / V)^2 + (0.12 r / L_c)^2)) [-].
+
+    Parameters
+    ----------
+    r : ndarray
+        Separations [m].
+    f : ndarray
+        Frequencies [Hz], broadcast with ``r``.
+    mean_speed : float
+        Hub-height mean wind speed [m/s].
+    lc : float
+        Coherence scale parameter L_c [m].
+
+    Returns
+    -------
+    ndarray
+        The coherence [-].
+    """
     r = np.asarray(r, dtype=float)
     f = np.asarray(f, dtype=float)
     return np.exp(-12.0 * np.sqrt((f * r / mean_speed) ** 2 + (0.12 * r / lc) ** 2))
@@ -558,7 +613,24 @@ def simley_pao_evolution(mean_speed: float, sigma: Any, length_scale: float
 def evolution_coherence(f: FloatArray, distance: float, mean_speed: float, a: float,
                         b: float) -> FloatArray:
     """Magnitude-squared coherence gamma^2 = exp(-a sqrt((f d / V)^2 + (b d)^2)) [-]
-    (Simley and Pao 2015; see :func:`simley_pao_evolution`)."""
+    (Simley and Pao 2015; see :func:`simley_pao_evolution`).
+
+    Parameters
+    ----------
+    f : (n_f,) ndarray
+        Frequencies [Hz].
+    distance : float
+        Separation along the mean wind [m].
+    mean_speed : float
+        Mean wind speed [m/s].
+    a, b : float
+        The model's parameters [-] and [1/m].
+
+    Returns
+    -------
+    (n_f,) ndarray
+        gamma^2 [-].
+    """
     f = np.asarray(f, dtype=float)
     return np.exp(-a * np.sqrt((f * distance / mean_speed) ** 2 + (b * distance) ** 2))
 

@@ -101,6 +101,18 @@ def build_polar_table(polars: tuple[Polar, ...], n_alpha: int = _N_ALPHA) -> Pol
     The Hermite cubic through the sampled values and slopes reproduces the Akima spline to
     O(h^3) and keeps the coefficients continuously differentiable in alpha, which the
     finite-difference linearization needs.
+
+    Parameters
+    ----------
+    polars : tuple of Polar
+        The airfoil polars.
+    n_alpha : int
+        Samples over -180..180 deg.
+
+    Returns
+    -------
+    PolarTable
+        Values and slopes of C_l, C_d on the grid.
     """
     grid = np.linspace(-_PI, _PI, n_alpha)
     out = np.empty((len(polars), 4, n_alpha))
@@ -493,7 +505,18 @@ _TABLE_CACHE: dict[int, tuple[Turbine, PolarTable]] = {}
 
 
 def polar_table_of(turbine: Turbine) -> PolarTable:
-    """The turbine's :class:`PolarTable`, built once per turbine object."""
+    """The turbine's :class:`PolarTable`, built once per turbine object.
+
+    Parameters
+    ----------
+    turbine : Turbine
+        The turbine.
+
+    Returns
+    -------
+    PolarTable
+        Its polars, sampled.
+    """
     hit = _TABLE_CACHE.get(id(turbine))
     if hit is not None and hit[0] is turbine:
         return hit[1]

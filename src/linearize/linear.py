@@ -273,7 +273,20 @@ class LinearModel:
         return len(self.states)
 
     def index(self, kind: str, name: str) -> int:
-        """Index of a named state, input, disturbance or output (``kind`` e.g. "output")."""
+        """Index of a named state, input, disturbance or output (``kind`` e.g. "output").
+
+        Parameters
+        ----------
+        kind : {"state", "input", "disturbance", "output"}
+            Which names to look in.
+        name : str
+            The name.
+
+        Returns
+        -------
+        int
+            Its index.
+        """
         names = {"state": self.states, "input": self.inputs, "disturbance": self.disturbances,
                  "output": self.outputs}[kind]
         if name not in names:
@@ -283,6 +296,16 @@ class LinearModel:
     # -- transformations
     def discretize(self, dt: float) -> "LinearModel":
         """Zero-order hold on inputs and disturbances at sample time ``dt`` [s].
+
+        Parameters
+        ----------
+        dt : float
+            Sample time [s].
+
+        Returns
+        -------
+        LinearModel
+            The discrete-time model.
 
         Raises
         ------
@@ -302,7 +325,13 @@ class LinearModel:
                        dt=float(dt))
 
     def to_statespace(self) -> Any:
-        """python-control ``StateSpace`` with inputs [u, d] and the model's names."""
+        """python-control ``StateSpace`` with inputs [u, d] and the model's names.
+
+        Returns
+        -------
+        control.StateSpace
+            The model.
+        """
         import control
 
         return control.ss(self.A, np.hstack([self.B_u, self.B_d]), self.C_z,
@@ -314,7 +343,18 @@ class LinearModel:
     def select(self, inputs: Sequence[str] | None = None,
                disturbances: Sequence[str] | None = None,
                outputs: Sequence[str] | None = None) -> "LinearModel":
-        """The same dynamics with a subset of inputs, disturbances and outputs (names)."""
+        """The same dynamics with a subset of inputs, disturbances and outputs (names).
+
+        Parameters
+        ----------
+        inputs, disturbances, outputs : sequence of str, optional
+            The names kept (default: all).
+
+        Returns
+        -------
+        LinearModel
+            The reduced model.
+        """
         iu = [self.index("input", n) for n in (inputs or self.inputs)]
         idd = [self.index("disturbance", n) for n in (disturbances or self.disturbances)]
         iz = [self.index("output", n) for n in (outputs or self.outputs)]
@@ -335,6 +375,12 @@ class LinearModel:
         The name is the state group with the largest participation factor abs(phi_k psi_k)
         (right and left eigenvectors): tower fore-aft, tower side-side, drivetrain torsion,
         blade flap or blade edge (collective or asymmetric), rotor, pitch actuator.
+
+        Returns
+        -------
+        list of dict
+            One per oscillatory mode: ``frequency_Hz`` (natural), ``damped_frequency_Hz``,
+            ``damping_ratio`` and ``name``.
         """
         a = self.A
         if self.dt is not None:
@@ -377,7 +423,15 @@ class LinearModel:
 
     # -- I/O
     def to_dict(self) -> dict[str, Any]:
-        """Plain dict (lists, floats, strings) for JSON."""
+        """Plain dict (lists, floats, strings) for JSON.
+
+        Returns
+        -------
+        dict
+            Names and units of states, inputs, disturbances and outputs, the matrices
+            (``A``, ``B_u``, ``B_d``, ``C_z``, ``D_u``, ``D_d``), the operating point, wake,
+            coordinates, sample time and schema version.
+        """
         d = {k: getattr(self, k) for k in ("states", "inputs", "disturbances", "outputs",
                                             "state_units", "input_units", "disturbance_units",
                                             "output_units", "wake", "coordinates", "dt", "info")}
@@ -655,6 +709,21 @@ def jacobian_check(turbine: Turbine, wind_mps: float, *, config: PlantConfig | N
                                                                 tuple[FloatArray, ...]]:
     """Full Jacobians at azimuth 0 by central differences and by complex step.
 
+    Parameters
+    ----------
+    turbine : Turbine
+        The turbine.
+    wind_mps : float
+        Mean wind speed of the trim [m/s].
+    config : PlantConfig, optional
+        Plant configuration (default all DOFs).
+    wake : {"quasi-steady", "frozen"}
+        Wake model of the derivatives.
+    shear_exponent : float
+        Power-law shear exponent [-].
+    params : PlantParams, optional
+        Precomputed plant parameters.
+
     Returns
     -------
     fd, cs : tuple of 6 ndarray
@@ -677,6 +746,20 @@ def augment_actuator(model: LinearModel, time_constant: float,
     2020, eq 6): d/dt [x; beta] = [[A, B], [0, -I/tau]] [x; beta] + [0; I/tau] u.
 
     The new states are named after the inputs with ``_ref`` dropped (``pitch_1`` ...).
+
+    Parameters
+    ----------
+    model : LinearModel
+        The model.
+    time_constant : float
+        Actuator time constant tau [s].
+    inputs : sequence of str
+        The inputs that get an actuator.
+
+    Returns
+    -------
+    LinearModel
+        The augmented model.
 
     Raises
     ------
@@ -714,6 +797,18 @@ def with_power_input(model: LinearModel, generator_efficiency: float) -> LinearM
     becomes the power input (scaled) and feeds back on generator speed. This is the model of a
     turbine following a power reference (down-regulation, active power control; Clemens et al.
     eq 11).
+
+    Parameters
+    ----------
+    model : LinearModel
+        A model with a generator-torque input.
+    generator_efficiency : float
+        eta [-].
+
+    Returns
+    -------
+    LinearModel
+        The model with ``power_ref`` in place of ``gen_torque_ref``.
 
     Raises
     ------
@@ -773,12 +868,34 @@ class LinearModelFamily:
                 raise ValueError("models of a family must have the same names")
 
     def stacked(self, name: str) -> FloatArray:
-        """Matrices or operating-point vectors stacked over wind: (n_op, ...)."""
+        """Matrices or operating-point vectors stacked over wind: (n_op, ...).
+
+        Parameters
+        ----------
+        name : str
+            An attribute of :class:`LinearModel`: ``A``, ``B_u``, ``B_d``, ``C_z``, ``D_u``,
+            ``D_d``, ``x0``, ``u0``, ``d0`` or ``z0``.
+
+        Returns
+        -------
+        (n_op, ...) ndarray
+            The stack.
+        """
         return np.stack([getattr(m, name) for m in self.models])
 
     def at(self, wind_mps: float) -> LinearModel:
         """The model at a mean wind speed, interpolated linearly in every matrix and in the
         operating point between the two neighbouring grid points.
+
+        Parameters
+        ----------
+        wind_mps : float
+            Mean wind speed [m/s].
+
+        Returns
+        -------
+        LinearModel
+            The interpolated model.
 
         Raises
         ------
@@ -800,7 +917,18 @@ class LinearModelFamily:
 
     # -- I/O
     def save(self, path: str | Path) -> Path:
-        """Write ``.mat`` (MATLAB), ``.npz`` or ``.json`` by the file suffix."""
+        """Write ``.mat`` (MATLAB), ``.npz`` or ``.json`` by the file suffix.
+
+        Parameters
+        ----------
+        path : str or Path
+            ``.mat``, ``.npz`` or ``.json``.
+
+        Returns
+        -------
+        Path
+            The file written.
+        """
         path = Path(path)
         suffix = path.suffix.lower()
         ref = self.models[0]
@@ -911,6 +1039,22 @@ def linearize_family(turbine: Turbine, wind_mps: Sequence[float] | FloatArray | 
     ``kwargs`` are those of :func:`linearize` (config, wake, disturbance, coordinates,
     power_W, shear_exponent, n_azimuth).
 
+    Parameters
+    ----------
+    turbine : Turbine
+        The turbine.
+    wind_mps : sequence of float, optional
+        Mean wind speeds [m/s] (default 4..25 step 1).
+    progress : bool
+        Show a progress bar.
+    **kwargs
+        Options of :func:`linearize`.
+
+    Returns
+    -------
+    LinearModelFamily
+        One model per wind speed.
+
     Raises
     ------
     ValueError
@@ -931,6 +1075,11 @@ def linearize_family(turbine: Turbine, wind_mps: Sequence[float] | FloatArray | 
 
 def sensitivities(model: LinearModel) -> dict[str, float]:
     """Aerodynamic sensitivities of a blade-coordinate or MBC model.
+
+    Parameters
+    ----------
+    model : LinearModel
+        A model with ``aero_power``, ``aero_torque`` and ``thrust`` outputs.
 
     Returns
     -------

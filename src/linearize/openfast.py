@@ -122,31 +122,99 @@ class OpenFASTFile:
                 self.keys.setdefault(_norm(key), (values, i))
 
     def has(self, key: str) -> bool:
-        """Whether ``key`` appears in the file."""
+        """Whether ``key`` appears in the file.
+
+        Parameters
+        ----------
+        key : str
+            The key, as OpenFAST names it.
+
+        Returns
+        -------
+        bool
+            Whether it is there.
+        """
         return _norm(key) in self.keys
 
     def where(self, key: str) -> str:
-        """``file:line key`` of a key, for reports and errors."""
+        """``file:line key`` of a key, for reports and errors.
+
+        Parameters
+        ----------
+        key : str
+            The key, as OpenFAST names it.
+
+        Returns
+        -------
+        str
+            ``file:line key``.
+        """
         _, i = self.keys[_norm(key)]
         return f"{self.path.name}:{i + 1} {key}"
 
     def raw(self, key: str) -> list[str]:
-        """The value tokens of ``key`` (quotes kept)."""
+        """The value tokens of ``key`` (quotes kept).
+
+        Parameters
+        ----------
+        key : str
+            The key, as OpenFAST names it.
+
+        Returns
+        -------
+        list of str
+            The tokens.
+        """
         try:
             return self.keys[_norm(key)][0]
         except KeyError:
             raise TurbineFileError(f"{self.path}: key {key!r} not found") from None
 
     def text(self, key: str) -> str:
-        """A string value, unquoted."""
+        """A string value, unquoted.
+
+        Parameters
+        ----------
+        key : str
+            The key, as OpenFAST names it.
+
+        Returns
+        -------
+        str
+            The value.
+        """
         return _unquote(self.raw(key)[0])
 
     def is_default(self, key: str) -> bool:
-        """Whether the value is OpenFAST's ``DEFAULT``."""
+        """Whether the value is OpenFAST's ``DEFAULT``.
+
+        Parameters
+        ----------
+        key : str
+            The key, as OpenFAST names it.
+
+        Returns
+        -------
+        bool
+            Whether it reads DEFAULT.
+        """
         return self.text(key).lower() == "default"
 
     def number(self, key: str, lo: float = -math.inf, hi: float = math.inf) -> float:
-        """A finite number in ``[lo, hi]``; the error names file, line, key and range."""
+        """A finite number in ``[lo, hi]``; the error names file, line, key and range.
+
+        Parameters
+        ----------
+        key : str
+            The key, as OpenFAST names it.
+        lo, hi : float
+            Allowed range.
+
+        Returns
+        -------
+        float
+            The value.
+        """
         tok = self.text(key)
         try:
             v = float(tok.replace("d", "e").replace("D", "E"))
@@ -159,7 +227,18 @@ class OpenFASTFile:
         return v
 
     def numbers(self, key: str) -> FloatArray:
-        """All numeric value tokens of ``key``."""
+        """All numeric value tokens of ``key``.
+
+        Parameters
+        ----------
+        key : str
+            The key, as OpenFAST names it.
+
+        Returns
+        -------
+        ndarray
+            The values.
+        """
         out = []
         for tok in self.raw(key):
             try:
@@ -170,7 +249,18 @@ class OpenFASTFile:
         return np.array(out)
 
     def flag(self, key: str) -> bool:
-        """A boolean (``True``/``False``/``T``/``F``)."""
+        """A boolean (``True``/``False``/``T``/``F``).
+
+        Parameters
+        ----------
+        key : str
+            The key, as OpenFAST names it.
+
+        Returns
+        -------
+        bool
+            The value.
+        """
         tok = self.text(key).lower()
         if tok in ("true", "t"):
             return True
@@ -179,7 +269,20 @@ class OpenFASTFile:
         raise TurbineFileError(f"{self.path}: {self.where(key)} = {tok!r}; allowed True/False")
 
     def integer(self, key: str, lo: int = -(2**31), hi: int = 2**31) -> int:
-        """An integer in ``[lo, hi]``."""
+        """An integer in ``[lo, hi]``.
+
+        Parameters
+        ----------
+        key : str
+            The key, as OpenFAST names it.
+        lo, hi : int
+            Allowed range.
+
+        Returns
+        -------
+        int
+            The value.
+        """
         v = self.number(key, lo, hi)
         if v != int(v):
             raise TurbineFileError(f"{self.path}: {self.where(key)} = {v!r} must be an integer")
@@ -191,6 +294,20 @@ class OpenFASTFile:
 
         A units line (``(m) (deg) ...``) under the header is skipped. The error names the file,
         the line and the column of a missing or non-numeric entry.
+
+        Parameters
+        ----------
+        columns : sequence of str
+            Column names wanted.
+        n_rows : int
+            Number of rows.
+        after_key : str, optional
+            Search for the header only after this key's line.
+
+        Returns
+        -------
+        dict of str to ndarray
+            Each wanted column.
         """
         start = self.keys[_norm(after_key)][1] + 1 if after_key else 0
         want = [c.lower() for c in columns]

@@ -74,7 +74,18 @@ SI_UNIT = {"kn-m": "N m", "knm": "N m", "kn·m": "N m", "n-m": "N m", "nm": "N m
 
 
 def unit_key(unit: str) -> str:
-    """A unit as the tables key it: lower case, no brackets or spaces."""
+    """A unit as the tables key it: lower case, no brackets or spaces.
+
+    Parameters
+    ----------
+    unit : str
+        A unit as written in a file.
+
+    Returns
+    -------
+    str
+        The key.
+    """
     return unit.strip().strip("()[]").strip().lower().replace(" ", "")
 
 
@@ -84,6 +95,20 @@ def resolve_channels(names: list[str] | tuple[str, ...], units: list[str] | tupl
     another channel of the file maps to the same one of ours with higher priority (earlier in
     :data:`CHANNEL_MAP`) or the channel is not in the map; then its own name. The factor is from
     :data:`UNIT_SCALE`, NaN for a unit it does not know.
+
+    Parameters
+    ----------
+    names : sequence of str
+        The file's channel names.
+    units : sequence of str
+        Their units, as written.
+    source : str
+        The file, for messages.
+
+    Returns
+    -------
+    list of (str, float)
+        Name and factor to SI per channel.
 
     Raises
     ------

@@ -74,7 +74,17 @@ class RotorPerformance:
         return np.radians(self.pitch_deg)
 
     def cp_max(self) -> tuple[float, float, float]:
-        """Largest C_P on the grid and where: (C_P, TSR, pitch [rad])."""
+        """Largest C_P on the grid and where: (C_P, TSR, pitch [rad]).
+
+        Returns
+        -------
+        cp : float
+            Largest C_P [-].
+        tsr : float
+            Its tip-speed ratio [-].
+        pitch_rad : float
+            Its pitch [rad].
+        """
         i, j = np.unravel_index(int(np.argmax(self.cp)), self.cp.shape)
         return float(self.cp[i, j]), float(self.tsr[i]), float(self.pitch_rad[j])
 

@@ -260,7 +260,18 @@ class PlantParams:
     pack: Any = field(repr=False, compare=False, default=None)
 
     def dof(self, name: str) -> bool:
-        """True if the degree of freedom ``name`` is on."""
+        """True if the degree of freedom ``name`` is on.
+
+        Parameters
+        ----------
+        name : str
+            A name of :data:`DOF_NAMES`.
+
+        Returns
+        -------
+        bool
+            Whether it is on.
+        """
         return name in self.config.dofs
 
 
@@ -278,6 +289,18 @@ def plant_params(turbine: Turbine, config: PlantConfig | None = None) -> PlantPa
     Modal mass and stiffness of each assumed mode phi (Hansen 2015, ch. 11):
     ``m = int mu phi^2 + sum_bodies``, ``k = int EI phi''^2 - g int N(h) phi'^2`` (gravity
     softening with N the weight above h), damping ``c = 2 zeta sqrt(k m)``.
+
+    Parameters
+    ----------
+    turbine : Turbine
+        The turbine.
+    config : PlantConfig, optional
+        Degrees of freedom and aerodynamic options (default: all on).
+
+    Returns
+    -------
+    PlantParams
+        The plant's parameters.
     """
     cfg = config or PlantConfig()
     t = turbine
@@ -853,7 +876,26 @@ def plant_rhs(t: float, x: FloatArray, u: FloatArray, d: FloatArray,
 
 def plant_outputs(t: float, x: FloatArray, u: FloatArray, d: FloatArray,
                   params: PlantParams) -> FloatArray:
-    """Performance outputs z (Madsen eq 17 first, then :data:`OUTPUT_NAMES`), (n_z,) ndarray."""
+    """Performance outputs z (Madsen eq 17 first, then :data:`OUTPUT_NAMES`), (n_z,) ndarray.
+
+    Parameters
+    ----------
+    t : float
+        Time [s].
+    x : (n_x,) ndarray
+        State.
+    u : (n_u,) ndarray
+        Inputs.
+    d : (n_d,) ndarray
+        Wind disturbances [m/s].
+    params : PlantParams
+        The plant.
+
+    Returns
+    -------
+    (n_z,) ndarray
+        The outputs.
+    """
     x, u, d = _check_xud(x, u, d, params.pack.r.size)
     hint = np.full((4, _N_BLADE, params.pack.r.size), np.nan)
     _, z, _ = evaluate_plant(x, u, d, params.pack, hint, 0)
@@ -862,7 +904,24 @@ def plant_outputs(t: float, x: FloatArray, u: FloatArray, d: FloatArray,
 
 def element_wind(params: PlantParams, azimuth_rad: float, hub_speed: float,
                  shear_exponent: float = 0.0) -> FloatArray:
-    """Free wind at each element from a steady power-law profile, (n_blade, n_r) [m/s]."""
+    """Free wind at each element from a steady power-law profile, (n_blade, n_r) [m/s].
+
+    Parameters
+    ----------
+    params : PlantParams
+        The plant.
+    azimuth_rad : float
+        Azimuth of blade 1 [rad].
+    hub_speed : float
+        Hub-height wind speed [m/s].
+    shear_exponent : float
+        Power-law exponent [-].
+
+    Returns
+    -------
+    (n_blade, n_r) ndarray
+        Free wind at each element [m/s].
+    """
     ws = SteadyWind(hub_speed, shear_exponent)
     kind, wpar, grid = ws._kernel_args()
     return sample_wind(0.0, float(azimuth_rad), params.pack, kind, wpar, grid)
@@ -896,7 +955,15 @@ class SteadyWind:
                 np.zeros((1, 1, 1), dtype=np.float32))
 
     def check_covers(self, params: PlantParams, t_end: float) -> None:
-        """Steady wind covers any rotor and any duration."""
+        """Steady wind covers any rotor and any duration.
+
+        Parameters
+        ----------
+        params : PlantParams
+            The plant.
+        t_end : float
+            End of the simulation [s].
+        """
 
 
 @dataclass(frozen=True)
@@ -948,7 +1015,15 @@ class GridWind:
         return 1, par, self.u
 
     def check_covers(self, params: PlantParams, t_end: float) -> None:
-        """Raise if the grid does not cover the rotor disc or the time span."""
+        """Raise if the grid does not cover the rotor disc or the time span.
+
+        Parameters
+        ----------
+        params : PlantParams
+            The plant (rotor size and hub height).
+        t_end : float
+            End of the simulation [s].
+        """
         g = params.turbine.geometry
         rad = g.tip_radius
         if (self.y[0] > -rad or self.y[-1] < rad or self.z[0] > g.hub_height - rad
@@ -984,13 +1059,35 @@ class SimulationResult:
     z: FloatArray
 
     def state(self, name: str) -> FloatArray:
-        """One state's time series by name."""
+        """One state's time series by name.
+
+        Parameters
+        ----------
+        name : str
+            A name of :data:`STATE_NAMES`.
+
+        Returns
+        -------
+        (n_t,) ndarray
+            Its time series (SI).
+        """
         if name not in STATE_NAMES:
             raise KeyError(f"no state {name!r}; states are {list(STATE_NAMES)}")
         return self.x[:, STATE_NAMES.index(name)]
 
     def output(self, name: str) -> FloatArray:
-        """One output's time series by name."""
+        """One output's time series by name.
+
+        Parameters
+        ----------
+        name : str
+            A name of :data:`OUTPUT_NAMES`.
+
+        Returns
+        -------
+        (n_t,) ndarray
+            Its time series (SI).
+        """
         if name not in OUTPUT_NAMES:
             raise KeyError(f"no output {name!r}; outputs are {list(OUTPUT_NAMES)}")
         return self.z[:, OUTPUT_NAMES.index(name)]
@@ -1200,7 +1297,22 @@ class PlantStepper:
                 self._dphi, self.limits)
 
     def outputs(self, t: float, x: FloatArray, u: FloatArray) -> FloatArray:
-        """The outputs at ``t`` without stepping, (n_z,) (:data:`OUTPUT_NAMES`)."""
+        """The outputs at ``t`` without stepping, (n_z,) (:data:`OUTPUT_NAMES`).
+
+        Parameters
+        ----------
+        t : float
+            Time [s].
+        x : (n_x,) ndarray
+            State.
+        u : (n_u,) ndarray
+            Inputs.
+
+        Returns
+        -------
+        (n_z,) ndarray
+            Outputs.
+        """
         w = sample_wind(t, x[16], self._pack, self._kind, self._wpar, self._grid)
         return evaluate_plant(x, u, w, self._pack, self._hint, 0)[1]
 
@@ -1234,6 +1346,13 @@ def structural_frequencies(params: PlantParams, rotor_speed_rad_s: float = 0.0) 
     (RotSpeed = 0, GenDOF = False), the collective edge mode and the shaft torsion coupled
     through the rotor inertia: M = [[J_r, 3 S_e], [3 S_e, 3 M_e]], K = diag(K_shaft, 3 K_e)
     with S_e = int m phi_e r ds. The plant's state equations do not carry the edge DOF yet.
+
+    Parameters
+    ----------
+    params : PlantParams
+        The plant.
+    rotor_speed_rad_s : float
+        Rotor speed for the centrifugal stiffening [rad/s].
 
     Returns
     -------

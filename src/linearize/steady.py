@@ -73,6 +73,19 @@ def rotor_average(params: PlantParams, x: FloatArray, u: FloatArray, wind_mps: f
                   shear_exponent: float = 0.0) -> tuple[FloatArray, FloatArray]:
     """State derivative and outputs averaged over azimuth in steady power-law wind.
 
+    Parameters
+    ----------
+    params : PlantParams
+        The plant.
+    x : (n_x,) ndarray
+        State.
+    u : (n_u,) ndarray
+        Inputs.
+    wind_mps : float
+        Hub-height wind speed [m/s].
+    shear_exponent : float
+        Power-law shear exponent [-].
+
     Returns
     -------
     dxdt : (n_x,) ndarray
@@ -143,6 +156,19 @@ def optimal_tsr(turbine: Turbine, pitch_deg: float = 0.0, options: AeroOptions |
                 *, shear_exponent: float = 0.0, integration: str = "midpoint"
                 ) -> tuple[float, float]:
     """Tip-speed ratio of maximum C_P at a fixed pitch.
+
+    Parameters
+    ----------
+    turbine : Turbine
+        The turbine.
+    pitch_deg : float
+        Blade pitch [deg].
+    options : AeroOptions, optional
+        Aerodynamic options.
+    shear_exponent : float
+        Power-law shear exponent [-].
+    integration : {"midpoint", "trapezoid"}
+        Span integration.
 
     Returns
     -------

@@ -111,11 +111,29 @@ class OperatingPoint:
         return self.rotor_speed_rad_s * 30.0 / math.pi
 
     def state(self, name: str) -> float:
-        """One equilibrium state by name."""
+        """One equilibrium state by name.
+
+        Parameters
+        ----------
+        name : str
+            A name of :data:`STATE_NAMES`.
+
+        Returns
+        -------
+        float
+            Its equilibrium value (SI).
+        """
         return float(self.x[STATE_NAMES.index(name)])
 
     def as_dict(self) -> dict[str, Any]:
-        """Plain dict with unit-suffixed keys, for JSON and tables."""
+        """Plain dict with unit-suffixed keys, for JSON and tables.
+
+        Returns
+        -------
+        dict
+            Wind, region, pitch, rotor and generator speed, torques, powers, thrust, TSR,
+            C_P, C_T and the structure's deflections, each key with its unit.
+        """
         return {
             "wind_mps": self.wind_mps, "region": self.region, "pitch_deg": self.pitch_deg,
             "rotor_speed_rpm": self.rotor_speed_rpm,
@@ -418,6 +436,24 @@ def operating_schedule(turbine: Turbine, wind_mps: FloatArray, power_W: float | 
 
     Unlike :func:`trim`, a power reference above what the wind offers is not an error here:
     those points follow the normal schedule (the derated turbine's partial-load region).
+
+    Parameters
+    ----------
+    turbine : Turbine
+        The turbine.
+    wind_mps : (n_op,) array_like
+        Mean wind speeds [m/s].
+    power_W : float, optional
+        Power reference [W] (default rated).
+    config : PlantConfig, optional
+        Plant configuration.
+    shear_exponent : float
+        Power-law shear exponent [-].
+
+    Returns
+    -------
+    list of OperatingPoint
+        One per wind speed.
     """
     p = plant_params(turbine, config)
     out = []
@@ -437,6 +473,20 @@ def operating_schedule(turbine: Turbine, wind_mps: FloatArray, power_W: float | 
 def rated_wind_speed(turbine: Turbine, *, config: PlantConfig | None = None,
                      shear_exponent: float = 0.0) -> float:
     """Lowest wind speed at which rated power is reached at fine pitch [m/s].
+
+    Parameters
+    ----------
+    turbine : Turbine
+        The turbine.
+    config : PlantConfig, optional
+        Plant configuration.
+    shear_exponent : float
+        Power-law shear exponent [-].
+
+    Returns
+    -------
+    float
+        Rated wind speed [m/s].
 
     Raises
     ------

@@ -160,7 +160,15 @@ class Operation(_Section):
 
 @dataclass(frozen=True)
 class Environment(_Section):
-    """Air and gravity: ``air_density`` [kg/m^3], ``gravity`` [m/s^2]."""
+    """Air and gravity: ``air_density`` [kg/m^3], ``gravity`` [m/s^2].
+
+    Parameters
+    ----------
+    air_density : float
+        [kg/m^3].
+    gravity : float
+        [m/s^2].
+    """
 
     air_density: float = _f("air_density_kgpm3", 0.5, 1.6)
     gravity: float = _f("gravity_mps2", 0.0, 20.0)
@@ -168,7 +176,17 @@ class Environment(_Section):
 
 @dataclass(frozen=True)
 class RotorMass(_Section):
-    """Hub mass [kg], hub inertia about the shaft [kg m^2], blade mass scale factor [-]."""
+    """Hub mass [kg], hub inertia about the shaft [kg m^2], blade mass scale factor [-].
+
+    Parameters
+    ----------
+    hub_mass : float
+        [kg].
+    hub_inertia : float
+        About the shaft [kg m^2].
+    blade_mass_scale : float
+        Factor on the blade's mass per length [-].
+    """
 
     hub_mass: float = _f("hub_mass_kg", 0.0, 1e7, lo_open=True)
     hub_inertia: float = _f("hub_inertia_kgm2", 0.0, 1e10, lo_open=True)
@@ -177,7 +195,15 @@ class RotorMass(_Section):
 
 @dataclass(frozen=True)
 class Nacelle(_Section):
-    """Nacelle mass [kg] and yaw inertia [kg m^2]."""
+    """Nacelle mass [kg] and yaw inertia [kg m^2].
+
+    Parameters
+    ----------
+    mass : float
+        [kg].
+    yaw_inertia : float
+        [kg m^2].
+    """
 
     mass: float = _f("mass_kg", 0.0, 1e8, lo_open=True)
     yaw_inertia: float = _f("yaw_inertia_kgm2", 0.0, 1e10, lo_open=True)
@@ -211,7 +237,15 @@ class Drivetrain(_Section):
 
 @dataclass(frozen=True)
 class Generator(_Section):
-    """Generator torque limits on the high-speed shaft [N m] and rate limit [N m/s]."""
+    """Generator torque limits on the high-speed shaft [N m] and rate limit [N m/s].
+
+    Parameters
+    ----------
+    min_torque, max_torque : float
+        Torque limits on the high-speed shaft [N m].
+    max_torque_rate : float
+        Torque rate limit [N m/s].
+    """
 
     min_torque: float = _f("min_torque_Nm", -1e8, 1e8)
     max_torque: float = _f("max_torque_Nm", 0.0, 1e8, lo_open=True)
@@ -250,7 +284,15 @@ class PitchActuator(_Section):
 
 @dataclass(frozen=True)
 class Damping(_Section):
-    """Structural damping ratios of the first modes [-]."""
+    """Structural damping ratios of the first modes [-].
+
+    Parameters
+    ----------
+    blade : float
+        Blade modes' damping ratio [-].
+    tower_fa, tower_ss : float
+        Tower fore-aft and side-side damping ratios [-].
+    """
 
     blade: float = _f("blade_damping_ratio", 0.0, 0.5)
     tower_fa: float = _f("tower_fa_damping_ratio", 0.0, 0.5)
@@ -351,6 +393,15 @@ class BladeStructure:
     """Distributed blade properties at span fractions 0..1 from the root.
 
     ``mass_per_length`` [kg/m] (already scaled), ``flap_stiffness``, ``edge_stiffness`` [N m^2].
+
+    Parameters
+    ----------
+    span_fraction : (n,) ndarray
+        Span fractions from the root, 0..1 [-].
+    mass_per_length : (n,) ndarray
+        Mass per unit length, scaled [kg/m].
+    flap_stiffness, edge_stiffness : (n,) ndarray
+        Bending stiffness [N m^2].
     """
 
     span_fraction: FloatArray
@@ -368,6 +419,15 @@ class TowerStructure:
     """Distributed tower properties at height fractions 0..1 of the flexible tower.
 
     ``mass_per_length`` [kg/m], ``fa_stiffness``, ``ss_stiffness`` [N m^2].
+
+    Parameters
+    ----------
+    height_fraction : (n,) ndarray
+        Fractions of the flexible tower's height, 0..1 [-].
+    mass_per_length : (n,) ndarray
+        [kg/m].
+    fa_stiffness, ss_stiffness : (n,) ndarray
+        Fore-aft and side-side bending stiffness [N m^2].
     """
 
     height_fraction: FloatArray
@@ -395,6 +455,13 @@ class ModeShapes:
     Each field is a (5,) ndarray of coefficients for x^2..x^6 (x = fraction of height/span).
     ``blade_edge1`` (ElastoDyn's first edgewise blade mode) is optional: without it the
     edgewise modal properties of :class:`~linearize.PlantParams` are NaN.
+
+    Parameters
+    ----------
+    tower_fa1, tower_ss1, blade_flap1 : (5,) ndarray
+        Coefficients of x^2..x^6 of the first tower fore-aft, side-side and blade flap modes.
+    blade_edge1 : (5,) ndarray, optional
+        The first edgewise blade mode's.
     """
 
     tower_fa1: FloatArray
@@ -435,7 +502,17 @@ def mode_shape(coeffs: FloatArray, x: FloatArray, derivative: int = 0) -> FloatA
 @dataclass(frozen=True)
 class ReportEntry:
     """One line of a :class:`LoadReport`: a quantity, its value with unit, and where it came
-    from (``file:line key`` or ``default: why``)."""
+    from (``file:line key`` or ``default: why``).
+
+    Parameters
+    ----------
+    quantity : str
+        What was read.
+    value : str
+        Its value with unit.
+    source : str
+        ``file:line key`` or ``default: why``.
+    """
 
     quantity: str
     value: str
@@ -477,6 +554,27 @@ class Turbine:
 
     ``report`` says what was read from where (OpenFAST decks) or holds nothing (YAML files,
     whose comments carry the sources).
+
+    Parameters
+    ----------
+    name : str
+        The turbine's name.
+    source : str
+        The file it was read from.
+    geometry, operation, environment, rotor, nacelle, drivetrain, generator, pitch_actuator, damping
+        The sections of the turbine file (:class:`Geometry` ... :class:`Damping`).
+    blade : BladeAero
+        The blade's aerodynamic layout.
+    polars : tuple of Polar
+        The airfoil polars.
+    blade_structure : BladeStructure
+        Distributed blade properties.
+    tower_structure : TowerStructure
+        Distributed tower properties.
+    mode_shapes : ModeShapes
+        The assumed modes.
+    report : LoadReport
+        What was read from where.
     """
 
     name: str
@@ -552,7 +650,13 @@ _FILE_KEYS = {"blade_aero", "airfoil_index", "blade_structure", "tower_structure
 
 
 def available_turbines() -> list[str]:
-    """Names of the turbines shipped as package data (``nrel5mw``, ``iea15mw``)."""
+    """Names of the turbines shipped as package data (``nrel5mw``, ``iea15mw``).
+
+    Returns
+    -------
+    list of str
+        The packaged turbines' names.
+    """
     root = resources.files("linearize") / "data"
     return sorted(p.name for p in root.iterdir() if (p / "turbine.yaml").is_file())
 

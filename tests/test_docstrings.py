@@ -1,7 +1,8 @@
-"""Every public function, class and method of ``mpc_wt`` documents its parameters and its
-return value in numpydoc sections (issue 16; python-control's ``docstrings_test.py`` shows the
-idea). Public means: named in a module's ``__all__``; methods: those a public class defines
-without a leading underscore (an override without a docstring inherits its base's)."""
+"""Every public function, class and method of ``linearize``, ``lidar`` and ``mpc_wt`` documents
+its parameters and its return value in numpydoc sections (python-control's
+``docstrings_test.py`` shows the idea). Public means: named in a module's ``__all__``; methods:
+those a public class defines without a leading underscore (an override without a docstring
+inherits its base's)."""
 from __future__ import annotations
 
 import importlib
@@ -11,20 +12,25 @@ from typing import Any
 
 import pytest
 
+import lidar
+import linearize
 import mpc_wt
+
+PACKAGES = (linearize, lidar, mpc_wt)
 
 
 def _public_api() -> dict[str, Any]:
     out: dict[str, Any] = {}
-    mods = ["mpc_wt"] + [m.name for m in pkgutil.walk_packages(mpc_wt.__path__, "mpc_wt.")
-                         if not m.name.endswith("__main__")]
+    mods = [p.__name__ for p in PACKAGES] + [
+        m.name for p in PACKAGES for m in pkgutil.walk_packages(p.__path__, p.__name__ + ".")
+        if not m.name.endswith("__main__")]
     for name in mods:
         mod = importlib.import_module(name)
         for attr in getattr(mod, "__all__", []):
             obj = getattr(mod, attr)
             if not (inspect.isfunction(obj) or inspect.isclass(obj)):
                 continue
-            if not getattr(obj, "__module__", "").startswith("mpc_wt"):
+            if not getattr(obj, "__module__", "").startswith(name.split(".")[0]):
                 continue
             out[f"{obj.__module__}.{obj.__qualname__}"] = obj
             if inspect.isclass(obj):
