@@ -22,6 +22,7 @@ from tqdm import tqdm
 
 import linearize
 from mpc_wt.run import run_controller
+from mpc_wt.simulation.scenario import Scenario
 
 BOUNDS = {"speed_std": 0.15, "power_mean": 0.005, "pitch_travel": 0.20}
 
@@ -43,11 +44,9 @@ def main() -> int:
     rows = []
     for design, v in tqdm(cases, desc="cases"):
         frac = 0.8 if design == "derate80" else 1.0
-        ours = _metrics(run_controller(t, design, v, "A", 1, 600.0))
-        ro = _metrics(run_controller(t, "rosco", v, "A", 1, 600.0,
-                                     options={"power_fraction": frac}))
-        shipped = (_metrics(run_controller(t, "rosco", v, "A", 1, 600.0,
-                                           options={"discon_in": "shipped"}))
+        ours = _metrics(run_controller(t, design, Scenario(v, "A", 1, 600.0)))
+        ro = _metrics(run_controller(t, "rosco", Scenario(v, "A", 1, 600.0), options={"power_fraction": frac}))
+        shipped = (_metrics(run_controller(t, "rosco", Scenario(v, "A", 1, 600.0), options={"discon_in": "shipped"}))
                    if design == "baseline" else None)
         ratio = {k: ro[k] / ours[k] - 1 for k in ours}
         rows.append({"design": design, "wind_mps": v, "ours": ours, "rosco_export": ro,

@@ -71,7 +71,7 @@ def main() -> int:
         est = r.channel("wind_est")
         fs = 1.0 / float(np.median(np.diff(r.t)))
         f, g2 = lidar.coherence(est[k], truth[k], fs, nperseg=int(120 * fs))
-        b = run_controller(tb, "baseline", v, "A", seed=args.seed, duration=dur)
+        b = run_controller(tb, "baseline", Scenario(v, "A", seed=args.seed, duration=dur))
         wb = b.channel("rotor_speed")[b.t >= args.transient]
         row = {"wind_mps": v, "rotor_mean_pct": 100 * (w.mean() / rated - 1),
                "rotor_std_pct": 100 * w.std() / rated, "rotor_max_pct": 100 * (w.max() / rated - 1),

@@ -25,6 +25,7 @@ from mpc_wt import run_controller
 from mpc_wt.assessment.fatigue import damage_equivalent_load
 from mpc_wt.assessment.performance import harmonic_psd, psd
 from mpc_wt.plotting import plot_psd_comparison
+from mpc_wt.simulation.scenario import Scenario
 
 PAPER = {"power_std_pct_lidar": 0.29, "power_std_pct_no_lidar": 0.36,
          "flap_1P_reduction_pct": 60.0, "shaft_1P_reduction_pct": 85.0,
@@ -44,9 +45,7 @@ def main() -> int:
     for ctl in ("mpc", "mpc-lidar"):
         t0 = time.perf_counter()
         # the paper's LIDAR model assumes Taylor's frozen turbulence (sec. II-E): no evolution
-        r = run_controller(t, ctl, 18.0, "A", seed=args.seed,
-                           duration=args.duration + args.transient, progress=True,
-                           options={"lidar": {"evolution": False}} if ctl == "mpc-lidar"
+        r = run_controller(t, ctl, Scenario(18.0, "A", seed=args.seed, duration=args.duration + args.transient), progress=True, options={"lidar": {"evolution": False}} if ctl == "mpc-lidar"
                            else None)
         figs[f"{ctl}_wall_s"] = time.perf_counter() - t0
         r.save(out / f"{ctl}.nc")

@@ -34,6 +34,7 @@ from mpc_wt.assessment.fatigue import wind_bin_probabilities
 from mpc_wt.assessment.performance import tracking_response
 from mpc_wt.assessment.series import assess_series, lifetime_comparison
 from mpc_wt.controllers.derating import aep_change
+from mpc_wt.simulation.scenario import Scenario
 
 PAPER = {"aep_change_pct": {"derate90": -6.5, "derate80": -13.5},
          "lss_del_change_pct": {"derate90": -14.0, "derate80": -11.0},
@@ -45,8 +46,7 @@ def _case(job: tuple) -> tuple:
     """One simulation -> (key, metrics); a pure function for the process pool."""
     key, ctl, v, seed, dur, transient, opts = job
     tb = linearize.load_turbine()
-    r = run_controller(tb, ctl, v, "A", seed, dur + transient, shear_exponent=0.2,
-                       options=opts)
+    r = run_controller(tb, ctl, Scenario(v, "A", seed, dur + transient, shear_exponent=0.2), options=opts)
     k = r.t >= transient
     m = assess_series(r.t[k], {n: r.channel(n)[k] for n in r.channels()})
     m["rotor_speed_mean_rad_s"] = float(r.channel("rotor_speed")[k].mean())

@@ -79,7 +79,7 @@ def _tower_first(spec, r, out: Path) -> list[str]:
     run_campaign(cspec, out / "campaign", progress=False)
     with CampaignStore(out / "campaign") as st:
         rows = st.rows()
-    from mpc_wt.campaign.report import relative_metrics
+    from mpc_wt.campaign.aggregate import relative_metrics
 
     held = relative_metrics(cspec, rows, name)
     keys = [key, "cs1", "cs2", "rotor_speed_std", "pitch_travel"]

@@ -11,7 +11,8 @@ import linearize
 import mpc_wt
 
 turbine = linearize.load_turbine("nrel5mw")
-res = mpc_wt.run_controller(turbine, "baseline", 18.0, turbulence="A", seed=1, duration=60.0)
+scenario = mpc_wt.Scenario(18.0, turbulence="A", seed=1, duration=60.0)
+res = mpc_wt.run_controller(turbine, "baseline", scenario)
 
 fig, axes = plt.subplots(3, 1, sharex=True, figsize=(7, 6))
 axes[0].plot(res.t, res.channel("gen_power") / 1e6)

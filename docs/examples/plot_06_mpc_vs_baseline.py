@@ -11,9 +11,8 @@ import linearize
 import mpc_wt
 
 turbine = linearize.load_turbine("nrel5mw")
-runs = {name: mpc_wt.run_controller(turbine, name, 18.0, turbulence="A", seed=2,
-                                    duration=60.0)
-        for name in ("baseline", "mpc-lidar")}
+scenario = mpc_wt.Scenario(18.0, turbulence="A", seed=2, duration=60.0)
+runs = {name: mpc_wt.run_controller(turbine, name, scenario) for name in ("baseline", "mpc-lidar")}
 
 fig, ax = plt.subplots(figsize=(7, 3.5))
 for name, res in runs.items():

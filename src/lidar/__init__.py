@@ -26,6 +26,7 @@ from lidar.preview import (
            rotor_effective_wind,
 )
 from lidar.turbulence import (
+           SamplerCache,
            TurbulenceSpec,
            evolution_coherence,
            evolve_field,
@@ -34,12 +35,11 @@ from lidar.turbulence import (
            iec_coherence,
            iec_sigma,
            kaimal_spectrum,
-           keep_samplers,
            simley_pao_evolution,
 )
 
 __all__ = ["IECSite", "iec_field", "event_duration", "CONDITIONS", "IEC_REFERENCE_SPEED",
-           "IEC_TURBULENCE", "keep_samplers", "CWLidar", "LidarMeasurement", "FieldFileError", "WindField", "Preview",
+           "IEC_TURBULENCE", "SamplerCache", "CWLidar", "LidarMeasurement", "FieldFileError", "WindField", "Preview",
            "PreviewBuffer", "blade_effective_wind", "coherence", "coherence_bandwidth", "peak_lag", "preview",
            "preview_series", "rms_preview_error", "rotor_effective_wind", "TurbulenceSpec",
            "evolution_coherence", "evolve_field", "generate_evolved_field", "generate_field", "iec_coherence", "iec_sigma",

@@ -49,7 +49,7 @@ from lidar.field import WindField
 
 __all__ = ["TurbulenceSpec", "iec_sigma", "kaimal_spectrum", "iec_coherence", "generate_field",
            "evolve_field", "generate_evolved_field", "evolution_coherence",
-           "simley_pao_evolution", "keep_samplers"]
+           "simley_pao_evolution", "SamplerCache"]
 
 log = logging.getLogger(__name__)
 
@@ -243,7 +243,7 @@ class _CirculantSampler:
     Cholesky factor of the coherence matrix instead, so every frequency is exact in
     distribution. The factors (4 MB each on 32 x 32 points, some 80 MB for a 600 s field) are
     kept only by a sampler built with ``keep_factors`` (one shared between fields, see
-    :func:`keep_samplers`); otherwise each is formed when drawn (38 ms on 32 x 32 points) and
+    :class:`SamplerCache`); otherwise each is formed when drawn (38 ms on 32 x 32 points) and
     only the last is held, which is what two streams drawn side by side need.
     """
 
@@ -349,52 +349,64 @@ class _CirculantSampler:
             self._r = None
 
 
-#: the last circulant sampler built, by its grid and decay rates: the seeds of one wind (a
-#: campaign worker's consecutive cases, a LIDAR's evolved copy of the field) share it; it draws
-#: no random numbers, so sharing it changes no field
-_LAST_SAMPLER: dict[tuple[Any, ...], _CirculantSampler] = {}
-_KEEP = {"sampler": False}
+class SamplerCache:
+    """Keeps the last field's circulant sampler for the next field of the same wind and grid.
 
+    The seeds of one wind (a campaign worker's consecutive cases, the controllers of one
+    comparison that meet the same field, a LIDAR's evolved copy of the field) share the
+    sampler: a 680 s, 32 x 32 field then costs 2.1 s instead of 3.6 s, at the price of holding
+    it between fields (for a 620 s field on 32 x 32 points, 13 MB of eigenvalues and 84 MB of
+    the Cholesky factors of its 20 exactly drawn frequencies). It holds one sampler at a time
+    and draws no random numbers, so the fields are the same with or without it (bit for bit).
+    Without one, a field's sampler forms those factors when drawn (38 ms each) and is released
+    with the field's making.
 
-def keep_samplers(on: bool = True) -> bool:
-    """Keep the last field's circulant sampler for the next field of the same wind and grid
-    (a campaign's seeds: a 680 s, 32 x 32 field then costs 2.1 s instead of 3.6 s) at the
-    price of holding it between fields: for a 620 s field on 32 x 32 points, 13 MB of
-    eigenvalues and 84 MB of the Cholesky factors of its 20 exactly drawn frequencies, which a
-    sampler that is not kept forms again at each draw (38 ms each). Off by default: a single
-    run does not hold it after its field is made. Process-wide; the fields are the same
-    either way (bit for bit).
+    Pass it to :func:`generate_field`, :func:`generate_evolved_field` and
+    :func:`evolve_field` as ``samplers=``; as a context manager it releases what it holds on
+    exit::
 
-    Parameters
-    ----------
-    on : bool
-        Keep (True) or release now and no longer keep (False).
-
-    Returns
-    -------
-    bool
-        The previous setting.
+        with SamplerCache() as samplers:
+            fields = [generate_field(spec, seed, samplers=samplers) for seed in range(6)]
     """
-    was = _KEEP["sampler"]
-    _KEEP["sampler"] = bool(on)
-    if not on:
-        _LAST_SAMPLER.clear()
-    return was
+
+    def __init__(self) -> None:
+        self._key: tuple[Any, ...] | None = None
+        self._sampler: _CirculantSampler | None = None
+
+    def __enter__(self) -> "SamplerCache":
+        return self
+
+    def __exit__(self, *exc: Any) -> None:
+        self.clear()
+
+    @property
+    def holds(self) -> bool:
+        """Whether a sampler is kept."""
+        return self._sampler is not None
+
+    def clear(self) -> None:
+        """Release the kept sampler."""
+        self._key = self._sampler = None
+
+    def _get(self, c: FloatArray, spec: TurbulenceSpec) -> _CirculantSampler:
+        key = (spec.n_y, spec.n_z, spec.width, spec.height,
+               hashlib.sha1(np.ascontiguousarray(c, dtype=np.float64).tobytes()).hexdigest())
+        if key != self._key:
+            self.clear()                     # one at a time: release the last before building
+            self._sampler = _CirculantSampler(c, spec, keep_factors=True)
+            self._key = key
+        assert self._sampler is not None
+        return self._sampler
 
 
-def _shared_sampler(c: FloatArray, spec: TurbulenceSpec) -> _CirculantSampler:
-    """The circulant sampler for decay rates ``c`` on the spec's grid, built once for
-    consecutive fields of the same wind and grid while :func:`keep_samplers` is on (then with
-    its Cholesky factors: about 1.7 s and 97 MB for 620 s on 32 x 32 points)."""
-    key = (spec.n_y, spec.n_z, spec.width, spec.height,
-           hashlib.sha1(np.ascontiguousarray(c, dtype=np.float64).tobytes()).hexdigest())
-    hit = _LAST_SAMPLER.get(key)
-    if hit is None:
-        _LAST_SAMPLER.clear()                 # one at a time: release the last before building
-        hit = _CirculantSampler(c, spec, keep_factors=_KEEP["sampler"])
-        if _KEEP["sampler"]:
-            _LAST_SAMPLER[key] = hit
-    return hit
+def _shared_sampler(c: FloatArray, spec: TurbulenceSpec,
+                    samplers: SamplerCache | None) -> _CirculantSampler:
+    """The circulant sampler for decay rates ``c`` on the spec's grid: the one ``samplers``
+    keeps (built with its Cholesky factors: about 1.7 s and 97 MB for 620 s on 32 x 32 points),
+    or a new one whose factors are formed when drawn."""
+    if samplers is None:
+        return _CirculantSampler(c, spec, keep_factors=False)
+    return samplers._get(c, spec)
 
 
 def _distances(spec: TurbulenceSpec) -> FloatArray:
@@ -433,7 +445,7 @@ def _coefficients_cholesky(c: FloatArray, spec: TurbulenceSpec,
 
 def generate_field(spec: TurbulenceSpec, seed: int | np.random.Generator | None = None, *,
                    method: str = "circulant", low_frequency: str = "lump",
-                   components: str = "uvw") -> WindField:
+                   components: str = "uvw", samplers: SamplerCache | None = None) -> WindField:
     """Generate a turbulent wind field (IEC 61400-1 Kaimal model, Veers' method).
 
     Parameters
@@ -448,6 +460,8 @@ def generate_field(spec: TurbulenceSpec, seed: int | np.random.Generator | None 
         What to do with the Kaimal variance below 1/T (module docstring).
     components : str
         Which components carry turbulence ("uvw" default; "u" leaves v = w = 0).
+    samplers : SamplerCache, optional
+        Keeps the circulant sampler for the next field of the same wind and grid.
 
     Returns
     -------
@@ -472,7 +486,7 @@ def generate_field(spec: TurbulenceSpec, seed: int | np.random.Generator | None 
                          f"{spec.n_y * spec.n_z} > 400")
     rng = np.random.default_rng(seed)            # a Generator is returned as it is
     t, y, z = spec.grid()
-    fields = dict(_components(spec, rng, method, low_frequency, components))
+    fields = dict(_components(spec, rng, method, low_frequency, components, samplers))
     meta = _field_meta(spec, seed, method, low_frequency, components)
     return WindField(t=t, y=y, z=z, u=fields["u"], v=fields["v"], w=fields["w"],
                      mean_speed=spec.mean_speed, hub_height=spec.hub_height, meta=meta)
@@ -520,13 +534,13 @@ def _bin_variance(spec: TurbulenceSpec, k: int, f: FloatArray, low_frequency: st
 
 
 def _components(spec: TurbulenceSpec, rng: np.random.Generator, method: str = "circulant",
-                low_frequency: str = "lump", components: str = "uvw"
-                ) -> Iterator[tuple[str, FloatArray]]:
+                low_frequency: str = "lump", components: str = "uvw",
+                samplers: SamplerCache | None = None) -> Iterator[tuple[str, FloatArray]]:
     """The field's components u, v, w in turn, each (n_t, n_y, n_z) float32 and read-only,
     drawn from ``rng`` in that order (one at a time: a caller that needs one component at a
     time never holds the three)."""
     n_t, nf, f, c = _frequencies(spec)
-    sampler = _shared_sampler(c, spec) if method == "circulant" else None
+    sampler = _shared_sampler(c, spec, samplers) if method == "circulant" else None
     shear = _shear_profile(spec)
     for k, comp in enumerate("uvw"):
         if comp not in components:
@@ -652,7 +666,7 @@ def _spec_like(field: WindField) -> TurbulenceSpec:
 
 def evolve_field(field: WindField, distance: float, spec: TurbulenceSpec | None = None,
                  seed: int | np.random.Generator | None = None, *, a: float | None = None,
-                 b: float | None = None) -> WindField:
+                 b: float | None = None, samplers: SamplerCache | None = None) -> WindField:
     """The field as it is upstream, ``distance`` ahead of the rotor, with wind evolution.
 
     Frozen turbulence would make the upstream wind equal to the field (shifted by
@@ -676,6 +690,8 @@ def evolve_field(field: WindField, distance: float, spec: TurbulenceSpec | None 
     a, b : float, optional
         The coherence parameters (default: :func:`simley_pao_evolution` of the spec's sigma and
         the field's hub height).
+    samplers : SamplerCache, optional
+        Keeps the circulant sampler for the next field of the same wind and grid.
 
     Returns
     -------
@@ -704,7 +720,7 @@ def evolve_field(field: WindField, distance: float, spec: TurbulenceSpec | None 
     # back over its coefficients (_series_in_place): per component the peak holds one buffer
     rng = np.random.default_rng(seed)            # a Generator is returned as it is
     n_t, nf, f, c = _frequencies(spec)
-    sampler = _shared_sampler(c, spec)
+    sampler = _shared_sampler(c, spec, samplers)
     keep, fresh = _evolution_gains(n_t, spec.dt, distance, field.mean_speed, a, b)
     n_p = spec.n_y * spec.n_z
     out = {}
@@ -736,7 +752,8 @@ def evolve_field(field: WindField, distance: float, spec: TurbulenceSpec | None 
 def generate_evolved_field(spec: TurbulenceSpec, seed: int | np.random.Generator | None,
                            distance: float,
                            evolution_seed: int | np.random.Generator | None = None, *,
-                           a: float | None = None, b: float | None = None) -> WindField:
+                           a: float | None = None, b: float | None = None,
+                           samplers: SamplerCache | None = None) -> WindField:
     """The field ``distance`` upstream of ``generate_field(spec, seed)``, with wind evolution,
     without that field: ``evolve_field(generate_field(spec, seed), distance, spec,
     evolution_seed)`` to single-precision rounding.
@@ -763,6 +780,8 @@ def generate_evolved_field(spec: TurbulenceSpec, seed: int | np.random.Generator
         Of the independent part, as given to :func:`evolve_field`.
     a, b : float, optional
         Coherence parameters (default: :func:`simley_pao_evolution` of the spec).
+    samplers : SamplerCache, optional
+        Keeps the circulant sampler for the next field of the same wind and grid.
 
     Returns
     -------
@@ -778,13 +797,13 @@ def generate_evolved_field(spec: TurbulenceSpec, seed: int | np.random.Generator
     a, b, model = _evolution_parameters(spec, spec.hub_height, distance, a, b)
     evo = {"distance": distance, "a": a, "b": b, "model": model}
     if distance == 0.0:
-        f0 = generate_field(spec, seed)
+        f0 = generate_field(spec, seed, samplers=samplers)
         return dataclasses.replace(f0, meta={**f0.meta, "evolution": evo})
     # default_rng returns a Generator given as it is
     rng, rng_o = np.random.default_rng(seed), np.random.default_rng(evolution_seed)
     n_t, nf, f, c = _frequencies(spec)
     t, y, z = spec.grid()
-    sampler = _shared_sampler(c, spec)
+    sampler = _shared_sampler(c, spec, samplers)
     keep, fresh = _evolution_gains(n_t, spec.dt, distance, spec.mean_speed, a, b)
     n_p = spec.n_y * spec.n_z
     out = {}

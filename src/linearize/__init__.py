@@ -10,17 +10,15 @@ from linearize.errors import (
     TrimError,
     TurbineFileError,
 )
-from linearize.linear import (
+from linearize.linear import jacobian_check, linearize, linearize_family
+from linearize.load import load_turbine
+from linearize.models import (
     LinearModel,
     LinearModelFamily,
     augment_actuator,
-    jacobian_check,
-    linearize,
-    linearize_family,
     sensitivities,
     with_power_input,
 )
-from linearize.load import load_turbine
 from linearize.openfast import load_openfast
 from linearize.openfast_lin import read_lin, read_lin_set, write_lin
 from linearize.performance import (

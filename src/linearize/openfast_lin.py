@@ -30,7 +30,8 @@ import numpy as np
 
 from linearize._typing import FloatArray
 from linearize.errors import LinearizationError, LinFileError
-from linearize.linear import LinearModel, mbc_matrices
+from linearize.linear import mbc_matrices
+from linearize.models import LinearModel
 from linearize.openfast_channels import SI_UNIT, resolve_channels, unit_key
 
 __all__ = ["read_lin", "read_lin_set", "write_lin", "compare_with_openfast", "LinFileError"]

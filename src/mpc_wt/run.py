@@ -3,6 +3,7 @@ from __future__ import annotations
 
 from typing import Any, Mapping, Sequence
 
+import lidar
 import linearize
 from mpc_wt.registry.context import DEFAULT_CACHE, BuildContext, Built, DesignCache
 from mpc_wt.registry.options import Options
@@ -36,7 +37,9 @@ def _condition(raw: Mapping[str, Any] | None) -> dict[str, Any]:
 
 def build_controller(turbine: linearize.Turbine, controller: str, scenario: Scenario,
                      options: Mapping[str, Any] | None = None, *,
-                     cache: DesignCache = DEFAULT_CACHE, naming: Naming = API_NAMING
+                     cache: DesignCache = DEFAULT_CACHE, naming: Naming = API_NAMING,
+                     params: linearize.PlantParams | None = None,
+                     samplers: lidar.SamplerCache | None = None
                      ) -> tuple[Built, linearize.OperatingPoint, Any]:
     """Resolve, check, trim and build a controller for one scenario (no simulation).
 
@@ -45,7 +48,7 @@ def build_controller(turbine: linearize.Turbine, controller: str, scenario: Scen
     turbine : Turbine
         The turbine.
     controller : str
-        A registered name (``mpc_wt.controllers.kinds()``), with a pattern or add-ons
+        A registered name (``mpc_wt.registry.kinds()``), with a pattern or add-ons
         (``derate80+ibc``).
     scenario : Scenario
         The load case.
@@ -55,6 +58,10 @@ def build_controller(turbine: linearize.Turbine, controller: str, scenario: Scen
         For designs that cost seconds.
     naming : Naming
         How error messages name options (keys, or command-line flags).
+    params : PlantParams, optional
+        The turbine's plant parameters, if already derived (:func:`linearize.plant_params`).
+    samplers : lidar.SamplerCache, optional
+        Keeps the turbulence generator's sampler for the next field of the same wind and grid.
 
     Returns
     -------
@@ -74,62 +81,77 @@ def build_controller(turbine: linearize.Turbine, controller: str, scenario: Scen
     opts = sel.options(options, naming)
     op = _operating_point(turbine, sel, opts, scenario)
     needs = set().union(*(k.field_components for k in (sel.base, *sel.addons)))
-    wind, field = make_wind(turbine, scenario, "".join(c for c in "uvw" if c in needs))
-    ctx = BuildContext(turbine=turbine, params=linearize.plant_params(turbine), op=op,
-                       scenario=scenario, field=field, cache=cache)
+    wind, field = make_wind(turbine, scenario, "".join(c for c in "uvw" if c in needs),
+                            samplers=samplers)
+    ctx = BuildContext(turbine=turbine, params=params or linearize.plant_params(turbine), op=op,
+                       scenario=scenario, field=field, cache=cache, samplers=samplers)
     built = sel.base.build(ctx, opts[0])
     for kind, o in zip(sel.addons, opts[1:]):
         built = kind.build(ctx, o, built)
     return built, op, wind
 
 
-def run_controller(turbine: linearize.Turbine, controller: str, wind_mps: float,
-                   turbulence: str | float = "A", seed: int = 1, duration: float = 600.0,
-                   progress: bool = False, shear_exponent: float = 0.2,
+def _scenario_of(scenario: Scenario | float, fields: dict[str, Any]) -> Scenario:
+    """The run's scenario: given whole, or made from a mean wind and the keyword fields."""
+    given = {k: v for k, v in fields.items() if v is not None}
+    if isinstance(scenario, Scenario):
+        if given:
+            raise TypeError(f"run_controller: {sorted(given)} apply only with a mean wind; "
+                            f"a Scenario carries them (dataclasses.replace(scenario, ...))")
+        return scenario
+    if isinstance(scenario, bool) or not isinstance(scenario, (int, float)):
+        raise TypeError(f"scenario must be a Scenario or a mean wind speed [m/s], got "
+                        f"{type(scenario).__name__}")
+    cond = _condition(given.pop("condition", None))
+    return Scenario(float(scenario), **given, **cond)
+
+
+def run_controller(turbine: linearize.Turbine, controller: str, scenario: Scenario | float,
                    options: Mapping[str, Any] | None = None, *,
-                   cache: DesignCache = DEFAULT_CACHE,
-                   naming: Naming = API_NAMING,
-                   condition: Mapping[str, Any] | None = None,
-                   supervisor: Mapping[str, Any] | None = None) -> ClosedLoopResult:
-    """Trim, build the controller, generate the wind and simulate.
+                   supervisor: Mapping[str, Any] | None = None, progress: bool = False,
+                   cache: DesignCache = DEFAULT_CACHE, naming: Naming = API_NAMING,
+                   samplers: lidar.SamplerCache | None = None,
+                   turbulence: str | float | None = None, seed: int | None = None,
+                   duration: float | None = None, shear_exponent: float | None = None,
+                   condition: Mapping[str, Any] | None = None) -> ClosedLoopResult:
+    """Trim, build the controller, generate the scenario's wind and simulate.
 
     Parameters
     ----------
     turbine : Turbine
         The turbine (:func:`linearize.load_turbine`).
     controller : str
-        A registered kind (``mpc_wt.controllers.kinds()`` lists them with their options):
+        A registered kind (``mpc_wt.registry.kinds()`` lists them with their options):
         ``baseline``, ``baseline-ct``, ``derateNN``, ``apc``, ``ibc``, ``coleman-ipc``,
         ``derateNN+ibc``, ``mpc``, ``mpc-collective``, ``mpc-lidar``, ``lqr-pio``, ``ts``, or a
         user-registered one.
-    wind_mps : float
-        Mean hub-height wind [m/s].
-    turbulence : str or float
-        IEC class "A", "B", "C", "steady", or an intensity [-].
-    seed : int
-        Seed of the turbulent field.
-    duration : float
-        [s]
-    progress : bool
-        Show a progress bar.
-    shear_exponent : float
-        Power-law shear [-].
+    scenario : Scenario or float
+        The load case (:class:`~mpc_wt.simulation.scenario.Scenario`: mean wind, turbulence,
+        seed, duration, shear, IEC condition). A mean wind speed [m/s] instead makes one with
+        the keyword fields below (a shorthand for ``Scenario(wind, turbulence=..., ...)``).
     options : mapping, optional
         The kind's options by name, e.g. ``{"apc_frequency": 0.1}`` for ``apc`` or
         ``{"horizon": 10, "lidar": {"focus_distance": 80}}`` for ``mpc-lidar``.
+    supervisor : mapping, optional
+        Runs the controller under :class:`mpc_wt.controllers.supervisor.Supervisor` with these
+        settings (``overspeed``, ``shutdown_at``, ``grid_loss_at`` [s], ``pitch_rate``,
+        ``torque_ramp_s``).
+    progress : bool
+        Show a progress bar.
     cache : DesignCache
         For designs that cost seconds (the TS LMIs), keyed on the turbine's content.
     naming : Naming
         How error messages name options.
+    samplers : lidar.SamplerCache, optional
+        Keeps the turbulence generator's sampler for the next run of the same wind and grid
+        (a campaign's seeds, controllers compared on one field); the fields are the same with
+        or without it.
+    turbulence, seed, duration, shear_exponent : optional
+        With a mean wind only: the :class:`Scenario`'s fields (defaults "A", 1, 600 s, 0.2).
     condition : mapping, optional
-        An IEC 61400-1 wind condition instead of normal turbulence: ``condition`` ("etm",
-        "eog", "edc", "ecd", "ews-v", "ews-h", "nwp"), ``iec_class`` ("I"), ``sign`` (1),
-        ``event_at`` (when the transient starts [s]); ``turbulence`` is then the category
-        (:class:`~mpc_wt.simulation.scenario.Scenario`).
-    supervisor : mapping, optional
-        Runs the controller under :class:`mpc_wt.controllers.supervisor.Supervisor` with these settings
-        (``overspeed``, ``shutdown_at``, ``grid_loss_at`` [s], ``pitch_rate``,
-        ``torque_ramp_s``).
+        With a mean wind only: an IEC 61400-1 wind condition, ``condition`` ("etm", "eog",
+        "edc", "ecd", "ews-v", "ews-h", "nwp"), ``iec_class`` ("I"), ``sign`` (1),
+        ``event_at`` (when the transient starts [s]).
 
     Returns
     -------
@@ -139,15 +161,19 @@ def run_controller(turbine: linearize.Turbine, controller: str, wind_mps: float,
     Raises
     ------
     ValueError
-        Unknown controller or bad options (naming the option and what is allowed), or a wind at
-        which the kind cannot operate.
+        Unknown controller or bad options (naming the option and what is allowed), a bad
+        scenario (naming the field), or a wind at which the kind cannot operate.
+    TypeError
+        Scenario fields given beside a whole :class:`Scenario`.
     SimulationDivergedError
         If the run leaves the physical envelope (``.partial`` keeps what was simulated).
     """
-    scenario = Scenario(wind_mps, turbulence, seed, duration, shear_exponent,
-                        **_condition(condition))
+    scenario = _scenario_of(scenario, {"turbulence": turbulence, "seed": seed,
+                                       "duration": duration, "shear_exponent": shear_exponent,
+                                       "condition": condition})
+    params = linearize.plant_params(turbine)
     built, op, wind = build_controller(turbine, controller, scenario, options, cache=cache,
-                                       naming=naming)
+                                       naming=naming, params=params, samplers=samplers)
     meta = {"controller": controller, **scenario.meta(), "turbine": turbine.name,
             **built.meta}
     ctl = built.controller
@@ -156,6 +182,6 @@ def run_controller(turbine: linearize.Turbine, controller: str, wind_mps: float,
 
         ctl = Supervisor(ctl, turbine, **dict(supervisor))
         meta["supervisor"] = {k: v for k, v in dict(supervisor).items() if v is not None}
-    return simulate_closed_loop(linearize.plant_params(turbine), ctl, wind,
-                                duration, x0=op.x, u0=op.u, controller_dt=built.controller_dt,
-                                preview=built.preview, progress=progress, meta=meta)
+    return simulate_closed_loop(params, ctl, wind, scenario.duration, x0=op.x, u0=op.u,
+                                controller_dt=built.controller_dt, preview=built.preview,
+                                progress=progress, meta=meta)

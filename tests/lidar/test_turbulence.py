@@ -289,38 +289,34 @@ def test_evolution_of_a_field_without_a_class() -> None:
 
 
 def test_shared_sampler_changes_no_field() -> None:
-    """Issue 23: consecutive fields of one wind and grid share the circulant sampler (built
-    once); a field drawn with the shared sampler is bit for bit the field drawn with a fresh
-    one, and another wind builds its own."""
-    from lidar import turbulence
-
+    """Consecutive fields of one wind and grid share the circulant sampler a SamplerCache
+    keeps (built once); a field drawn with the shared sampler is bit for bit the field drawn
+    with a fresh one, another wind builds its own, and the cache releases it on exit."""
     spec = TurbulenceSpec(12.0, "B", width=60, height=60, n_y=6, n_z=6, duration=60, dt=0.1)
-    was = lidar.keep_samplers(True)
-    try:
-        generate_field(spec, 1)
-        shared = generate_field(spec, 2)
-        assert len(turbulence._LAST_SAMPLER) == 1
-        turbulence._LAST_SAMPLER.clear()
-        fresh = generate_field(spec, 2)
+    with lidar.SamplerCache() as samplers:
+        generate_field(spec, 1, samplers=samplers)
+        kept = samplers._get(*_decay_and(spec))
+        shared = generate_field(spec, 2, samplers=samplers)
+        assert samplers._get(*_decay_and(spec)) is kept          # built once for the wind
+        fresh = generate_field(spec, 2)                          # no cache: a sampler of its own
         for comp in "uvw":
             assert np.array_equal(getattr(shared, comp), getattr(fresh, comp))
         other = TurbulenceSpec(16.0, "B", width=60, height=60, n_y=6, n_z=6, duration=60,
                                dt=0.1)
-        key = next(iter(turbulence._LAST_SAMPLER))
-        generate_field(other, 2)
-        assert next(iter(turbulence._LAST_SAMPLER)) != key
-        assert len(turbulence._LAST_SAMPLER) == 1
-    finally:
-        lidar.keep_samplers(was)
-    assert len(turbulence._LAST_SAMPLER) == (1 if was else 0)
-    lidar.keep_samplers(False)
-    generate_field(spec, 3)                  # off (the default): nothing held after the field
-    assert not turbulence._LAST_SAMPLER
-    lidar.keep_samplers(was)
+        generate_field(other, 2, samplers=samplers)
+        assert samplers._get(*_decay_and(other)) is not kept      # one at a time
+        assert samplers.holds
+    assert not samplers.holds                                    # released on exit
+
+
+def _decay_and(spec: TurbulenceSpec) -> tuple[np.ndarray, TurbulenceSpec]:
+    from lidar import turbulence
+
+    return turbulence._frequencies(spec)[3], spec
 
 
 def test_u_only_field_has_the_full_fields_u() -> None:
-    """Issue 23: runs without a LIDAR generate u alone (v = w = 0); u is drawn first from the
+    """runs without a LIDAR generate u alone (v = w = 0); u is drawn first from the
     seed's stream, so it is the full field's u bit for bit."""
     spec = TurbulenceSpec(12.0, "B", width=60, height=60, n_y=6, n_z=6, duration=60, dt=0.1)
     full, only = generate_field(spec, 5), generate_field(spec, 5, components="u")
@@ -338,7 +334,7 @@ def _evolution_spec() -> TurbulenceSpec:
 
 @pytest.mark.parametrize("keep", [False, True])
 def test_generated_evolved_field_is_the_evolved_generated_field(keep: bool) -> None:
-    """Issue 23: the LIDAR's upstream field made from the spec and seed alone (both spectra
+    """the LIDAR's upstream field made from the spec and seed alone (both spectra
     drawn side by side, the rotor's field never made) is evolve_field(generate_field(spec,
     seed)) to single-precision rounding: 2e-5 m/s (the float32 ulp at 20-30 m/s is 1.9e-6;
     the evolve path adds two single-precision transforms). The Cholesky factors of the
@@ -349,12 +345,11 @@ def test_generated_evolved_field_is_the_evolved_generated_field(keep: bool) -> N
     spec = _evolution_spec()
     n_t, nf, f, c = turbulence._frequencies(spec)
     assert len(turbulence._CirculantSampler(c, spec).exact) > 5
-    was = lidar.keep_samplers(keep)
-    try:
-        made = lidar.generate_evolved_field(spec, 21, 54.0, np.random.default_rng(8))
-        ref = lidar.evolve_field(generate_field(spec, 21), 54.0, spec, np.random.default_rng(8))
-    finally:
-        lidar.keep_samplers(was)
+    samplers = lidar.SamplerCache() if keep else None
+    made = lidar.generate_evolved_field(spec, 21, 54.0, np.random.default_rng(8),
+                                        samplers=samplers)
+    ref = lidar.evolve_field(generate_field(spec, 21, samplers=samplers), 54.0, spec,
+                             np.random.default_rng(8), samplers=samplers)
     for comp in "uvw":
         assert_allclose(getattr(made, comp), getattr(ref, comp), rtol=0, atol=2e-5)
     assert made.meta["evolution"] == ref.meta["evolution"]

@@ -12,6 +12,7 @@ import rosco  # in the test extras
 import linearize
 from mpc_wt.cli import main
 from mpc_wt.run import run_controller
+from mpc_wt.simulation.scenario import Scenario
 
 CASES = Path(rosco.__file__).parents[1] / "Examples" / "Test_Cases"
 
@@ -24,7 +25,7 @@ def test_iea15mw_baseline_600s_regulates() -> None:
     (measured 1.72), generator torque <= VS_MaxTq = 21.77 MN m (21.35), torque rate <=
     VS_MaxRat = 4.5 MN m/s (1.05)."""
     t = linearize.load_turbine("iea15mw")
-    res = run_controller(t, "baseline", 18.0, "A", 1, 600.0)
+    res = run_controller(t, "baseline", Scenario(18.0, "A", 1, 600.0))
     keep = res.t >= 60.0
     assert abs(res.channel("gen_power")[keep].mean() / 15e6 - 1) <= 0.01
     pa, gen = t.pitch_actuator, t.generator

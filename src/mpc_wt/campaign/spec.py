@@ -11,6 +11,7 @@ time series without simulating again.
 from __future__ import annotations
 
 import copy
+import dataclasses
 import hashlib
 import json
 import math
@@ -22,6 +23,7 @@ import numpy as np
 import yaml
 
 from mpc_wt.errors import SpecError
+from mpc_wt.simulation.scenario import Scenario, check_condition, check_turbulence, is_deterministic
 
 __all__ = ["SpecError", "CampaignSpec", "ControllerSpec", "Case", "LoadCase", "DLC_DEFAULTS",
            "load_spec", "spec_from_dict"]
@@ -112,13 +114,10 @@ def _turbulence(key: str, val: Any) -> tuple[str | float, ...]:
     out: list[str | float] = []
     for i, v in enumerate(vals):
         k = f"{key}[{i}]" if isinstance(val, (list, tuple)) else key
-        if isinstance(v, str):
-            if v not in ("A", "B", "C", "steady"):
-                raise _fail(k, f"must be an IEC class 'A', 'B', 'C', 'steady' or an intensity "
-                               f"in (0, 1), got {v!r}")
-            out.append(v)
-        else:
-            out.append(_number(k, v, 0.0, 1.0, lo_open=True))
+        try:
+            out.append(check_turbulence(v))
+        except ValueError as err:
+            raise _fail(k, str(err).replace("turbulence ", "", 1)) from None
     if not out or len(set(out)) != len(out):
         raise _fail(key, f"needs distinct values, got {vals}")
     return tuple(out)
@@ -214,12 +213,7 @@ class LoadCase:
     @property
     def deterministic(self) -> bool:
         """True for a condition without turbulence (one run per wind and sign)."""
-        return not _turbulent(self.condition, self.turbulence)
-
-
-def _turbulent(condition: str, turbulence: tuple[str | float, ...]) -> bool:
-    """A load case whose runs are turbulent (seeds), not deterministic (signs)."""
-    return condition in ("ntm", "etm") and turbulence != ("steady",)
+        return is_deterministic(self.condition, self.turbulence)
 
 
 @dataclass(frozen=True)
@@ -229,23 +223,18 @@ class Case:
     Parameters
     ----------
     case_id : str
-        ``controller__turbulence__vWIND__sSEED``.
+        ``controller__turbulence__vWIND__sSEED`` (and the load case's forms).
     controller : str
         The controller's label in the spec.
     run_name : str
         The registered kind it runs.
     options : dict
         The kind's options.
-    wind_mps : float
-        Mean wind [m/s].
-    seed : int
-        Seed of the field.
-    turbulence : str or float
-        Class letter or intensity.
-    duration, transient : float
-        Assessed length and discarded start [s].
-    shear_exponent : float
-        Power-law shear [-].
+    scenario : Scenario
+        What the simulator meets: mean wind, turbulence, seed, simulated time (the assessed
+        duration plus the transient), shear and the IEC condition.
+    transient : float
+        Discarded start [s].
     turbine : str
         Packaged name or resolved path.
     turbine_hash : str
@@ -257,32 +246,23 @@ class Case:
     plugins : tuple of str
         Modules that register controller kinds, imported by the worker.
     del_convention : str
-        The DEL convention of the assessment (:data:`mpc_wt.assessment.series.DEL_CONVENTIONS`).
+        The DEL convention of the assessment (:data:`mpc_wt.assessment.fatigue.DEL_CONVENTIONS`).
     dlc : str
         Its load case.
-    condition : dict or None
-        The IEC wind condition (``condition``, ``iec_class``, ``sign``, ``event_at`` [s of
-        simulation]) for :func:`mpc_wt.controllers.run_controller`; None: normal turbulence.
     supervisor : dict or None
         :class:`mpc_wt.controllers.supervisor.Supervisor` settings (times of simulation) or None.
     family : str
         Partial safety factor family of the load case.
     fatigue : bool
         The case enters the fatigue tables.
-    sign : int
-        Direction of a deterministic condition (1 or -1).
     """
 
     case_id: str
     controller: str
     run_name: str
     options: dict[str, Any]
-    wind_mps: float
-    seed: int
-    turbulence: str | float
-    duration: float
+    scenario: Scenario
     transient: float
-    shear_exponent: float
     turbine: str
     turbine_hash: str
     channels: dict[str, float]
@@ -291,21 +271,74 @@ class Case:
     plugins: tuple[str, ...] = ()
     del_convention: str = "range-1hz"
     dlc: str = "1.2"
-    condition: dict[str, Any] | None = None
     supervisor: dict[str, Any] | None = None
     family: str = "N"
     fatigue: bool = True
-    sign: int = 1
+
+    @property
+    def wind_mps(self) -> float:
+        """Mean wind [m/s]."""
+        return self.scenario.wind_mps
+
+    @property
+    def seed(self) -> int:
+        """Seed of the field."""
+        return self.scenario.seed
+
+    @property
+    def turbulence(self) -> str | float:
+        """Class letter or intensity."""
+        return self.scenario.turbulence
+
+    @property
+    def sign(self) -> int:
+        """Direction of a deterministic condition (1 or -1)."""
+        return self.scenario.sign
+
+    @property
+    def duration(self) -> float:
+        """Assessed length [s] (the simulated time less the transient)."""
+        return self.scenario.duration - self.transient
 
     def to_dict(self) -> dict[str, Any]:
-        """Plain data for a worker (pickles and JSON-serialises).
+        """Plain data for a worker and the store (pickles and JSON-serialises).
 
         Returns
         -------
         dict
-            Every field.
+            Every field; ``scenario`` as the dict of its fields.
         """
-        return {k: copy.deepcopy(getattr(self, k)) for k in self.__dataclass_fields__}
+        out = {k: copy.deepcopy(getattr(self, k)) for k in self.__dataclass_fields__}
+        out["scenario"] = dataclasses.asdict(self.scenario)
+        return out
+
+    @classmethod
+    def from_dict(cls, d: Mapping[str, Any]) -> "Case":
+        """A case from :meth:`to_dict`'s data, or from the flat form of stores written before
+        a case held its :class:`Scenario` (wind, seed, turbulence, duration, shear, condition
+        and sign as fields of their own).
+
+        Parameters
+        ----------
+        d : mapping
+            The data.
+
+        Returns
+        -------
+        Case
+        """
+        d = dict(d)
+        d["plugins"] = tuple(d.get("plugins", ()))
+        if "scenario" in d:
+            sc = d.pop("scenario")
+            scenario = sc if isinstance(sc, Scenario) else Scenario(**sc)
+        else:
+            cond = d.pop("condition", None) or {}
+            d.pop("sign", None)
+            scenario = Scenario(d.pop("wind_mps"), d.pop("turbulence"), d.pop("seed"),
+                                d.pop("duration") + d["transient"], d.pop("shear_exponent"),
+                                **cond)
+        return cls(scenario=scenario, **d)
 
 
 @dataclass(frozen=True)
@@ -474,14 +507,14 @@ class CampaignSpec:
                 sim["supervisor"] = sup
             out.append(Case(
                 case_id=_case_id(c.name, lc, turb, v, seed, sign), controller=c.name,
-                run_name=c.controller, options=copy.deepcopy(c.options), wind_mps=v,
-                seed=seed, turbulence=turb, duration=lc.duration, transient=lc.transient,
-                shear_exponent=self.shear_exponent, turbine=self.turbine,
+                run_name=c.controller, options=copy.deepcopy(c.options),
+                scenario=Scenario(v, turb, seed, lc.duration + lc.transient,
+                                  self.shear_exponent, **(cond or {})),
+                transient=lc.transient, turbine=self.turbine,
                 turbine_hash=self.turbine_hash, channels=dict(self.channels),
                 case_hash=_digest(sim), assess_hash=_digest(a), plugins=self.plugins,
-                del_convention=self.del_convention, dlc=lc.dlc, condition=cond,
-                supervisor=copy.deepcopy(sup), family=lc.family, fatigue=lc.fatigue,
-                sign=sign))
+                del_convention=self.del_convention, dlc=lc.dlc,
+                supervisor=copy.deepcopy(sup), family=lc.family, fatigue=lc.fatigue))
         return out
 
 
@@ -654,10 +687,11 @@ def _load_case(i: int, raw: Any, top: Mapping[str, Any]) -> LoadCase:
         raise _fail(f"{key}.family", f"must be 'N', 'A' or 'T' (IEC 61400-1 table 3), got "
                                      f"{family!r}")
     turb = _turbulence(f"{key}.turbulence", raw.get("turbulence", top["turbulence"]))
-    if cond != "ntm" and not all(t in ("A", "B", "C") for t in turb):
-        raise _fail(f"{key}.turbulence", f"condition {cond!r} needs IEC categories 'A', 'B' "
-                                         f"or 'C', got {list(turb)}")
-    turbulent = _turbulent(cond, turb)
+    try:
+        check_condition(cond, turb)
+    except ValueError as err:
+        raise _fail(f"{key}.turbulence", str(err)) from None
+    turbulent = not is_deterministic(cond, turb)
     signs = raw.get("signs", [1])
     if not isinstance(signs, list) or not signs or any(g not in (1, -1) for g in signs) \
             or len(set(signs)) != len(signs):

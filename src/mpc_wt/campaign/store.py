@@ -278,7 +278,7 @@ class CampaignStore:
                 "ORDER BY rowid"):
             if status == "done" and file and (self.root / file).is_file():
                 continue
-            out.append(Case(**json.loads(cj)))
+            out.append(Case.from_dict(json.loads(cj)))
         return out
 
     def mark_submitted(self, case_ids: Iterable[str]) -> None:

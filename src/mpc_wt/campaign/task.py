@@ -19,13 +19,20 @@ from typing import Any
 
 import numpy as np
 
+import lidar
 from mpc_wt.assessment.ultimate import case_extremes
+from mpc_wt.simulation.scenario import Scenario
 
 __all__ = ["run_case", "case_metrics", "case_file", "actuator_limit_metrics",
            "load_case_turbine"]
 
 #: A pitch rate at or above this fraction of the actuator's limit counts as at the limit.
 RATE_LIMIT_FRACTION = 0.98
+
+#: the turbulence generator's sampler, kept by a worker process from one case to the next (a
+#: worker's next case is often the next seed of the same wind; the fields are the same with or
+#: without it)
+WORKER_SAMPLERS = lidar.SamplerCache()
 
 
 def case_file(case_id: str) -> str:
@@ -213,19 +220,15 @@ def run_case(case: dict[str, Any], root: str) -> dict[str, Any]:
             except ResultFileError:
                 res = None
         if res is None:
-            import lidar
             from mpc_wt.registry.registry import load_plugins
             from mpc_wt.run import run_controller
 
             load_plugins(case.get("plugins", ()))
-            lidar.keep_samplers(True)        # a worker's next case is often the next seed
             try:
                 res = run_controller(load_case_turbine(case["turbine"]), case["run_name"],
-                                     case["wind_mps"], case["turbulence"], case["seed"],
-                                     duration=case["duration"] + case["transient"],
-                                     shear_exponent=case["shear_exponent"],
-                                     options=case["options"], condition=case.get("condition"),
-                                     supervisor=case.get("supervisor"))
+                                     Scenario(**case["scenario"]), case["options"],
+                                     supervisor=case.get("supervisor"),
+                                     samplers=WORKER_SAMPLERS)
             except SimulationDivergedError as err:
                 if getattr(err, "partial", None) is not None:
                     err.partial.meta["campaign_case"] = {"case_id": case["case_id"],

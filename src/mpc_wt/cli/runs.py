@@ -145,10 +145,9 @@ def _simulate(args: argparse.Namespace) -> int:
         prefix = "" if hasattr(err, "key") else "--controller: "
         raise UsageError(f"{prefix}{err}") from None
     turbine = linearize.load_turbine(args.turbine)
-    cond, sup = _events(args, turbine)
-    res = run_controller(turbine, args.controller, args.wind, args.turbulence, args.seed,
-                         args.duration, progress=True, options=opts, naming=naming,
-                         condition=cond, supervisor=sup)
+    scenario, sup = _events(args, turbine)
+    res = run_controller(turbine, args.controller, scenario, opts, supervisor=sup,
+                         progress=True, naming=naming)
     out = Path(args.out)
     if out.suffix == "":
         out = out.with_suffix(".nc")
@@ -159,22 +158,56 @@ def _simulate(args: argparse.Namespace) -> int:
     return 0
 
 
-def _events(args: argparse.Namespace, turbine: linearize.Turbine
-            ) -> tuple[dict[str, Any] | None, dict[str, Any] | None]:
-    """The wind condition and the supervisor settings of ``simulate``, checked here so that
-    an error names the flag."""
-    from mpc_wt.controllers.supervisor import Supervisor
+def scenario_of(args: argparse.Namespace, turbine: linearize.Turbine) -> Any:
+    """The :class:`~mpc_wt.simulation.scenario.Scenario` of ``simulate``'s and ``run``'s flags,
+    checked by the Scenario itself; an error names the flag.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        Parsed arguments (``--wind``, ``--turbulence``, ``--seed``, ``--duration`` and, for
+        ``simulate``, the wind condition's flags).
+    turbine : Turbine
+        The turbine (the IEC condition's speed range).
+
+    Returns
+    -------
+    Scenario
+
+    Raises
+    ------
+    UsageError
+        Naming the flag.
+    """
     from mpc_wt.simulation.scenario import Scenario, iec_site
 
-    cond = None
-    if args.condition != "ntm":
-        cond = {"condition": args.condition, "iec_class": args.iec_class, "sign": args.sign,
-                "event_at": args.event_at}
+    cond = getattr(args, "condition", "ntm")
+    extra = {} if cond == "ntm" else {"condition": cond, "iec_class": args.iec_class,
+                                       "sign": args.sign, "event_at": args.event_at}
+    try:
+        sc = Scenario(args.wind, args.turbulence, args.seed, args.duration, **extra)
+    except ValueError as err:
+        flag = next((f"--{k.replace('_', '-')}" for k in ("wind", "duration", "seed",
+                                                          "event_at", "sign")
+                     if str(err).startswith(k)), f"--condition {cond}")
+        if str(err).startswith("turbulence"):
+            flag = "--turbulence" if cond == "ntm" else f"--condition {cond}"
+        raise UsageError(f"{flag}: {err}") from None
+    if cond != "ntm":
         try:
-            sc = Scenario(args.wind, args.turbulence, args.seed, args.duration, **cond)
-            iec_site(turbine, sc).check_speed(args.condition, args.wind)
+            iec_site(turbine, sc).check_speed(cond, args.wind)
         except ValueError as err:
-            raise UsageError(f"--condition {args.condition}: {err}") from None
+            raise UsageError(f"--condition {cond}: {err}") from None
+    return sc
+
+
+def _events(args: argparse.Namespace, turbine: linearize.Turbine
+            ) -> tuple[Any, dict[str, Any] | None]:
+    """The scenario and the supervisor settings of ``simulate``, checked here so that an
+    error names the flag."""
+    from mpc_wt.controllers.supervisor import Supervisor
+
+    cond = scenario_of(args, turbine)
     sup = {k: v for k, v in (("overspeed", args.overspeed), ("shutdown_at", args.shutdown_at),
                              ("grid_loss_at", args.grid_loss_at),
                              ("torque_ramp_s", args.torque_ramp)) if v is not None}
@@ -322,11 +355,11 @@ def _comparison_runs(turbine: linearize.Turbine, args: argparse.Namespace, out: 
     from mpc_wt.run import run_controller
 
     names = [c.strip() for c in args.controllers.split(",") if c.strip()]
+    scenario = scenario_of(args, turbine)
     rows, runs = [], []
-    lidar.keep_samplers(True)                # every controller meets the same field
+    samplers = lidar.SamplerCache()          # every controller meets the same field
     for name in names:
-        res = run_controller(turbine, name, args.wind, args.turbulence, args.seed,
-                             args.duration, progress=True)
+        res = run_controller(turbine, name, scenario, progress=True, samplers=samplers)
         fname = name.replace("+", "_") + "_run.nc"
         res.save(out / fname)
         keep = res.t >= min(60.0, 0.1 * args.duration)
@@ -334,6 +367,7 @@ def _comparison_runs(turbine: linearize.Turbine, args: argparse.Namespace, out: 
         a = assess_series(res.t[keep], cols)
         rows.append(_comparison_row(name, a, cols, res.controller.get("qp_solve_ms"), fname))
         runs.append((name, res.t[keep], cols))
+    samplers.clear()
     (out / "comparison.json").write_text(json.dumps(rows, indent=1))
     made = assess_plots(runs, out) + plot_comparison(runs, out / "comparison.png")
     print(f"# {args.duration:g} s at {args.wind:g} m/s, turbulence {args.turbulence}, seed "

@@ -31,6 +31,8 @@ import numpy as np
 
 import linearize
 from mpc_wt.controllers.base import ControllerBase
+from mpc_wt.controllers.baseline_law import N_STATE, SIGNALS, law_parameters, law_step
+from mpc_wt.controllers.baseline_law import torque as law_torque
 
 __all__ = ["BaselineGains", "tune_baseline", "tune_baseline_schedule", "BaselineController",
            "check_power_fraction", "effective_pi_gains"]
@@ -305,7 +307,8 @@ class BaselineController(ControllerBase):
         g = self.gains
         n = turbine.drivetrain.gearbox_ratio
         self.wc = 2 * math.pi * filter_hz
-        self._a_filt = math.exp(-self.wc * self.dt)      # the speed filter's pole at dt
+        #: the speed low-pass's pole at dt [-]
+        self.filter_pole = math.exp(-self.wc * self.dt)
         self.pitch_min = turbine.operation.fine_pitch_rad
         self.pitch_max = turbine.pitch_actuator.max_pitch_rad
         self.rate = turbine.pitch_actuator.max_rate_rad_s
@@ -330,19 +333,46 @@ class BaselineController(ControllerBase):
         self.tq_cap = g.rated_power / turbine.drivetrain.generator_efficiency / self.w_rated
         if self.w_trans > self.w_rated:
             self.w_trans = self.w_rated
+        self._par = law_parameters(self)
+        self._cmd, self._sig = np.empty(4), np.empty(len(SIGNALS))
         self.reset()
 
     def reset(self) -> None:
         """Forget the filter, integral and last commands."""
-        self.w_filt: float | None = None
-        self.integral = 0.0
+        #: the law's state (:mod:`mpc_wt.controllers.baseline_law`): filtered speed, integral,
+        #: last pitch, last torque, started (0 / 1)
+        self._st = np.zeros(N_STATE)
         #: an add-on's feedforward pitch [rad], set before each step (None: none); its change
         #: from step to step enters the integral, so the PI stays consistent with it
         self.pitch_feedforward: float | None = None
         self._ff_last: float | None = None
-        self.last_pitch: float | None = None
-        self.last_torque: float | None = None
         self.signals: dict[str, float] = {}
+
+    @property
+    def started(self) -> bool:
+        """Whether the controller has stepped since its last reset."""
+        return bool(self._st[4])
+
+    @property
+    def w_filt(self) -> float | None:
+        """Filtered generator speed [rad/s] (None before the first step)."""
+        return float(self._st[0]) if self.started else None
+
+    @property
+    def integral(self) -> float:
+        """The PI's integral state (DISCON form: of the speed error [rad]; with a gain schedule
+        in pitch units [rad])."""
+        return float(self._st[1])
+
+    @property
+    def last_pitch(self) -> float | None:
+        """The last pitch command [rad] (None before the first step)."""
+        return float(self._st[2]) if self.started else None
+
+    @property
+    def last_torque(self) -> float | None:
+        """The last torque command [N m] (None before the first step)."""
+        return float(self._st[3]) if self.started else None
 
     def compiled_law(self, gen_speed_index: int) -> tuple[np.ndarray, np.ndarray] | None:
         """The law's state and parameters for the closed loop compiled with the plant
@@ -363,9 +393,9 @@ class BaselineController(ControllerBase):
                 or self.power_reference is not None or self._sched_f is not None
                 or self.pitch_feedforward is not None):
             return None
-        from mpc_wt.controllers.baseline_law import law_arrays
-
-        return law_arrays(self, gen_speed_index)
+        par = self._par.copy()
+        par[-1] = gen_speed_index
+        return self._st.copy(), par
 
     def adopt_compiled_state(self, state: np.ndarray, signals: np.ndarray) -> None:
         """Take the state a compiled run left (:meth:`compiled_law`'s layout) and its last
@@ -378,12 +408,9 @@ class BaselineController(ControllerBase):
         signals : (6,) ndarray
             The last step's signals (:data:`mpc_wt.simulation.compiled.SIGNALS`).
         """
-        from mpc_wt.controllers.baseline_law import SIGNALS
-
         if state[4] == 0.0:                 # never stepped
             return
-        self.w_filt, self.integral, self.last_pitch, self.last_torque = (
-            float(v) for v in state[:4])
+        self._st[:] = state
         self.signals = {k: float(v) for k, v in zip(SIGNALS, signals)}
 
     def torque(self, w: float, pitch: float, power: float | None = None) -> float:
@@ -404,22 +431,9 @@ class BaselineController(ControllerBase):
         float
             Generator torque demand [N m].
         """
-        g = self.gains
-        eta = self.turbine.drivetrain.generator_efficiency
-        p3 = g.rated_power if power is None else power
-        if w >= self.w_rated or pitch >= math.radians(1.0):
-            if self.region3 == "constant_power":
-                return p3 / eta / max(w, 1e-6)
-            return g.rated_torque * p3 / g.rated_power
-        if w <= self.w_cutin:
-            return 0.0
-        if w < self.w_rgn2:
-            tq = self.slope15 * (w - self.w_cutin)
-        elif w < self.w_trans:
-            tq = g.k_opt * w * w
-        else:
-            tq = self.slope25 * (w - self.w_sync)
-        return min(tq, self.tq_cap, p3 / eta / max(w, 1e-6))
+        p3 = self.gains.rated_power if power is None else power
+        return float(law_torque(float(w), float(pitch), float(p3), self._par))
+
 
     def _ff_step(self) -> float:
         """The feedforward pitch's change since the last step [rad]."""
@@ -447,62 +461,63 @@ class BaselineController(ControllerBase):
             raise ValueError(f"measurement gen_speed is not finite at t = {t:g} s: {w!r}")
         p1, p2, p3 = meas["pitch"]
         pitch_meas = float(p1 + p2 + p3) / 3.0
-        first = self.w_filt is None
-        if first:
-            self.w_filt = w
-            self.last_pitch = pitch_meas
-        a = self._a_filt
-        self.w_filt = a * self.w_filt + (1 - a) * w
-        g = self.gains
         p_ref = self._reference(t)
-        err = self.w_filt - g.rated_gen_speed_rad_s
         if self._sched_f is None:
-            # DISCON form: the integral of the speed error, scaled by GK with the P part
-            gk = 1.0 / (1.0 + self.last_pitch / g.theta_k_rad)
-            if first:                       # bumpless start at the measured pitch
-                self.integral = (pitch_meas / gk - g.kp * err) / g.ki
-            self.integral += err * self.dt + self._ff_step() / (gk * g.ki)
-            # anti-windup: keep the integral term within the pitch limits
-            lo, hi = self.pitch_min / (gk * g.ki), self.pitch_max / (gk * g.ki)
-            self.integral = min(max(self.integral, lo), hi)
-            cmd = gk * (g.kp * err + g.ki * self.integral)
+            # DISCON form, the law of mpc_wt.controllers.baseline_law
+            power = self.gains.rated_power if p_ref is None else p_ref
+            law_step(w, pitch_meas, self._ff_step(), power, self._st, self._par, self._cmd,
+                     self._sig)
+            cmd, tq, err = float(self._cmd[0]), float(self._cmd[3]), float(self._sig[1])
+            self.signals = dict(zip(SIGNALS, self._sig.tolist()))
         else:
-            # scheduled on P_ref / P_r and pitch: the integral is kept in pitch units (ROSCO
-            # form) so that a gain change moves no command
-            frac = p_ref / (g.rated_power / g.power_fraction) if p_ref is not None \
-                else g.power_fraction
-            gks = 1.0 / (1.0 + self.last_pitch / self._sched[:, 2])
-            kp = float(np.interp(frac, self._sched_f, self._sched[:, 0] * gks))
-            ki = float(np.interp(frac, self._sched_f, self._sched[:, 1] * gks))
-            gk = kp / g.kp
-            if first:
-                self.integral = pitch_meas - kp * err
-                self._p_ref_last = p_ref
-            ff = 0.0
-            if self.feedforward and p_ref is not None:
-                # pitch that sheds the reference change at this operating point:
-                # d theta = d P_aero / (dP/dtheta), dP/dtheta = (dP/dtheta)_0 / GK
-                dpdt = float(np.interp(frac, self._sched_f, self._sched[:, 3] / gks))
-                eta = self.turbine.drivetrain.generator_efficiency
-                ff = (p_ref - self._p_ref_last) / eta / dpdt
-                self._p_ref_last = p_ref
-            self.integral = min(max(self.integral + ki * err * self.dt + ff + self._ff_step(),
-                                    self.pitch_min), self.pitch_max)
-            cmd = kp * err + self.integral
-        cmd = min(max(cmd, self.pitch_min), self.pitch_max)
-        step = self.rate * self.dt
-        cmd = min(max(cmd, self.last_pitch - step), self.last_pitch + step)
-        self.last_pitch = cmd
-        tq = min(self.torque(self.w_filt, cmd, p_ref), self.tq_max)
-        if self.last_torque is not None:
-            d = self.tq_rate * self.dt
-            tq = min(max(tq, self.last_torque - d), self.last_torque + d)
-        self.last_torque = tq
-        self.signals = {"gen_speed_filtered": self.w_filt, "speed_error": err,
-                        "pitch_integral": self.integral, "gain_schedule": gk,
-                        "pitch_command": cmd, "torque_command": tq}
+            cmd, tq, err = self._scheduled_step(w, pitch_meas, p_ref)
         if p_ref is not None:
             self.signals["power_reference"] = p_ref
             self.signals["apc_saturated"] = float(cmd <= self.pitch_min + 1e-9
                                                   and err < 0.0)
         return np.array((cmd, cmd, cmd)), tq
+
+    def _scheduled_step(self, w: float, pitch_meas: float, p_ref: float | None
+                        ) -> tuple[float, float, float]:
+        """The step with gains scheduled on P_ref / P_r and pitch (active power control): the
+        integral is kept in pitch units (ROSCO form) so that a gain change moves no command.
+        Returns (pitch command [rad], torque command [N m], speed error [rad/s])."""
+        st, g = self._st, self.gains
+        first = st[4] == 0.0
+        if first:
+            st[0], st[2] = w, pitch_meas
+        a = self.filter_pole
+        st[0] = a * st[0] + (1 - a) * w
+        w_filt, last_pitch = float(st[0]), float(st[2])
+        err = w_filt - g.rated_gen_speed_rad_s
+        frac = p_ref / (g.rated_power / g.power_fraction) if p_ref is not None \
+            else g.power_fraction
+        gks = 1.0 / (1.0 + last_pitch / self._sched[:, 2])
+        kp = float(np.interp(frac, self._sched_f, self._sched[:, 0] * gks))
+        ki = float(np.interp(frac, self._sched_f, self._sched[:, 1] * gks))
+        gk = kp / g.kp
+        if first:
+            st[1] = pitch_meas - kp * err
+            self._p_ref_last = p_ref
+        ff = 0.0
+        if self.feedforward and p_ref is not None:
+            # pitch that sheds the reference change at this operating point:
+            # d theta = d P_aero / (dP/dtheta), dP/dtheta = (dP/dtheta)_0 / GK
+            dpdt = float(np.interp(frac, self._sched_f, self._sched[:, 3] / gks))
+            eta = self.turbine.drivetrain.generator_efficiency
+            ff = (p_ref - self._p_ref_last) / eta / dpdt
+            self._p_ref_last = p_ref
+        integral = min(max(float(st[1]) + ki * err * self.dt + ff + self._ff_step(),
+                           self.pitch_min), self.pitch_max)
+        cmd = min(max(kp * err + integral, self.pitch_min), self.pitch_max)
+        step = self.rate * self.dt
+        cmd = min(max(cmd, last_pitch - step), last_pitch + step)
+        tq = min(self.torque(w_filt, cmd, p_ref), self.tq_max)
+        if not first:
+            d = self.tq_rate * self.dt
+            tq = min(max(tq, float(st[3]) - d), float(st[3]) + d)
+        st[1], st[2], st[3], st[4] = integral, cmd, tq, 1.0
+        self.signals = {"gen_speed_filtered": w_filt, "speed_error": err,
+                        "pitch_integral": integral, "gain_schedule": gk,
+                        "pitch_command": cmd, "torque_command": tq}
+        return cmd, tq, err

@@ -1,4 +1,15 @@
-"""The baseline's law (DISCON form) as compiled functions on a state and a parameter vector.
+"""The baseline's law in DISCON form, written once as compiled functions on a state and a
+parameter vector.
+
+The law of Jonkman's baseline (NREL/TP-500-38060, sec. 7): a first-order low-pass on the
+generator speed; a PI on the filtered speed error with the gain schedule
+GK = 1 / (1 + theta / theta_K) applied at the previous command, the integral kept within the
+pitch limits (anti-windup) and a bumpless start at the measured pitch; the pitch-rate limit; the
+torque law of regions 1.5, 2, 2.5 and 3 (constant power or constant torque) capped at the
+maximum torque, and its rate limit. :class:`~mpc_wt.controllers.baseline.BaselineController`
+runs it from Python at each step (:func:`law_step`); the closed loop compiled with the plant
+(:mod:`mpc_wt.simulation.compiled`) runs it on the plant's outputs (:func:`law`). Both are the
+same operations in the same order, so the two loops agree to the last bit.
 """
 from __future__ import annotations
 
@@ -8,47 +19,46 @@ from typing import Any
 import numba as nb
 import numpy as np
 
-__all__ = ['SIGNALS', 'law_arrays']
+__all__ = ["SIGNALS", "N_STATE", "N_PARAMS", "law_parameters", "law_step", "torque", "law"]
 
 _JIT = dict(cache=True, error_model="numpy")
-
 
 #: the law's signals, in the order of the recorded columns (BaselineController.signals)
 SIGNALS = ("gen_speed_filtered", "speed_error", "pitch_integral", "gain_schedule",
            "pitch_command", "torque_command")
 
-
 # parameter vector layout
 (_A, _W_RATED_SET, _KP, _KI, _THETA_K, _DT, _P_MIN, _P_MAX, _RATE, _TQ_RATE, _TQ_MAX,
  _W_CUTIN, _W_RGN2, _W_TRANS, _W_RATED, _W_SYNC, _SLOPE15, _SLOPE25, _K_OPT, _TQ_CAP,
  _P_RATED, _ETA, _TQ_RATED, _CONST_POWER, _ONE_DEG, _I_GEN_SPEED) = range(26)
-
+#: length of the parameter vector
+N_PARAMS = 26
 
 # state vector layout: filtered speed, integral, last pitch, last torque, started (0 / 1)
 _W_FILT, _INTEGRAL, _LAST_PITCH, _LAST_TQ, _STARTED = range(5)
+#: length of the state vector
+N_STATE = 5
 
 
-def law_arrays(ctl: Any, gen_speed_index: int) -> tuple[np.ndarray, np.ndarray]:
-    """The state and parameter vectors of a baseline controller's law.
+def law_parameters(ctl: Any, gen_speed_index: int = -1) -> np.ndarray:
+    """The parameter vector of a baseline controller's law.
 
     Parameters
     ----------
     ctl : BaselineController
-        A controller whose law is the plain one (see the module docstring); its state (a run
-        under way) is carried over.
+        The controller (its gains, breakpoints, limits and period).
     gen_speed_index : int
-        Index of the generator speed in the plant's outputs.
+        Index of the generator speed in the plant's outputs (for :func:`law`; -1: unused).
 
     Returns
     -------
-    state : (5,) ndarray
-    params : (26,) ndarray
+    (N_PARAMS,) ndarray
     """
     g = ctl.gains
-    par = np.empty(26)
+    par = np.empty(N_PARAMS)
     par[[_A, _W_RATED_SET, _KP, _KI, _THETA_K, _DT, _P_MIN, _P_MAX, _RATE, _TQ_RATE]] = (
-        ctl._a_filt, g.rated_gen_speed_rad_s, g.kp, g.ki, g.theta_k_rad, ctl.dt, ctl.pitch_min,
-        ctl.pitch_max, ctl.rate, ctl.tq_rate)
+        ctl.filter_pole, g.rated_gen_speed_rad_s, g.kp, g.ki, g.theta_k_rad, ctl.dt,
+        ctl.pitch_min, ctl.pitch_max, ctl.rate, ctl.tq_rate)
     par[[_TQ_MAX, _W_CUTIN, _W_RGN2, _W_TRANS, _W_RATED, _W_SYNC, _SLOPE15, _SLOPE25]] = (
         ctl.tq_max, ctl.w_cutin, ctl.w_rgn2, ctl.w_trans, ctl.w_rated, ctl.w_sync, ctl.slope15,
         ctl.slope25)
@@ -56,16 +66,13 @@ def law_arrays(ctl: Any, gen_speed_index: int) -> tuple[np.ndarray, np.ndarray]:
         g.k_opt, ctl.tq_cap, g.rated_power, ctl.turbine.drivetrain.generator_efficiency,
         g.rated_torque, float(ctl.region3 == "constant_power"), math.radians(1.0),
         gen_speed_index)
-    st = np.zeros(5)
-    if ctl.w_filt is not None:          # a run under way (the filter and last commands set)
-        st[:] = (ctl.w_filt, ctl.integral, ctl.last_pitch, ctl.last_torque, 1.0)
-    return st, par
+    return par
 
 
 @nb.njit(**_JIT)
-def torque(w, pitch, par):  # pragma: no cover - compiled
-    """BaselineController.torque without a power reference."""
-    p3 = par[_P_RATED]
+def torque(w, pitch, p3, par):  # pragma: no cover - compiled
+    """Generator torque demand [N m] at filtered generator speed ``w`` [rad/s] and collective
+    pitch [rad], with ``p3`` [W] in place of rated power in region 3."""
     if w >= par[_W_RATED] or pitch >= par[_ONE_DEG]:
         if par[_CONST_POWER] != 0.0:
             return p3 / par[_ETA] / max(w, 1e-6)
@@ -82,13 +89,12 @@ def torque(w, pitch, par):  # pragma: no cover - compiled
 
 
 @nb.njit(**_JIT)
-def law(z, st, par, cmd, sig):  # pragma: no cover - compiled
-    """BaselineController.step on the plant's outputs z: writes the commands (3 pitch, torque)
-    and the signals; returns 1 on a non-finite generator speed, else 0."""
-    w = z[int(par[_I_GEN_SPEED])]
-    if not math.isfinite(w):
-        return 1
-    pitch_meas = (z[1] + z[2] + z[3]) / 3.0
+def law_step(w, pitch_meas, ff, p3, st, par, cmd, sig):  # pragma: no cover - compiled
+    """One step of the law: measured generator speed ``w`` [rad/s] and mean pitch [rad], the
+    change of an add-on's feedforward pitch since the last step ``ff`` [rad] (it enters the
+    integral, so the PI stays consistent with it) and the power ``p3`` [W] of region 3. Updates
+    the state ``st`` and writes the commands ``cmd`` (3 pitch [rad], torque [N m]) and the
+    signals ``sig`` (:data:`SIGNALS`)."""
     first = st[_STARTED] == 0.0
     if first:
         st[_W_FILT] = w
@@ -98,9 +104,9 @@ def law(z, st, par, cmd, sig):  # pragma: no cover - compiled
     kp, ki, dt = par[_KP], par[_KI], par[_DT]
     err = st[_W_FILT] - par[_W_RATED_SET]
     gk = 1.0 / (1.0 + st[_LAST_PITCH] / par[_THETA_K])
-    if first:
+    if first:                                   # bumpless start at the measured pitch
         st[_INTEGRAL] = (pitch_meas / gk - kp * err) / ki
-    st[_INTEGRAL] += err * dt + 0.0 / (gk * ki)
+    st[_INTEGRAL] += err * dt + ff / (gk * ki)
     lo, hi = par[_P_MIN] / (gk * ki), par[_P_MAX] / (gk * ki)
     st[_INTEGRAL] = min(max(st[_INTEGRAL], lo), hi)
     p = gk * (kp * err + ki * st[_INTEGRAL])
@@ -108,7 +114,7 @@ def law(z, st, par, cmd, sig):  # pragma: no cover - compiled
     step = par[_RATE] * dt
     p = min(max(p, st[_LAST_PITCH] - step), st[_LAST_PITCH] + step)
     st[_LAST_PITCH] = p
-    tq = min(torque(st[_W_FILT], p, par), par[_TQ_MAX])
+    tq = min(torque(st[_W_FILT], p, p3, par), par[_TQ_MAX])
     if st[_STARTED] == 1.0:
         d = par[_TQ_RATE] * dt
         tq = min(max(tq, st[_LAST_TQ] - d), st[_LAST_TQ] + d)
@@ -116,4 +122,14 @@ def law(z, st, par, cmd, sig):  # pragma: no cover - compiled
     st[_STARTED] = 1.0
     sig[0], sig[1], sig[2], sig[3], sig[4], sig[5] = st[_W_FILT], err, st[_INTEGRAL], gk, p, tq
     cmd[0], cmd[1], cmd[2], cmd[3] = p, p, p, tq
+
+
+@nb.njit(**_JIT)
+def law(z, st, par, cmd, sig):  # pragma: no cover - compiled
+    """:func:`law_step` on the plant's outputs ``z`` at rated power, without feedforward;
+    returns 1 on a non-finite generator speed, else 0."""
+    w = z[int(par[_I_GEN_SPEED])]
+    if not math.isfinite(w):
+        return 1
+    law_step(w, (z[1] + z[2] + z[3]) / 3.0, 0.0, par[_P_RATED], st, par, cmd, sig)
     return 0

@@ -138,6 +138,9 @@ class BuildContext:
         The wind field of the case (for a LIDAR in the loop).
     cache : DesignCache
         For designs that cost seconds.
+    samplers : lidar.SamplerCache, optional
+        Keeps the turbulence generator's sampler between the fields of a run and, if the
+        caller keeps it, of the next runs.
     """
 
     turbine: linearize.Turbine
@@ -146,6 +149,7 @@ class BuildContext:
     scenario: Scenario
     field: Any
     cache: DesignCache = DEFAULT_CACHE
+    samplers: lidar.SamplerCache | None = None
 
     def lidar_field(self, distance: float) -> Any:
         """The field a LIDAR focused ``distance`` upstream measures: the case's field evolved
@@ -175,12 +179,14 @@ class BuildContext:
                 return self.field
             # the case's field was made with u only (the plant's): the whole field, whose u
             # is the same
-            return dataclasses.replace(lidar.generate_field(spec, self.scenario.seed),
+            return dataclasses.replace(lidar.generate_field(spec, self.scenario.seed,
+                                                            samplers=self.samplers),
                                        meta=self.field.meta | {"components": "uvw"})
         # made without the case's field: it is generate_evolved_field(spec, seed, ...), the
         # evolution of generate_field(spec, seed) to single-precision rounding
         seed = np.random.default_rng([self.scenario.seed, _EVOLUTION_STREAM])
-        seen = lidar.generate_evolved_field(spec, self.scenario.seed, distance, seed)
+        seen = lidar.generate_evolved_field(spec, self.scenario.seed, distance, seed,
+                                            samplers=self.samplers)
         return dataclasses.replace(seen, meta={**self.field.meta, **seen.meta,
                                                "components": "uvw"})
 

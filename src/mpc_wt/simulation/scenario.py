@@ -14,7 +14,8 @@ import lidar
 import linearize
 from linearize.validate import check_finite_scalar, check_positive, check_range
 
-__all__ = ['Scenario', 'field_grid', 'make_wind', 'field_spec', 'iec_site']
+__all__ = ['Scenario', 'check_turbulence', 'check_condition', 'is_deterministic', 'field_grid',
+           'make_wind', 'field_spec', 'iec_site']
 
 @dataclass(frozen=True)
 class Scenario:
@@ -60,21 +61,11 @@ class Scenario:
         check_positive("wind_mps", self.wind_mps)
         check_positive("duration", self.duration)
         check_range("shear_exponent", self.shear_exponent, -1.0, 1.0)
-        if isinstance(self.turbulence, str):
-            if self.turbulence not in ("A", "B", "C", "steady"):
-                raise ValueError(f"turbulence must be 'A', 'B', 'C', 'steady' or an intensity "
-                                 f"in (0, 1), got {self.turbulence!r}")
-        elif not 0.0 < check_finite_scalar("turbulence", self.turbulence) < 1.0:
-            raise ValueError(f"turbulence intensity must be in (0, 1), got {self.turbulence!r}")
+        check_turbulence(self.turbulence)
         if isinstance(self.seed, bool) or not isinstance(self.seed, (int, np.integer)) \
                 or self.seed < 0:
             raise ValueError(f"seed must be an integer >= 0, got {self.seed!r}")
-        if self.condition not in lidar.CONDITIONS:
-            raise ValueError(f"condition must be one of {sorted(lidar.CONDITIONS)}, got "
-                             f"{self.condition!r}")
-        if self.condition not in ("ntm", "nwp") and self.turbulence not in ("A", "B", "C"):
-            raise ValueError(f"condition {self.condition!r} needs an IEC turbulence category "
-                             f"'A', 'B' or 'C' as turbulence, got {self.turbulence!r}")
+        check_condition(self.condition, (self.turbulence,))
         if self.sign not in (1, -1):
             raise ValueError(f"sign must be 1 or -1, got {self.sign!r}")
         check_range("event_at", self.event_at, 0.0, math.inf)
@@ -82,7 +73,7 @@ class Scenario:
     @property
     def deterministic(self) -> bool:
         """True for a wind without turbulence: steady, NWP or an IEC transient."""
-        return self.turbulence == "steady" or self.condition not in ("ntm", "etm")
+        return is_deterministic(self.condition, (self.turbulence,))
 
     def meta(self) -> dict[str, Any]:
         """The case as plain data for a result's ``meta``.
@@ -100,6 +91,82 @@ class Scenario:
             out.update(condition=self.condition, iec_class=self.iec_class, sign=self.sign,
                        event_at_s=self.event_at)
         return out
+
+
+# The scenario's rules, written once: Scenario checks itself with them, and the campaign spec
+# and the command line call them to name their own key or flag in the message.
+
+def check_turbulence(value: Any) -> str | float:
+    """An IEC class letter, "steady", or a turbulence intensity, checked.
+
+    Parameters
+    ----------
+    value : str or float
+        "A", "B", "C", "steady" or an intensity in (0, 1) [-].
+
+    Returns
+    -------
+    str or float
+        The value (an intensity as float).
+
+    Raises
+    ------
+    ValueError
+        Naming what is allowed and the value.
+    """
+    if isinstance(value, str):
+        if value not in ("A", "B", "C", "steady"):
+            raise ValueError(f"turbulence must be 'A', 'B', 'C', 'steady' or an intensity in "
+                             f"(0, 1), got {value!r}")
+        return value
+    if isinstance(value, bool) or not isinstance(value, (int, float, np.floating)) \
+            or not 0.0 < check_finite_scalar("turbulence", value) < 1.0:
+        raise ValueError(f"turbulence intensity must be in (0, 1), got {value!r}")
+    return float(value)
+
+
+def check_condition(condition: str, turbulence: tuple[str | float, ...]) -> None:
+    """An IEC 61400-1 wind condition and the turbulence it is given with, checked: a
+    condition other than NTM and NWP takes the turbulence as the site's category.
+
+    Parameters
+    ----------
+    condition : str
+        A key of :data:`lidar.CONDITIONS`.
+    turbulence : tuple of str or float
+        The turbulence values it runs with.
+
+    Raises
+    ------
+    ValueError
+        An unknown condition, or a condition that needs a category given an intensity or
+        "steady".
+    """
+    if condition not in lidar.CONDITIONS:
+        raise ValueError(f"condition must be one of {sorted(lidar.CONDITIONS)}, got "
+                         f"{condition!r}")
+    if condition not in ("ntm", "nwp") and not all(t in ("A", "B", "C") for t in turbulence):
+        shown = turbulence[0] if len(turbulence) == 1 else list(turbulence)
+        raise ValueError(f"condition {condition!r} needs an IEC turbulence category 'A', 'B' "
+                         f"or 'C' as turbulence, got {shown!r}")
+
+
+def is_deterministic(condition: str, turbulence: tuple[str | float, ...]) -> bool:
+    """Whether runs of this condition and turbulence have no turbulence (one run per wind and
+    sign: steady wind, NWP or an IEC transient) rather than seeds.
+
+    Parameters
+    ----------
+    condition : str
+        A key of :data:`lidar.CONDITIONS`.
+    turbulence : tuple of str or float
+        The turbulence values.
+
+    Returns
+    -------
+    bool
+    """
+    return condition not in ("ntm", "etm") or tuple(turbulence) == ("steady",)
 
 
 def field_grid(turbine: linearize.Turbine) -> tuple[float, int]:
@@ -125,7 +192,8 @@ def field_grid(turbine: linearize.Turbine) -> tuple[float, int]:
     return width, n
 
 
-def make_wind(turbine: linearize.Turbine, scenario: Scenario, components: str = "uvw"
+def make_wind(turbine: linearize.Turbine, scenario: Scenario, components: str = "uvw", *,
+              samplers: lidar.SamplerCache | None = None
               ) -> tuple[linearize.SteadyWind | linearize.GridWind, lidar.WindField]:
     """The plant's wind for a scenario and the same field for a LIDAR in the loop.
 
@@ -138,6 +206,9 @@ def make_wind(turbine: linearize.Turbine, scenario: Scenario, components: str = 
     components : str
         The turbulent components to generate ("uvw" default; "u": v = w = 0, for runs
         without a LIDAR; u is the same either way, drawn first from the seed's stream).
+    samplers : lidar.SamplerCache, optional
+        Keeps the turbulence generator's sampler for the next field of the same wind and grid
+        (the fields are the same with or without it).
 
     Returns
     -------
@@ -163,7 +234,7 @@ def make_wind(turbine: linearize.Turbine, scenario: Scenario, components: str = 
                             meta={"model": "steady power law"})
         return linearize.SteadyWind(v, alpha), f
     spec = field_spec(turbine, scenario)
-    f = lidar.generate_field(spec, scenario.seed, components=components)
+    f = lidar.generate_field(spec, scenario.seed, components=components, samplers=samplers)
     if scenario.condition == "etm":
         f = dataclasses.replace(f, meta={**f.meta, "condition": "etm",
                                          "iec_class": scenario.iec_class,

@@ -20,7 +20,7 @@ import time
 from pathlib import Path
 from typing import Any, Iterator, Mapping
 
-from mpc_wt.campaign.report import absolute_metrics, relative_metrics
+from mpc_wt.campaign.aggregate import absolute_metrics, relative_metrics
 from mpc_wt.campaign.runner import run_campaign
 from mpc_wt.campaign.store import CampaignStore
 from mpc_wt.errors import CampaignLockedError, TrialFailed

@@ -20,7 +20,7 @@ YAML, the campaign's keys (``turbine``, ``duration``, ``transient``, ``turbulenc
     holdout_seeds: [4, 5, 6]                               # evaluated once, after the search
 
 Every measure is a ratio to the reference over the same cases
-(:func:`mpc_wt.campaign.report.relative_metrics`): ``del:CHANNEL`` (lifetime DEL of a channel
+(:func:`mpc_wt.campaign.aggregate.relative_metrics`): ``del:CHANNEL`` (lifetime DEL of a channel
 of ``channels``), ``cs1``..``cs5``, ``power_mean``, ``power_std``, ``rotor_speed_std``,
 ``rotor_speed_max``, ``pitch_travel``, ``pitch_rate_std``, ``pitch_acc_std``, ``flap_1p``,
 ``flap_3p``. A constraint may give ``max_change_pct`` instead (``max_ratio = 1 + pct/100``),
@@ -39,7 +39,7 @@ from typing import Any, Mapping
 
 import yaml
 
-from mpc_wt.campaign.report import ABSOLUTE_METRICS, RELATIVE_METRICS
+from mpc_wt.campaign.aggregate import ABSOLUTE_METRICS, RELATIVE_METRICS
 from mpc_wt.campaign.spec import CampaignSpec, spec_from_dict
 from mpc_wt.errors import SpecError
 from mpc_wt.tuning.optimizer import SAMPLERS, Constraint, Parameter

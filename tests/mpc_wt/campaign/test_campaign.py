@@ -2,6 +2,7 @@
 worker and a killed client, aggregation and the report (issue 9)."""
 from __future__ import annotations
 
+import json
 import os
 import signal
 import sqlite3
@@ -25,6 +26,7 @@ from mpc_wt.campaign import (
     spec_from_dict,
 )
 from mpc_wt.simulation.results import ClosedLoopResult
+from mpc_wt.simulation.scenario import Scenario
 
 BASE = {"name": "t", "duration": 20, "transient": 5, "winds": [14],
         "seeds": 1, "controllers": ["baseline"]}
@@ -248,7 +250,7 @@ def test_killed_worker_and_killed_client_lose_nothing_duplicate_nothing(tmp_path
 
 # -- aggregation and report -------------------------------------------------------------------
 def test_report_tables_and_plots(tmp_path):
-    from mpc_wt.campaign.report import aggregate, make_report
+    from mpc_wt.campaign.aggregate import aggregate, make_report
 
     spec = _spec(winds=[10, 14], seeds=2, controllers=["baseline", "derate80"],
                  duration=30, wind_distribution={"kind": "rayleigh", "mean": 10},
@@ -336,15 +338,15 @@ def test_do_controllers_pick_their_region():
     from mpc_wt import run_controller
 
     tb = linearize.load_turbine()
-    r2 = run_controller(tb, "lqr-pio", 8.0, 0.12, 1, 60.0)
-    b2 = run_controller(tb, "baseline", 8.0, 0.12, 1, 60.0)
+    r2 = run_controller(tb, "lqr-pio", Scenario(8.0, 0.12, 1, 60.0))
+    b2 = run_controller(tb, "baseline", Scenario(8.0, 0.12, 1, 60.0))
     assert r2.meta["lqr"]["region"] == "II"
     k = r2.t > 20
     assert r2.channel("gen_power")[k].mean() == pytest.approx(
         b2.channel("gen_power")[k].mean(), rel=0.02)
-    assert run_controller(tb, "lqr-pio", 18.0, 0.12, 1, 5.0).meta["lqr"]["region"] == "III"
-    ct = run_controller(tb, "baseline-ct", 18.0, 0.12, 1, 60.0)
-    cp = run_controller(tb, "baseline", 18.0, 0.12, 1, 60.0)
+    assert run_controller(tb, "lqr-pio", Scenario(18.0, 0.12, 1, 5.0)).meta["lqr"]["region"] == "III"
+    ct = run_controller(tb, "baseline-ct", Scenario(18.0, 0.12, 1, 60.0))
+    cp = run_controller(tb, "baseline", Scenario(18.0, 0.12, 1, 60.0))
     q_rated = tb.operation.rated_power / tb.operation.rated_rotor_speed_rad_s / \
         tb.drivetrain.gearbox_ratio
     assert ct.channel("gen_torque")[k].std() < 0.005 * q_rated
@@ -355,7 +357,7 @@ def test_aggregate_flags_a_seed_far_above_its_bin_and_weights_lifetime(tmp_path)
     """Synthetic index (no simulation): the lifetime DEL is the eq-18 m-power mean, and a seed
     with 10x its bin's median DEL is listed as suspect (kept in the tables)."""
     from mpc_wt.assessment.fatigue import lifetime_del, wind_bin_probabilities
-    from mpc_wt.campaign.report import aggregate
+    from mpc_wt.campaign.aggregate import aggregate
 
     raw = {**BASE, "winds": [8, 12], "seeds": 3, "channels": {"lss_torque": 4}}
     spec = spec_from_dict(raw)
@@ -385,7 +387,7 @@ def test_clemens_convention_weights_bins_by_counted_cycles(tmp_path):
     (eq 18). Independent check: eq 18 equals the DEL of all bins' cycles pooled with the wind
     probabilities, computed here from the stored series' rainflow cycles."""
     from mpc_wt.assessment.fatigue import rainflow, wind_bin_probabilities
-    from mpc_wt.campaign.report import aggregate
+    from mpc_wt.campaign.aggregate import aggregate
 
     spec = _spec(winds=[12, 18], duration=20, transient=5, turbulence="steady",
                  channels={"flap_moment_1": 10}, del_convention="clemens")
@@ -403,3 +405,114 @@ def test_clemens_convention_weights_bins_by_counted_cycles(tmp_path):
     np.testing.assert_allclose(row["lifetime_del"], (num / den) ** 0.1, rtol=1e-9)
     with pytest.raises(SpecError, match="del_convention"):
         _spec(del_convention="mlife")
+
+
+# A spec and two of its cases as the store kept them before a case held its Scenario (flat
+# wind, seed, turbulence, duration, shear, condition and sign; written by the code of that
+# time): their simulation hashes must not change, or every stored case would be re-run.
+LEGACY_SPEC = {"name": "h", "turbine": "nrel5mw", "duration": 60, "transient": 10, "winds": [8, 18],
+       "seeds": [1, 2], "turbulence": ["A", 0.12],
+       "controllers": ["baseline", {"name": "mpc-s", "controller": "mpc", "horizon": 12}],
+       "load_cases": [{"dlc": "1.2"},
+                      {"dlc": "1.4", "condition": "ecd", "turbulence": "A", "winds": [11.4],
+                       "signs": [1, -1]},
+                      {"dlc": "2.3", "condition": "eog", "turbulence": "B", "winds": [13.4],
+                       "supervisor": {"grid_loss_at": 8.0}}]}
+LEGACY_CASES = {
+ "baseline__dlc1.4__ecd__v11.4__neg": {
+  "assess_hash": "4a724c3b7b4c6473f3c1a7a1e8eca75576c792cef24e512bef16bb10d499c1ff",
+  "case_hash": "e4d9eacf2a32d02e73ce26bf56546d04c52ed0fc5201767a4c1a99c61881c970",
+  "case_id": "baseline__dlc1.4__ecd__v11.4__neg",
+  "channels": {
+   "edge_moment_1": 10.0,
+   "edge_moment_2": 10.0,
+   "edge_moment_3": 10.0,
+   "flap_moment_1": 10.0,
+   "flap_moment_2": 10.0,
+   "flap_moment_3": 10.0,
+   "lss_torque": 4.0,
+   "shaft_bending_blade1": 4.0,
+   "tilt_moment": 4.0,
+   "tower_base_fa_moment": 4.0,
+   "tower_base_ss_moment": 4.0,
+   "yaw_moment": 4.0
+  },
+  "condition": {
+   "condition": "ecd",
+   "event_at": 20.0,
+   "iec_class": "I",
+   "sign": -1
+  },
+  "controller": "baseline",
+  "del_convention": "range-1hz",
+  "dlc": "1.4",
+  "duration": 60.0,
+  "family": "N",
+  "fatigue": False,
+  "options": {},
+  "plugins": [],
+  "run_name": "baseline",
+  "seed": 0,
+  "shear_exponent": 0.2,
+  "sign": -1,
+  "supervisor": None,
+  "transient": 10.0,
+  "turbine": "nrel5mw",
+  "turbine_hash": "c03e0c22fc8a8937a060db014bd341ccc146b93dc00fe02e8859bfa65be73495",
+  "turbulence": "A",
+  "wind_mps": 11.4
+ },
+ "mpc-s__dlc1.2__ti12__v18__s2": {
+  "assess_hash": "4a724c3b7b4c6473f3c1a7a1e8eca75576c792cef24e512bef16bb10d499c1ff",
+  "case_hash": "f958a637e87eb02bc949c95b1a290c5a82ffb6b081904844d77c89f4bba444bd",
+  "case_id": "mpc-s__dlc1.2__ti12__v18__s2",
+  "channels": {
+   "edge_moment_1": 10.0,
+   "edge_moment_2": 10.0,
+   "edge_moment_3": 10.0,
+   "flap_moment_1": 10.0,
+   "flap_moment_2": 10.0,
+   "flap_moment_3": 10.0,
+   "lss_torque": 4.0,
+   "shaft_bending_blade1": 4.0,
+   "tilt_moment": 4.0,
+   "tower_base_fa_moment": 4.0,
+   "tower_base_ss_moment": 4.0,
+   "yaw_moment": 4.0
+  },
+  "condition": None,
+  "controller": "mpc-s",
+  "del_convention": "range-1hz",
+  "dlc": "1.2",
+  "duration": 60.0,
+  "family": "N",
+  "fatigue": True,
+  "options": {
+   "horizon": 12
+  },
+  "plugins": [],
+  "run_name": "mpc",
+  "seed": 2,
+  "shear_exponent": 0.2,
+  "sign": 1,
+  "supervisor": None,
+  "transient": 10.0,
+  "turbine": "nrel5mw",
+  "turbine_hash": "c03e0c22fc8a8937a060db014bd341ccc146b93dc00fe02e8859bfa65be73495",
+  "turbulence": 0.12,
+  "wind_mps": 18.0
+ }
+}
+
+
+def test_cases_of_an_older_store_read_back_with_their_hashes() -> None:
+    from mpc_wt.campaign.spec import Case
+
+    new = {c.case_id: c for c in spec_from_dict(LEGACY_SPEC).cases()}
+    for case_id, old in LEGACY_CASES.items():
+        assert new[case_id].case_hash == old["case_hash"]
+        assert Case.from_dict(old) == new[case_id]
+        assert Case.from_dict(json.loads(json.dumps(new[case_id].to_dict()))) == new[case_id]
+    ecd = new["baseline__dlc1.4__ecd__v11.4__neg"]
+    assert (ecd.scenario.condition, ecd.scenario.sign, ecd.scenario.event_at) == ("ecd", -1, 20.0)
+    assert ecd.scenario.duration == 70.0 and ecd.duration == 60.0

@@ -13,7 +13,7 @@ from scipy.stats import gumbel_r
 import linearize
 from mpc_wt.assessment.ultimate import extrapolate_maxima, ultimate_table
 from mpc_wt.campaign import SpecError, run_campaign, spec_from_dict
-from mpc_wt.campaign.report import aggregate, make_report
+from mpc_wt.campaign.aggregate import aggregate, make_report
 from mpc_wt.simulation.results import ClosedLoopResult
 from mpc_wt.simulation.scenario import Scenario, make_wind
 
@@ -136,9 +136,10 @@ def test_load_cases_expand_into_cases() -> None:
     # IEC table 2: DLC 2.3 is abnormal; event times are counted from the transient's end
     assert c.family == "A" and not c.fatigue and c.duration == 60.0
     assert c.supervisor == {"overspeed": 1.25, "grid_loss_at": 8.0}
-    assert c.condition == {"condition": "eog", "iec_class": "I", "sign": 1, "event_at": 15.0}
+    sc = c.scenario
+    assert (sc.condition, sc.iec_class, sc.sign, sc.event_at) == ("eog", "I", 1, 15.0)
     assert by["baseline__dlc1.2__A__v13__s1"].fatigue
-    assert by["baseline__dlc1.4__ecd__v11.4__neg"].condition["sign"] == -1
+    assert by["baseline__dlc1.4__ecd__v11.4__neg"].scenario.sign == -1
     # the same simulation as a spec without load cases has the same hash (its files reuse)
     legacy = spec_from_dict({"name": "so", "duration": 20.0, "transient": 5.0,
                              "supervisor": {"overspeed": 1.25}, "winds": [13.0], "seeds": 2,
@@ -162,7 +163,7 @@ def test_load_cases_expand_into_cases() -> None:
     ({"load_cases": [{"dlc": "1.4", "condition": "ecd", "winds": [10], "signs": [2]}]},
      r"load_cases\[0\].signs", "distinct 1 and -1"),
     ({"load_cases": [{"dlc": "1.4", "condition": "ecd", "winds": [10], "turbulence": 0.1}]},
-     r"load_cases\[0\].turbulence", "needs IEC categories"),
+     r"load_cases\[0\].turbulence", "needs an IEC turbulence category"),
     ({"load_cases": [{"dlc": "2.3", "winds": [10], "supervisor": {"trip_at": 3}}]},
      r"load_cases\[0\].supervisor.trip_at", "unknown key"),
     ({"supervisor": {"overspeed": 0.9}}, "supervisor", "overspeed must be a fraction of rated"),
@@ -234,7 +235,7 @@ def test_signoff_campaign_end_to_end(tmp_path) -> None:
     # a tuning objective (relative_metrics) reads the fatigue load case only: at its one wind
     # the weighted power ratio is the seed means' ratio (the 2.3 gust cases at 13.4 m/s, with
     # the same turbulence letter, are left out)
-    from mpc_wt.campaign.report import relative_metrics
+    from mpc_wt.campaign.aggregate import relative_metrics
 
     def power(ctl):
         return np.mean([r.metrics["power_mean_W"] for cid, r in rows.items()
@@ -253,7 +254,7 @@ def test_signoff_campaign_end_to_end(tmp_path) -> None:
 def test_incomplete_fatigue_bins_counted_against_the_load_cases_seeds() -> None:
     """DLC 1.2 runs 2 seeds at 13 m/s: a bin with one finished seed is incomplete, with two it
     is not (the spec's top-level seeds, 1 by default, do not apply to load cases)."""
-    from mpc_wt.campaign.report import _Group
+    from mpc_wt.campaign.aggregate import _Group
 
     spec = _spec()
     one = _Group(spec, "baseline", "A", {13.0: ["s1"]}, {})

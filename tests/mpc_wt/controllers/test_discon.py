@@ -18,6 +18,7 @@ from mpc_wt.controllers.discon import SWAP_SIZE, DisconController, rosco_discon,
 from mpc_wt.errors import ControllerLibraryError
 from mpc_wt.run import run_controller
 from mpc_wt.simulation.loop import simulate_closed_loop
+from mpc_wt.simulation.scenario import Scenario
 
 PROBE_C = Path(__file__).resolve().parents[2] / "data" / "discon_probe.c"
 needs_cc = pytest.mark.skipif(shutil.which("gcc") is None and shutil.which("cc") is None,
@@ -136,8 +137,7 @@ def test_rosco_holds_rated_power_for_60s() -> None:
     rad/s)."""
     t = linearize.load_turbine()
     for turbulence, tol_p, tol_w in (("steady", 1e-3, 1e-3), ("A", 0.05, 0.15)):
-        res = run_controller(t, "rosco", 18.0, turbulence, 1, 60.0,
-                             options={"discon_in": "shipped"})
+        res = run_controller(t, "rosco", Scenario(18.0, turbulence, 1, 60.0), options={"discon_in": "shipped"})
         keep = res.t >= 10.0
         assert abs(res.channel("gen_power")[keep].mean() / 5e6 - 1) <= tol_p, turbulence
         w = res.channel("gen_speed")[keep]
@@ -221,7 +221,7 @@ def test_exported_design_through_rosco_regulates_as_ours(kind) -> None:
     frac = 0.8 if kind == "derate80" else 1.0
     out = {}
     for name, opts in ((kind, {}), ("rosco", {"power_fraction": frac})):
-        res = run_controller(t, name, 18.0, "A", 2, 180.0, options=opts)
+        res = run_controller(t, name, Scenario(18.0, "A", 2, 180.0), options=opts)
         k = res.t >= 30.0
         out[name] = (res.channel("rotor_speed")[k].std(), res.channel("gen_power")[k].mean(),
                      np.abs(np.diff(res.channel("pitch_1")[k])).sum())
@@ -244,7 +244,7 @@ def test_exported_coleman_ipc_through_rosco_acts_as_ours(turbine, tmp_path) -> N
     discon, _ = export(coleman_ipc_table(turbine, tune_coleman_ipc(turbine)), "rosco", tmp_path)
     out = {}
     for name, opts in (("coleman-ipc", {}), ("rosco", {"discon_in": str(discon)})):
-        res = run_controller(turbine, name, 18.0, "A", 1, 300.0, options=opts)
+        res = run_controller(turbine, name, Scenario(18.0, "A", 1, 300.0), options=opts)
         k = res.t >= 60.0
         a = assess_series(res.t[k], {n: res.channel(n)[k] for n in res.channels()})
         out[name] = (a["channels"]["flap_moment_1"]["del"], a["pitch_travel_deg"])

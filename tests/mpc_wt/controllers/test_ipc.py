@@ -23,6 +23,7 @@ from mpc_wt.controllers.derating import aep_change, steady_power_curve
 from mpc_wt.controllers.filters import SOSFilterBank, filter_sos
 from mpc_wt.controllers.ipc import tune_coleman_ipc, tune_ibc
 from mpc_wt.io.gain_tables import coleman_ipc_table, export, ibc_table, load_design, save_design
+from mpc_wt.simulation.scenario import Scenario
 
 DUR = 150.0       # s per closed-loop run; the first TRANSIENT s are left out of the metrics
 TRANSIENT = 20.0
@@ -43,7 +44,7 @@ def runs18(turbine):
     """Baseline, IBC, Coleman IPC and derated baselines at 18 m/s, class A, shear 0.2, seed 1."""
     out = {}
     for c in ("baseline", "ibc", "coleman-ipc", "derate90", "derate80"):
-        res = run_controller(turbine, c, 18.0, "A", 1, DUR, shear_exponent=0.2)
+        res = run_controller(turbine, c, Scenario(18.0, "A", 1, DUR, shear_exponent=0.2))
         out[c] = (res, _metrics(res))
     return out
 
@@ -266,8 +267,7 @@ def test_controller_names_parse() -> None:
 # --------------------------------------------------------------------------------------------
 @pytest.fixture(scope="module")
 def apc_runs(turbine):
-    return {f: run_controller(turbine, "apc", 15.0, "A", 1, DUR,
-                             options={"apc_frequency": f})
+    return {f: run_controller(turbine, "apc", Scenario(15.0, "A", 1, DUR), options={"apc_frequency": f})
             for f in (0.0, 0.1)}
 
 
@@ -304,7 +304,7 @@ def test_apc_reference_outside_the_turbine_is_an_error(kw, match) -> None:
 
 def test_apc_reference_above_available_power_is_an_error(turbine) -> None:
     with pytest.raises(ValueError, match="above the power available at the mean wind 8"):
-        run_controller(turbine, "apc", 8.0, "steady", 1, 5.0, options={"apc_frequency": 0.1})
+        run_controller(turbine, "apc", Scenario(8.0, "steady", 1, 5.0), options={"apc_frequency": 0.1})
     with pytest.raises(linearize.TrimError, match="above the power available"):
         linearize.trim(turbine, 8.0, 3e6)
 

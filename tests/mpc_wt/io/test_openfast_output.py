@@ -16,6 +16,7 @@ from mpc_wt.io.openfast_output import (
     write_openfast_output,
 )
 from mpc_wt.simulation.results import load_series
+from mpc_wt.simulation.scenario import Scenario
 
 
 @pytest.fixture(scope="module")
@@ -76,7 +77,7 @@ def test_assess_openfast_run_beside_ours(tmp_path, capsys) -> None:
     import linearize
     from mpc_wt.run import run_controller
 
-    res = run_controller(linearize.load_turbine("nrel5mw"), "baseline", 14.0, "B", 3, 120.0)
+    res = run_controller(linearize.load_turbine("nrel5mw"), "baseline", Scenario(14.0, "B", 3, 120.0))
     nc = res.save(tmp_path / "ours.nc")
     cols = {n: res.channel(n) for n in res.channels()}
     of, units = from_mpcwt_channels(cols)

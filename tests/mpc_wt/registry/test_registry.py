@@ -265,10 +265,9 @@ def test_lqr_pio_region2_shares_the_baselines_torque_law() -> None:
     from mpc_wt import run_controller
 
     t = linearize.load_turbine()
-    base = run_controller(t, "baseline", 8.0, 0.12, 1, 60.0)
+    base = run_controller(t, "baseline", Scenario(8.0, 0.12, 1, 60.0))
     q_rated = t.generator.max_torque / 1.1
-    runs = {law: run_controller(t, "lqr-pio", 8.0, 0.12, 1, 60.0,
-                                options={"w_pitch": 1e6, "region2_torque": law})
+    runs = {law: run_controller(t, "lqr-pio", Scenario(8.0, 0.12, 1, 60.0), options={"w_pitch": 1e6, "region2_torque": law})
             for law in ("baseline", "k_opt")}
     assert np.allclose(runs["baseline"].channel("rotor_speed"), base.channel("rotor_speed"),
                        rtol=1e-3)

@@ -7,7 +7,8 @@ from pathlib import Path
 import pytest
 from numpy.testing import assert_allclose
 
-from mpc_wt.simulation.loop import ClosedLoopResult, ResultFileError
+from mpc_wt.errors import ResultFileError
+from mpc_wt.simulation.results import ClosedLoopResult
 
 
 def test_result_round_trip(run18: ClosedLoopResult, tmp_path: Path) -> None:

@@ -271,7 +271,7 @@ def test_relative_and_absolute_metrics_hand_worked() -> None:
     against 2 and 2 give 2; the per-case limit hits 1 and 4 give 2.5 (no ratio: the reference
     has none)."""
     from mpc_wt.campaign import spec_from_dict
-    from mpc_wt.campaign.report import absolute_metrics, relative_metrics
+    from mpc_wt.campaign.aggregate import absolute_metrics, relative_metrics
     from mpc_wt.campaign.store import CaseRow
 
     spec = spec_from_dict({"name": "h", "winds": [18], "seeds": 2,
