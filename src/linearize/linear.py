@@ -207,7 +207,22 @@ def _check_options(wake: str, disturbance: str, coordinates: str) -> None:
 
 def mbc_matrices(psi: float, omega: float) -> tuple[FloatArray, FloatArray, FloatArray,
                                                       FloatArray]:
-    """T(psi) with rows [1, cos psi_i, sin psi_i], its inverse, dT/dpsi, d2T/dpsi2."""
+    """Bir's multi-blade coordinate transform (Bir 2008, NREL/CP-500-42553): T(psi) with rows
+    [1, cos psi_i, sin psi_i] for the blades at psi_i = psi + 2 pi (i - 1) / 3, its inverse, and
+    its first and second time derivatives at rotor speed omega.
+
+    Parameters
+    ----------
+    psi : float
+        Azimuth of blade 1 [rad].
+    omega : float
+        Rotor speed [rad/s].
+
+    Returns
+    -------
+    t, t_inv, t_dot, t_ddot : (3, 3) ndarray
+        T, T^-1, dT/dt and d2T/dt2.
+    """
     ang = psi + 2 * math.pi * np.arange(3) / 3
     t = np.column_stack([np.ones(3), np.cos(ang), np.sin(ang)])
     dt = np.column_stack([np.zeros(3), -np.sin(ang), np.cos(ang)])

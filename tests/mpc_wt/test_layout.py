@@ -210,8 +210,9 @@ def test_the_private_name_checker_catches_both_forms(tmp_path: Path) -> None:
 #: the roles and the modules a newcomer finds in them
 LAYOUT = {
     "controllers": {"base", "baseline", "baseline_law", "mpc", "qp", "estimator", "lqr",
-                    "takagi_sugeno", "ipc", "apc", "derating", "lidar_feedforward",
-                    "supervisor", "discon", "filters"},
+                    "ipc", "apc", "derating", "lidar_feedforward", "supervisor", "discon",
+                    "filters"},
+    "controllers/takagi_sugeno": {"model", "synthesis", "controller"},
     "registry": {"registry", "options", "builtin", "context"},
     "simulation": {"scenario", "loop", "compiled", "results", "preview", "solver_timing"},
     "assessment": {"fatigue", "performance", "series", "ultimate", "lidar"},

@@ -1,0 +1,289 @@
+"""The Takagi-Sugeno model of Clemens et al.: the plant's linear models at the vertices of a grid
+over rotor-effective wind and power reduction, blended by triangular membership functions.
+"""
+from __future__ import annotations
+
+import itertools
+import math
+from dataclasses import dataclass, field
+from typing import Any, Sequence
+
+import numpy as np
+
+import linearize
+from mpc_wt.errors import PremiseError
+
+__all__ = ['CLEMENS_MEASURED', 'DEFAULT_SCALES', 'TSModel', 'build_ts_model']
+
+#: Clemens et al. eq 6: tower side-side and fore-aft displacement, rotor and generator speed.
+CLEMENS_MEASURED = ("tower_ss_displacement", "tower_fa_displacement", "rotor_speed", "gen_speed")
+
+
+#: Typical magnitudes of the TS model's variables (scaling of the LMIs; SI units).
+DEFAULT_SCALES = {"tower_fa_displacement": 0.1, "tower_fa_velocity": 0.1, "rotor_speed": 0.1,
+                  "gen_speed": 0.1 * 97.0, "shaft_torsion": 1e-3, "tower_ss_displacement": 0.02,
+                  "tower_ss_velocity": 0.02, "pitch_ref_coll": math.radians(1.0),
+                  "gen_torque_ref": 4e3, "wind": 1.0}
+
+
+def _hats(grid: np.ndarray, s: float) -> np.ndarray:
+    """One-dimensional hat memberships of ``s`` on ``grid`` (sum to 1 inside the grid)."""
+    w = np.zeros(grid.size)
+    if grid.size == 1:
+        w[0] = 1.0
+        return w
+    k = int(np.clip(np.searchsorted(grid, s) - 1, 0, grid.size - 2))
+    f = (s - grid[k]) / (grid[k + 1] - grid[k])
+    w[k], w[k + 1] = 1.0 - f, f
+    return w
+
+
+@dataclass(frozen=True)
+class TSModel:
+    """Takagi-Sugeno model over the premise z = [v, Delta P] (Clemens et al. eqs 1-3).
+
+    Vertex i = (a, b) of the grid ``wind_grid`` x ``reduction_grid`` (row-major: wind index
+    outer) carries A[i] (n_x, n_x), B[i] (n_x, n_u), B_d[i] (n_x,) and the equilibrium
+    x0[i], u0[i], v0[i] (v0 = the vertex wind [m/s]).
+
+    Parameters
+    ----------
+    wind_grid : (n_a,) ndarray
+        Vertex wind speeds [m/s], strictly increasing.
+    reduction_grid : (n_b,) ndarray
+        Vertex power reductions Delta P [-] in [0, 1), strictly increasing.
+    A, B, B_d, x0, u0, v0 : ndarray
+        Stacked over the N = n_a n_b vertices.
+    states, inputs : names
+    C : (n_y, n_x) ndarray
+        Measured rows (``measured`` names).
+    rated_power : float
+        Electrical power at Delta P = 0 [W].
+    """
+
+    wind_grid: np.ndarray
+    reduction_grid: np.ndarray
+    A: np.ndarray
+    B: np.ndarray
+    B_d: np.ndarray
+    x0: np.ndarray
+    u0: np.ndarray
+    v0: np.ndarray
+    states: tuple[str, ...]
+    inputs: tuple[str, ...]
+    measured: tuple[str, ...]
+    C: np.ndarray
+    rated_power: float
+    info: dict[str, Any] = field(default_factory=dict, compare=False)
+
+    def __post_init__(self) -> None:
+        for n in ("wind_grid", "reduction_grid", "A", "B", "B_d", "x0", "u0", "v0", "C"):
+            a = np.array(getattr(self, n), dtype=float)
+            a.flags.writeable = False
+            object.__setattr__(self, n, a)
+        for n, g in (("wind_grid", self.wind_grid), ("reduction_grid", self.reduction_grid)):
+            if g.ndim != 1 or g.size < 1 or np.any(np.diff(g) <= 0) or not np.all(np.isfinite(g)):
+                raise ValueError(f"{n} must be finite and strictly increasing, got {g}")
+        nv = self.wind_grid.size * self.reduction_grid.size
+        nx, nu = len(self.states), len(self.inputs)
+        want = {"A": (nv, nx, nx), "B": (nv, nx, nu), "B_d": (nv, nx), "x0": (nv, nx),
+                "u0": (nv, nu), "v0": (nv,), "C": (len(self.measured), nx)}
+        for n, shp in want.items():
+            if getattr(self, n).shape != shp:
+                raise ValueError(f"TSModel.{n} has shape {getattr(self, n).shape}; expected "
+                                 f"{shp}")
+
+    @property
+    def n_vertices(self) -> int:
+        return self.A.shape[0]
+
+    @property
+    def vertices(self) -> np.ndarray:
+        """(N, 2) premise values [v, Delta P] of the vertices."""
+        return np.array(list(itertools.product(self.wind_grid, self.reduction_grid)))
+
+    def cells(self) -> list[tuple[int, ...]]:
+        """Vertex indices of each grid cell (the vertices that can be active together).
+
+        Returns
+        -------
+        list of tuple of int
+            Vertex indices per cell.
+        """
+        na, nb = self.wind_grid.size, self.reduction_grid.size
+        out = []
+        for a in range(max(na - 1, 1)):
+            for b in range(max(nb - 1, 1)):
+                ia = [a] if na == 1 else [a, a + 1]
+                ib = [b] if nb == 1 else [b, b + 1]
+                out.append(tuple(i * nb + j for i in ia for j in ib))
+        return out
+
+    def check_premise(self, wind: float, reduction: float) -> None:
+        """Raise :class:`PremiseError` unless [wind, reduction] lies in the vertex grid.
+
+        Parameters
+        ----------
+        wind : float
+            Premise wind [m/s].
+        reduction : float
+            Premise power reduction [-].
+        """
+        for name, s, g, unit in (("wind speed", wind, self.wind_grid, " m/s"),
+                                 ("power reduction", reduction, self.reduction_grid, "")):
+            tol = 1e-9 * max(1.0, abs(g[-1]))
+            if not (math.isfinite(s) and g[0] - tol <= s <= g[-1] + tol):
+                raise PremiseError(f"premise {name} = {s!r}{unit} is outside the TS model's "
+                                   f"vertices {g[0]:g}..{g[-1]:g}{unit}; add vertices or clip")
+
+    def membership(self, wind: float, reduction: float = 0.0) -> np.ndarray:
+        """h_i(z) for z = [wind, reduction] (N,): >= 0, summing to 1 (eq 3).
+
+
+        Parameters
+        ----------
+        wind : float
+            Premise wind [m/s].
+        reduction : float
+            Premise power reduction [-].
+
+        Returns
+        -------
+        (N,) ndarray
+            Memberships h_i [-].
+
+        Raises
+        ------
+        PremiseError
+            If z is outside the vertex grid (or not finite).
+        """
+        self.check_premise(wind, reduction)
+        return np.kron(_hats(self.wind_grid, wind), _hats(self.reduction_grid, reduction))
+
+    def blend(self, h: np.ndarray) -> dict[str, np.ndarray]:
+        """The model's matrices and equilibria weighted by memberships ``h``.
+
+        Parameters
+        ----------
+        h : (N,) ndarray
+            Memberships.
+
+        Returns
+        -------
+        dict of str to ndarray
+            ``A``, ``B``, ``B_d``, ``x0``, ``u0``, ``v0`` weighted by ``h``.
+        """
+        return {n: np.tensordot(h, getattr(self, n), axes=1)
+                for n in ("A", "B", "B_d", "x0", "u0", "v0")}
+
+    def rhs(self, x: np.ndarray, u: np.ndarray, v: float, reduction: float = 0.0) -> np.ndarray:
+        """dx/dt of eq 1 with premise [v, reduction] [state units / s].
+
+        Parameters
+        ----------
+        x : (n_x,) ndarray
+            State.
+        u : (n_u,) ndarray
+            Inputs.
+        v : float
+            Wind [m/s] (the premise and the disturbance).
+        reduction : float
+            Premise power reduction [-].
+
+        Returns
+        -------
+        (n_x,) ndarray
+            dx/dt.
+        """
+        h = self.membership(v, reduction)
+        x, u = np.asarray(x, dtype=float), np.asarray(u, dtype=float)
+        return sum(h[i] * (self.A[i] @ (x - self.x0[i]) + self.B[i] @ (u - self.u0[i])
+                           + self.B_d[i] * (v - self.v0[i]))
+                   for i in np.nonzero(h)[0])
+
+    def to_dict(self) -> dict[str, Any]:
+        """Plain data for JSON.
+
+        Returns
+        -------
+        dict
+            Grids, names and the vertex matrices as lists.
+        """
+        return {"wind_grid": self.wind_grid.tolist(), "reduction_grid":
+                self.reduction_grid.tolist(), "states": list(self.states),
+                "inputs": list(self.inputs), "measured": list(self.measured),
+                "rated_power": self.rated_power, "A": self.A.tolist(), "B": self.B.tolist(),
+                "B_d": self.B_d.tolist(), "x0": self.x0.tolist(), "u0": self.u0.tolist(),
+                "v0": self.v0.tolist(), "C": self.C.tolist()}
+
+
+def build_ts_model(turbine: linearize.Turbine,
+                   wind_grid: Sequence[float] = (12.0, 14.0, 16.0, 19.0, 22.0, 25.0),
+                   reduction_grid: Sequence[float] = (0.0, 0.4, 0.8), *,
+                   measured: Sequence[str] = CLEMENS_MEASURED,
+                   progress: bool = False) -> TSModel:
+    """The TS model of ``turbine`` at the vertices wind_grid x reduction_grid.
+
+    Each vertex is a :func:`linearize.linearize` of the Clemens 7-state configuration with one
+    rotor-effective wind disturbance, in multi-blade coordinates (collective pitch input), at
+    the trim for electrical power (1 - Delta P) P_rated (full load: rated rotor speed).
+
+
+    Returns
+    -------
+    TSModel
+        Vertex matrices, equilibria and memberships over the grid.
+
+
+    Parameters
+    ----------
+    turbine : Turbine
+        The turbine.
+    wind_grid : sequence of float
+        Vertex winds [m/s], increasing.
+    reduction_grid : sequence of float
+        Vertex power reductions Delta P in [0, 1) [-].
+    measured : sequence of str
+        The measured outputs.
+    progress : bool
+        Show a progress bar.
+
+    Raises
+    ------
+    ValueError
+        A grid not strictly increasing, a reduction outside [0, 1), an unknown measured name.
+    linearize.TrimError
+        A vertex that cannot be trimmed (wind outside cut-in..cut-out, power not available).
+    """
+    from tqdm import tqdm
+
+    va = np.asarray(wind_grid, dtype=float)
+    vb = np.asarray(reduction_grid, dtype=float)
+    if vb.size and (vb.min() < 0 or vb.max() >= 1):
+        raise ValueError(f"reduction_grid values must be in [0, 1), got {vb}")
+    rated = turbine.operation.rated_power
+    cfg = linearize.PlantConfig.clemens()
+    params = linearize.plant_params(turbine, cfg)
+    mats: dict[str, list[np.ndarray]] = {k: [] for k in ("A", "B", "B_d", "x0", "u0", "v0")}
+    model = None
+    for v, dp in tqdm(list(itertools.product(va, vb)), desc="TS vertices", unit="vertex",
+                      disable=not progress):
+        m = linearize.linearize(turbine, float(v), params=params, disturbance="rotor",
+                                coordinates="mbc",
+                                power_W=None if dp == 0 else rated * (1.0 - float(dp)))
+        model = m.select(inputs=("pitch_ref_coll", "gen_torque_ref"))
+        mats["A"].append(model.A)
+        mats["B"].append(model.B_u)
+        mats["B_d"].append(model.B_d[:, 0])
+        mats["x0"].append(model.x0)
+        mats["u0"].append(model.u0)
+        mats["v0"].append(np.asarray(v))
+    assert model is not None
+    bad = [n for n in measured if n not in model.states]
+    if bad:
+        raise ValueError(f"measured {bad} are not states of the TS model {list(model.states)}")
+    c = np.array([np.eye(len(model.states))[model.states.index(n)] for n in measured])
+    return TSModel(wind_grid=va, reduction_grid=vb, states=model.states, inputs=model.inputs,
+                   measured=tuple(measured), C=c, rated_power=float(rated),
+                   info={"turbine": turbine.name, "config": "clemens"},
+                   **{k: np.array(v) for k, v in mats.items()})
