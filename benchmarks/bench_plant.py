@@ -30,7 +30,7 @@ import numba as nb
 import numpy as np
 
 import linearize
-from linearize.plant import evaluate_plant
+from linearize.kernel import evaluate_plant
 from linearize.steady import _avg_eval
 
 

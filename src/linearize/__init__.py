@@ -21,13 +21,7 @@ from linearize.models import (
 )
 from linearize.openfast import load_openfast
 from linearize.openfast_lin import read_lin, read_lin_set, write_lin
-from linearize.performance import (
-    RotorPerformance,
-    read_rotor_performance,
-    rotor_performance,
-    write_rotor_performance,
-)
-from linearize.plant import (
+from linearize.params import (
     DOF_NAMES,
     INPUT_NAMES,
     INPUT_UNITS,
@@ -36,19 +30,18 @@ from linearize.plant import (
     OUTPUT_UNITS,
     STATE_NAMES,
     STATE_UNITS,
-    GridWind,
     PlantConfig,
     PlantParams,
-    PlantStepper,
-    SimulationResult,
-    SteadyWind,
-    element_wind,
-    plant_outputs,
     plant_params,
-    plant_rhs,
-    rk4_simulate,
     structural_frequencies,
 )
+from linearize.performance import (
+    RotorPerformance,
+    read_rotor_performance,
+    rotor_performance,
+    write_rotor_performance,
+)
+from linearize.plant import PlantStepper, SimulationResult, plant_outputs, plant_rhs, rk4_simulate
 from linearize.steady import optimal_tsr, rotor_average, steady_coefficients
 from linearize.trim import (
     OperatingPoint,
@@ -58,6 +51,7 @@ from linearize.trim import (
     trim,
 )
 from linearize.turbine import LoadReport, Turbine, available_turbines
+from linearize.wind import GridWind, SteadyWind, element_wind
 
 __all__ = [
     "AeroOptions", "element_induction", "element_loads", "DOF_NAMES", "INPUT_NAMES", "INPUT_UNITS", "MADSEN_OUTPUTS",

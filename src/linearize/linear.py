@@ -54,8 +54,9 @@ import numpy as np
 from linearize._typing import FloatArray
 from linearize.bem import MODE_CS, MODE_FROZEN, MODE_NOLIMITS, MODE_TIGHT
 from linearize.errors import LinearizationError
+from linearize.kernel import evaluate_plant, sample_wind
 from linearize.models import LinearModel, LinearModelFamily, check_wind_grid
-from linearize.plant import (
+from linearize.params import (
     INPUT_NAMES,
     INPUT_UNITS,
     OUTPUT_NAMES,
@@ -64,11 +65,9 @@ from linearize.plant import (
     STATE_UNITS,
     PlantConfig,
     PlantParams,
-    evaluate_plant,
     n_x,
     n_z,
     plant_params,
-    sample_wind,
 )
 from linearize.trim import OperatingPoint, trim
 from linearize.turbine import Turbine

@@ -658,7 +658,7 @@ def compare_with_openfast(turbine: object, openfast: LinearModel) -> dict[str, o
         If the model has no finite wind speed or no pitch operating point.
     """
     from linearize.linear import linearize
-    from linearize.plant import PlantConfig
+    from linearize.params import PlantConfig
     from linearize.trim import operating_point
 
     v = openfast.wind_mps

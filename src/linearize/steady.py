@@ -14,7 +14,8 @@ from scipy.optimize import minimize_scalar
 
 from linearize._typing import FloatArray
 from linearize.bem import MODE_NOLIMITS, AeroOptions
-from linearize.plant import PlantConfig, PlantParams, evaluate_plant, n_x, plant_params, sample_wind
+from linearize.kernel import evaluate_plant, sample_wind
+from linearize.params import PlantConfig, PlantParams, n_x, plant_params
 from linearize.turbine import Turbine
 
 __all__ = ["steady_coefficients", "optimal_tsr", "rotor_average"]

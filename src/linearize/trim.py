@@ -29,7 +29,7 @@ from scipy.optimize import brentq, minimize_scalar
 
 from linearize._typing import FloatArray
 from linearize.errors import TrimError
-from linearize.plant import STATE_NAMES, PlantConfig, PlantParams, n_x, plant_params
+from linearize.params import STATE_NAMES, PlantConfig, PlantParams, n_x, plant_params
 from linearize.steady import optimal_tsr, rotor_average
 from linearize.turbine import Turbine
 from linearize.validate import check_finite_scalar

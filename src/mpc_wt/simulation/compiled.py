@@ -27,7 +27,10 @@ import numba as nb
 import numpy as np
 
 import linearize
-from linearize.plant import step_kernel
+import linearize.bem
+import linearize.kernel
+from linearize.kernel import step_kernel
+from mpc_wt.controllers import baseline_law
 from mpc_wt.controllers.baseline_law import law
 
 __all__ = ['run_steps']
@@ -74,8 +77,9 @@ def _loop(k0, k1, ratio, h, pk, kind, wpar, grid, hint, dphi, lim, xs, us, zs, u
 
 def _tie_cache_to_sources(dispatcher: Any, paths: tuple[str, ...]) -> None:
     """numba keys a kernel's disk cache on its own file's source only; :func:`_loop` compiles
-    the plant's kernels into itself, so their sources enter the key too: an edit of
-    linearize's plant or BEM recompiles the loop instead of loading a stale one. Through
+    the plant's kernels and the baseline's law into itself, so their sources enter the key
+    too: an edit of linearize's plant kernels or BEM, or of the law, recompiles the loop
+    instead of loading a stale one. Through
     numba's cache object (its attributes as of numba 0.68); without them, numba's own key
     and a debug log."""
     try:
@@ -88,7 +92,8 @@ def _tie_cache_to_sources(dispatcher: Any, paths: tuple[str, ...]) -> None:
         log.debug("compiled loop's cache keyed on its own source only: %s", err)
 
 
-_tie_cache_to_sources(_loop, (linearize.plant.__file__, linearize.bem.__file__))
+_tie_cache_to_sources(_loop, (linearize.kernel.__file__, linearize.bem.__file__,
+                              baseline_law.__file__))
 
 
 def run_steps(k0: int, k1: int, ratio: int, stepper: Any, arrays: tuple[np.ndarray, ...]

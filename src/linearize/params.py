@@ -1,0 +1,480 @@
+"""The plant's names and parameters: states, inputs and outputs with their units, the degrees of
+freedom a configuration switches on (:class:`PlantConfig`), and the modal, inertial and
+geometric parameters derived from the turbine data (:class:`PlantParams`,
+:func:`plant_params`; Hansen 2015, ch. 11), with the structural frequencies they give.
+"""
+from __future__ import annotations
+
+import math
+from collections import namedtuple
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from linearize._typing import FloatArray
+from linearize.bem import (
+    AeroOptions,
+    aero_flags,
+    polar_table_of,
+)
+from linearize.turbine import Turbine, mode_shape
+
+__all__ = ['DOF_NAMES', 'STATE_NAMES', 'STATE_UNITS', 'INPUT_NAMES', 'INPUT_UNITS', 'OUTPUT_NAMES', 'OUTPUT_UNITS', 'MADSEN_OUTPUTS', 'n_x', 'n_u', 'n_z', 'PlantConfig', 'PlantParams', 'plant_params', 'structural_frequencies']
+
+DOF_NAMES = ("tower_fa", "tower_ss", "drivetrain", "generator", "blade_flap", "pitch_actuator",
+             "blade_edge")
+
+
+STATE_NAMES = (
+    "tower_fa_displacement", "tower_fa_velocity", "rotor_speed", "gen_speed", "shaft_torsion",
+    "pitch_1", "pitch_2", "pitch_3", "tower_ss_displacement", "tower_ss_velocity",
+    "flap_1", "flap_2", "flap_3", "flap_rate_1", "flap_rate_2", "flap_rate_3", "azimuth",
+    "edge_1", "edge_2", "edge_3", "edge_rate_1", "edge_rate_2", "edge_rate_3")
+
+
+STATE_UNITS = ("m", "m/s", "rad/s", "rad/s", "rad", "rad", "rad", "rad", "m", "m/s",
+               "m", "m", "m", "m/s", "m/s", "m/s", "rad", "m", "m", "m", "m/s", "m/s", "m/s")
+
+
+INPUT_NAMES = ("pitch_ref_1", "pitch_ref_2", "pitch_ref_3", "gen_torque_ref")
+
+
+INPUT_UNITS = ("rad", "rad", "rad", "N m")
+
+
+OUTPUT_NAMES = (
+    "gen_power", "pitch_1", "pitch_2", "pitch_3", "pitch_rate_1", "pitch_rate_2",
+    "pitch_rate_3", "tower_fa_velocity", "rotor_speed", "shaft_torsion",
+    "flap_moment_1", "flap_moment_2", "flap_moment_3",
+    "edge_moment_1", "edge_moment_2", "edge_moment_3",
+    "tower_base_fa_moment", "tower_base_ss_moment", "lss_torque", "tilt_moment", "yaw_moment",
+    "azimuth", "aero_torque", "thrust", "aero_power", "gen_speed", "gen_torque",
+    "tower_fa_acceleration", "tower_ss_acceleration", "tower_fa_displacement",
+    "tower_ss_displacement")
+
+
+OUTPUT_UNITS = (
+    "W", "rad", "rad", "rad", "rad/s", "rad/s", "rad/s", "m/s", "rad/s", "rad",
+    "N m", "N m", "N m", "N m", "N m", "N m", "N m", "N m", "N m", "N m", "N m",
+    "rad", "N m", "N", "W", "rad/s", "N m", "m/s^2", "m/s^2", "m", "m")
+
+
+#: The performance outputs z of Madsen et al. (2012) eq 17, in order.
+MADSEN_OUTPUTS = OUTPUT_NAMES[:13]
+
+
+n_x = len(STATE_NAMES)
+
+
+n_u = len(INPUT_NAMES)
+
+
+n_z = len(OUTPUT_NAMES)
+
+
+N_BLADE = 3
+
+
+_IX = {n: i for i, n in enumerate(STATE_NAMES)}
+
+
+@dataclass(frozen=True)
+class PlantConfig:
+    """Which degrees of freedom and aerodynamic effects the plant has.
+
+    Parameters
+    ----------
+    dofs : frozenset of str
+        Enabled degrees of freedom, a subset of :data:`DOF_NAMES`. Default: all.
+    aero : AeroOptions
+        Aerodynamic switches (tilt, cone, gravity, loss models, ...).
+    integration : {"midpoint", "trapezoid"}
+        Spanwise load integration: element-centre midpoint rule with the element lengths
+        (AeroDyn v13 / WT_Perf style) or trapezoid over the element centres with zero load at
+        hub and tip (CCBlade style).
+    """
+
+    dofs: frozenset[str] = frozenset(DOF_NAMES)
+    aero: AeroOptions = field(default_factory=AeroOptions)
+    integration: str = "midpoint"
+
+    def __post_init__(self) -> None:
+        dofs = frozenset(self.dofs)
+        unknown = sorted(dofs - set(DOF_NAMES))
+        if unknown:
+            raise ValueError(f"dofs has unknown names {unknown}; allowed {list(DOF_NAMES)}")
+        object.__setattr__(self, "dofs", dofs)
+        if self.integration not in ("midpoint", "trapezoid"):
+            raise ValueError(f"integration must be 'midpoint' or 'trapezoid', "
+                             f"got {self.integration!r}")
+
+    @classmethod
+    def madsen(cls, aero: AeroOptions | None = None) -> "PlantConfig":
+        """Madsen et al. (2012) 8-state model: tower fore-aft, drivetrain, generator, pitch."""
+        return cls(frozenset({"tower_fa", "drivetrain", "generator", "pitch_actuator"}),
+                   aero or AeroOptions())
+
+    @classmethod
+    def clemens(cls, aero: AeroOptions | None = None) -> "PlantConfig":
+        """Clemens et al. 7-state model: tower fore-aft and side-side, drivetrain, generator."""
+        return cls(frozenset({"tower_fa", "tower_ss", "drivetrain", "generator"}),
+                   aero or AeroOptions())
+
+    @classmethod
+    def do(cls, aero: AeroOptions | None = None) -> "PlantConfig":
+        """Do et al. model: tower fore-aft, drivetrain, generator, blade flap, pitch."""
+        return cls(frozenset({"tower_fa", "drivetrain", "generator", "blade_flap",
+                              "pitch_actuator"}), aero or AeroOptions())
+
+    def active_states(self) -> tuple[str, ...]:
+        """Names of the states that evolve under this configuration (azimuth excluded).
+
+        With a rigid drivetrain (no ``drivetrain`` DOF) the generator speed is N times the rotor
+        speed: it is not a state of the linear models (an exact zero, uncontrollable eigenvalue
+        otherwise), and the outputs that depend on it act through the rotor speed.
+
+        Returns
+        -------
+        tuple of str
+            Names of :data:`STATE_NAMES`, in their order.
+        """
+        groups = {
+            "tower_fa": ("tower_fa_displacement", "tower_fa_velocity"),
+            "generator": ("rotor_speed", "gen_speed"),
+            "drivetrain": ("shaft_torsion",),
+            "pitch_actuator": ("pitch_1", "pitch_2", "pitch_3"),
+            "tower_ss": ("tower_ss_displacement", "tower_ss_velocity"),
+            "blade_flap": ("flap_1", "flap_2", "flap_3", "flap_rate_1", "flap_rate_2",
+                           "flap_rate_3"),
+            "blade_edge": ("edge_1", "edge_2", "edge_3", "edge_rate_1", "edge_rate_2",
+                           "edge_rate_3"),
+        }
+        on = {n for d in self.dofs for n in groups[d]}
+        if "drivetrain" not in self.dofs:
+            # rigid shaft: the generator turns at N times the rotor, no state of its own
+            on.discard("shaft_torsion")
+            on.discard("gen_speed")
+        return tuple(n for n in STATE_NAMES if n in on)
+
+
+_Pack = namedtuple("_Pack", [
+    "dof", "flags", "opt", "nb", "rho", "grav", "rtip", "rhub", "zhub", "cone", "tilt",
+    "r", "w", "chord", "twist", "af", "phi_flap", "table", "alpha0", "dalpha",
+    "ngear", "eta_gen", "j_rot", "j_gen", "k_shaft", "c_shaft",
+    "m_fa", "k_fa", "c_fa", "hub_fa", "slope_fa", "m_ss", "k_ss", "c_ss", "hub_ss", "slope_ss",
+    "m_b", "k_b", "k_cf", "c_b", "m_c", "s1", "s_phi_s", "s_phi_r", "i_edge",
+    "tau_p", "rate_p", "min_p", "max_p", "min_tq", "max_tq",
+    "fa_static", "fa_pdelta", "fa_inertia", "ss_pdelta", "ss_inertia",
+    "phi_edge", "m_e", "k_e", "k_cf_e", "c_e", "s_e", "g_e", "s_phie_s"])
+
+
+@dataclass(frozen=True)
+class PlantParams:
+    """Numbers the plant equations use, derived from a :class:`Turbine` and a config.
+
+    Parameters
+    ----------
+    turbine : Turbine
+    config : PlantConfig
+    rotor_inertia : float
+        Rotor (hub + blades) inertia about the shaft [kg m^2].
+    rotor_mass : float
+        Hub plus blades [kg].
+    blade_mass : float
+        One blade [kg].
+    tower_fa_modal_mass, tower_fa_modal_stiffness, tower_fa_modal_damping : float
+        Fore-aft first mode referred to the tower-top displacement [kg, N/m, N s/m].
+    tower_ss_modal_mass, tower_ss_modal_stiffness, tower_ss_modal_damping : float
+        Side-side first mode [kg, N/m, N s/m].
+    blade_modal_mass, blade_modal_stiffness, blade_centrifugal_stiffness : float
+        Flap mode per blade referred to the tip deflection: mass [kg], non-rotating stiffness
+        [N/m], centrifugal stiffness per Omega^2 [N s^2/m].
+    blade_modal_damping : float
+        [N s/m].
+    blade_tower_coupling : float
+        int m phi ds, the flap mode's inertial coupling to rotor translation [kg].
+    edge_modal_mass, edge_modal_stiffness, edge_centrifugal_stiffness : float
+        First edgewise mode per blade referred to the tip deflection (ElastoDyn's edge mode
+        shape and EdgStff): int m phi_e^2 [kg], int EI_e phi_e''^2 [N/m], int N phi_e'^2 per
+        Omega^2 [N s^2/m]; NaN when the turbine has no edge mode shape.
+    edge_rotor_coupling : float
+        int m phi_e r ds, the edge mode's inertial coupling to rotor rotation [kg m].
+    """
+
+    turbine: Turbine
+    config: PlantConfig
+    rotor_inertia: float
+    rotor_mass: float
+    blade_mass: float
+    tower_fa_modal_mass: float
+    tower_fa_modal_stiffness: float
+    tower_fa_modal_damping: float
+    tower_ss_modal_mass: float
+    tower_ss_modal_stiffness: float
+    tower_ss_modal_damping: float
+    blade_modal_mass: float
+    blade_modal_stiffness: float
+    blade_centrifugal_stiffness: float
+    blade_modal_damping: float
+    blade_tower_coupling: float
+    edge_modal_mass: float = math.nan
+    edge_modal_stiffness: float = math.nan
+    edge_centrifugal_stiffness: float = math.nan
+    edge_rotor_coupling: float = math.nan
+    pack: Any = field(repr=False, compare=False, default=None)
+
+    def dof(self, name: str) -> bool:
+        """True if the degree of freedom ``name`` is on.
+
+        Parameters
+        ----------
+        name : str
+            A name of :data:`DOF_NAMES`.
+
+        Returns
+        -------
+        bool
+            Whether it is on.
+        """
+        return name in self.config.dofs
+
+
+def _cumtrapz_from_end(y: FloatArray, x: FloatArray) -> FloatArray:
+    """int_x^end y dx at each x."""
+    seg = 0.5 * (y[1:] + y[:-1]) * np.diff(x)
+    out = np.zeros_like(x)
+    out[:-1] = np.cumsum(seg[::-1])[::-1]
+    return out
+
+
+def plant_params(turbine: Turbine, config: PlantConfig | None = None) -> PlantParams:
+    """Derive modal, inertial and geometric plant parameters from the turbine data.
+
+    Modal mass and stiffness of each assumed mode phi (Hansen 2015, ch. 11):
+    ``m = int mu phi^2 + sum_bodies``, ``k = int EI phi''^2 - g int N(h) phi'^2`` (gravity
+    softening with N the weight above h), damping ``c = 2 zeta sqrt(k m)``.
+
+    Parameters
+    ----------
+    turbine : Turbine
+        The turbine.
+    config : PlantConfig, optional
+        Degrees of freedom and aerodynamic options (default: all on).
+
+    Returns
+    -------
+    PlantParams
+        The plant's parameters.
+    """
+    cfg = config or PlantConfig()
+    t = turbine
+    g = t.geometry
+    grav = t.environment.gravity
+    nblade = g.number_of_blades
+    cone = g.precone_rad if cfg.aero.cone else 0.0
+    tilt = g.shaft_tilt_rad if cfg.aero.tilt else 0.0
+
+    # --- blade distributed properties on a fine grid
+    lb = g.tip_radius - g.hub_radius
+    xs = np.linspace(0.0, 1.0, 2001)
+    s = xs * lb
+    bs = t.blade_structure
+    mu = np.interp(xs, bs.span_fraction, bs.mass_per_length)
+    ei = np.interp(xs, bs.span_fraction, bs.flap_stiffness)
+    phi = mode_shape(t.mode_shapes.blade_flap1, xs)
+    dphi = mode_shape(t.mode_shapes.blade_flap1, xs, 1) / lb
+    ddphi = mode_shape(t.mode_shapes.blade_flap1, xs, 2) / lb**2
+    blade_mass = float(np.trapezoid(mu, s))
+    s1 = float(np.trapezoid(mu * s, s))
+    m_b = float(np.trapezoid(mu * phi**2, s))
+    k_b = float(np.trapezoid(ei * ddphi**2, s))
+    tension = _cumtrapz_from_end(mu * (g.hub_radius + s), s)   # per Omega^2
+    k_cf = float(np.trapezoid(tension * dphi**2, s))
+    m_c = float(np.trapezoid(mu * phi, s))
+    s_phi_s = float(np.trapezoid(mu * phi * s, s))
+    s_phi_r = float(np.trapezoid(mu * phi * (g.hub_radius + s), s))
+    i_edge = float(np.trapezoid(mu * s * (g.hub_radius + s), s))
+    c_b = 2.0 * t.damping.blade * math.sqrt(k_b * m_b)
+    j_blade = float(np.trapezoid(mu * ((g.hub_radius + s) * math.cos(g.precone_rad)) ** 2, s))
+    rotor_inertia = t.rotor.hub_inertia + nblade * j_blade
+    rotor_mass = t.rotor.hub_mass + nblade * blade_mass
+
+    # --- tower
+    ht = g.tower_height - g.tower_base_height          # flexible length, clamped at its base
+    xh = np.linspace(0.0, 1.0, 2001)
+    h = xh * ht
+    ts = t.tower_structure
+    mt = np.interp(xh, ts.height_fraction, ts.mass_per_length)
+    m_top = rotor_mass + t.nacelle.mass
+    # bodies above the tower top: (mass, downwind x, height above top, rotary inertia in plane)
+    bodies = ((rotor_mass, -g.overhang, g.twr2shft),
+              (t.nacelle.mass, g.nacelle_cm_downwind, g.nacelle_cm_vertical))
+    weight_above = grav * (_cumtrapz_from_end(mt, h) + m_top)
+
+    def tower_mode(coeffs: FloatArray, ei_tab: FloatArray, rot_inertia: float,
+                   zeta: float) -> tuple[float, float, float, float, float, float, float]:
+        ph = mode_shape(coeffs, xh)
+        dph = mode_shape(coeffs, xh, 1) / ht
+        ddph = mode_shape(coeffs, xh, 2) / ht**2
+        eit = np.interp(xh, ts.height_fraction, ei_tab)
+        slope = float(dph[-1])
+        mass = float(np.trapezoid(mt * ph**2, h)) + rot_inertia * slope**2
+        inertia_moment = float(np.trapezoid(mt * ph * h, h)) + rot_inertia * slope
+        k = float(np.trapezoid(eit * ddph**2, h)) - float(np.trapezoid(weight_above * dph**2, h))
+        for mb, xb, zb in bodies:
+            mass += mb * ((1.0 + zb * slope) ** 2 + (xb * slope) ** 2)
+            inertia_moment += mb * (ht + zb) * (1.0 + zb * slope)
+            k -= grav * mb * zb * slope**2
+        if k <= 0:
+            raise ValueError(f"tower modal stiffness {k:g} N/m is not positive: the tower "
+                             f"buckles under the top mass")
+        c = 2.0 * zeta * math.sqrt(k * mass)
+        pdelta = grav * (m_top + float(np.trapezoid(mt * ph, h)))
+        return mass, k, c, 1.0 + g.twr2shft * slope, slope, pdelta, inertia_moment
+
+    m_fa, k_fa, c_fa, hub_fa, slope_fa, pd_fa, in_fa = tower_mode(
+        t.mode_shapes.tower_fa1, ts.fa_stiffness, 0.5 * rotor_inertia, t.damping.tower_fa)
+    m_ss, k_ss, c_ss, hub_ss, slope_ss, pd_ss, in_ss = tower_mode(
+        t.mode_shapes.tower_ss1, ts.ss_stiffness, 0.0, t.damping.tower_ss)
+
+    # --- aero element data
+    b = t.blade
+    if cfg.integration == "midpoint":
+        weights = b.dr.copy()
+    else:
+        rr = np.concatenate(([g.hub_radius], b.r, [g.tip_radius]))
+        weights = 0.5 * (rr[2:] - rr[:-2])
+    phi_el = mode_shape(t.mode_shapes.blade_flap1, (b.r - g.hub_radius) / lb)
+    edge, edge_pack = _edge_mode(t, s, mu, tension)
+    if "blade_edge" in cfg.dofs and not edge:
+        raise ValueError("config.dofs has 'blade_edge' but the turbine's mode-shape table has "
+                         "no 'blade_edge_1' row; add it or leave the DOF out "
+                         f"(PlantConfig(dofs={sorted(cfg.dofs - {'blade_edge'})!r}))")
+    tab = polar_table_of(t)
+    pa = t.pitch_actuator
+    dofs = np.array([d in cfg.dofs for d in DOF_NAMES], dtype=np.int64)
+    opt = np.array([cfg.aero.gravity], dtype=np.int64)
+    fa_static = grav * (t.nacelle.mass * g.nacelle_cm_downwind - rotor_mass * g.overhang)
+    pack = _Pack(
+        dof=dofs, flags=aero_flags(cfg.aero), opt=opt, nb=float(nblade),
+        rho=t.environment.air_density, grav=grav, rtip=g.tip_radius, rhub=g.hub_radius,
+        zhub=g.hub_height, cone=cone, tilt=tilt, r=b.r, w=weights, chord=b.chord,
+        twist=b.twist_rad, af=b.airfoil, phi_flap=phi_el, table=tab.table, alpha0=tab.alpha0,
+        dalpha=tab.dalpha, ngear=t.drivetrain.gearbox_ratio,
+        eta_gen=t.drivetrain.generator_efficiency * t.drivetrain.gearbox_efficiency,
+        j_rot=rotor_inertia, j_gen=t.drivetrain.generator_inertia,
+        k_shaft=t.drivetrain.shaft_stiffness, c_shaft=t.drivetrain.shaft_damping,
+        m_fa=m_fa, k_fa=k_fa, c_fa=c_fa, hub_fa=hub_fa, slope_fa=slope_fa,
+        m_ss=m_ss, k_ss=k_ss, c_ss=c_ss, hub_ss=hub_ss, slope_ss=slope_ss,
+        m_b=m_b, k_b=k_b, k_cf=k_cf, c_b=c_b, m_c=m_c * hub_fa, s1=s1, s_phi_s=s_phi_s,
+        s_phi_r=s_phi_r, i_edge=i_edge, tau_p=pa.time_constant, rate_p=pa.max_rate_rad_s,
+        min_p=pa.min_pitch_rad, max_p=pa.max_pitch_rad, min_tq=t.generator.min_torque,
+        max_tq=t.generator.max_torque, fa_static=fa_static, fa_pdelta=pd_fa,
+        fa_inertia=in_fa, ss_pdelta=pd_ss, ss_inertia=in_ss, **edge_pack)
+    return PlantParams(
+        turbine=t, config=cfg, rotor_inertia=rotor_inertia, rotor_mass=rotor_mass,
+        blade_mass=blade_mass, tower_fa_modal_mass=m_fa, tower_fa_modal_stiffness=k_fa,
+        tower_fa_modal_damping=c_fa, tower_ss_modal_mass=m_ss, tower_ss_modal_stiffness=k_ss,
+        tower_ss_modal_damping=c_ss, blade_modal_mass=m_b, blade_modal_stiffness=k_b,
+        blade_centrifugal_stiffness=k_cf, blade_modal_damping=c_b, blade_tower_coupling=m_c,
+        **edge, pack=pack)
+
+
+def _edge_mode(t: Turbine, s: FloatArray, mu: FloatArray,
+               tension: FloatArray) -> tuple[dict[str, float], dict[str, Any]]:
+    """Edgewise modal properties of one blade (assumed mode, as the flap one; Hansen 2015,
+    ch. 11) on the span grid ``s`` [m] from the root, with mass per length ``mu`` and the
+    centrifugal tension per Omega^2 ``tension``: the :class:`PlantParams` fields and the
+    kernel's (zeros when the turbine has no edge mode shape). The damping ratio is the flap
+    mode's (ElastoDyn's BldEdDmp1 = BldFlDmp1 = 0.477 % for the NREL 5-MW)."""
+    shape = t.mode_shapes.blade_edge1
+    b = t.blade
+    if shape is None:
+        zero = dict.fromkeys(("m_e", "k_e", "k_cf_e", "c_e", "s_e", "g_e", "s_phie_s"), 0.0)
+        return {}, {"phi_edge": np.zeros_like(b.r), **zero}
+    g = t.geometry
+    lb = g.tip_radius - g.hub_radius
+    xs = s / lb
+    phi = mode_shape(shape, xs)
+    dphi = mode_shape(shape, xs, 1) / lb
+    ddphi = mode_shape(shape, xs, 2) / lb**2
+    ei = np.interp(xs, t.blade_structure.span_fraction, t.blade_structure.edge_stiffness)
+    m_e = float(np.trapezoid(mu * phi**2, s))
+    k_e = float(np.trapezoid(ei * ddphi**2, s))
+    k_cf_e = float(np.trapezoid(tension * dphi**2, s))
+    s_e = float(np.trapezoid(mu * phi * (g.hub_radius + s), s))
+    public = {"edge_modal_mass": m_e, "edge_modal_stiffness": k_e,
+              "edge_centrifugal_stiffness": k_cf_e, "edge_rotor_coupling": s_e}
+    kernel = {"phi_edge": mode_shape(shape, (b.r - g.hub_radius) / lb), "m_e": m_e, "k_e": k_e,
+              "k_cf_e": k_cf_e, "c_e": 2.0 * t.damping.blade * math.sqrt(k_e * m_e),
+              "s_e": s_e, "g_e": float(np.trapezoid(mu * phi, s)),
+              "s_phie_s": float(np.trapezoid(mu * phi * s, s))}
+    return public, kernel
+
+
+def structural_frequencies(params: PlantParams, rotor_speed_rad_s: float = 0.0) -> dict[str, float]:
+    """Natural frequencies of the structural modes without aerodynamics [Hz].
+
+    Tower fore-aft coupled with the three flap modes through the mass matrix (so a collective
+    and two asymmetric flap modes appear), tower side-side alone. The flap stiffness includes
+    centrifugal stiffening at ``rotor_speed_rad_s``; the drivetrain torsion frequency is that
+    of the free-free two-mass system (rigid blades).
+
+    With an edge mode shape in the turbine data, also the edgewise modes: the asymmetric edge
+    mode of one blade (stiffness K_e + Omega^2 (K_cf,e - M_e): centrifugal stiffening and the
+    in-plane softening), and, with the generator locked as in the NREL 5-MW report's Table 9-1
+    (RotSpeed = 0, GenDOF = False), the collective edge mode and the shaft torsion coupled
+    through the rotor inertia: M = [[J_r, 3 S_e], [3 S_e, 3 M_e]], K = diag(K_shaft, 3 K_e)
+    with S_e = int m phi_e r ds. The plant's state equations do not carry the edge DOF yet.
+
+    Parameters
+    ----------
+    params : PlantParams
+        The plant.
+    rotor_speed_rad_s : float
+        Rotor speed for the centrifugal stiffening [rad/s].
+
+    Returns
+    -------
+    dict
+        Keys ``tower_fa``, ``tower_ss``, ``flap_collective``, ``flap_asymmetric``,
+        ``drivetrain``, ``drivetrain_locked_generator_rigid_blades`` [Hz]; with an edge mode
+        shape also ``edge_asymmetric``, ``edge_collective_locked_generator`` and
+        ``drivetrain_locked_generator`` [Hz].
+    """
+    import scipy.linalg as sl
+
+    pk = params.pack
+    kq = pk.k_b + rotor_speed_rad_s**2 * pk.k_cf
+    m = np.array([[pk.m_fa, pk.m_c, pk.m_c, pk.m_c], [pk.m_c, pk.m_b, 0, 0],
+                  [pk.m_c, 0, pk.m_b, 0], [pk.m_c, 0, 0, pk.m_b]])
+    k = np.diag([pk.k_fa, kq, kq, kq])
+    w2, vec = sl.eigh(k, m)
+    f = np.sqrt(w2) / (2 * math.pi)
+    tower_share = np.abs(vec[0]) * math.sqrt(pk.m_fa)
+    i_tower = int(np.argmax(tower_share))
+    others = [i for i in range(4) if i != i_tower]
+    coll = max(others, key=lambda i: abs(vec[0, i]))
+    asym = [i for i in others if i != coll]
+    j_eq = pk.j_rot * pk.j_gen * pk.ngear**2 / (pk.j_rot + pk.j_gen * pk.ngear**2)
+    out = {"tower_fa": float(f[i_tower]),
+           "tower_ss": math.sqrt(pk.k_ss / pk.m_ss) / (2 * math.pi),
+           "flap_collective": float(f[coll]), "flap_asymmetric": float(np.mean(f[asym])),
+           "drivetrain": math.sqrt(pk.k_shaft / j_eq) / (2 * math.pi),
+           "drivetrain_locked_generator_rigid_blades":
+               math.sqrt(pk.k_shaft / pk.j_rot) / (2 * math.pi)}
+    if math.isfinite(params.edge_modal_mass):
+        me, se = params.edge_modal_mass, params.edge_rotor_coupling
+        ke = (params.edge_modal_stiffness
+              + rotor_speed_rad_s**2 * (params.edge_centrifugal_stiffness - me))
+        w2e, vece = sl.eigh(np.diag([pk.k_shaft, 3 * ke]),
+                            np.array([[pk.j_rot, 3 * se], [3 * se, 3 * me]]))
+        # the drivetrain mode is the one whose strain energy is mostly the shaft's
+        shaft_energy = pk.k_shaft * vece[0] ** 2
+        i_dt = int(np.argmax(shaft_energy / (shaft_energy + 3 * ke * vece[1] ** 2)))
+        fe = np.sqrt(w2e) / (2 * math.pi)
+        out.update(edge_asymmetric=math.sqrt(ke / me) / (2 * math.pi),
+                   drivetrain_locked_generator=float(fe[i_dt]),
+                   edge_collective_locked_generator=float(fe[1 - i_dt]))
+    return out
