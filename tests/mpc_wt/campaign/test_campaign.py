@@ -250,7 +250,8 @@ def test_killed_worker_and_killed_client_lose_nothing_duplicate_nothing(tmp_path
 
 # -- aggregation and report -------------------------------------------------------------------
 def test_report_tables_and_plots(tmp_path):
-    from mpc_wt.campaign.aggregate import aggregate, make_report
+    from mpc_wt.campaign.aggregate import aggregate
+    from mpc_wt.campaign.report import make_report
 
     spec = _spec(winds=[10, 14], seeds=2, controllers=["baseline", "derate80"],
                  duration=30, wind_distribution={"kind": "rayleigh", "mean": 10},

@@ -13,7 +13,8 @@ from scipy.stats import gumbel_r
 import linearize
 from mpc_wt.assessment.ultimate import extrapolate_maxima, ultimate_table
 from mpc_wt.campaign import SpecError, run_campaign, spec_from_dict
-from mpc_wt.campaign.aggregate import aggregate, make_report
+from mpc_wt.campaign.aggregate import aggregate
+from mpc_wt.campaign.report import make_report
 from mpc_wt.simulation.results import ClosedLoopResult
 from mpc_wt.simulation.scenario import Scenario, make_wind
 
