@@ -35,6 +35,7 @@ from mpc_wt.controllers.takagi_sugeno import (
                                          design_ts_controller,
                                          design_ts_observer,
 )
+from mpc_wt.controllers.wind_estimator import WindSpeedEstimator
 from mpc_wt.errors import (
                                          OptionsError,
                                          ResultFileError,
@@ -60,4 +61,4 @@ __all__ = ["__version__", "controllers", "registry", "DEFAULT_CHANNELS", "assess
            "IBCController", "apc_reference", "tune_coleman_ipc", "tune_ibc", "LidarPreview",
            "simulate_closed_loop", "LQRPIOController", "design_lqr", "design_lqr_family",
            "design_pi_observer", "TSController", "build_ts_model", "design_ts_controller",
-           "design_ts_observer", "tune"]
+           "design_ts_observer", "WindSpeedEstimator", "tune"]

@@ -6,7 +6,8 @@ torque law (:mod:`.baseline`, its law compiled in :mod:`.baseline_law`), Madsen'
 et al.'s LQR with a PI observer (:mod:`.lqr`), Clemens et al.'s Takagi-Sugeno controller and
 wind observer (:mod:`.takagi_sugeno`), individual blade control and Coleman IPC (:mod:`.ipc`),
 active power control (:mod:`.apc`), down-regulation (:mod:`.derating`), LIDAR collective pitch
-feedforward (:mod:`.lidar_feedforward`), the supervisor (:mod:`.supervisor`) and Bladed-style
+feedforward (:mod:`.lidar_feedforward`), the rotor-effective wind from measurements
+(:mod:`.wind_estimator`), the supervisor (:mod:`.supervisor`) and Bladed-style
 DISCON libraries in the loop (:mod:`.discon`). Every controller offers ``reset()`` and
 ``step(t, measurements)`` (:class:`~mpc_wt.controllers.base.Controller`).
 
@@ -42,6 +43,7 @@ from mpc_wt.controllers.takagi_sugeno import (
     design_ts_controller,
     design_ts_observer,
 )
+from mpc_wt.controllers.wind_estimator import WindEstimatorSettings, WindSpeedEstimator
 
 #: names of :mod:`mpc_wt.registry` served from this package (the plugin API's former home)
 REGISTRY_NAMES = ("register", "register_kind", "kinds", "describe", "get_kind", "resolve",
@@ -68,4 +70,4 @@ __all__ = ["apc_reference", "Controller", "ControllerBase", "BaselineController"
            "design_lqr_family", "design_pi_observer", "MPC", "MPCSettings", "MPCWeights",
            "ScheduledMPC", "BACKENDS", "default_backend", "Supervisor", "TorqueLawGuard",
            "TSController", "build_ts_model", "design_ts_controller", "design_ts_observer",
-           "REGISTRY_NAMES", *REGISTRY_NAMES]
+           "WindEstimatorSettings", "WindSpeedEstimator", "REGISTRY_NAMES", *REGISTRY_NAMES]

@@ -1,0 +1,158 @@
+"""The rotor-effective wind speed estimator: its aerodynamic torque against the BEM's, its
+derivatives against central differences, its estimates in steady sheared wind, and in
+turbulence against the true rotor-effective wind of the field (and against ROSCO's own
+estimator on the same runs)."""
+from __future__ import annotations
+
+import math
+import pathlib
+import tempfile
+
+import numpy as np
+import pytest
+from numpy.testing import assert_allclose
+
+import lidar
+import linearize
+from mpc_wt.controllers.wind_estimator import WindEstimatorSettings, WindSpeedEstimator
+from mpc_wt.run import run_controller
+from mpc_wt.simulation.scenario import Scenario, make_wind
+
+
+@pytest.fixture(scope="module")
+def estimator(turbine: linearize.Turbine) -> WindSpeedEstimator:
+    return WindSpeedEstimator(turbine, 0.1)
+
+
+def _estimates(est: WindSpeedEstimator, res, every: int = 8) -> tuple[np.ndarray, np.ndarray]:
+    """The estimator run on a result's measurements at its own step (every 8th plant step:
+    10 Hz): rotor speed, mean pitch and generator torque only."""
+    est.reset()
+    k = slice(None, None, every)
+    pitch = (res.channel("pitch_1") + res.channel("pitch_2") + res.channel("pitch_3")) / 3.0
+    v = [est.step(w, p, q) for w, p, q in zip(res.channel("rotor_speed")[k], pitch[k],
+                                             res.channel("gen_torque")[k])]
+    return res.t[k], np.array(v)
+
+
+@pytest.mark.parametrize("v, lam, pitch_deg", [(8.0, 7.3, 0.3), (12.0, 6.1, 4.1),
+                                               (20.0, 3.9, 17.6)])
+def test_aero_torque_is_the_bems(estimator, turbine, v: float, lam: float,
+                                 pitch_deg: float) -> None:
+    # independent: the BEM's steady C_P at the point (off the table's grid), shear 0.2 as the
+    # table; Q = 1/2 rho pi R_p^2 v^3 C_P / omega. The bicubic fit of the 69 x 91 table is
+    # within 5e-4 of the BEM there (measured 1.2e-5 to 6.3e-5)
+    rp = turbine.geometry.tip_radius * math.cos(turbine.geometry.precone_rad)
+    cp, _ = linearize.steady_coefficients(turbine, lam, pitch_deg, shear_exponent=0.2)
+    omega = lam * v / rp
+    q_bem = 0.5 * turbine.environment.air_density * math.pi * rp**2 * v**3 * float(cp) / omega
+    q, _, _ = estimator.aero_torque(v, omega, math.radians(pitch_deg))
+    assert_allclose(q, q_bem, rtol=5e-4, atol=0)
+
+
+@pytest.mark.parametrize("v, omega, pitch", [(7.0, 0.8, 0.0), (13.0, 1.267, 0.1),
+                                             (22.0, 1.267, 0.33)])
+def test_torque_derivatives_match_central_differences(estimator, v: float, omega: float,
+                                                      pitch: float) -> None:
+    q, dv, dw = estimator.aero_torque(v, omega, pitch)
+    hv, hw = 1e-5 * v, 1e-5 * omega
+    fd_v = (estimator.aero_torque(v + hv, omega, pitch)[0]
+            - estimator.aero_torque(v - hv, omega, pitch)[0]) / (2 * hv)
+    fd_w = (estimator.aero_torque(v, omega + hw, pitch)[0]
+            - estimator.aero_torque(v, omega - hw, pitch)[0]) / (2 * hw)
+    # central differences of a cubic spline with a 1e-5 relative step: truncation ~1e-10,
+    # rounding ~1e-16 * q / h ~ 1e-9 relative (measured 3e-11 to 4e-10)
+    assert_allclose([dv, dw], [fd_v, fd_w], rtol=1e-7, atol=0)
+
+
+@pytest.mark.parametrize("v", [6.0, 11.0, 20.0])
+def test_steady_sheared_wind_is_found(estimator, turbine, v: float) -> None:
+    # the baseline in steady wind with shear 0.2 (the table's): after 60 s the estimate is the
+    # hub wind to 0.2 % (measured 0.01-0.06 % in regions 2, 2.5 and 3), starting from the
+    # measured torque balance (within 1.5 % at the first step)
+    res = run_controller(turbine, "baseline", Scenario(v, "steady", 1, 60.0))
+    t, est = _estimates(estimator, res)
+    assert abs(est[0] - v) < 0.015 * v
+    assert_allclose(est[t >= 55.0].mean(), v, rtol=2e-3, atol=0)
+
+
+@pytest.fixture(scope="module")
+def turbulent_runs(turbine):
+    runs = {}
+    for v in (8.0, 12.0, 18.0):
+        sc = Scenario(v, "A", 3, 300.0)
+        res = run_controller(turbine, "baseline", sc)
+        _, field = make_wind(turbine, sc, "u")
+        truth = lidar.rotor_effective_wind(field, turbine.geometry.tip_radius, method="cube")
+        runs[v] = (res, field.t, truth)
+    return runs
+
+
+@pytest.mark.parametrize("v", [8.0, 12.0, 18.0])
+def test_turbulent_estimate_follows_the_rotor_effective_wind(estimator, turbulent_runs,
+                                                              v: float) -> None:
+    """Class A, 300 s, against the power-equivalent rotor-effective wind of the field (the cube
+    root of the disc mean of u^3, IEC 61400-12-1). Measured (seed 3, after 30 s): bias -0.08,
+    -0.10, -0.07 m/s and RMS error 0.16, 0.22, 0.31 m/s at 8, 12, 18 m/s (600 s: 0.16, 0.21,
+    0.29), correlation 0.99; against the disc mean of u instead, +0.21..+0.31 m/s bias (the
+    estimator sees the aerodynamic, cube-weighted wind). Bounds: abs(bias) < 0.15 m/s,
+    RMS < 0.4 m/s."""
+    res, tf, truth = turbulent_runs[v]
+    t, est = _estimates(estimator, res)
+    keep = t >= 30.0
+    err = est[keep] - np.interp(t[keep], tf, truth)
+    assert abs(err.mean()) < 0.15
+    assert math.sqrt(float(np.mean(err**2))) < 0.4
+
+
+def _read_rosco_debug(path: pathlib.Path) -> dict[str, np.ndarray]:
+    lines = path.read_text().splitlines()
+    names = lines[1].split()
+    rows = []
+    for line in lines[2:]:
+        try:
+            rows.append([float(x) for x in line.split()])
+        except ValueError:
+            continue                             # a units line
+    a = np.array(rows)
+    return {n: a[:, i] for i, n in enumerate(names)}
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("v", [8.0, 12.0, 18.0])
+def test_as_good_as_roscos_estimator_on_the_same_run(turbine, estimator, v: float) -> None:
+    """ROSCO 2.10 (its shipped NREL 5-MW DISCON.IN, WE_Mode 2: its extended Kalman filter) in
+    the loop for 600 s, class A, seed 3; ROSCO's own estimate (WE_Vw of its debug file) and
+    ours from the same run's measurements, against the power-equivalent rotor-effective wind.
+    Measured RMS error: ROSCO 0.26, 0.37, 0.59 m/s; ours 0.17, 0.23, 0.29 m/s (bias -0.05 to
+    -0.12 m/s for both). Asserted: ours no worse than ROSCO's."""
+    pytest.importorskip("rosco")
+    from mpc_wt.controllers.discon import DisconController, rosco_discon, rosco_library
+    from mpc_wt.simulation.loop import simulate_closed_loop
+
+    sc = Scenario(v, "A", 3, 600.0)
+    wind, field = make_wind(turbine, sc, "u")
+    op = linearize.trim(turbine, v)
+    with tempfile.TemporaryDirectory() as wd:
+        ctl = DisconController(rosco_library(), rosco_discon(), turbine, workdir=wd)
+        res = simulate_closed_loop(linearize.plant_params(turbine), ctl, wind, 600.0, x0=op.x,
+                                   u0=op.u)
+        dbg = _read_rosco_debug(pathlib.Path(wd) / ctl.root_name)
+    truth = lidar.rotor_effective_wind(field, turbine.geometry.tip_radius, method="cube")
+    keep = dbg["Time"] >= 30.0
+    e_rosco = dbg["WE_Vw"][keep] - np.interp(dbg["Time"][keep], field.t, truth)
+    t, est = _estimates(estimator, res)
+    e_ours = est[t >= 30.0] - np.interp(t[t >= 30.0], field.t, truth)
+    rms = [math.sqrt(float(np.mean(e**2))) for e in (e_ours, e_rosco)]
+    assert rms[0] <= rms[1]
+
+
+def test_bad_input_is_named(turbine, estimator) -> None:
+    with pytest.raises(ValueError, match="dt"):
+        WindSpeedEstimator(turbine, 0.0)
+    with pytest.raises(ValueError, match="wind_std_per_sqrt_s"):
+        WindEstimatorSettings(wind_std_per_sqrt_s=-1.0)
+    estimator.reset()
+    with pytest.raises(ValueError, match="measurement rotor_speed must be finite, got nan"):
+        estimator.step(float("nan"), 0.0, 4e4)
+    assert estimator.estimate is None
