@@ -19,7 +19,7 @@ from linearize.params import n_x
 #: the blades' azimuth spacing [rad]
 TWO_PI_3 = 2.0 * math.pi / 3.0
 
-__all__ = ['evaluate_plant', 'sample_wind', 'step_kernel']
+__all__ = ["evaluate_plant", "sample_wind", "step_kernel"]
 
 DENSE_STRIDES = (8,)                   # the strides of a 1-D C-contiguous float64 array
 

@@ -73,7 +73,7 @@ from linearize.trim import OperatingPoint, trim
 from linearize.turbine import Turbine
 from linearize.validate import check_finite_scalar
 
-__all__ = ['mbc_matrices', 'linearize', 'jacobian_check', 'linearize_family']
+__all__ = ["mbc_matrices", "linearize", "jacobian_check", "linearize_family"]
 
 _OUT_IDX = [i for i, n in enumerate(OUTPUT_NAMES) if n != "azimuth"]
 

@@ -17,7 +17,8 @@ from linearize._typing import FloatArray
 from linearize.errors import LinearizationError
 from linearize.validate import check_finite_scalar, check_positive
 
-__all__ = ['SCHEMA_VERSION', 'LinearModel', 'augment_actuator', 'with_power_input', 'LinearModelFamily', 'sensitivities']
+__all__ = ["SCHEMA_VERSION", "LinearModel", "augment_actuator", "with_power_input",
+           "LinearModelFamily", "sensitivities"]
 
 SCHEMA_VERSION = 1
 

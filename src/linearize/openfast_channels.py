@@ -55,7 +55,6 @@ CHANNEL_MAP: dict[str, tuple[str, tuple[str, ...]]] = {
 }
 
 
-
 #: The unit OpenFAST writes for each mapped channel, assumed for a CSV column without one.
 DEFAULT_UNITS = {**{k: "kN-m" for k, (_, u) in CHANNEL_MAP.items() if u == _MOMENT},
                  **{k: "deg" for k, (_, u) in CHANNEL_MAP.items() if u == _ANGLE},

@@ -20,7 +20,9 @@ from linearize.bem import (
 )
 from linearize.turbine import Turbine, mode_shape
 
-__all__ = ['DOF_NAMES', 'STATE_NAMES', 'STATE_UNITS', 'INPUT_NAMES', 'INPUT_UNITS', 'OUTPUT_NAMES', 'OUTPUT_UNITS', 'MADSEN_OUTPUTS', 'n_x', 'n_u', 'n_z', 'PlantConfig', 'PlantParams', 'plant_params', 'structural_frequencies']
+__all__ = ["DOF_NAMES", "STATE_NAMES", "STATE_UNITS", "INPUT_NAMES", "INPUT_UNITS", "OUTPUT_NAMES",
+           "OUTPUT_UNITS", "MADSEN_OUTPUTS", "n_x", "n_u", "n_z", "PlantConfig", "PlantParams",
+           "plant_params", "structural_frequencies"]
 
 DOF_NAMES = ("tower_fa", "tower_ss", "drivetrain", "generator", "blade_flap", "pitch_actuator",
              "blade_edge")

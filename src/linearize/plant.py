@@ -78,8 +78,7 @@ from linearize.params import (
 from linearize.validate import check_array, check_positive
 from linearize.wind import GridWind, SteadyWind
 
-__all__ = ['plant_rhs', 'plant_outputs', 'SimulationResult', 'rk4_simulate', 'PlantStepper']
-
+__all__ = ["plant_rhs", "plant_outputs", "SimulationResult", "rk4_simulate", "PlantStepper"]
 
 
 # --------------------------------------------------------------------------------------------

@@ -14,7 +14,8 @@ from linearize.kernel import sample_wind
 from linearize.params import PlantParams
 from linearize.validate import check_array
 
-__all__ = ['element_wind', 'SteadyWind', 'GridWind']
+__all__ = ["element_wind", "SteadyWind", "GridWind"]
+
 
 def element_wind(params: PlantParams, azimuth_rad: float, hub_speed: float,
                  shear_exponent: float = 0.0) -> FloatArray:

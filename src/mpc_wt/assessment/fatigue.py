@@ -13,7 +13,10 @@ from scipy import stats
 from linearize.validate import check_number
 from mpc_wt._typing import FloatArray
 
-__all__ = ['check_series', 'rainflow', 'DELConvention', 'DEL_CONVENTIONS', 'del_convention', 'CycleCount', 'cycle_count', 'damage_equivalent_load', 'wind_bin_probabilities', 'lifetime_del', 'miner_damage', 'lifetime_extension', 'WOEHLER_EXPONENTS']
+__all__ = ["check_series", "rainflow", "DELConvention", "DEL_CONVENTIONS", "del_convention",
+           "CycleCount", "cycle_count", "damage_equivalent_load", "wind_bin_probabilities",
+           "lifetime_del", "miner_damage", "lifetime_extension", "WOEHLER_EXPONENTS"]
+
 
 def check_series(name: str, x: Any) -> FloatArray:
     """A load or signal series as a finite 1-D float array, or an error naming it.

@@ -13,7 +13,9 @@ from linearize.validate import check_number
 from mpc_wt._typing import FloatArray
 from mpc_wt.assessment.fatigue import check_series
 
-__all__ = ['CSMeasures', 'cs_measures', 'psd', 'harmonic_psd', 'pitch_duty', 'energy_Wh', 'aep_Wh', 'tracking_response', 'pct_change']
+__all__ = ["CSMeasures", "cs_measures", "psd", "harmonic_psd", "pitch_duty", "energy_Wh", "aep_Wh",
+           "tracking_response", "pct_change"]
+
 
 @dataclass(frozen=True)
 class CSMeasures:

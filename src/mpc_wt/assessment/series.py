@@ -1,7 +1,8 @@
-"""Load and performance assessment: rainflow, damage-equivalent loads, lifetime damage and
-extension, covariance-ellipse measures CS1-CS5, spectra at rotor harmonics, pitch duty, energy.
+"""One run's summary and comparisons: every channel's damage-equivalent loads, CS1-CS5, pitch
+duty, power and the blade-1 flap moment's harmonics (:func:`assess_series`), the changes
+between two runs (:func:`reductions`) and lifetime comparisons over wind bins.
 
-Pure functions on arrays (the run-level wrappers come with the simulation harness).
+Pure functions on arrays, built on :mod:`.fatigue` and :mod:`.performance`.
 
 References
 ----------
@@ -31,8 +32,7 @@ from mpc_wt.assessment.performance import (
     pitch_duty,
 )
 
-__all__ = ['DEFAULT_CHANNELS', 'assess_series', 'reductions', 'lifetime_comparison']
-
+__all__ = ["DEFAULT_CHANNELS", "assess_series", "reductions", "lifetime_comparison"]
 
 
 #: Load channels and their default Woehler exponents (10 composite blades, 4 steel elsewhere).

@@ -22,7 +22,8 @@ from mpc_wt.campaign.signoff import governing_rows, signoff_rows, ultimate_rows
 from mpc_wt.campaign.spec import CampaignSpec, spec_from_dict
 from mpc_wt.campaign.store import CampaignStore, CaseRow
 
-__all__ = ['OUTLIER_RATIO', 'PITCH_METRICS', 'RELATIVE_METRICS', 'ABSOLUTE_METRICS', 'relative_metrics', 'absolute_metrics', 'aggregate']
+__all__ = ["OUTLIER_RATIO", "PITCH_METRICS", "RELATIVE_METRICS", "ABSOLUTE_METRICS",
+           "relative_metrics", "absolute_metrics", "aggregate"]
 
 #: A seed whose DEL exceeds this multiple of its bin's median (3 seeds or more) is listed as
 #: suspect in the report: with m = 10 one such run can carry a lifetime DEL.
@@ -57,7 +58,7 @@ ABSOLUTE_METRICS: dict[str, tuple[str, ...]] = {
 
 
 def _pct(a: float | None, b: float | None) -> float | None:
-    """:func:`mpc_wt.assessment.series.pct_change`, None where it states no change (JSON/CSV cells)."""
+    """:func:`mpc_wt.assessment.performance.pct_change`, None where it states no change (JSON/CSV cells)."""
     if a is None or b is None:
         return None
     v = pct_change(a, b)

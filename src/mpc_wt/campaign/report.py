@@ -3,7 +3,7 @@ figures of :mod:`.plots`.
 
 Per controller, turbulence and channel: short-term DELs per wind bin and seed; the DEL per bin
 over seeds (m-power mean of equal-length runs); the lifetime DEL, the m-power mean weighted by
-the wind distribution (Clemens et al. eq 18, :func:`mpc_wt.assessment.series.lifetime_del`); AEP from the
+the wind distribution (Clemens et al. eq 18, :func:`mpc_wt.assessment.fatigue.lifetime_del`); AEP from the
 mean power per bin; pitch duty weighted the same way (Pettas and Cheng sec. 4); CS1-CS5 per bin
 (Do et al. eqs 21-26); lifetime extension for a retrofit after 15 of 20 years (Pettas and Cheng
 eq 1). Every comparison with the reference controller is made over the winds both ran.
@@ -23,7 +23,8 @@ from mpc_wt.campaign.aggregate import OUTLIER_RATIO, PITCH_METRICS, aggregate
 from mpc_wt.campaign.plots import campaign_plots
 from mpc_wt.campaign.spec import CampaignSpec, turbulence_tag
 
-__all__ = ['make_report']
+__all__ = ["make_report"]
+
 
 # -- paper comparison -------------------------------------------------------------------------
 def _ours(agg: dict[str, Any], p: dict[str, Any]) -> float | None:

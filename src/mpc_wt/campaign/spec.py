@@ -422,7 +422,7 @@ class CampaignSpec:
 
     def bin_probabilities(self, winds: Any) -> np.ndarray:
         """The wind distribution's probability of each mean-wind bin
-        (:func:`mpc_wt.assessment.series.wind_bin_probabilities`).
+        (:func:`mpc_wt.assessment.fatigue.wind_bin_probabilities`).
 
         Parameters
         ----------

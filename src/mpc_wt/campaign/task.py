@@ -88,7 +88,7 @@ def case_metrics(t: np.ndarray, cols: dict[str, np.ndarray], channels: dict[str,
     transient : float
         Discarded start [s].
     convention : str
-        The DEL convention (:data:`mpc_wt.assessment.series.DEL_CONVENTIONS`).
+        The DEL convention (:data:`mpc_wt.assessment.fatigue.DEL_CONVENTIONS`).
 
     Returns
     -------

@@ -7,7 +7,8 @@ from typing import Callable
 
 from linearize.validate import check_number
 
-__all__ = ['check_weight_range', 'apc_reference', 'power_weight']
+__all__ = ["check_weight_range", "apc_reference", "power_weight"]
+
 
 # --------------------------------------------------------------------------------------------
 # Active power control reference

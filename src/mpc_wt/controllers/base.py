@@ -6,7 +6,8 @@ from typing import Any, Protocol
 
 import numpy as np
 
-__all__ = ['ControllerBase', 'Controller']
+__all__ = ["ControllerBase", "Controller"]
+
 
 class ControllerBase:
     """Base of the controllers mpc-wt ships; a user's controller need not subclass it (any

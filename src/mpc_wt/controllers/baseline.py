@@ -406,7 +406,7 @@ class BaselineController(ControllerBase):
         state : (5,) ndarray
             Filtered speed, integral, last pitch, last torque, started (0 / 1).
         signals : (6,) ndarray
-            The last step's signals (:data:`mpc_wt.simulation.compiled.SIGNALS`).
+            The last step's signals (:data:`mpc_wt.controllers.baseline_law.SIGNALS`).
         """
         if state[4] == 0.0:                 # never stepped
             return
@@ -433,7 +433,6 @@ class BaselineController(ControllerBase):
         """
         p3 = self.gains.rated_power if power is None else power
         return float(law_torque(float(w), float(pitch), float(p3), self._par))
-
 
     def _ff_step(self) -> float:
         """The feedforward pitch's change since the last step [rad]."""

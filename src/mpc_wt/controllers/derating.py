@@ -11,7 +11,8 @@ import linearize
 from mpc_wt.assessment.performance import aep_Wh, pct_change
 from mpc_wt.controllers.baseline import BaselineController, BaselineGains, check_power_fraction
 
-__all__ = ['steady_power_curve', 'aep_change']
+__all__ = ["steady_power_curve", "aep_change"]
+
 
 # --------------------------------------------------------------------------------------------
 # Down-regulation: steady power curve and AEP

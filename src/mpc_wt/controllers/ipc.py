@@ -1,5 +1,5 @@
-"""Retrofit control strategies: individual blade control, Coleman-frame IPC, down-regulation,
-active power control, and the metrics that judge them.
+"""Retrofit load control: individual blade control and Coleman-frame IPC, added to a baseline
+(down-regulation and active power control are in :mod:`.derating` and :mod:`.apc`).
 
 Individual blade control (Pettas and Cheng 2018, sec. 3.1, fig. 3): three decoupled
 proportional loops, one per blade, on the blade-root flap moment M_i. A high-pass filter on the
@@ -50,7 +50,9 @@ from mpc_wt.controllers.base import ControllerBase
 from mpc_wt.controllers.baseline import BaselineController, check_power_fraction
 from mpc_wt.controllers.filters import SOSFilterBank, filter_sos
 
-__all__ = ['IBCGains', 'tune_ibc', 'IBCController', 'ColemanIPCGains', 'tune_coleman_ipc', 'ColemanIPCController']
+__all__ = ["IBCGains", "tune_ibc", "IBCController", "ColemanIPCGains", "tune_coleman_ipc",
+           "ColemanIPCController"]
+
 
 def _region3_winds(turbine: linearize.Turbine, step: float = 2.0) -> np.ndarray:
     lo = float(np.floor(linearize.rated_wind_speed(turbine))) + 1.0

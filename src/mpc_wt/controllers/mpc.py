@@ -858,7 +858,6 @@ class MPC(ControllerBase):
         self.qp_backend = make_backend(self.backend, self.formulation, opts)
         self.qp_backend.setup(p_s, np.zeros(nv), a_s, 0)
 
-
     # ------------------------------------------------------------------------------------
     def reset(self) -> None:
         """Forget the previous plan and command."""

@@ -35,6 +35,7 @@ __all__ = ["OpenFASTSeries", "read_openfast_output", "write_openfast_output", "C
            "UNIT_SCALE", "DEFAULT_UNITS", "to_mpcwt_channels", "from_mpcwt_channels",
            "split_csv_header"]
 
+
 @dataclass(frozen=True)
 class OpenFASTSeries:
     """An OpenFAST output as read.

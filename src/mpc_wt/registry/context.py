@@ -15,7 +15,8 @@ import lidar
 import linearize
 from mpc_wt.simulation.scenario import Scenario, field_spec
 
-__all__ = ['turbine_key', 'DesignCache', 'DEFAULT_CACHE', 'BuildContext', 'Built']
+__all__ = ["turbine_key", "DesignCache", "DEFAULT_CACHE", "BuildContext", "Built"]
+
 
 def turbine_key(turbine: linearize.Turbine) -> str:
     """A digest of a turbine's content (every field and array; not where it was read from),
@@ -112,7 +113,7 @@ class DesignCache:
             self._items.clear()
 
 
-#: The process-wide cache used by :func:`~mpc_wt.controllers.run_controller` by default.
+#: The process-wide cache used by :func:`~mpc_wt.run.run_controller` by default.
 DEFAULT_CACHE = DesignCache()
 
 

@@ -4,7 +4,7 @@ A kind declares its name, its options class, how it finds its operating point an
 builds the controller; optionally a design function and a gain-table function. An *add-on*
 kind (IBC, Coleman IPC) wraps a base controller; a name such as ``derate80+ibc`` selects a
 base (``derate`` through its name pattern, with ``power_fraction = 0.8``) and add-ons. The
-command line, campaign specs and :func:`~mpc_wt.controllers.run_controller` all resolve names
+command line, campaign specs and :func:`~mpc_wt.run.run_controller` all resolve names
 and check options here (STYLE rule 10: cvxpy's solver map is the model).
 
 User kinds register with :func:`register`; modules named by ``--plugin`` (command line),

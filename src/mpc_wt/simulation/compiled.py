@@ -6,14 +6,13 @@ and torque law at the plant's rate that is more than the law itself. This module
 loop (RK4 step, the law, the command checks, the generator's torque-rate limit, the signals and
 the envelope check) in one compiled call per block of steps.
 
-It is the same loop as :func:`mpc_wt.simulation.loop.simulate_closed_loop`'s Python path, operation for
-operation: :class:`~mpc_wt.controllers.baseline.BaselineController`'s ``step`` (DISCON form: the speed
-low-pass, the PI on the filtered speed error with the gain schedule GK = 1 / (1 + theta /
-theta_K) and its anti-windup, the pitch-rate limit, the torque law of regions 1.5, 2, 2.5 and 3
-and its rate limit), in the same floating-point order, so the two paths agree to rounding (the
-test compares them over turbulent runs in regions 2 and 3). It applies only where the law is
-exactly that: no power reference, gain schedule or add-on feedforward
-(:meth:`~mpc_wt.controllers.baseline.BaselineController.compiled_law` says None otherwise), and no LIDAR.
+It is the same loop as :func:`mpc_wt.simulation.loop.simulate_closed_loop`'s Python path,
+operation for operation, around the same law (:mod:`mpc_wt.controllers.baseline_law`, which
+:class:`~mpc_wt.controllers.baseline.BaselineController` runs too), so the two paths agree to
+the last bit (the test compares them over turbulent runs in regions 2 and 3). It applies only
+where the law is exactly that: no power reference, gain schedule or add-on feedforward
+(:meth:`~mpc_wt.controllers.baseline.BaselineController.compiled_law` says None otherwise),
+and no LIDAR.
 """
 from __future__ import annotations
 
@@ -33,7 +32,7 @@ from linearize.kernel import step_kernel
 from mpc_wt.controllers import baseline_law
 from mpc_wt.controllers.baseline_law import law
 
-__all__ = ['run_steps']
+__all__ = ["run_steps"]
 
 log = logging.getLogger(__name__)
 

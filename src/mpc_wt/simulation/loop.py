@@ -34,7 +34,7 @@ from mpc_wt.errors import ControllerLibraryError, SimulationDivergedError
 from mpc_wt.simulation.preview import LidarPreview
 from mpc_wt.simulation.results import ClosedLoopResult
 
-__all__ = ['simulate_closed_loop']
+__all__ = ["simulate_closed_loop"]
 
 log = logging.getLogger(__name__)
 

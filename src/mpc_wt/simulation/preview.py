@@ -6,7 +6,8 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ['LidarPreview']
+__all__ = ["LidarPreview"]
+
 
 class LidarPreview:
     """A simulated LIDAR in the loop: measures the wind field at the rotor's current azimuth

@@ -173,7 +173,6 @@ class ClosedLoopResult:
                    meta=json.loads(ds.attrs.get("meta_json", "{}")))
 
 
-
 def load_series(path: str | Path, time_column: str = "time") -> tuple[np.ndarray,
                                                                        dict[str, np.ndarray]]:
     """Time and channels of a run: ours (netCDF), an OpenFAST output (``.out``, ``.outb``) or a

@@ -1,5 +1,6 @@
-"""What a controller kind builds from: the load case (:class:`Scenario`), its wind, the
-operating point, and a cache for designs that cost seconds (:class:`DesignCache`).
+"""The load case as the simulator meets it (:class:`Scenario`: mean wind, turbulence, seed,
+duration, shear, an IEC 61400-1 wind condition), its rules written once, and its wind
+(:func:`make_wind`).
 """
 from __future__ import annotations
 
@@ -14,8 +15,9 @@ import lidar
 import linearize
 from linearize.validate import check_finite_scalar, check_positive, check_range
 
-__all__ = ['Scenario', 'check_turbulence', 'check_condition', 'is_deterministic', 'field_grid',
-           'make_wind', 'field_spec', 'iec_site']
+__all__ = ["Scenario", "check_turbulence", "check_condition", "is_deterministic", "field_grid",
+           "make_wind", "field_spec", "iec_site"]
+
 
 @dataclass(frozen=True)
 class Scenario:

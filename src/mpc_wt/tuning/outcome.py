@@ -12,7 +12,7 @@ import numpy as np
 
 from mpc_wt.tuning.optimizer import TuneResult
 
-__all__ = ['REPORT_METRICS', 'TuneOutcome', 'write_trials_csv', 'pareto_front']
+__all__ = ["REPORT_METRICS", "TuneOutcome", "write_trials_csv", "pareto_front"]
 
 #: Measures the report always shows (besides the objective's and the constraints').
 REPORT_METRICS = ("rotor_speed_std", "power_std", "pitch_travel", "cs1", "cs2")

@@ -28,7 +28,7 @@ from mpc_wt.tuning.optimizer import optimize
 from mpc_wt.tuning.outcome import TuneOutcome
 from mpc_wt.tuning.spec import TuneSpec, load_tune_spec
 
-__all__ = ['tune']
+__all__ = ["tune"]
 
 log = logging.getLogger(__name__)
 

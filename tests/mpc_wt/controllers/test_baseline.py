@@ -80,12 +80,6 @@ def test_region2_tracks_optimal_tsr(turbine: linearize.Turbine, params: lineariz
     assert_allclose(tsr, gains.info["tsr_opt"], rtol=0.02)
 
 
-
-
-
-
-
-
 def test_torque_law_is_continuous_and_monotone(turbine: linearize.Turbine, gains) -> None:
     # regions 1.5 -> 2 -> 2.5 -> 3 meet without jumps below rated (the 2 -> 2.5 switch is where
     # K w^2 meets the 2.5 line, as DISCON's VS_TrGnSp), and the torque rises with speed

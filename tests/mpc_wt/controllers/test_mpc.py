@@ -406,10 +406,6 @@ def test_step_rejects_a_state_of_the_wrong_length(model, turbine) -> None:
         MPC(model, turbine, MPCSettings(backend="osqp")).step(0.0, {"state": np.zeros(5)})
 
 
-
-
-
-
 @pytest.mark.parametrize("rows", [15, 4, 1])
 def test_step_with_a_preview_equals_the_qp_of_its_deviations(model, turbine, rows: int) -> None:
     """The harness step writes the per-blade preview into the QP data in compiled code

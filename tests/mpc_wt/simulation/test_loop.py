@@ -54,7 +54,6 @@ class _PreviewProbe:
         return np.full(3, 0.26), 43093.55
 
 
-
 def test_controller_returning_nan(turbine: linearize.Turbine,
                                   params: linearize.PlantParams) -> None:
     op = linearize.trim(turbine, 12.0)

@@ -19,7 +19,8 @@ from mpc_wt.controllers.takagi_sugeno.synthesis import TSControllerDesign, TSObs
 
 log = logging.getLogger(__name__)
 
-__all__ = ['TSController']
+__all__ = ["TSController"]
+
 
 # --------------------------------------------------------------------------------------------
 # Controller in the harness

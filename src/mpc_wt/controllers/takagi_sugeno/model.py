@@ -13,7 +13,7 @@ import numpy as np
 import linearize
 from mpc_wt.errors import PremiseError
 
-__all__ = ['CLEMENS_MEASURED', 'DEFAULT_SCALES', 'TSModel', 'build_ts_model']
+__all__ = ["CLEMENS_MEASURED", "DEFAULT_SCALES", "TSModel", "build_ts_model"]
 
 #: Clemens et al. eq 6: tower side-side and fore-aft displacement, rotor and generator speed.
 CLEMENS_MEASURED = ("tower_ss_displacement", "tower_fa_displacement", "rotor_speed", "gen_speed")

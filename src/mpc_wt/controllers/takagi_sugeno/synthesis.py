@@ -16,7 +16,8 @@ from linearize.validate import check_number
 from mpc_wt.controllers.takagi_sugeno.model import DEFAULT_SCALES, TSModel
 from mpc_wt.errors import SynthesisError
 
-__all__ = ['Certificate', 'TSControllerDesign', 'TSObserverDesign', 'design_ts_controller', 'verify_controller', 'design_ts_observer', 'verify_observer']
+__all__ = ["Certificate", "TSControllerDesign", "TSObserverDesign", "design_ts_controller",
+           "verify_controller", "design_ts_observer", "verify_observer"]
 
 log = logging.getLogger(__name__)
 
