@@ -2,7 +2,8 @@
 duty, power and the blade-1 flap moment's harmonics (:func:`assess_series`), the changes
 between two runs (:func:`reductions`) and lifetime comparisons over wind bins.
 
-Pure functions on arrays, built on :mod:`.fatigue` and :mod:`.performance`.
+Pure functions on arrays, built on :mod:`mpc_wt.assessment.fatigue` and
+:mod:`mpc_wt.assessment.performance`.
 
 References
 ----------
