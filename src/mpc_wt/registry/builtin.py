@@ -565,8 +565,7 @@ def _build_ts(ctx: BuildContext, opts: TSOptions) -> Built:
                              make)
     dp = None if opts.apc_frequency is None else apc_reference(
         opts.apc_frequency, amplitude=opts.apc_amplitude, offset=opts.apc_offset)
-    w0 = float(np.clip(ctx.scenario.wind_mps, ts.wind_grid[0], ts.wind_grid[-1]))
-    ctl = TSController(ts, c, o, ctx.turbine, initial_wind_mps=w0, power_reduction=dp)
+    ctl = TSController(ts, c, o, ctx.turbine, power_reduction=dp)  # starts from its measurements
     return Built(ctl, meta={"ts": {"vertices": ts.n_vertices, "decay_rate": c.decay_rate,
                                    "observer_decay_rate": o.decay_rate,
                                    "apc_frequency_Hz": opts.apc_frequency}})

@@ -179,3 +179,31 @@ def test_ts_controller_bad_input(turbine, ts, designs) -> None:
             "state": np.zeros(len(linearize.STATE_NAMES))}
     with pytest.raises(ValueError, match="non-finite measurement"):
         c.step(0.0, meas)
+
+
+@pytest.fixture(scope="module")
+def ts_default(turbine: linearize.Turbine):
+    return build_ts_model(turbine)
+
+
+@pytest.mark.parametrize("v", [15.0, 18.0, 21.0])
+def test_the_wind_of_a_measured_pitch(turbine: linearize.Turbine, ts_default, v: float) -> None:
+    """The wind an observer starts from at the plant's trim pitch (sheared inflow; the vertices
+    are the TS model's own trims) on the default 6-wind grid: measured within 0.07 m/s of the
+    trim wind; bound 0.2 m/s."""
+    op = linearize.trim(turbine, v)
+    assert abs(ts_default.wind_at_pitch(float(op.u[0])) - v) < 0.2
+
+
+def test_observer_starts_from_its_first_measurement(turbine: linearize.Turbine, ts,
+                                                    designs) -> None:
+    """With no initial wind given, nothing is known before the first step, whose measured
+    pitch sets the observer's start (within 0.3 m/s of the trim wind after that step on this
+    module's 4-wind grid)."""
+    ctl = TSController(ts, *designs, turbine)
+    assert ctl.xi is None
+    op = linearize.trim(turbine, 18.0)
+    meas = {"pitch": np.full(3, op.u[0]), **{n: op.state(n) for n in (
+        "rotor_speed", "gen_speed", "tower_fa_displacement", "tower_ss_displacement")}}
+    ctl.step(0.0, meas)
+    assert abs(ctl.signals["wind_est"] - 18.0) < 0.3

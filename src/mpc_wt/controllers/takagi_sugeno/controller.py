@@ -41,7 +41,10 @@ class TSController(ControllerBase):
     dt : controller period [s]
     power_reduction : callable t -> Delta P [-], optional (active power control, eq 11)
     initial_wind_mps : float, optional
-        Initial wind estimate [m/s] (default the middle of the grid).
+        Initial wind estimate [m/s]. Default: from the first step's measured collective pitch,
+        the wind whose vertex equilibrium (no power reduction) has that pitch, interpolated
+        over the wind grid (clipped to it): the controller starts in operation from what it
+        measures.
 
     Signals recorded: ``wind_est`` [m/s], ``power_reduction`` [-], ``power_ref`` [W],
     ``premise_clipped`` (0/1).
@@ -56,9 +59,9 @@ class TSController(ControllerBase):
         self.ts, self.ctl, self.obs, self.turbine = ts, controller, observer, turbine
         self.dt = float(dt)
         self.power_reduction = power_reduction
-        v_init = float(np.mean(ts.wind_grid) if initial_wind_mps is None else initial_wind_mps)
-        ts.check_premise(v_init, float(ts.reduction_grid[0]))
-        self._v_init = v_init
+        if initial_wind_mps is not None:
+            ts.check_premise(float(initial_wind_mps), float(ts.reduction_grid[0]))
+        self._v_given = None if initial_wind_mps is None else float(initial_wind_mps)
         aa, bb, cc = observer.A_aug, observer.B_aug, observer.C_aug
         nv, n = aa.shape[:2]
         nu, ny = bb.shape[2], cc.shape[0]
@@ -79,14 +82,21 @@ class TSController(ControllerBase):
         self.reset()
 
     def reset(self) -> None:
-        h = self.ts.membership(self._v_init, float(self.ts.reduction_grid[0]))
-        m = self.ts.blend(h)
-        self.xi = np.concatenate([m["x0"], [self._v_init]])
-        self._u = m["u0"].copy()
+        """Forget the estimates; with no initial wind given, the next step starts from its
+        measurements."""
+        self.xi: np.ndarray | None = None
+        if self._v_given is not None:
+            self._start(self._v_given)
         self.signals: dict[str, float] = {}
         self.premise_clipped = 0
         self._warned = False
         self._q = 0.0
+
+    def _start(self, v_init: float) -> None:
+        """The observer's state at the vertex equilibrium of wind ``v_init``."""
+        m = self.ts.blend(self.ts.membership(v_init, float(self.ts.reduction_grid[0])))
+        self.xi = np.concatenate([m["x0"], [v_init]])
+        self._u = m["u0"].copy()
 
     def _premise(self, v: float, dp: float) -> tuple[float, float, bool]:
         g1, g2 = self.ts.wind_grid, self.ts.reduction_grid
@@ -107,6 +117,8 @@ class TSController(ControllerBase):
         if not np.all(np.isfinite(y)):
             raise ValueError(f"non-finite measurement at t = {t:g} s: "
                              f"{dict(zip(self.ts.measured, y))}")
+        if self.xi is None:                 # start in operation from the measured pitch
+            self._start(self.ts.wind_at_pitch(float(np.mean(meas["pitch"]))))
         dp_raw = float(self.power_reduction(t)) if self.power_reduction else 0.0
         if not math.isfinite(dp_raw):
             raise ValueError(f"power_reduction({t:g}) returned {dp_raw!r}")

@@ -160,6 +160,27 @@ class TSModel:
         self.check_premise(wind, reduction)
         return np.kron(_hats(self.wind_grid, wind), _hats(self.reduction_grid, reduction))
 
+    def wind_at_pitch(self, pitch: float) -> float:
+        """The wind whose vertex equilibrium (no power reduction) has a collective pitch,
+        interpolated linearly over the wind grid and clipped to it: where an observer can
+        start from a measured pitch.
+
+        Parameters
+        ----------
+        pitch : float
+            Collective pitch [rad].
+
+        Returns
+        -------
+        float
+            Wind speed [m/s].
+        """
+        dp0 = float(self.reduction_grid[0])
+        eq = np.array([self.blend(self.membership(float(v), dp0))["u0"][0]
+                       for v in self.wind_grid])
+        order = np.argsort(eq)
+        return float(np.interp(pitch, eq[order], np.asarray(self.wind_grid, float)[order]))
+
     def blend(self, h: np.ndarray) -> dict[str, np.ndarray]:
         """The model's matrices and equilibria weighted by memberships ``h``.
 
