@@ -391,12 +391,12 @@ class SamplerCache:
     def _get(self, c: FloatArray, spec: TurbulenceSpec) -> _CirculantSampler:
         key = (spec.n_y, spec.n_z, spec.width, spec.height,
                hashlib.sha1(np.ascontiguousarray(c, dtype=np.float64).tobytes()).hexdigest())
-        if key != self._key:
+        kept = self._sampler
+        if kept is None or key != self._key:
             self.clear()                     # one at a time: release the last before building
-            self._sampler = _CirculantSampler(c, spec, keep_factors=True)
+            kept = self._sampler = _CirculantSampler(c, spec, keep_factors=True)
             self._key = key
-        assert self._sampler is not None
-        return self._sampler
+        return kept
 
 
 def _shared_sampler(c: FloatArray, spec: TurbulenceSpec,

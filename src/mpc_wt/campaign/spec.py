@@ -330,8 +330,7 @@ class Case:
         d = dict(d)
         d["plugins"] = tuple(d.get("plugins", ()))
         if "scenario" in d:
-            sc = d.pop("scenario")
-            scenario = sc if isinstance(sc, Scenario) else Scenario(**sc)
+            scenario = Scenario(**d.pop("scenario"))
         else:
             cond = d.pop("condition", None) or {}
             d.pop("sign", None)

@@ -207,12 +207,12 @@ def _events(args: argparse.Namespace, turbine: linearize.Turbine
     error names the flag."""
     from mpc_wt.controllers.supervisor import Supervisor
 
-    cond = scenario_of(args, turbine)
+    scenario = scenario_of(args, turbine)
     sup = {k: v for k, v in (("overspeed", args.overspeed), ("shutdown_at", args.shutdown_at),
                              ("grid_loss_at", args.grid_loss_at),
                              ("torque_ramp_s", args.torque_ramp)) if v is not None}
     if not sup:
-        return cond, None
+        return scenario, None
     try:
         Supervisor.check_settings(turbine, **sup)
     except ValueError as err:
@@ -220,7 +220,7 @@ def _events(args: argparse.Namespace, turbine: linearize.Turbine
                 "grid_loss_at": "--grid-loss-at", "torque_ramp_s": "--torque-ramp"}
         name = next((f for k, f in flag.items() if str(err).startswith(k)), "--overspeed")
         raise UsageError(f"{name}: {err}") from None
-    return cond, sup
+    return scenario, sup
 
 
 def _controllers(args: argparse.Namespace) -> int:

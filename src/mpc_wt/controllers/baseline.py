@@ -393,9 +393,7 @@ class BaselineController(ControllerBase):
                 or self.power_reference is not None or self._sched_f is not None
                 or self.pitch_feedforward is not None):
             return None
-        par = self._par.copy()
-        par[-1] = gen_speed_index
-        return self._st.copy(), par
+        return self._st.copy(), law_parameters(self, gen_speed_index)
 
     def adopt_compiled_state(self, state: np.ndarray, signals: np.ndarray) -> None:
         """Take the state a compiled run left (:meth:`compiled_law`'s layout) and its last
