@@ -2,7 +2,8 @@
 
 This package imports neither ``linearize`` nor ``mpc_wt``; turbine geometry arrives as numbers.
 """
-from lidar.cw import CWLidar, LidarMeasurement
+from lidar.coherence import coherence_corner_model, rotor_coherence_model
+from lidar.cw import CWLidar, LidarMeasurement, LidarSensor
 from lidar.errors import FieldFileError
 from lidar.field import WindField
 from lidar.iec import (
@@ -39,7 +40,8 @@ from lidar.turbulence import (
 )
 
 __all__ = ["IECSite", "iec_field", "event_duration", "CONDITIONS", "IEC_REFERENCE_SPEED",
-           "IEC_TURBULENCE", "SamplerCache", "CWLidar", "LidarMeasurement", "FieldFileError", "WindField", "Preview",
+           "IEC_TURBULENCE", "SamplerCache", "CWLidar", "LidarMeasurement", "LidarSensor",
+           "rotor_coherence_model", "coherence_corner_model", "FieldFileError", "WindField", "Preview",
            "PreviewBuffer", "blade_effective_wind", "coherence", "coherence_bandwidth", "peak_lag", "preview",
            "preview_series", "rms_preview_error", "rotor_effective_wind", "TurbulenceSpec",
            "evolution_coherence", "evolve_field", "generate_evolved_field", "generate_field", "iec_coherence", "iec_sigma",

@@ -303,3 +303,83 @@ class LidarMeasurement:
     beam_azimuth_rad: FloatArray
     preview_time: float
     radius: float
+
+
+class LidarSensor:
+    """A CW LIDAR in a controller: the instrument, and the wind field it measures, which the
+    simulator binds before each run (:meth:`bind`). A controller's design chooses the
+    instrument; the wind it sees is the case's, so the design never holds it.
+
+    Parameters
+    ----------
+    instrument : CWLidar
+        The LIDAR.
+    evolution : bool
+        Whether the field it measures is the rotor's evolved over the focus distance
+        (:func:`lidar.evolve_field`; the simulator makes it) or the rotor's own (frozen
+        turbulence).
+    field : WindField, optional
+        Bind at once (a field made by hand, e.g. in a test).
+    """
+
+    def __init__(self, instrument: CWLidar, evolution: bool = True,
+                 field: WindField | None = None) -> None:
+        if not isinstance(instrument, CWLidar):
+            raise TypeError(f"instrument must be a CWLidar, got {type(instrument).__name__}")
+        self.instrument, self.evolution = instrument, bool(evolution)
+        self._field = field
+
+    @property
+    def distance(self) -> float:
+        """The distance over which the wind it measures has evolved [m] (0: frozen)."""
+        return self.instrument.focus_distance if self.evolution else 0.0
+
+    @property
+    def focus_distance(self) -> float:
+        """The instrument's focus distance D [m]."""
+        return self.instrument.focus_distance
+
+    def bind(self, field: WindField) -> None:
+        """Give the sensor the wind field of the next run.
+
+        Parameters
+        ----------
+        field : WindField
+            What the LIDAR measures.
+        """
+        if not isinstance(field, WindField):
+            raise TypeError(f"field must be a WindField, got {type(field).__name__}")
+        self._field = field
+
+    @property
+    def field(self) -> WindField:
+        """The bound field.
+
+        Raises
+        ------
+        RuntimeError
+            Before :meth:`bind`.
+        """
+        if self._field is None:
+            raise RuntimeError("the LIDAR has no wind to measure: the simulator binds the "
+                               "case's field (LidarSensor.bind) before the run")
+        return self._field
+
+    def measure(self, t: FloatArray, blade_azimuth_rad: FloatArray,
+                rotor_speed_rad_s: FloatArray | float) -> LidarMeasurement:
+        """:meth:`CWLidar.measure` on the bound field.
+
+        Parameters
+        ----------
+        t : (n_t,) ndarray
+            Measurement times [s].
+        blade_azimuth_rad : (n_t,) ndarray
+            Azimuth of blade 1 [rad].
+        rotor_speed_rad_s : (n_t,) ndarray or float
+            [rad/s].
+
+        Returns
+        -------
+        LidarMeasurement
+        """
+        return self.instrument.measure(self.field, t, blade_azimuth_rad, rotor_speed_rad_s)

@@ -93,18 +93,27 @@ class PreviewBuffer:
     Parameters
     ----------
     preview_time : float
-        T_p of the instrument [s] (``LidarMeasurement.preview_time``), > 0.
+        T_p of the instrument [s] (``LidarMeasurement.preview_time``), > 0: the default of
+        :meth:`preview`.
     dt : float
         Interval between pushes (the controller step) [s], > 0.
+    max_preview_time : float, optional
+        The longest T_p a :meth:`preview` will ask for [s] (a preview time that follows the
+        measured mean wind); the buffer keeps enough samples for it (default ``preview_time``).
     """
 
-    def __init__(self, preview_time: float, dt: float) -> None:
+    def __init__(self, preview_time: float, dt: float,
+                 max_preview_time: float | None = None) -> None:
         if not (math.isfinite(preview_time) and preview_time > 0):
             raise ValueError(f"preview_time must be > 0 s, got {preview_time!r}")
         if not (math.isfinite(dt) and dt > 0):
             raise ValueError(f"dt must be > 0 s, got {dt!r}")
+        longest = preview_time if max_preview_time is None else max_preview_time
+        if not (math.isfinite(longest) and longest >= preview_time):
+            raise ValueError(f"max_preview_time must be >= preview_time = {preview_time:g} s, "
+                             f"got {max_preview_time!r}")
         self.preview_time, self.dt = float(preview_time), float(dt)
-        self.capacity = int(math.ceil(self.preview_time / self.dt)) + 3
+        self.capacity = int(math.ceil(longest / self.dt)) + 3
         self._t = np.empty(2 * self.capacity)
         self._u = np.empty((3, 2 * self.capacity))
         self._n = 0                           # samples pushed so far
@@ -146,7 +155,8 @@ class PreviewBuffer:
         lo = self._n % self.capacity if self._n >= self.capacity else 0
         return self._t[lo:lo + n], self._u[:, lo:lo + n]
 
-    def preview(self, t_now: float, horizon: int = 15) -> Preview:
+    def preview(self, t_now: float, horizon: int = 15,
+                preview_time: float | None = None) -> Preview:
         """The preview of the next ``horizon`` steps at ``t_now`` (eq. of :func:`preview`).
 
         Parameters
@@ -155,6 +165,9 @@ class PreviewBuffer:
             Controller time, within the kept measurements [s].
         horizon : int
             Steps H_p (>= 1).
+        preview_time : float, optional
+            T_p for this preview [s], at most the buffer's ``max_preview_time`` (default the
+            buffer's ``preview_time``).
 
         Returns
         -------
@@ -166,8 +179,12 @@ class PreviewBuffer:
             raise ValueError(f"t_now = {t_now!r} s is outside the kept measurements ({span})")
         if not isinstance(horizon, (int, np.integer)) or horizon < 1:
             raise ValueError(f"horizon must be an integer >= 1, got {horizon!r}")
+        tp = self.preview_time if preview_time is None else float(preview_time)
+        if not (math.isfinite(tp) and 0 < tp <= (self.capacity - 3) * self.dt + 1e-9):
+            raise ValueError(f"preview_time must be in (0, {(self.capacity - 3) * self.dt:g}] s "
+                             f"(the buffer's longest), got {preview_time!r}")
         steps = t_now + self.dt * np.arange(1, horizon + 1)
-        tm = steps - self.preview_time
+        tm = steps - tp
         measured = tm <= t_now + 1e-9
         tm = np.clip(np.minimum(tm, t_now), tk[0], tk[-1])
         blade = np.column_stack([np.interp(tm, tk, uk[i]) for i in range(3)])

@@ -7,7 +7,7 @@ from linearize import SimulationDivergedError
 
 __all__ = ["UsageError", "OptionsError", "SpecError", "CampaignLockedError", "GainTableError",
            "ResultFileError", "PremiseError", "SynthesisError", "SimulationDivergedError",
-           "QPSetupError", "ControllerLibraryError", "TrialFailed"]
+           "QPSetupError", "ControllerLibraryError", "TrialFailed", "CaseDataError"]
 
 
 class UsageError(ValueError):
@@ -80,3 +80,8 @@ class ControllerLibraryError(RuntimeError):
 class TrialFailed(RuntimeError):
     """A tuning trial's design that could not be assessed (a diverged case, a synthesis error):
     the trial is recorded as failed with this message, and the search goes on."""
+
+
+class CaseDataError(RuntimeError):
+    """A controller's design asked for what only the simulator knows (the case's mean wind,
+    seed, turbulence or wind field)."""

@@ -1,18 +1,19 @@
 """One closed-loop run from a controller name: trim, build, wind, simulate (STYLE rule 12)."""
 from __future__ import annotations
 
+import dataclasses
 from typing import Any, Mapping, Sequence
 
 import lidar
 import linearize
-from mpc_wt.registry.context import DEFAULT_CACHE, BuildContext, Built, DesignCache
+from mpc_wt.registry.context import DEFAULT_CACHE, BuildContext, Built, DesignCache, design_digest
 from mpc_wt.registry.options import Options
 from mpc_wt.registry.registry import API_NAMING, Naming, Selection, resolve
 from mpc_wt.simulation.loop import simulate_closed_loop
 from mpc_wt.simulation.results import ClosedLoopResult
-from mpc_wt.simulation.scenario import Scenario, make_wind
+from mpc_wt.simulation.scenario import Scenario, lidar_field, make_wind
 
-__all__ = ["run_controller", "build_controller"]
+__all__ = ["run_controller", "build_controller", "design_controller"]
 
 
 def _operating_point(turbine: linearize.Turbine, sel: Selection, opts: Sequence[Options],
@@ -35,13 +36,65 @@ def _condition(raw: Mapping[str, Any] | None) -> dict[str, Any]:
     return dict(raw)
 
 
+def design_controller(turbine: linearize.Turbine, controller: str,
+                      options: Mapping[str, Any] | None = None, *,
+                      cache: DesignCache = DEFAULT_CACHE, naming: Naming = API_NAMING,
+                      params: linearize.PlantParams | None = None) -> tuple[Built, bool]:
+    """The design of a controller for a turbine: made once and kept in ``cache`` (keyed on the
+    turbine's content, the name and the options), so that every case after the first runs the
+    same design (``reset()`` between runs). The build sees the turbine, its options and the
+    harness's step only (:class:`~mpc_wt.registry.context.BuildContext`).
+
+    Parameters
+    ----------
+    turbine : Turbine
+        The turbine.
+    controller : str
+        A registered name, with a pattern or add-ons (``derate80+ibc``).
+    options : mapping, optional
+        Flat option name -> value, split over the base and its add-ons.
+    cache : DesignCache
+        Where designs are kept.
+    naming : Naming
+        How error messages name options.
+    params : PlantParams, optional
+        The turbine's plant parameters, if already derived.
+
+    Returns
+    -------
+    built : Built
+        The design; ``meta["design"]`` holds its digest
+        (:func:`~mpc_wt.registry.context.design_digest`).
+    new : bool
+        True when it was made now, False when it came from the cache.
+    """
+    sel = resolve(controller)
+    opts = sel.options(options, naming)
+    made: list[bool] = []
+
+    def make() -> Built:
+        made.append(True)
+        ctx = BuildContext(turbine=turbine, params=params or linearize.plant_params(turbine),
+                           cache=cache)
+        built = sel.base.build(ctx, opts[0])
+        for kind, o in zip(sel.addons, opts[1:]):
+            built = kind.build(ctx, o, built)
+        built.sensors = list(ctx.sensors)
+        built.meta["design"] = {"digest": design_digest(built.controller)}
+        return built
+
+    key = ("built", sel.name, tuple(repr(o) for o in opts))
+    return cache.get(turbine, key, make), bool(made)
+
+
 def build_controller(turbine: linearize.Turbine, controller: str, scenario: Scenario,
                      options: Mapping[str, Any] | None = None, *,
                      cache: DesignCache = DEFAULT_CACHE, naming: Naming = API_NAMING,
                      params: linearize.PlantParams | None = None,
                      samplers: lidar.SamplerCache | None = None
                      ) -> tuple[Built, linearize.OperatingPoint, Any]:
-    """Resolve, check, trim and build a controller for one scenario (no simulation).
+    """The controller's design (:func:`design_controller`, from the cache when it is there),
+    the scenario's trim point and wind, and the design's LIDARs bound to the wind they see.
 
     Parameters
     ----------
@@ -51,11 +104,11 @@ def build_controller(turbine: linearize.Turbine, controller: str, scenario: Scen
         A registered name (``mpc_wt.registry.kinds()``), with a pattern or add-ons
         (``derate80+ibc``).
     scenario : Scenario
-        The load case.
+        The load case: the simulator's, never the design's.
     options : mapping, optional
         Flat option name -> value, split over the base and its add-ons.
     cache : DesignCache
-        For designs that cost seconds.
+        For designs (kept between runs).
     naming : Naming
         How error messages name options (keys, or command-line flags).
     params : PlantParams, optional
@@ -66,7 +119,8 @@ def build_controller(turbine: linearize.Turbine, controller: str, scenario: Scen
     Returns
     -------
     built : Built
-        Controller, its period, LIDAR preview and design metadata.
+        Controller (reset), its period, LIDAR preview and design metadata
+        (``meta["design"]["new"]``: made for this run or reused).
     op : OperatingPoint
         The trim point the run starts from.
     wind : SteadyWind or GridWind
@@ -80,15 +134,18 @@ def build_controller(turbine: linearize.Turbine, controller: str, scenario: Scen
     sel = resolve(controller)
     opts = sel.options(options, naming)
     op = _operating_point(turbine, sel, opts, scenario)
+    built, new = design_controller(turbine, controller, options, cache=cache, naming=naming,
+                                   params=params)
     needs = set().union(*(k.field_components for k in (sel.base, *sel.addons)))
     wind, field = make_wind(turbine, scenario, "".join(c for c in "uvw" if c in needs),
                             samplers=samplers)
-    ctx = BuildContext(turbine=turbine, params=params or linearize.plant_params(turbine), op=op,
-                       scenario=scenario, field=field, cache=cache, samplers=samplers)
-    built = sel.base.build(ctx, opts[0])
-    for kind, o in zip(sel.addons, opts[1:]):
-        built = kind.build(ctx, o, built)
-    return built, op, wind
+    for sensor in built.sensors:
+        sensor.bind(lidar_field(turbine, scenario, field, sensor.distance, samplers))
+    built.controller.reset()
+    if built.preview is not None:
+        built.preview.reset()
+    meta = {**built.meta, "design": {**built.meta["design"], "new": new}}
+    return dataclasses.replace(built, meta=meta), op, wind
 
 
 def _scenario_of(scenario: Scenario | float, fields: dict[str, Any]) -> Scenario:

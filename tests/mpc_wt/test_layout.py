@@ -211,7 +211,7 @@ def test_the_private_name_checker_catches_both_forms(tmp_path: Path) -> None:
 LAYOUT = {
     "controllers": {"base", "baseline", "baseline_law", "mpc", "qp", "estimator", "lqr",
                     "ipc", "apc", "derating", "lidar_feedforward", "supervisor", "discon",
-                    "filters", "wind_estimator"},
+                    "filters", "wind_estimator", "scheduling"},
     "controllers/takagi_sugeno": {"model", "synthesis", "controller"},
     "registry": {"registry", "options", "builtin", "context"},
     "simulation": {"scenario", "loop", "compiled", "results", "preview", "solver_timing"},

@@ -2,16 +2,19 @@
 "LIDAR-assisted collective pitch control"; Schlipf 2015, dissertation, ch. 5).
 
 At each LIDAR sample the rotor-effective wind is estimated as the mean of the three beams'
-reconstructed speeds, low-pass filtered (first order, corner at the LIDAR-rotor coherence
-bandwidth: the wavenumber k_c where the coherence falls to 0.5, omega_c = k_c V; second order,
-damping 0.7, by default), and stored
-under the time it reaches the rotor, t + T_p (T_p = focus distance / mean wind). At control
+reconstructed speeds and low-pass filtered (second order, damping 0.7, by default; or first
+order) at the corner where the coherence between the LIDAR's and the rotor's effective wind
+falls to 0.5. That corner is designed from the turbulence model (the IEC Kaimal spectra and
+coherence, the LIDAR's geometry and range weighting, Simley and Pao's wind evolution;
+:func:`lidar.coherence_corner_model`) over mean wind, once per turbine and LIDAR, and read in
+operation at the LIDAR's own measured mean wind. The filtered estimate is stored under the time
+it reaches the rotor, t + T_p, with T_p = focus distance / the measured mean wind. At control
 time t the feedforward pitch is the static pitch curve theta_ss(v) of the trim at the filtered
 wind due at t + tau, tau = the actuator's time constant + the filter's delay (1.4 / omega_c for
-the second order, 1 / omega_c for the first), so the
-pitch arrives when the wind does. Its change enters the PI's integral at every step
-(:attr:`mpc_wt.controllers.baseline.BaselineController.pitch_feedforward`), so the feedback acts on what the
-feedforward leaves and the two never fight.
+the second order, 1 / omega_c for the first), so the pitch arrives when the wind does. Its
+change enters the PI's integral at every step
+(:attr:`mpc_wt.controllers.baseline.BaselineController.pitch_feedforward`), so the feedback acts
+on what the feedforward leaves and the two never fight.
 """
 from __future__ import annotations
 
@@ -25,7 +28,7 @@ import linearize
 from mpc_wt.controllers.base import ControllerBase
 
 __all__ = ["LidarFeedforward", "static_pitch_curve", "rews_coherence_corner",
-           "corner_within_preview"]
+           "corner_within_preview", "model_corner_table"]
 
 #: Low-frequency group delay of the low-pass times its corner, by order (second: damping 0.7).
 FILTER_DELAY = {1: 1.0, 2: 1.4}
@@ -57,65 +60,61 @@ def static_pitch_curve(turbine: linearize.Turbine, power_W: float | None = None
 class LidarFeedforward(ControllerBase):
     """The baseline PI with LIDAR collective pitch feedforward.
 
+    Everything it uses in operation is measured: the rotor-effective wind estimate (mean of the
+    three beams), and its own low-passed mean (``mean_time_constant``), which sets the preview
+    time T_p = D / V_m and, through the design's corner table, the filter's corner at that
+    wind. Nothing of the case is known to it.
+
     Parameters
     ----------
     base : BaselineController
         The feedback controller (derated or not).
-    lidar_model : lidar.CWLidar
-        The instrument (range weighting and line-of-sight error on by default).
-    field : lidar.WindField
-        The wind field the LIDAR measures: the plant's, evolved over the focus distance
-        (:meth:`mpc_wt.controllers.BuildContext.lidar_field`), or the plant's own under frozen
-        turbulence.
+    sensor : lidar.LidarSensor
+        The LIDAR (range weighting and line-of-sight error on by default); the simulator binds
+        the wind it measures.
     turbine : Turbine
         For the static pitch curve and the actuator lag.
-    mean_wind_mps : float
-        The preview time's mean wind [m/s].
-    corner_rad_s : float
-        The estimate's low-pass corner omega_c [rad/s].
+    corner : float or (winds, corners)
+        The estimate's low-pass corner omega_c [rad/s]: one value, or a table over mean wind
+        [m/s] -> [rad/s] (from the turbulence model, :func:`model_corner_table`), read at the
+        measured mean wind.
     lead_s : float, optional
-        tau [s]; default the actuator time constant + 1 / omega_c.
+        tau [s]; default the actuator time constant + the filter's delay, with the corner raised
+        where needed so that tau fits the preview time (:func:`corner_within_preview`).
     sample_dt : float
         LIDAR sample period [s] (default 0.1).
     filter_order : {1, 2}
         Second order with damping 0.7 (default; delay 1.4 / omega_c at low frequency, steeper
-        above the corner) or first order (delay 1 / omega_c). At 18 m/s, class A, seeds 1-4
-        the second order gives the same speed-std reduction (-38..-45 %) with 8-11 % less pitch
-        travel than the baseline, the first order +14..+27 % more.
+        above the corner) or first order (delay 1 / omega_c).
     power_W : float, optional
         A derated design's power for its pitch curve [W].
+    mean_time_constant : float
+        Low-pass of the measured mean wind [s] (default 30).
     """
 
-    def __init__(self, base: Any, lidar_model: Any, field: Any, turbine: linearize.Turbine, *,
-                 mean_wind_mps: float, corner_rad_s: float, lead_s: float | None = None,
-                 sample_dt: float = 0.1, filter_order: int = 2,
-                 power_W: float | None = None) -> None:
-        if not (math.isfinite(corner_rad_s) and corner_rad_s > 0):
-            raise ValueError(f"corner_rad_s must be > 0, got {corner_rad_s!r}")
-        if not (math.isfinite(mean_wind_mps) and mean_wind_mps > 0):
-            raise ValueError(f"mean_wind_mps must be > 0, got {mean_wind_mps!r}")
+    def __init__(self, base: Any, sensor: Any, turbine: linearize.Turbine, *,
+                 corner: Any, lead_s: float | None = None, sample_dt: float = 0.1,
+                 filter_order: int = 2, power_W: float | None = None,
+                 mean_time_constant: float = 30.0) -> None:
+        if isinstance(corner, (int, float)):
+            cw_, cc = np.array([0.0, 1.0]), np.array([float(corner)] * 2)
+        else:
+            cw_, cc = (np.asarray(a, dtype=float) for a in corner)
+        if cc.ndim != 1 or cc.shape != cw_.shape or cc.size < 1 or \
+                not np.all(np.isfinite(cc) & (cc > 0)):
+            raise ValueError(f"corner must be > 0 rad/s (or a table of them), got {corner!r}")
         if filter_order not in (1, 2):
             raise ValueError(f"filter_order must be 1 or 2, got {filter_order!r}")
-        self.base, self.lidar, self.field = base, lidar_model, field
+        if lead_s is not None and not (math.isfinite(lead_s) and lead_s >= 0):
+            raise ValueError(f"lead_s must be >= 0 s, got {lead_s!r}")
+        self.base, self.sensor = base, sensor
         self.dt = base.dt
-        self.corner = float(corner_rad_s)
+        self.corner_winds, self.corners = cw_, cc
         self.order = filter_order
-        delay = FILTER_DELAY[filter_order] / self.corner
-        self.lead = (turbine.pitch_actuator.time_constant + delay
-                     if lead_s is None else float(lead_s))
-        self.preview_time = lidar_model.preview_time(mean_wind_mps)
-        if self.lead > self.preview_time:
-            raise ValueError(f"lead time {self.lead:.3g} s exceeds the preview time "
-                             f"{self.preview_time:.3g} s (focus {lidar_model.focus_distance:g} m "
-                             f"at {mean_wind_mps:g} m/s): focus further upstream or raise "
-                             f"the filter corner")
+        self.tau_act = turbine.pitch_actuator.time_constant
+        self.lead_given = lead_s
         self.sample_dt = float(sample_dt)
-        w = self.corner
-        a = np.array([[0.0, 1.0], [-w * w, -1.4 * w]])
-        from scipy.linalg import expm
-        e = expm(np.block([[a, np.array([[0.0], [w * w]])], [np.zeros((1, 3))]])
-                 * self.sample_dt)
-        self._phi, self._gam = e[:2, :2], e[:2, 2]
+        self.mean_tau = float(mean_time_constant)
         self.curve_v, self.curve_pitch = static_pitch_curve(turbine, power_W)
         self.reset()
 
@@ -125,14 +124,47 @@ class LidarFeedforward(ControllerBase):
         self._arrival: list[float] = []
         self._v: list[float] = []
         self._vf: float | None = None
-        self._x = np.zeros(2)                 # second-order filter state (value, rate)
+        self._vm: float | None = None             # the measured mean wind
+        self._x = np.zeros(2)                     # second-order filter state (value, rate)
         self._next = -math.inf
+        self._w_disc = math.nan                   # the corner the filter is discretized at
+        self.corner = math.nan
+        self.lead = math.nan
+        self.preview_time = math.nan
+        self.raised = 0                           # samples with the corner raised
         self.signals: dict[str, float] = {}
 
+    def _set_corner(self, vm: float) -> None:
+        """Corner, lead and preview time at the measured mean wind ``vm``."""
+        self.preview_time = self.sensor.focus_distance / vm
+        w = float(np.interp(vm, self.corner_winds, self.corners))
+        if self.lead_given is None:
+            room = self.preview_time - self.tau_act - self.sample_dt
+            need = FILTER_DELAY[self.order] / room if room > 0 else math.inf
+            if w < need:
+                w = need if math.isfinite(need) else w
+                self.raised += 1
+            self.lead = self.tau_act + FILTER_DELAY[self.order] / w
+        else:
+            self.lead = self.lead_given
+        self.corner = w
+        if not abs(w - self._w_disc) <= 0.005 * w:       # the filter at the new corner
+            a = np.array([[0.0, 1.0], [-w * w, -1.4 * w]])
+            from scipy.linalg import expm
+            e = expm(np.block([[a, np.array([[0.0], [w * w]])], [np.zeros((1, 3))]])
+                     * self.sample_dt)
+            self._phi, self._gam = e[:2, :2], e[:2, 2]
+            self._w_disc = w
+
     def _sample(self, t: float, meas: dict[str, Any]) -> None:
-        m = self.lidar.measure(self.field, np.array([t]), np.array([float(meas["azimuth"])]),
-                               float(meas["rotor_speed"]))
+        m = self.sensor.measure(np.array([t]), np.array([float(meas["azimuth"])]),
+                                float(meas["rotor_speed"]))
         u = float(np.mean(m.u_hat[0]))
+        if self._vm is None:
+            self._vm = max(u, 0.5)
+        else:
+            self._vm += min(1.0, self.sample_dt / self.mean_tau) * (u - self._vm)
+        self._set_corner(max(self._vm, 0.5))
         if self._vf is None:
             self._vf = u
             self._x = np.array([u, 0.0])
@@ -142,8 +174,14 @@ class LidarFeedforward(ControllerBase):
         else:                                 # x'' = w^2 (u - x) - 2 zeta w x', exact ZOH
             self._x = self._phi @ self._x + self._gam * u
             self._vf = float(self._x[0])
-        self._arrival.append(t + self.preview_time)
+        arrival = t + self.preview_time
+        if self._arrival and arrival <= self._arrival[-1]:
+            arrival = self._arrival[-1] + 1e-6
+        self._arrival.append(arrival)
         self._v.append(self._vf)
+        if len(self._arrival) > 4096:               # keep what is still to arrive
+            keep = int(np.searchsorted(self._arrival, t - 1.0))
+            del self._arrival[:keep], self._v[:keep]
 
     def step(self, t: float, meas: dict[str, Any]) -> tuple[np.ndarray, float]:
         """Sample the LIDAR when due, set the feedforward pitch, step the PI.
@@ -169,8 +207,48 @@ class LidarFeedforward(ControllerBase):
         ff = float(np.interp(v, self.curve_v, self.curve_pitch))
         self.base.pitch_feedforward = ff
         out = self.base.step(t, meas)
-        self.signals = {**self.base.signals, "ff_wind": v, "ff_pitch": ff}
+        self.signals = {**self.base.signals, "ff_wind": v, "ff_pitch": ff,
+                        "ff_mean_wind": float(self._vm or math.nan),
+                        "ff_corner": self.corner}
         return out
+
+
+def model_corner_table(lidar_model: Any, turbine: linearize.Turbine, turbulence: str | float = "A",
+                       *, evolution: bool = True, step: float = 1.0
+                       ) -> tuple[np.ndarray, np.ndarray]:
+    """The feedforward filter's corner over mean wind from the turbulence model: where the
+    model coherence of the LIDAR's and the rotor's effective wind falls to 0.5
+    (:func:`lidar.coherence_corner_model`; Schlipf 2015, sec. 5.2), cut-in to cut-out.
+
+    Parameters
+    ----------
+    lidar_model : lidar.CWLidar
+        The instrument.
+    turbine : Turbine
+        Rotor radius, hub height, operating range.
+    turbulence : str or float
+        The design's IEC class ("A", "B", "C") or turbulence intensity.
+    evolution : bool
+        With wind evolution over the focus distance.
+    step : float
+        Grid spacing [m/s].
+
+    Returns
+    -------
+    winds : (n,) ndarray
+        [m/s]
+    corners : (n,) ndarray
+        omega_c [rad/s].
+    """
+    import lidar
+
+    op = turbine.operation
+    winds = np.arange(op.cut_in_wind, op.cut_out_wind + 1e-9, step)
+    corners = np.array([2.0 * math.pi * lidar.coherence_corner_model(
+        lidar_model, lidar.TurbulenceSpec(float(v), turbulence,
+                                          hub_height=turbine.geometry.hub_height),
+        turbine.geometry.tip_radius, evolution=evolution) for v in winds])
+    return winds, corners
 
 
 def rews_coherence_corner(lidar_model: Any, field: Any, turbine: linearize.Turbine,

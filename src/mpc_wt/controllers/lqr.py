@@ -38,7 +38,8 @@ from mpc_wt.controllers.estimator import read_signals
 from mpc_wt.errors import SynthesisError
 
 __all__ = ["LQRDesign", "PIObserver", "design_lqr", "design_lqr_family", "design_pi_observer",
-           "LQRPIOController", "SynthesisError", "REGION3_WEIGHTS", "REGION3_SCALES"]
+           "LQRPIOController", "ScheduledLQRPIO", "SynthesisError", "REGION3_WEIGHTS",
+           "REGION3_SCALES"]
 
 #: Region-III LQR weights that hold the loop stable with the PI observer (q = 1e3) on the
 #: nonlinear plant: rotor-speed regulation and tower fore-aft damping (``state_weights``).
@@ -434,6 +435,24 @@ class LQRPIOController(ControllerBase):
         self._w_filt: float | None = None
         self.signals: dict[str, float] = {}
 
+    def hand_over(self, other: "LQRPIOController") -> None:
+        """Continue from another design's observer estimate, last command and filtered speed
+        (gain scheduling), carried over in absolute units.
+
+        Parameters
+        ----------
+        other : LQRPIOController
+            The design being replaced (same model structure, another operating point).
+        """
+        offset = np.concatenate([other.model.x0 - self.model.x0,
+                                 (other.model.d0 - self.model.d0)[:other._nf]])
+        if offset.size != self.xe.size:
+            raise ValueError(f"hand_over needs the same model structure: {other.xe.size} "
+                             f"observer states against {self.xe.size}")
+        self.xe = other.xe + offset
+        self._u_dev = other._u_dev + other.model.u0 - self.model.u0
+        self._w_filt = other._w_filt
+
     def step(self, t: float, meas: dict[str, Any]) -> tuple[np.ndarray, float]:
         # One control step: observer update, then u = u0 - K (x_hat - x0) (+ feedforward).
         y = read_signals(meas, self.obs.measured) - self.obs.y0
@@ -468,3 +487,90 @@ class LQRPIOController(ControllerBase):
         a = self._a_law
         self._w_filt = w if self._w_filt is None else a * self._w_filt + (1 - a) * w
         return float(self.torque_law.torque(self._w_filt, float(np.mean(pitch))))
+
+
+class ScheduledLQRPIO(ControllerBase):
+    """LQR-PIO designs over a grid of mean winds, one acting at a time, chosen on a measured
+    mean wind (:class:`~mpc_wt.controllers.scheduling.WindSchedule`: the rotor-effective wind
+    estimated from rotor speed, pitch and generator torque, low-passed, with hysteresis).
+
+    Below the rated wind each design is Do et al.'s region II (the torque law, the LQR on the
+    pitch around fine pitch), above it region III (torque held at rated, the LQR with the
+    unknown-input feedforward). On a switch the observer's estimate, the last command and the
+    torque law's filtered speed are carried over in absolute units (bumpless): the new design
+    continues from where the old one left the turbine.
+
+    Parameters
+    ----------
+    controllers : sequence of LQRPIOController
+        One per grid wind, all at the same ``dt``.
+    winds : (n,) array
+        Their mean winds [m/s], increasing.
+    turbine : Turbine
+        For the wind estimator.
+    time_constant : float
+        Low-pass of the scheduling wind [s].
+    hysteresis : float
+        Beyond the midpoint between grid winds [m/s].
+    """
+
+    def __init__(self, controllers: Sequence[LQRPIOController], winds: Any,
+                 turbine: linearize.Turbine, *, time_constant: float = 30.0,
+                 hysteresis: float = 0.25) -> None:
+        from mpc_wt.controllers.scheduling import WindSchedule
+
+        self.controllers = list(controllers)
+        w = np.asarray(winds, dtype=float)
+        if len(self.controllers) != w.size or w.size == 0:
+            raise ValueError(f"need one controller per wind: {len(self.controllers)} "
+                             f"controllers, {w.size} winds")
+        dts = {c.dt for c in self.controllers}
+        if len(dts) != 1:
+            raise ValueError(f"every controller must run at one dt, got {sorted(dts)}")
+        self.dt = dts.pop()
+        self.winds = w
+        self.schedule = WindSchedule(w, turbine, self.dt, time_constant=time_constant,
+                                     hysteresis=hysteresis)
+        self.reset()
+
+    @property
+    def switches(self) -> int:
+        """Switches between designs since the last reset."""
+        return self.schedule.switches
+
+    def reset(self) -> None:
+        """Forget the wind and every design's state."""
+        self.schedule.reset()
+        for c in self.controllers:
+            c.reset()
+        self.active: int | None = None
+        self.signals: dict[str, float] = {}
+
+    def step(self, t: float, meas: dict[str, Any]) -> tuple[np.ndarray, float]:
+        """Update the schedule, hand over on a switch, step the acting design.
+
+        Parameters
+        ----------
+        t : float
+            [s]
+        meas : dict
+            The harness's measurements.
+
+        Returns
+        -------
+        pitch_ref : (3,) ndarray
+            [rad]
+        gen_torque_ref : float
+            [N m]
+        """
+        k, switched = self.schedule.update(meas)
+        ctl = self.controllers[k]
+        if switched and self.active is not None:
+            ctl.reset()
+            ctl.hand_over(self.controllers[self.active])
+        self.active = k
+        out = ctl.step(t, meas)
+        self.signals = dict(ctl.signals, schedule_wind=float(self.schedule.wind or math.nan),
+                            schedule_grid_wind=float(self.winds[k]),
+                            region=2.0 if ctl.region == "II" else 3.0)
+        return out

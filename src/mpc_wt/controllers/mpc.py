@@ -1126,64 +1126,49 @@ class MPC(ControllerBase):
 
 
 class ScheduledMPC(ControllerBase):
-    """MPC scheduled over a :class:`linearize.LinearModelFamily` by mean wind.
+    """MPC scheduled over a :class:`linearize.LinearModelFamily` on a measured mean wind.
 
     One :class:`MPC` per grid wind of the family, built on first use and kept, so that the QP
     matrices, the OSQP factorization and the DAQP workspace of an operating point are set up
-    once and reused whenever the schedule returns to it. Each step the active controller is
-    the one whose grid wind is nearest to a low-passed mean-wind signal (first-order filter with
-    ``time_constant``), with ``hysteresis`` [m/s] beyond the midpoint between grid winds against
-    chattering. On a switch the previous command and the estimator state are handed over in
-    absolute units.
-
-    The wind signal is the mean of the Kalman estimator's blade-wind estimates
-    (``wind_source="estimator"``, which turns on ``estimator="kalman"``) or the rotor mean of the
-    LIDAR preview's first step (``wind_source="preview"``).
+    once and reused whenever the schedule returns to it. Which one acts is decided by a
+    :class:`~mpc_wt.controllers.scheduling.WindSchedule`: the grid wind nearest a low-passed
+    wind that the controller measures -- the rotor-effective wind of
+    :class:`~mpc_wt.controllers.wind_estimator.WindSpeedEstimator` (rotor speed, pitch,
+    generator torque; ``wind_source="estimator"``) or the LIDAR's rotor-mean measurement
+    (``wind_source="preview"``) -- with hysteresis against chattering. The first step starts at
+    the grid wind nearest the first estimate. On a switch the previous command and the
+    estimator state are handed over in absolute units (bumpless).
 
     Parameters
     ----------
     family : LinearModelFamily
-        Models over mean wind (Madsen's configuration).
+        Models over mean wind (Madsen's configuration), e.g. cut-in to cut-out
+        (:func:`~mpc_wt.controllers.scheduling.envelope_winds`).
     turbine : Turbine
-        For the actuator limits.
+        For the actuator limits and the wind estimator.
     settings : MPCSettings, optional
-        Settings of every MPC (default: with the Kalman estimator when ``wind_source`` is
-        "estimator").
+        Settings of every MPC (default: with the Kalman estimator).
     wind_source : {"estimator", "preview"}
         The scheduling signal.
     time_constant : float
         Low-pass time constant of the scheduling wind [s].
     hysteresis : float
         Beyond the midpoint between grid winds [m/s].
-    initial_wind_mps : float, optional
-        Start wind [m/s] (default the family's middle).
     """
 
     def __init__(self, family: linearize.LinearModelFamily, turbine: linearize.Turbine,
                  settings: MPCSettings | None = None, *, wind_source: str = "estimator",
-                 time_constant: float = 30.0, hysteresis: float = 0.25,
-                 initial_wind_mps: float | None = None) -> None:
-        if wind_source not in ("estimator", "preview"):
-            raise ValueError(f"wind_source must be 'estimator' or 'preview', got {wind_source!r}")
-        check_number("time_constant", time_constant, lo=0.0)
-        check_number("hysteresis", hysteresis, lo=0.0)
-        st = settings or MPCSettings()
-        if wind_source == "estimator":
-            if settings is None:
-                st = st.replace(estimator="kalman")
-            if st.estimator is None:
-                raise ValueError("wind_source='estimator' needs estimator='kalman'")
+                 time_constant: float = 30.0, hysteresis: float = 0.25) -> None:
+        from mpc_wt.controllers.scheduling import WindSchedule
+
+        st = settings or MPCSettings(estimator="kalman")
         self.settings = st
         self.family, self.turbine = family, turbine
-        self.wind_source, self.tau, self.hyst = wind_source, float(time_constant), \
-            float(hysteresis)
+        self.wind_source = wind_source
+        self.schedule = WindSchedule(family.wind_mps, turbine, st.dt, source=wind_source,
+                                     time_constant=time_constant, hysteresis=hysteresis)
+        self.dt = st.dt
         self._ctl: dict[int, MPC] = {}
-        grid = family.wind_mps
-        w0 = float(grid[len(grid) // 2]) if initial_wind_mps is None else initial_wind_mps
-        if not (math.isfinite(w0) and grid[0] <= w0 <= grid[-1]):
-            raise ValueError(f"initial_wind_mps must lie in the family's range {grid[0]:g}.."
-                             f"{grid[-1]:g} m/s, got {initial_wind_mps!r}")
-        self._w_init = w0
         self.reset()
 
     def controller(self, k: int) -> MPC:
@@ -1203,42 +1188,44 @@ class ScheduledMPC(ControllerBase):
             self._ctl[k] = MPC(self.family.models[k], self.turbine, self.settings)
         return self._ctl[k]
 
+    @property
+    def switches(self) -> int:
+        """Switches between grid points since the last reset."""
+        return self.schedule.switches
+
     def reset(self) -> None:
-        """Back to the initial wind's controller; every controller reset."""
-        self._w = self._w_init
-        self.active = int(np.argmin(np.abs(self.family.wind_mps - self._w)))
+        """Forget the wind and every controller's state: the next step starts the schedule."""
+        self.schedule.reset()
+        self.active: int | None = None
         for c in self._ctl.values():
             c.reset()
-        self.switches = 0
         self.signals: dict[str, float] = {}
 
-    def _switch(self, k: int) -> None:
-        old, new = self.controller(self.active), self.controller(k)
-        new.reset()
-        new.hand_over(old)
-        self.active = k
-        self.switches += 1
-
     def step(self, t: float, meas: dict[str, Any]) -> tuple[np.ndarray, float]:
-        # Update the scheduling wind, switch controllers past the hysteresis, step the active one.
-        ctl = self.controller(self.active)
-        if self.wind_source == "preview" and meas.get("preview") is not None:
-            wsig: float | None = float(np.mean(np.asarray(meas["preview"].blade)[0]))
-        elif self.wind_source == "estimator" and "wind_est_1" in ctl.signals:
-            wsig = float(np.mean([ctl.signals[f"wind_est_{i}"] for i in (1, 2, 3)]))
-        else:
-            wsig = None
-        if wsig is not None:
-            a = 1.0 if self.tau == 0 else min(1.0, ctl.dt / self.tau)
-            self._w += a * (wsig - self._w)
-        grid = self.family.wind_mps
-        k = int(np.argmin(np.abs(grid - self._w)))
-        if k != self.active:
-            mid = 0.5 * (grid[k] + grid[self.active])
-            if abs(self._w - mid) > self.hyst:
-                self._switch(k)
-                ctl = self.controller(k)
+        """Update the schedule, switch (handing over) when it says so, step the active MPC.
+
+        Parameters
+        ----------
+        t : float
+            Time [s].
+        meas : dict
+            The harness's measurements.
+
+        Returns
+        -------
+        pitch_ref : (3,) ndarray
+            [rad]
+        gen_torque_ref : float
+            [N m]
+        """
+        k, switched = self.schedule.update(meas)
+        ctl = self.controller(k)
+        if switched and self.active is not None:
+            old = self.controller(self.active)
+            ctl.reset()
+            ctl.hand_over(old)
+        self.active = k
         u = ctl.step(t, meas)
-        self.signals = dict(ctl.signals, schedule_wind=self._w,
-                            schedule_grid_wind=float(grid[self.active]))
+        self.signals = dict(ctl.signals, schedule_wind=float(self.schedule.wind or math.nan),
+                            schedule_grid_wind=float(self.family.wind_mps[k]))
         return u

@@ -285,11 +285,18 @@ class MPCOptions(Options):
     formulation: str = option("condensed", help="QP formulation (sparse: OSQP only)",
                               choices=("condensed", "sparse"))
     horizon: int = option(15, help="H_p = H_u", lo=1)
-    estimator: Optional[str] = option(None, help="kalman: states and blade winds estimated "
-                                      "from measured signals; none: full-state information",
-                                      choices=(None, "kalman"))
-    scheduled: bool = option(False, help="scheduled over a model family above rated on the "
-                             "estimated wind (or the preview with mpc-lidar)", flag_value=True)
+    estimator: str = option("kalman", help="kalman: states and blade winds estimated from "
+                            "measured signals (rotor and generator speed, pitch, flap moments, "
+                            "tower-top acceleration); none: the plant's true states, an "
+                            "idealization no turbine has (labelled so in results)",
+                            choices=("kalman", "none"))
+    design_wind_mps: Optional[float] = option(None, help="one design at this mean wind "
+                                              "(Madsen's single-point design); default: "
+                                              "designs from cut-in to cut-out scheduled on the "
+                                              "measured wind", unit="m/s", lo=0.0,
+                                              lo_open=True)
+    schedule_step: float = option(1.0, help="spacing of the scheduled designs' grid",
+                                  unit="m/s", lo=0.1, hi=5.0, flag="")
     weights: MPCWeightOptions = option(MPCWeightOptions(), help="cost weights (gen_power, "
                                        "flap_moment, rotor_speed, ...)", flag="")
 
@@ -323,23 +330,21 @@ class LidarOptions(Options):
         -------
         dict
             Name -> value of the CWLidar options that are not None (``evolution`` is not one:
-            it acts on the field the LIDAR sees, :meth:`BuildContext.lidar_field`).
+            it acts on the field the LIDAR sees, :func:`mpc_wt.simulation.scenario.lidar_field`).
         """
         return {k: v for k, v in self.to_dict().items() if v is not None and k != "evolution"}
 
-    def lidar(self, ctx: BuildContext) -> tuple[Any, Any]:
-        """The CW LIDAR and the field it measures for a build.
+    def instrument(self, turbine: linearize.Turbine) -> Any:
+        """The CW LIDAR of these settings on the turbine's rotor.
 
         Parameters
         ----------
-        ctx : BuildContext
-            The build's turbine and wind.
+        turbine : Turbine
+            For the rotor radius.
 
         Returns
         -------
-        cw : lidar.CWLidar
-        field : lidar.WindField
-            The case's field, evolved over the focus distance unless ``evolution`` is off.
+        lidar.CWLidar
 
         Raises
         ------
@@ -349,10 +354,9 @@ class LidarOptions(Options):
         import lidar
 
         try:
-            cw = lidar.CWLidar(ctx.turbine.geometry.tip_radius, **self.given())
+            return lidar.CWLidar(turbine.geometry.tip_radius, **self.given())
         except (TypeError, ValueError) as err:
             raise ValueError(f"lidar options: {err}") from err
-        return cw, ctx.lidar_field(cw.focus_distance if self.evolution else 0.0)
 
 
 @dataclass(frozen=True)
@@ -367,51 +371,61 @@ def _mpc_settings(opts: MPCOptions, collective: bool) -> Any:
     from mpc_wt.controllers.mpc import MPCSettings
 
     return MPCSettings(horizon=opts.horizon, backend=opts.backend,
-                       formulation=opts.formulation, estimator=opts.estimator,
+                       formulation=opts.formulation,
+                       estimator=None if opts.estimator == "none" else opts.estimator,
                        collective=collective, weights=opts.weights.weights())
 
 
-def _scheduled(ctx: BuildContext, settings: Any, source: str) -> Any:
-    from mpc_wt.controllers.mpc import ScheduledMPC
+#: The result label of a design that reads the plant's true states.
+FULL_STATE = "full-state information (idealization)"
 
-    turbine, v = ctx.turbine, ctx.scenario.wind_mps
-    lo = float(np.floor(linearize.rated_wind_speed(turbine))) + 1.0
-    winds = np.arange(lo, min(25.0, turbine.operation.cut_out_wind) + 0.5, 1.0)
-    if not winds[0] <= v <= winds[-1]:
-        raise ValueError(f"scheduled MPC covers {winds[0]:g}..{winds[-1]:g} m/s; the wind "
-                         f"{v:g} m/s is outside")
-    fam = linearize.linearize_family(turbine, winds, config=linearize.PlantConfig.madsen())
-    return ScheduledMPC(fam, turbine, settings, wind_source=source, initial_wind_mps=v)
+
+def _envelope_family(ctx: BuildContext, config: str, step: float) -> Any:
+    """The turbine's linear models from cut-in to cut-out (kept in the design cache)."""
+    from mpc_wt.controllers.scheduling import envelope_winds
+
+    grid = envelope_winds(ctx.turbine, step)
+    conf = {"madsen": linearize.PlantConfig.madsen, "do": linearize.PlantConfig.do}[config]
+    return ctx.cache.get(ctx.turbine, ("family", config, tuple(grid)),
+                         lambda: linearize.linearize_family(ctx.turbine, grid, config=conf()))
+
+
+def _check_design_wind(turbine: linearize.Turbine, v: float) -> float:
+    op = turbine.operation
+    if not op.cut_in_wind <= v <= op.cut_out_wind:
+        raise ValueError(f"design_wind_mps = {v:g} m/s is outside the turbine's operating range "
+                         f"{op.cut_in_wind:g}..{op.cut_out_wind:g} m/s")
+    return float(v)
 
 
 def _mpc(collective: bool, with_lidar: bool) -> Any:
     def build(ctx: BuildContext, opts: MPCOptions) -> Built:
-        from mpc_wt.controllers.mpc import MPC
+        from mpc_wt.controllers.mpc import MPC, ScheduledMPC
 
         settings = _mpc_settings(opts, collective)
-        # the LIDAR's field first: its making is the run's peak of memory, lower before the
-        # MPC's design is held
-        lidar_opts = opts.lidar if with_lidar else None  # type: ignore[attr-defined]
-        instrument = lidar_opts.lidar(ctx) if lidar_opts is not None else None   # (cw, field)
-        if opts.scheduled:
-            if not with_lidar and settings.estimator is None:
-                settings = settings.replace(estimator="kalman")
-            ctl = _scheduled(ctx, settings, "preview" if with_lidar else "estimator")
-            cdt = ctl.controller(ctl.active).dt
+        if opts.design_wind_mps is None:
+            fam = _envelope_family(ctx, "madsen", opts.schedule_step)
+            ctl = ScheduledMPC(fam, ctx.turbine, settings,
+                               wind_source="preview" if with_lidar else "estimator")
+            grid = [float(fam.wind_mps[0]), float(fam.wind_mps[-1])]
         else:
-            model = linearize.linearize(ctx.turbine, ctx.scenario.wind_mps,
-                                        config=linearize.PlantConfig.madsen())
+            v = _check_design_wind(ctx.turbine, opts.design_wind_mps)
+            model = linearize.linearize(ctx.turbine, v, config=linearize.PlantConfig.madsen())
             ctl = MPC(model, ctx.turbine, settings)
-            cdt = ctl.dt
+            grid = [v, v]
+        cdt = ctl.dt
         meta: dict[str, Any] = {"mpc": {
             "horizon": settings.horizon, "backend": settings.resolved_backend, "dt": cdt,
-            "formulation": settings.formulation, "estimator": str(settings.estimator),
-            "scheduled": bool(opts.scheduled)}}
+            "formulation": settings.formulation, "estimator": opts.estimator,
+            "design_winds_mps": grid, "schedule_step_mps": opts.schedule_step,
+            **({"idealization": FULL_STATE} if opts.estimator == "none" else {})}}
         preview = None
-        if lidar_opts is not None and instrument is not None:
+        if with_lidar:
             from mpc_wt.simulation.preview import LidarPreview
 
-            preview = LidarPreview(*instrument, settings.horizon, cdt)
+            lidar_opts = opts.lidar  # type: ignore[attr-defined]
+            sensor = ctx.lidar(lidar_opts.instrument(ctx.turbine), lidar_opts.evolution)
+            preview = LidarPreview(sensor, settings.horizon, cdt)
             meta["lidar"] = {**lidar_opts.given(), "evolution": lidar_opts.evolution}
         return Built(ctl, cdt, preview, meta)
     return build
@@ -419,10 +433,11 @@ def _mpc(collective: bool, with_lidar: bool) -> Any:
 
 _MPC_GROUP = "the MPC controllers"
 register("mpc", MPCOptions, field_components="u", group=_MPC_GROUP,
-         summary="Madsen's Coleman-weighted individual-pitch MPC, disturbance held at the mean"
+         summary="Madsen's Coleman-weighted individual-pitch MPC, scheduled from cut-in to "
+                 "cut-out on the estimated wind, Kalman estimator"
          )(_mpc(False, False))
 register("mpc-collective", MPCOptions, field_components="u", group=_MPC_GROUP,
-         summary="the MPC with one collective pitch input")(_mpc(True, False))
+         summary="the scheduled MPC with one collective pitch input")(_mpc(True, False))
 register("mpc-lidar", MPCLidarOptions, field_components="u", group=_MPC_GROUP,
          summary="the individual-pitch MPC with a CW LIDAR's per-blade preview "
                  "(range weighting, LOS error and wind evolution on)")(_mpc(False, True))
@@ -468,6 +483,12 @@ class LQRPIOOptions(Options):
                                           unit="-", lo=0.0)
     w_pitch: float = option(1.0, help="LQR input weight on each blade's pitch (scale 1 deg)",
                             unit="-", lo=0.0, lo_open=True)
+    design_wind_mps: Optional[float] = option(None, help="one design at this mean wind (Do et "
+                                              "al.'s single point); default: designs from "
+                                              "cut-in to cut-out scheduled on the measured "
+                                              "wind", unit="m/s", lo=0.0, lo_open=True)
+    schedule_step: float = option(1.0, help="spacing of the scheduled designs' grid",
+                                  unit="m/s", lo=0.1, hi=5.0, flag="")
     region2_torque: str = option("baseline", help="region-II torque: the baseline's schedule "
                                  "(1.5/2/2.5 on filtered speed, as the PI it is compared with) "
                                  "or Do's bare K_opt Omega_g^2 on raw speed",
@@ -502,8 +523,33 @@ class LQRPIOOptions(Options):
 
 @register("lqr-pio", LQRPIOOptions, field_components="u", design=_design_lqr,
           design_name="lqr",
-          summary="Do et al.'s LQR with a PI observer at the mean wind (region II or III)")
+          summary="Do et al.'s LQR with a PI observer, scheduled from cut-in to cut-out on the "
+                  "estimated wind (region II below rated, III above)")
 def _build_lqr_pio(ctx: BuildContext, opts: LQRPIOOptions) -> Built:
+    from mpc_wt.controllers.lqr import ScheduledLQRPIO
+
+    turbine = ctx.turbine
+    if opts.design_wind_mps is not None:
+        v = _check_design_wind(turbine, opts.design_wind_mps)
+        ctl: Any = _lqr_pio_at(turbine, linearize.linearize(turbine, v,
+                                                            config=linearize.PlantConfig.do()),
+                               v, opts)
+        winds = [v]
+    else:
+        fam = _envelope_family(ctx, "do", opts.schedule_step)
+        winds = [float(w) for w in fam.wind_mps]
+        ctl = ScheduledLQRPIO([_lqr_pio_at(turbine, m, w, opts)
+                               for m, w in zip(fam.models, winds)], winds, turbine)
+    rated = linearize.rated_wind_speed(turbine)
+    return Built(ctl, meta={"lqr": {
+        "weights": {r: dict(zip(("state", "input"), opts.lqr_weights(r))) for r in ("II", "III")},
+        "observer_q": opts.observer_q, "design_winds_mps": [winds[0], winds[-1]],
+        "regions": "II below, III above " + f"{rated:.2f} m/s"}})
+
+
+def _lqr_pio_at(turbine: linearize.Turbine, model: linearize.LinearModel, wind: float,
+                opts: LQRPIOOptions) -> Any:
+    """Do et al.'s LQR-PIO at one grid wind: region II below the rated wind, III above."""
     from mpc_wt.controllers.baseline import BaselineController, tune_baseline
     from mpc_wt.controllers.lqr import (
         REGION2_SCALES,
@@ -513,20 +559,16 @@ def _build_lqr_pio(ctx: BuildContext, opts: LQRPIOOptions) -> Built:
         design_pi_observer,
     )
 
-    turbine, v = ctx.turbine, ctx.scenario.wind_mps
-    model = linearize.linearize(turbine, v, config=linearize.PlantConfig.do())
-    region = "II" if v < linearize.rated_wind_speed(turbine) else "III"
+    region = "II" if wind < linearize.rated_wind_speed(turbine) else "III"
     w, iw = opts.lqr_weights(region)
     lq = design_lqr(model, state_weights=w, input_weights=iw,
                     scales={**REGION2_SCALES, **REGION3_SCALES})
-    ctl = LQRPIOController(model, turbine, lq, design_pi_observer(model, q=opts.observer_q),
-                           region=region,
-                           k_opt=tune_baseline(turbine).k_opt if region == "II" else None,
-                           feedforward=region == "III",
-                           torque_law=BaselineController(turbine)
-                           if region == "II" and opts.region2_torque == "baseline" else None)
-    return Built(ctl, meta={"lqr": {"weights": lq.weights, "observer_q": opts.observer_q,
-                                    "region": region}})
+    return LQRPIOController(model, turbine, lq, design_pi_observer(model, q=opts.observer_q),
+                            region=region,
+                            k_opt=tune_baseline(turbine).k_opt if region == "II" else None,
+                            feedforward=region == "III",
+                            torque_law=BaselineController(turbine)
+                            if region == "II" and opts.region2_torque == "baseline" else None)
 
 
 # -- Takagi-Sugeno ------------------------------------------------------------------------------
@@ -720,11 +762,15 @@ class LidarFFOptions(Options):
     lidar: LidarOptions = option(LidarOptions(), help="CW LIDAR settings (focus_distance, "
                                  "range_weighting, los_error, ...)", flag="")
     filter_corner_hz: Optional[float] = option(None, help="low-pass corner of the wind estimate "
-                                               "(default: where the coherence of the LIDAR's "
-                                               "and the rotor's effective wind falls to 0.5 on "
-                                               "the run's field, raised if its delay would not "
-                                               "fit the preview)", unit="Hz",
-                                               lo=0.0, lo_open=True, flag="--ff-corner-hz")
+                                               "(default: where the model coherence of the "
+                                               "LIDAR's and the rotor's effective wind falls "
+                                               "to 0.5 at the measured mean wind, raised if "
+                                               "its delay would not fit the preview)",
+                                               unit="Hz", lo=0.0, lo_open=True,
+                                               flag="--ff-corner-hz")
+    design_turbulence: str = option("A", help="IEC turbulence class of the corner's design "
+                                    "(the turbine's class)", choices=("A", "B", "C"),
+                                    flag="--ff-design-class")
     lead_time: Optional[float] = option(None, help="lead of the pitch over the wind's arrival "
                                         "(default: actuator time constant + the filter's "
                                         "delay)", unit="s", lo=0.0, flag="--ff-lead-time")
@@ -737,38 +783,29 @@ class LidarFFOptions(Options):
           summary="collective pitch feedforward from the CW LIDAR on a baseline "
                   "(baseline+lidar-ff, derate80+lidar-ff)")
 def _build_lidar_ff(ctx: BuildContext, opts: LidarFFOptions, base: Built) -> Built:
-    from mpc_wt.controllers.lidar_feedforward import (
-        LidarFeedforward,
-        corner_within_preview,
-        rews_coherence_corner,
-    )
+    from mpc_wt.controllers.lidar_feedforward import LidarFeedforward, model_corner_table
 
-    cw, seen = opts.lidar.lidar(ctx)
-    v = ctx.scenario.wind_mps
-    coherence_corner, raised = None, False
+    cw = opts.lidar.instrument(ctx.turbine)
+    sensor = ctx.lidar(cw, opts.lidar.evolution)
     if opts.filter_corner_hz is None:
-        # keyed on the whole scenario: the estimate depends on the field's length too
-        key = (*sorted(opts.lidar.given().items()), ("evolution", opts.lidar.evolution))
-        corner = coherence_corner = ctx.cache.get(
-            ctx.turbine, ("lidar-ff-corner", ctx.scenario, key),
-            lambda: rews_coherence_corner(cw, ctx.field, ctx.turbine, v, seen=seen))
-        if opts.lead_time is None:
-            corner, raised = corner_within_preview(
-                corner, cw.preview_time(v), ctx.turbine.pitch_actuator.time_constant,
-                opts.filter_order)
+        key = (*sorted(opts.lidar.given().items()), ("evolution", opts.lidar.evolution),
+               ("class", opts.design_turbulence))
+        corner: Any = ctx.cache.get(ctx.turbine, ("lidar-ff-corner", key),
+                                    lambda: model_corner_table(cw, ctx.turbine,
+                                                               opts.design_turbulence,
+                                                               evolution=opts.lidar.evolution))
+        shown = {"corner_winds_mps": corner[0].tolist(),
+                 "corner_rad_s": corner[1].tolist(), "corner_design": "turbulence model"}
     else:
         corner = 2.0 * math.pi * opts.filter_corner_hz
+        shown = {"corner_rad_s": corner, "corner_design": "given"}
     frac = base.power_fraction
-    ctl = LidarFeedforward(base.controller, cw, seen, ctx.turbine, mean_wind_mps=v,
-                           corner_rad_s=corner, lead_s=opts.lead_time,
-                           filter_order=opts.filter_order,
+    ctl = LidarFeedforward(base.controller, sensor, ctx.turbine, corner=corner,
+                           lead_s=opts.lead_time, filter_order=opts.filter_order,
                            power_W=None if frac == 1.0
                            else frac * ctx.turbine.operation.rated_power)
-    meta = {"corner_rad_s": corner, "corner_raised": raised,
-            **({} if coherence_corner is None else {"coherence_corner_rad_s": coherence_corner}),
-            "lead_s": ctl.lead, "preview_time_s": ctl.preview_time,
-            "filter_order": opts.filter_order,
+    meta = {**shown, "lead_s": opts.lead_time, "filter_order": opts.filter_order,
+            "design_turbulence": opts.design_turbulence,
             "focus_distance_m": cw.focus_distance, "evolution": opts.lidar.evolution}
     return Built(ctl, base.controller_dt, base.preview, {**base.meta, "lidar_ff": meta},
                  base.power_fraction)
-

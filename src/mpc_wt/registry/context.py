@@ -13,9 +13,9 @@ import numpy as np
 
 import lidar
 import linearize
-from mpc_wt.simulation.scenario import Scenario, field_spec
 
-__all__ = ["turbine_key", "DesignCache", "DEFAULT_CACHE", "BuildContext", "Built"]
+__all__ = ["turbine_key", "design_digest", "DesignCache", "DEFAULT_CACHE", "BuildContext",
+           "Built"]
 
 
 def turbine_key(turbine: linearize.Turbine) -> str:
@@ -61,6 +61,79 @@ def _feed(h: Any, obj: Any) -> None:
         h.update(repr(obj).encode())
 
 
+#: Types a design digest does not walk into: solver handles and compiled functions hold
+#: addresses and caches, not design data (their data are the QP's arrays, walked beside them).
+_OPAQUE = ("ctypes", "numba", "osqp", "daqp", "scipy.interpolate", "logging", "threading",
+           "_thread", "concurrent", "multiprocessing")
+
+
+def design_digest(obj: Any) -> str:
+    """A digest of a built controller's design: every array, number, string and option it holds
+    (walked through dataclasses, containers and object attributes; solver handles, compiled
+    functions and modules are not design data and are skipped).
+
+    Two builds give equal digests when they hold the same gains, models and QP data; a design
+    that read the case (its mean wind, its field) differs from case to case.
+
+    Parameters
+    ----------
+    obj : object
+        A controller (or any design object).
+
+    Returns
+    -------
+    str
+        SHA-256 hex digest.
+    """
+    h = hashlib.sha256()
+    seen: set[int] = set()
+
+    def walk(o: Any, depth: int) -> None:
+        if depth > 40:
+            return
+        if o is None or isinstance(o, (bool, int, str, bytes)):
+            h.update(repr(o).encode())
+        elif isinstance(o, float):
+            h.update(b"nan" if math.isnan(o) else repr(o).encode())
+        elif isinstance(o, np.ndarray):
+            if o.dtype.kind in "fciub":
+                h.update(str(o.shape).encode())
+                h.update(np.ascontiguousarray(o).tobytes())
+        elif isinstance(o, np.generic):
+            h.update(repr(o.item()).encode())
+        elif isinstance(o, (list, tuple)):
+            h.update(f"[{len(o)}".encode())
+            for v in o:
+                walk(v, depth + 1)
+        elif isinstance(o, dict):
+            for k in sorted(o, key=str):
+                h.update(str(k).encode())
+                walk(o[k], depth + 1)
+        elif callable(o) and not hasattr(o, "__dict__") or isinstance(o, type):
+            return
+        else:
+            mod = type(o).__module__ or ""
+            if mod.startswith(_OPAQUE) or id(o) in seen:
+                return
+            seen.add(id(o))
+            h.update(type(o).__name__.encode())
+            if dataclasses.is_dataclass(o):
+                items = {f.name: getattr(o, f.name) for f in dataclasses.fields(o)}
+            else:
+                items = dict(getattr(o, "__dict__", {}))
+                for name in getattr(type(o), "__slots__", ()):
+                    if hasattr(o, name):
+                        items[name] = getattr(o, name)
+            for k in sorted(items):
+                if k.startswith("__") or callable(items[k]) and not hasattr(items[k], "__dict__"):
+                    continue
+                h.update(k.encode())
+                walk(items[k], depth + 1)
+
+    walk(obj, 0)
+    return h.hexdigest()
+
+
 class DesignCache:
     """Designs kept per process, keyed on the turbine's content and the design's settings
     (a campaign worker designs a TS controller once, not once per case).
@@ -76,6 +149,8 @@ class DesignCache:
         self._items: dict[tuple[Any, ...], Any] = {}
         self._lock = threading.Lock()
         self.hits = 0
+        #: designs made (misses), by the key's first element ("built", "ts", ...)
+        self.made: dict[str, int] = {}
 
     def get(self, turbine: linearize.Turbine, key: tuple[Any, ...],
             make: Callable[[], Any]) -> Any:
@@ -102,6 +177,8 @@ class DesignCache:
                 return self._items[full]
         value = make()
         with self._lock:
+            name = str(key[0]) if key else ""
+            self.made[name] = self.made.get(name, 0) + 1
             self._items[full] = value
             while len(self._items) > self.max_items:
                 self._items.pop(next(iter(self._items)))
@@ -117,13 +194,27 @@ class DesignCache:
 DEFAULT_CACHE = DesignCache()
 
 
-#: Second word of the seed of the wind-evolution field (ASCII "evol"): a stream of its own.
-_EVOLUTION_STREAM = 0x65766F6C
+#: What a design may not read, and why (the message of :class:`~mpc_wt.errors.CaseDataError`).
+_CASE_DATA = ("a controller's design depends on the turbine, its options and the controller's "
+              "sample time only: the case's mean wind, seed, turbulence and wind field are the "
+              "simulator's, and a real controller knows none of them. Start from the first "
+              "measurement in step() (as ROSCO starts its integrator from the measured pitch), "
+              "schedule on a wind estimated from measurements "
+              "(mpc_wt.controllers.wind_estimator.WindSpeedEstimator), and take a LIDAR's wind "
+              "from ctx.lidar(...)")
 
 
 @dataclass(frozen=True)
 class BuildContext:
-    """Everything a kind's ``build`` may use.
+    """Everything a kind's ``build`` may use: the turbine and the harness's step, nothing of
+    the case.
+
+    A design made from it is the same whatever case it then runs (the registry keeps it in
+    :attr:`cache` and runs every case of a campaign worker with it, ``reset()`` between
+    them); reading :attr:`scenario`, :attr:`field` or :attr:`op` raises
+    :class:`~mpc_wt.errors.CaseDataError`. A LIDAR is declared with :meth:`lidar`: the
+    instrument is the design's, the wind it measures is bound by the simulator before each
+    run.
 
     Parameters
     ----------
@@ -131,65 +222,76 @@ class BuildContext:
         The turbine.
     params : PlantParams
         Its plant parameters.
-    op : OperatingPoint
-        The trim point the run starts from.
-    scenario : Scenario
-        The load case.
-    field : lidar.WindField
-        The wind field of the case (for a LIDAR in the loop).
+    dt : float
+        The plant's (and the fastest controller's) step [s].
     cache : DesignCache
         For designs that cost seconds.
-    samplers : lidar.SamplerCache, optional
-        Keeps the turbulence generator's sampler between the fields of a run and, if the
-        caller keeps it, of the next runs.
     """
 
     turbine: linearize.Turbine
     params: linearize.PlantParams
-    op: linearize.OperatingPoint
-    scenario: Scenario
-    field: Any
+    dt: float = 1.0 / 80.0
     cache: DesignCache = DEFAULT_CACHE
-    samplers: lidar.SamplerCache | None = None
+    sensors: list[Any] = field(default_factory=list, compare=False, repr=False)
 
-    def lidar_field(self, distance: float) -> Any:
-        """The field a LIDAR focused ``distance`` upstream measures: the case's field evolved
-        over that distance with Simley and Pao's coherence (:func:`lidar.evolve_field`; its
-        independent part seeded from the case's seed, so every kind sees the same wind).
-
-        A turbulent case's evolved field is made from the case's spec and seed
-        (:func:`lidar.generate_evolved_field`), not from ``field``: so the case's field needs
-        only the plant's u (``field_components="u"``), and the two are never held side by side
-        with the case's v and w (a 600 s mpc-lidar run peaks some 300 MB lower). With frozen
-        turbulence (distance 0) a u-only case field is made whole again from its seed.
+    def lidar(self, instrument: Any, evolution: bool = True) -> Any:
+        """Declare a LIDAR of the design: the simulator binds the wind it measures before each
+        run (the case's field, evolved over the focus distance unless ``evolution`` is off).
 
         Parameters
         ----------
-        distance : float
-            [m], >= 0; 0 (or a steady case) gives the field itself: frozen turbulence.
+        instrument : lidar.CWLidar
+            The instrument.
+        evolution : bool
+            Wind evolution between the focus and the rotor (False: frozen turbulence).
 
         Returns
         -------
-        lidar.WindField
+        lidar.LidarSensor
+            Unbound; give it to the controller or the preview.
         """
-        if self.scenario.deterministic:
-            return self.field
-        spec = field_spec(self.turbine, self.scenario)
-        if distance == 0.0:
-            if set(self.field.meta.get("components", "uvw")) >= set("uvw"):
-                return self.field
-            # the case's field was made with u only (the plant's): the whole field, whose u
-            # is the same
-            return dataclasses.replace(lidar.generate_field(spec, self.scenario.seed,
-                                                            samplers=self.samplers),
-                                       meta=self.field.meta | {"components": "uvw"})
-        # made without the case's field: it is generate_evolved_field(spec, seed, ...), the
-        # evolution of generate_field(spec, seed) to single-precision rounding
-        seed = np.random.default_rng([self.scenario.seed, _EVOLUTION_STREAM])
-        seen = lidar.generate_evolved_field(spec, self.scenario.seed, distance, seed,
-                                            samplers=self.samplers)
-        return dataclasses.replace(seen, meta={**self.field.meta, **seen.meta,
-                                               "components": "uvw"})
+        sensor = lidar.LidarSensor(instrument, evolution)
+        self.sensors.append(sensor)
+        return sensor
+
+    @property
+    def scenario(self) -> Any:
+        """Not available to a design.
+
+        Raises
+        ------
+        CaseDataError
+            Always.
+        """
+        from mpc_wt.errors import CaseDataError
+
+        raise CaseDataError(f"BuildContext.scenario: {_CASE_DATA}")
+
+    @property
+    def field(self) -> Any:
+        """Not available to a design.
+
+        Raises
+        ------
+        CaseDataError
+            Always.
+        """
+        from mpc_wt.errors import CaseDataError
+
+        raise CaseDataError(f"BuildContext.field: {_CASE_DATA}")
+
+    @property
+    def op(self) -> Any:
+        """Not available to a design (the trim point holds the case's mean wind).
+
+        Raises
+        ------
+        CaseDataError
+            Always.
+        """
+        from mpc_wt.errors import CaseDataError
+
+        raise CaseDataError(f"BuildContext.op: {_CASE_DATA}")
 
 
 @dataclass
@@ -208,6 +310,8 @@ class Built:
         Design data stored with the result.
     power_fraction : float
         The fraction of rated power the design targets (add-ons tune for it) [-].
+    sensors : list of lidar.LidarSensor
+        The LIDARs the design declared (:meth:`BuildContext.lidar`); the harness binds them.
     """
 
     controller: Any
@@ -215,3 +319,4 @@ class Built:
     preview: Any = None
     meta: dict[str, Any] = field(default_factory=dict)
     power_fraction: float = 1.0
+    sensors: list[Any] = field(default_factory=list)

@@ -16,7 +16,10 @@ import linearize
 from linearize.validate import check_finite_scalar, check_positive, check_range
 
 __all__ = ["Scenario", "check_turbulence", "check_condition", "is_deterministic", "field_grid",
-           "make_wind", "field_spec", "iec_site"]
+           "make_wind", "field_spec", "iec_site", "lidar_field"]
+
+#: Second word of the seed of the wind-evolution field (ASCII "evol"): a stream of its own.
+_EVOLUTION_STREAM = 0x65766F6C
 
 
 @dataclass(frozen=True)
@@ -284,7 +287,7 @@ def _grid_wind(f: lidar.WindField) -> tuple[linearize.GridWind, lidar.WindField]
     low wind (or a direction change beyond 90 deg) runs backwards: then the clipped copy. A
     field made for the plant alone (u only) then holds the clipped u itself instead of
     beside it (50 MB for a 600 s field on 32 x 32 points), with ``meta["u_clipped_at_zero"]``;
-    a LIDAR never measures it (:meth:`BuildContext.lidar_field` makes its own field)."""
+    a LIDAR never measures it (:func:`lidar_field` makes its own field)."""
     u = f.u
     if float(u.min()) < 0.0:
         u = np.maximum(f.u, np.float32(0.0))
@@ -326,3 +329,51 @@ def _iec_wind(scenario: Scenario, site: lidar.IECSite, width: float, n: int
                         t_start=scenario.event_at, duration=scenario.duration + 20.0,
                         dt=0.05, width=width, n=n, sign=scenario.sign)
     return _grid_wind(f)
+
+
+def lidar_field(turbine: linearize.Turbine, scenario: Scenario, field: lidar.WindField,
+                distance: float, samplers: lidar.SamplerCache | None = None) -> lidar.WindField:
+    """The field a LIDAR focused ``distance`` upstream measures in a case: the case's field
+    evolved over that distance with Simley and Pao's coherence (:func:`lidar.evolve_field`; its
+    independent part seeded from the case's seed, so every controller sees the same wind).
+
+    This is the simulator's side of a LIDAR in the loop (the wind it sees is physics, not
+    design): the harness binds it to each LIDAR a controller declared
+    (:class:`~mpc_wt.simulation.preview.LidarSensor`). A turbulent case's evolved field is
+    made from the case's spec and seed (:func:`lidar.generate_evolved_field`), not from
+    ``field``: so the case's field needs only the plant's u, and the two are never held side by
+    side with the case's v and w. With frozen turbulence (distance 0) a u-only case field is
+    made whole again from its seed.
+
+    Parameters
+    ----------
+    turbine : Turbine
+        For the field's grid.
+    scenario : Scenario
+        The case.
+    field : lidar.WindField
+        The case's field (:func:`make_wind`).
+    distance : float
+        [m], >= 0; 0 (or a deterministic case) gives the field itself: frozen turbulence.
+    samplers : lidar.SamplerCache, optional
+        Keeps the turbulence generator's sampler.
+
+    Returns
+    -------
+    lidar.WindField
+    """
+    if scenario.deterministic:
+        return field
+    spec = field_spec(turbine, scenario)
+    if distance == 0.0:
+        if set(field.meta.get("components", "uvw")) >= set("uvw"):
+            return field
+        # the case's field was made with u only (the plant's): the whole field, whose u is
+        # the same
+        return dataclasses.replace(lidar.generate_field(spec, scenario.seed, samplers=samplers),
+                                   meta=field.meta | {"components": "uvw"})
+    # made without the case's field: it is generate_evolved_field(spec, seed, ...), the
+    # evolution of generate_field(spec, seed) to single-precision rounding
+    seed = np.random.default_rng([scenario.seed, _EVOLUTION_STREAM])
+    seen = lidar.generate_evolved_field(spec, scenario.seed, distance, seed, samplers=samplers)
+    return dataclasses.replace(seen, meta={**field.meta, **seen.meta, "components": "uvw"})

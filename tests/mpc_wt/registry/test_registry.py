@@ -44,14 +44,18 @@ PLUGIN = textwrap.dedent('''
         extra_pitch_deg: float = option(0.0, help="pitch added to the trim pitch", unit="deg")
 
     class Hold:
-        def __init__(self, pitch, torque): self.pitch, self.torque = pitch, torque
-        def reset(self): pass
-        def step(self, t, meas): return np.full(3, self.pitch), self.torque
+        """Holds the first measured pitch (plus extra) and torque."""
+        def __init__(self, extra): self.extra = extra; self.reset()
+        def reset(self): self.cmd = None
+        def step(self, t, meas):
+            if self.cmd is None:
+                self.cmd = (np.asarray(meas["pitch"], float) + self.extra,
+                            float(meas["gen_torque"]))
+            return self.cmd[0].copy(), self.cmd[1]
 
-    @register("hold-trim", HoldOptions, summary="trim pitch and torque, held")
+    @register("hold-trim", HoldOptions, summary="first measured pitch and torque, held")
     def build(ctx, opts):
-        pitch = ctx.op.u[0] + np.radians(opts.extra_pitch_deg)
-        return Built(Hold(pitch, float(ctx.op.u[3])), controller_dt=0.1)
+        return Built(Hold(np.radians(opts.extra_pitch_deg)), controller_dt=0.1)
 ''')
 
 
@@ -59,7 +63,8 @@ def test_registry_lists_every_kind_with_its_options() -> None:
     rows = {r["name"]: r for r in controllers.describe()}
     assert list(rows)[:len(BUILTIN)] == BUILTIN
     assert {o["name"] for o in rows["mpc"]["options"]} == {
-        "backend", "formulation", "horizon", "estimator", "scheduled", "weights"}
+        "backend", "formulation", "horizon", "estimator", "design_wind_mps", "schedule_step",
+        "weights"}
     assert rows["ibc"]["addon_to"] == ["baseline", "derate"]
     assert rows["derate"]["pattern"].startswith("derateNN")
     horizon = next(o for o in rows["mpc"]["options"] if o["name"] == "horizon")
@@ -108,12 +113,13 @@ def test_options_error_carries_the_key() -> None:
 
 @settings(max_examples=40, deadline=None)
 @given(st.sampled_from([None, "osqp", "daqp"]), st.sampled_from(["condensed", "sparse"]),
-       st.integers(1, 60), st.sampled_from([None, "kalman"]), st.booleans())
-def test_options_round_trip(backend, formulation, horizon, estimator, scheduled) -> None:
+       st.integers(1, 60), st.sampled_from(["none", "kalman"]),
+       st.one_of(st.none(), st.floats(3.0, 25.0)))
+def test_options_round_trip(backend, formulation, horizon, estimator, design_wind) -> None:
     """Invariant: from_dict(to_dict(o)) == o, and every field keeps its type."""
     o = MPCOptions.from_dict({"backend": backend, "formulation": formulation,
                               "horizon": horizon, "estimator": estimator,
-                              "scheduled": scheduled})
+                              "design_wind_mps": design_wind})
     assert MPCOptions.from_dict(o.to_dict()) == o
     assert isinstance(o.horizon, int) and o.horizon == horizon
 
@@ -247,10 +253,10 @@ def test_design_weights_reach_the_designs() -> None:
     gains = {}
     for wp in (1.0, 10.0):
         b, _, _ = build_controller(t, "lqr-pio", sc, {"w_pitch": wp, "w_rotor_speed": 2.0})
-        lq = b.meta["lqr"]["weights"]
+        lq = b.meta["lqr"]["weights"]["III"]
         assert lq["state"] == {"rotor_speed": 2.0, "tower_fa_velocity": 1.0}
         assert lq["input"] == {f"pitch_ref_{i}": wp for i in (1, 2, 3)}
-        gains[wp] = np.linalg.norm(b.controller.lqr.K)
+        gains[wp] = np.linalg.norm(b.controller.controllers[-1].lqr.K)
     assert gains[10.0] < gains[1.0]
     with pytest.raises(OptionsError, match="weights.flap_moment must be >= 0"):
         resolve("mpc").options({"weights": {"flap_moment": -1}})
@@ -285,8 +291,7 @@ def test_lidar_field_is_made_from_the_seed_not_beside_the_case_field() -> None:
     field, whose u is the case's. A u-only field whose u runs backwards holds the plant's
     clipped u itself, not a second copy."""
     import lidar
-    from mpc_wt.registry.context import _EVOLUTION_STREAM, BuildContext
-    from mpc_wt.simulation.scenario import field_spec
+    from mpc_wt.simulation.scenario import _EVOLUTION_STREAM, field_spec, lidar_field
 
     tb = linearize.load_turbine()
     for name in ("mpc-lidar", "baseline+lidar-ff"):
@@ -297,12 +302,11 @@ def test_lidar_field_is_made_from_the_seed_not_beside_the_case_field() -> None:
     assert not field.v.any() and not field.w.any()
     whole = lidar.generate_field(field_spec(tb, sc), 4)
     assert np.array_equal(field.u, whole.u)
-    ctx = BuildContext(turbine=tb, params=None, op=None, scenario=sc, field=field)
-    seen = ctx.lidar_field(54.0)
+    seen = lidar_field(tb, sc, field, 54.0)
     ref = lidar.evolve_field(whole, 54.0, seed=np.random.default_rng([4, _EVOLUTION_STREAM]))
     for comp in "uvw":
         np.testing.assert_allclose(getattr(seen, comp), getattr(ref, comp), rtol=0, atol=2e-5)
-    frozen = ctx.lidar_field(0.0)
+    frozen = lidar_field(tb, sc, field, 0.0)
     assert np.array_equal(frozen.u, whole.u) and np.array_equal(frozen.w, whole.w)
     low = Scenario(4.0, 0.9, 1, 20.0, 0.2)           # 90 % intensity at 4 m/s: u < 0 somewhere
     wind, field = make_wind(tb, low, "u")

@@ -1,0 +1,145 @@
+"""Which design of a gain-scheduled controller acts: a grid of mean winds, a scheduling wind
+that the controller measures, and hysteresis against chattering.
+
+The scheduling wind is the rotor-effective wind of :class:`WindSpeedEstimator` (rotor speed,
+pitch and generator torque) or, for a controller with a LIDAR, the rotor mean of the LIDAR's
+own measurements; either one is low-passed (first order, ``time_constant``) so that the
+schedule follows the mean wind, not the gusts. At the first step the schedule starts at the
+grid wind nearest the first estimate: nothing of the case is known before it.
+"""
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+
+import linearize
+from linearize.validate import check_number
+from mpc_wt.controllers.wind_estimator import WindEstimatorSettings, WindSpeedEstimator
+
+__all__ = ["WindSchedule", "envelope_winds", "SCHEDULE_SOURCES"]
+
+#: Where a schedule's wind comes from.
+SCHEDULE_SOURCES = ("estimator", "preview")
+
+
+def envelope_winds(turbine: linearize.Turbine, step: float = 1.0) -> np.ndarray:
+    """The grid of a design over the whole operating envelope: cut-in to cut-out every
+    ``step``, with the rated wind speed added (where the regions meet).
+
+    Parameters
+    ----------
+    turbine : Turbine
+        Its operating range and rated wind.
+    step : float
+        Grid spacing [m/s], > 0.
+
+    Returns
+    -------
+    (n,) ndarray
+        Mean winds [m/s], increasing.
+    """
+    check_number("step", step, lo=0.0, lo_open=True, unit="m/s")
+    op = turbine.operation
+    grid = np.arange(op.cut_in_wind, op.cut_out_wind + 1e-9, step)
+    rated = linearize.rated_wind_speed(turbine)
+    if op.cut_in_wind < rated < op.cut_out_wind and np.min(np.abs(grid - rated)) > 0.05:
+        grid = np.sort(np.append(grid, round(rated, 2)))
+    return grid
+
+
+class WindSchedule:
+    """The active grid point of a wind-scheduled controller.
+
+    Parameters
+    ----------
+    grid : (n,) array
+        The designs' mean winds [m/s], increasing.
+    turbine : Turbine
+        For the wind estimator.
+    dt : float
+        The controller's step [s].
+    source : {"estimator", "preview"}
+        The scheduling wind: :class:`WindSpeedEstimator` on the measurements, or the LIDAR's
+        rotor-mean measurement (``meas["preview"].rotor[0]``; the estimator stands in while no
+        preview is given).
+    time_constant : float
+        Low-pass of the scheduling wind [s] (default 30).
+    hysteresis : float
+        Beyond the midpoint between grid winds before a switch [m/s] (default 0.25).
+    estimator : WindEstimatorSettings, optional
+        The wind estimator's tuning.
+    """
+
+    def __init__(self, grid: Any, turbine: linearize.Turbine, dt: float, *,
+                 source: str = "estimator", time_constant: float = 30.0,
+                 hysteresis: float = 0.25,
+                 estimator: WindEstimatorSettings | None = None) -> None:
+        g = np.asarray(grid, dtype=float)
+        if g.ndim != 1 or g.size < 1 or not np.all(np.isfinite(g)) or np.any(np.diff(g) <= 0):
+            raise ValueError(f"grid must be increasing finite mean winds [m/s], got {grid!r}")
+        if source not in SCHEDULE_SOURCES:
+            raise ValueError(f"source must be one of {SCHEDULE_SOURCES}, got {source!r}")
+        self.grid, self.source = g, source
+        self.dt = check_number("dt", dt, lo=0.0, lo_open=True, unit="s")
+        self.tau = check_number("time_constant", time_constant, lo=0.0, unit="s")
+        self.hyst = check_number("hysteresis", hysteresis, lo=0.0, unit="m/s")
+        self.estimator = WindSpeedEstimator(turbine, dt, estimator)
+        self.reset()
+
+    def reset(self) -> None:
+        """Forget the wind: the next :meth:`update` starts the schedule again."""
+        self.estimator.reset()
+        self.wind: float | None = None
+        self.active: int | None = None
+        self.switches = 0
+
+    def measured_wind(self, meas: dict[str, Any]) -> float:
+        """This step's scheduling wind before the low-pass [m/s].
+
+        Parameters
+        ----------
+        meas : dict
+            The harness's measurements.
+
+        Returns
+        -------
+        float
+        """
+        v = self.estimator.step_measurements(meas)
+        if self.source == "preview" and meas.get("preview") is not None:
+            return float(np.mean(np.asarray(meas["preview"].blade)[0]))
+        return v
+
+    def update(self, meas: dict[str, Any]) -> tuple[int, bool]:
+        """Take this step's measurements; the active grid index and whether it changed.
+
+        Parameters
+        ----------
+        meas : dict
+            The harness's measurements (``rotor_speed``, ``pitch``, ``gen_torque``; ``preview``
+            for the LIDAR source).
+
+        Returns
+        -------
+        k : int
+            The active grid index.
+        switched : bool
+            True when ``k`` differs from the last step's (never at the first step).
+        """
+        w = self.measured_wind(meas)
+        if not math.isfinite(w):
+            raise ValueError(f"scheduling wind is not finite ({w!r})")
+        if self.wind is None:
+            self.wind = w
+            self.active = int(np.argmin(np.abs(self.grid - w)))
+            return self.active, False
+        a = 1.0 if self.tau == 0 else min(1.0, self.dt / self.tau)
+        self.wind += a * (w - self.wind)
+        k, now = int(np.argmin(np.abs(self.grid - self.wind))), int(self.active or 0)
+        if k != now and abs(self.wind - 0.5 * (self.grid[k] + self.grid[now])) > self.hyst:
+            self.active = k
+            self.switches += 1
+            return k, True
+        return now, False
