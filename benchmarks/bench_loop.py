@@ -1,4 +1,4 @@
-"""Issue 23: closed loops at the plant's speed, the MPC step at the solver's, a run's memory.
+"""Closed loops at the plant's speed, the MPC step at the solver's, a run's memory.
 
 Measured side by side in one run, on one 600 s IEC class-A field at 18 m/s (seed 1, 32 x 32
 points, 20 Hz), all DOFs, one core:
@@ -9,11 +9,16 @@ points, 20 Hz), all DOFs, one core:
   Python loop, ``compiled=False``) and Madsen's MPC with the realistic LIDAR's per-blade
   preview (``mpc-lidar``: range weighting, LOS error, wind evolution; 10 Hz), each as a
   real-time factor and as a ratio to the plant alone;
-- the MPC-with-LIDAR loop's cost per controller step in its first and its last minute (a loop
+- the scheduled kinds, which know only measurements (``mpc``, ``mpc-lidar`` on the Kalman
+  estimator and the wind they estimate or the LIDAR measures; ``lqr-pio`` over its 24 designs),
+  and ``mpc-lidar`` as the paper designs it (one model at the case's 18 m/s, the plant's true
+  states: ``design_wind_mps: 18, estimator: full-state``, the like-for-like figure of earlier runs):
+  600 s wall time and the cost per controller step in the first and the last minute (a loop
   whose cost grows with elapsed time shows a ratio above 1);
-- the MPC's whole step (state and preview in, commands out), replayed on the recorded
-  measurements with each backend (DAQP, OSQP), median and p99, in this process and in a few
-  fresh ones, against DAQP's solve alone through its own Python interface;
+- the MPC's whole step (measurements and preview in, commands out), replayed on the recorded
+  measurements with each backend (DAQP, OSQP), median and p99, for the paper's design and the
+  scheduled one, in this process and (paper's design) in a few fresh ones, against DAQP's solve
+  alone through its own Python interface;
 - peak resident memory of ``mpcwt simulate`` for 600 s (baseline and mpc-lidar), every signal
   kept and written, each in its own process.
 
@@ -75,9 +80,17 @@ def _baseline(t: Any, wind: Any, op: Any, repeat: int, compiled: bool = True) ->
                                               x0=op.x, u0=op.u, compiled=compiled), repeat)
 
 
-def _mpc_lidar(t: Any) -> dict[str, Any]:
-    """One 600 s mpc-lidar loop with the controller's calls time-stamped and their inputs kept."""
-    built, op, wind = build_controller(t, "mpc-lidar", Scenario(18.0, "A", 1, DURATION))
+#: The paper's point design of the MPC (the former default): like for like with earlier runs.
+ORACLE = {"design_wind_mps": 18.0, "estimator": "full-state"}
+
+#: Loops timed per controller step: name -> (kind, options).
+LOOPS = {"mpc_lidar_oracle": ("mpc-lidar", ORACLE), "mpc_lidar": ("mpc-lidar", None),
+         "mpc": ("mpc", None), "lqr_pio": ("lqr-pio", None)}
+
+
+def _timed_loop(t: Any, kind: str, options: Any) -> dict[str, Any]:
+    """One 600 s loop with the controller's calls time-stamped and their measurements kept."""
+    built, op, wind = build_controller(t, kind, Scenario(18.0, "A", 1, DURATION), options)
     ctl = built.controller
     stamps: list[float] = []
     rec: list[tuple[float, dict[str, Any]]] = []
@@ -85,28 +98,31 @@ def _mpc_lidar(t: Any) -> dict[str, Any]:
 
     def step(tt: float, meas: dict[str, Any]) -> Any:
         stamps.append(time.perf_counter())
-        rec.append((tt, {"state": np.array(meas["state"]), "preview": meas.get("preview")}))
+        rec.append((tt, {k: (np.array(v) if isinstance(v, np.ndarray) else v)
+                         for k, v in meas.items()}))
         return step0(tt, meas)
     ctl.step = step
     t0 = time.perf_counter()
     simulate_closed_loop(linearize.plant_params(t), ctl, wind, DURATION, x0=op.x, u0=op.u,
                          controller_dt=built.controller_dt, preview=built.preview)
     wall = time.perf_counter() - t0
+    del ctl.step
     s = np.diff(np.array(stamps))
-    per_min = int(round(60.0 / built.controller_dt))
+    dt = built.controller_dt or 1.0 / 80.0
+    per_min = int(round(60.0 / dt))
     first, last = s[:per_min].mean(), s[-per_min:].mean()
-    return {"mpc_lidar_s": wall, "first_minute_us_per_step": first * 1e6,
+    return {"s": wall, "first_minute_us_per_step": first * 1e6,
             "last_minute_us_per_step": last * 1e6, "last_over_first": last / first,
-            "rec": rec, "dt": built.controller_dt}
+            "rec": rec}
 
 
-def _whole_step(t: Any, rec: list[tuple[float, dict[str, Any]]], backend: str
-                ) -> dict[str, float]:
-    """The MPC's step replayed on the recorded state and preview (its own warm starts). With
-    DAQP, also DAQP's solve alone through its own Python ``Model`` on a twin controller (the
-    reference the step is held against: the solver's cost)."""
-    built, _, _ = build_controller(t, "mpc-lidar", Scenario(18.0, "A", 1, 10.0),
-                                   {"backend": backend})
+def _whole_step(t: Any, rec: list[tuple[float, dict[str, Any]]], backend: str,
+                options: Any = None) -> dict[str, float]:
+    """The MPC's step replayed on the recorded measurements and preview (its own warm starts).
+    With DAQP and the paper's design, also DAQP's solve alone through its own Python ``Model``
+    on a twin controller (the reference the step is held against: the solver's cost)."""
+    opts = {**(ORACLE if options is None else options), "backend": backend}
+    built, _, _ = build_controller(t, "mpc-lidar", Scenario(18.0, "A", 1, 10.0), opts)
     c = built.controller
     c.reset()
     times = []
@@ -117,7 +133,7 @@ def _whole_step(t: Any, rec: list[tuple[float, dict[str, Any]]], backend: str
     us = np.array(times[10:]) * 1e6
     out = {"median_us": float(np.median(us)), "p99_us": float(np.percentile(us, 99)),
            "max_us": float(us.max())}
-    if backend == "daqp":
+    if backend == "daqp" and isinstance(c, MPC):
         twin = MPC(c.model, t, c.settings.replace(solver_options={"interface": "python"}))
         timer = _Timed(twin.qp_backend.model, "solve")
         twin.qp_backend.model = timer
@@ -178,13 +194,18 @@ def main() -> int:
     res.update(_plant(t, wind, op, args.repeat))
     res["baseline_s"] = _baseline(t, wind, op, args.repeat)
     res["baseline_python_s"] = _baseline(t, wind, op, args.repeat, compiled=False)
-    m = _mpc_lidar(t)
-    rec = m.pop("rec")
-    m.pop("dt")
-    res.update(m)
+    recs = {}
+    for name, (kind, opts) in LOOPS.items():
+        m = _timed_loop(t, kind, opts)
+        recs[name] = m.pop("rec")
+        res[name] = m
+        res[f"{name}_s"] = m["s"]
+    rec = recs["mpc_lidar_oracle"]
     res["whole_step"] = {b: _whole_step(t, rec, b) for b in ("daqp", "osqp")}
+    res["whole_step_scheduled"] = {b: _whole_step(t, recs["mpc_lidar"], b, {})
+                                   for b in ("daqp", "osqp")}
     res["whole_step_processes"] = _whole_step_processes(rec, args.step_processes)
-    for k in ("plant_compiled", "plant_stepper", "baseline", "baseline_python", "mpc_lidar"):
+    for k in ("plant_compiled", "plant_stepper", "baseline", "baseline_python", *LOOPS):
         res[f"{k}_realtime"] = DURATION / res[f"{k}_s"]
     res["baseline_over_plant"] = res["baseline_s"] / res["plant_compiled_s"]
     res["baseline_python_over_plant"] = res["baseline_python_s"] / res["plant_compiled_s"]
@@ -199,16 +220,24 @@ def main() -> int:
                      ("plant_stepper", "plant alone, PlantStepper from Python"),
                      ("baseline", "baseline closed loop (80 Hz), compiled"),
                      ("baseline_python", "the same, Python loop (compiled=False)"),
-                     ("mpc_lidar", "MPC + realistic LIDAR preview (10 Hz)")):
+                     ("mpc_lidar_oracle", "mpc-lidar, the paper's design (10 Hz)"),
+                     ("mpc_lidar", "mpc-lidar, scheduled on measurements"),
+                     ("mpc", "mpc, scheduled on measurements"),
+                     ("lqr_pio", "lqr-pio, scheduled (80 Hz)")):
         print(f"{label:42s} {res[k + '_s']:7.2f} s  {res[k + '_realtime']:6.1f}x real time")
     print(f"baseline / plant alone {res['baseline_over_plant']:.2f} (Python loop "
           f"{res['baseline_python_over_plant']:.2f}), "
           f"mpc-lidar / plant alone {res['mpc_lidar_over_plant']:.2f}")
-    print(f"mpc-lidar loop per controller step: first minute "
-          f"{res['first_minute_us_per_step']:.0f} us, last minute "
-          f"{res['last_minute_us_per_step']:.0f} us (ratio {res['last_over_first']:.2f})")
+    for k in LOOPS:
+        print(f"{k} loop per controller step: first minute "
+              f"{res[k]['first_minute_us_per_step']:.0f} us, last minute "
+              f"{res[k]['last_minute_us_per_step']:.0f} us (ratio "
+              f"{res[k]['last_over_first']:.2f})")
+    for b, w in res["whole_step_scheduled"].items():
+        print(f"scheduled MPC whole step (estimators, schedule, QP), {b:5s}: median "
+              f"{w['median_us']:6.1f} us, p99 {w['p99_us']:6.1f} us")
     for b, w in res["whole_step"].items():
-        print(f"MPC whole step with preview, {b:5s}: median {w['median_us']:6.1f} us, "
+        print(f"MPC whole step, paper's design, {b:5s}: median {w['median_us']:6.1f} us, "
               f"p99 {w['p99_us']:6.1f} us, max {w['max_us']:6.0f} us (this process)")
     ref = res["whole_step"]["daqp"]["daqp_model_solve_median_us"]
     print(f"  DAQP's solve alone through its Python Model: median {ref:.1f} us; whole step / "

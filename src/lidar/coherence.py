@@ -176,16 +176,21 @@ def coherence_corner_model(lidar_model: CWLidar, spec: TurbulenceSpec, rotor_rad
     """
     if not 0.0 < level < 1.0:
         raise ValueError(f"level must be in (0, 1), got {level!r}")
-    f = np.geomspace(1e-3, 2.0, 120)
-    g = rotor_coherence_model(lidar_model, spec, rotor_radius, f, evolution=evolution,
-                              evolution_parameters=evolution_parameters)
+    f = np.geomspace(1e-3, 2.0, 40)
+    kw = {"evolution": evolution, "evolution_parameters": evolution_parameters}
+    g = rotor_coherence_model(lidar_model, spec, rotor_radius, f, **kw)
     below = np.flatnonzero(g < level)
     if below.size == 0:
         return float(f[-1])
     k = int(below[0])
     if k == 0:
         return float(f[0])
-    # interpolate in log frequency
-    lf = np.log(f[k - 1]) + (g[k - 1] - level) / (g[k - 1] - g[k]) * (np.log(f[k]) -
-                                                                      np.log(f[k - 1]))
-    return float(np.exp(lf))
+    lo, hi = math.log(f[k - 1]), math.log(f[k])       # bisection in log frequency
+    for _ in range(12):
+        mid = 0.5 * (lo + hi)
+        if rotor_coherence_model(lidar_model, spec, rotor_radius, np.array([math.exp(mid)]),
+                                 **kw)[0] < level:
+            hi = mid
+        else:
+            lo = mid
+    return float(math.exp(0.5 * (lo + hi)))

@@ -11,7 +11,7 @@ from mpc_wt.registry.options import Options
 from mpc_wt.registry.registry import API_NAMING, Naming, Selection, resolve
 from mpc_wt.simulation.loop import simulate_closed_loop
 from mpc_wt.simulation.results import ClosedLoopResult
-from mpc_wt.simulation.scenario import Scenario, lidar_field, make_wind
+from mpc_wt.simulation.scenario import Scenario, lidar_field, make_wind, start_wind
 
 __all__ = ["run_controller", "build_controller", "design_controller"]
 
@@ -20,7 +20,7 @@ def _operating_point(turbine: linearize.Turbine, sel: Selection, opts: Sequence[
                      scenario: Scenario) -> linearize.OperatingPoint:
     if sel.base.operating_point is not None:
         return sel.base.operating_point(turbine, scenario, opts[0])
-    return linearize.trim(turbine, scenario.wind_mps)
+    return linearize.trim(turbine, start_wind(turbine, scenario))
 
 
 _CONDITION_KEYS = ("condition", "iec_class", "sign", "event_at")
@@ -233,6 +233,8 @@ def run_controller(turbine: linearize.Turbine, controller: str, scenario: Scenar
                                        naming=naming, params=params, samplers=samplers)
     meta = {"controller": controller, **scenario.meta(), "turbine": turbine.name,
             **built.meta}
+    if scenario.wind_file is not None:      # for the reader (no design sees it)
+        meta["start_wind_mps"] = start_wind(turbine, scenario)
     ctl = built.controller
     if supervisor is not None:
         from mpc_wt.controllers.supervisor import Supervisor

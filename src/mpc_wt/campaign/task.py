@@ -237,7 +237,8 @@ def run_case(case: dict[str, Any], root: str) -> dict[str, Any]:
                     err.partial.save(path.with_name(f"{case['case_id']}.partial.nc"))
                 raise
             res.meta["campaign_case"] = {"case_id": case["case_id"],
-                                         "case_hash": case["case_hash"]}
+                                         "case_hash": case["case_hash"],
+                                         "worker": base["worker"]}
             path.parent.mkdir(parents=True, exist_ok=True)
             res.save(path)
         cols = {n: res.channel(n) for n in res.channels()}

@@ -70,10 +70,17 @@ def _add_simulate(sub: Any) -> None:
     p.add_argument("--controller", default="baseline",
                    help=" | ".join(names).replace("%", "%%") + " (+ibc, +coleman-ipc on a "
                         "baseline); `mpcwt controllers` lists each with its options")
-    p.add_argument("--wind", type=float, required=True, help="mean hub-height wind [m/s]")
+    w = p.add_mutually_exclusive_group(required=True)
+    w.add_argument("--wind", type=float, help="mean hub-height wind of a generated field [m/s]")
+    w.add_argument("--wind-file", metavar="FILE",
+                   help="the wind from a file instead: TurbSim full-field .bts (or an mpc-wt "
+                        ".npz field); the plant starts from the trim at the rotor-disc mean "
+                        "of its first 5 s")
     p.add_argument("--turbulence", choices=("A", "B", "C", "steady"), default="A")
     p.add_argument("--seed", type=int, default=1)
-    p.add_argument("--duration", type=float, default=600.0, help="[s]")
+    p.add_argument("--duration", type=float, default=None,
+                   help="[s] (default 600; with --wind-file the file's length less 20 s, the "
+                        "time a LIDAR 54 m ahead needs at 2.7 m/s)")
     p.add_argument("--out", required=True, help="result file (netCDF, .nc)")
     p.add_argument("--option", action="append", metavar="NAME=VALUE",
                    help="any option of the controller kind (repeatable; YAML values)")
@@ -181,7 +188,26 @@ def scenario_of(args: argparse.Namespace, turbine: linearize.Turbine) -> Any:
     """
     from mpc_wt.simulation.scenario import Scenario, iec_site
 
+    from mpc_wt.simulation.scenario import read_wind_file
+
     cond = getattr(args, "condition", "ntm")
+    if getattr(args, "wind_file", None) is not None:
+        if cond != "ntm":
+            raise UsageError(f"--condition {cond}: a wind file is the case's wind; no IEC "
+                             f"condition applies to it")
+        try:
+            length = read_wind_file(args.wind_file).duration
+            duration = max(length - 20.0, 1.0) if args.duration is None else args.duration
+            sc = Scenario(wind_file=args.wind_file, duration=duration)
+        except (ValueError, lidar.FieldFileError) as err:
+            flag = "--duration" if str(err).startswith("duration") else "--wind-file"
+            raise UsageError(f"{flag}: {err}") from None
+        if duration > length:
+            raise UsageError(f"--duration: the wind file holds {length:g} s of wind; the run's "
+                             f"duration is {duration:g} s")
+        return sc
+    if args.duration is None:
+        args.duration = 600.0
     extra = {} if cond == "ntm" else {"condition": cond, "iec_class": args.iec_class,
                                        "sign": args.sign, "event_at": args.event_at}
     try:

@@ -11,7 +11,7 @@ from scipy import signal
 
 from linearize.validate import check_number
 
-__all__ = ["check_corner", "filter_sos", "SOSFilterBank"]
+__all__ = ["check_corner", "filter_sos", "SOSFilterBank", "MeanTracker"]
 
 
 def check_corner(name: str, freq_hz: float, fs: float) -> float:
@@ -162,3 +162,50 @@ class SOSFilterBank:
         """
         return signal.sosfreqz(self.sos, worN=np.atleast_1d(np.asarray(freq_hz, float)),
                                fs=fs)[1]
+
+
+class MeanTracker:
+    """The mean of a measured signal over about the last ``time_constant``: the average of
+    every sample while fewer than ``time_constant / dt`` have come (so the start is not one
+    sample's), then a first-order low-pass with that time constant.
+
+    Parameters
+    ----------
+    time_constant : float
+        [s], > 0.
+    dt : float
+        Sample period [s], > 0.
+    """
+
+    def __init__(self, time_constant: float, dt: float) -> None:
+        if not (math.isfinite(time_constant) and time_constant > 0):
+            raise ValueError(f"time_constant must be > 0 s, got {time_constant!r}")
+        if not (math.isfinite(dt) and dt > 0):
+            raise ValueError(f"dt must be > 0 s, got {dt!r}")
+        self.alpha = min(1.0, dt / time_constant)
+        self.reset()
+
+    def reset(self) -> None:
+        """Forget every sample."""
+        self.n = 0
+        self.value: float | None = None
+
+    def update(self, x: float) -> float:
+        """Take one sample; the mean.
+
+        Parameters
+        ----------
+        x : float
+            The sample.
+
+        Returns
+        -------
+        float
+            The mean so far.
+        """
+        self.n += 1
+        if self.value is None:
+            self.value = float(x)
+        else:
+            self.value += max(1.0 / self.n, self.alpha) * (float(x) - self.value)
+        return self.value

@@ -26,6 +26,7 @@ import numpy as np
 
 import linearize
 from mpc_wt.controllers.base import ControllerBase
+from mpc_wt.controllers.filters import MeanTracker
 
 __all__ = ["LidarFeedforward", "static_pitch_curve", "rews_coherence_corner",
            "corner_within_preview", "model_corner_table"]
@@ -61,7 +62,7 @@ class LidarFeedforward(ControllerBase):
     """The baseline PI with LIDAR collective pitch feedforward.
 
     Everything it uses in operation is measured: the rotor-effective wind estimate (mean of the
-    three beams), and its own low-passed mean (``mean_time_constant``), which sets the preview
+    three beams), and its own mean over about 10 minutes (``mean_time_constant``), which sets the preview
     time T_p = D / V_m and, through the design's corner table, the filter's corner at that
     wind. Nothing of the case is known to it.
 
@@ -89,13 +90,15 @@ class LidarFeedforward(ControllerBase):
     power_W : float, optional
         A derated design's power for its pitch curve [W].
     mean_time_constant : float
-        Low-pass of the measured mean wind [s] (default 30).
+        The measured mean wind's averaging time [s] (default 600: the mean wind that carries
+        the turbulence in Taylor's hypothesis;
+        :class:`~mpc_wt.controllers.filters.MeanTracker`).
     """
 
     def __init__(self, base: Any, sensor: Any, turbine: linearize.Turbine, *,
                  corner: Any, lead_s: float | None = None, sample_dt: float = 0.1,
                  filter_order: int = 2, power_W: float | None = None,
-                 mean_time_constant: float = 30.0) -> None:
+                 mean_time_constant: float = 600.0) -> None:
         if isinstance(corner, (int, float)):
             cw_, cc = np.array([0.0, 1.0]), np.array([float(corner)] * 2)
         else:
@@ -114,7 +117,7 @@ class LidarFeedforward(ControllerBase):
         self.tau_act = turbine.pitch_actuator.time_constant
         self.lead_given = lead_s
         self.sample_dt = float(sample_dt)
-        self.mean_tau = float(mean_time_constant)
+        self._mean = MeanTracker(mean_time_constant, self.sample_dt)
         self.curve_v, self.curve_pitch = static_pitch_curve(turbine, power_W)
         self.reset()
 
@@ -124,6 +127,7 @@ class LidarFeedforward(ControllerBase):
         self._arrival: list[float] = []
         self._v: list[float] = []
         self._vf: float | None = None
+        self._mean.reset()
         self._vm: float | None = None             # the measured mean wind
         self._x = np.zeros(2)                     # second-order filter state (value, rate)
         self._next = -math.inf
@@ -160,10 +164,7 @@ class LidarFeedforward(ControllerBase):
         m = self.sensor.measure(np.array([t]), np.array([float(meas["azimuth"])]),
                                 float(meas["rotor_speed"]))
         u = float(np.mean(m.u_hat[0]))
-        if self._vm is None:
-            self._vm = max(u, 0.5)
-        else:
-            self._vm += min(1.0, self.sample_dt / self.mean_tau) * (u - self._vm)
+        self._vm = self._mean.update(u)
         self._set_corner(max(self._vm, 0.5))
         if self._vf is None:
             self._vf = u

@@ -512,11 +512,13 @@ class ScheduledLQRPIO(ControllerBase):
         Low-pass of the scheduling wind [s].
     hysteresis : float
         Beyond the midpoint between grid winds [m/s].
+    wind_estimator : WindSpeedEstimator, optional
+        The scheduling wind's estimator at the controllers' ``dt`` (default: made here).
     """
 
     def __init__(self, controllers: Sequence[LQRPIOController], winds: Any,
                  turbine: linearize.Turbine, *, time_constant: float = 30.0,
-                 hysteresis: float = 0.25) -> None:
+                 hysteresis: float = 0.25, wind_estimator: Any = None) -> None:
         from mpc_wt.controllers.scheduling import WindSchedule
 
         self.controllers = list(controllers)
@@ -530,7 +532,7 @@ class ScheduledLQRPIO(ControllerBase):
         self.dt = dts.pop()
         self.winds = w
         self.schedule = WindSchedule(w, turbine, self.dt, time_constant=time_constant,
-                                     hysteresis=hysteresis)
+                                     hysteresis=hysteresis, estimator=wind_estimator)
         self.reset()
 
     @property

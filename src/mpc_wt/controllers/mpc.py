@@ -1154,19 +1154,25 @@ class ScheduledMPC(ControllerBase):
         Low-pass time constant of the scheduling wind [s].
     hysteresis : float
         Beyond the midpoint between grid winds [m/s].
+    wind_estimator : WindSpeedEstimator, optional
+        The scheduling wind's estimator at the MPC's ``dt`` (default: made here).
     """
 
     def __init__(self, family: linearize.LinearModelFamily, turbine: linearize.Turbine,
                  settings: MPCSettings | None = None, *, wind_source: str = "estimator",
-                 time_constant: float = 30.0, hysteresis: float = 0.25) -> None:
-        from mpc_wt.controllers.scheduling import WindSchedule
+                 time_constant: float = 30.0, hysteresis: float = 0.25,
+                 wind_estimator: Any = None) -> None:
+        from mpc_wt.controllers.scheduling import SCHEDULE_SOURCES, WindSchedule
 
+        if wind_source not in SCHEDULE_SOURCES:
+            raise ValueError(f"wind_source must be 'estimator' or 'preview', got {wind_source!r}")
         st = settings or MPCSettings(estimator="kalman")
         self.settings = st
         self.family, self.turbine = family, turbine
         self.wind_source = wind_source
         self.schedule = WindSchedule(family.wind_mps, turbine, st.dt, source=wind_source,
-                                     time_constant=time_constant, hysteresis=hysteresis)
+                                     time_constant=time_constant, hysteresis=hysteresis,
+                                     estimator=wind_estimator)
         self.dt = st.dt
         self._ctl: dict[int, MPC] = {}
         self.reset()

@@ -68,14 +68,14 @@ class WindSchedule:
         Low-pass of the scheduling wind [s] (default 30).
     hysteresis : float
         Beyond the midpoint between grid winds before a switch [m/s] (default 0.25).
-    estimator : WindEstimatorSettings, optional
-        The wind estimator's tuning.
+    estimator : WindSpeedEstimator or WindEstimatorSettings, optional
+        The wind estimator (at ``dt``), or its tuning.
     """
 
     def __init__(self, grid: Any, turbine: linearize.Turbine, dt: float, *,
                  source: str = "estimator", time_constant: float = 30.0,
                  hysteresis: float = 0.25,
-                 estimator: WindEstimatorSettings | None = None) -> None:
+                 estimator: WindSpeedEstimator | WindEstimatorSettings | None = None) -> None:
         g = np.asarray(grid, dtype=float)
         if g.ndim != 1 or g.size < 1 or not np.all(np.isfinite(g)) or np.any(np.diff(g) <= 0):
             raise ValueError(f"grid must be increasing finite mean winds [m/s], got {grid!r}")
@@ -85,7 +85,13 @@ class WindSchedule:
         self.dt = check_number("dt", dt, lo=0.0, lo_open=True, unit="s")
         self.tau = check_number("time_constant", time_constant, lo=0.0, unit="s")
         self.hyst = check_number("hysteresis", hysteresis, lo=0.0, unit="m/s")
-        self.estimator = WindSpeedEstimator(turbine, dt, estimator)
+        if isinstance(estimator, WindSpeedEstimator):
+            if abs(estimator.dt - self.dt) > 1e-12:
+                raise ValueError(f"the wind estimator runs at {estimator.dt:g} s, the schedule "
+                                 f"at {self.dt:g} s")
+            self.estimator = estimator
+        else:
+            self.estimator = WindSpeedEstimator(turbine, dt, estimator)
         self.reset()
 
     def reset(self) -> None:

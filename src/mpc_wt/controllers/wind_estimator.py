@@ -31,7 +31,7 @@ from scipy.optimize import brentq
 import linearize
 from linearize.validate import check_positive, check_range
 
-__all__ = ["WindEstimatorSettings", "WindSpeedEstimator"]
+__all__ = ["WindEstimatorSettings", "WindSpeedEstimator", "estimator_performance"]
 
 
 @dataclass(frozen=True)
@@ -63,6 +63,27 @@ class WindEstimatorSettings:
         check_range("shear_exponent", self.shear_exponent, -1.0, 1.0)
 
 
+def estimator_performance(turbine: linearize.Turbine, shear_exponent: float = 0.2) -> Any:
+    """The C_P table of :class:`WindSpeedEstimator` (tip-speed ratio 1-18, pitch -5 to 40 deg),
+    to make once and share between estimators of one turbine (it takes seconds).
+
+    Parameters
+    ----------
+    turbine : Turbine
+        The turbine.
+    shear_exponent : float
+        Power-law shear of the table [-].
+
+    Returns
+    -------
+    linearize.RotorPerformance
+        From :func:`linearize.rotor_performance`.
+    """
+    return linearize.rotor_performance(turbine, np.linspace(1.0, 18.0, 69),
+                                       np.linspace(-5.0, 40.0, 91),
+                                       shear_exponent=shear_exponent)
+
+
 class WindSpeedEstimator:
     """Extended Kalman filter for the rotor-effective wind speed (module docstring).
 
@@ -74,6 +95,9 @@ class WindSpeedEstimator:
         Step [s], > 0.
     settings : WindEstimatorSettings, optional
         Noise intensities and the table's shear.
+    performance : linearize.RotorPerformance, optional
+        The C_P table made beforehand (:func:`estimator_performance` with the settings'
+        shear); default: made now.
 
     Raises
     ------
@@ -82,7 +106,8 @@ class WindSpeedEstimator:
     """
 
     def __init__(self, turbine: linearize.Turbine, dt: float,
-                 settings: WindEstimatorSettings | None = None) -> None:
+                 settings: WindEstimatorSettings | None = None, *,
+                 performance: Any = None) -> None:
         self.dt = check_positive("dt", dt)
         self.settings = settings or WindEstimatorSettings()
         g = turbine.geometry
@@ -93,10 +118,9 @@ class WindSpeedEstimator:
         self.inertia = params.rotor_inertia + self.gear**2 * turbine.drivetrain.generator_inertia
         op = turbine.operation
         self.wind_range = (0.5 * op.cut_in_wind, 1.5 * op.cut_out_wind)
-        tsr = np.linspace(1.0, 18.0, 69)
-        pitch = np.linspace(-5.0, 40.0, 91)
-        table = linearize.rotor_performance(turbine, tsr, pitch,
-                                            shear_exponent=self.settings.shear_exponent)
+        table = (estimator_performance(turbine, self.settings.shear_exponent)
+                 if performance is None else performance)
+        tsr, pitch = np.asarray(table.tsr, float), np.asarray(table.pitch_deg, float)
         self._cp = RectBivariateSpline(tsr, np.radians(pitch), table.cp, kx=3, ky=3)
         self._tsr_range = (tsr[0], tsr[-1])
         s = self.settings

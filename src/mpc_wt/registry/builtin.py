@@ -17,7 +17,7 @@ import linearize
 from mpc_wt.registry.context import BuildContext, Built
 from mpc_wt.registry.options import REQUIRED, Options, option
 from mpc_wt.registry.registry import register
-from mpc_wt.simulation.scenario import Scenario
+from mpc_wt.simulation.scenario import Scenario, start_wind
 
 __all__ = ["BaselineOptions", "DerateOptions", "APCOptions", "IBCOptions", "ColemanIPCOptions",
            "MPCOptions", "MPCWeightOptions", "LidarOptions", "MPCLidarOptions", "LQRPIOOptions", "TSOptions",
@@ -131,10 +131,10 @@ def _derated_trim(turbine: linearize.Turbine, sc: Scenario, opts: DerateOptions
                   ) -> linearize.OperatingPoint:
     """Trim at the derated power; below it (low wind) at the turbine's own optimum."""
     try:
-        return linearize.trim(turbine, sc.wind_mps, opts.power_fraction
+        return linearize.trim(turbine, start_wind(turbine, sc), opts.power_fraction
                               * turbine.operation.rated_power)
     except linearize.TrimError:
-        return linearize.trim(turbine, sc.wind_mps)
+        return linearize.trim(turbine, start_wind(turbine, sc))
 
 
 def _derate_preset(mt: Any) -> dict[str, Any]:
@@ -287,9 +287,9 @@ class MPCOptions(Options):
     horizon: int = option(15, help="H_p = H_u", lo=1)
     estimator: str = option("kalman", help="kalman: states and blade winds estimated from "
                             "measured signals (rotor and generator speed, pitch, flap moments, "
-                            "tower-top acceleration); none: the plant's true states, an "
+                            "tower-top acceleration); full-state: the plant's true states, an "
                             "idealization no turbine has (labelled so in results)",
-                            choices=("kalman", "none"))
+                            choices=("kalman", "full-state"))
     design_wind_mps: Optional[float] = option(None, help="one design at this mean wind "
                                               "(Madsen's single-point design); default: "
                                               "designs from cut-in to cut-out scheduled on the "
@@ -372,7 +372,7 @@ def _mpc_settings(opts: MPCOptions, collective: bool) -> Any:
 
     return MPCSettings(horizon=opts.horizon, backend=opts.backend,
                        formulation=opts.formulation,
-                       estimator=None if opts.estimator == "none" else opts.estimator,
+                       estimator=None if opts.estimator == "full-state" else opts.estimator,
                        collective=collective, weights=opts.weights.weights())
 
 
@@ -388,6 +388,15 @@ def _envelope_family(ctx: BuildContext, config: str, step: float) -> Any:
     conf = {"madsen": linearize.PlantConfig.madsen, "do": linearize.PlantConfig.do}[config]
     return ctx.cache.get(ctx.turbine, ("family", config, tuple(grid)),
                          lambda: linearize.linearize_family(ctx.turbine, grid, config=conf()))
+
+
+def _wind_estimator(ctx: BuildContext, dt: float) -> Any:
+    """A wind estimator at ``dt`` on the turbine's C_P table (the table kept in the cache)."""
+    from mpc_wt.controllers.wind_estimator import WindSpeedEstimator, estimator_performance
+
+    table = ctx.cache.get(ctx.turbine, ("estimator-cp", 0.2),
+                          lambda: estimator_performance(ctx.turbine, 0.2))
+    return WindSpeedEstimator(ctx.turbine, dt, performance=table)
 
 
 def _check_design_wind(turbine: linearize.Turbine, v: float) -> float:
@@ -406,7 +415,8 @@ def _mpc(collective: bool, with_lidar: bool) -> Any:
         if opts.design_wind_mps is None:
             fam = _envelope_family(ctx, "madsen", opts.schedule_step)
             ctl = ScheduledMPC(fam, ctx.turbine, settings,
-                               wind_source="preview" if with_lidar else "estimator")
+                               wind_source="preview" if with_lidar else "estimator",
+                               wind_estimator=_wind_estimator(ctx, settings.dt))
             grid = [float(fam.wind_mps[0]), float(fam.wind_mps[-1])]
         else:
             v = _check_design_wind(ctx.turbine, opts.design_wind_mps)
@@ -418,7 +428,7 @@ def _mpc(collective: bool, with_lidar: bool) -> Any:
             "horizon": settings.horizon, "backend": settings.resolved_backend, "dt": cdt,
             "formulation": settings.formulation, "estimator": opts.estimator,
             "design_winds_mps": grid, "schedule_step_mps": opts.schedule_step,
-            **({"idealization": FULL_STATE} if opts.estimator == "none" else {})}}
+            **({"idealization": FULL_STATE} if opts.estimator == "full-state" else {})}}
         preview = None
         if with_lidar:
             from mpc_wt.simulation.preview import LidarPreview
@@ -526,6 +536,7 @@ class LQRPIOOptions(Options):
           summary="Do et al.'s LQR with a PI observer, scheduled from cut-in to cut-out on the "
                   "estimated wind (region II below rated, III above)")
 def _build_lqr_pio(ctx: BuildContext, opts: LQRPIOOptions) -> Built:
+    from mpc_wt.controllers.baseline import tune_baseline
     from mpc_wt.controllers.lqr import ScheduledLQRPIO
 
     turbine = ctx.turbine
@@ -533,13 +544,15 @@ def _build_lqr_pio(ctx: BuildContext, opts: LQRPIOOptions) -> Built:
         v = _check_design_wind(turbine, opts.design_wind_mps)
         ctl: Any = _lqr_pio_at(turbine, linearize.linearize(turbine, v,
                                                             config=linearize.PlantConfig.do()),
-                               v, opts)
+                               v, opts, tune_baseline(turbine))
         winds = [v]
     else:
         fam = _envelope_family(ctx, "do", opts.schedule_step)
         winds = [float(w) for w in fam.wind_mps]
-        ctl = ScheduledLQRPIO([_lqr_pio_at(turbine, m, w, opts)
-                               for m, w in zip(fam.models, winds)], winds, turbine)
+        base = tune_baseline(turbine)
+        ctl = ScheduledLQRPIO([_lqr_pio_at(turbine, m, w, opts, base)
+                               for m, w in zip(fam.models, winds)], winds, turbine,
+                              wind_estimator=_wind_estimator(ctx, 1.0 / 80.0))
     rated = linearize.rated_wind_speed(turbine)
     return Built(ctl, meta={"lqr": {
         "weights": {r: dict(zip(("state", "input"), opts.lqr_weights(r))) for r in ("II", "III")},
@@ -548,9 +561,10 @@ def _build_lqr_pio(ctx: BuildContext, opts: LQRPIOOptions) -> Built:
 
 
 def _lqr_pio_at(turbine: linearize.Turbine, model: linearize.LinearModel, wind: float,
-                opts: LQRPIOOptions) -> Any:
-    """Do et al.'s LQR-PIO at one grid wind: region II below the rated wind, III above."""
-    from mpc_wt.controllers.baseline import BaselineController, tune_baseline
+                opts: LQRPIOOptions, base: Any) -> Any:
+    """Do et al.'s LQR-PIO at one grid wind: region II below the rated wind, III above (the
+    baseline's gains ``base`` give region II's torque law)."""
+    from mpc_wt.controllers.baseline import BaselineController
     from mpc_wt.controllers.lqr import (
         REGION2_SCALES,
         REGION3_SCALES,
@@ -565,9 +579,9 @@ def _lqr_pio_at(turbine: linearize.Turbine, model: linearize.LinearModel, wind: 
                     scales={**REGION2_SCALES, **REGION3_SCALES})
     return LQRPIOController(model, turbine, lq, design_pi_observer(model, q=opts.observer_q),
                             region=region,
-                            k_opt=tune_baseline(turbine).k_opt if region == "II" else None,
+                            k_opt=base.k_opt if region == "II" else None,
                             feedforward=region == "III",
-                            torque_law=BaselineController(turbine)
+                            torque_law=BaselineController(turbine, base)
                             if region == "II" and opts.region2_torque == "baseline" else None)
 
 
@@ -634,11 +648,13 @@ def _apc_trim(turbine: linearize.Turbine, sc: Scenario, opts: APCOptions
     rated = turbine.operation.rated_power
     p_peak = rated * (1.0 - opts.apc_offset + opts.apc_amplitude)
     try:    # the reference peaks at P_r (1 - offset + amplitude): the mean wind must give it
-        linearize.trim(turbine, sc.wind_mps, min(p_peak, rated))
+        linearize.trim(turbine, start_wind(turbine, sc), min(p_peak, rated))
     except linearize.TrimError as err:
+        which = "mean" if sc.wind_file is None else "start"
         raise ValueError(f"apc: the power reference peaks at {p_peak:g} W, above the power "
-                         f"available at the mean wind {sc.wind_mps:g} m/s ({err})") from err
-    return linearize.trim(turbine, sc.wind_mps, rated * (1.0 - dp(0.0)))
+                         f"available at the {which} wind {start_wind(turbine, sc):g} m/s "
+                         f"({err})") from err
+    return linearize.trim(turbine, start_wind(turbine, sc), rated * (1.0 - dp(0.0)))
 
 
 @register("apc", APCOptions, field_components="u", operating_point=_apc_trim,
@@ -714,7 +730,7 @@ def _rosco_operating_point(turbine: linearize.Turbine, sc: Scenario, opts: Rosco
                            ) -> linearize.OperatingPoint:
     if opts.discon_in is None and opts.power_fraction < 1.0:
         return _derated_trim(turbine, sc, opts)     # type: ignore[arg-type]
-    return linearize.trim(turbine, sc.wind_mps)
+    return linearize.trim(turbine, start_wind(turbine, sc))
 
 
 @register("rosco", RoscoOptions, field_components="u", operating_point=_rosco_operating_point,

@@ -16,9 +16,10 @@ class LidarPreview:
     Only the last measurements are kept (a fixed-size ring), so a step costs the same at any
     time of a run.
 
-    The preview time is the LIDAR's own: T_p = D / V_m with V_m the low-passed mean of its
-    rotor-mean measurements (first order, ``mean_time_constant``), started at the first
-    measurement. Nothing of the case is known to it.
+    The preview time is the LIDAR's own: T_p = D / V_m with V_m the mean of its rotor-mean
+    measurements over about the last ``mean_time_constant`` (10 minutes, the mean wind that
+    carries the turbulence in Taylor's hypothesis; the average of all samples before that,
+    :class:`~mpc_wt.controllers.filters.MeanTracker`). Nothing of the case is known to it.
 
     Parameters
     ----------
@@ -29,28 +30,46 @@ class LidarPreview:
     dt : float
         Controller step [s] (default 0.1).
     mean_time_constant : float
-        Low-pass of the measured mean wind [s] (default 30).
+        Averaging time of the measured mean wind [s] (default 600).
     min_wind : float
         The lowest mean wind the preview time is kept for [m/s] (default 2).
+    preview_time : float, optional
+        A fixed T_p [s] instead of the measured one (a configured instrument; an idealization
+        when it is the simulator's D / V).
     """
 
     def __init__(self, sensor: Any, horizon: int = 15, dt: float = 0.1,
-                 mean_time_constant: float = 30.0, min_wind: float = 2.0) -> None:
+                 mean_time_constant: float = 600.0, min_wind: float = 2.0,
+                 preview_time: float | None = None) -> None:
         self.sensor = sensor
         self.horizon = int(horizon)
         self.dt = float(dt)
-        self.mean_tau, self.min_wind = float(mean_time_constant), float(min_wind)
+        from mpc_wt.controllers.filters import MeanTracker
+
+        self.min_wind = float(min_wind)
+        if preview_time is not None and not (np.isfinite(preview_time) and preview_time > 0):
+            raise ValueError(f"preview_time must be > 0 s, got {preview_time!r}")
+        self.fixed = None if preview_time is None else float(preview_time)
+        self.mean = MeanTracker(mean_time_constant, self.dt)
         self.reset()
 
     def reset(self) -> None:
         """Forget the measurement history and the mean wind."""
         #: the kept measurements (:class:`lidar.PreviewBuffer`), made at the first call
         self.buffer: Any = None
-        self.mean_wind: float | None = None
+        self.mean.reset()
+
+    @property
+    def mean_wind(self) -> float | None:
+        """The LIDAR's measured mean wind [m/s] (None before the first measurement)."""
+        return self.mean.value
 
     @property
     def preview_time(self) -> float:
-        """T_p at the measured mean wind [s] (nan before the first measurement)."""
+        """T_p at the measured mean wind [s] (nan before the first measurement), or the fixed
+        one."""
+        if self.fixed is not None:
+            return self.fixed
         if self.mean_wind is None:
             return float("nan")
         return self.sensor.focus_distance / max(self.mean_wind, self.min_wind)
@@ -60,14 +79,11 @@ class LidarPreview:
         import lidar
 
         m = self.sensor.measure(np.array([t]), np.array([azimuth_rad]), rotor_speed_rad_s)
-        u = float(np.mean(m.u_hat[0]))
-        if self.mean_wind is None:
-            self.mean_wind = u
+        u = self.mean.update(float(np.mean(m.u_hat[0])))
+        if self.buffer is None:
             d = self.sensor.focus_distance
-            self.buffer = lidar.PreviewBuffer(d / max(u, self.min_wind), self.dt,
-                                              max_preview_time=max(d / self.min_wind,
-                                                                   d / max(u, self.min_wind)))
-        else:
-            self.mean_wind += min(1.0, self.dt / self.mean_tau) * (u - self.mean_wind)
+            first = self.fixed or d / max(u, self.min_wind)
+            self.buffer = lidar.PreviewBuffer(first, self.dt, max_preview_time=max(
+                first, d / self.min_wind if self.fixed is None else first))
         self.buffer.push(t, m.u_hat[0])
         return self.buffer.preview(t, self.horizon, self.preview_time)

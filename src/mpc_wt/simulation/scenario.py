@@ -5,8 +5,10 @@ duration, shear, an IEC 61400-1 wind condition), its rules written once, and its
 from __future__ import annotations
 
 import dataclasses
+import functools
 import math
 from dataclasses import dataclass
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -16,7 +18,8 @@ import linearize
 from linearize.validate import check_finite_scalar, check_positive, check_range
 
 __all__ = ["Scenario", "check_turbulence", "check_condition", "is_deterministic", "field_grid",
-           "make_wind", "field_spec", "iec_site", "lidar_field"]
+           "make_wind", "field_spec", "iec_site", "lidar_field", "check_wind_file",
+           "read_wind_file", "start_wind", "START_WINDOW"]
 
 #: Second word of the seed of the wind-evolution field (ASCII "evol"): a stream of its own.
 _EVOLUTION_STREAM = 0x65766F6C
@@ -25,12 +28,12 @@ _EVOLUTION_STREAM = 0x65766F6C
 @dataclass(frozen=True)
 class Scenario:
     """One load case: mean wind, turbulence, seed, length and shear, and optionally an IEC
-    61400-1 wind condition (:func:`lidar.iec_field`).
+    61400-1 wind condition (:func:`lidar.iec_field`); or the user's own wind from a file.
 
     Parameters
     ----------
     wind_mps : float
-        Mean hub-height wind [m/s], > 0.
+        Mean hub-height wind [m/s], > 0 (None with ``wind_file``).
     turbulence : str or float
         IEC class "A", "B", "C", "steady", or a turbulence intensity in (0, 1) [-].
     seed : int
@@ -50,9 +53,19 @@ class Scenario:
         Direction of a direction change or a shear.
     event_at : float
         When a transient starts [s] (simulation time).
+    wind_file : str, optional
+        A wind field file instead of a generated one: TurbSim full-field binary (``.bts``) or
+        mpc-wt's own ``.npz`` (:meth:`lidar.WindField.load`). No mean wind is declared
+        (``wind_mps`` None); the plant starts from the trim at the rotor-disc mean of the
+        file's first 5 s; turbulence, seed and shear are the file's.
+
+    Raises
+    ------
+    ValueError
+        Naming the field, the value and what is allowed.
     """
 
-    wind_mps: float
+    wind_mps: float | None = None
     turbulence: str | float = "A"
     seed: int = 1
     duration: float = 600.0
@@ -61,9 +74,22 @@ class Scenario:
     iec_class: str = "I"
     sign: int = 1
     event_at: float = 0.0
+    wind_file: str | None = None
 
     def __post_init__(self) -> None:
-        check_positive("wind_mps", self.wind_mps)
+        if self.wind_file is None:
+            if self.wind_mps is None:
+                raise ValueError("wind_mps must be a mean wind > 0 m/s (or give wind_file), "
+                                 "got None")
+            check_positive("wind_mps", self.wind_mps)
+        else:
+            check_wind_file(self.wind_file)
+            if self.wind_mps is not None:
+                raise ValueError(f"wind_mps must be None with a wind_file (the file's wind is "
+                                 f"the case's; nothing declares a mean), got {self.wind_mps!r}")
+            if self.condition != "ntm":
+                raise ValueError(f"condition must be 'ntm' with a wind_file, got "
+                                 f"{self.condition!r}")
         check_positive("duration", self.duration)
         check_range("shear_exponent", self.shear_exponent, -1.0, 1.0)
         check_turbulence(self.turbulence)
@@ -77,8 +103,9 @@ class Scenario:
 
     @property
     def deterministic(self) -> bool:
-        """True for a wind without turbulence: steady, NWP or an IEC transient."""
-        return is_deterministic(self.condition, (self.turbulence,))
+        """True for a wind without turbulence: steady, NWP or an IEC transient (False for a
+        wind file)."""
+        return self.wind_file is None and is_deterministic(self.condition, (self.turbulence,))
 
     def meta(self) -> dict[str, Any]:
         """The case as plain data for a result's ``meta``.
@@ -90,6 +117,8 @@ class Scenario:
             carry units); with an IEC condition also ``condition``, ``iec_class``, ``sign``,
             ``event_at_s``.
         """
+        if self.wind_file is not None:
+            return {"wind_file": str(self.wind_file), "duration_s": self.duration}
         out = {"wind_mps": self.wind_mps, "turbulence": self.turbulence, "seed": self.seed,
                "duration_s": self.duration, "shear_exponent": self.shear_exponent}
         if self.condition != "ntm":
@@ -222,6 +251,8 @@ def make_wind(turbine: linearize.Turbine, scenario: Scenario, components: str = 
     field : lidar.WindField
         The same field.
     """
+    if scenario.wind_file is not None:
+        return _file_wind(turbine, scenario)
     hub = turbine.geometry.hub_height
     v, alpha = scenario.wind_mps, scenario.shear_exponent
     if scenario.condition not in ("ntm", "nwp", "etm"):
@@ -331,6 +362,107 @@ def _iec_wind(scenario: Scenario, site: lidar.IECSite, width: float, n: int
     return _grid_wind(f)
 
 
+def check_wind_file(path: Any) -> Path:
+    """A wind field file that exists and has a suffix mpc-wt reads.
+
+    Parameters
+    ----------
+    path : str or Path
+        ``.bts`` (TurbSim) or ``.npz``.
+
+    Returns
+    -------
+    Path
+
+    Raises
+    ------
+    ValueError
+        Naming the file and what is allowed.
+    """
+    p = Path(str(path))
+    if p.suffix.lower() not in (".bts", ".npz"):
+        raise ValueError(f"wind_file must be a TurbSim .bts or an mpc-wt .npz field, got "
+                         f"{str(path)!r}")
+    if not p.is_file():
+        raise ValueError(f"wind_file {str(path)!r}: no such file")
+    return p
+
+
+@functools.lru_cache(maxsize=2)
+def _load_field(path: str, mtime_ns: int) -> lidar.WindField:
+    return lidar.WindField.load(path)
+
+
+def read_wind_file(path: str) -> lidar.WindField:
+    """A wind file's field (the last two read are kept: the trim and the run read it once).
+
+    Parameters
+    ----------
+    path : str
+        ``.bts`` or ``.npz``.
+
+    Returns
+    -------
+    lidar.WindField
+
+    Raises
+    ------
+    lidar.FieldFileError
+        A missing, truncated or broken file.
+    """
+    p = check_wind_file(path)
+    return _load_field(str(p.resolve()), p.stat().st_mtime_ns)
+
+
+#: The first seconds of a wind file whose rotor-disc mean wind sets the plant's start [s].
+START_WINDOW = 5.0
+
+
+def start_wind(turbine: linearize.Turbine, scenario: Scenario) -> float:
+    """The wind the plant is trimmed at before the run: the scenario's mean wind, or the
+    rotor-disc mean of a wind file's first :data:`START_WINDOW` seconds (within the turbine's
+    operating range). The simulator's, never a controller's.
+
+    Parameters
+    ----------
+    turbine : Turbine
+        Rotor radius and operating range.
+    scenario : Scenario
+        The case.
+
+    Returns
+    -------
+    float
+        [m/s]
+    """
+    if scenario.wind_file is None:
+        return float(scenario.wind_mps)         # type: ignore[arg-type]
+    f = read_wind_file(scenario.wind_file)
+    first = f.t <= f.t[0] + START_WINDOW
+    u = lidar.rotor_effective_wind(f, turbine.geometry.tip_radius)[first].mean()
+    op = turbine.operation
+    return float(min(max(u, op.cut_in_wind), op.cut_out_wind))
+
+
+def _file_wind(turbine: linearize.Turbine, scenario: Scenario
+               ) -> tuple[linearize.GridWind, lidar.WindField]:
+    """The plant's wind from the scenario's file, checked to cover the rotor and the run."""
+    f = read_wind_file(str(scenario.wind_file))
+    r, hub = turbine.geometry.tip_radius, turbine.geometry.hub_height
+    name = scenario.wind_file
+    if f.y[0] > -r or f.y[-1] < r or f.z[0] > hub - r or f.z[-1] < hub + r:
+        raise ValueError(f"wind_file {name!r}: its grid (y {f.y[0]:g}..{f.y[-1]:g} m, z "
+                         f"{f.z[0]:g}..{f.z[-1]:g} m) does not cover the rotor (radius {r:g} m "
+                         f"at hub height {hub:g} m)")
+    if f.t[-1] - f.t[0] < scenario.duration:
+        raise ValueError(f"wind_file {name!r} holds {f.t[-1] - f.t[0]:g} s of wind; the run's "
+                         f"duration is {scenario.duration:g} s")
+    f = dataclasses.replace(f, t=f.t - f.t[0],
+                            meta={**f.meta, "wind_file": str(name),
+                                  "file_mean_wind_mps": float(f.mean_speed)})
+    return _grid_wind(f)
+
+
 def lidar_field(turbine: linearize.Turbine, scenario: Scenario, field: lidar.WindField,
                 distance: float, samplers: lidar.SamplerCache | None = None) -> lidar.WindField:
     """The field a LIDAR focused ``distance`` upstream measures in a case: the case's field
@@ -364,6 +496,11 @@ def lidar_field(turbine: linearize.Turbine, scenario: Scenario, field: lidar.Win
     """
     if scenario.deterministic:
         return field
+    if scenario.wind_file is not None:
+        if distance == 0.0:
+            return field
+        return lidar.evolve_field(field, distance, seed=np.random.default_rng(
+            [0, _EVOLUTION_STREAM]), samplers=samplers)
     spec = field_spec(turbine, scenario)
     if distance == 0.0:
         if set(field.meta.get("components", "uvw")) >= set("uvw"):

@@ -332,8 +332,9 @@ def test_report_refuses_empty_campaign(tmp_path):
 
 # -- controllers the studies added -------------------------------------------------------------
 def test_do_controllers_pick_their_region():
-    """lqr-pio below rated wind runs Do's region II (torque law, pitch only damps: the mean
-    power stays that of the baseline within 2 %); baseline-ct holds torque constant above rated
+    """lqr-pio, scheduled on its own wind estimate, runs Do's region II below the rated wind
+    (torque law, pitch only damps: the mean power stays that of the baseline within 2 %) and
+    region III above it; baseline-ct holds torque constant above rated
     (torque std below 0.5 % of rated torque, the constant-power baseline's is larger)."""
     import linearize
     from mpc_wt import run_controller
@@ -341,11 +342,12 @@ def test_do_controllers_pick_their_region():
     tb = linearize.load_turbine()
     r2 = run_controller(tb, "lqr-pio", Scenario(8.0, 0.12, 1, 60.0))
     b2 = run_controller(tb, "baseline", Scenario(8.0, 0.12, 1, 60.0))
-    assert r2.meta["lqr"]["region"] == "II"
     k = r2.t > 20
+    assert np.all(r2.channel("region")[k] == 2.0)
     assert r2.channel("gen_power")[k].mean() == pytest.approx(
         b2.channel("gen_power")[k].mean(), rel=0.02)
-    assert run_controller(tb, "lqr-pio", Scenario(18.0, 0.12, 1, 5.0)).meta["lqr"]["region"] == "III"
+    assert np.all(run_controller(tb, "lqr-pio", Scenario(18.0, 0.12, 1, 5.0)).channel("region")
+                  == 3.0)
     ct = run_controller(tb, "baseline-ct", Scenario(18.0, 0.12, 1, 60.0))
     cp = run_controller(tb, "baseline", Scenario(18.0, 0.12, 1, 60.0))
     q_rated = tb.operation.rated_power / tb.operation.rated_rotor_speed_rad_s / \
@@ -517,3 +519,23 @@ def test_cases_of_an_older_store_read_back_with_their_hashes() -> None:
     ecd = new["baseline__dlc1.4__ecd__v11.4__neg"]
     assert (ecd.scenario.condition, ecd.scenario.sign, ecd.scenario.event_at) == ("ecd", -1, 20.0)
     assert ecd.scenario.duration == 70.0 and ecd.duration == 60.0
+
+
+def test_a_worker_designs_each_controller_once(tmp_path):
+    """One design per controller per worker, whatever the number of cases: 2 controllers x
+    3 winds x 2 seeds on 2 process workers; each case's file says whether its design was made
+    for it, and every (worker, controller) made exactly one, with one digest per controller."""
+    spec = _spec(winds=[6, 13, 20], seeds=2, duration=4, transient=1,
+                 controllers=["baseline", "coleman-ipc"])
+    s = run_campaign(spec, tmp_path, engine="processes", workers=2, progress=False)
+    assert (s.done, s.failed) == (12, 0)
+    made: dict = {}
+    digests: dict = {}
+    for f in sorted((tmp_path / "cases").glob("*.nc")):
+        meta = ClosedLoopResult.load(f).meta
+        key = (meta["campaign_case"]["worker"], meta["controller"])
+        made.setdefault(key, []).append(meta["design"]["new"])
+        digests.setdefault(meta["controller"], set()).add(meta["design"]["digest"])
+    assert sum(len(v) for v in made.values()) == 12
+    assert all(sum(v) == 1 for v in made.values()), made
+    assert {len(d) for d in digests.values()} == {1}

@@ -207,8 +207,9 @@ def test_assess_csv_from_another_tool(tmp_path: Path, capsys: pytest.CaptureFixt
       "x"], "apply to the MPC controllers only"),
     (["simulate", "--controller", "mpc", "--formulation", "sparse", "--backend", "daqp",
       "--wind", "18", "--duration", "1", "--out", "x"], "formulation='sparse' needs backend"),
-    (["simulate", "--controller", "mpc", "--scheduled", "--wind", "8", "--duration", "1",
-      "--out", "x"], "wind 8 m/s is outside"),
+    (["simulate", "--controller", "mpc", "--design-wind-mps", "30", "--wind", "8",
+      "--duration", "1", "--out", "x"], "design_wind_mps = 30 m/s is outside the turbine's "
+                                         "operating range 3..25 m/s"),
     (["simulate", "--controller", "lqr-pio", "--apc-frequency", "0.1", "--wind", "18",
       "--out", "x"], "--apc-frequency applies to --controller ts and apc only"),
     (["simulate", "--controller", "ts", "--horizon", "5", "--wind", "18", "--out", "x"],
@@ -245,8 +246,11 @@ def test_simulate_mpc_controllers(controller: str, tmp_path: Path,
 @pytest.mark.parametrize("extra, meta", [
     (["--formulation", "sparse", "--backend", "osqp"], {"formulation": "sparse",
                                                          "backend": "osqp"}),
-    (["--scheduled", "--estimator", "kalman", "--horizon", "10"],
-     {"scheduled": True, "estimator": "kalman", "horizon": 10}),
+    (["--estimator", "full-state", "--design-wind-mps", "17", "--horizon", "10"],
+     {"estimator": "full-state", "design_winds_mps": [17.0, 17.0], "horizon": 10,
+      "idealization": "full-state information (idealization)"}),
+    (["--horizon", "10"], {"estimator": "kalman", "design_winds_mps": [3.0, 25.0],
+                           "horizon": 10}),
 ])
 def test_simulate_mpc_options(extra: list[str], meta: dict, tmp_path: Path,
                               capsys: pytest.CaptureFixture[str]) -> None:

@@ -39,12 +39,12 @@ def test_feedforward_arrives_with_the_wind(turbine) -> None:
     cw = lidar.CWLidar(turbine.geometry.tip_radius, range_weighting=False, los_error=False)
     g = tune_baseline(turbine)
     base = BaselineController(turbine, g)
-    ctl = LidarFeedforward(base, cw, field, turbine, mean_wind_mps=v, corner_rad_s=300.0)
-    assert ctl.lead == pytest.approx(0.1 + 1.4 / 300.0)
+    ctl = LidarFeedforward(base, lidar.LidarSensor(cw, field=field), turbine, corner=300.0)
     p = linearize.plant_params(turbine)
     op = linearize.trim(turbine, v, params=p)
     wind = linearize.GridWind(t=field.t, y=field.y, z=field.z, u=field.u)
     res = simulate_closed_loop(p, ctl, wind, 30.0, x0=op.x, u0=op.u)
+    assert ctl.lead == pytest.approx(0.1 + 1.4 / 300.0)
     vf = res.controller["ff_wind"]
     k = int(np.argmax(vf >= 19.0))
     t_cross = np.interp(19.0, vf[k - 1:k + 1], res.t[k - 1:k + 1])
@@ -100,10 +100,15 @@ def test_bad_feedforward_settings_are_named(turbine) -> None:
     field = _gust_field(18.0, 0.0, 10.0, 1.0, turbine.geometry.hub_height)
     cw = lidar.CWLidar(turbine.geometry.tip_radius, focus_distance=10.0)
     base = BaselineController(turbine, tune_baseline(turbine))
-    with pytest.raises(ValueError, match=r"lead time .* exceeds the preview time"):
-        LidarFeedforward(base, cw, field, turbine, mean_wind_mps=18.0, corner_rad_s=0.3)
-    with pytest.raises(ValueError, match=r"corner_rad_s must be > 0"):
-        LidarFeedforward(base, cw, field, turbine, mean_wind_mps=18.0, corner_rad_s=-1.0)
+    sensor = lidar.LidarSensor(cw, field=field)
+    with pytest.raises(ValueError, match=r"corner must be > 0 rad/s"):
+        LidarFeedforward(base, sensor, turbine, corner=-1.0)
+    with pytest.raises(ValueError, match=r"corner must be > 0 rad/s"):
+        LidarFeedforward(base, sensor, turbine, corner=([10.0, 20.0], [0.3, float("nan")]))
+    with pytest.raises(ValueError, match=r"lead_s must be >= 0 s"):
+        LidarFeedforward(base, sensor, turbine, corner=0.3, lead_s=-1.0)
+    with pytest.raises(RuntimeError, match="the LIDAR has no wind to measure"):
+        lidar.LidarSensor(cw).field
 
 
 def test_corner_is_raised_to_fit_the_preview(turbine, caplog) -> None:
@@ -119,9 +124,12 @@ def test_corner_is_raised_to_fit_the_preview(turbine, caplog) -> None:
     with pytest.raises(ValueError, match=r"preview time 0.15 s does not cover the actuator "
                                          r"time constant 0.1 s and one LIDAR sample 0.1 s"):
         corner_within_preview(1.0, 0.15, 0.1)
-    # in a build: a 30 m focus (1.67 s preview at 18 m/s) forces the raise; the lead fits
-    built, _, _ = build_controller(turbine, "baseline+lidar-ff", Scenario(18.0, "A", 2, 200.0),
-                                   {"lidar": {"focus_distance": 30.0}})
-    ff = built.meta["lidar_ff"]
-    assert ff["corner_raised"] and ff["corner_rad_s"] > ff["coherence_corner_rad_s"]
-    assert ff["lead_s"] == pytest.approx(30.0 / 18.0 - 0.1)
+    # in a run: a 30 m focus (1.67 s preview at 18 m/s) forces the raise at every sample; the
+    # lead then fills the preview less one sample, at the LIDAR's measured mean wind
+    res = run_controller(turbine, "baseline+lidar-ff", Scenario(18.0, "A", 2, 20.0),
+                         {"lidar": {"focus_distance": 30.0}})
+    corner = res.controller["ff_corner"][-1]
+    model = np.interp(res.controller["ff_mean_wind"][-1], res.meta["lidar_ff"]["corner_winds_mps"],
+                      res.meta["lidar_ff"]["corner_rad_s"])
+    tp = 30.0 / res.controller["ff_mean_wind"][-1]
+    assert corner > model and corner == pytest.approx(1.4 / (tp - 0.1 - 0.1), rel=1e-9)

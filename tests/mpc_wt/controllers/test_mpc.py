@@ -180,7 +180,8 @@ def test_lidar_preview_reduces_asymmetric_loads(turbine: linearize.Turbine,
     op = linearize.trim(turbine, 18.0)
     lid = lidar.CWLidar(63.0, range_weighting=False, los_error=False)
     out = {}
-    for label, prev in (("none", None), ("lidar", LidarPreview(lid, f, 15, 0.1))):
+    for label, prev in (("none", None), ("lidar", LidarPreview(lidar.LidarSensor(lid, field=f), 15, 0.1,
+                                                   preview_time=54.0 / 18.0))):
         # OSQP: runs where DAQP is not installed (both give the same moves, tested above)
         r = simulate_closed_loop(params, MPC(model, turbine, MPCSettings(backend="osqp")), gw,
                                  70.0, x0=op.x, u0=op.u, controller_dt=0.1, preview=prev)
@@ -190,7 +191,7 @@ def test_lidar_preview_reduces_asymmetric_loads(turbine: linearize.Turbine,
                       harmonic_psd(r.channel("flap_moment_1")[late], 80.0, frot, (1,),
                                    nperseg=2048)[1], r.channel("gen_power")[late].std())
         assert r.controller["qp_fallback"].sum() == 0
-    # issue 23: 700 controller steps, the preview keeps only the last T_p (+3 samples)
+    # 700 controller steps, the preview keeps only the last T_p + 3 samples
     if prev is not None:
         assert len(prev.buffer) == prev.buffer.capacity < 40
     # measured (2026-11-22): tilt std x0.58, yaw std x0.48, 1P flap x0.16, power std x0.44;

@@ -113,7 +113,7 @@ def test_options_error_carries_the_key() -> None:
 
 @settings(max_examples=40, deadline=None)
 @given(st.sampled_from([None, "osqp", "daqp"]), st.sampled_from(["condensed", "sparse"]),
-       st.integers(1, 60), st.sampled_from(["none", "kalman"]),
+       st.integers(1, 60), st.sampled_from(["full-state", "kalman"]),
        st.one_of(st.none(), st.floats(3.0, 25.0)))
 def test_options_round_trip(backend, formulation, horizon, estimator, design_wind) -> None:
     """Invariant: from_dict(to_dict(o)) == o, and every field keeps its type."""

@@ -104,18 +104,27 @@ def test_lidar_preview_in_the_loop(turbine: linearize.Turbine,
     op = linearize.trim(turbine, 18.0)
     probe = _PreviewProbe()
     lid = lidar.CWLidar(63.0, range_weighting=False, los_error=False)
+    sensor = lidar.LidarSensor(lid, field=f)
     r = simulate_closed_loop(params, probe, gw, 20.0, x0=op.x, u0=op.u, controller_dt=0.1,
-                             preview=LidarPreview(lid, f, 15, 0.1))
+                             preview=LidarPreview(sensor, 15, 0.1, preview_time=3.0))
     t, p = next((tt, pp) for tt, pp in probe.seen if tt >= 15.0)   # steps inside the run
     assert p.blade.shape == (15, 3) and p.measured.all()
-    # exact plumbing: each step's preview is the wind at the position predicted when it was
-    # measured (t_m = t - T_p): azimuth psi(t_m) + omega(t_m) T_p, at 75 % span, at time t
+    # exact plumbing (the preview time fixed at the field's D / V): each step's preview is the
+    # wind at the position predicted when it was measured (t_m = t - T_p): azimuth psi(t_m) +
+    # omega(t_m) T_p, at 75 % span, at time t
     tp = 54.0 / 18.0
     tm = p.t - tp
     psi_m = np.interp(tm, r.t, r.x[:, 16])
     om_m = np.interp(tm, r.t, r.x[:, 2])
     predicted = lidar.blade_effective_wind(f, p.t, psi_m + om_m * tp, lid.radius)
     assert_allclose(p.blade, predicted, rtol=0, atol=1e-9)
+    # with the preview time the LIDAR measures (its mean wind since the start, within 4 % of
+    # the field's 18 m/s over these 20 s) the preview is the same wind moved by that error
+    measured = LidarPreview(lidar.LidarSensor(lid, field=f), 15, 0.1)
+    for k in range(200):
+        measured(k * 0.1, float(np.interp(k * 0.1, r.t, r.x[:, 16])),
+                 float(np.interp(k * 0.1, r.t, r.x[:, 2])))
+    assert measured.preview_time == pytest.approx(tp, rel=0.04)
     # the blade actually arrives where the rotor turned to; with fixed pitch and torque its
     # speed drifts over T_p, so the preview is only as good as that prediction (here < 2 m/s)
     truth = lidar.blade_effective_wind(f, p.t, np.interp(p.t, r.t, r.x[:, 16]), lid.radius)

@@ -1,0 +1,90 @@
+"""A case on the user's own wind: ``mpcwt simulate --wind-file`` on a TurbSim .bts runs every
+controller kind; the plant starts from the trim at the rotor-disc mean of the file's first 5 s;
+bad files and flags are named."""
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import lidar
+import linearize
+from mpc_wt.cli import UsageError, main
+from mpc_wt.controllers.discon import rosco_discon, rosco_library
+from mpc_wt.registry.registry import kinds
+from mpc_wt.simulation.results import ClosedLoopResult
+from mpc_wt.simulation.scenario import Scenario, field_spec, start_wind
+
+#: extra flags of the kinds that require an option
+REQUIRED = {"apc": ["--apc-frequency", "0.05"],
+            "discon": ["--discon-library", str(rosco_library()), "--discon-in",
+                       str(rosco_discon())]}
+
+
+@pytest.fixture(scope="module")
+def bts(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """45 s of class B turbulence at 15 m/s written as a TurbSim full-field file."""
+    tb = linearize.load_turbine()
+    f = lidar.generate_field(field_spec(tb, Scenario(15.0, "B", 77, duration=25.0)), 77)
+    path = tmp_path_factory.mktemp("wind") / "turbsim.bts"
+    f.save(path)
+    return path
+
+
+def _names() -> list[str]:
+    out = []
+    for name, k in kinds().items():
+        if k.addon_to:
+            out.append(f"{k.default_base}+{name}")
+        elif k.pattern:
+            out.append("derate80")
+        else:
+            out.append(name)
+    return out
+
+
+@pytest.mark.parametrize("name", _names())
+def test_every_kind_runs_on_a_turbsim_file(bts: Path, tmp_path: Path, name: str) -> None:
+    kind = name.split("+")[-1].rstrip("0123456789")
+    out = tmp_path / "r.nc"
+    assert main(["simulate", "--wind-file", str(bts), "--controller", name, "--duration",
+                 "10", "--out", str(out), *REQUIRED.get(kind, [])]) == 0
+    res = ClosedLoopResult.load(out)
+    assert res.meta["wind_file"] == str(bts) and "wind_mps" not in res.meta
+    assert res.t[-1] == pytest.approx(10.0)
+    assert np.all(np.isfinite(res.channel("rotor_speed")))
+
+
+def test_the_plant_starts_at_the_files_first_seconds(bts: Path) -> None:
+    """The start wind is the rotor-disc mean of u over the first 5 s of the file, computed here
+    from the field itself."""
+    tb = linearize.load_turbine()
+    f = lidar.WindField.load(bts)
+    yy, zz = np.meshgrid(f.y, f.z - f.hub_height, indexing="ij")
+    disc = yy**2 + zz**2 <= tb.geometry.tip_radius**2
+    first = f.t <= f.t[0] + 5.0
+    assert start_wind(tb, Scenario(wind_file=str(bts), duration=10.0)) == pytest.approx(
+        float(f.u[first][:, disc].mean()), rel=1e-6)
+
+
+def test_bad_wind_files_are_named(bts: Path, tmp_path: Path) -> None:
+    with pytest.raises(ValueError, match="wind_file 'nope.bts': no such file"):
+        Scenario(wind_file="nope.bts")
+    with pytest.raises(ValueError, match="wind_file must be a TurbSim .bts or an mpc-wt .npz"):
+        Scenario(wind_file=str(tmp_path / "w.wnd"))
+    with pytest.raises(ValueError, match="wind_mps must be None with a wind_file"):
+        Scenario(12.0, wind_file=str(bts))
+    with pytest.raises(ValueError, match="wind_mps must be a mean wind > 0 m/s"):
+        Scenario()
+    broken = tmp_path / "broken.bts"
+    broken.write_bytes(bts.read_bytes()[:1000])
+    with pytest.raises(UsageError, match="--wind-file: .*truncated .bts"):
+        main(["simulate", "--wind-file", str(broken), "--out", str(tmp_path / "x.nc")])
+    with pytest.raises(UsageError, match="--duration: the wind file holds 44.95 s of wind; "
+                                         "the run's duration is 100 s"):
+        main(["simulate", "--wind-file", str(bts), "--duration", "100", "--out",
+              str(tmp_path / "x.nc")])
+    with pytest.raises(SystemExit):
+        main(["simulate", "--wind-file", str(bts), "--wind", "12", "--out",
+              str(tmp_path / "x.nc")])

@@ -1,0 +1,102 @@
+"""A controller's design depends on the turbine and its options only.
+
+Each advanced kind is built for cases at 5, 11, 18 and 25 m/s (different seeds, turbulence
+classes, conditions), each time from an empty design cache: the designs' digests (every gain,
+model and QP array they hold) are equal. A build that reads the case's wind or field fails with
+:class:`~mpc_wt.errors.CaseDataError`. A design reused from the cache runs a case exactly as a
+fresh one (``reset()`` forgets everything of the case before).
+"""
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+import pytest
+
+import linearize
+from mpc_wt.errors import CaseDataError
+from mpc_wt.registry.context import Built, DesignCache, design_digest
+from mpc_wt.registry.registry import _KINDS, register
+from mpc_wt.run import build_controller, run_controller
+from mpc_wt.simulation.scenario import Scenario
+
+ADVANCED = ["mpc", "mpc-lidar", "mpc-collective", "lqr-pio", "ts", "baseline+lidar-ff", "ibc",
+            "coleman-ipc"]
+
+#: four cases that share nothing a design could read
+CASES = [Scenario(5.0, "C", 11, 5.0), Scenario(11.0, "B", 23, 5.0),
+         Scenario(18.0, "A", 37, 5.0, shear_exponent=0.1),
+         Scenario(25.0, "steady", 1, 5.0, condition="nwp")]
+
+
+@pytest.fixture(scope="module")
+def turbine() -> linearize.Turbine:
+    return linearize.load_turbine()
+
+
+@pytest.mark.parametrize("kind", ADVANCED)
+def test_the_design_is_the_same_for_every_case(turbine: linearize.Turbine, kind: str) -> None:
+    digests = set()
+    for sc in CASES:
+        cache = DesignCache()
+        built, _, _ = build_controller(turbine, kind, sc, cache=cache)
+        assert built.meta["design"]["new"] is True
+        digests.add(design_digest(built.controller))
+        assert built.meta["design"]["digest"] in digests
+    assert len(digests) == 1, f"{kind}: {len(digests)} different designs for {len(CASES)} cases"
+
+
+def test_the_digest_sees_a_design_change(turbine: linearize.Turbine) -> None:
+    """The digest is not blind: other options give another design."""
+    a, _ = _design(turbine, "mpc", {})
+    b, _ = _design(turbine, "mpc", {"horizon": 10})
+    c, _ = _design(turbine, "coleman-ipc", {"crossover_rad_s": 0.3})
+    d, _ = _design(turbine, "coleman-ipc", {})
+    assert a != b and c != d
+
+
+def _design(turbine: linearize.Turbine, kind: str, options: dict) -> tuple[str, Built]:
+    from mpc_wt.run import design_controller
+
+    built, _ = design_controller(turbine, kind, options, cache=DesignCache())
+    return design_digest(built.controller), built
+
+
+@pytest.mark.parametrize("reads", ["scenario", "field", "op"])
+def test_a_build_that_reads_the_case_fails(turbine: linearize.Turbine, reads: str) -> None:
+    from mpc_wt.controllers import Options
+
+    @dataclasses.dataclass(frozen=True)
+    class NoOptions(Options):
+        pass
+
+    name = f"peek-{reads}"
+
+    def build(ctx, opts):
+        getattr(ctx, reads)
+        raise AssertionError("unreachable: the case was readable")
+
+    register(name, NoOptions, summary="reads the case")(build)
+    try:
+        with pytest.raises(CaseDataError, match=f"BuildContext.{reads}: a controller's design "
+                                                "depends on the turbine"):
+            build_controller(turbine, name, Scenario(12.0, "steady", 1, 2.0), cache=DesignCache())
+    finally:
+        _KINDS.pop(name, None)
+
+
+@pytest.mark.parametrize("kind", ["mpc", "lqr-pio", "baseline+lidar-ff"])
+def test_a_reused_design_runs_as_a_fresh_one(turbine: linearize.Turbine, kind: str) -> None:
+    """Run case A, then case B with the same design from the cache: B equals B run with a fresh
+    design, bit for bit (reset forgets the schedule, the estimators, the filters and the
+    LIDAR's history)."""
+    a = Scenario(16.0, "A", 5, 12.0)
+    b = Scenario(13.0, "B", 6, 12.0)
+    cache = DesignCache()
+    run_controller(turbine, kind, a, cache=cache)
+    reused = run_controller(turbine, kind, b, cache=cache)
+    fresh = run_controller(turbine, kind, b, cache=DesignCache())
+    assert reused.meta["design"]["new"] is False and fresh.meta["design"]["new"] is True
+    assert cache.made["built"] == 1
+    for ch in ("pitch_1", "gen_torque", "rotor_speed"):
+        np.testing.assert_array_equal(reused.channel(ch), fresh.channel(ch))
