@@ -232,9 +232,7 @@ def run_controller(turbine: linearize.Turbine, controller: str, scenario: Scenar
     built, op, wind = build_controller(turbine, controller, scenario, options, cache=cache,
                                        naming=naming, params=params, samplers=samplers)
     meta = {"controller": controller, **scenario.meta(), "turbine": turbine.name,
-            **built.meta}
-    if scenario.wind_file is not None:      # for the reader (no design sees it)
-        meta["start_wind_mps"] = start_wind(turbine, scenario)
+            **built.meta, **({} if scenario.wind_file is None else {"start_wind_mps": op.wind_mps})}
     ctl = built.controller
     if supervisor is not None:
         from mpc_wt.controllers.supervisor import Supervisor

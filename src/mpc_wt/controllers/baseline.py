@@ -334,7 +334,7 @@ class BaselineController(ControllerBase):
         if self.w_trans > self.w_rated:
             self.w_trans = self.w_rated
         self._par = law_parameters(self)
-        self._cmd, self._sig = np.empty(4), np.empty(len(SIGNALS))
+        self._cmd, self._sig = np.zeros(4), np.zeros(len(SIGNALS))
         self.reset()
 
     def reset(self) -> None:

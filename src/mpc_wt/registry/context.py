@@ -70,7 +70,8 @@ _OPAQUE = ("ctypes", "numba", "osqp", "daqp", "scipy.interpolate", "logging", "t
 def design_digest(obj: Any) -> str:
     """A digest of a built controller's design: every array, number, string and option it holds
     (walked through dataclasses, containers and object attributes; solver handles, compiled
-    functions and modules are not design data and are skipped).
+    functions, modules, the wind a LIDAR is bound to and the design's own solve times
+    (``*_time_s``) are not design data and are skipped).
 
     Two builds give equal digests when they hold the same gains, models and QP data; a design
     that read the case (its mean wind, its field) differs from case to case.
@@ -90,6 +91,13 @@ def design_digest(obj: Any) -> str:
 
     def walk(o: Any, depth: int) -> None:
         if depth > 40:
+            return
+        if isinstance(o, lidar.WindField):      # the wind a LIDAR measures: the case's
+            return
+        if isinstance(o, lidar.LidarSensor):    # the instrument, not the wind bound to it
+            h.update(b"LidarSensor")
+            walk(o.instrument, depth + 1)
+            walk(o.evolution, depth + 1)
             return
         if o is None or isinstance(o, (bool, int, str, bytes)):
             h.update(repr(o).encode())
@@ -125,8 +133,9 @@ def design_digest(obj: Any) -> str:
                     if hasattr(o, name):
                         items[name] = getattr(o, name)
             for k in sorted(items):
-                if k.startswith("__") or callable(items[k]) and not hasattr(items[k], "__dict__"):
-                    continue
+                if k.startswith("__") or k.endswith("_time_s") \
+                        or callable(items[k]) and not hasattr(items[k], "__dict__"):
+                    continue                # (a design's own solve time is no design data)
                 h.update(k.encode())
                 walk(items[k], depth + 1)
 
@@ -184,10 +193,21 @@ class DesignCache:
                 self._items.pop(next(iter(self._items)))
         return value
 
-    def clear(self) -> None:
-        """Drop every design."""
+    def clear(self, kind: str | None = None) -> None:
+        """Drop every design, or those whose key starts with ``kind`` (``"built"``: the whole
+        controllers, keeping the parts they are made of).
+
+        Parameters
+        ----------
+        kind : str, optional
+            The first element of the keys to drop.
+        """
         with self._lock:
-            self._items.clear()
+            if kind is None:
+                self._items.clear()
+                return
+            for k in [k for k in self._items if len(k) > 1 and k[1] == kind]:
+                del self._items[k]
 
 
 #: The process-wide cache used by :func:`~mpc_wt.run.run_controller` by default.

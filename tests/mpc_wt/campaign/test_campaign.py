@@ -525,7 +525,7 @@ def test_a_worker_designs_each_controller_once(tmp_path):
     """One design per controller per worker, whatever the number of cases: 2 controllers x
     3 winds x 2 seeds on 2 process workers; each case's file says whether its design was made
     for it, and every (worker, controller) made exactly one, with one digest per controller."""
-    spec = _spec(winds=[6, 13, 20], seeds=2, duration=4, transient=1,
+    spec = _spec(winds=[6, 13, 20], seeds=2, duration=10, transient=1,
                  controllers=["baseline", "coleman-ipc"])
     s = run_campaign(spec, tmp_path, engine="processes", workers=2, progress=False)
     assert (s.done, s.failed) == (12, 0)
