@@ -13,7 +13,7 @@ from mpc_wt.controllers.lidar_feedforward import (
     rews_coherence_corner,
     static_pitch_curve,
 )
-from mpc_wt.run import build_controller, run_controller
+from mpc_wt.run import run_controller
 from mpc_wt.simulation.loop import simulate_closed_loop
 from mpc_wt.simulation.scenario import Scenario
 
