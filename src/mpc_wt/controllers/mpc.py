@@ -1128,9 +1128,10 @@ class MPC(ControllerBase):
 class ScheduledMPC(ControllerBase):
     """MPC scheduled over a :class:`linearize.LinearModelFamily` on a measured mean wind.
 
-    One :class:`MPC` per grid wind of the family, built on first use and kept, so that the QP
-    matrices, the OSQP factorization and the DAQP workspace of an operating point are set up
-    once and reused whenever the schedule returns to it. Which one acts is decided by a
+    One :class:`MPC` per grid wind of the family, all built with the design (``prebuild``: a
+    QP's setup takes some 70 ms, which a 10 Hz step must not spend on a switch) and kept, so
+    that the QP matrices, the OSQP factorization and the DAQP workspace of an operating point
+    are set up once and reused whenever the schedule returns to it. Which one acts is decided by a
     :class:`~mpc_wt.controllers.scheduling.WindSchedule`: the grid wind nearest a low-passed
     wind that the controller measures -- the rotor-effective wind of
     :class:`~mpc_wt.controllers.wind_estimator.WindSpeedEstimator` (rotor speed, pitch,
@@ -1156,12 +1157,14 @@ class ScheduledMPC(ControllerBase):
         Beyond the midpoint between grid winds [m/s].
     wind_estimator : WindSpeedEstimator, optional
         The scheduling wind's estimator at the MPC's ``dt`` (default: made here).
+    prebuild : bool
+        Build every grid point's MPC now (default); False builds each on first use.
     """
 
     def __init__(self, family: linearize.LinearModelFamily, turbine: linearize.Turbine,
                  settings: MPCSettings | None = None, *, wind_source: str = "estimator",
                  time_constant: float = 30.0, hysteresis: float = 0.25,
-                 wind_estimator: Any = None) -> None:
+                 wind_estimator: Any = None, prebuild: bool = True) -> None:
         from mpc_wt.controllers.scheduling import SCHEDULE_SOURCES, WindSchedule
 
         if wind_source not in SCHEDULE_SOURCES:
@@ -1175,6 +1178,9 @@ class ScheduledMPC(ControllerBase):
                                      estimator=wind_estimator)
         self.dt = st.dt
         self._ctl: dict[int, MPC] = {}
+        if prebuild:
+            for k in range(len(family.wind_mps)):
+                self.controller(k)
         self.reset()
 
     def controller(self, k: int) -> MPC:
