@@ -388,6 +388,9 @@ class MPC(ControllerBase):
         weights make the QP non-convex.
     """
 
+    #: run-time handles into the solver's workspace, not design data
+    __not_design__ = ("_daqp",)
+
     def __init__(self, model: linearize.LinearModel, turbine: linearize.Turbine,
                  settings: MPCSettings | None = None) -> None:
         st = settings or MPCSettings()

@@ -339,6 +339,10 @@ class _DAQPDirect:
         Number of bounds and of simple bounds.
     """
 
+    #: a solver workspace (addresses, C memory): no design data (its data are the QP's
+    #: arrays, which the MPC holds)
+    __design__ = False
+
     def __init__(self, fns: dict[str, Any], h: np.ndarray, q: np.ndarray, a: np.ndarray,
                  m: int, ms: int) -> None:
         n = h.shape[0]

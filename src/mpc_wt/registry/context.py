@@ -70,8 +70,9 @@ _OPAQUE = ("ctypes", "numba", "osqp", "daqp", "scipy.interpolate", "logging", "t
 def design_digest(obj: Any) -> str:
     """A digest of a built controller's design: every array, number, string and option it holds
     (walked through dataclasses, containers and object attributes; solver handles, compiled
-    functions, modules, the wind a LIDAR is bound to and the design's own solve times
-    (``*_time_s``) are not design data and are skipped).
+    functions, modules, the wind a LIDAR is bound to, the design's own solve times
+    (``*_time_s``), classes marked ``__design__ = False`` and the attributes a class names in
+    ``__not_design__`` are not design data and are skipped).
 
     Two builds give equal digests when they hold the same gains, models and QP data; a design
     that read the case (its mean wind, its field) differs from case to case.
@@ -121,7 +122,8 @@ def design_digest(obj: Any) -> str:
             return
         else:
             mod = type(o).__module__ or ""
-            if mod.startswith(_OPAQUE) or id(o) in seen:
+            if mod.startswith(_OPAQUE) or id(o) in seen \
+                    or getattr(type(o), "__design__", True) is False:
                 return
             seen.add(id(o))
             h.update(type(o).__name__.encode())
@@ -132,8 +134,9 @@ def design_digest(obj: Any) -> str:
                 for name in getattr(type(o), "__slots__", ()):
                     if hasattr(o, name):
                         items[name] = getattr(o, name)
+            skip = set(getattr(type(o), "__not_design__", ()))
             for k in sorted(items):
-                if k.startswith("__") or k.endswith("_time_s") \
+                if k.startswith("__") or k.endswith("_time_s") or k in skip \
                         or callable(items[k]) and not hasattr(items[k], "__dict__"):
                     continue                # (a design's own solve time is no design data)
                 h.update(k.encode())
