@@ -49,10 +49,10 @@ def test_every_kind_runs_on_a_turbsim_file(bts: Path, tmp_path: Path, name: str)
     kind = name.split("+")[-1].rstrip("0123456789")
     out = tmp_path / "r.nc"
     assert main(["simulate", "--wind-file", str(bts), "--controller", name, "--duration",
-                 "10", "--out", str(out), *REQUIRED.get(kind, [])]) == 0
+                 "4", "--out", str(out), *REQUIRED.get(kind, [])]) == 0
     res = ClosedLoopResult.load(out)
     assert res.meta["wind_file"] == str(bts) and "wind_mps" not in res.meta
-    assert res.t[-1] == pytest.approx(10.0)
+    assert res.t[-1] == pytest.approx(4.0)
     assert np.all(np.isfinite(res.channel("rotor_speed")))
 
 
