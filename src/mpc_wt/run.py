@@ -69,7 +69,12 @@ def design_controller(turbine: linearize.Turbine, controller: str,
         True when it was made now, False when it came from the cache.
     """
     sel = resolve(controller)
-    opts = sel.options(options, naming)
+    return _design(turbine, sel, sel.options(options, naming), cache, params)
+
+
+def _design(turbine: linearize.Turbine, sel: Selection, opts: Sequence[Options],
+            cache: DesignCache, params: linearize.PlantParams | None) -> tuple[Built, bool]:
+    """The design of a resolved selection with checked options (see design_controller)."""
     made: list[bool] = []
 
     def make() -> Built:
@@ -134,8 +139,7 @@ def build_controller(turbine: linearize.Turbine, controller: str, scenario: Scen
     sel = resolve(controller)
     opts = sel.options(options, naming)
     op = _operating_point(turbine, sel, opts, scenario)
-    built, new = design_controller(turbine, controller, options, cache=cache, naming=naming,
-                                   params=params)
+    built, new = _design(turbine, sel, opts, cache, params)
     needs = set().union(*(k.field_components for k in (sel.base, *sel.addons)))
     wind, field = make_wind(turbine, scenario, "".join(c for c in "uvw" if c in needs),
                             samplers=samplers)

@@ -143,8 +143,7 @@ class LidarFeedforward(ControllerBase):
         self.preview_time = self.sensor.focus_distance / vm
         w = float(np.interp(vm, self.corner_winds, self.corners))
         if self.lead_given is None:
-            room = self.preview_time - self.tau_act - self.sample_dt
-            need = FILTER_DELAY[self.order] / room if room > 0 else math.inf
+            need = _fitting_corner(self.preview_time, self.tau_act, self.order, self.sample_dt)
             if w < need:
                 w = need if math.isfinite(need) else w
                 self.raised += 1
@@ -298,6 +297,14 @@ def rews_coherence_corner(lidar_model: Any, field: Any, turbine: linearize.Turbi
     return 2.0 * math.pi * lidar.coherence_bandwidth(f, g2)
 
 
+def _fitting_corner(preview_time_s: float, actuator_tau_s: float, filter_order: int,
+                    sample_dt: float) -> float:
+    """The lowest corner whose filter delay fits the preview less the actuator constant and one
+    LIDAR sample [rad/s] (inf when nothing fits)."""
+    room = preview_time_s - actuator_tau_s - sample_dt
+    return FILTER_DELAY[filter_order] / room if room > 0 else math.inf
+
+
 def corner_within_preview(corner_rad_s: float, preview_time_s: float, actuator_tau_s: float,
                           filter_order: int = 2, sample_dt: float = 0.1) -> tuple[float, bool]:
     """The coherence corner, raised where needed so that the lead (actuator time constant + the
@@ -333,12 +340,11 @@ def corner_within_preview(corner_rad_s: float, preview_time_s: float, actuator_t
     ValueError
         If the preview is too short for any corner (naming the preview and what it must cover).
     """
-    room = preview_time_s - actuator_tau_s - sample_dt
-    if room <= 0:
+    need = _fitting_corner(preview_time_s, actuator_tau_s, filter_order, sample_dt)
+    if not math.isfinite(need):
         raise ValueError(f"preview time {preview_time_s:.3g} s does not cover the actuator time "
                          f"constant {actuator_tau_s:.3g} s and one LIDAR sample "
                          f"{sample_dt:.3g} s: focus further upstream")
-    need = FILTER_DELAY[filter_order] / room
     if corner_rad_s >= need:
         return corner_rad_s, False
     logging.getLogger(__name__).warning(

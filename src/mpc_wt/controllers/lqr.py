@@ -545,7 +545,6 @@ class ScheduledLQRPIO(ControllerBase):
         self.schedule.reset()
         for c in self.controllers:
             c.reset()
-        self.active: int | None = None
         self.signals: dict[str, float] = {}
 
     def step(self, t: float, meas: dict[str, Any]) -> tuple[np.ndarray, float]:
@@ -565,12 +564,7 @@ class ScheduledLQRPIO(ControllerBase):
         gen_torque_ref : float
             [N m]
         """
-        k, switched = self.schedule.update(meas)
-        ctl = self.controllers[k]
-        if switched and self.active is not None:
-            ctl.reset()
-            ctl.hand_over(self.controllers[self.active])
-        self.active = k
+        k, ctl = self.schedule.acting(meas, self.controllers.__getitem__)
         out = ctl.step(t, meas)
         self.signals = dict(ctl.signals, schedule_wind=float(self.schedule.wind or math.nan),
                             schedule_grid_wind=float(self.winds[k]),

@@ -1211,7 +1211,6 @@ class ScheduledMPC(ControllerBase):
     def reset(self) -> None:
         """Forget the wind and every controller's state: the next step starts the schedule."""
         self.schedule.reset()
-        self.active: int | None = None
         for c in self._ctl.values():
             c.reset()
         self.signals: dict[str, float] = {}
@@ -1233,13 +1232,7 @@ class ScheduledMPC(ControllerBase):
         gen_torque_ref : float
             [N m]
         """
-        k, switched = self.schedule.update(meas)
-        ctl = self.controller(k)
-        if switched and self.active is not None:
-            old = self.controller(self.active)
-            ctl.reset()
-            ctl.hand_over(old)
-        self.active = k
+        k, ctl = self.schedule.acting(meas, self.controller)
         u = ctl.step(t, meas)
         self.signals = dict(ctl.signals, schedule_wind=float(self.schedule.wind or math.nan),
                             schedule_grid_wind=float(self.family.wind_mps[k]))

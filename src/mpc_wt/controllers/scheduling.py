@@ -62,8 +62,8 @@ class WindSchedule:
         The controller's step [s].
     source : {"estimator", "preview"}
         The scheduling wind: :class:`WindSpeedEstimator` on the measurements, or the LIDAR's
-        rotor-mean measurement (``meas["preview"].rotor[0]``; the estimator stands in while no
-        preview is given).
+        rotor-mean measurement (``meas["preview"].rotor[0]``; the estimator stands in, from
+        the measured torque balance, while no preview is given).
     time_constant : float
         Low-pass of the scheduling wind [s] (default 30).
     hysteresis : float
@@ -113,10 +113,9 @@ class WindSchedule:
         -------
         float
         """
-        v = self.estimator.step_measurements(meas)
         if self.source == "preview" and meas.get("preview") is not None:
-            return float(np.mean(np.asarray(meas["preview"].blade)[0]))
-        return v
+            return float(meas["preview"].rotor[0])
+        return self.estimator.step_measurements(meas)
 
     def update(self, meas: dict[str, Any]) -> tuple[int, bool]:
         """Take this step's measurements; the active grid index and whether it changed.
@@ -149,3 +148,29 @@ class WindSchedule:
             self.switches += 1
             return k, True
         return now, False
+
+    def acting(self, meas: dict[str, Any], design: Any) -> tuple[int, Any]:
+        """Update with this step's measurements and return the design that acts now; on a
+        switch it is reset and continues from the one before (``hand_over``: bumpless).
+
+        Parameters
+        ----------
+        meas : dict
+            The harness's measurements.
+        design : callable
+            Grid index -> its controller (with ``reset()`` and ``hand_over(other)``).
+
+        Returns
+        -------
+        k : int
+            The active grid index.
+        controller : object
+            ``design(k)``.
+        """
+        before = self.active
+        k, switched = self.update(meas)
+        ctl = design(k)
+        if switched:
+            ctl.reset()
+            ctl.hand_over(design(before))
+        return k, ctl

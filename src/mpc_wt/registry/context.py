@@ -13,6 +13,7 @@ import numpy as np
 
 import lidar
 import linearize
+from mpc_wt.errors import CaseDataError
 
 __all__ = ["turbine_key", "design_digest", "DesignCache", "DEFAULT_CACHE", "BuildContext",
            "Built"]
@@ -227,6 +228,20 @@ _CASE_DATA = ("a controller's design depends on the turbine, its options and the
               "from ctx.lidar(...)")
 
 
+def _case_data(name: str, what: str) -> property:
+    """A BuildContext attribute that a design may not read: it raises CaseDataError."""
+    def get(self: Any) -> Any:
+        raise CaseDataError(f"BuildContext.{name}: {_CASE_DATA}")
+    get.__doc__ = f"""Not available to a design ({what}).
+
+        Raises
+        ------
+        CaseDataError
+            Always.
+        """
+    return property(get)
+
+
 @dataclass(frozen=True)
 class BuildContext:
     """Everything a kind's ``build`` may use: the turbine and the harness's step, nothing of
@@ -277,44 +292,9 @@ class BuildContext:
         self.sensors.append(sensor)
         return sensor
 
-    @property
-    def scenario(self) -> Any:
-        """Not available to a design.
-
-        Raises
-        ------
-        CaseDataError
-            Always.
-        """
-        from mpc_wt.errors import CaseDataError
-
-        raise CaseDataError(f"BuildContext.scenario: {_CASE_DATA}")
-
-    @property
-    def field(self) -> Any:
-        """Not available to a design.
-
-        Raises
-        ------
-        CaseDataError
-            Always.
-        """
-        from mpc_wt.errors import CaseDataError
-
-        raise CaseDataError(f"BuildContext.field: {_CASE_DATA}")
-
-    @property
-    def op(self) -> Any:
-        """Not available to a design (the trim point holds the case's mean wind).
-
-        Raises
-        ------
-        CaseDataError
-            Always.
-        """
-        from mpc_wt.errors import CaseDataError
-
-        raise CaseDataError(f"BuildContext.op: {_CASE_DATA}")
+    scenario = _case_data("scenario", "the load case")
+    field = _case_data("field", "the case's wind field")
+    op = _case_data("op", "the trim point, which holds the case's mean wind")
 
 
 @dataclass
