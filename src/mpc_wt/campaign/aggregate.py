@@ -130,8 +130,8 @@ class _Group:
             want: dict[float, int] = {}
             for lc in self.spec.load_cases:
                 if lc.fatigue and (cs is None or cs.dlcs is None or lc.dlc in cs.dlcs):
-                    for v in lc.winds:
-                        want[v] = want.get(v, 0) + len(lc.seeds)
+                    for v, n in lc.runs_per_wind().items():
+                        want[v] = want.get(v, 0) + n
             return sorted(v for v, n in want.items() if len(self.bins.get(v, [])) < n)
         winds = set(cs.winds if cs and cs.winds else self.spec.winds)
         n_seed = len(cs.seeds if cs and cs.seeds else self.spec.seeds)

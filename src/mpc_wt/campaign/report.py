@@ -219,6 +219,7 @@ def _md_head(agg: dict[str, Any], paper: list[dict[str, Any]]) -> list[str]:
 def _load_case_row(lc: Any) -> dict[str, Any]:
     """A load case as a row of the report's head."""
     runs = (f"signs {', '.join(f'{g:+d}' for g in lc.signs)}" if lc.deterministic
+            else f"{len(lc.wind_files)} wind files" if lc.wind_files
             else f"{len(lc.seeds)} seeds")
     return {"dlc": lc.dlc, "condition": f"{lc.condition.upper()} "
                                          f"({', '.join(map(turbulence_tag, lc.turbulence))})",

@@ -197,7 +197,7 @@ def _write_spec(spec: CampaignSpec, out: Path, store: CampaignStore) -> None:
 
         (out / "spec.yaml").write_text(yaml.safe_dump(spec.raw, sort_keys=False))
     store.set_meta(name=spec.name, spec_hash=spec.spec_hash, software_version=__version__,
-                   spec_raw={**spec.raw, "turbine": spec.turbine},
+                   spec_raw=spec.resolved_raw(),
                    reference=spec.reference, last_run=time.strftime("%Y-%m-%dT%H:%M:%S"))
 
 

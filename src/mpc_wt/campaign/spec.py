@@ -25,8 +25,8 @@ import yaml
 from mpc_wt.errors import SpecError
 from mpc_wt.simulation.scenario import Scenario, check_condition, check_turbulence, is_deterministic
 
-__all__ = ["SpecError", "CampaignSpec", "ControllerSpec", "Case", "LoadCase", "DLC_DEFAULTS",
-           "load_spec", "spec_from_dict"]
+__all__ = ["SpecError", "CampaignSpec", "ControllerSpec", "Case", "LoadCase", "WindFile",
+           "DLC_DEFAULTS", "FILE_MARGIN_S", "load_spec", "spec_from_dict"]
 
 
 _TOP_KEYS = {"name", "description", "turbine", "duration", "transient", "turbulence",
@@ -38,7 +38,12 @@ _CONTROLLER_KEYS = {"name", "controller", "winds", "seeds", "turbulence", "label
                     "mpc_options", "retrofit_options", "dlcs"}
 _LOAD_CASE_KEYS = {"dlc", "condition", "winds", "seeds", "signs", "turbulence", "family",
                    "fatigue", "duration", "transient", "event_at", "supervisor", "extrapolate",
-                   "label"}
+                   "label", "wind_files"}
+#: The keys a load case of wind files does not take: its files are its winds and seeds.
+_GRID_KEYS = ("winds", "seeds", "signs", "event_at", "condition")
+#: Seconds of a wind file left after a case's run by default: the time a LIDAR 54 m ahead
+#: needs at 2.7 m/s (the same margin as ``mpcwt simulate --wind-file``).
+FILE_MARGIN_S = 20.0
 #: IEC 61400-1 ed. 3 table 2: the partial safety factor family of a DLC's ultimate loads
 #: ("N" normal, "A" abnormal) and whether its runs count for fatigue. DLC 1.2's turbulent runs
 #: also give its ultimate loads (the runs of DLC 1.1, normal family).
@@ -193,6 +198,8 @@ class LoadCase:
         Extrapolate its maxima statistically to 50 years (turbulent conditions).
     legacy : bool
         The grid of a spec without ``load_cases`` (case ids without the DLC).
+    wind_files : tuple of WindFile
+        The user's own wind: one case per file instead of the ``winds`` x ``seeds`` grid.
     """
 
     dlc: str
@@ -209,11 +216,61 @@ class LoadCase:
     supervisor: dict[str, Any] = field(default_factory=dict)
     extrapolate: bool = False
     legacy: bool = False
+    wind_files: tuple["WindFile", ...] = ()
 
     @property
     def deterministic(self) -> bool:
         """True for a condition without turbulence (one run per wind and sign)."""
-        return is_deterministic(self.condition, self.turbulence)
+        return not self.wind_files and is_deterministic(self.condition, self.turbulence)
+
+    def runs_per_wind(self) -> dict[float, int]:
+        """How many runs each mean-wind bin holds (per turbulence and controller).
+
+        Returns
+        -------
+        dict of float to int
+            Bin [m/s] -> runs: the seeds (or signs) of a grid, the files of a bin.
+        """
+        if self.wind_files:
+            out: dict[float, int] = {}
+            for f in self.wind_files:
+                out[f.wind_mps] = out.get(f.wind_mps, 0) + 1
+            return out
+        n = len(self.signs) if self.deterministic else len(self.seeds)
+        return {v: n for v in self.winds}
+
+
+@dataclass(frozen=True)
+class WindFile:
+    """One of the user's wind files in a campaign (a load case's ``wind_files``).
+
+    Parameters
+    ----------
+    path : str
+        The file, resolved (TurbSim ``.bts`` or mpc-wt ``.npz``).
+    wind_mps : float
+        The mean-wind bin its case counts in for the lifetime tables [m/s]: as the spec gives
+        it, or the file's mean hub-height wind rounded to a whole m/s. The assessment's, never
+        the controller's (the controller sees only the wind the file blows).
+    sha256 : str
+        The file's content hash (the case hash's: an edited file is a new case).
+    duration : float
+        Simulated time of its case [s] (the load case's ``duration`` plus its transient, or
+        the file's length less :data:`FILE_MARGIN_S`).
+    index : int
+        1, 2, ... in the spec's order: the case's "seed" in the tables.
+    """
+
+    path: str
+    wind_mps: float
+    sha256: str
+    duration: float
+    index: int
+
+    @property
+    def stem(self) -> str:
+        """The file name without its suffix, made safe for a case id."""
+        return "".join(ch if ch.isalnum() or ch in "-_." else "_" for ch in Path(self.path).stem)
 
 
 @dataclass(frozen=True)
@@ -274,10 +331,13 @@ class Case:
     supervisor: dict[str, Any] | None = None
     family: str = "N"
     fatigue: bool = True
+    bin_wind_mps: float | None = None
 
     @property
     def wind_mps(self) -> float:
-        """Mean wind [m/s]."""
+        """Mean wind [m/s]: the scenario's, or the bin of a wind file's case."""
+        if self.scenario.wind_mps is None:
+            return float(self.bin_wind_mps)         # type: ignore[arg-type]
         return self.scenario.wind_mps
 
     @property
@@ -419,6 +479,22 @@ class CampaignSpec:
         """SHA-256 of the canonical spec (with the turbine files' hash)."""
         return _digest({"spec": self.raw, "turbine": self.turbine_hash})
 
+    def resolved_raw(self) -> dict[str, Any]:
+        """The spec as given, with its turbine and wind files as resolved paths (and each file's
+        bin): what the index keeps, to be read again from any folder.
+
+        Returns
+        -------
+        dict
+        """
+        raw = copy.deepcopy(self.raw)
+        raw["turbine"] = self.turbine
+        for lc, entry in zip(self.load_cases, raw.get("load_cases") or ()):
+            if lc.wind_files:
+                entry["wind_files"] = [{"file": f.path, "wind": f.wind_mps}
+                                       for f in lc.wind_files]
+        return raw
+
     def bin_probabilities(self, winds: Any) -> np.ndarray:
         """The wind distribution's probability of each mean-wind bin
         (:func:`mpc_wt.assessment.fatigue.wind_bin_probabilities`).
@@ -481,6 +557,8 @@ class CampaignSpec:
     def _cases_of(self, c: ControllerSpec, lc: LoadCase, assess: dict[str, Any]
                   ) -> list[Case]:
         """The cases of one controller in one load case."""
+        if lc.wind_files:
+            return self._file_cases(c, lc, assess)
         if lc.legacy:
             grid = [(t, v, s, 1) for t in c.turbulence or lc.turbulence
                     for v in c.winds or lc.winds for s in c.seeds or lc.seeds]
@@ -514,6 +592,30 @@ class CampaignSpec:
                 case_hash=_digest(sim), assess_hash=_digest(a), plugins=self.plugins,
                 del_convention=self.del_convention, dlc=lc.dlc,
                 supervisor=copy.deepcopy(sup), family=lc.family, fatigue=lc.fatigue))
+        return out
+
+    def _file_cases(self, c: ControllerSpec, lc: LoadCase, assess: dict[str, Any]
+                    ) -> list[Case]:
+        """One case per wind file of a load case: the file is the case's wind and seed."""
+        a = assess if lc.transient == self.transient else {**assess, "transient": lc.transient}
+        sup = ({k: (lc.transient + x if k.endswith("_at") else x)
+                for k, x in lc.supervisor.items()} if lc.supervisor else None)
+        out = []
+        for f in lc.wind_files:
+            sim = {"turbine": self.turbine_hash, "controller": c.controller,
+                   "options": c.options, "wind_file": f.sha256, "duration": f.duration}
+            if sup:
+                sim["supervisor"] = sup
+            out.append(Case(
+                case_id=f"{c.name}__dlc{lc.dlc}__file-{f.stem}__v{f.wind_mps:g}",
+                controller=c.name, run_name=c.controller, options=copy.deepcopy(c.options),
+                scenario=Scenario(turbulence=lc.turbulence[0], seed=f.index,
+                                  duration=f.duration, wind_file=f.path),
+                transient=lc.transient, turbine=self.turbine, turbine_hash=self.turbine_hash,
+                channels=dict(self.channels), case_hash=_digest(sim), assess_hash=_digest(a),
+                plugins=self.plugins, del_convention=self.del_convention, dlc=lc.dlc,
+                supervisor=copy.deepcopy(sup), family=lc.family, fatigue=lc.fatigue,
+                bin_wind_mps=f.wind_mps))
         return out
 
 
@@ -685,6 +787,8 @@ def _load_case(i: int, raw: Any, top: Mapping[str, Any]) -> LoadCase:
     if family not in ("N", "A", "T"):
         raise _fail(f"{key}.family", f"must be 'N', 'A' or 'T' (IEC 61400-1 table 3), got "
                                      f"{family!r}")
+    if "wind_files" in raw:
+        return _file_load_case(key, raw, top, dlc, family, fat0)
     turb = _turbulence(f"{key}.turbulence", raw.get("turbulence", top["turbulence"]))
     try:
         check_condition(cond, turb)
@@ -717,13 +821,103 @@ def _load_case(i: int, raw: Any, top: Mapping[str, Any]) -> LoadCase:
         supervisor=sup, extrapolate=extrapolate)
 
 
+def _file_load_case(key: str, raw: Mapping[str, Any], top: Mapping[str, Any], dlc: str,
+                    family: str, fat0: bool) -> LoadCase:
+    """A load case of the user's wind files: one case per file, binned by its mean wind."""
+    given = [k for k in _GRID_KEYS if k in raw]
+    if given:
+        raise _fail(f"{key}.{given[0]}", "not with wind_files: each file is a case's wind "
+                                         "(its mean wind, turbulence and seed are the file's)")
+    turb = _turbulence(f"{key}.turbulence", raw.get("turbulence", top["turbulence"]))
+    if len(turb) != 1:
+        raise _fail(f"{key}.turbulence", f"with wind_files, one class or intensity that labels "
+                                         f"the files in the tables, got {list(turb)}")
+    transient = _number(f"{key}.transient", raw.get("transient", top["transient"]), 0.0)
+    duration = (None if "duration" not in raw else
+                _number(f"{key}.duration", raw["duration"], 0.0, lo_open=True))
+    files = _wind_files(f"{key}.wind_files", raw["wind_files"], top.get("base"), transient,
+                        duration)
+    extrapolate = raw.get("extrapolate", False)
+    fatigue = raw.get("fatigue", fat0)
+    for k, v in (("extrapolate", extrapolate), ("fatigue", fatigue)):
+        if not isinstance(v, bool):
+            raise _fail(f"{key}.{k}", f"must be true or false, got {v!r}")
+    sup = {**top["supervisor"], **_supervisor(f"{key}.supervisor", raw.get("supervisor"),
+                                              top["turbine"])}
+    return LoadCase(
+        dlc=dlc, condition="ntm", winds=tuple(sorted({f.wind_mps for f in files})),
+        seeds=tuple(f.index for f in files), signs=(1,), turbulence=turb, family=family,
+        fatigue=fatigue, duration=min(f.duration for f in files) - transient,
+        transient=transient, supervisor=sup, extrapolate=extrapolate, wind_files=files)
+
+
+def _file_sha256(path: Path) -> str:
+    h = hashlib.sha256()
+    with path.open("rb") as fh:
+        for block in iter(lambda: fh.read(1 << 20), b""):
+            h.update(block)
+    return h.hexdigest()
+
+
+def _wind_files(key: str, raw: Any, base: Path | None, transient: float,
+                duration: float | None) -> tuple[WindFile, ...]:
+    """The entries of ``wind_files``: a path, or {file, wind} to set the file's mean-wind bin
+    [m/s]; relative paths against the spec's folder. Each file is read once here: its length
+    must hold the transient and the duration."""
+    import lidar
+    from mpc_wt.simulation.scenario import check_wind_file, read_wind_file
+
+    if not isinstance(raw, list) or not raw:
+        raise _fail(key, f"must be a non-empty list of files (or {{file, wind}} entries), "
+                         f"got {raw!r}")
+    out: list[WindFile] = []
+    for i, entry in enumerate(raw):
+        k = f"{key}[{i}]"
+        if isinstance(entry, Mapping):
+            _keys_of(k, entry, {"file", "wind"})
+            if "file" not in entry:
+                raise _fail(f"{k}.file", "missing (the wind file's path)")
+            name, wind = entry["file"], entry.get("wind")
+        else:
+            name, wind = entry, None
+        if not isinstance(name, (str, Path)) or not str(name).strip():
+            raise _fail(k, f"must be a file's path, got {name!r}")
+        p = Path(str(name)).expanduser()
+        if not p.is_absolute() and base is not None:
+            p = base / p
+        try:
+            p = check_wind_file(p).resolve()
+            f = read_wind_file(str(p))
+        except (ValueError, lidar.FieldFileError) as err:
+            raise _fail(k, str(err)) from None
+        length = float(f.t[-1] - f.t[0])
+        sim = length - FILE_MARGIN_S if duration is None else duration + transient
+        if sim <= transient or sim > length:
+            need = (f"the transient {transient:g} s plus {FILE_MARGIN_S:g} s" if duration is None
+                    else f"the transient and duration, {duration + transient:g} s")
+            raise _fail(k, f"{str(name)!r} holds {length:g} s of wind; it must hold {need}")
+        v = (round(float(f.mean_speed)) if wind is None else
+             _number(f"{k}.wind", wind, 0.0, 60.0, lo_open=True))
+        if v <= 0:
+            raise _fail(k, f"{str(name)!r}: its mean wind {float(f.mean_speed):g} m/s rounds "
+                           f"to no bin; give {{file, wind}}")
+        out.append(WindFile(path=str(p), wind_mps=float(v), sha256=_file_sha256(p),
+                            duration=sim, index=i + 1))
+    stems = [f.stem for f in out]
+    dup = sorted({s for s in stems if stems.count(s) > 1})
+    if dup:
+        raise _fail(key, f"files of the same name {dup}: a case is named by its file; rename "
+                         f"them")
+    return tuple(out)
+
+
 def _load_cases(raw: Mapping[str, Any], duration: float, transient: float,
-                turbine: str) -> tuple[LoadCase, ...]:
+                turbine: str, base: Path | None = None) -> tuple[LoadCase, ...]:
     """The spec's load cases, or the one legacy DLC 1.2 of a spec without them."""
     sup = _supervisor("supervisor", raw.get("supervisor"), turbine)
     top = {"turbulence": raw.get("turbulence", "A"), "seeds": raw.get("seeds", 1),
            "duration": duration, "transient": transient, "supervisor": sup,
-           "turbine": turbine}
+           "turbine": turbine, "base": base}
     if "winds" in raw:
         top["winds"] = raw["winds"]
     if "load_cases" not in raw:
@@ -896,7 +1090,7 @@ def spec_from_dict(raw: Mapping[str, Any], base: Path | None = None,
     if iec_class not in ("I", "II", "III"):
         raise _fail("iec_class", f"must be 'I', 'II' or 'III' (IEC 61400-1 table 1), got "
                                  f"{iec_class!r}")
-    load_cases = _load_cases(raw, duration, transient, turbine)
+    load_cases = _load_cases(raw, duration, transient, turbine, base)
     _check_controller_grids(ctls, load_cases)
     names = [c.name for c in ctls]
     dup = sorted({n for n in names if names.count(n) > 1})
