@@ -11,10 +11,11 @@ points, 20 Hz), all DOFs, one core:
   real-time factor and as a ratio to the plant alone;
 - the scheduled kinds, which know only measurements (``mpc``, ``mpc-lidar`` on the Kalman
   estimator and the wind they estimate or the LIDAR measures; ``lqr-pio`` over its 24 designs),
-  and ``mpc-lidar`` as the paper designs it (one model at the case's 18 m/s, the plant's true
-  states: ``design_wind_mps: 18, estimator: full-state``, the like-for-like figure of earlier runs):
-  600 s wall time and the cost per controller step in the first and the last minute (a loop
-  whose cost grows with elapsed time shows a ratio above 1);
+  each beside its former point design (``mpc``/``mpc-lidar`` at the case's 18 m/s on the
+  plant's true states: ``design_wind_mps: 18, estimator: full-state``; ``lqr-pio`` designed at
+  18 m/s): 600 s wall time, the cost per controller step in the first and the last minute (a
+  loop whose cost grows with elapsed time shows a ratio above 1), and each controller's own
+  step replayed on its loop's measurements;
 - the MPC's whole step (measurements and preview in, commands out), replayed on the recorded
   measurements with each backend (DAQP, OSQP), median and p99, for the paper's design and the
   scheduled one, in this process and (paper's design) in a few fresh ones, against DAQP's solve
@@ -83,9 +84,13 @@ def _baseline(t: Any, wind: Any, op: Any, repeat: int, compiled: bool = True) ->
 #: The paper's point design of the MPC (the former default): like for like with earlier runs.
 ORACLE = {"design_wind_mps": 18.0, "estimator": "full-state"}
 
-#: Loops timed per controller step: name -> (kind, options).
+#: Loops timed per controller step: name -> (kind, options). Each scheduled kind beside its
+#: former point design (the case's 18 m/s; the MPC on the plant's true states).
 LOOPS = {"mpc_lidar_oracle": ("mpc-lidar", ORACLE), "mpc_lidar": ("mpc-lidar", None),
-         "mpc": ("mpc", None), "lqr_pio": ("lqr-pio", None)}
+         "mpc_oracle": ("mpc", ORACLE), "mpc": ("mpc", None),
+         "lqr_pio_point": ("lqr-pio", {"design_wind_mps": 18.0}), "lqr_pio": ("lqr-pio", None)}
+#: scheduled loop -> its former point design
+FORMER = {"mpc_lidar": "mpc_lidar_oracle", "mpc": "mpc_oracle", "lqr_pio": "lqr_pio_point"}
 
 
 def _timed_loop(t: Any, kind: str, options: Any) -> dict[str, Any]:
@@ -122,17 +127,7 @@ def _whole_step(t: Any, rec: list[tuple[float, dict[str, Any]]], backend: str,
     With DAQP and the paper's design, also DAQP's solve alone through its own Python ``Model``
     on a twin controller (the reference the step is held against: the solver's cost)."""
     opts = {**(ORACLE if options is None else options), "backend": backend}
-    built, _, _ = build_controller(t, "mpc-lidar", Scenario(18.0, "A", 1, 10.0), opts)
-    c = built.controller
-    c.reset()
-    times = []
-    for tt, meas in rec:
-        t0 = time.perf_counter()
-        c.step(tt, meas)
-        times.append(time.perf_counter() - t0)
-    us = np.array(times[10:]) * 1e6
-    out = {"median_us": float(np.median(us)), "p99_us": float(np.percentile(us, 99)),
-           "max_us": float(us.max())}
+    out, c = _replay(t, "mpc-lidar", opts, rec)
     if backend == "daqp" and isinstance(c, MPC):
         twin = MPC(c.model, t, c.settings.replace(solver_options={"interface": "python"}))
         timer = _Timed(twin.qp_backend.model, "solve")
@@ -142,6 +137,23 @@ def _whole_step(t: Any, rec: list[tuple[float, dict[str, Any]]], backend: str,
             twin.step(tt, meas)
         out["daqp_model_solve_median_us"] = float(np.median(timer.times[10:]) * 1e6)
     return out
+
+
+def _replay(t: Any, kind: str, options: Any, rec: list[tuple[float, dict[str, Any]]]
+            ) -> tuple[dict[str, float], Any]:
+    """A controller's own step (estimators, schedule, law or QP) replayed on its loop's
+    recorded measurements: median, p99 and max [us], and the controller."""
+    built, _, _ = build_controller(t, kind, Scenario(18.0, "A", 1, 10.0), options)
+    c = built.controller
+    c.reset()
+    times = []
+    for tt, meas in rec:
+        t0 = time.perf_counter()
+        c.step(tt, meas)
+        times.append(time.perf_counter() - t0)
+    us = np.array(times[10:]) * 1e6
+    return {"median_us": float(np.median(us)), "p99_us": float(np.percentile(us, 99)),
+            "max_us": float(us.max())}, c
 
 
 def _whole_step_processes(rec: list[tuple[float, dict[str, Any]]], n: int
@@ -200,6 +212,8 @@ def main() -> int:
         recs[name] = m.pop("rec")
         res[name] = m
         res[f"{name}_s"] = m["s"]
+    res["step_replay"] = {name: _replay(t, kind, opts, recs[name])[0]
+                          for name, (kind, opts) in LOOPS.items()}
     rec = recs["mpc_lidar_oracle"]
     res["whole_step"] = {b: _whole_step(t, rec, b) for b in ("daqp", "osqp")}
     res["whole_step_scheduled"] = {b: _whole_step(t, recs["mpc_lidar"], b, {})
@@ -222,7 +236,9 @@ def main() -> int:
                      ("baseline_python", "the same, Python loop (compiled=False)"),
                      ("mpc_lidar_oracle", "mpc-lidar, the paper's design (10 Hz)"),
                      ("mpc_lidar", "mpc-lidar, scheduled on measurements"),
+                     ("mpc_oracle", "mpc, the paper's design (10 Hz)"),
                      ("mpc", "mpc, scheduled on measurements"),
+                     ("lqr_pio_point", "lqr-pio, one design at 18 m/s (80 Hz)"),
                      ("lqr_pio", "lqr-pio, scheduled (80 Hz)")):
         print(f"{label:42s} {res[k + '_s']:7.2f} s  {res[k + '_realtime']:6.1f}x real time")
     print(f"baseline / plant alone {res['baseline_over_plant']:.2f} (Python loop "
@@ -233,6 +249,11 @@ def main() -> int:
               f"{res[k]['first_minute_us_per_step']:.0f} us, last minute "
               f"{res[k]['last_minute_us_per_step']:.0f} us (ratio "
               f"{res[k]['last_over_first']:.2f})")
+    for k, former in FORMER.items():
+        a, b0 = res["step_replay"][k], res["step_replay"][former]
+        print(f"{k} step (replayed) median {a['median_us']:.1f} us, p99 {a['p99_us']:.0f} us;"
+              f" former design {b0['median_us']:.1f} us, p99 {b0['p99_us']:.0f} us; loop "
+              f"{res[k + '_s'] / res[former + '_s']:.3f} x the former's")
     for b, w in res["whole_step_scheduled"].items():
         print(f"scheduled MPC whole step (estimators, schedule, QP), {b:5s}: median "
               f"{w['median_us']:6.1f} us, p99 {w['p99_us']:6.1f} us")

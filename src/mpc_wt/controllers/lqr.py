@@ -28,13 +28,14 @@ import math
 from dataclasses import dataclass, field
 from typing import Any, Mapping, Sequence
 
+import numba as nb
 import numpy as np
 import scipy.linalg
 
 import linearize
 from linearize.validate import check_number
 from mpc_wt.controllers.base import ControllerBase
-from mpc_wt.controllers.estimator import read_signals
+from mpc_wt.controllers.estimator import SignalReader
 from mpc_wt.errors import SynthesisError
 
 __all__ = ["LQRDesign", "PIObserver", "design_lqr", "design_lqr_family", "design_pi_observer",
@@ -383,6 +384,9 @@ class LQRPIOController(ControllerBase):
         default rotor speed).
     """
 
+    #: the step's output buffer, not design data
+    __not_design__ = ("_ubuf",)
+
     def __init__(self, model: linearize.LinearModel, turbine: linearize.Turbine,
                  lqr: LQRDesign, observer: PIObserver, *, dt: float = 1.0 / 80.0,
                  region: str = "III", k_opt: float | None = None, feedforward: bool = True,
@@ -402,6 +406,7 @@ class LQRPIOController(ControllerBase):
         self._a_law = (math.exp(-torque_law.wc * dt) if self.torque_law is not None
                        else math.nan)
         self.model, self.turbine, self.lqr, self.obs = model, turbine, lqr, observer
+        self._read = SignalReader(observer.measured)
         self.dt, self.region, self.k_opt = float(dt), region, k_opt
         nx, nf = model.A.shape[0], observer.L2.shape[0]
         nu_all = model.B_u.shape[1]
@@ -427,6 +432,13 @@ class LQRPIOController(ControllerBase):
             ainv = np.linalg.solve(acl, np.eye(nx))
             kf = np.linalg.lstsq(ainv[sel] @ bsel, ainv[sel] @ nmat, rcond=None)[0]
         self.K_f = kf
+        # the compiled step's data: the gains side by side, the inputs' columns, the limits
+        self._gain = np.ascontiguousarray(np.hstack([lqr.K, kf]))
+        self._iu_arr = np.asarray(self._iu, dtype=np.int64)
+        pa = turbine.pitch_actuator
+        self._pitch_lim = np.array([pa.min_pitch_rad, pa.max_pitch_rad])
+        self._ubuf = np.empty(nu_all)
+        self._d0_mean = float(np.mean(model.d0))
         self.reset()
 
     def reset(self) -> None:
@@ -455,24 +467,18 @@ class LQRPIOController(ControllerBase):
 
     def step(self, t: float, meas: dict[str, Any]) -> tuple[np.ndarray, float]:
         # One control step: observer update, then u = u0 - K (x_hat - x0) (+ feedforward).
-        y = read_signals(meas, self.obs.measured) - self.obs.y0
-        if not np.all(np.isfinite(y)):
+        y = self._read(meas)
+        u = self._ubuf
+        if not _lqr_pio_step(self._ad, self._bd, self._gain, self.xe, self._u_dev, y,
+                             self.obs.y0, self.model.u0, self._iu_arr, self._pitch_lim, u):
             raise ValueError(f"non-finite measurement at t = {t:g} s: "
-                             f"{dict(zip(self.obs.measured, y))}")
-        # observer: propagate over the last period with the last input and this measurement
-        self.xe = self._ad @ self.xe + self._bd @ np.concatenate([self._u_dev, y])
-        xh, fh = self.xe[:self._nx], self.xe[self._nx:]
-        du = -self.lqr.K @ xh - self.K_f @ fh
-        u_abs = self.model.u0.copy()
-        u_abs[self._iu] += du
-        pa = self.turbine.pitch_actuator
-        pitch = np.clip(u_abs[:3], pa.min_pitch_rad, pa.max_pitch_rad)
-        torque = self._torque(meas, pitch)
-        torque = float(np.clip(torque, self.turbine.generator.min_torque,
-                               self.turbine.generator.max_torque))
-        ud = np.r_[pitch, torque] - self.model.u0
-        self._u_dev = ud
-        self.signals = {"wind_est": float(np.mean(fh[:3]) + np.mean(self.model.d0))
+                             f"{dict(zip(self.obs.measured, y - self.obs.y0))}")
+        pitch = u[:3].copy()
+        g = self.turbine.generator
+        torque = min(max(self._torque(meas, pitch), g.min_torque), g.max_torque)
+        self._u_dev = np.array([pitch[0], pitch[1], pitch[2], torque]) - self.model.u0
+        fh = self.xe[self._nx:]
+        self.signals = {"wind_est": (float(fh[0] + fh[1] + fh[2]) / 3.0 + self._d0_mean)
                         if self._nf >= 3 else float(fh[0]),
                         "pitch_ref_1": float(pitch[0]), "torque_ref": torque}
         return pitch, torque
@@ -486,7 +492,42 @@ class LQRPIOController(ControllerBase):
             return float(self.k_opt * w ** 2)
         a = self._a_law
         self._w_filt = w if self._w_filt is None else a * self._w_filt + (1 - a) * w
-        return float(self.torque_law.torque(self._w_filt, float(np.mean(pitch))))
+        return float(self.torque_law.torque(self._w_filt, float(pitch.sum()) / pitch.size))
+
+
+@nb.njit(cache=True, nogil=True)
+def _lqr_pio_step(ad: np.ndarray, bd: np.ndarray, gain: np.ndarray, xe: np.ndarray,
+                  u_dev: np.ndarray, y: np.ndarray, y0: np.ndarray, u0: np.ndarray,
+                  iu: np.ndarray, pitch_lim: np.ndarray,
+                  u: np.ndarray) -> bool:  # pragma: no cover (compiled)
+    """:meth:`LQRPIOController.step`'s linear part in place: the observer over the last period,
+    xe = A_d xe + B_d [u_dev; y - y0], then the command u = u0, u[iu] -= [K K_f] xe, its
+    pitch clipped to ``pitch_lim``. False, with nothing changed, on a non-finite measurement."""
+    n, nu, ny = xe.shape[0], u_dev.shape[0], y.shape[0]
+    for j in range(ny):
+        if not np.isfinite(y[j]):
+            return False
+    new = np.empty(n)
+    for i in range(n):
+        acc = 0.0
+        for k in range(n):
+            acc += ad[i, k] * xe[k]
+        for k in range(nu):
+            acc += bd[i, k] * u_dev[k]
+        for j in range(ny):
+            acc += bd[i, nu + j] * (y[j] - y0[j])
+        new[i] = acc
+    xe[:] = new
+    for k in range(u0.shape[0]):
+        u[k] = u0[k]
+    for r in range(iu.shape[0]):
+        acc = 0.0
+        for k in range(n):
+            acc += gain[r, k] * xe[k]
+        u[iu[r]] -= acc
+    for k in range(3):
+        u[k] = min(max(u[k], pitch_lim[0]), pitch_lim[1])
+    return True
 
 
 class ScheduledLQRPIO(ControllerBase):

@@ -567,6 +567,7 @@ class MPC(ControllerBase):
                              f"{lam_min:g})")
         self._psi, self._theta, self._qbar, self._h = psi, theta, qbar, h
         self._nx, self._nu, self._nd = nx, nu, nd
+        self._wind_est_names = tuple(f"wind_est_{i + 1}" for i in range(nd))
         self._up0 = np.zeros(nu)
         vars(k).update(a=a, b=b, bd=bd, c=c, du=du, dd=dd, nx=nx, nu=nu, nd=nd, nz=nz, hp=hp,
                        hu=hu, q1=q1, psi=psi, theta=theta, phi=phi, qbar=qbar, rbar=rbar,
@@ -1039,9 +1040,8 @@ class MPC(ControllerBase):
                      else self._u_abs(self._u_prev) - self.model.u0)
             xe, dhat = self.estimator.update(self.estimator.measurement(meas), u_dev)
             z[1:1 + nx] = xe
-            dprev = np.tile(dhat, (self.hp, 1))
-            self.signals_est = {f"wind_est_{i + 1}": float(v + self.model.d0[i])
-                                for i, v in enumerate(dhat)}
+            dprev = dhat
+            self.signals_est = dict(zip(self._wind_est_names, (dhat + self.model.d0).tolist()))
         else:
             st = meas.get("state")
             if st is None:
@@ -1064,10 +1064,10 @@ class MPC(ControllerBase):
             raise ValueError("this MPC was built with preview='lidar' but the harness gives no "
                              "preview: pass simulate_closed_loop(..., preview=LidarPreview(...))")
         if dprev is not None and blade.shape[0] == 0:          # the estimator's wind, held
-            if dprev.shape != (self.hp, self._nd):
-                raise ValueError(f"preview has shape {dprev.shape}; expected (H_p, n_d) = "
-                                 f"({self.hp}, {self._nd})")
-            z[1 + nx + nu:] = dprev.ravel()
+            if dprev.shape != (self._nd,):
+                raise ValueError(f"the estimated wind has shape {dprev.shape}; expected "
+                                 f"(n_d,) = ({self._nd},)")
+            z[1 + nx + nu:].reshape(self.hp, self._nd)[:] = dprev
         t_qp = time.perf_counter()
         v, status = self._solve_z(dprev is not None or blade.shape[0] > 0, st,
                                   self._up0 if self._u_prev is None else self._u_prev, blade)

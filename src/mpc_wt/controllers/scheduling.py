@@ -9,6 +9,7 @@ grid wind nearest the first estimate: nothing of the case is known before it.
 """
 from __future__ import annotations
 
+import bisect
 import math
 from typing import Any
 
@@ -82,6 +83,7 @@ class WindSchedule:
         if source not in SCHEDULE_SOURCES:
             raise ValueError(f"source must be one of {SCHEDULE_SOURCES}, got {source!r}")
         self.grid, self.source = g, source
+        self._mid = (0.5 * (g[1:] + g[:-1])).tolist()     # the midpoints between grid winds
         self.dt = check_number("dt", dt, lo=0.0, lo_open=True, unit="s")
         self.tau = check_number("time_constant", time_constant, lo=0.0, unit="s")
         self.hyst = check_number("hysteresis", hysteresis, lo=0.0, unit="m/s")
@@ -138,11 +140,11 @@ class WindSchedule:
             raise ValueError(f"scheduling wind is not finite ({w!r})")
         if self.wind is None:
             self.wind = w
-            self.active = int(np.argmin(np.abs(self.grid - w)))
+            self.active = bisect.bisect_left(self._mid, w)      # the nearest grid wind
             return self.active, False
         a = 1.0 if self.tau == 0 else min(1.0, self.dt / self.tau)
         self.wind += a * (w - self.wind)
-        k, now = int(np.argmin(np.abs(self.grid - self.wind))), int(self.active or 0)
+        k, now = bisect.bisect_left(self._mid, self.wind), int(self.active or 0)
         if k != now and abs(self.wind - 0.5 * (self.grid[k] + self.grid[now])) > self.hyst:
             self.active = k
             self.switches += 1

@@ -24,6 +24,7 @@ import math
 from dataclasses import dataclass
 from typing import Any
 
+import numba as nb
 import numpy as np
 from scipy.interpolate import RectBivariateSpline
 from scipy.optimize import brentq
@@ -84,6 +85,105 @@ def estimator_performance(turbine: linearize.Turbine, shear_exponent: float = 0.
                                        shear_exponent=shear_exponent)
 
 
+@nb.njit(cache=True, nogil=True)
+def _basis(t: np.ndarray, k: int, x: float, out: np.ndarray,
+           dout: np.ndarray) -> int:  # pragma: no cover (compiled)
+    """The k + 1 B-spline basis functions of degree k on knots ``t`` that are non-zero at x
+    and their first derivatives (de Boor's recurrence, Piegl and Tiller's algorithms A2.2 and
+    A2.3), into ``out`` and ``dout``; x is clamped to the spline's interval, as FITPACK's
+    ``bispev`` does. Returns the index of the first of them."""
+    n = t.shape[0] - k - 1
+    x = min(max(x, t[k]), t[n])
+    span = k
+    while span < n - 1 and x >= t[span + 1]:
+        span += 1
+    left = np.empty(k + 1)
+    right = np.empty(k + 1)
+    out[0] = 1.0
+    for j in range(1, k + 1):
+        left[j] = x - t[span + 1 - j]
+        right[j] = t[span + j] - x
+        saved = 0.0
+        for r in range(j):
+            tmp = out[r] / (right[r + 1] + left[j - r])
+            out[r] = saved + right[r + 1] * tmp
+            saved = left[j - r] * tmp
+        out[j] = saved
+        if j == k - 1:          # degree k - 1: the derivative's ingredients
+            for r in range(k + 1):
+                i = span - k + r
+                a = out[r - 1] / (t[i + k] - t[i]) if r >= 1 else 0.0
+                b = out[r] / (t[i + k + 1] - t[i + 1]) if r <= k - 1 else 0.0
+                dout[r] = k * (a - b)
+    if k == 0:
+        dout[0] = 0.0
+    return span - k
+
+
+@nb.njit(cache=True, nogil=True)
+def _spline2(tx: np.ndarray, ty: np.ndarray, c: np.ndarray, kx: int, ky: int, x: float,
+             y: float) -> tuple[float, float]:  # pragma: no cover (compiled)
+    """A tensor-product spline (FITPACK's tx, ty, c) and its x-derivative at (x, y)."""
+    bx, dbx = np.empty(kx + 1), np.empty(kx + 1)
+    by, dby = np.empty(ky + 1), np.empty(ky + 1)
+    ix = _basis(tx, kx, x, bx, dbx)
+    iy = _basis(ty, ky, y, by, dby)
+    ncy = ty.shape[0] - ky - 1
+    val, dval = 0.0, 0.0
+    for r in range(kx + 1):
+        row = 0.0
+        for q in range(ky + 1):
+            row += c[(ix + r) * ncy + iy + q] * by[q]
+        val += bx[r] * row
+        dval += dbx[r] * row
+    return val, dval
+
+
+#: :class:`WindSpeedEstimator`'s constants in one array for the compiled step.
+_RADIUS, _RHO, _GEAR, _INERTIA, _DT, _Q0, _Q1, _R, _VMIN, _VMAX, _TSR0, _TSR1 = range(12)
+
+
+@nb.njit(cache=True, nogil=True)
+def _aero_torque(tx: np.ndarray, ty: np.ndarray, c: np.ndarray, kx: int, ky: int,
+                 k: np.ndarray, wind: float, rotor_speed: float,
+                 pitch: float) -> tuple[float, float, float]:  # pragma: no cover (compiled)
+    """:meth:`WindSpeedEstimator.aero_torque`, compiled."""
+    v, w = max(wind, 0.1), max(rotor_speed, 1e-3)
+    radius = k[_RADIUS]
+    lam = min(max(w * radius / v, k[_TSR0]), k[_TSR1])
+    cp, dcp = _spline2(tx, ty, c, kx, ky, lam, pitch)
+    g = 0.5 * k[_RHO] * math.pi * radius**2
+    q = g * v**3 * cp / w
+    dq_dv = g * (3.0 * v**2 * cp - v**3 * dcp * lam / v) / w
+    dq_dw = g * v**3 * (dcp * radius / v / w - cp / w**2)
+    return q, dq_dv, dq_dw
+
+
+@nb.njit(cache=True, nogil=True)
+def _ekf_step(tx: np.ndarray, ty: np.ndarray, c: np.ndarray, kx: int, ky: int, k: np.ndarray,
+              x: np.ndarray, p: np.ndarray, u: np.ndarray,
+              rotor_speed: float) -> None:  # pragma: no cover (compiled)
+    """One predict-correct step of :meth:`WindSpeedEstimator.step` in place on the state x
+    (rotor speed, wind), its covariance p (2 x 2) with the last inputs u (pitch, torque)."""
+    w, v = x[0], x[1]
+    q, dq_dv, dq_dw = _aero_torque(tx, ty, c, kx, ky, k, v, w, u[0])
+    h = k[_DT] / k[_INERTIA]
+    x0 = w + h * (q - k[_GEAR] * u[1])
+    a, b = 1.0 + h * dq_dw, h * dq_dv
+    p00, p01, p10, p11 = p[0, 0], p[0, 1], p[1, 0], p[1, 1]
+    n00 = a * (a * p00 + b * p10) + b * (a * p01 + b * p11) + k[_Q0]
+    n01 = a * p01 + b * p11
+    n10 = a * p10 + b * p11
+    n11 = p11 + k[_Q1]
+    s = n00 + k[_R]
+    g0, g1 = n00 / s, n10 / s
+    e = rotor_speed - x0
+    x[0] = x0 + g0 * e
+    x[1] = min(max(v + g1 * e, k[_VMIN]), k[_VMAX])
+    p[0, 0], p[0, 1] = n00 - g0 * n00, n01 - g0 * n01
+    p[1, 0], p[1, 1] = n10 - g1 * n00, n11 - g1 * n01
+
+
 class WindSpeedEstimator:
     """Extended Kalman filter for the rotor-effective wind speed (module docstring).
 
@@ -121,18 +221,23 @@ class WindSpeedEstimator:
         table = (estimator_performance(turbine, self.settings.shear_exponent)
                  if performance is None else performance)
         tsr, pitch = np.asarray(table.tsr, float), np.asarray(table.pitch_deg, float)
-        self._cp = RectBivariateSpline(tsr, np.radians(pitch), table.cp, kx=3, ky=3)
-        self._tsr_range = (tsr[0], tsr[-1])
+        spline = RectBivariateSpline(tsr, np.radians(pitch), table.cp, kx=3, ky=3)
+        tx, ty, c = spline.tck
+        self._spline = (np.ascontiguousarray(tx, float), np.ascontiguousarray(ty, float),
+                        np.ascontiguousarray(c, float), *spline.degrees)
         s = self.settings
-        self._q = np.diag([(s.torque_model_std / self.inertia) ** 2 * self.dt,
-                           s.wind_std_per_sqrt_s**2 * self.dt])
-        self._r = s.speed_std**2
+        self._k = np.array([self.radius, self.rho, self.gear, self.inertia, self.dt,
+                            (s.torque_model_std / self.inertia) ** 2 * self.dt,
+                            s.wind_std_per_sqrt_s**2 * self.dt, s.speed_std**2,
+                            *self.wind_range, tsr[0], tsr[-1]])
+        self._u = np.zeros(2)
         self.reset()
 
     def reset(self) -> None:
         """Forget the estimate: the next step starts again from the measured torque balance."""
         self.x: np.ndarray | None = None          # [rotor speed, wind]
         self.p = np.diag([self.settings.speed_std**2, 1.0])
+        self._u = np.zeros(2)
 
     @property
     def estimate(self) -> float | None:
@@ -161,16 +266,9 @@ class WindSpeedEstimator:
         dq_domega : float
             Its derivative with respect to the rotor speed [N m s/rad].
         """
-        v, w = max(wind, 0.1), max(rotor_speed, 1e-3)
-        lam = min(max(w * self.radius / v, self._tsr_range[0]), self._tsr_range[1])
-        cp = float(self._cp.ev(lam, pitch))
-        dcp = float(self._cp.ev(lam, pitch, dx=1))
-        k = 0.5 * self.rho * math.pi * self.radius**2
-        q = k * v**3 * cp / w
         # d/dv: lambda = w R / v, d lambda / dv = -lambda / v
-        dq_dv = k * (3.0 * v**2 * cp - v**3 * dcp * lam / v) / w
-        dq_dw = k * v**3 * (dcp * self.radius / v / w - cp / w**2)
-        return q, dq_dv, dq_dw
+        return _aero_torque(*self._spline, self._k, float(wind), float(rotor_speed),
+                            float(pitch))
 
     def _balance(self, rotor_speed: float, pitch: float, gen_torque: float) -> float:
         """The wind at which the aerodynamic torque balances the generator's, or the nearest
@@ -210,22 +308,11 @@ class WindSpeedEstimator:
                 raise ValueError(f"measurement {name} must be finite, got {val!r}")
         if self.x is None:
             self.x = np.array([rotor_speed, self._balance(rotor_speed, pitch, gen_torque)])
-            self._u = (pitch, gen_torque)
-            return float(self.x[1])
-        # predict with the previous step's inputs (held over the step)
-        w, v = self.x
-        q, dq_dv, dq_dw = self.aero_torque(v, w, self._u[0])
-        dt, j = self.dt, self.inertia
-        x_pred = np.array([w + dt / j * (q - self.gear * self._u[1]), v])
-        f = np.array([[1.0 + dt / j * dq_dw, dt / j * dq_dv], [0.0, 1.0]])
-        p = f @ self.p @ f.T + self._q
-        # update with the measured rotor speed
-        s = p[0, 0] + self._r
-        k = p[:, 0] / s
-        self.x = x_pred + k * (rotor_speed - x_pred[0])
-        self.x[1] = min(max(self.x[1], self.wind_range[0]), self.wind_range[1])
-        self.p = p - np.outer(k, p[0, :])
-        self._u = (pitch, gen_torque)
+        else:
+            # predict with the previous step's inputs (held over the step), then correct with
+            # the measured rotor speed: x = f(x, u) + k (omega - f_omega), P = (I - k h) F P F' + Q
+            _ekf_step(*self._spline, self._k, self.x, self.p, self._u, float(rotor_speed))
+        self._u[0], self._u[1] = pitch, gen_torque
         return float(self.x[1])
 
     def step_measurements(self, meas: dict[str, Any]) -> float:
@@ -242,5 +329,7 @@ class WindSpeedEstimator:
         float
             The estimate [m/s].
         """
-        return self.step(float(meas["rotor_speed"]), float(np.mean(meas["pitch"])),
-                         float(meas["gen_torque"]))
+        p = meas["pitch"]
+        pitch = (float(p[0]) + float(p[1]) + float(p[2])) / 3.0 if len(p) == 3 else \
+            float(np.mean(p))
+        return self.step(float(meas["rotor_speed"]), pitch, float(meas["gen_torque"]))

@@ -10,6 +10,8 @@ import tempfile
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 from numpy.testing import assert_allclose
 
 import lidar
@@ -156,3 +158,22 @@ def test_bad_input_is_named(turbine, estimator) -> None:
     with pytest.raises(ValueError, match="measurement rotor_speed must be finite, got nan"):
         estimator.step(float("nan"), 0.0, 4e4)
     assert estimator.estimate is None
+
+
+@settings(max_examples=200, deadline=None)
+@given(st.floats(-2.0, 21.0), st.floats(-0.3, 0.9), st.integers(2, 5), st.integers(1, 5))
+def test_compiled_spline_is_fitpacks(x: float, y: float, kx: int, ky: int) -> None:
+    """The estimator's compiled tensor-product spline and its x-derivative against FITPACK's
+    (scipy's ``RectBivariateSpline.ev``), inside and outside the knots (both clamp), for
+    degrees 2-5 in x (FITPACK's derivative needs one more than its order) and 1-5 in y."""
+    from scipy.interpolate import RectBivariateSpline
+
+    from mpc_wt.controllers.wind_estimator import _spline2
+
+    gx, gy = np.linspace(1.0, 18.0, 23), np.radians(np.linspace(-5.0, 40.0, 19))
+    z = np.sin(gx[:, None] / 3.0) * np.cos(2.0 * gy[None, :]) + 0.01 * gx[:, None] ** 2
+    s = RectBivariateSpline(gx, gy, z, kx=kx, ky=ky)
+    tx, ty, c = s.tck
+    v, d = _spline2(tx, ty, c, kx, ky, x, y)
+    assert v == pytest.approx(float(s.ev(x, y)), abs=1e-12)
+    assert d == pytest.approx(float(s.ev(x, y, dx=1)), abs=1e-11)

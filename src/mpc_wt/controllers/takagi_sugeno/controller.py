@@ -13,7 +13,7 @@ import scipy.linalg
 import linearize
 from linearize.validate import check_number
 from mpc_wt.controllers.base import ControllerBase
-from mpc_wt.controllers.estimator import read_signals
+from mpc_wt.controllers.estimator import SignalReader
 from mpc_wt.controllers.takagi_sugeno.model import TSModel
 from mpc_wt.controllers.takagi_sugeno.synthesis import TSControllerDesign, TSObserverDesign
 
@@ -79,6 +79,7 @@ class TSController(ControllerBase):
             m[:n, :n], m[:n, n:] = f, g
             e = scipy.linalg.expm(m * dt)
             self._phi[i], self._gam[i] = e[:n, :n], e[:n, n:]
+        self._read = SignalReader(ts.measured)
         self.reset()
 
     def reset(self) -> None:
@@ -113,7 +114,7 @@ class TSController(ControllerBase):
 
     def step(self, t: float, meas: dict[str, Any]) -> tuple[np.ndarray, float]:
         # Observer update, memberships, PDC control law (Clemens eqs 5-10).
-        y = read_signals(meas, self.ts.measured)
+        y = self._read(meas)
         if not np.all(np.isfinite(y)):
             raise ValueError(f"non-finite measurement at t = {t:g} s: "
                              f"{dict(zip(self.ts.measured, y))}")
