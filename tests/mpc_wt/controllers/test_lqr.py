@@ -2,6 +2,7 @@
 observer of Do et al. (eqs 13-16), LQR+PIO in the loop, bad input."""
 from __future__ import annotations
 
+import functools
 import math
 
 import numpy as np
@@ -22,10 +23,16 @@ from mpc_wt.controllers.lqr import (
 from mpc_wt.errors import SynthesisError
 
 
-def _scalar_model(a: float, b: float, dt: float | None = None) -> linearize.LinearModel:
+@functools.lru_cache(maxsize=1)
+def _rotor_speed_model() -> linearize.LinearModel:
+    """A real model's structure (names, units) to put the scalar systems in."""
     base = linearize.linearize(linearize.load_turbine(), 18.0,
                                config=linearize.PlantConfig.madsen())
-    m = base.select(outputs=["rotor_speed"])
+    return base.select(outputs=["rotor_speed"])
+
+
+def _scalar_model(a: float, b: float, dt: float | None = None) -> linearize.LinearModel:
+    m = _rotor_speed_model()
     import dataclasses
 
     return dataclasses.replace(
