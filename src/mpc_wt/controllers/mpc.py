@@ -22,6 +22,7 @@ applied, else the previous command is held; the fallback used is recorded in ``s
 """
 from __future__ import annotations
 
+import bisect
 import dataclasses
 import logging
 import math
@@ -681,11 +682,19 @@ class MPC(ControllerBase):
         gu = np.zeros((nvu + ns, nu))
         gx[:nvu], gd[:nvu] = su[:nvu, None] * (g @ psi), su[:nvu, None] * (g @ phi)
         gu[:nvu] = -su[:nvu, None] * (dmat.T @ wr)[:, :nu]
+        # the targets r_z, r_u held over the horizon: cost (z - r_z)' Q (z - r_z) +
+        # (u - r_u)' R (u - r_u), so q = ... - Theta' Qbar (1 x r_z) - Rbar (1 x r_u)
+        nzo = k.nz
+        grz, gru = np.zeros((nvu + ns, nzo)), np.zeros((nvu + ns, nu))
+        grz[:nvu] = -su[:nvu, None] * (g @ np.kron(np.ones((k.hp, 1)), np.eye(nzo)))
+        gru[:nvu] = -su[:nvu, None] * (k.rbar @ np.kron(np.ones((hu, 1)), np.eye(nu)))
+        lr = np.zeros((ncon, nzo + nu))
         q0 = np.zeros(nvu + ns)
         if soft:
             q0[-ns:] = self.slack_linear
         w_orig = np.hstack([np.concatenate([q0, lo_s, hi_s])[:, None], np.vstack([gx, lx, lx]),
-                            np.vstack([gu, lu, lu]), np.vstack([gd, ld, ld])])
+                            np.vstack([gu, lu, lu]), np.vstack([np.hstack([grz, gru]), lr, lr]),
+                            np.vstack([gd, ld, ld])])
         self._nv, self._ncon, self._nvu = nvu + ns, ncon, nvu
         self._h_s = np.ascontiguousarray(h_s)
         self._a_gen_s = np.ascontiguousarray(acon_s[nvu + ns:])  # rows after the box bounds
@@ -698,7 +707,7 @@ class MPC(ControllerBase):
         ac = acon_s @ wc
         w_shift = np.vstack([wc, w_orig[nvv:nvv + ncon] - ac, w_orig[nvv + ncon:] - ac])
         self._w_orig = np.ascontiguousarray(w_orig)
-        nzd = 1 + nx + nu                     # [1, x, u_prev] columns; the preview follows
+        nzd = 1 + nx + 2 * nu + nzo           # [1, x, u_prev, r_z, r_u]; the preview follows
         self._nzd = nzd
         self._z = np.zeros(w_shift.shape[1])
         self._z[0] = 1.0
@@ -732,10 +741,13 @@ class MPC(ControllerBase):
         ns = hp if soft else 0
         nvu, nxv = hu * nu, (hp - 1) * nx
         nv = nvu + nxv + ns
-        nzd = 1 + nx + nu + hp * nd                        # data: [1, x_0, u_prev, d_0..d_hp-1]
+        # data: [1, x_0, u_prev, r_z, r_u, d_0..d_hp-1]
+        nr = nz + nu
+        nzd = 1 + nx + nu + nr + hp * nd
         iu = [slice(min(i, hu - 1) * nu, (min(i, hu - 1) + 1) * nu) for i in range(hp)]
         ix = [None] + [slice(nvu + (i - 1) * nx, nvu + i * nx) for i in range(1, hp)]
-        col_d = [slice(1 + nx + nu + i * nd, 1 + nx + nu + (i + 1) * nd) for i in range(hp)]
+        d0c = 1 + nx + nu + nr
+        col_d = [slice(d0c + i * nd, d0c + (i + 1) * nd) for i in range(hp)]
         # outputs z = G v + G0 z_data
         g = np.zeros((hp * nz, nv))
         g0 = np.zeros((hp * nz, nzd))
@@ -752,6 +764,9 @@ class MPC(ControllerBase):
         pmat[:nvu, :nvu] += k["rbar"] + k["dmat"].T @ k["wr"] @ k["dmat"]
         qz = g.T @ qbar @ g0
         qz[:nvu, 1 + nx:1 + nx + nu] -= (k["dmat"].T @ k["wr"])[:, :nu]
+        # the targets held over the horizon (as the condensed form's)
+        qz[:, 1 + nx + nu:1 + nx + nu + nz] -= g.T @ qbar @ np.kron(np.ones((hp, 1)), np.eye(nz))
+        qz[:nvu, 1 + nx + nu + nz:d0c] -= k["rbar"] @ np.kron(np.ones((hu, 1)), np.eye(nu))
         # state scales: largest response to a unit scaled input over the horizon
         resp, ap = np.zeros(nx), np.eye(nx)
         for _ in range(hp):
@@ -853,8 +868,7 @@ class MPC(ControllerBase):
         w_shift = np.vstack([cz, lo_map - ac, hi_map - ac])
         w_shift[nv + nvu + ns:nv + nvu + ns + neq] = 0.0        # equalities hold at c exactly
         w_shift[nv + len(rs) + nvu + ns:nv + len(rs) + nvu + ns + neq] = 0.0
-        nzn = 1 + nx + nu
-        self._nzd = nzn
+        self._nzd = 1 + nx + 2 * nu + q.nz
         self._set_map(w_shift, nv)
         self._slack0 = nvu + nxv
         self._sparse_shape = (nv, len(rs))
@@ -871,7 +885,43 @@ class MPC(ControllerBase):
         self._last_slack = 0.0
         if getattr(self, "estimator", None) is not None:
             self.estimator.reset()
+        self.set_target()
         self.signals: dict[str, float] = {}
+
+    def set_target(self, z_target: np.ndarray | None = None,
+                   u_target: np.ndarray | None = None) -> None:
+        """The steady state the cost tracks from the next step on, in absolute units: the
+        performance outputs (Madsen's z, the model's output order) and the inputs (three
+        pitch angles [rad] and the generator torque [N m]); held over the horizon. None (the
+        default, and after :meth:`reset`): the operating point of the model.
+
+        Below rated wind the operating point of a grid wind is not where the turbine should be
+        at another wind: a scheduled MPC sets the trim at the wind it measures
+        (:class:`ScheduledMPC`), so that it tracks the power-optimal speed and torque there
+        instead of holding the grid point's power.
+
+        Parameters
+        ----------
+        z_target : (n_z,) ndarray, optional
+            Performance outputs [their units].
+        u_target : (4,) ndarray, optional
+            Pitch 1-3 [rad], generator torque [N m].
+        """
+        nx, nu = self._nx, self._nu
+        nzo = len(self.model.outputs)
+        r = self._z[1 + nx + nu:self._nzd]
+        if z_target is None:
+            r[:nzo] = 0.0
+        else:
+            r[:nzo] = np.asarray(z_target, float) - self.model.z0
+        if u_target is None:
+            r[nzo:] = 0.0
+        else:
+            du = np.asarray(u_target, float) - self.model.u0
+            if self.collective:
+                r[nzo], r[nzo + 1] = (du[0] + du[1] + du[2]) / 3.0, du[3]
+            else:
+                r[nzo:] = du
 
     def _u_abs(self, du: np.ndarray) -> np.ndarray:
         u0 = self.model.u0
@@ -913,7 +963,7 @@ class MPC(ControllerBase):
             if dp.shape != (hp, nd):
                 raise ValueError(f"d_preview has shape {dp.shape}; expected (H_p, n_d) = "
                                  f"({hp}, {nd})")
-            z[1 + nx + nu:] = dp.ravel()
+            z[self._nzd:] = dp.ravel()
         v, status = self._solve_z(d_preview is not None)
         return (None if v is None else (v[:self._nvu] * self._su[:self._nvu]).reshape(hu, nu)), \
             status
@@ -1067,7 +1117,7 @@ class MPC(ControllerBase):
             if dprev.shape != (self._nd,):
                 raise ValueError(f"the estimated wind has shape {dprev.shape}; expected "
                                  f"(n_d,) = ({self._nd},)")
-            z[1 + nx + nu:].reshape(self.hp, self._nd)[:] = dprev
+            z[self._nzd:].reshape(self.hp, self._nd)[:] = dprev
         t_qp = time.perf_counter()
         v, status = self._solve_z(dprev is not None or blade.shape[0] > 0, st,
                                   self._up0 if self._u_prev is None else self._u_prev, blade)
@@ -1162,12 +1212,25 @@ class ScheduledMPC(ControllerBase):
         The scheduling wind's estimator at the MPC's ``dt`` (default: made here).
     prebuild : bool
         Build every grid point's MPC now (default); False builds each on first use.
+    target_time_constant : float or None
+        Low-pass [s] of the measured wind at which the family's trim is the cost's target
+        (:meth:`MPC.set_target`, default 10); None: each design's own operating point
+        (Madsen's).
+    torque_law : object, optional
+        A torque law with ``torque(gen_speed, pitch)`` and a speed filter ``wc`` [rad/s] (the
+        baseline's, :class:`~mpc_wt.controllers.baseline.BaselineController`): the target
+        torque at the measured generator speed, and the power target capped at what that
+        torque gives there.
+    below_rated : MPCSettings, optional
+        Settings of the designs at grid winds below rated (default: ``settings``).
     """
 
     def __init__(self, family: linearize.LinearModelFamily, turbine: linearize.Turbine,
                  settings: MPCSettings | None = None, *, wind_source: str = "estimator",
                  time_constant: float = 30.0, hysteresis: float = 0.25,
-                 wind_estimator: Any = None, prebuild: bool = True) -> None:
+                 wind_estimator: Any = None, prebuild: bool = True,
+                 target_time_constant: float | None = 10.0, torque_law: Any = None,
+                 below_rated: MPCSettings | None = None) -> None:
         from mpc_wt.controllers.scheduling import SCHEDULE_SOURCES, WindSchedule
 
         if wind_source not in SCHEDULE_SOURCES:
@@ -1181,6 +1244,22 @@ class ScheduledMPC(ControllerBase):
                                      estimator=wind_estimator)
         self.dt = st.dt
         self._ctl: dict[int, MPC] = {}
+        # the trim over the grid: the target at the measured wind
+        if target_time_constant is not None:
+            check_number("target_time_constant", target_time_constant, lo=0.0, unit="s")
+        self.target_tau = target_time_constant
+        self._grid = [float(v) for v in family.wind_mps]
+        self._z_trim = np.array([m.z0[[m.outputs.index(n) for n in linearize.MADSEN_OUTPUTS]]
+                                 for m in family.models])
+        self._u_trim = np.array([m.u0 for m in family.models])
+        self.below_rated = below_rated
+        self._rated_wind = linearize.rated_wind_speed(turbine)
+        self.torque_law = torque_law
+        self._a_law = math.exp(-torque_law.wc * st.dt) if torque_law is not None else math.nan
+        self._ip = linearize.MADSEN_OUTPUTS.index("gen_power")
+        m0 = family.models[0]
+        self._eff = float(m0.z0[m0.outputs.index("gen_power")]
+                          / (m0.u0[3] * m0.x0[m0.states.index("gen_speed")]))
         if prebuild:
             for k in range(len(family.wind_mps)):
                 self.controller(k)
@@ -1200,7 +1279,11 @@ class ScheduledMPC(ControllerBase):
             Its controller.
         """
         if k not in self._ctl:
-            self._ctl[k] = MPC(self.family.models[k], self.turbine, self.settings)
+            st = self.settings
+            if self.below_rated is not None and \
+                    self.family.wind_mps[k] < self._rated_wind - 1e-9:
+                st = self.below_rated
+            self._ctl[k] = MPC(self.family.models[k], self.turbine, st)
         return self._ctl[k]
 
     @property
@@ -1213,7 +1296,53 @@ class ScheduledMPC(ControllerBase):
         self.schedule.reset()
         for c in self._ctl.values():
             c.reset()
+        self.target_wind: float | None = None
+        self._w_law: float | None = None
         self.signals: dict[str, float] = {}
+
+    def _target(self, meas: dict[str, Any]) -> tuple[np.ndarray, np.ndarray]:
+        """This step's target: the trim at the low-passed measured wind; with a torque law,
+        its torque at the measured generator speed, and no more power than that torque gives
+        there (so that a rotor slower than the trim is never asked to hold the trim's power,
+        which is how a power-tracking MPC stalls the rotor in a lull)."""
+        z, u = self.trim_at(self.target_wind)          # type: ignore[arg-type]
+        law = self.torque_law
+        if law is None:
+            return z, u
+        w = float(meas["gen_speed"])
+        a = self._a_law
+        self._w_law = w if self._w_law is None else a * self._w_law + (1.0 - a) * w
+        p = meas["pitch"]
+        g = self.turbine.generator
+        q = min(max(law.torque(self._w_law, (float(p[0]) + float(p[1]) + float(p[2])) / 3.0),
+                    g.min_torque), g.max_torque)
+        z, u = z.copy(), u.copy()
+        u[3] = q
+        z[self._ip] = min(z[self._ip], self._eff * q * w)
+        return z, u
+
+    def trim_at(self, wind: float) -> tuple[np.ndarray, np.ndarray]:
+        """The family's trim at ``wind``, linear between its grid winds (held beyond them).
+
+        Parameters
+        ----------
+        wind : float
+            [m/s]
+
+        Returns
+        -------
+        z : (n_z,) ndarray
+            Madsen's performance outputs at the trim.
+        u : (4,) ndarray
+            Pitch 1-3 [rad] and generator torque [N m].
+        """
+        g = self._grid
+        i = min(max(bisect.bisect_right(g, wind) - 1, 0), len(g) - 2) if len(g) > 1 else 0
+        if len(g) == 1:
+            return self._z_trim[0], self._u_trim[0]
+        a = min(max((wind - g[i]) / (g[i + 1] - g[i]), 0.0), 1.0)
+        return ((1.0 - a) * self._z_trim[i] + a * self._z_trim[i + 1],
+                (1.0 - a) * self._u_trim[i] + a * self._u_trim[i + 1])
 
     def step(self, t: float, meas: dict[str, Any]) -> tuple[np.ndarray, float]:
         """Update the schedule, switch (handing over) when it says so, step the active MPC.
@@ -1233,7 +1362,16 @@ class ScheduledMPC(ControllerBase):
             [N m]
         """
         k, ctl = self.schedule.acting(meas, self.controller)
+        if self.target_tau is not None:
+            w = float(self.schedule.measured)        # type: ignore[arg-type]
+            if self.target_wind is None:
+                self.target_wind = w
+            else:
+                a = 1.0 if self.target_tau == 0 else min(1.0, self.dt / self.target_tau)
+                self.target_wind += a * (w - self.target_wind)
+            ctl.set_target(*self._target(meas))
         u = ctl.step(t, meas)
         self.signals = dict(ctl.signals, schedule_wind=float(self.schedule.wind or math.nan),
-                            schedule_grid_wind=float(self.family.wind_mps[k]))
+                            schedule_grid_wind=float(self.family.wind_mps[k]),
+                            target_wind=float(self.target_wind or math.nan))
         return u

@@ -100,6 +100,7 @@ class WindSchedule:
         """Forget the wind: the next :meth:`update` starts the schedule again."""
         self.estimator.reset()
         self.wind: float | None = None
+        self.measured: float | None = None      # this step's wind before the low-pass
         self.active: int | None = None
         self.switches = 0
 
@@ -138,6 +139,7 @@ class WindSchedule:
         w = self.measured_wind(meas)
         if not math.isfinite(w):
             raise ValueError(f"scheduling wind is not finite ({w!r})")
+        self.measured = w
         if self.wind is None:
             self.wind = w
             self.active = bisect.bisect_left(self._mid, w)      # the nearest grid wind

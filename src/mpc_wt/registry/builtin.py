@@ -7,6 +7,7 @@ loop, :mod:`mpc_wt.controllers.discon`).
 """
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass
 from typing import Any, Optional
@@ -297,6 +298,14 @@ class MPCOptions(Options):
                                               lo_open=True)
     schedule_step: float = option(1.0, help="spacing of the scheduled designs' grid",
                                   unit="m/s", lo=0.1, hi=5.0, flag="")
+    schedule_time_constant: float = option(3.0, help="low-pass of the scheduling wind "
+                                           "(the designs switch at 0.25 m/s past the midpoint "
+                                           "between grid winds)", unit="s", lo=0.0, hi=600.0,
+                                           flag="")
+    speed_limit: Optional[float] = option(None, help="soft upper limit of the predicted rotor "
+                                          "speed, a fraction of rated (default 1.0 for the "
+                                          "scheduled designs, none for design_wind_mps)",
+                                          unit="-", lo=0.5, hi=2.0)
     weights: MPCWeightOptions = option(MPCWeightOptions(), help="cost weights (gen_power, "
                                        "flap_moment, rotor_speed, ...)", flag="")
 
@@ -412,11 +421,25 @@ def _mpc(collective: bool, with_lidar: bool) -> Any:
         from mpc_wt.controllers.mpc import MPC, ScheduledMPC
 
         settings = _mpc_settings(opts, collective)
+        limit = opts.speed_limit
+        if limit is None and opts.design_wind_mps is None:
+            limit = 1.0
+        if limit is not None:
+            settings = settings.replace(
+                max_rotor_speed=limit * ctx.turbine.operation.rated_rotor_speed_rad_s)
         if opts.design_wind_mps is None:
             fam = _envelope_family(ctx, "madsen", opts.schedule_step)
+            from mpc_wt.controllers.baseline import BaselineController, tune_baseline
+
+            law = BaselineController(ctx.turbine, ctx.cache.get(
+                ctx.turbine, ("baseline-gains",), lambda: tune_baseline(ctx.turbine)))
             ctl = ScheduledMPC(fam, ctx.turbine, settings,
                                wind_source="preview" if with_lidar else "estimator",
-                               wind_estimator=_wind_estimator(ctx, settings.dt))
+                               wind_estimator=_wind_estimator(ctx, settings.dt),
+                               time_constant=opts.schedule_time_constant,
+                               torque_law=law, below_rated=settings.replace(
+                                   weights=dataclasses.replace(settings.weights, outputs={
+                                       **settings.weights.outputs, "flap_moment": 0.0})))
             grid = [float(fam.wind_mps[0]), float(fam.wind_mps[-1])]
         else:
             v = _check_design_wind(ctx.turbine, opts.design_wind_mps)
