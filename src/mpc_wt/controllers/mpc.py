@@ -139,6 +139,9 @@ class MPCSettings:
         paper. "kalman": a :class:`~mpc_wt.controllers.estimator.KalmanEstimator` on the same model estimates
         the states and the blade-effective winds from measured signals; without a preview the
         disturbance over the horizon is held at the wind estimate.
+    estimator_settings : dict
+        Keyword arguments of the "kalman" estimator (``wind_std_per_step``,
+        ``measurement_std``; :class:`~mpc_wt.controllers.estimator.KalmanEstimator`).
 
     Raises
     ------
@@ -158,6 +161,7 @@ class MPCSettings:
     slack_weight: float = 1e4
     slack_linear: float = 1e3
     estimator: Any = None
+    estimator_settings: dict[str, Any] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
         hu = self.horizon if self.control_horizon is None else self.control_horizon
@@ -420,7 +424,7 @@ class MPC(ControllerBase):
         if isinstance(estimator, str):
             from mpc_wt.controllers.estimator import KalmanEstimator
 
-            estimator = KalmanEstimator(m)
+            estimator = KalmanEstimator(m, **st.estimator_settings)
         self.estimator = estimator
         self.x_names = m.states
         # "auto": use meas["preview"] when the harness gives one; from_turbine sets None/"lidar"

@@ -298,6 +298,13 @@ class MPCOptions(Options):
                                               lo_open=True)
     schedule_step: float = option(1.0, help="spacing of the scheduled designs' grid",
                                   unit="m/s", lo=0.1, hi=5.0, flag="")
+    kalman_wind_std: float = option(0.2, help="the Kalman estimator's random walk of each "
+                                    "blade wind per step (larger follows gusts faster and "
+                                    "passes more noise into the pitch)", unit="m/s", lo=0.0,
+                                    lo_open=True, flag="")
+    kalman_flap_std: float = option(2e4, help="the Kalman estimator's flap-moment "
+                                    "measurement noise", unit="N m", lo=0.0, lo_open=True,
+                                    flag="")
     schedule_time_constant: float = option(3.0, help="low-pass of the scheduling wind "
                                            "(the designs switch at 0.25 m/s past the midpoint "
                                            "between grid winds)", unit="s", lo=0.0, hi=600.0,
@@ -382,6 +389,10 @@ def _mpc_settings(opts: MPCOptions, collective: bool) -> Any:
     return MPCSettings(horizon=opts.horizon, backend=opts.backend,
                        formulation=opts.formulation,
                        estimator=None if opts.estimator == "full-state" else opts.estimator,
+                       estimator_settings={
+                           "wind_std_per_step": opts.kalman_wind_std,
+                           "measurement_std": {f"flap_moment_{b}": opts.kalman_flap_std
+                                               for b in (1, 2, 3)}},
                        collective=collective, weights=opts.weights.weights())
 
 

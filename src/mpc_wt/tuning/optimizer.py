@@ -85,18 +85,22 @@ class Parameter:
 
 @dataclass(frozen=True)
 class Constraint:
-    """An upper bound on one measure: feasible when ``metrics[metric] <= upper``.
+    """A bound on one measure: feasible when ``metrics[metric] <= upper`` (or, with
+    ``lower``, ``>= upper``).
 
     Parameters
     ----------
     metric : str
         A key of the metrics ``evaluate`` returns.
     upper : float
-        The largest allowed value.
+        The bound: the largest allowed value (the smallest with ``lower``).
+    lower : bool
+        The bound is a lower one (e.g. a power ratio that must not fall below 0.995).
     """
 
     metric: str
     upper: float
+    lower: bool = False
 
     def __post_init__(self) -> None:
         check_number(f"constraint {self.metric!r} upper", self.upper)
@@ -111,10 +115,16 @@ class Constraint:
         Returns
         -------
         float
-            metrics[metric] - upper (<= 0: met); +inf when the measure is missing.
+            metrics[metric] - upper (upper - metrics[metric] for a lower bound; <= 0: met);
+            +inf when the measure is missing.
         """
         v = metrics.get(self.metric)
-        return float(v) - self.upper if v is not None and math.isfinite(v) else math.inf
+        if v is None or not math.isfinite(v):
+            return math.inf
+        return self.upper - float(v) if self.lower else float(v) - self.upper
+
+    def __str__(self) -> str:
+        return f"{self.metric} {'>=' if self.lower else '<='} {self.upper:g}"
 
 
 @dataclass

@@ -164,7 +164,7 @@ def write_outputs(spec: TuneSpec, outcome: TuneOutcome, out: Path) -> list[Path]
              f"the last run, {outcome.wall_s:.0f} s); sampler {spec.sampler}, seed {spec.seed}. "
              f"Objective: " + " + ".join(f"{w:g} x {m}" for m, w in spec.objective)
              + " (weighted mean of ratios to the reference); constraints: "
-             + (", ".join(f"{c.metric} <= {c.upper:g}" for c in spec.constraints) or "none")
+             + (", ".join(str(c) for c in spec.constraints) or "none")
              + ".", ""]
     if best is None:
         lines += ["**No trial met the constraints.**", ""]

@@ -24,6 +24,7 @@ Every measure is a ratio to the reference over the same cases
 of ``channels``), ``cs1``..``cs5``, ``power_mean``, ``power_std``, ``rotor_speed_std``,
 ``rotor_speed_max``, ``pitch_travel``, ``pitch_rate_std``, ``pitch_acc_std``, ``flap_1p``,
 ``flap_3p``. A constraint may give ``max_change_pct`` instead (``max_ratio = 1 + pct/100``),
+a lower bound with ``min_ratio`` or ``min_change_pct`` (``power_mean`` at least 0.995),
 or bound a measure per case with ``max_value``: ``pitch_rate_limit_hits`` (times a blade
 reached its pitch-rate limit per case), ``pitch_rate_limit_s``, ``pitch_rate_max_degps``.
 """
@@ -277,14 +278,16 @@ def _objective(raw: Any, channels: Mapping[str, float]) -> tuple[tuple[str, floa
 def _constraints(raw: Any, channels: Mapping[str, float]) -> tuple[Constraint, ...]:
     if not isinstance(raw, list):
         raise _fail("constraints", f"must be a list of {{metric, max_ratio | "
-                                   f"max_change_pct | max_value}}, got {raw!r}")
+                                   f"max_change_pct | min_ratio | min_change_pct | max_value}}, "
+                                   f"got {raw!r}")
     out = []
-    bounds = ("max_ratio", "max_change_pct", "max_value")
+    bounds = ("max_ratio", "max_change_pct", "min_ratio", "min_change_pct", "max_value")
     for i, e in enumerate(raw):
         key = f"constraints[{i}]"
         if not isinstance(e, Mapping) or "metric" not in e or \
                 set(e) - {"metric", *bounds} or sum(b in e for b in bounds) != 1:
-            raise _fail(key, f"must be {{metric, max_ratio}}, {{metric, max_change_pct}} or "
+            raise _fail(key, f"must be {{metric, max_ratio}}, {{metric, max_change_pct}}, "
+                             f"{{metric, min_ratio}}, {{metric, min_change_pct}} or "
                              f"{{metric, max_value}}, got {e!r}")
         if "max_value" in e:
             if e["metric"] not in ABSOLUTE_METRICS:
@@ -294,11 +297,13 @@ def _constraints(raw: Any, channels: Mapping[str, float]) -> tuple[Constraint, .
                                                             e["max_value"], 0.0)))
             continue
         m = _metric_name(f"{key}.metric", e["metric"], channels)
-        bound = (_number(f"{key}.max_ratio", e["max_ratio"], 0.0, lo_open=True)
-                 if "max_ratio" in e else
-                 1.0 + _number(f"{key}.max_change_pct", e["max_change_pct"], -100.0,
-                               lo_open=True) / 100.0)
-        out.append(Constraint(m, bound))
+        lower = "min_ratio" in e or "min_change_pct" in e
+        kind = next(b for b in bounds if b in e)
+        if kind.endswith("_ratio"):
+            bound = _number(f"{key}.{kind}", e[kind], 0.0, lo_open=True)
+        else:
+            bound = 1.0 + _number(f"{key}.{kind}", e[kind], -100.0, lo_open=True) / 100.0
+        out.append(Constraint(m, bound, lower))
     return tuple(out)
 
 

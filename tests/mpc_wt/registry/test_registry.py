@@ -64,7 +64,8 @@ def test_registry_lists_every_kind_with_its_options() -> None:
     assert list(rows)[:len(BUILTIN)] == BUILTIN
     assert {o["name"] for o in rows["mpc"]["options"]} == {
         "backend", "formulation", "horizon", "estimator", "design_wind_mps", "schedule_step",
-        "schedule_time_constant", "speed_limit", "weights"}
+        "schedule_time_constant", "speed_limit", "kalman_wind_std", "kalman_flap_std",
+        "weights"}
     assert rows["ibc"]["addon_to"] == ["baseline", "derate"]
     assert rows["derate"]["pattern"].startswith("derateNN")
     horizon = next(o for o in rows["mpc"]["options"] if o["name"] == "horizon")

@@ -59,6 +59,37 @@ def test_constraints_are_honoured(tmp_path: Path) -> None:
     assert any(not t.feasible for t in res.trials)
 
 
+def test_a_lower_bound_is_honoured(tmp_path: Path) -> None:
+    """E[u^2] >= 1.2 (a lower bound) cuts off the unconstrained optimum from the other side
+    (E[u^2] = 1.054 at r = rho, growing as r falls): the returned design meets it and sits at
+    the boundary r_c (brentq) within 1 % of its cost; every trial marked feasible meets it."""
+    floor = 1.2
+    res = optimize(lambda p: _scalar_lqr(p["r"]), [Parameter("r", 1e-3, 1e3, log=True)],
+                   storage=tmp_path / "s.sqlite", objective="cost",
+                   constraints=[Constraint("u2", floor, lower=True)], n_trials=40, seed=1,
+                   progress=False)
+    assert _scalar_lqr(RHO)["u2"] < floor
+    assert res.best is not None and res.best.metrics["u2"] >= floor
+    r_c = brentq(lambda r: _scalar_lqr(r)["u2"] - floor, 1e-3, RHO)
+    assert res.best.value == pytest.approx(_scalar_lqr(r_c)["cost"], rel=0.01)
+    assert all(t.metrics["u2"] >= floor for t in res.trials if t.feasible)
+    assert str(Constraint("power_mean", 0.995, lower=True)) == "power_mean >= 0.995"
+
+
+def test_min_ratio_in_a_spec_is_a_lower_bound() -> None:
+    """``min_ratio`` and ``min_change_pct`` give lower bounds; ``max_ratio`` an upper one."""
+    from mpc_wt.tuning.spec import _constraints
+
+    c = _constraints([{"metric": "power_mean", "min_ratio": 0.995},
+                      {"metric": "power_mean", "min_change_pct": -0.5},
+                      {"metric": "pitch_travel", "max_ratio": 3}], {})
+    assert [(x.metric, x.upper, x.lower) for x in c] == [
+        ("power_mean", 0.995, True), ("power_mean", pytest.approx(0.995), True),
+        ("pitch_travel", 3.0, False)]
+    assert c[0].violation({"power_mean": 0.99}) == pytest.approx(0.005)
+    assert c[0].violation({"power_mean": 1.01}) < 0
+
+
 def test_no_feasible_design_gives_none(tmp_path: Path) -> None:
     res = optimize(lambda p: _scalar_lqr(p["r"]), [Parameter("r", 1e-2, 1e2, log=True)],
                    storage=tmp_path / "s.sqlite", objective="cost",
@@ -179,7 +210,7 @@ def _spec_raw(**over: object) -> dict:
     ({"objective": [{"metric": "del:flap_moment_1"}]}, "objective[0].metric",
      "unknown measure 'del:flap_moment_1'"),
     ({"constraints": [{"metric": "cs1", "max_ratio": 1, "max_change_pct": 0}]},
-     "constraints[0]", "must be {metric, max_ratio}, {metric, max_change_pct} or "),
+     "constraints[0]", "must be {metric, max_ratio}, {metric, max_change_pct}, "),
     ({"constraints": [{"metric": "cs1", "max_value": 3}]}, "constraints[0].metric",
      "max_value bounds a measure per case"),
     ({"controller": {"controller": "baseline", "zeta": 0}}, "controller.zeta",
