@@ -400,7 +400,7 @@ class LQRPIOController(ControllerBase):
             raise ValueError(f"region must be 'II' or 'III', got {region!r}")
         if region == "II" and torque_law is None and not (k_opt and k_opt > 0):
             raise ValueError("region 'II' needs k_opt > 0 [N m/(rad/s)^2] or a torque_law")
-        self.torque_law = torque_law if region == "II" else None
+        self.torque_law = torque_law
         check_number("dt", dt, lo=0.0, lo_open=True, unit="s")
         # the torque law's speed filter pole at our period
         self._a_law = (math.exp(-torque_law.wc * dt) if self.torque_law is not None
@@ -473,7 +473,16 @@ class LQRPIOController(ControllerBase):
                              self.obs.y0, self.model.u0, self._iu_arr, self._pitch_lim, u):
             raise ValueError(f"non-finite measurement at t = {t:g} s: "
                              f"{dict(zip(self.obs.measured, y - self.obs.y0))}")
+        # the command the actuator can follow: first order (time constant tau) at most at its
+        # rate, so (ref - measured pitch) / tau stays within the rate; the observer is fed
+        # this command, not one the actuator cannot take (whose gap it would read as wind)
         pitch = u[:3].copy()
+        pa = self.turbine.pitch_actuator
+        if pa.time_constant > 0:
+            reach = pa.max_rate_rad_s * pa.time_constant
+            pm = meas["pitch"]
+            for b in range(3):
+                pitch[b] = min(max(pitch[b], pm[b] - reach), pm[b] + reach)
         g = self.turbine.generator
         torque = min(max(self._torque(meas, pitch), g.min_torque), g.max_torque)
         self._u_dev = np.array([pitch[0], pitch[1], pitch[2], torque]) - self.model.u0
@@ -484,15 +493,20 @@ class LQRPIOController(ControllerBase):
         return pitch, torque
 
     def _torque(self, meas: dict[str, Any], pitch: np.ndarray) -> float:
-        """The generator torque demand of the region (see ``region`` and ``torque_law``)."""
-        if self.region == "III":
+        """The generator torque demand of the region (see ``region`` and ``torque_law``):
+        region III holds the operating point's torque (Do et al.'s constant torque), capped by
+        the torque law where one is given (below rated speed at fine pitch the law asks less:
+        a rotor slowed by a lull is not braked into a stall); region II follows the law (or
+        K_opt Omega_g^2)."""
+        if self.region == "III" and self.torque_law is None:
             return float(self.model.u0[3])
         w = float(meas["gen_speed"])
         if self.torque_law is None:
             return float(self.k_opt * w ** 2)
         a = self._a_law
         self._w_filt = w if self._w_filt is None else a * self._w_filt + (1 - a) * w
-        return float(self.torque_law.torque(self._w_filt, float(pitch.sum()) / pitch.size))
+        q = float(self.torque_law.torque(self._w_filt, float(pitch.sum()) / pitch.size))
+        return min(q, float(self.model.u0[3])) if self.region == "III" else q
 
 
 @nb.njit(cache=True, nogil=True)

@@ -533,6 +533,8 @@ class LQRPIOOptions(Options):
                                               "wind", unit="m/s", lo=0.0, lo_open=True)
     schedule_step: float = option(1.0, help="spacing of the scheduled designs' grid",
                                   unit="m/s", lo=0.1, hi=5.0, flag="")
+    schedule_time_constant: float = option(3.0, help="low-pass of the scheduling wind",
+                                           unit="s", lo=0.0, hi=600.0, flag="")
     region2_torque: str = option("baseline", help="region-II torque: the baseline's schedule "
                                  "(1.5/2/2.5 on filtered speed, as the PI it is compared with) "
                                  "or Do's bare K_opt Omega_g^2 on raw speed",
@@ -584,8 +586,9 @@ def _build_lqr_pio(ctx: BuildContext, opts: LQRPIOOptions) -> Built:
         fam = _envelope_family(ctx, "do", opts.schedule_step)
         winds = [float(w) for w in fam.wind_mps]
         base = tune_baseline(turbine)
-        ctl = ScheduledLQRPIO([_lqr_pio_at(turbine, m, w, opts, base)
+        ctl = ScheduledLQRPIO([_lqr_pio_at(turbine, m, w, opts, base, stall_guard=True)
                                for m, w in zip(fam.models, winds)], winds, turbine,
+                              time_constant=opts.schedule_time_constant,
                               wind_estimator=_wind_estimator(ctx, 1.0 / 80.0))
     rated = linearize.rated_wind_speed(turbine)
     return Built(ctl, meta={"lqr": {
@@ -595,9 +598,10 @@ def _build_lqr_pio(ctx: BuildContext, opts: LQRPIOOptions) -> Built:
 
 
 def _lqr_pio_at(turbine: linearize.Turbine, model: linearize.LinearModel, wind: float,
-                opts: LQRPIOOptions, base: Any) -> Any:
+                opts: LQRPIOOptions, base: Any, stall_guard: bool = False) -> Any:
     """Do et al.'s LQR-PIO at one grid wind: region II below the rated wind, III above (the
-    baseline's gains ``base`` give region II's torque law)."""
+    baseline's gains ``base`` give region II's torque law; with ``stall_guard`` region III's
+    constant torque is capped by that law, as a scheduled design needs in lulls)."""
     from mpc_wt.controllers.baseline import BaselineController
     from mpc_wt.controllers.lqr import (
         REGION2_SCALES,
@@ -616,7 +620,8 @@ def _lqr_pio_at(turbine: linearize.Turbine, model: linearize.LinearModel, wind: 
                             k_opt=base.k_opt if region == "II" else None,
                             feedforward=region == "III",
                             torque_law=BaselineController(turbine, base)
-                            if region == "II" and opts.region2_torque == "baseline" else None)
+                            if (region == "II" and opts.region2_torque == "baseline")
+                            or (region == "III" and stall_guard) else None)
 
 
 # -- Takagi-Sugeno ------------------------------------------------------------------------------

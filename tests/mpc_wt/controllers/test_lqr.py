@@ -11,7 +11,6 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import linearize
-from mpc_wt import SimulationDivergedError
 from mpc_wt.controllers.lqr import (
     REGION3_SCALES,
     REGION3_WEIGHTS,
@@ -193,17 +192,13 @@ def test_lqr_pio_regulates_speed_in_turbulence(turbine, params, do_model) -> Non
     assert abs(np.mean(est[len(est) // 6:]) - 18.0) < 2.0
 
 
-def test_high_gain_pi_observer_diverges_in_turbulence_on_our_plant(turbine, params,
-                                                                   do_model) -> None:
-    """Issue 17, defect 5: Do et al. (sec. 2.4) ask for ||L2||_F >> ||L1||_F. On our plant the
-    condition cannot be met in the loop: in steady wind every q holds the rotor, but in class-A
-    turbulence at 18 m/s the loop with the unknown-input feedforward diverges from q = 1e4
-    (ratio 0.69) on; at q = 1e7 (ratio 1.98) it diverges within 30 s, and without the
-    feedforward it survives but regulates 3x worse (rotor-speed std 7.4 % against 2.6 %). The
-    observer takes the turbulence's fast blade-wind content (and the plant's 1P gravity and
-    shear flap content) for unknown inputs and the feedforward -K_f f_hat feeds it back. So
-    the default q = 1e3 (ratio 0.28) is the highest gain that keeps the loop; the README says so.
-    """
+def test_high_gain_pi_observer_holds_the_loop_in_turbulence(turbine, params, do_model) -> None:
+    """Do et al. (sec. 2.4) ask for ||L2||_F >> ||L1||_F. With the pitch command held to what
+    the actuator can follow, the high-gain observer (q = 1e7, ratio 1.98) keeps the loop in
+    class-A turbulence at 18 m/s and regulates as the default q = 1e3 (ratio 0.28) does:
+    rotor-speed std within 10 % of the default's over 120 s (measured 2.5 % of rated for
+    both, seeds 1 and 2). Before that hold, the observer read the gap to the rate-limited pitch as
+    an unknown input and the loop diverged from q = 1e4 on."""
     from mpc_wt.simulation.loop import simulate_closed_loop
     from mpc_wt.simulation.scenario import Scenario, make_wind
 
@@ -211,14 +206,15 @@ def test_high_gain_pi_observer_diverges_in_turbulence_on_our_plant(turbine, para
     default, high = design_pi_observer(do_model), design_pi_observer(do_model, q=1e7)
     # the ratio of the default and of the paper's "high gain" direction (Do et al. sec. 2.4)
     assert default.q == 1e3 and default.gain_ratio < 0.3 and high.gain_ratio > 1.9
-    wind, _ = make_wind(turbine, Scenario(18.0, "A", 1, 40.0, 0.2))
+    wind, _ = make_wind(turbine, Scenario(18.0, "A", 1, 120.0, 0.2))
     op = linearize.trim(turbine, 18.0)
-    with pytest.raises(SimulationDivergedError):
-        simulate_closed_loop(params, LQRPIOController(do_model, turbine, lq, high), wind, 40.0,
-                             x0=op.x, u0=op.u)
-    r = simulate_closed_loop(params, LQRPIOController(do_model, turbine, lq, default), wind,
-                             40.0, x0=op.x, u0=op.u)
-    assert r.x[r.t > 10, 2].std() < 0.05
+    std = []
+    for obs in (default, high):
+        r = simulate_closed_loop(params, LQRPIOController(do_model, turbine, lq, obs), wind,
+                                 120.0, x0=op.x, u0=op.u)
+        std.append(r.x[r.t > 10, 2].std())
+    assert std[0] < 0.05
+    assert std[1] == pytest.approx(std[0], rel=0.10)
 
 
 def test_scheduled_lqr_pio_switches_without_a_bump() -> None:
@@ -250,3 +246,24 @@ def test_scheduled_lqr_pio_switches_without_a_bump() -> None:
     assert step[at - 1].max() <= np.percentile(step, 99)
     rated = tb.operation.rated_rotor_speed_rad_s
     assert np.abs(r.channel("rotor_speed") / rated - 1.0).max() < 0.003
+
+
+@pytest.mark.parametrize("wind", [11.0, 12.0, 13.0])
+def test_scheduled_lqr_pio_rides_turbulence_through_rated(turbine, wind: float) -> None:
+    """Near rated wind in class-A turbulence (200 s, seed 5, not one its settings were chosen
+    on) the scheduled LQR-PIO neither stalls nor runs away: the rotor stays within 0.5..1.15 x
+    rated speed and the mean power within 2 % of the baseline's on the same field. (Before
+    its pitch command was held to what the actuator can follow, the observer read the gap to
+    a rate-limited pitch as wind, estimated 55-83 m/s and pitched the rotor to a stop.)"""
+    from mpc_wt.run import run_controller
+    from mpc_wt.simulation.scenario import Scenario
+
+    sc = Scenario(wind, "A", 5, 200.0)
+    res = run_controller(turbine, "lqr-pio", sc)
+    base = run_controller(turbine, "baseline", sc)
+    rated = turbine.operation.rated_rotor_speed_rad_s
+    w = res.channel("rotor_speed")[res.t >= 30.0] / rated
+    assert 0.5 <= w.min() and w.max() <= 1.15, (w.min(), w.max())
+    p = res.channel("gen_power")[res.t >= 30.0].mean()
+    p0 = base.channel("gen_power")[base.t >= 30.0].mean()
+    assert abs(p / p0 - 1.0) <= 0.02, p / p0
