@@ -557,8 +557,11 @@ class CampaignSpec:
     def _cases_of(self, c: ControllerSpec, lc: LoadCase, assess: dict[str, Any]
                   ) -> list[Case]:
         """The cases of one controller in one load case."""
+        a = assess if lc.transient == self.transient else {**assess, "transient": lc.transient}
+        sup = ({k: (lc.transient + x if k.endswith("_at") else x)
+                for k, x in lc.supervisor.items()} if lc.supervisor else None)
         if lc.wind_files:
-            return self._file_cases(c, lc, assess)
+            return self._file_cases(c, lc, a, sup)
         if lc.legacy:
             grid = [(t, v, s, 1) for t in c.turbulence or lc.turbulence
                     for v in c.winds or lc.winds for s in c.seeds or lc.seeds]
@@ -566,9 +569,6 @@ class CampaignSpec:
             grid = [(t, v, 0, g) for t in lc.turbulence for v in lc.winds for g in lc.signs]
         else:
             grid = [(t, v, s, 1) for t in lc.turbulence for v in lc.winds for s in lc.seeds]
-        a = assess if lc.transient == self.transient else {**assess, "transient": lc.transient}
-        sup = ({k: (lc.transient + x if k.endswith("_at") else x)
-                for k, x in lc.supervisor.items()} if lc.supervisor else None)
         out = []
         for turb, v, seed, sign in grid:
             sim = {"turbine": self.turbine_hash, "controller": c.controller,
@@ -594,12 +594,10 @@ class CampaignSpec:
                 supervisor=copy.deepcopy(sup), family=lc.family, fatigue=lc.fatigue))
         return out
 
-    def _file_cases(self, c: ControllerSpec, lc: LoadCase, assess: dict[str, Any]
-                    ) -> list[Case]:
-        """One case per wind file of a load case: the file is the case's wind and seed."""
-        a = assess if lc.transient == self.transient else {**assess, "transient": lc.transient}
-        sup = ({k: (lc.transient + x if k.endswith("_at") else x)
-                for k, x in lc.supervisor.items()} if lc.supervisor else None)
+    def _file_cases(self, c: ControllerSpec, lc: LoadCase, a: dict[str, Any],
+                    sup: dict[str, Any] | None) -> list[Case]:
+        """One case per wind file of a load case (assessment ``a``, supervisor ``sup`` as
+        :meth:`_cases_of` makes them): the file is the case's wind and seed."""
         out = []
         for f in lc.wind_files:
             sim = {"turbine": self.turbine_hash, "controller": c.controller,

@@ -52,18 +52,7 @@ def read_signals(meas: dict[str, Any], names: tuple[str, ...] | list[str]) -> np
     (n,) ndarray
         The signals in that order.
     """
-    y = np.empty(len(names))
-    for i, n in enumerate(names):
-        if n in meas:
-            y[i] = meas[n]
-        elif n[-2:] in ("_1", "_2", "_3") and n[:-2] in meas:
-            y[i] = meas[n[:-2]][int(n[-1]) - 1]
-        elif n in linearize.STATE_NAMES and "state" in meas:
-            y[i] = meas["state"][linearize.STATE_NAMES.index(n)]
-        else:
-            raise KeyError(f"signal {n!r} is neither in the measurements {sorted(meas)} nor a "
-                           f"plant state")
-    return y
+    return SignalReader(names)(meas)
 
 
 class SignalReader:
@@ -104,13 +93,16 @@ class SignalReader:
         ``meas`` as :func:`read_signals` takes it)."""
         if self._plan is None:
             self._plan = self._resolve(meas)
-        y = self._y
         try:
-            for i, (key, j) in enumerate(self._plan):
-                y[i] = meas[key] if j < 0 else meas[key][j]
-        except (KeyError, IndexError, TypeError):
+            return self._read(meas)
+        except (KeyError, IndexError, TypeError):      # the measurements changed shape
             self._plan = self._resolve(meas)
-            return read_signals(meas, self.names)
+            return self._read(meas)
+
+    def _read(self, meas: dict[str, Any]) -> np.ndarray:
+        y = self._y
+        for i, (key, j) in enumerate(self._plan):       # type: ignore[arg-type]
+            y[i] = meas[key] if j < 0 else meas[key][j]
         return y.copy()
 
 

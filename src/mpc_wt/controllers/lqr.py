@@ -437,6 +437,9 @@ class LQRPIOController(ControllerBase):
         self._iu_arr = np.asarray(self._iu, dtype=np.int64)
         pa = turbine.pitch_actuator
         self._pitch_lim = np.array([pa.min_pitch_rad, pa.max_pitch_rad])
+        # how far a command may lead the measured pitch: a first-order actuator (time
+        # constant tau) then moves at most at its rate
+        self._reach = pa.max_rate_rad_s * pa.time_constant if pa.time_constant > 0 else math.inf
         self._ubuf = np.empty(nu_all)
         self._d0_mean = float(np.mean(model.d0))
         self.reset()
@@ -477,12 +480,9 @@ class LQRPIOController(ControllerBase):
         # rate, so (ref - measured pitch) / tau stays within the rate; the observer is fed
         # this command, not one the actuator cannot take (whose gap it would read as wind)
         pitch = u[:3].copy()
-        pa = self.turbine.pitch_actuator
-        if pa.time_constant > 0:
-            reach = pa.max_rate_rad_s * pa.time_constant
-            pm = meas["pitch"]
-            for b in range(3):
-                pitch[b] = min(max(pitch[b], pm[b] - reach), pm[b] + reach)
+        reach, pm = self._reach, meas["pitch"]
+        for b in range(3):
+            pitch[b] = min(max(pitch[b], pm[b] - reach), pm[b] + reach)
         g = self.turbine.generator
         torque = min(max(self._torque(meas, pitch), g.min_torque), g.max_torque)
         self._u_dev = np.array([pitch[0], pitch[1], pitch[2], torque]) - self.model.u0

@@ -1341,9 +1341,9 @@ class ScheduledMPC(ControllerBase):
             Pitch 1-3 [rad] and generator torque [N m].
         """
         g = self._grid
-        i = min(max(bisect.bisect_right(g, wind) - 1, 0), len(g) - 2) if len(g) > 1 else 0
         if len(g) == 1:
             return self._z_trim[0], self._u_trim[0]
+        i = min(max(bisect.bisect_right(g, wind) - 1, 0), len(g) - 2)
         a = min(max((wind - g[i]) / (g[i + 1] - g[i]), 0.0), 1.0)
         return ((1.0 - a) * self._z_trim[i] + a * self._z_trim[i + 1],
                 (1.0 - a) * self._u_trim[i] + a * self._u_trim[i + 1])

@@ -230,7 +230,6 @@ class WindSpeedEstimator:
                             (s.torque_model_std / self.inertia) ** 2 * self.dt,
                             s.wind_std_per_sqrt_s**2 * self.dt, s.speed_std**2,
                             *self.wind_range, tsr[0], tsr[-1]])
-        self._u = np.zeros(2)
         self.reset()
 
     def reset(self) -> None:
