@@ -54,7 +54,8 @@ DLC_DEFAULTS: dict[str, tuple[str, bool]] = {
     "5.1": ("N", False)}
 #: The supervisor's settings a spec may give (:class:`mpc_wt.controllers.supervisor.Supervisor`); the
 #: times are counted from the end of the case's transient.
-_SUPERVISOR_KEYS = {"overspeed", "shutdown_at", "grid_loss_at", "pitch_rate", "torque_ramp_s"}
+_SUPERVISOR_KEYS = {"overspeed", "shutdown_at", "grid_loss_at", "pitch_rate", "torque_ramp_s",
+                    "pitch_fault_at", "pitch_fault", "pitch_fault_blade", "fault_detect_s"}
 _REPORT_KEYS = {"paper", "notes", "psd_wind", "cs_wind", "sweep", "title"}
 
 
@@ -763,7 +764,8 @@ def _supervisor(key: str, raw: Any, turbine: str) -> dict[str, Any]:
         Supervisor.check_settings(load_case_turbine(turbine), **dict(raw))
     except (TypeError, ValueError) as err:
         raise _fail(key, str(err)) from err
-    return {k: (None if v is None else float(v)) for k, v in raw.items()}
+    return {k: (v if v is None or k == "pitch_fault" else
+                int(v) if k == "pitch_fault_blade" else float(v)) for k, v in raw.items()}
 
 
 def _load_case(i: int, raw: Any, top: Mapping[str, Any]) -> LoadCase:

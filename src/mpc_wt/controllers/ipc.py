@@ -613,26 +613,40 @@ class ColemanIPCController(_PitchAddOn):
     """
 
     def _reset_own(self) -> None:
-        self._theta_cs = np.zeros(2)
+        self._theta_cs = (0.0, 0.0)
 
     def step(self, t: float, meas: dict[str, Any]) -> tuple[np.ndarray, float]:
         # One control step; returns (pitch_ref (3,) [rad], gen_torque_ref [N m]).
         pc, tq = self.collective.step(t, meas)
-        m = np.asarray(meas["flap_moment"], float)
         psi = float(meas["azimuth"])
-        if m.shape != (3,) or not np.all(np.isfinite(m)) or not math.isfinite(psi):
+        try:                                  # scalar arithmetic: three blades, no arrays
+            m1, m2, m3 = (float(x) for x in meas["flap_moment"])
+            ok = all(map(math.isfinite, (m1, m2, m3, psi)))
+        except (TypeError, ValueError):
+            ok = False
+        if not ok:
             raise ValueError(f"measurements flap_moment (3,) and azimuth must be finite at "
                              f"t = {t:g} s, got {meas['flap_moment']!r}, {meas['azimuth']!r}")
-        ang = psi + 2 * math.pi * np.arange(3) / 3
-        m_cs = 2.0 / 3.0 * np.array([np.sum(m * np.cos(ang)), np.sum(m * np.sin(ang))])
+        a2, a3 = psi + 2 * math.pi / 3, psi + 4 * math.pi / 3
+        c1, c2, c3 = math.cos(psi), math.cos(a2), math.cos(a3)
+        s1, s2, s3 = math.sin(psi), math.sin(a2), math.sin(a3)
+        tilt = 2.0 / 3.0 * (m1 * c1 + m2 * c2 + m3 * c3)       # Coleman transform
+        yaw = 2.0 / 3.0 * (m1 * s1 + m2 * s2 + m3 * s3)
         w = self._weight(meas)
-        ki, phi = self.gains.at(float(np.mean(pc)))
-        self._theta_cs += -w * ki * (_rot(-phi) @ m_cs) * self.dt
-        amp = float(np.hypot(*self._theta_cs))
+        ki, phi = self.gains.at((float(pc[0]) + float(pc[1]) + float(pc[2])) / 3.0)
+        cp, sp = math.cos(phi), math.sin(phi)                   # R(-phi) [tilt, yaw]
+        th_c, th_s = self._theta_cs
+        th_c -= w * ki * (cp * tilt + sp * yaw) * self.dt
+        th_s -= w * ki * (-sp * tilt + cp * yaw) * self.dt
+        amp = math.hypot(th_c, th_s)
         if amp > self.gains.max_amplitude_rad:            # anti-windup: clamp the amplitude
-            self._theta_cs *= self.gains.max_amplitude_rad / amp
-        th = w * self._theta_cs
-        u = th[0] * np.cos(ang) + th[1] * np.sin(ang)
+            th_c *= self.gains.max_amplitude_rad / amp
+            th_s *= self.gains.max_amplitude_rad / amp
+        self._theta_cs = (th_c, th_s)
+        th = (w * th_c, w * th_s)
+        u = np.array([th[0] * c1 + th[1] * s1, th[0] * c2 + th[1] * s2,
+                      th[0] * c3 + th[1] * s3])
+        m_cs = (tilt, yaw)
         cmd = self._limit(pc + u, meas)
         self.signals = {**self.collective.signals, "ipc_weight": w,
                         "ipc_tilt_moment": float(m_cs[0]), "ipc_yaw_moment": float(m_cs[1]),

@@ -18,6 +18,7 @@ on what the feedforward leaves and the two never fight.
 """
 from __future__ import annotations
 
+import bisect
 import logging
 import math
 from typing import Any
@@ -203,7 +204,7 @@ class LidarFeedforward(ControllerBase):
         if t >= self._next - 1e-9:
             self._sample(t, meas)
             self._next = t + self.sample_dt
-        v = float(np.interp(t + self.lead, self._arrival, self._v))
+        v = _interp_list(t + self.lead, self._arrival, self._v)
         ff = float(np.interp(v, self.curve_v, self.curve_pitch))
         self.base.pitch_feedforward = ff
         out = self.base.step(t, meas)
@@ -211,6 +212,18 @@ class LidarFeedforward(ControllerBase):
                         "ff_mean_wind": float(self._vm or math.nan),
                         "ff_corner": self.corner}
         return out
+
+
+def _interp_list(x: float, xs: list[float], ys: list[float]) -> float:
+    """``np.interp(x, xs, ys)`` for increasing Python lists without copying them to arrays
+    (held at the end values outside ``xs``)."""
+    k = bisect.bisect_right(xs, x)
+    if k == 0:
+        return ys[0]
+    if k == len(xs):
+        return ys[-1]
+    x0, x1 = xs[k - 1], xs[k]
+    return ys[k - 1] + (ys[k] - ys[k - 1]) * (x - x0) / (x1 - x0)
 
 
 def model_corner_table(lidar_model: Any, turbine: linearize.Turbine, turbulence: str | float = "A",

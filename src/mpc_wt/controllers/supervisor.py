@@ -13,11 +13,19 @@ and shutdown sequence in the loop. :class:`Supervisor` wraps any controller (``r
   limit);
 * **grid loss** at ``grid_loss_at``: the generator torque drops to zero at once (the harness
   applies no torque-rate limit to it: :attr:`grid_connected` is False) and the blades pitch to
-  feather at ``pitch_rate``.
+  feather at ``pitch_rate``;
+* **a pitch fault on one blade** at ``pitch_fault_at`` (IEC 61400-1 ed. 3 DLC 2.1/2.2: a
+  control or protection system fault while producing): blade ``pitch_fault_blade``'s drive
+  either seizes (``pitch_fault="seized"``: the blade holds the pitch it had when the fault
+  came) or runs away towards fine pitch at the actuator's maximum rate (``"runaway"``, the
+  direction that adds aerodynamic torque). The controller keeps running on the other blades
+  until the protection detects the fault ``fault_detect_s`` later (a command-versus-measured
+  pitch deviation check; our assumed delay); the protection then stops the turbine as in a
+  normal shutdown, with the healthy blades to feather and the faulty one held where it is.
 
 The state and the trip time are recorded (signals ``supervisor_state``: 0 running, 1
-shutdown, 2 overspeed stop, 3 grid loss; ``supervisor_trip_time``); the wrapped controller's
-signals are held at their last values after the trip.
+shutdown, 2 overspeed stop, 3 grid loss, 4 pitch-fault stop; ``supervisor_trip_time``); the
+wrapped controller's signals are held at their last values after the trip.
 """
 from __future__ import annotations
 
@@ -32,7 +40,10 @@ from mpc_wt.controllers.base import ControllerBase
 __all__ = ["Supervisor", "STATES", "TorqueLawGuard"]
 
 #: Supervisor states and their codes in the signal ``supervisor_state``.
-STATES = {"running": 0, "shutdown": 1, "overspeed": 2, "grid_loss": 3}
+STATES = {"running": 0, "shutdown": 1, "overspeed": 2, "grid_loss": 3, "pitch_fault": 4}
+
+#: The kinds of pitch fault on one blade.
+PITCH_FAULTS = ("seized", "runaway")
 
 
 def _opt_time(name: str, value: Any) -> float | None:
@@ -63,12 +74,23 @@ class Supervisor(ControllerBase):
         Pitch rate towards feather [rad/s] (default the actuator's maximum).
     torque_ramp_s : float
         Time in which a shutdown ramps the generator torque to zero [s].
+    pitch_fault_at : float, optional
+        Time of a pitch fault on one blade [s] (None: none).
+    pitch_fault : {"seized", "runaway"}
+        The fault: the blade's drive holds its pitch, or runs towards fine pitch at the
+        actuator's maximum rate.
+    pitch_fault_blade : int
+        The faulty blade, 1-3.
+    fault_detect_s : float
+        Time from the fault to the protection's stop [s] (default 1 s, our assumption).
     """
 
     def __init__(self, controller: Any, turbine: linearize.Turbine, *,
                  overspeed: float | None = None, shutdown_at: float | None = None,
                  grid_loss_at: float | None = None, pitch_rate: float | None = None,
-                 torque_ramp_s: float = 5.0) -> None:
+                 torque_ramp_s: float = 5.0, pitch_fault_at: float | None = None,
+                 pitch_fault: str = "seized", pitch_fault_blade: int = 1,
+                 fault_detect_s: float = 1.0) -> None:
         self.controller = controller
         pa = turbine.pitch_actuator
         if overspeed is not None and not (math.isfinite(float(overspeed))
@@ -89,6 +111,20 @@ class Supervisor(ControllerBase):
         if not (math.isfinite(ramp) and ramp > 0.0):
             raise ValueError(f"torque_ramp_s must be > 0 s, got {torque_ramp_s!r}")
         self.torque_ramp_s = ramp
+        self.pitch_fault_at = _opt_time("pitch_fault_at", pitch_fault_at)
+        if pitch_fault not in PITCH_FAULTS:
+            raise ValueError(f"pitch_fault must be one of {PITCH_FAULTS}, got {pitch_fault!r}")
+        self.pitch_fault = pitch_fault
+        if pitch_fault_blade not in (1, 2, 3) or isinstance(pitch_fault_blade, bool):
+            raise ValueError(f"pitch_fault_blade must be 1, 2 or 3, got {pitch_fault_blade!r}")
+        self.fault_blade = int(pitch_fault_blade) - 1
+        det = float(fault_detect_s)
+        if not (math.isfinite(det) and det >= 0.0):
+            raise ValueError(f"fault_detect_s must be a finite time >= 0 s, got "
+                             f"{fault_detect_s!r}")
+        self.fault_detect_s = det
+        self.fine = pa.min_pitch_rad
+        self.max_rate = pa.max_rate_rad_s
         self.feather = pa.max_pitch_rad
         self.reset()
 
@@ -122,6 +158,7 @@ class Supervisor(ControllerBase):
         self._pitch0 = np.zeros(3)
         self._torque0 = 0.0
         self._inner: dict[str, float] = {}
+        self._fault_pitch: float | None = None      # the faulty blade's pitch at the fault
         self.signals: dict[str, float] = {"supervisor_state": 0.0,
                                           "supervisor_trip_time": math.nan}
 
@@ -134,6 +171,9 @@ class Supervisor(ControllerBase):
             self.state = "overspeed"
         elif self.shutdown_at is not None and t >= self.shutdown_at:
             self.state = "shutdown"
+        elif self.pitch_fault_at is not None and \
+                t >= self.pitch_fault_at + self.fault_detect_s:
+            self.state = "pitch_fault"
         else:
             return
         self.trip_time = t
@@ -150,17 +190,31 @@ class Supervisor(ControllerBase):
             self._inner = dict(getattr(self.controller, "signals", {}))
             self.signals = {**self._inner, "supervisor_state": 0.0,
                             "supervisor_trip_time": math.nan}
+            if self.pitch_fault_at is not None and t >= self.pitch_fault_at:
+                pitch = np.array(pitch, dtype=float)
+                pitch[self.fault_blade] = self._faulty(t, meas)
             return pitch, tq
         assert self.trip_time is not None
         el = t - self.trip_time
         pitch = np.minimum(self._pitch0 + self.pitch_rate * el, self.feather)
         pitch = np.maximum(pitch, self._pitch0)
+        if self.state == "pitch_fault":     # the faulty drive stays where it is
+            pitch[self.fault_blade] = self._pitch0[self.fault_blade]
         tq = 0.0 if self.state == "grid_loss" else \
             self._torque0 * max(0.0, 1.0 - el / self.torque_ramp_s)
         self.signals = {**self._inner,                       # held at their last values
                         "supervisor_state": float(STATES[self.state]),
                         "supervisor_trip_time": self.trip_time}
         return pitch, tq
+
+    def _faulty(self, t: float, meas: dict[str, Any]) -> float:
+        """The faulty blade's pitch command after the fault (before the protection acts)."""
+        assert self.pitch_fault_at is not None
+        if self._fault_pitch is None:
+            self._fault_pitch = float(meas["pitch"][self.fault_blade])
+        if self.pitch_fault == "seized":
+            return self._fault_pitch
+        return max(self.fine, self._fault_pitch - self.max_rate * (t - self.pitch_fault_at))
 
     def finalize(self) -> None:
         """Pass the harness's last call on to the wrapped controller."""

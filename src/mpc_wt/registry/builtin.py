@@ -656,6 +656,10 @@ class TSOptions(Options):
                                lo_open=True, flag="")
     observer_decay_rate: float = option(1.0, help="observer decay rate", unit="1/s", lo=0.0,
                                         lo_open=True, flag="")
+    region2_torque: str = option("baseline", help="below rated, with the pitch at fine pitch: "
+                                 "baseline (the baseline's torque law, power-optimal tip-speed "
+                                 "ratio) or ts (the TS law's own torque, Clemens et al.'s "
+                                 "full-load design everywhere)", choices=("baseline", "ts"))
 
 
 @register("ts", TSOptions, field_components="u", design=_design_ts,
@@ -678,7 +682,13 @@ def _build_ts(ctx: BuildContext, opts: TSOptions) -> Built:
                              make)
     dp = None if opts.apc_frequency is None else apc_reference(
         opts.apc_frequency, amplitude=opts.apc_amplitude, offset=opts.apc_offset)
-    ctl = TSController(ts, c, o, ctx.turbine, power_reduction=dp)  # starts from its measurements
+    law = None
+    if opts.region2_torque == "baseline":
+        from mpc_wt.controllers.baseline import BaselineController, tune_baseline
+
+        law = BaselineController(ctx.turbine, tune_baseline(ctx.turbine))
+    ctl = TSController(ts, c, o, ctx.turbine, power_reduction=dp,  # starts from its measurements
+                       torque_law=law)
     return Built(ctl, meta={"ts": {"vertices": ts.n_vertices, "decay_rate": c.decay_rate,
                                    "observer_decay_rate": o.decay_rate,
                                    "apc_frequency_Hz": opts.apc_frequency}})

@@ -3,12 +3,15 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 import lidar
 import linearize
 from mpc_wt.controllers.baseline import BaselineController, tune_baseline
 from mpc_wt.controllers.lidar_feedforward import (
     LidarFeedforward,
+    _interp_list,
     corner_within_preview,
     rews_coherence_corner,
     static_pitch_curve,
@@ -133,3 +136,16 @@ def test_corner_is_raised_to_fit_the_preview(turbine, caplog) -> None:
                       res.meta["lidar_ff"]["corner_rad_s"])
     tp = 30.0 / res.controller["ff_mean_wind"][-1]
     assert corner > model and corner == pytest.approx(1.4 / (tp - 0.1 - 0.1), rel=1e-9)
+
+
+@settings(max_examples=200, deadline=None)
+@given(st.lists(st.floats(-50.0, 50.0), min_size=1, max_size=30, unique=True),
+       st.floats(-60.0, 60.0), st.integers(0, 2**31 - 1))
+def test_preview_lookup_equals_numpy_interp(xs, x, seed) -> None:
+    """The feedforward's lookup of the filtered wind at its arrival time on the sample lists
+    equals numpy's ``interp`` (held at the ends) for any increasing times."""
+    xs = sorted(xs)
+    ys = list(np.random.default_rng(seed).normal(12.0, 3.0, len(xs)))
+    for q in (x, *xs):
+        assert _interp_list(q, xs, ys) == pytest.approx(float(np.interp(q, xs, ys)),
+                                                        rel=1e-12, abs=1e-12)

@@ -92,10 +92,46 @@ def test_grid_loss_drops_the_torque_at_once(turbine, steady18) -> None:
     (dict(grid_loss_at=math.nan), r"grid_loss_at must be a finite time"),
     (dict(pitch_rate=1.0), r"pitch_rate must be in \(0, 0.1396\d*\] rad/s.*got 1.0"),
     (dict(torque_ramp_s=0.0), r"torque_ramp_s must be > 0 s, got 0.0"),
+    (dict(pitch_fault_at=5.0, pitch_fault="stuck"), r"pitch_fault must be one of .*'stuck'"),
+    (dict(pitch_fault_at=5.0, pitch_fault_blade=4), r"pitch_fault_blade must be 1, 2 or 3"),
+    (dict(pitch_fault_at=-2.0), r"pitch_fault_at must be a finite time >= 0 s"),
+    (dict(fault_detect_s=math.inf), r"fault_detect_s must be a finite time >= 0 s, got inf"),
 ])
 def test_bad_settings_are_named(turbine, kwargs, match) -> None:
     with pytest.raises(ValueError, match=match):
         Supervisor(BaselineController(turbine), turbine, **kwargs)
+
+
+@pytest.mark.parametrize("fault", ["seized", "runaway"])
+def test_pitch_fault_on_one_blade_and_the_protection(turbine, steady18, fault) -> None:
+    """A pitch fault on blade 2 at 2 s at 18 m/s (trim pitch about 15 deg), detected 1 s later.
+    Seized: blade 2's command holds its pitch at the fault until the end (to 1e-9 rad), while
+    the healthy blades feather from the stop. Runaway: blade 2's command falls at the actuator's
+    8 deg/s for the detection's 1 s, and the drive is cut where the blade is: its first-order
+    lag (tau = 0.1 s) trails a ramp by rate x tau, so the blade stops 8 x (1 - 0.1) = 7.2 deg
+    below its pitch at the fault (hand-worked; measured 7.0), and holds. The stop (state 4) trips
+    at 3 s; the torque ramps to zero."""
+    op, wind = steady18
+    pa = turbine.pitch_actuator
+    sup = Supervisor(BaselineController(turbine), turbine, pitch_fault_at=2.0,
+                     pitch_fault=fault, pitch_fault_blade=2, fault_detect_s=1.0,
+                     torque_ramp_s=4.0)
+    res = _run(turbine, sup, wind, op, 9.0)
+    t, dt = res.t, res.meta["dt"]
+    assert res.controller["supervisor_state"][-1] == 4.0
+    assert res.controller["supervisor_trip_time"][-1] == pytest.approx(3.0, abs=dt)
+    p1, p2 = res.channel("pitch_1"), res.channel("pitch_2")
+    k = int(round(2.0 / dt))
+    theta = p2[k]
+    if fault == "seized":
+        assert np.max(np.abs(p2[t > 2.0 + 5 * pa.time_constant] - theta)) < math.radians(0.05)
+    else:
+        drop = theta - p2[t > 3.0 + 5 * pa.time_constant].mean()
+        expect = pa.max_rate_rad_s * (1.0 - pa.time_constant)
+        assert drop == pytest.approx(expect, abs=math.radians(0.5))
+        assert np.ptp(p2[t > 3.5]) < math.radians(0.05)
+    assert p1[-1] > theta + math.radians(25.0)           # the healthy blades feather
+    assert res.channel("gen_torque")[t > 7.0 + 2 * dt].max() == pytest.approx(0.0, abs=1.0)
 
 
 class _MaxTorque:

@@ -7,6 +7,7 @@ import logging
 import math
 from typing import Any, Callable
 
+import numba as nb
 import numpy as np
 import scipy.linalg
 
@@ -45,6 +46,13 @@ class TSController(ControllerBase):
         the wind whose vertex equilibrium (no power reduction) has that pitch, interpolated
         over the wind grid (clipped to it): the controller starts in operation from what it
         measures.
+    torque_law : BaselineController, optional
+        The region-II law below rated: while the TS law's pitch is held at fine pitch (region
+        II: nothing left to regulate with the pitch), the generator torque follows this
+        baseline's torque schedule on the generator speed low-passed at its filter corner
+        (power-optimal tip-speed ratio, regions 1.5-2.5), and the observer is fed that torque.
+        Clemens et al.'s design is a full-load one; without a law the TS torque regulates the
+        rotor towards rated speed in low winds, off the optimal tip-speed ratio.
 
     Signals recorded: ``wind_est`` [m/s], ``power_reduction`` [-], ``power_ref`` [W],
     ``premise_clipped`` (0/1).
@@ -54,7 +62,8 @@ class TSController(ControllerBase):
                  observer: TSObserverDesign, turbine: linearize.Turbine, *,
                  dt: float = 1.0 / 80.0,
                  power_reduction: Callable[[float], float] | None = None,
-                 initial_wind_mps: float | None = None) -> None:
+                 initial_wind_mps: float | None = None,
+                 torque_law: Any = None) -> None:
         check_number("dt", dt, lo=0.0, lo_open=True, unit="s")
         self.ts, self.ctl, self.obs, self.turbine = ts, controller, observer, turbine
         self.dt = float(dt)
@@ -79,7 +88,11 @@ class TSController(ControllerBase):
             m[:n, :n], m[:n, n:] = f, g
             e = scipy.linalg.expm(m * dt)
             self._phi[i], self._gam[i] = e[:n, :n], e[:n, n:]
+        self.torque_law = torque_law
+        self._a_law = math.exp(-torque_law.wc * dt) if torque_law is not None else math.nan
         self._read = SignalReader(ts.measured)
+        self._K = np.ascontiguousarray(controller.K, dtype=float)
+        self._w = np.zeros((2, nv))
         self.reset()
 
     def reset(self) -> None:
@@ -92,6 +105,8 @@ class TSController(ControllerBase):
         self.premise_clipped = 0
         self._warned = False
         self._q = 0.0
+        self._w_filt: float | None = None
+        self.law_active = 0                 # steps with the torque from the region-II law
 
     def _start(self, v_init: float) -> None:
         """The observer's state at the vertex equilibrium of wind ``v_init``."""
@@ -99,21 +114,8 @@ class TSController(ControllerBase):
         self.xi = np.concatenate([m["x0"], [v_init]])
         self._u = m["u0"].copy()
 
-    def _premise(self, v: float, dp: float) -> tuple[float, float, bool]:
-        g1, g2 = self.ts.wind_grid, self.ts.reduction_grid
-        vc, dc = float(np.clip(v, g1[0], g1[-1])), float(np.clip(dp, g2[0], g2[-1]))
-        clipped = (vc != v) or (dc != dp)
-        if clipped:
-            self.premise_clipped += 1
-            if not self._warned:
-                log.warning("TS premise (v = %.3g m/s, dP = %.3g) outside the vertex grid; "
-                            "clipped to it (further clips are counted in premise_clipped)",
-                            v, dp)
-                self._warned = True
-        return vc, dc, clipped
-
     def step(self, t: float, meas: dict[str, Any]) -> tuple[np.ndarray, float]:
-        # Observer update, memberships, PDC control law (Clemens eqs 5-10).
+        # Observer update, memberships, PDC control law (Clemens eqs 5-10), compiled.
         y = self._read(meas)
         if not np.all(np.isfinite(y)):
             raise ValueError(f"non-finite measurement at t = {t:g} s: "
@@ -123,30 +125,120 @@ class TSController(ControllerBase):
         dp_raw = float(self.power_reduction(t)) if self.power_reduction else 0.0
         if not math.isfinite(dp_raw):
             raise ValueError(f"power_reduction({t:g}) returned {dp_raw!r}")
-        v, dp, clipped = self._premise(float(self.xi[-1]), dp_raw)
-        h = self.ts.membership(v, dp)
-        act = np.nonzero(h)[0]
-        w = np.concatenate([self._u, y, [1.0]])
-        self.xi = sum(h[i] * (self._phi[i] @ self.xi + self._gam[i] @ w) for i in act)
-        v, dp, clipped2 = self._premise(float(self.xi[-1]), dp_raw)
-        h = self.ts.membership(v, dp)
-        act = np.nonzero(h)[0]
-        xh = self.xi[:-1]
-        q_prev = self._q
-        if self._ki is not None:
-            src = self._int_src
-            err = (y[src] if src is not None else xh[self._ki]) - h @ self.ts.x0[:, self._ki]
-            self._q = q_prev + err * self.dt
-        u = sum(h[i] * (self.ts.u0[i] - self.ctl.K[i] @ (
-            np.append(xh - self.ts.x0[i], self._q) if self._ki is not None
-            else xh - self.ts.x0[i])) for i in act)
-        pa, gen = self.turbine.pitch_actuator, self.turbine.generator
-        pitch = float(np.clip(u[0], pa.min_pitch_rad, pa.max_pitch_rad))
-        torque = float(np.clip(u[1], gen.min_torque, gen.max_torque))
-        if pitch != u[0] or torque != u[1]:
-            self._q = q_prev  # anti-windup: no integration while an input saturates
-        self._u = np.array([pitch, torque])
+        ts, pa, gen = self.ts, self.turbine.pitch_actuator, self.turbine.generator
+        v_seen = float(self.xi[-1])
+        q, dp, clipped = _ts_step(
+            self.xi, self._u, y, dp_raw, ts.wind_grid, ts.reduction_grid, self._phi, self._gam,
+            ts.x0, ts.u0, self._K, -1 if self._ki is None else self._ki,
+            -1 if self._int_src is None else self._int_src, self._q, self.dt,
+            pa.min_pitch_rad, pa.max_pitch_rad, gen.min_torque, gen.max_torque, self._w)
+        if clipped:
+            self.premise_clipped += 1
+            if not self._warned:
+                log.warning("TS premise (v = %.3g m/s, dP = %.3g) outside the vertex grid; "
+                            "clipped to it (further clips are counted in premise_clipped)",
+                            v_seen, dp_raw)
+                self._warned = True
+        self._q = q
+        pitch, torque = float(self._u[0]), float(self._u[1])
+        law = self.torque_law
+        if law is not None:
+            w = float(meas["gen_speed"])
+            a = self._a_law
+            self._w_filt = w if self._w_filt is None else a * self._w_filt + (1 - a) * w
+            if pitch <= self.turbine.pitch_actuator.min_pitch_rad:
+                torque = law.torque(self._w_filt, pitch)
+                self._u[1] = torque
+                self.law_active += 1
         self.signals = {"wind_est": float(self.xi[-1]), "power_reduction": dp,
-                        "power_ref": self.ts.rated_power * (1.0 - dp),
-                        "premise_clipped": float(clipped or clipped2)}
+                        "power_ref": ts.rated_power * (1.0 - dp),
+                        "premise_clipped": float(clipped),
+                        "torque_law_active": float(law is not None and pitch <= self.turbine
+                                                   .pitch_actuator.min_pitch_rad)}
         return np.full(3, pitch), torque
+
+
+@nb.njit(cache=True, nogil=True)
+def _hat_weights(grid: np.ndarray, s: float) -> tuple[int, float, float, bool]:
+    """The clipped premise's cell k on ``grid`` and the hat weights of its two ends (one end
+    weight 1 for a single-point grid); whether ``s`` was clipped."""
+    n = grid.size
+    c = min(max(s, grid[0]), grid[n - 1])
+    clipped = c != s
+    if n == 1:
+        return 0, 1.0, 0.0, clipped
+    k = np.searchsorted(grid, c) - 1
+    k = min(max(k, 0), n - 2)
+    f = (c - grid[k]) / (grid[k + 1] - grid[k])
+    return k, 1.0 - f, f, clipped
+
+
+@nb.njit(cache=True, nogil=True)
+def _memberships(wg: np.ndarray, rg: np.ndarray, v: float, dp: float, h: np.ndarray
+                 ) -> tuple[float, bool]:
+    """h (zeroed, then filled) = the tensor-product hats of Clemens et al. eq 3 at the clipped
+    premise (v, dp); returns the clipped dp and whether either was clipped."""
+    h[:] = 0.0
+    ka, wa0, wa1, c1 = _hat_weights(wg, v)
+    kb, wb0, wb1, c2 = _hat_weights(rg, dp)
+    nb_ = rg.size
+    for ia, wa in ((ka, wa0), (ka + 1, wa1)):
+        if wa == 0.0 or ia >= wg.size:
+            continue
+        for ib, wb in ((kb, wb0), (kb + 1, wb1)):
+            if wb == 0.0 or ib >= nb_:
+                continue
+            h[ia * nb_ + ib] += wa * wb
+    return min(max(dp, rg[0]), rg[rg.size - 1]), c1 or c2
+
+
+@nb.njit(cache=True, nogil=True)
+def _ts_step(xi: np.ndarray, u: np.ndarray, y: np.ndarray, dp_raw: float, wg: np.ndarray,
+             rg: np.ndarray, phi: np.ndarray, gam: np.ndarray, x0: np.ndarray, u0: np.ndarray,
+             kk: np.ndarray, ki: int, src: int, q_prev: float, dt: float, pmin: float,
+             pmax: float, tmin: float, tmax: float, work: np.ndarray
+             ) -> tuple[float, float, bool]:
+    """One TS step in place: xi (observer, eq 10, exact ZOH per vertex, blended) and u (PDC
+    law, eq 7, clipped to the actuators); returns the integral, the clipped dp and whether the
+    premise was clipped. ``work`` is (2, N) scratch for the memberships."""
+    nv, n = phi.shape[0], phi.shape[1]
+    nu, ny = u.size, y.size
+    h = work[0]
+    dp, c1 = _memberships(wg, rg, xi[n - 1], dp_raw, h)
+    w = np.empty(nu + ny + 1)
+    w[:nu] = u
+    w[nu:nu + ny] = y
+    w[nu + ny] = 1.0
+    new = np.zeros(n)
+    for i in range(nv):
+        if h[i] == 0.0:
+            continue
+        new += h[i] * (phi[i] @ xi + gam[i] @ w)
+    xi[:] = new
+    h2 = work[1]
+    dp, c2 = _memberships(wg, rg, xi[n - 1], dp_raw, h2)
+    nx = n - 1
+    q = q_prev
+    if ki >= 0:
+        ref = 0.0
+        for i in range(nv):
+            ref += h2[i] * x0[i, ki]
+        err = (y[src] if src >= 0 else xi[ki]) - ref
+        q = q_prev + err * dt
+    out = np.zeros(nu)
+    for i in range(nv):
+        if h2[i] == 0.0:
+            continue
+        for r in range(nu):
+            acc = u0[i, r]
+            for j in range(nx):
+                acc -= kk[i, r, j] * (xi[j] - x0[i, j])
+            if ki >= 0:
+                acc -= kk[i, r, nx] * q
+            out[r] += h2[i] * acc
+    pitch = min(max(out[0], pmin), pmax)
+    torque = min(max(out[1], tmin), tmax)
+    if pitch != out[0] or torque != out[1]:
+        q = q_prev        # anti-windup: no integration while an input saturates
+    u[0], u[1] = pitch, torque
+    return q, dp, c1 or c2
