@@ -22,9 +22,11 @@ points, 20 Hz), all DOFs, one core:
   scheduled one, in this process and (paper's design) in a few fresh ones, against DAQP's solve
   alone through its own Python interface;
 - peak resident memory of ``mpcwt simulate`` for 600 s (baseline and mpc-lidar), every signal
-  kept and written, each in its own process.
+  kept and written, each in its own process;
+- with ``--signoff DIR``: a finished sign-off campaign's wall time (its start to its last
+  case) and its cases, per controller the mean case time.
 
-Run:  python benchmarks/bench_loop.py [--json] [--repeat 3] [--skip-memory]
+Run:  python benchmarks/bench_loop.py [--json] [--repeat 3] [--skip-memory] [--signoff DIR]
 """
 from __future__ import annotations
 
@@ -185,6 +187,28 @@ def _peak_memory(controller: str) -> float:
     return int(out.stdout.split()[-1]) / 1024.0
 
 
+def _signoff_wall(root: str) -> dict[str, Any]:
+    """A finished campaign's wall time: from its last start (``meta.last_run``) to its last
+    finished case; cases and mean case time per controller."""
+    import datetime
+    import sqlite3
+
+    db = sqlite3.connect(str(Path(root) / "index.sqlite"))
+    try:
+        start = json.loads(dict(db.execute("select key, value from meta"))["last_run"])
+        t0 = datetime.datetime.fromisoformat(start).timestamp()
+        rows = list(db.execute("select controller, status, wall_s, updated from cases"))
+    finally:
+        db.close()
+    done = [r for r in rows if r[1] == "done"]
+    per: dict[str, list[float]] = {}
+    for ctl, _, w, _ in done:
+        per.setdefault(ctl, []).append(float(w or 0.0))
+    return {"cases": len(rows), "done": len(done),
+            "wall_s": max(r[3] for r in done) - t0 if done else None,
+            "mean_case_s": {k: float(np.mean(v)) for k, v in per.items()}}
+
+
 def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--json", action="store_true")
@@ -192,6 +216,7 @@ def main() -> int:
     ap.add_argument("--skip-memory", action="store_true")
     ap.add_argument("--step-processes", type=int, default=3,
                     help="fresh processes for the MPC step replay (default 3)")
+    ap.add_argument("--signoff", help="a finished sign-off campaign's directory (its wall time)")
     ap.add_argument("--replay", help=argparse.SUPPRESS)
     args = ap.parse_args()
     if args.replay:
@@ -231,6 +256,8 @@ def main() -> int:
     res["baseline_over_plant"] = res["baseline_s"] / res["plant_compiled_s"]
     res["baseline_python_over_plant"] = res["baseline_python_s"] / res["plant_compiled_s"]
     res["mpc_lidar_over_plant"] = res["mpc_lidar_s"] / res["plant_compiled_s"]
+    if args.signoff:
+        res["signoff"] = _signoff_wall(args.signoff)
     if not args.skip_memory:
         res["peak_rss_mb"] = {c: _peak_memory(c) for c in ("baseline", "mpc-lidar")}
     if args.json:
@@ -257,6 +284,10 @@ def main() -> int:
               f"{res[k]['last_minute_us_per_step']:.0f} us (ratio "
               f"{res[k]['last_over_first']:.2f})")
     w8, s8 = res["mpc_lidar_8mps"], res["step_replay"]["mpc_lidar_8mps"]
+    print(f"full-envelope mpc-lidar at 18 m/s: {res['mpc_lidar_s']:.2f} s, "
+          f"{res['mpc_lidar_realtime']:.1f}x real time; its whole step (replayed, DAQP) median "
+          f"{res['whole_step_scheduled']['daqp']['median_us']:.1f} us, p99 "
+          f"{res['whole_step_scheduled']['daqp']['p99_us']:.0f} us")
     print(f"mpc-lidar at 8 m/s (below rated): {w8['s']:.2f} s, "
           f"{res['mpc_lidar_8mps_realtime']:.1f}x real time; its step median "
           f"{s8['median_us']:.1f} us, p99 {s8['p99_us']:.0f} us")
@@ -280,6 +311,11 @@ def main() -> int:
         print(f"  {b} in {len(med)} fresh processes: medians "
               f"{', '.join(f'{v:.1f}' for v in med)} us; p99 {', '.join(f'{v:.0f}' for v in p99)}"
               f" us")
+    so = res.get("signoff")
+    if so:
+        print(f"sign-off campaign {args.signoff}: {so['done']} of {so['cases']} cases done, wall "
+              f"{so['wall_s'] / 60:.1f} min; mean case time "
+              + ", ".join(f"{k} {v:.1f} s" for k, v in so["mean_case_s"].items()))
     for c, mb in res.get("peak_rss_mb", {}).items():
         print(f"peak resident memory, mpcwt simulate --controller {c} (600 s): {mb:.0f} MB")
     return 0

@@ -97,7 +97,8 @@ def case_metrics(t: np.ndarray, cols: dict[str, np.ndarray], channels: dict[str,
         ``extremes``: each channel's and the rotor speed's maximum and minimum and their times,
         :func:`mpc_wt.assessment.ultimate.case_extremes`); with a supervisor in the loop
         ``supervisor_state`` (the largest :data:`mpc_wt.controllers.supervisor.STATES` code after the
-        transient) and ``supervisor_trip_s`` (when it tripped, even within the transient).
+        transient) and ``supervisor_trip_s`` (when it tripped, even within the transient); for
+        an MPC ``qp_fallback_s``, the time its commands came from the QP fallback [s].
 
     Raises
     ------
@@ -129,6 +130,9 @@ def case_metrics(t: np.ndarray, cols: dict[str, np.ndarray], channels: dict[str,
         # when it tripped, also if that was in the discarded transient (the signal holds it)
         trip = float(np.asarray(cols.get("supervisor_trip_time", [math.nan]))[-1])
         out["supervisor_trip_s"] = trip if math.isfinite(trip) else None
+    if "qp_fallback" in sub:            # the MPC's QP fallbacks: seconds under a fallback
+        dt = float(np.median(np.diff(t[k])))
+        out["qp_fallback_s"] = float(np.count_nonzero(sub["qp_fallback"] > 0) * dt)
     for key in ("power_ref",):
         if key in sub:
             out[f"{key}_mean_W"] = float(np.mean(sub[key]))

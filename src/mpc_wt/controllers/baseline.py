@@ -35,7 +35,7 @@ from mpc_wt.controllers.baseline_law import N_STATE, SIGNALS, law_parameters, la
 from mpc_wt.controllers.baseline_law import torque as law_torque
 
 __all__ = ["BaselineGains", "tune_baseline", "tune_baseline_schedule", "BaselineController",
-           "check_power_fraction", "effective_pi_gains"]
+           "LawTorque", "check_power_fraction", "effective_pi_gains"]
 
 
 def check_power_fraction(value: Any, name: str = "power_fraction") -> float:
@@ -518,3 +518,49 @@ class BaselineController(ControllerBase):
                         "pitch_integral": integral, "gain_schedule": gk,
                         "pitch_command": cmd, "torque_command": tq}
         return cmd, tq, err
+
+
+class LawTorque:
+    """The baseline's torque schedule as another controller's generator torque: the generator
+    speed low-passed at the law's filter corner, then :meth:`BaselineController.torque`,
+    within the generator's limits (the region-II law of the scheduled LQR-PIO, MPC and TS).
+
+    Parameters
+    ----------
+    law : BaselineController
+        The schedule (its gains and filter corner).
+    dt : float
+        The calling controller's period [s].
+    """
+
+    def __init__(self, law: BaselineController, dt: float) -> None:
+        self.law = law
+        self._a = math.exp(-law.wc * float(dt))
+        g = law.turbine.generator
+        self._lo, self._hi = g.min_torque, g.max_torque
+        self.reset()
+
+    def reset(self) -> None:
+        """Forget the filtered speed (the next call starts from its measurement)."""
+        self.w_filt: float | None = None
+
+    def __call__(self, gen_speed: float, pitch: float, power: float | None = None) -> float:
+        """Filter one generator speed sample and return the schedule's torque.
+
+        Parameters
+        ----------
+        gen_speed : float
+            Measured generator speed [rad/s].
+        pitch : float
+            Collective pitch [rad].
+        power : float, optional
+            Region-3 power [W] (default rated).
+
+        Returns
+        -------
+        float
+            Generator torque demand [N m].
+        """
+        w, a = float(gen_speed), self._a
+        self.w_filt = w if self.w_filt is None else a * self.w_filt + (1.0 - a) * w
+        return min(max(self.law.torque(self.w_filt, pitch, power), self._lo), self._hi)

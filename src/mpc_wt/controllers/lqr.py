@@ -35,6 +35,7 @@ import scipy.linalg
 import linearize
 from linearize.validate import check_number
 from mpc_wt.controllers.base import ControllerBase
+from mpc_wt.controllers.baseline import LawTorque
 from mpc_wt.controllers.estimator import SignalReader
 from mpc_wt.errors import SynthesisError
 
@@ -403,8 +404,7 @@ class LQRPIOController(ControllerBase):
         self.torque_law = torque_law
         check_number("dt", dt, lo=0.0, lo_open=True, unit="s")
         # the torque law's speed filter pole at our period
-        self._a_law = (math.exp(-torque_law.wc * dt) if self.torque_law is not None
-                       else math.nan)
+        self._law = LawTorque(torque_law, dt) if torque_law is not None else None
         self.model, self.turbine, self.lqr, self.obs = model, turbine, lqr, observer
         self._read = SignalReader(observer.measured)
         self.dt, self.region, self.k_opt = float(dt), region, k_opt
@@ -447,7 +447,8 @@ class LQRPIOController(ControllerBase):
     def reset(self) -> None:
         self.xe = np.zeros(self._nx + self._nf)
         self._u_dev = np.zeros(self._nu_all)
-        self._w_filt: float | None = None
+        if self._law is not None:
+            self._law.reset()
         self.signals: dict[str, float] = {}
 
     def hand_over(self, other: "LQRPIOController") -> None:
@@ -466,7 +467,8 @@ class LQRPIOController(ControllerBase):
                              f"observer states against {self.xe.size}")
         self.xe = other.xe + offset
         self._u_dev = other._u_dev + other.model.u0 - self.model.u0
-        self._w_filt = other._w_filt
+        if self._law is not None and other._law is not None:
+            self._law.w_filt = other._law.w_filt
 
     def step(self, t: float, meas: dict[str, Any]) -> tuple[np.ndarray, float]:
         # One control step: observer update, then u = u0 - K (x_hat - x0) (+ feedforward).
@@ -503,9 +505,8 @@ class LQRPIOController(ControllerBase):
         w = float(meas["gen_speed"])
         if self.torque_law is None:
             return float(self.k_opt * w ** 2)
-        a = self._a_law
-        self._w_filt = w if self._w_filt is None else a * self._w_filt + (1 - a) * w
-        q = float(self.torque_law.torque(self._w_filt, float(pitch.sum()) / pitch.size))
+        assert self._law is not None
+        q = self._law(w, float(pitch.sum()) / pitch.size)
         return min(q, float(self.model.u0[3])) if self.region == "III" else q
 
 

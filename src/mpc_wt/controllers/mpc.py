@@ -17,8 +17,9 @@ set) on the condensed QP. All matrices are built and factorized once per operati
 variables are shifted to the unconstrained optimum, which like every QP vector of a step is
 affine in the step's data (state, previous command, preview): one precomputed map gives the
 bounds, the linear term stays zero, and when no constraint binds the warm-started solver stops
-at once. The status is checked every step: on failure the previous plan shifted by one step is
-applied, else the previous command is held; the fallback used is recorded in ``signals``.
+at once. The status is checked every step: on failure (or a solve over ``time_budget_ms``) the
+previous plan shifted by one step is applied, else the previous command is held; the fallback
+used is recorded in ``signals`` and logged, and the steps are counted (``fallbacks``).
 """
 from __future__ import annotations
 
@@ -37,6 +38,7 @@ import numpy as np
 import linearize
 from linearize.validate import check_number
 from mpc_wt.controllers.base import ControllerBase
+from mpc_wt.controllers.baseline import LawTorque
 from mpc_wt.controllers.qp import check_backend, daqp_update_solve, default_backend, make_backend
 
 __all__ = ["coleman_weight", "MPCWeights", "MPCSettings", "MPC", "ScheduledMPC"]
@@ -142,6 +144,13 @@ class MPCSettings:
     estimator_settings : dict
         Keyword arguments of the "kalman" estimator (``wind_std_per_step``,
         ``measurement_std``; :class:`~mpc_wt.controllers.estimator.KalmanEstimator`).
+    time_budget_ms : float or None
+        Wall time a step's QP may take [ms]: a solve that takes longer is treated as failed (its
+        plan would arrive after the command was due) and the fallback applies. None (default):
+        no wall-time check, so that a simulation is reproducible whatever the machine's load;
+        the solver's iteration limit is then the step's (deterministic) budget, and a solve
+        that reaches it fails and falls back. Set it for runs against real time (a controller
+        on hardware, or software in the loop).
 
     Raises
     ------
@@ -162,6 +171,7 @@ class MPCSettings:
     slack_linear: float = 1e3
     estimator: Any = None
     estimator_settings: dict[str, Any] = field(default_factory=dict)
+    time_budget_ms: float | None = None
 
     def __post_init__(self) -> None:
         hu = self.horizon if self.control_horizon is None else self.control_horizon
@@ -185,6 +195,9 @@ class MPCSettings:
                              f"{v!r}")
         check_number("slack_weight", self.slack_weight, lo=0.0, lo_open=True)
         check_number("slack_linear", self.slack_linear, lo=0.0, lo_open=True)
+        if self.time_budget_ms is not None:
+            check_number("time_budget_ms", self.time_budget_ms, lo=0.0, lo_open=True,
+                         unit="ms")
         if isinstance(self.estimator, str) and self.estimator != "kalman":
             raise ValueError(f"estimator must be None, 'kalman' or a KalmanEstimator, got "
                              f"{self.estimator!r}")
@@ -887,6 +900,7 @@ class MPC(ControllerBase):
         self._u_prev: np.ndarray | None = None
         self.qp_backend.reset()
         self._last_slack = 0.0
+        self.fallbacks = 0                  # steps that took the fallback since the reset
         if getattr(self, "estimator", None) is not None:
             self.estimator.reset()
         self.set_target()
@@ -1087,7 +1101,7 @@ class MPC(ControllerBase):
         gen_torque_ref : float
             Generator torque command [N m].
         """
-        nx, nu, z = self._nx, self._nu, self._z
+        nx, z = self._nx, self._z
         dprev, st = None, _EMPTY
         if self.estimator is not None:
             u_dev = (np.zeros(len(self.model.u0)) if self._u_prev is None
@@ -1126,6 +1140,9 @@ class MPC(ControllerBase):
         v, status = self._solve_z(dprev is not None or blade.shape[0] > 0, st,
                                   self._up0 if self._u_prev is None else self._u_prev, blade)
         qp_ms = 1e3 * (time.perf_counter() - t_qp)
+        budget = self.settings.time_budget_ms
+        if v is not None and budget is not None and qp_ms > budget:
+            v, status = None, f"took {qp_ms:.3g} ms, over its time budget of {budget:g} ms"
         if v is None:
             u, level = self._fallback(t, status)
         else:
@@ -1151,7 +1168,9 @@ class MPC(ControllerBase):
             if self._u_prev is not None:
                 v[:self._nvu] = np.tile(self._u_prev / self._su[:nu], self.hu)
             level = 2.0
-        log.warning("MPC QP %s at t = %g s: fallback %d", status, t, int(level))
+        self.fallbacks += 1
+        log.warning("MPC QP %s at t = %g s: fallback %d (%d so far)", status, t, int(level),
+                    self.fallbacks)
         self._plan = v[:self._nvu]
         du = v[:nu] * self._su[:nu]
         self._u_prev = du
@@ -1259,7 +1278,7 @@ class ScheduledMPC(ControllerBase):
         self.below_rated = below_rated
         self._rated_wind = linearize.rated_wind_speed(turbine)
         self.torque_law = torque_law
-        self._a_law = math.exp(-torque_law.wc * st.dt) if torque_law is not None else math.nan
+        self._law = LawTorque(torque_law, st.dt) if torque_law is not None else None
         self._ip = linearize.MADSEN_OUTPUTS.index("gen_power")
         m0 = family.models[0]
         self._eff = float(m0.z0[m0.outputs.index("gen_power")]
@@ -1295,13 +1314,19 @@ class ScheduledMPC(ControllerBase):
         """Switches between grid points since the last reset."""
         return self.schedule.switches
 
+    @property
+    def fallbacks(self) -> int:
+        """Steps that took the QP fallback since the reset, over every design."""
+        return sum(c.fallbacks for c in self._ctl.values())
+
     def reset(self) -> None:
         """Forget the wind and every controller's state: the next step starts the schedule."""
         self.schedule.reset()
         for c in self._ctl.values():
             c.reset()
         self.target_wind: float | None = None
-        self._w_law: float | None = None
+        if self._law is not None:
+            self._law.reset()
         self.signals: dict[str, float] = {}
 
     def _target(self, meas: dict[str, Any]) -> tuple[np.ndarray, np.ndarray]:
@@ -1310,16 +1335,11 @@ class ScheduledMPC(ControllerBase):
         there (so that a rotor slower than the trim is never asked to hold the trim's power,
         which is how a power-tracking MPC stalls the rotor in a lull)."""
         z, u = self.trim_at(self.target_wind)          # type: ignore[arg-type]
-        law = self.torque_law
-        if law is None:
+        if self._law is None:
             return z, u
         w = float(meas["gen_speed"])
-        a = self._a_law
-        self._w_law = w if self._w_law is None else a * self._w_law + (1.0 - a) * w
         p = meas["pitch"]
-        g = self.turbine.generator
-        q = min(max(law.torque(self._w_law, (float(p[0]) + float(p[1]) + float(p[2])) / 3.0),
-                    g.min_torque), g.max_torque)
+        q = self._law(w, (float(p[0]) + float(p[1]) + float(p[2])) / 3.0)
         z, u = z.copy(), u.copy()
         u[3] = q
         z[self._ip] = min(z[self._ip], self._eff * q * w)

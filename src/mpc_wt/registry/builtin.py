@@ -323,6 +323,10 @@ class MPCOptions(Options):
                                           unit="-", lo=0.5, hi=2.0)
     weights: MPCWeightOptions = option(MPCWeightOptions(), help="cost weights (gen_power, "
                                        "flap_moment, rotor_speed, ...)", flag="")
+    time_budget_ms: Optional[float] = option(None, help="wall time a QP may take; a slower "
+                                             "solve takes the logged fallback (default none: "
+                                             "reproducible runs, the solver's iteration limit "
+                                             "is the budget)", unit="ms", lo=0.0, lo_open=True)
 
 
 _CW = "lidar.CWLidar setting (unset: its default)"
@@ -411,7 +415,8 @@ def _mpc_settings(opts: MPCOptions, collective: bool) -> Any:
                            "measurement_std": {f"flap_moment_{b}": opts.kalman_flap_std
                                                for b in (1, 2, 3)}},
                        collective=collective, weights=opts.weights.weights(
-                           ENVELOPE_WEIGHTS if opts.design_wind_mps is None else None))
+                           ENVELOPE_WEIGHTS if opts.design_wind_mps is None else None),
+                       time_budget_ms=opts.time_budget_ms)
 
 
 #: The result label of a design that reads the plant's true states.
@@ -656,10 +661,11 @@ class TSOptions(Options):
                                lo_open=True, flag="")
     observer_decay_rate: float = option(1.0, help="observer decay rate", unit="1/s", lo=0.0,
                                         lo_open=True, flag="")
-    region2_torque: str = option("baseline", help="below rated, with the pitch at fine pitch: "
-                                 "baseline (the baseline's torque law, power-optimal tip-speed "
-                                 "ratio) or ts (the TS law's own torque, Clemens et al.'s "
-                                 "full-load design everywhere)", choices=("baseline", "ts"))
+    generator_torque: str = option("baseline", help="baseline: the baseline's torque "
+                                   "schedule (power-optimal tip-speed ratio below rated, "
+                                   "constant power above), the TS law setting the pitch; ts: "
+                                   "the TS law's own torque everywhere (Clemens et al.'s "
+                                   "full-load design)", choices=("baseline", "ts"))
 
 
 @register("ts", TSOptions, field_components="u", design=_design_ts,
@@ -683,7 +689,7 @@ def _build_ts(ctx: BuildContext, opts: TSOptions) -> Built:
     dp = None if opts.apc_frequency is None else apc_reference(
         opts.apc_frequency, amplitude=opts.apc_amplitude, offset=opts.apc_offset)
     law = None
-    if opts.region2_torque == "baseline":
+    if opts.generator_torque == "baseline":
         from mpc_wt.controllers.baseline import BaselineController, tune_baseline
 
         law = BaselineController(ctx.turbine, tune_baseline(ctx.turbine))

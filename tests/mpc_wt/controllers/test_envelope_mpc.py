@@ -12,7 +12,8 @@ import pytest
 
 import lidar
 import linearize
-from mpc_wt.run import run_controller
+from mpc_wt.run import build_controller, run_controller
+from mpc_wt.simulation.loop import simulate_closed_loop
 from mpc_wt.simulation.scenario import Scenario, field_grid
 
 
@@ -116,3 +117,30 @@ def test_a_failed_qp_takes_the_logged_fallback_and_the_run_goes_on(turbine, monk
     assert {1.0, 2.0} >= set(fb[fb > 0]) and fb[fb > 0][0] == 1.0
     assert sum("forced failure" in r.getMessage() for r in caplog.records) == 10
     assert np.all(np.isfinite(res.channel("rotor_speed")))
+
+
+def test_a_solve_over_its_time_budget_takes_the_fallback(turbine, caplog) -> None:
+    """With a time budget no solve can meet (1 ns), every step's plan counts as late: the
+    fallback applies at every controller step (10 Hz over 5 s: 50), each logged with the time
+    it took, counted by the controller, and the run continues; with no budget (the default)
+    the same run has no fallback. A budget <= 0 is refused, naming it."""
+    from mpc_wt.controllers.mpc import MPCSettings
+
+    with caplog.at_level(logging.WARNING, logger="mpc_wt.controllers.mpc"):
+        built, op, wind = build_controller(turbine, "mpc", Scenario(15.0, "B", 4, 5.0),
+                                           {"design_wind_mps": 15.0})
+        ctl = built.controller
+        ctl.settings = ctl.settings.replace(time_budget_ms=1e-6)
+        res = simulate_closed_loop(linearize.plant_params(turbine), ctl, wind, 5.0, x0=op.x,
+                                   u0=op.u, controller_dt=built.controller_dt)
+    assert res.t[-1] == pytest.approx(5.0)
+    assert ctl.fallbacks == 50
+    assert np.all(res.controller["qp_fallback"][::8] > 0)
+    assert sum("over its time budget of 1e-06 ms" in r.getMessage()
+               for r in caplog.records) == 50
+    ctl.settings = ctl.settings.replace(time_budget_ms=None)
+    simulate_closed_loop(linearize.plant_params(turbine), ctl, wind, 5.0, x0=op.x, u0=op.u,
+                         controller_dt=built.controller_dt)
+    assert ctl.fallbacks == 0
+    with pytest.raises(ValueError, match="time_budget_ms"):
+        MPCSettings(time_budget_ms=0.0)

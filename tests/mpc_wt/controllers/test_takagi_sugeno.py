@@ -234,3 +234,28 @@ def test_region_two_law_tracks_the_optimal_tip_speed_ratio(turbine, params, ts,
     assert got["law"][0] == pytest.approx(p_ref, rel=0.01)
     assert got["law"][1] == pytest.approx(op.state("rotor_speed"), rel=0.01)
     assert got["none"][1] / op.state("rotor_speed") - 1 > 0.03
+
+
+def test_beyond_the_last_vertex_the_pitch_follows_the_wind(turbine, params) -> None:
+    """A TS model whose vertices end at 16 m/s, with the baseline's torque schedule, in a steady
+    20 m/s wind with no shear, started at the 16 m/s trim: the pitch, extrapolated along the
+    last cell beyond the grid, settles within 0.5 deg of the plant's trim pitch at 20 m/s
+    (``linearize.trim``, independent), the rotor within 1 % of rated speed and the power
+    within 0.5 % of rated; the largest speed on the way stays below 1.15 x rated."""
+    from mpc_wt.controllers.baseline import BaselineController, tune_baseline
+
+    ts = build_ts_model(turbine, wind_grid=(12.0, 14.0, 16.0), reduction_grid=(0.0,))
+    c = TSController(ts, design_ts_controller(ts), design_ts_observer(ts), turbine,
+                     torque_law=BaselineController(turbine, tune_baseline(turbine)))
+    op16 = linearize.trim(turbine, 16.0, shear_exponent=0.0)
+    op20 = linearize.trim(turbine, 20.0, shear_exponent=0.0)
+    wind, _ = make_wind(turbine, Scenario(20.0, condition="nwp", shear_exponent=0.0,
+                                          duration=120.0))
+    r = simulate_closed_loop(params, c, wind, 120.0, x0=op16.x, u0=op16.u)
+    sel = r.t > 90.0
+    rated = turbine.operation.rated_rotor_speed_rad_s
+    assert abs(math.degrees(r.channel("pitch_1")[sel].mean() - op20.pitch_rad)) < 0.5
+    assert r.channel("rotor_speed")[sel].mean() == pytest.approx(rated, rel=0.01)
+    assert r.channel("gen_power")[sel].mean() == pytest.approx(
+        turbine.operation.rated_power, rel=0.005)
+    assert r.channel("rotor_speed").max() < 1.15 * rated

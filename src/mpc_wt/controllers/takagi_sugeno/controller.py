@@ -14,6 +14,7 @@ import scipy.linalg
 import linearize
 from linearize.validate import check_number
 from mpc_wt.controllers.base import ControllerBase
+from mpc_wt.controllers.baseline import LawTorque
 from mpc_wt.controllers.estimator import SignalReader
 from mpc_wt.controllers.takagi_sugeno.model import TSModel
 from mpc_wt.controllers.takagi_sugeno.synthesis import TSControllerDesign, TSObserverDesign
@@ -33,7 +34,10 @@ class TSController(ControllerBase):
     period and the vertex maps are blended with the memberships of the current premise: for
     slowly varying premises this is the discretization of eq 10. The premise is the estimated
     wind v_hat and the power reduction Delta P(t) of ``power_reduction``; a premise outside the
-    vertex grid is clipped to it (logged once per run, counted in ``premise_clipped``).
+    vertex grid is clipped to it (logged once per run, counted in ``premise_clipped``); above
+    the last vertex wind the equilibrium pitch is extrapolated along the last cell's slope
+    (d theta_0 / dv of the last two vertices), so that the pitch keeps following a wind beyond
+    the grid (a gust above cut-out) instead of holding the last vertex's equilibrium.
 
     Parameters
     ----------
@@ -47,12 +51,13 @@ class TSController(ControllerBase):
         over the wind grid (clipped to it): the controller starts in operation from what it
         measures.
     torque_law : BaselineController, optional
-        The region-II law below rated: while the TS law's pitch is held at fine pitch (region
-        II: nothing left to regulate with the pitch), the generator torque follows this
-        baseline's torque schedule on the generator speed low-passed at its filter corner
-        (power-optimal tip-speed ratio, regions 1.5-2.5), and the observer is fed that torque.
-        Clemens et al.'s design is a full-load one; without a law the TS torque regulates the
-        rotor towards rated speed in low winds, off the optimal tip-speed ratio.
+        The generator torque from this baseline's torque schedule on the generator speed
+        low-passed at its filter corner (power-optimal tip-speed ratio below rated, regions
+        1.5-2.5; constant power (1 - Delta P) P_rated above), the TS law setting the pitch; the
+        observer is fed the torque applied. Without it (Clemens et al.'s design) the TS law
+        sets both: a full-load design whose torque, below rated, drives the rotor towards the
+        lowest vertex's rated speed, off the optimal tip-speed ratio, and above rated lets the
+        power exceed rated with the rotor speed.
 
     Signals recorded: ``wind_est`` [m/s], ``power_reduction`` [-], ``power_ref`` [W],
     ``premise_clipped`` (0/1).
@@ -89,7 +94,7 @@ class TSController(ControllerBase):
             e = scipy.linalg.expm(m * dt)
             self._phi[i], self._gam[i] = e[:n, :n], e[:n, n:]
         self.torque_law = torque_law
-        self._a_law = math.exp(-torque_law.wc * dt) if torque_law is not None else math.nan
+        self._law = LawTorque(torque_law, dt) if torque_law is not None else None
         self._read = SignalReader(ts.measured)
         self._K = np.ascontiguousarray(controller.K, dtype=float)
         self._w = np.zeros((2, nv))
@@ -105,8 +110,8 @@ class TSController(ControllerBase):
         self.premise_clipped = 0
         self._warned = False
         self._q = 0.0
-        self._w_filt: float | None = None
-        self.law_active = 0                 # steps with the torque from the region-II law
+        if self._law is not None:
+            self._law.reset()
 
     def _start(self, v_init: float) -> None:
         """The observer's state at the vertex equilibrium of wind ``v_init``."""
@@ -131,7 +136,8 @@ class TSController(ControllerBase):
             self.xi, self._u, y, dp_raw, ts.wind_grid, ts.reduction_grid, self._phi, self._gam,
             ts.x0, ts.u0, self._K, -1 if self._ki is None else self._ki,
             -1 if self._int_src is None else self._int_src, self._q, self.dt,
-            pa.min_pitch_rad, pa.max_pitch_rad, gen.min_torque, gen.max_torque, self._w)
+            pa.min_pitch_rad, pa.max_pitch_rad, gen.min_torque, gen.max_torque,
+            self.torque_law is None, self._w)
         if clipped:
             self.premise_clipped += 1
             if not self._warned:
@@ -141,20 +147,12 @@ class TSController(ControllerBase):
                 self._warned = True
         self._q = q
         pitch, torque = float(self._u[0]), float(self._u[1])
-        law = self.torque_law
-        if law is not None:
-            w = float(meas["gen_speed"])
-            a = self._a_law
-            self._w_filt = w if self._w_filt is None else a * self._w_filt + (1 - a) * w
-            if pitch <= self.turbine.pitch_actuator.min_pitch_rad:
-                torque = law.torque(self._w_filt, pitch)
-                self._u[1] = torque
-                self.law_active += 1
+        if self._law is not None:           # torque from the schedule, pitch from the TS law
+            torque = self._law(float(meas["gen_speed"]), pitch, ts.rated_power * (1.0 - dp))
+            self._u[1] = torque
         self.signals = {"wind_est": float(self.xi[-1]), "power_reduction": dp,
                         "power_ref": ts.rated_power * (1.0 - dp),
-                        "premise_clipped": float(clipped),
-                        "torque_law_active": float(law is not None and pitch <= self.turbine
-                                                   .pitch_actuator.min_pitch_rad)}
+                        "premise_clipped": float(clipped)}
         return np.full(3, pitch), torque
 
 
@@ -196,11 +194,12 @@ def _memberships(wg: np.ndarray, rg: np.ndarray, v: float, dp: float, h: np.ndar
 def _ts_step(xi: np.ndarray, u: np.ndarray, y: np.ndarray, dp_raw: float, wg: np.ndarray,
              rg: np.ndarray, phi: np.ndarray, gam: np.ndarray, x0: np.ndarray, u0: np.ndarray,
              kk: np.ndarray, ki: int, src: int, q_prev: float, dt: float, pmin: float,
-             pmax: float, tmin: float, tmax: float, work: np.ndarray
+             pmax: float, tmin: float, tmax: float, own_torque: bool, work: np.ndarray
              ) -> tuple[float, float, bool]:
     """One TS step in place: xi (observer, eq 10, exact ZOH per vertex, blended) and u (PDC
     law, eq 7, clipped to the actuators); returns the integral, the clipped dp and whether the
-    premise was clipped. ``work`` is (2, N) scratch for the memberships."""
+    premise was clipped. ``own_torque``: the TS torque is applied (else only a saturated pitch
+    holds the integral). ``work`` is (2, N) scratch for the memberships."""
     nv, n = phi.shape[0], phi.shape[1]
     nu, ny = u.size, y.size
     h = work[0]
@@ -236,9 +235,20 @@ def _ts_step(xi: np.ndarray, u: np.ndarray, y: np.ndarray, dp_raw: float, wg: np
             if ki >= 0:
                 acc -= kk[i, r, nx] * q
             out[r] += h2[i] * acc
+    v_top = wg[wg.size - 1]
+    if wg.size > 1 and xi[n - 1] > v_top:   # beyond the last vertex: its pitch schedule goes on
+        nb_ = rg.size
+        kb, wb0, wb1, _c = _hat_weights(rg, dp)
+        slope = 0.0
+        for ib, wb in ((kb, wb0), (kb + 1, wb1)):
+            if wb == 0.0 or ib >= nb_:
+                continue
+            last, prev = (wg.size - 1) * nb_ + ib, (wg.size - 2) * nb_ + ib
+            slope += wb * (u0[last, 0] - u0[prev, 0]) / (v_top - wg[wg.size - 2])
+        out[0] += slope * (xi[n - 1] - v_top)
     pitch = min(max(out[0], pmin), pmax)
     torque = min(max(out[1], tmin), tmax)
-    if pitch != out[0] or torque != out[1]:
-        q = q_prev        # anti-windup: no integration while an input saturates
+    if pitch != out[0] or (own_torque and torque != out[1]):
+        q = q_prev        # anti-windup: no integration while an applied input saturates
     u[0], u[1] = pitch, torque
     return q, dp, c1 or c2
