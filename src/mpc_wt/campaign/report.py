@@ -225,8 +225,8 @@ def _load_case_row(lc: Any) -> dict[str, Any]:
                                          f"({', '.join(map(turbulence_tag, lc.turbulence))})",
             "winds": ", ".join(f"{v:g}" for v in lc.winds), "runs": runs, "family": lc.family,
             "fatigue": "yes" if lc.fatigue else "", "length": f"{lc.duration:g}",
-            "events": ", ".join(f"{k} {v:g}" for k, v in lc.supervisor.items()
-                                if v is not None)
+            "events": ", ".join(f"{k} {v:g}" if isinstance(v, (int, float)) else f"{k} {v}"
+                                for k, v in lc.supervisor.items() if v is not None)
             + (f"; event at {lc.event_at:g} s" if lc.deterministic else "")}
 
 

@@ -25,6 +25,7 @@ from __future__ import annotations
 
 import bisect
 import dataclasses
+import functools
 import logging
 import math
 import time
@@ -97,6 +98,63 @@ class MPCWeights:
                 check_number(f"weight {k!r}", v, lo=0.0, reason="the QP must be convex")
         for k, v in self.scales.items():
             check_number(f"scale {k!r}", v, lo=0.0, lo_open=True)
+
+    def for_turbine(self, turbine: linearize.Turbine) -> "MPCWeights":
+        """These weights with the scales of power, rotor speed, generator torque, flap moment
+        and shaft torsion carried from the NREL 5-MW (whose typical magnitudes the default
+        scales are) to ``turbine`` in proportion to its own at rated wind
+        (:func:`turbine_scale_ratios`); angles and the tower-top velocity keep theirs. For the
+        NREL 5-MW every ratio is 1.
+
+        Parameters
+        ----------
+        turbine : Turbine
+
+        Returns
+        -------
+        MPCWeights
+        """
+        r = turbine_scale_ratios(turbine)
+        return dataclasses.replace(self, scales={k: v * r.get(k, 1.0)
+                                                 for k, v in self.scales.items()})
+
+
+def _rated_magnitudes(turbine: linearize.Turbine) -> dict[str, float]:
+    """A turbine's magnitudes at its rated wind: power, rotor speed, generator torque, rotor
+    thrust x tip radius (the flap moment's size) and the shaft's torsion."""
+    op = linearize.trim(turbine, linearize.rated_wind_speed(turbine))
+    dt = turbine.drivetrain
+    return {"gen_power": turbine.operation.rated_power,
+            "rotor_speed": turbine.operation.rated_rotor_speed_rad_s,
+            "gen_torque_ref": float(op.gen_torque),
+            "flap_moment": float(op.thrust) * turbine.geometry.tip_radius,
+            "shaft_torsion": float(op.gen_torque) * dt.gearbox_ratio / dt.shaft_stiffness}
+
+
+@functools.lru_cache(maxsize=1)
+def _nrel5mw_magnitudes() -> tuple[tuple[str, float], ...]:
+    return tuple(_rated_magnitudes(linearize.load_turbine("nrel5mw")).items())
+
+
+def turbine_scale_ratios(turbine: linearize.Turbine) -> dict[str, float]:
+    """The ratios of ``turbine``'s magnitudes at rated wind to the NREL 5-MW's, per scaled
+    signal (``gen_power``, ``rotor_speed``, ``gen_torque_ref``, ``flap_moment``,
+    ``shaft_torsion``): the MPC's default scales are the NREL 5-MW's typical magnitudes, and a
+    15 MW rotor weighed with them would count power errors three times and speed errors half
+    as much as intended (on the IEA-15 the rotor ran at 0.85 x rated with the torque pinned).
+
+    Parameters
+    ----------
+    turbine : Turbine
+
+    Returns
+    -------
+    dict of str to float
+        Exactly 1 for the packaged NREL 5-MW (the same computation).
+    """
+    ref = dict(_nrel5mw_magnitudes())
+    mine = _rated_magnitudes(turbine)
+    return {k: mine[k] / ref[k] for k in ref}
 
 
 @dataclass(frozen=True)

@@ -455,6 +455,7 @@ def _mpc(collective: bool, with_lidar: bool) -> Any:
         from mpc_wt.controllers.mpc import MPC, ScheduledMPC
 
         settings = _mpc_settings(opts, collective)
+        settings = settings.replace(weights=settings.weights.for_turbine(ctx.turbine))
         limit = opts.speed_limit
         if limit is None and opts.design_wind_mps is None:
             limit = ENVELOPE_SPEED_LIMIT

@@ -152,6 +152,27 @@ def test_load_cases_expand_into_cases() -> None:
     assert by["baseline__dlc1.2__A__v13__s2"].case_hash == old[2]
 
 
+def test_a_pitch_fault_load_case() -> None:
+    """DLC 2.2 with a seized blade: the fault time shifted by the transient, the kind and the
+    blade kept as given, the family abnormal (IEC table 2), and the report's load-case row
+    naming the events (a fault's kind is text, not a number)."""
+    from mpc_wt.campaign.report import _load_case_row
+
+    spec = _spec(load_cases=[{"dlc": "2.2", "winds": [17.0], "seeds": 1, "duration": 60.0,
+                              "supervisor": {"pitch_fault_at": 20.0, "pitch_fault": "seized",
+                                             "pitch_fault_blade": 2}}],
+                 controllers=["baseline"])
+    (c,) = spec.cases()
+    assert c.family == "A"
+    assert c.supervisor == {"overspeed": 1.25, "pitch_fault_at": 25.0, "pitch_fault": "seized",
+                            "pitch_fault_blade": 2}
+    row = _load_case_row(spec.load_cases[0])
+    assert "pitch_fault seized" in row["events"] and "pitch_fault_at 20" in row["events"]
+    with pytest.raises(SpecError, match=r"pitch_fault must be one of"):
+        _spec(load_cases=[{"dlc": "2.2", "winds": [17.0], "seeds": 1,
+                           "supervisor": {"pitch_fault_at": 20.0, "pitch_fault": "jammed"}}])
+
+
 @pytest.mark.parametrize("over, key, what", [
     ({"load_cases": [{"dlc": "1.4", "condition": "gust", "winds": [10]}]},
      r"load_cases\[0\].condition", "must be one of"),

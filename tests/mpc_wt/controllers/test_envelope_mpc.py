@@ -144,3 +144,22 @@ def test_a_solve_over_its_time_budget_takes_the_fallback(turbine, caplog) -> Non
     assert ctl.fallbacks == 0
     with pytest.raises(ValueError, match="time_budget_ms"):
         MPCSettings(time_budget_ms=0.0)
+
+
+def test_cost_scales_follow_the_turbine() -> None:
+    """The MPC's default scales are the NREL 5-MW's typical magnitudes; for another turbine
+    they follow its rated values: on the IEA-15-240-RWT the power scale is 3x (15 MW against
+    5 MW, both published ratings) and the rotor-speed scale 7.56 / 12.1 rpm = 0.625x (the
+    published rated speeds), while angles keep theirs; for the NREL 5-MW nothing changes."""
+    from mpc_wt.controllers.mpc import MPCWeights, turbine_scale_ratios
+
+    five, fifteen = linearize.load_turbine("nrel5mw"), linearize.load_turbine("iea15mw")
+    assert set(turbine_scale_ratios(five).values()) == {1.0}
+    r = turbine_scale_ratios(fifteen)
+    assert r["gen_power"] == pytest.approx(3.0, rel=1e-9)
+    assert r["rotor_speed"] == pytest.approx(7.56 / 12.1, rel=2e-3)
+    w0 = MPCWeights()
+    w = w0.for_turbine(fifteen)
+    assert w.scales["gen_power"] == pytest.approx(3.0 * w0.scales["gen_power"])
+    assert w.scales["pitch_rate"] == w0.scales["pitch_rate"]
+    assert w0.for_turbine(five) == w0
