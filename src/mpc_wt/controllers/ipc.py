@@ -643,12 +643,10 @@ class ColemanIPCController(_PitchAddOn):
             th_c *= self.gains.max_amplitude_rad / amp
             th_s *= self.gains.max_amplitude_rad / amp
         self._theta_cs = (th_c, th_s)
-        th = (w * th_c, w * th_s)
-        u = np.array([th[0] * c1 + th[1] * s1, th[0] * c2 + th[1] * s2,
-                      th[0] * c3 + th[1] * s3])
-        m_cs = (tilt, yaw)
+        pc_, ps_ = w * th_c, w * th_s
+        u = np.array([pc_ * c1 + ps_ * s1, pc_ * c2 + ps_ * s2, pc_ * c3 + ps_ * s3])
         cmd = self._limit(pc + u, meas)
         self.signals = {**self.collective.signals, "ipc_weight": w,
-                        "ipc_tilt_moment": float(m_cs[0]), "ipc_yaw_moment": float(m_cs[1]),
-                        "ipc_pitch_cos": float(th[0]), "ipc_pitch_sin": float(th[1])}
+                        "ipc_tilt_moment": tilt, "ipc_yaw_moment": yaw,
+                        "ipc_pitch_cos": pc_, "ipc_pitch_sin": ps_}
         return cmd, tq

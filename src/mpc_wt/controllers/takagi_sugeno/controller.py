@@ -16,7 +16,7 @@ from linearize.validate import check_number
 from mpc_wt.controllers.base import ControllerBase
 from mpc_wt.controllers.baseline import LawTorque
 from mpc_wt.controllers.estimator import SignalReader
-from mpc_wt.controllers.takagi_sugeno.model import TSModel
+from mpc_wt.controllers.takagi_sugeno.model import TSModel, hat_weights, memberships
 from mpc_wt.controllers.takagi_sugeno.synthesis import TSControllerDesign, TSObserverDesign
 
 log = logging.getLogger(__name__)
@@ -157,40 +157,6 @@ class TSController(ControllerBase):
 
 
 @nb.njit(cache=True, nogil=True)
-def _hat_weights(grid: np.ndarray, s: float) -> tuple[int, float, float, bool]:
-    """The clipped premise's cell k on ``grid`` and the hat weights of its two ends (one end
-    weight 1 for a single-point grid); whether ``s`` was clipped."""
-    n = grid.size
-    c = min(max(s, grid[0]), grid[n - 1])
-    clipped = c != s
-    if n == 1:
-        return 0, 1.0, 0.0, clipped
-    k = np.searchsorted(grid, c) - 1
-    k = min(max(k, 0), n - 2)
-    f = (c - grid[k]) / (grid[k + 1] - grid[k])
-    return k, 1.0 - f, f, clipped
-
-
-@nb.njit(cache=True, nogil=True)
-def _memberships(wg: np.ndarray, rg: np.ndarray, v: float, dp: float, h: np.ndarray
-                 ) -> tuple[float, bool]:
-    """h (zeroed, then filled) = the tensor-product hats of Clemens et al. eq 3 at the clipped
-    premise (v, dp); returns the clipped dp and whether either was clipped."""
-    h[:] = 0.0
-    ka, wa0, wa1, c1 = _hat_weights(wg, v)
-    kb, wb0, wb1, c2 = _hat_weights(rg, dp)
-    nb_ = rg.size
-    for ia, wa in ((ka, wa0), (ka + 1, wa1)):
-        if wa == 0.0 or ia >= wg.size:
-            continue
-        for ib, wb in ((kb, wb0), (kb + 1, wb1)):
-            if wb == 0.0 or ib >= nb_:
-                continue
-            h[ia * nb_ + ib] += wa * wb
-    return min(max(dp, rg[0]), rg[rg.size - 1]), c1 or c2
-
-
-@nb.njit(cache=True, nogil=True)
 def _ts_step(xi: np.ndarray, u: np.ndarray, y: np.ndarray, dp_raw: float, wg: np.ndarray,
              rg: np.ndarray, phi: np.ndarray, gam: np.ndarray, x0: np.ndarray, u0: np.ndarray,
              kk: np.ndarray, ki: int, src: int, q_prev: float, dt: float, pmin: float,
@@ -203,7 +169,7 @@ def _ts_step(xi: np.ndarray, u: np.ndarray, y: np.ndarray, dp_raw: float, wg: np
     nv, n = phi.shape[0], phi.shape[1]
     nu, ny = u.size, y.size
     h = work[0]
-    dp, c1 = _memberships(wg, rg, xi[n - 1], dp_raw, h)
+    dp, c1 = memberships(wg, rg, xi[n - 1], dp_raw, h)
     w = np.empty(nu + ny + 1)
     w[:nu] = u
     w[nu:nu + ny] = y
@@ -215,7 +181,7 @@ def _ts_step(xi: np.ndarray, u: np.ndarray, y: np.ndarray, dp_raw: float, wg: np
         new += h[i] * (phi[i] @ xi + gam[i] @ w)
     xi[:] = new
     h2 = work[1]
-    dp, c2 = _memberships(wg, rg, xi[n - 1], dp_raw, h2)
+    dp, c2 = memberships(wg, rg, xi[n - 1], dp_raw, h2)
     nx = n - 1
     q = q_prev
     if ki >= 0:
@@ -238,7 +204,7 @@ def _ts_step(xi: np.ndarray, u: np.ndarray, y: np.ndarray, dp_raw: float, wg: np
     v_top = wg[wg.size - 1]
     if wg.size > 1 and xi[n - 1] > v_top:   # beyond the last vertex: its pitch schedule goes on
         nb_ = rg.size
-        kb, wb0, wb1, _c = _hat_weights(rg, dp)
+        kb, wb0, wb1, _c = hat_weights(rg, dp)
         slope = 0.0
         for ib, wb in ((kb, wb0), (kb + 1, wb1)):
             if wb == 0.0 or ib >= nb_:

@@ -8,6 +8,7 @@ import math
 from dataclasses import dataclass, field
 from typing import Any, Sequence
 
+import numba as nb
 import numpy as np
 
 import linearize
@@ -26,16 +27,39 @@ DEFAULT_SCALES = {"tower_fa_displacement": 0.1, "tower_fa_velocity": 0.1, "rotor
                   "gen_torque_ref": 4e3, "wind": 1.0}
 
 
-def _hats(grid: np.ndarray, s: float) -> np.ndarray:
-    """One-dimensional hat memberships of ``s`` on ``grid`` (sum to 1 inside the grid)."""
-    w = np.zeros(grid.size)
-    if grid.size == 1:
-        w[0] = 1.0
-        return w
-    k = int(np.clip(np.searchsorted(grid, s) - 1, 0, grid.size - 2))
-    f = (s - grid[k]) / (grid[k + 1] - grid[k])
-    w[k], w[k + 1] = 1.0 - f, f
-    return w
+@nb.njit(cache=True, nogil=True)
+def hat_weights(grid: np.ndarray, s: float) -> tuple[int, float, float, bool]:
+    """The clipped premise's cell k on ``grid`` and the hat weights of its two ends (one end
+    weight 1 for a single-point grid); whether ``s`` was clipped."""
+    n = grid.size
+    c = min(max(s, grid[0]), grid[n - 1])
+    clipped = c != s
+    if n == 1:
+        return 0, 1.0, 0.0, clipped
+    k = np.searchsorted(grid, c) - 1
+    k = min(max(k, 0), n - 2)
+    f = (c - grid[k]) / (grid[k + 1] - grid[k])
+    return k, 1.0 - f, f, clipped
+
+
+@nb.njit(cache=True, nogil=True)
+def memberships(wg: np.ndarray, rg: np.ndarray, v: float, dp: float, h: np.ndarray
+                 ) -> tuple[float, bool]:
+    """h (zeroed, then filled) = the tensor-product hats of Clemens et al. eq 3 at the clipped
+    premise (v, dp), vertex (a, b) at a * n_b + b (row-major, wind outer); returns the clipped
+    dp and whether either was clipped. Compiled: the TS controller's step calls it twice."""
+    h[:] = 0.0
+    ka, wa0, wa1, c1 = hat_weights(wg, v)
+    kb, wb0, wb1, c2 = hat_weights(rg, dp)
+    nb_ = rg.size
+    for ia, wa in ((ka, wa0), (ka + 1, wa1)):
+        if wa == 0.0 or ia >= wg.size:
+            continue
+        for ib, wb in ((kb, wb0), (kb + 1, wb1)):
+            if wb == 0.0 or ib >= nb_:
+                continue
+            h[ia * nb_ + ib] += wa * wb
+    return min(max(dp, rg[0]), rg[rg.size - 1]), c1 or c2
 
 
 @dataclass(frozen=True)
@@ -158,7 +182,9 @@ class TSModel:
             If z is outside the vertex grid (or not finite).
         """
         self.check_premise(wind, reduction)
-        return np.kron(_hats(self.wind_grid, wind), _hats(self.reduction_grid, reduction))
+        h = np.empty(self.n_vertices)
+        memberships(self.wind_grid, self.reduction_grid, float(wind), float(reduction), h)
+        return h
 
     def wind_at_pitch(self, pitch: float) -> float:
         """The wind whose vertex equilibrium (no power reduction) has a collective pitch,
