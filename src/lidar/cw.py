@@ -21,13 +21,15 @@ field (wind evolution is applied to the field, see :func:`lidar.evolve_field`).
 """
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 
+import numba as nb
 import numpy as np
 
 from lidar._typing import FloatArray
-from lidar.field import WindField
+from lidar.field import WindField, trilinear_point
 
 __all__ = ["CWLidar", "LidarMeasurement"]
 
@@ -160,6 +162,9 @@ class CWLidar:
         w : (n_s,) ndarray
             Weights, summing to 1 [-].
         """
+        return _range_quadrature(self, float(s_max))
+
+    def _quadrature(self, s_max: float) -> tuple[FloatArray, FloatArray]:
         if not self.range_weighting:
             return np.array([self.focus_range]), np.array([1.0])
         g, f = self.half_width, self.focus_range
@@ -251,15 +256,22 @@ class CWLidar:
         s, wts = self.range_quadrature(s_max)
         x_up = s * cos_b                                             # (n_s,)
         rad = s * sin_b
+        gam = 0.0 if self.perfect_alignment else self.misalignment_rad
+        if t.size and t.min() + x_up[0] / v >= field.t[0]:
+            # every point inside the field (s_max keeps them in y, z and the end of time):
+            # the compiled beam sums
+            los = np.empty((t.size, 3))
+            vw = (field.v, field.w) if self.los_error else (field.u, field.u)
+            _los_kernel(field.u, *vw, field.grid_spacing(), t, ang, x_up, rad,
+                        wts, field.hub_height, v, cos_b, sin_b, math.cos(gam), math.sin(gam),
+                        self.los_error, los)
+            return self._measurement(t, los, ang, cos_b, v, rng)
         tt = t[:, None, None] + x_up[None, None, :] / v               # (n_t, 1, n_s)
         yy = -rad[None, None, :] * np.sin(ang)[:, :, None]
         zz = field.hub_height + rad[None, None, :] * np.cos(ang)[:, :, None]
         tt = np.broadcast_to(tt, yy.shape)
-        u = field.sample(tt, yy, zz, "u")
         if self.los_error:
-            vv = field.sample(tt, yy, zz, "v")
-            ww = field.sample(tt, yy, zz, "w")
-            gam = 0.0 if self.perfect_alignment else self.misalignment_rad
+            u, vv, ww = field.sample_components(tt, yy, zz, "uvw")
             if gam:
                 u, vv = u * math.cos(gam) - vv * math.sin(gam), u * math.sin(gam) + vv * math.cos(gam)
             # beam direction (from the hub): (-cos_b, -sin_b sin(ang), sin_b cos(ang));
@@ -267,13 +279,54 @@ class CWLidar:
             los_pts = (u * cos_b + vv * (sin_b * np.sin(ang))[:, :, None]
                        - ww * (sin_b * np.cos(ang))[:, :, None])
         else:
-            los_pts = u * cos_b
+            los_pts = field.sample(tt, yy, zz, "u") * cos_b
         los = (los_pts * wts[None, None, :]).sum(axis=2)
+        return self._measurement(t, los, ang, cos_b, v, rng)
+
+    def _measurement(self, t: FloatArray, los: FloatArray, ang: FloatArray, cos_b: float,
+                     v: float, rng: np.random.Generator | None) -> "LidarMeasurement":
+        """The measurement of the beam sums ``los``, with the noise added."""
         if self.noise_std > 0:
             gen = rng if rng is not None else np.random.default_rng()
             los = los + gen.normal(0.0, self.noise_std, los.shape)
         return LidarMeasurement(t=t, los=los, u_hat=los / cos_b, beam_azimuth_rad=ang,
                                 preview_time=self.preview_time(v), radius=self.radius)
+
+
+@nb.njit(cache=True)
+def _los_kernel(u, v, w, grid, t, ang, x_up, rad, wts, hub, mean, cos_b, sin_b, cos_g, sin_g,
+                los_error, out):  # pragma: no cover - compiled
+    """The range-weighted LOS speed of each beam at each time, into ``out`` (n_t, 3): the
+    field (frozen turbulence: the wind at x upstream and time t is the field's at t + x / V)
+    at the quadrature's points, every point checked inside the field by the caller."""
+    for k in range(t.size):
+        for i in range(3):
+            sa = math.sin(ang[k, i])
+            ca = math.cos(ang[k, i])
+            acc = 0.0
+            for j in range(x_up.size):
+                tt = t[k] + x_up[j] / mean
+                yy = -rad[j] * sa
+                zz = hub + rad[j] * ca
+                uu = trilinear_point(u, grid, tt, yy, zz)
+                if los_error:
+                    vv = trilinear_point(v, grid, tt, yy, zz)
+                    ww = trilinear_point(w, grid, tt, yy, zz)
+                    uu, vv = uu * cos_g - vv * sin_g, uu * sin_g + vv * cos_g
+                    acc += wts[j] * (uu * cos_b + vv * (sin_b * sa) - ww * (sin_b * ca))
+                else:
+                    acc += wts[j] * (uu * cos_b)
+            out[k, i] = acc
+
+
+@functools.lru_cache(maxsize=64)
+def _range_quadrature(lidar: CWLidar, s_max: float) -> tuple[FloatArray, FloatArray]:
+    """:meth:`CWLidar.range_quadrature`, kept (read-only) for the next measurement of the same
+    LIDAR: a LIDAR in the loop measures once a step with the same beam limit."""
+    s, w = lidar._quadrature(s_max)
+    s.flags.writeable = False
+    w.flags.writeable = False
+    return s, w
 
 
 @dataclass(frozen=True)

@@ -48,31 +48,37 @@ def _frozen(a: Any, name: str, single: bool = False) -> FloatArray:
 
 
 @nb.njit(cache=True)
-def _trilinear(data, grid, tt, yy, zz, out):  # pragma: no cover - compiled
+def trilinear_point(data, grid, t, y, z):  # pragma: no cover - compiled
     """Trilinear interpolation of ``data`` (n_t, n_y, n_z) on the uniform grid ``grid`` =
-    (t0, dt, y0, dy, z0, dz) at the points (tt, yy, zz), written into ``out``; a point on the
-    edge (or within rounding of it) takes the last cell (compiled: one call per LIDAR
-    measurement instead of some fifty numpy operations)."""
+    (t0, dt, y0, dy, z0, dz) at one point; a point on the edge (or within rounding of it)
+    takes the last cell. The caller checks that the point is inside."""
     nt, ny, nz = data.shape
+    xt = (t - grid[0]) / grid[1]
+    xy = (y - grid[2]) / grid[3]
+    xz = (z - grid[4]) / grid[5]
+    it = min(max(int(math.floor(xt)), 0), nt - 2)
+    iy = min(max(int(math.floor(xy)), 0), ny - 2)
+    iz = min(max(int(math.floor(xz)), 0), nz - 2)
+    at = min(max(xt - it, 0.0), 1.0)
+    ay = min(max(xy - iy, 0.0), 1.0)
+    az = min(max(xz - iz, 0.0), 1.0)
+    acc = 0.0
+    for dt_ in range(2):
+        wt = at if dt_ else 1.0 - at
+        for dy_ in range(2):
+            wy = ay if dy_ else 1.0 - ay
+            for dz_ in range(2):
+                wz = az if dz_ else 1.0 - az
+                acc += wt * wy * wz * data[it + dt_, iy + dy_, iz + dz_]
+    return acc
+
+
+@nb.njit(cache=True)
+def _trilinear(data, grid, tt, yy, zz, out):  # pragma: no cover - compiled
+    """:func:`trilinear_point` at the points (tt, yy, zz), written into ``out`` (compiled: one
+    call per LIDAR measurement instead of some fifty numpy operations)."""
     for k in range(tt.size):
-        xt = (tt[k] - grid[0]) / grid[1]
-        xy = (yy[k] - grid[2]) / grid[3]
-        xz = (zz[k] - grid[4]) / grid[5]
-        it = min(max(int(math.floor(xt)), 0), nt - 2)
-        iy = min(max(int(math.floor(xy)), 0), ny - 2)
-        iz = min(max(int(math.floor(xz)), 0), nz - 2)
-        at = min(max(xt - it, 0.0), 1.0)
-        ay = min(max(xy - iy, 0.0), 1.0)
-        az = min(max(xz - iz, 0.0), 1.0)
-        acc = 0.0
-        for dt_ in range(2):
-            wt = at if dt_ else 1.0 - at
-            for dy_ in range(2):
-                wy = ay if dy_ else 1.0 - ay
-                for dz_ in range(2):
-                    wz = az if dz_ else 1.0 - az
-                    acc += wt * wy * wz * data[it + dt_, iy + dy_, iz + dz_]
-        out[k] = acc
+        out[k] = trilinear_point(data, grid, tt[k], yy[k], zz[k])
 
 
 def _uniform(name: str, a: FloatArray) -> float:
@@ -144,6 +150,11 @@ class WindField:
     # ---------------------------------------------------------------------------------------
     # Sampling
     # ---------------------------------------------------------------------------------------
+    def grid_spacing(self) -> FloatArray:
+        """(t0, dt, y0, dy, z0, dz) of the uniform grid [s, m], for :func:`trilinear_point`."""
+        return np.array([self.t[0], self.t[1] - self.t[0], self.y[0], self.y[1] - self.y[0],
+                         self.z[0], self.z[1] - self.z[0]])
+
     def sample(self, t: Any, y: Any, z: Any, component: str = "u") -> FloatArray:
         """Trilinear interpolation of one component at points (t, y, z), broadcast together.
 
@@ -167,6 +178,31 @@ class WindField:
         """
         if component not in ("u", "v", "w"):
             raise ValueError(f"component must be 'u', 'v' or 'w', got {component!r}")
+        return self.sample_components(t, y, z, component)[0]
+
+    def sample_components(self, t: Any, y: Any, z: Any, components: str = "uvw"
+                          ) -> tuple[FloatArray, ...]:
+        """:meth:`sample` of several components at the same points (checked once).
+
+        Parameters
+        ----------
+        t, y, z : array_like
+            Times [s] and lateral and vertical positions [m], broadcast together.
+        components : str
+            Letters of "uvw", in the order wanted.
+
+        Returns
+        -------
+        tuple of ndarray
+            One per letter, in the points' broadcast shape [m/s].
+
+        Raises
+        ------
+        ValueError
+            As :meth:`sample`.
+        """
+        if not components or set(components) - set("uvw"):
+            raise ValueError(f"components must be letters of 'uvw', got {components!r}")
         tt, yy, zz = np.broadcast_arrays(np.asarray(t, float), np.asarray(y, float),
                                          np.asarray(z, float))
         for name, val, ax in (("t", tt, self.t), ("y", yy, self.y), ("z", zz, self.z)):
@@ -176,12 +212,15 @@ class WindField:
                 bad = val.min() if val.min() < lo - tol else val.max()
                 raise ValueError(f"point {name} = {bad:.6g} is outside the wind field "
                                  f"({name} {lo:.6g}..{hi:.6g}); a longer or wider field is needed")
-        grid = np.array([self.t[0], self.t[1] - self.t[0], self.y[0], self.y[1] - self.y[0],
-                         self.z[0], self.z[1] - self.z[0]])
-        out = np.empty(tt.size)
-        _trilinear(getattr(self, component), grid, np.ascontiguousarray(tt).ravel(),
-                   np.ascontiguousarray(yy).ravel(), np.ascontiguousarray(zz).ravel(), out)
-        return out.reshape(tt.shape)
+        grid = self.grid_spacing()
+        ft, fy, fz = (np.ascontiguousarray(tt).ravel(), np.ascontiguousarray(yy).ravel(),
+                      np.ascontiguousarray(zz).ravel())
+        outs = []
+        for comp in components:
+            out = np.empty(tt.size)
+            _trilinear(getattr(self, comp), grid, ft, fy, fz, out)
+            outs.append(out.reshape(tt.shape))
+        return tuple(outs)
 
     # ---------------------------------------------------------------------------------------
     # I/O

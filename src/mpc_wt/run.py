@@ -11,7 +11,7 @@ from mpc_wt.registry.options import Options
 from mpc_wt.registry.registry import API_NAMING, Naming, Selection, resolve
 from mpc_wt.simulation.loop import simulate_closed_loop
 from mpc_wt.simulation.results import ClosedLoopResult
-from mpc_wt.simulation.scenario import Scenario, lidar_field, make_wind, start_wind
+from mpc_wt.simulation.scenario import FieldMemo, Scenario, lidar_field, make_wind, start_wind
 
 __all__ = ["run_controller", "build_controller", "design_controller"]
 
@@ -96,7 +96,8 @@ def build_controller(turbine: linearize.Turbine, controller: str, scenario: Scen
                      options: Mapping[str, Any] | None = None, *,
                      cache: DesignCache = DEFAULT_CACHE, naming: Naming = API_NAMING,
                      params: linearize.PlantParams | None = None,
-                     samplers: lidar.SamplerCache | None = None
+                     samplers: lidar.SamplerCache | None = None,
+                     fields: FieldMemo | None = None
                      ) -> tuple[Built, linearize.OperatingPoint, Any]:
     """The controller's design (:func:`design_controller`, from the cache when it is there),
     the scenario's trim point and wind, and the design's LIDARs bound to the wind they see.
@@ -120,6 +121,8 @@ def build_controller(turbine: linearize.Turbine, controller: str, scenario: Scen
         The turbine's plant parameters, if already derived (:func:`linearize.plant_params`).
     samplers : lidar.SamplerCache, optional
         Keeps the turbulence generator's sampler for the next field of the same wind and grid.
+    fields : FieldMemo, optional
+        Keeps the scenario's fields for the next run of the same scenario.
 
     Returns
     -------
@@ -142,9 +145,9 @@ def build_controller(turbine: linearize.Turbine, controller: str, scenario: Scen
     built, new = _design(turbine, sel, opts, cache, params)
     needs = set().union(*(k.field_components for k in (sel.base, *sel.addons)))
     wind, field = make_wind(turbine, scenario, "".join(c for c in "uvw" if c in needs),
-                            samplers=samplers)
+                            samplers=samplers, fields=fields)
     for sensor in built.sensors:
-        sensor.bind(lidar_field(turbine, scenario, field, sensor.distance, samplers))
+        sensor.bind(lidar_field(turbine, scenario, field, sensor.distance, samplers, fields))
     built.controller.reset()
     if built.preview is not None:
         built.preview.reset()
@@ -172,6 +175,7 @@ def run_controller(turbine: linearize.Turbine, controller: str, scenario: Scenar
                    supervisor: Mapping[str, Any] | None = None, progress: bool = False,
                    cache: DesignCache = DEFAULT_CACHE, naming: Naming = API_NAMING,
                    samplers: lidar.SamplerCache | None = None,
+                   fields: FieldMemo | None = None,
                    turbulence: str | float | None = None, seed: int | None = None,
                    duration: float | None = None, shear_exponent: float | None = None,
                    condition: Mapping[str, Any] | None = None) -> ClosedLoopResult:
@@ -207,6 +211,9 @@ def run_controller(turbine: linearize.Turbine, controller: str, scenario: Scenar
         Keeps the turbulence generator's sampler for the next run of the same wind and grid
         (a campaign's seeds, controllers compared on one field); the fields are the same with
         or without it.
+    fields : FieldMemo, optional
+        Keeps the scenario's fields (the plant's and the LIDARs') for the next run of the same
+        scenario (a campaign's controllers on one seed); the same fields with or without it.
     turbulence, seed, duration, shear_exponent : optional
         With a mean wind only: the :class:`Scenario`'s fields (defaults "A", 1, 600 s, 0.2).
     condition : mapping, optional
@@ -234,7 +241,8 @@ def run_controller(turbine: linearize.Turbine, controller: str, scenario: Scenar
                                        "condition": condition})
     params = linearize.plant_params(turbine)
     built, op, wind = build_controller(turbine, controller, scenario, options, cache=cache,
-                                       naming=naming, params=params, samplers=samplers)
+                                       naming=naming, params=params, samplers=samplers,
+                                       fields=fields)
     meta = {"controller": controller, **scenario.meta(), "turbine": turbine.name,
             **built.meta, **({} if scenario.wind_file is None else {"start_wind_mps": op.wind_mps})}
     ctl = built.controller

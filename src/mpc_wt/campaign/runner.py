@@ -27,7 +27,7 @@ from mpc_wt.campaign.spec import CampaignSpec
 from mpc_wt.campaign.store import CampaignStore
 from mpc_wt.campaign.task import run_case
 
-__all__ = ["run_campaign", "RunSummary", "ENGINES"]
+__all__ = ["run_campaign", "RunSummary", "ENGINES", "submission_order"]
 
 log = logging.getLogger(__name__)
 
@@ -133,7 +133,7 @@ def run_campaign(spec: CampaignSpec, out: str | Path, *, workers: int | None = N
     with CampaignStore(out, lock=True) as store:
         _write_spec(spec, out, store)
         sync = store.sync(spec)
-        todo = store.todo()
+        todo = submission_order(store.todo())
         total = len(spec.cases())
         summary = RunSummary(total=total, skipped=total - len(todo), submitted=len(todo),
                              engine=engine, workers=n_workers, sync=sync)
@@ -172,6 +172,21 @@ def run_campaign(spec: CampaignSpec, out: str | Path, *, workers: int | None = N
             bar.close()
             summary.wall_s = time.perf_counter() - t_start
         return summary
+
+
+def submission_order(cases: list[Any]) -> list[Any]:
+    """The cases in the order they are handed out: the longest simulations first (the last
+    ones to finish are then short), and the controllers of one scenario (wind, turbulence,
+    seed, condition) one after another, so that a worker meets a field it has just made
+    (:data:`mpc_wt.campaign.task.WORKER_FIELDS`). Otherwise the spec's order."""
+    def key(ic: tuple[int, Any]) -> tuple[Any, ...]:
+        i, c = ic
+        sc = c.scenario
+        return (-float(sc.duration), str(sc.condition), str(sc.turbulence), str(sc.iec_class),
+                -1.0 if sc.wind_mps is None else float(sc.wind_mps), int(sc.seed),
+                int(sc.sign), str(sc.wind_file or ""),
+                float(sc.shear_exponent), i)
+    return [c for _, c in sorted(enumerate(cases), key=key)]
 
 
 def _check_engine(engine: str, scheduler: str | None, workers: int | None) -> int:
@@ -264,11 +279,12 @@ def _run_dask(todo: list[Any], root: str, n: int, scheduler: str | None,
         client = distributed.Client(scheduler, timeout="30s")
     try:
         futs = {}
-        for c in todo:
+        for i, c in enumerate(todo):
             # the key carries the case and its inputs' hash: a restarted client that finds the
             # same task still on the scheduler attaches to it instead of running it twice
             key = f"mpcwt-{c.case_id}-{c.case_hash[:12]}-{c.assess_hash[:6]}"
-            futs[client.submit(run_case, c.to_dict(), root, key=key, pure=False)] = c.case_id
+            futs[client.submit(run_case, c.to_dict(), root, key=key, pure=False,
+                               priority=len(todo) - i)] = c.case_id
         pending = set(futs)
         while pending:
             bar.running(_dask_running(client, pending))

@@ -21,7 +21,7 @@ import numpy as np
 
 import lidar
 from mpc_wt.assessment.ultimate import case_extremes
-from mpc_wt.simulation.scenario import Scenario
+from mpc_wt.simulation.scenario import FieldMemo, Scenario
 
 __all__ = ["run_case", "case_metrics", "case_file", "actuator_limit_metrics",
            "load_case_turbine"]
@@ -33,6 +33,10 @@ RATE_LIMIT_FRACTION = 0.98
 #: worker's next case is often the next seed of the same wind; the fields are the same with or
 #: without it)
 WORKER_SAMPLERS = lidar.SamplerCache()
+
+#: the fields of a worker's last scenarios: the runner hands a worker the controllers of one
+#: scenario one after another, and they meet the same field (the same with or without it)
+WORKER_FIELDS = FieldMemo()
 
 
 def case_file(case_id: str) -> str:
@@ -232,7 +236,7 @@ def run_case(case: dict[str, Any], root: str) -> dict[str, Any]:
                 res = run_controller(load_case_turbine(case["turbine"]), case["run_name"],
                                      Scenario(**case["scenario"]), case["options"],
                                      supervisor=case.get("supervisor"),
-                                     samplers=WORKER_SAMPLERS)
+                                     samplers=WORKER_SAMPLERS, fields=WORKER_FIELDS)
             except SimulationDivergedError as err:
                 if getattr(err, "partial", None) is not None:
                     err.partial.meta["campaign_case"] = {"case_id": case["case_id"],

@@ -375,11 +375,19 @@ class _PitchAddOn(ControllerBase):
         self.signals: dict[str, float] = {}
         self._reset_own()
 
-    def _limit(self, cmd: np.ndarray, meas: dict[str, Any]) -> np.ndarray:
-        cmd = np.clip(cmd, self.pitch_min, self.pitch_max)
-        last = np.asarray(meas["pitch"], float) if self._last is None else self._last
-        cmd = np.clip(cmd, last - self.step_max, last + self.step_max)
-        self._last = cmd
+    def _limit(self, pc: Any, u: tuple[float, float, float], meas: dict[str, Any]
+               ) -> np.ndarray:
+        """The collective ``pc`` (3,) plus the add-on's ``u`` within the pitch limits and,
+        from the last command (the measured pitch at the first step), the rate limit
+        (scalar arithmetic: three blades)."""
+        lo_p, hi_p, d = self.pitch_min, self.pitch_max, self.step_max
+        last = (np.asarray(meas["pitch"], float) if self._last is None
+                else self._last).tolist()
+        out = []
+        for c, du, prev in zip(pc.tolist(), u, last):
+            v = min(max(c + du, lo_p), hi_p)
+            out.append(min(max(v, prev - d), prev + d))
+        self._last = cmd = np.array(out)
         return cmd
 
     def _weight(self, meas: dict[str, Any]) -> float:
@@ -433,17 +441,19 @@ class IBCController(_PitchAddOn):
         # One control step; returns (pitch_ref (3,) [rad], gen_torque_ref [N m]).
         pc, tq = self.collective.step(t, meas)
         m = np.asarray(meas["flap_moment"], float)
-        if m.shape != (3,) or not np.all(np.isfinite(m)):
+        if m.shape != (3,) or not all(map(math.isfinite, m.tolist())):
             raise ValueError(f"measurement flap_moment must be 3 finite moments [N m] at "
                              f"t = {t:g} s, got {meas['flap_moment']!r}")
         w = self._weight(meas)
-        k = self.gains.gain_at(float(np.mean(pc)))
-        u = w * self._bs.step(k * self._hp.step(m))
+        p1, p2, p3 = pc.tolist()
+        k = self.gains.gain_at((p1 + p2 + p3) / 3.0)
+        u1, u2, u3 = (w * self._bs.step(k * self._hp.step(m))).tolist()
         if self.remove_collective:
-            u = u - u.mean()
-        cmd = self._limit(pc + u, meas)
+            mean = (u1 + u2 + u3) / 3.0
+            u1, u2, u3 = u1 - mean, u2 - mean, u3 - mean
+        cmd = self._limit(pc, (u1, u2, u3), meas)
         self.signals = {**self.collective.signals, "ibc_weight": w, "ibc_gain": k,
-                        **{f"ibc_pitch_{i + 1}": float(u[i]) for i in range(3)}}
+                        "ibc_pitch_1": u1, "ibc_pitch_2": u2, "ibc_pitch_3": u3}
         return cmd, tq
 
 
@@ -644,8 +654,8 @@ class ColemanIPCController(_PitchAddOn):
             th_s *= self.gains.max_amplitude_rad / amp
         self._theta_cs = (th_c, th_s)
         pc_, ps_ = w * th_c, w * th_s
-        u = np.array([pc_ * c1 + ps_ * s1, pc_ * c2 + ps_ * s2, pc_ * c3 + ps_ * s3])
-        cmd = self._limit(pc + u, meas)
+        cmd = self._limit(pc, (pc_ * c1 + ps_ * s1, pc_ * c2 + ps_ * s2, pc_ * c3 + ps_ * s3),
+                          meas)
         self.signals = {**self.collective.signals, "ipc_weight": w,
                         "ipc_tilt_moment": tilt, "ipc_yaw_moment": yaw,
                         "ipc_pitch_cos": pc_, "ipc_pitch_sin": ps_}

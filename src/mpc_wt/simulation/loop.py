@@ -104,6 +104,8 @@ class _Loop:
         self.xs, self.us = np.empty((n + 1, len(linearize.STATE_NAMES))), np.empty((n + 1, 4))
         self.zs = np.empty((n + 1, 31))
         self.sig: dict[str, list[float]] = {}
+        self._sig_keys: tuple[str, ...] = ()
+        self._sig_rows: list[tuple[float, ...]] = []
         self.x = np.asarray(x0, float).copy()
         self.u = np.asarray(u0, float).copy()
         self.u_tq = float(self.u[3])
@@ -146,9 +148,23 @@ class _Loop:
             log.info("grid lost at t = %g s: generator torque zero from here", t)
 
     def record_signals(self) -> None:
-        """Append the controller's internal signals of this plant step."""
-        for name, val in getattr(self.controller, "signals", {}).items():
-            self.sig.setdefault(name, []).append(float(val))
+        """Append the controller's internal signals of this plant step (as rows while the
+        names stay the same; :meth:`flush_signals` moves them into ``sig``)."""
+        sig = getattr(self.controller, "signals", None)
+        if not sig:
+            return
+        keys = tuple(sig)
+        if keys != self._sig_keys:
+            self.flush_signals()
+            self._sig_keys = keys
+        self._sig_rows.append(tuple(map(float, sig.values())))
+
+    def flush_signals(self) -> None:
+        """Move the recorded rows into ``sig`` (name -> values)."""
+        if self._sig_rows:
+            for name, col in zip(self._sig_keys, zip(*self._sig_rows)):
+                self.sig.setdefault(name, []).extend(col)
+            self._sig_rows = []
 
     def apply_torque_rate(self) -> None:
         """Move the applied torque toward the command by at most the generator's rate (after
@@ -160,6 +176,7 @@ class _Loop:
 
     def result(self, k: int, meta: dict[str, Any]) -> ClosedLoopResult:
         """The first ``k`` samples as a result."""
+        self.flush_signals()
         return ClosedLoopResult(t=self.dt * np.arange(k), x=self.xs[:k], u=self.us[:k],
                                 z=self.zs[:k],
                                 controller={s: np.array(v[:k]) for s, v in self.sig.items()},

@@ -19,7 +19,7 @@ from linearize.validate import check_finite_scalar, check_positive, check_range
 
 __all__ = ["Scenario", "check_turbulence", "check_condition", "is_deterministic", "field_grid",
            "make_wind", "field_spec", "iec_site", "lidar_field", "check_wind_file",
-           "read_wind_file", "start_wind", "START_WINDOW"]
+           "read_wind_file", "start_wind", "START_WINDOW", "FieldMemo"]
 
 #: Second word of the seed of the wind-evolution field (ASCII "evol"): a stream of its own.
 _EVOLUTION_STREAM = 0x65766F6C
@@ -226,8 +226,84 @@ def field_grid(turbine: linearize.Turbine) -> tuple[float, int]:
     return width, n
 
 
+
+class FieldMemo:
+    """Keeps the turbulent fields of the last few scenarios for the next run that meets the
+    same one: the controllers of a campaign compared on one seed, a LIDAR's evolved field.
+
+    A field is a pure function of the turbine's grid, the scenario's turbulence, mean wind,
+    duration and seed (and for a LIDAR's field the focus distance), so a kept one is the same
+    object a new generation would equal bit for bit; its arrays are read-only. Fields are
+    dropped oldest first once the kept arrays pass ``max_bytes``. A campaign worker keeps one
+    (:data:`mpc_wt.campaign.task.WORKER_FIELDS`) and the runner hands it the cases of one
+    field one after another.
+
+    Parameters
+    ----------
+    max_bytes : float
+        Largest memory the kept arrays may hold [B] (default 1 GB: three 600 s fields on
+        32 x 32 points with a LIDAR's evolved field).
+    """
+
+    def __init__(self, max_bytes: float = 1.0e9) -> None:
+        if not (math.isfinite(max_bytes) and max_bytes >= 0):
+            raise ValueError(f"max_bytes must be finite and >= 0, got {max_bytes!r}")
+        self.max_bytes = float(max_bytes)
+        self._kept: dict[tuple[Any, ...], tuple[Any, int]] = {}
+        self.hits = 0
+        self.misses = 0
+
+    def __len__(self) -> int:
+        return len(self._kept)
+
+    @property
+    def nbytes(self) -> int:
+        """Bytes held by the kept arrays."""
+        return sum(n for _, n in self._kept.values())
+
+    def clear(self) -> None:
+        """Drop every kept field."""
+        self._kept.clear()
+
+    def get(self, key: tuple[Any, ...], make: Any) -> Any:
+        """The value kept under ``key``, else ``make()`` (kept if it fits)."""
+        if key in self._kept:
+            self.hits += 1
+            val = self._kept.pop(key)
+            self._kept[key] = val                  # most recently used last
+            return val[0]
+        self.misses += 1
+        value = make()
+        size = _array_bytes(value)
+        if size <= self.max_bytes:
+            while self._kept and self.nbytes + size > self.max_bytes:
+                self._kept.pop(next(iter(self._kept)))
+            self._kept[key] = (value, size)
+        return value
+
+
+def _array_bytes(value: Any) -> int:
+    """Bytes of the distinct arrays (and their bases) in a field, a wind or a tuple of them."""
+    seen: dict[int, int] = {}
+
+    def visit(obj: Any) -> None:
+        if isinstance(obj, np.ndarray):
+            base = obj
+            while isinstance(base.base, np.ndarray):
+                base = base.base
+            seen[id(base)] = base.nbytes
+        elif isinstance(obj, tuple):
+            for o in obj:
+                visit(o)
+        elif dataclasses.is_dataclass(obj):
+            for f in dataclasses.fields(obj):
+                visit(getattr(obj, f.name))
+    visit(value)
+    return sum(seen.values())
+
+
 def make_wind(turbine: linearize.Turbine, scenario: Scenario, components: str = "uvw", *,
-              samplers: lidar.SamplerCache | None = None
+              samplers: lidar.SamplerCache | None = None, fields: FieldMemo | None = None
               ) -> tuple[linearize.SteadyWind | linearize.GridWind, lidar.WindField]:
     """The plant's wind for a scenario and the same field for a LIDAR in the loop.
 
@@ -243,6 +319,9 @@ def make_wind(turbine: linearize.Turbine, scenario: Scenario, components: str = 
     samplers : lidar.SamplerCache, optional
         Keeps the turbulence generator's sampler for the next field of the same wind and grid
         (the fields are the same with or without it).
+    fields : FieldMemo, optional
+        Keeps the turbulent field (and the plant's wind made of it) for the next run of the
+        same scenario.
 
     Returns
     -------
@@ -270,12 +349,19 @@ def make_wind(turbine: linearize.Turbine, scenario: Scenario, components: str = 
                             meta={"model": "steady power law"})
         return linearize.SteadyWind(v, alpha), f
     spec = field_spec(turbine, scenario)
-    f = lidar.generate_field(spec, scenario.seed, components=components, samplers=samplers)
-    if scenario.condition == "etm":
-        f = dataclasses.replace(f, meta={**f.meta, "condition": "etm",
-                                         "iec_class": scenario.iec_class,
-                                         "turbulence_class": scenario.turbulence})
-    return _grid_wind(f)
+
+    def make() -> tuple[linearize.GridWind, lidar.WindField]:
+        f = lidar.generate_field(spec, scenario.seed, components=components, samplers=samplers)
+        if scenario.condition == "etm":
+            f = dataclasses.replace(f, meta={**f.meta, "condition": "etm",
+                                             "iec_class": scenario.iec_class,
+                                             "turbulence_class": scenario.turbulence})
+        return _grid_wind(f)
+    if fields is None:
+        return make()
+    key = ("case", spec, scenario.seed, components, scenario.condition, scenario.iec_class,
+           scenario.turbulence)
+    return fields.get(key, make)
 
 
 def field_spec(turbine: linearize.Turbine, scenario: Scenario) -> lidar.TurbulenceSpec:
@@ -464,7 +550,8 @@ def _file_wind(turbine: linearize.Turbine, scenario: Scenario
 
 
 def lidar_field(turbine: linearize.Turbine, scenario: Scenario, field: lidar.WindField,
-                distance: float, samplers: lidar.SamplerCache | None = None) -> lidar.WindField:
+                distance: float, samplers: lidar.SamplerCache | None = None,
+                fields: FieldMemo | None = None) -> lidar.WindField:
     """The field a LIDAR focused ``distance`` upstream measures in a case: the case's field
     evolved over that distance with Simley and Pao's coherence (:func:`lidar.evolve_field`; its
     independent part seeded from the case's seed, so every controller sees the same wind).
@@ -489,6 +576,8 @@ def lidar_field(turbine: linearize.Turbine, scenario: Scenario, field: lidar.Win
         [m], >= 0; 0 (or a deterministic case) gives the field itself: frozen turbulence.
     samplers : lidar.SamplerCache, optional
         Keeps the turbulence generator's sampler.
+    fields : FieldMemo, optional
+        Keeps a turbulent case's LIDAR field for the next run of the same case and distance.
 
     Returns
     -------
@@ -502,15 +591,23 @@ def lidar_field(turbine: linearize.Turbine, scenario: Scenario, field: lidar.Win
         return lidar.evolve_field(field, distance, seed=np.random.default_rng(
             [0, _EVOLUTION_STREAM]), samplers=samplers)
     spec = field_spec(turbine, scenario)
-    if distance == 0.0:
-        if set(field.meta.get("components", "uvw")) >= set("uvw"):
-            return field
-        # the case's field was made with u only (the plant's): the whole field, whose u is
-        # the same
-        return dataclasses.replace(lidar.generate_field(spec, scenario.seed, samplers=samplers),
-                                   meta=field.meta | {"components": "uvw"})
-    # made without the case's field: it is generate_evolved_field(spec, seed, ...), the
-    # evolution of generate_field(spec, seed) to single-precision rounding
-    seed = np.random.default_rng([scenario.seed, _EVOLUTION_STREAM])
-    seen = lidar.generate_evolved_field(spec, scenario.seed, distance, seed, samplers=samplers)
-    return dataclasses.replace(seen, meta={**field.meta, **seen.meta, "components": "uvw"})
+    if distance == 0.0 and set(field.meta.get("components", "uvw")) >= set("uvw"):
+        return field
+
+    def make() -> lidar.WindField:
+        if distance == 0.0:
+            # the case's field was made with u only (the plant's): the whole field, whose u
+            # is the same
+            whole = lidar.generate_field(spec, scenario.seed, samplers=samplers)
+            return dataclasses.replace(whole, meta=field.meta | {"components": "uvw"})
+        # made without the case's field: it is generate_evolved_field(spec, seed, ...), the
+        # evolution of generate_field(spec, seed) to single-precision rounding
+        seed = np.random.default_rng([scenario.seed, _EVOLUTION_STREAM])
+        seen = lidar.generate_evolved_field(spec, scenario.seed, distance, seed,
+                                            samplers=samplers)
+        return dataclasses.replace(seen, meta={**field.meta, **seen.meta, "components": "uvw"})
+    if fields is None:
+        return make()
+    key = ("lidar", spec, scenario.seed, float(distance), scenario.condition,
+           scenario.iec_class, scenario.turbulence)
+    return fields.get(key, make)

@@ -1,5 +1,5 @@
 """Campaigns: spec validation, case hashing, the results store, the Dask runner under a killed
-worker and a killed client, aggregation and the report (issue 9)."""
+worker and a killed client, aggregation and the report."""
 from __future__ import annotations
 
 import json
@@ -539,3 +539,23 @@ def test_a_worker_designs_each_controller_once(tmp_path):
     assert sum(len(v) for v in made.values()) == 12
     assert all(sum(v) == 1 for v in made.values()), made
     assert {len(d) for d in digests.values()} == {1}
+
+
+def test_the_runner_hands_out_long_cases_first_and_a_scenarios_controllers_together():
+    """Submission order: the 60 s cases before the 20 s ones, and within a length the
+    controllers of one (wind, seed) one after another, so a worker meets the field it has just
+    made; the spec's own order is controller-major."""
+    from mpc_wt.campaign.runner import submission_order
+
+    raw = {k: v for k, v in BASE.items() if k not in ("winds", "seeds")}
+    spec = spec_from_dict({**raw, "controllers": ["baseline", "coleman-ipc"], "load_cases": [
+        {"dlc": "1.2", "winds": [6, 13], "seeds": 2},
+        {"dlc": "1.3", "condition": "etm", "winds": [13], "seeds": 1, "duration": 60}]})
+    cases = spec.cases()
+    assert [c.controller for c in cases[:5]] == ["baseline"] * 5
+    order = submission_order(cases)
+    assert sorted(c.case_id for c in order) == sorted(c.case_id for c in cases)
+    assert [c.scenario.duration for c in order] == [65.0] * 2 + [25.0] * 8
+    pairs = [(c.scenario.wind_mps, c.scenario.seed, c.controller) for c in order[2:]]
+    assert pairs == [(v, s, k) for v in (6.0, 13.0) for s in (1, 2)
+                     for k in ("baseline", "coleman-ipc")]

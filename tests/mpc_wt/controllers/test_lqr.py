@@ -217,19 +217,22 @@ def test_high_gain_pi_observer_holds_the_loop_in_turbulence(turbine, params, do_
     assert std[1] == pytest.approx(std[0], rel=0.10)
 
 
-def test_scheduled_lqr_pio_switches_without_a_bump() -> None:
+@pytest.mark.parametrize("observer_q, speed_tol", [(1000.0, 0.003), (None, 0.01)])
+def test_scheduled_lqr_pio_switches_without_a_bump(observer_q, speed_tol) -> None:
     """The scheduled lqr-pio on a ramp 16 -> 18 m/s over 40 s (uniform wind, from the 16 m/s trim):
     it moves to the grid winds 17 and 18 on its own wind estimate (low-passed over 30 s, so
     it trails the ramp), and at each switch
     the pitch command moves by no more than the 99th percentile of its step-to-step moves
     elsewhere (measured: 0.0007 deg at the switches against 0.0016 deg), the rotor speed
-    within 0.3 % of rated throughout (measured 0.16 %)."""
+    within 0.3 % of rated throughout with the PI observer's q = 1000 (measured 0.16 %), within
+    1 % with the kind's default q = 100, slower to follow the ramp (measured 0.8 %)."""
     from mpc_wt.run import build_controller
     from mpc_wt.simulation.loop import simulate_closed_loop
     from mpc_wt.simulation.scenario import Scenario
 
     tb = linearize.load_turbine()
-    built, _, _ = build_controller(tb, "lqr-pio", Scenario(16.0, "steady", 1, 5.0))
+    opts = {} if observer_q is None else {"observer_q": observer_q}
+    built, _, _ = build_controller(tb, "lqr-pio", Scenario(16.0, "steady", 1, 5.0), opts)
     t = np.arange(0.0, 100.0, 0.5)
     y = np.linspace(-80.0, 80.0, 9)
     z = tb.geometry.hub_height + y
@@ -245,7 +248,7 @@ def test_scheduled_lqr_pio_switches_without_a_bump() -> None:
     step = np.abs(np.diff(np.degrees(r.channel("pitch_ref_1"))))
     assert step[at - 1].max() <= np.percentile(step, 99)
     rated = tb.operation.rated_rotor_speed_rad_s
-    assert np.abs(r.channel("rotor_speed") / rated - 1.0).max() < 0.003
+    assert np.abs(r.channel("rotor_speed") / rated - 1.0).max() < speed_tol
 
 
 @pytest.mark.parametrize("wind", [11.0, pytest.param(12.0, marks=pytest.mark.slow), 13.0])
@@ -268,3 +271,11 @@ def test_scheduled_lqr_pio_rides_turbulence_through_rated(turbine, wind: float) 
     p = res.channel("gen_power")[res.t >= 30.0].mean()
     p0 = base.channel("gen_power")[base.t >= 30.0].mean()
     assert abs(p / p0 - 1.0) <= 0.02, p / p0
+    if wind >= 13.0:
+        # above rated, where both pitch, the sign-off's bound: at most 3x the baseline's pitch
+        # travel (measured 2.8x at 13 m/s; 4.2x at 11 m/s, where the baseline hardly
+        # pitches; 5-6x with the PI observer's earlier default q = 1000)
+        def travel(r):
+            p = np.column_stack([r.channel(f"pitch_{i}") for i in (1, 2, 3)])[r.t >= 30.0]
+            return float(np.abs(np.diff(p, axis=0)).sum())
+        assert travel(res) <= 3.0 * travel(base), travel(res) / travel(base)

@@ -122,7 +122,7 @@ class TSController(ControllerBase):
     def step(self, t: float, meas: dict[str, Any]) -> tuple[np.ndarray, float]:
         # Observer update, memberships, PDC control law (Clemens eqs 5-10), compiled.
         y = self._read(meas)
-        if not np.all(np.isfinite(y)):
+        if not all(map(math.isfinite, y.tolist())):
             raise ValueError(f"non-finite measurement at t = {t:g} s: "
                              f"{dict(zip(self.ts.measured, y))}")
         if self.xi is None:                 # start in operation from the measured pitch
@@ -153,7 +153,7 @@ class TSController(ControllerBase):
         self.signals = {"wind_est": float(self.xi[-1]), "power_reduction": dp,
                         "power_ref": ts.rated_power * (1.0 - dp),
                         "premise_clipped": float(clipped)}
-        return np.full(3, pitch), torque
+        return np.array((pitch, pitch, pitch)), torque
 
 
 @nb.njit(cache=True, nogil=True)

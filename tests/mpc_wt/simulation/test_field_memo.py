@@ -1,0 +1,70 @@
+"""The field memo: a kept field is the one a new generation makes, bit for bit (the plant's
+wind, the field and a LIDAR's evolved field); it keeps no more than its byte limit, oldest out
+first; a bad limit is named."""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import linearize
+from mpc_wt.simulation.scenario import FieldMemo, Scenario, lidar_field, make_wind
+
+
+@pytest.fixture(scope="module")
+def turbine() -> linearize.Turbine:
+    return linearize.load_turbine()
+
+
+def _same(a: np.ndarray, b: np.ndarray) -> bool:
+    return a.shape == b.shape and a.dtype == b.dtype and np.array_equal(a, b)
+
+
+def test_a_kept_field_is_the_one_a_new_generation_makes(turbine: linearize.Turbine) -> None:
+    sc = Scenario(13.0, "B", 4, duration=20.0)
+    memo = FieldMemo()
+    wind, field = make_wind(turbine, sc, "u", fields=memo)
+    again, field2 = make_wind(turbine, sc, "u", fields=memo)
+    assert again is wind and field2 is field and (memo.hits, memo.misses) == (1, 1)
+    fresh, fresh_field = make_wind(turbine, sc, "u")
+    assert _same(fresh.u, wind.u) and _same(fresh_field.u, field.u)
+    # another seed, turbulence or component set is another field
+    other, _ = make_wind(turbine, Scenario(13.0, "B", 5, duration=20.0), "u", fields=memo)
+    assert not _same(other.u, wind.u) and memo.misses == 2
+    make_wind(turbine, sc, "uvw", fields=memo)
+    assert memo.misses == 3
+    # the LIDAR's evolved field, 54 m upstream
+    seen = lidar_field(turbine, sc, field, 54.0, fields=memo)
+    assert lidar_field(turbine, sc, field, 54.0, fields=memo) is seen
+    new = lidar_field(turbine, sc, fresh_field, 54.0)
+    assert all(_same(getattr(new, c), getattr(seen, c)) for c in "uvw")
+    assert not _same(lidar_field(turbine, sc, field, 80.0, fields=memo).u, seen.u)
+    # the kept arrays are read-only: no run can change another's wind
+    with pytest.raises(ValueError):
+        wind.u[0, 0, 0] = 1.0
+
+
+def test_the_memo_keeps_within_its_limit_oldest_out(turbine: linearize.Turbine) -> None:
+    probe = FieldMemo()
+    wind, field = make_wind(turbine, Scenario(9.0, "A", 1, duration=20.0), "u", fields=probe)
+    size = probe.nbytes
+    # at least the plant's wind, at most it and every component of the field
+    assert wind.u.nbytes <= size <= wind.u.nbytes + sum(
+        getattr(field, c).nbytes for c in "uvw")
+    memo = FieldMemo(max_bytes=1.5 * size)
+    for seed in (1, 2, 1):
+        make_wind(turbine, Scenario(9.0, "A", seed, duration=20.0), "u", fields=memo)
+    # seed 2 pushed seed 1 out: the third call made it again
+    assert (len(memo), memo.misses, memo.hits) == (1, 3, 0)
+    assert 0 < memo.nbytes <= 1.5 * size
+    none = FieldMemo(max_bytes=0)
+    make_wind(turbine, Scenario(9.0, "A", 1, duration=20.0), "u", fields=none)
+    assert len(none) == 0
+    # deterministic and steady winds are not kept (nothing to save)
+    make_wind(turbine, Scenario(9.0, condition="eog"), "u", fields=memo)
+    assert memo.misses == 3
+
+
+@pytest.mark.parametrize("bad", [-1.0, float("nan"), float("inf")])
+def test_a_bad_limit_is_named(bad: float) -> None:
+    with pytest.raises(ValueError, match="max_bytes"):
+        FieldMemo(max_bytes=bad)
