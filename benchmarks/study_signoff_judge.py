@@ -7,7 +7,12 @@ for the MPC with preview) and the largest lifetime-DEL and governing-design-load
 every channel (at most +5 % unless the trade is shown). Prints a Markdown table; a bound not
 met is marked with its measured value.
 
+With ``--without DLC ...`` the governing loads are taken over the other DLCs only (from the
+report's ``ultimate.csv``, as the report takes them: the largest seed-mean design load in
+magnitude), and ``--governing FILE`` writes them per channel.
+
 Run:  python benchmarks/study_signoff_judge.py CAMPAIGN_DIR [--out table.md]
+      [--without 2.1 2.2 --governing governing_no_faults.md]
 """
 from __future__ import annotations
 
@@ -27,6 +32,9 @@ def main() -> int:
     ap.add_argument("campaign", help="a finished sign-off campaign's directory")
     ap.add_argument("--out", help="also write the table here")
     ap.add_argument("--reference", default="baseline")
+    ap.add_argument("--without", nargs="+", default=[], metavar="DLC",
+                    help="leave these DLCs out of the governing loads")
+    ap.add_argument("--governing", help="write the governing loads per channel here")
     args = ap.parse_args()
     rep = Path(args.campaign) / "report"
     so = _rows(rep / "signoff.csv")
@@ -37,8 +45,13 @@ def main() -> int:
     for r in _rows(rep / "lifetime_del.csv"):
         life.setdefault(r["controller"], {})[r["channel"]] = float(r["change_pct"])
     gov: dict[str, dict[str, float]] = {}
-    for r in _rows(rep / "governing.csv"):
-        gov.setdefault(r["controller"], {})[r["channel"]] = float(r["change_pct"])
+    if args.without:
+        gov, where = _governing(_rows(rep / "ultimate.csv"), set(args.without), args.reference)
+    else:
+        where = {}
+        for r in _rows(rep / "governing.csv"):
+            gov.setdefault(r["controller"], {})[r["channel"]] = float(r["change_pct"])
+            where.setdefault(r["controller"], {})[r["channel"]] = r["dlc"]
     ctls = list(dict.fromkeys(r["controller"] for r in so))
     agg = {}
     for c in ctls:
@@ -77,7 +90,41 @@ def main() -> int:
     print(text)
     if args.out:
         Path(args.out).write_text(text + "\n")
+    if args.governing:
+        chans = list(dict.fromkeys(ch for g in gov.values() for ch in g))
+        rows = ["| controller | " + " | ".join(chans) + " |", "|" + "---|" * (len(chans) + 1)]
+        for c in ctls:
+            rows.append(f"| {c} | " + " | ".join(
+                f"{gov[c][ch]:+.1f} % ({where[c][ch]})" if ch in gov.get(c, {}) else "-"
+                for ch in chans) + " |")
+        Path(args.governing).write_text("\n".join(rows) + "\n")
     return 0
+
+
+def _governing(ult: list[dict[str, str]], without: set[str], reference: str
+               ) -> tuple[dict[str, dict[str, float]], dict[str, dict[str, str]]]:
+    """Governing-load change [%] against the reference and its DLC, per controller and
+    channel, over the DLCs not in ``without``."""
+    best: dict[tuple[str, str], tuple[float, str]] = {}
+    for u in ult:
+        if u["dlc"] in without:
+            continue
+        for side in ("max", "min"):
+            if not u[f"design_{side}"]:
+                continue
+            v = abs(float(u[f"design_{side}"]))
+            key = (u["controller"], u["channel"])
+            if key not in best or v > best[key][0]:
+                best[key] = (v, u["dlc"])
+    gov: dict[str, dict[str, float]] = {}
+    where: dict[str, dict[str, str]] = {}
+    for (c, ch), (v, dlc) in best.items():
+        ref = best.get((reference, ch))
+        if ref is None or ref[0] == 0:
+            continue
+        gov.setdefault(c, {})[ch] = 100.0 * (v / ref[0] - 1.0)
+        where.setdefault(c, {})[ch] = dlc
+    return gov, where
 
 
 if __name__ == "__main__":

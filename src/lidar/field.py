@@ -151,7 +151,13 @@ class WindField:
     # Sampling
     # ---------------------------------------------------------------------------------------
     def grid_spacing(self) -> FloatArray:
-        """(t0, dt, y0, dy, z0, dz) of the uniform grid [s, m], for :func:`trilinear_point`."""
+        """The uniform grid's origin and spacing, for :func:`trilinear_point`.
+
+        Returns
+        -------
+        (6,) ndarray
+            (t0, dt, y0, dy, z0, dz) [s, s, m, m, m, m].
+        """
         return np.array([self.t[0], self.t[1] - self.t[0], self.y[0], self.y[1] - self.y[0],
                          self.z[0], self.z[1] - self.z[0]])
 

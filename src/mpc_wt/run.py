@@ -207,13 +207,9 @@ def run_controller(turbine: linearize.Turbine, controller: str, scenario: Scenar
         For designs that cost seconds (the TS LMIs), keyed on the turbine's content.
     naming : Naming
         How error messages name options.
-    samplers : lidar.SamplerCache, optional
-        Keeps the turbulence generator's sampler for the next run of the same wind and grid
-        (a campaign's seeds, controllers compared on one field); the fields are the same with
-        or without it.
-    fields : FieldMemo, optional
-        Keeps the scenario's fields (the plant's and the LIDARs') for the next run of the same
-        scenario (a campaign's controllers on one seed); the same fields with or without it.
+    samplers, fields : lidar.SamplerCache, FieldMemo, optional
+        Keep the turbulence generator's sampler and the scenario's fields for the next runs (a
+        campaign's seeds and controllers); the fields are the same with or without them.
     turbulence, seed, duration, shear_exponent : optional
         With a mean wind only: the :class:`Scenario`'s fields (defaults "A", 1, 600 s, 0.2).
     condition : mapping, optional

@@ -178,7 +178,18 @@ def submission_order(cases: list[Any]) -> list[Any]:
     """The cases in the order they are handed out: the longest simulations first (the last
     ones to finish are then short), and the controllers of one scenario (wind, turbulence,
     seed, condition) one after another, so that a worker meets a field it has just made
-    (:data:`mpc_wt.campaign.task.WORKER_FIELDS`). Otherwise the spec's order."""
+    (:data:`mpc_wt.campaign.task.WORKER_FIELDS`). Otherwise the spec's order.
+
+    Parameters
+    ----------
+    cases : list of Case
+        The cases to run.
+
+    Returns
+    -------
+    list of Case
+        The same cases, reordered.
+    """
     def key(ic: tuple[int, Any]) -> tuple[Any, ...]:
         i, c = ic
         sc = c.scenario

@@ -43,7 +43,9 @@ def add_parsers(sub: Any) -> None:
                    help="lqr: NAME=VALUE typical magnitude dividing a weight (repeatable)")
     p.add_argument("--observer-q", type=float, default=1e3,
                    help="lqr: PI observer q of Q_obs = diag(I, q I) (0: no observer)")
-    p.add_argument("--omega-n", type=float, default=0.6, help="baseline: PI design [rad/s]")
+    p.add_argument("--omega-n", type=float, default=None,
+                   help="baseline: PI design [rad/s] (default 0.6 x rated rotor speed / 12.1 "
+                        "rpm)")
     p.add_argument("--zeta", type=float, default=0.7, help="baseline: PI damping [-]")
     p.add_argument("--power-fraction", type=float, default=1.0,
                    help="baseline, ibc, coleman-ipc: tune for a derated turbine at this "
@@ -77,7 +79,9 @@ def _design_args(args: argparse.Namespace) -> dict[str, Any]:
     except ValueError as err:
         raise UsageError(str(err)) from None
     winds = parse_range(args.wind, "--wind") if args.wind else None
-    return {"power_fraction": frac, "omega_n_rad_s": _positive("--omega-n", args.omega_n),
+    return {"power_fraction": frac,
+            "omega_n_rad_s": (None if args.omega_n is None
+                              else _positive("--omega-n", args.omega_n)),
             "zeta": _positive("--zeta", args.zeta),
             "loop_gain": _positive("--loop-gain", args.loop_gain), "winds": winds,
             "reductions": floats(args.reductions, "--reductions"),

@@ -277,6 +277,8 @@ class DisconController(ControllerBase):
         if self._lib is None or self._status != 0:
             self._load()
         if self._own_workdir:
+            if self.workdir is not None:        # a run that was never finalized
+                shutil.rmtree(self.workdir, ignore_errors=True)
             self.workdir = Path(tempfile.mkdtemp(prefix="mpcwt_discon_run_"))
         assert self.workdir is not None
         self.workdir.mkdir(parents=True, exist_ok=True)
@@ -307,10 +309,13 @@ class DisconController(ControllerBase):
             self._fds = None
         if self._own_workdir and self.workdir is not None:
             shutil.rmtree(self.workdir, ignore_errors=True)
+            self.workdir = None
 
     def __del__(self) -> None:  # pragma: no cover - interpreter shutdown order varies
         try:
             self._unload()
+            if self._own_workdir and self.workdir is not None:
+                shutil.rmtree(self.workdir, ignore_errors=True)
         except Exception:  # noqa: BLE001
             pass
 

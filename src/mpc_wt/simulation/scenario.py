@@ -266,7 +266,20 @@ class FieldMemo:
         self._kept.clear()
 
     def get(self, key: tuple[Any, ...], make: Any) -> Any:
-        """The value kept under ``key``, else ``make()`` (kept if it fits)."""
+        """The value kept under ``key``, else ``make()`` (kept if it fits).
+
+        Parameters
+        ----------
+        key : tuple
+            What the value is a pure function of (hashable).
+        make : callable
+            Makes the value on a miss.
+
+        Returns
+        -------
+        object
+            The kept or the new value.
+        """
         if key in self._kept:
             self.hits += 1
             val = self._kept.pop(key)
