@@ -348,6 +348,8 @@ class BaselineController(ControllerBase):
         self.rate = turbine.pitch_actuator.max_rate_rad_s
         self.tq_rate = turbine.generator.max_torque_rate
         self.tq_max = turbine.generator.max_torque
+        #: the largest below-rated trim pitch [rad], set by the first LawTorque on this law
+        self.below_rated_pitch: float | None = None
         # torque-law breakpoints (report sec. 7.3, DISCON): rated speed 99 % of the set point
         # region 1.5 runs from the minimum rotor speed to 30 % above it on the generator (the
         # NREL 5-MW's 670 and 871 rpm)
@@ -559,6 +561,13 @@ class LawTorque:
     speed low-passed at the law's filter corner, then :meth:`BaselineController.torque`,
     within the generator's limits (the region-II law of the scheduled LQR-PIO, MPC and TS).
 
+    The schedule tells region 3 from a pitch 1 deg above fine (the NREL 5-MW controller's
+    switch). A controller that tracks the trim holds a turbine with a minimum-pitch schedule
+    (the IEA-15: 3.8 deg at 3 m/s, 1.7 deg at 5.9 m/s) above that at its minimum rotor speed,
+    where the schedule would then ask for rated power and stall the rotor; below region 2's
+    speed the pitch is therefore counted from the largest below-rated trim pitch
+    (:func:`below_rated_pitch`; 0 for the NREL 5-MW, where nothing changes).
+
     Parameters
     ----------
     law : BaselineController
@@ -572,6 +581,9 @@ class LawTorque:
         self._a = math.exp(-law.wc * float(dt))
         g = law.turbine.generator
         self._lo, self._hi = g.min_torque, g.max_torque
+        if getattr(law, "below_rated_pitch", None) is None:    # one trim sweep per law
+            law.below_rated_pitch = below_rated_pitch(law.turbine)
+        self._offset = law.below_rated_pitch
         self.reset()
 
     def reset(self) -> None:
@@ -597,4 +609,27 @@ class LawTorque:
         """
         w, a = float(gen_speed), self._a
         self.w_filt = w if self.w_filt is None else a * self.w_filt + (1.0 - a) * w
+        if self.w_filt < self.law.w_rgn2:
+            pitch = pitch - self._offset
         return min(max(self.law.torque(self.w_filt, pitch, power), self._lo), self._hi)
+
+
+def below_rated_pitch(turbine: linearize.Turbine, n: int = 6) -> float:
+    """The largest trim pitch between cut-in and rated wind (``n`` winds up to 97 % of rated)
+    [rad]: a minimum-pitch schedule's largest pitch, 0 for a turbine at fine pitch there.
+
+    Parameters
+    ----------
+    turbine : Turbine
+    n : int
+        Winds trimmed.
+
+    Returns
+    -------
+    float
+        [rad], >= 0.
+    """
+    vr = linearize.rated_wind_speed(turbine)
+    winds = np.linspace(turbine.operation.cut_in_wind, 0.97 * vr, n)
+    pitch = [float(np.mean(linearize.trim(turbine, float(v)).u[:3])) for v in winds]
+    return max(0.0, max(pitch) - turbine.operation.fine_pitch_rad)

@@ -112,3 +112,27 @@ def test_the_default_pi_design_scales_to_a_larger_rotor() -> None:
     w = res.channel("rotor_speed")[res.t >= 30.0] / tb.operation.rated_rotor_speed_rad_s
     assert res.channel("supervisor_state").max() == 0.0
     assert w.max() < 1.2, w.max()
+
+
+def test_the_torque_law_of_the_scheduled_kinds_holds_a_minimum_pitch_schedule() -> None:
+    """The IEA-15 trims to 2.9 deg of pitch at 5 m/s (its minimum-pitch schedule at minimum
+    rotor speed). The baseline's schedule, given that pitch as a controller tracking the trim
+    holds it, read region 3 (pitch above fine + 1 deg) and asked for rated power at minimum
+    speed: the generator's 21.8 MN m limit, and LQR-PIO stalled the rotor in 13 s. The law the
+    scheduled kinds share counts the pitch from the largest below-rated trim pitch there: at the
+    5 m/s trim's speed and pitch it asks for no more than the trim's own torque (2.9 MN m; the
+    region-1.5 ramp starts at that speed), where the bare schedule asks for more than five
+    times it. On the NREL 5-MW (fine pitch below rated) the offset is 0."""
+    import math
+
+    from mpc_wt.controllers.baseline import LawTorque, below_rated_pitch
+
+    assert below_rated_pitch(linearize.load_turbine("nrel5mw")) == 0.0
+    tb = linearize.load_turbine("iea15mw")
+    op = linearize.trim(tb, 5.0)
+    pitch = float(np.mean(op.u[:3]))
+    assert math.degrees(pitch) > 2.0
+    law = LawTorque(BaselineController(tb), 0.1)
+    w_gen = op.x[linearize.STATE_NAMES.index("gen_speed")]
+    assert law.law.torque(w_gen, pitch) > 5.0 * op.u[3]
+    assert 0.0 <= law(w_gen, pitch) <= op.u[3], (law(w_gen, pitch), op.u[3])
