@@ -1212,7 +1212,11 @@ class MPC(ControllerBase):
                         "rotor_speed_slack": self._last_slack, "qp_solve_ms": qp_ms}
         if self.estimator is not None:
             self.signals.update(self.signals_est)
-        return u[:3].copy(), float(u[3])
+        # within the actuators' limits: the QP holds them to its tolerance (a fine pitch of
+        # -1e-8 rad would count as a clipped command)
+        pa, gen = self.turbine.pitch_actuator, self.turbine.generator
+        return (np.clip(u[:3], pa.min_pitch_rad, pa.max_pitch_rad),
+                min(max(float(u[3]), gen.min_torque), gen.max_torque))
 
     def _fallback(self, t: float, status: str) -> tuple[np.ndarray, float]:
         """The command when the QP failed and the fallback's level: the rest of the last plan
