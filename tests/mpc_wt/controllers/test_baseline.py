@@ -5,6 +5,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
+import pytest
 from numpy.testing import assert_allclose
 
 import lidar
@@ -93,6 +94,7 @@ def test_torque_law_is_continuous_and_monotone(turbine: linearize.Turbine, gains
     assert_allclose(c.torque(c.w_trans, 0.0), gains.k_opt * c.w_trans**2, rtol=1e-9)
 
 
+@pytest.mark.slow
 def test_the_default_pi_design_scales_to_a_larger_rotor() -> None:
     """The PI's natural frequency is the NREL 5-MW report's 0.6 rad/s on that turbine
     (Jonkman et al. 2009, sec. 7.2) and scales with rated rotor speed for others. On the IEA-15

@@ -217,7 +217,8 @@ def test_high_gain_pi_observer_holds_the_loop_in_turbulence(turbine, params, do_
     assert std[1] == pytest.approx(std[0], rel=0.10)
 
 
-@pytest.mark.parametrize("observer_q, speed_tol", [(1000.0, 0.003), (None, 0.01)])
+@pytest.mark.parametrize("observer_q, speed_tol", [
+    pytest.param(1000.0, 0.003, marks=pytest.mark.slow), (None, 0.01)])
 def test_scheduled_lqr_pio_switches_without_a_bump(observer_q, speed_tol) -> None:
     """The scheduled lqr-pio on a ramp 16 -> 18 m/s over 40 s (uniform wind, from the 16 m/s trim):
     it moves to the grid winds 17 and 18 on its own wind estimate (low-passed over 30 s, so
