@@ -581,7 +581,7 @@ class LawTorque:
         self._a = math.exp(-law.wc * float(dt))
         g = law.turbine.generator
         self._lo, self._hi = g.min_torque, g.max_torque
-        if getattr(law, "below_rated_pitch", None) is None:    # one trim sweep per law
+        if law.below_rated_pitch is None:                      # one trim sweep per law
             law.below_rated_pitch = below_rated_pitch(law.turbine)
         self._offset = law.below_rated_pitch
         self.reset()

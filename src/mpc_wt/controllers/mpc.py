@@ -478,6 +478,8 @@ class MPC(ControllerBase):
         self.slack_weight, self.slack_linear = st.slack_weight, st.slack_linear
         self.backend = st.resolved_backend
         self.turbine = turbine
+        pa, gen = turbine.pitch_actuator, turbine.generator
+        self._limits = (pa.min_pitch_rad, pa.max_pitch_rad, gen.min_torque, gen.max_torque)
         self.dt = st.dt
         self.hp, self.hu = st.horizon, st.hu
         self.w = st.weights
@@ -1214,9 +1216,8 @@ class MPC(ControllerBase):
             self.signals.update(self.signals_est)
         # within the actuators' limits: the QP holds them to its tolerance (a fine pitch of
         # -1e-8 rad would count as a clipped command)
-        pa, gen = self.turbine.pitch_actuator, self.turbine.generator
-        return (np.clip(u[:3], pa.min_pitch_rad, pa.max_pitch_rad),
-                min(max(float(u[3]), gen.min_torque), gen.max_torque))
+        p_lo, p_hi, q_lo, q_hi = self._limits
+        return np.clip(u[:3], p_lo, p_hi), min(max(float(u[3]), q_lo), q_hi)
 
     def _fallback(self, t: float, status: str) -> tuple[np.ndarray, float]:
         """The command when the QP failed and the fallback's level: the rest of the last plan
