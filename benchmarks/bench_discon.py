@@ -1,13 +1,17 @@
-"""A Bladed-style library in the loop (issue 20): 600 s with ROSCO against the same run with our
-baseline, closed loop only (the field and the trim are made before the clock starts).
+"""A Bladed-style library in the loop: 600 s with ROSCO and with our own exported baseline
+library against the same run with our Python baseline, closed loop only (the field and the trim
+are made before the clock starts).
 
 Run:  python benchmarks/bench_discon.py [--json]
 
 Prints best-of-3 wall times of ``simulate_closed_loop`` for 600 s at 18 m/s, IEC class A, seed
 1, NREL 5-MW: ROSCO (the rosco package's libdiscon.so called at 80 Hz through ctypes) with the
 DISCON.IN exported from our baseline and with ROSCO's own NREL-5MW file (which writes a .dbg
-line per call), and our baseline; the real-time factors (floor for ROSCO: 30x) and the cost of
-one library call net of our baseline's (the difference over 48,000 calls).
+line per call), the baseline exported as a library by ``mpc_wt.io.discon_export`` (built with
+the system's C compiler), and our baseline; the real-time factors (floor for ROSCO: 30x), the
+cost of one library call net of our baseline's (the difference over 48,000 calls), and the step
+time (median, p99) of the exported library (through ctypes, as the harness calls it) beside the
+Python controller's ``step`` over the same 600 s.
 """
 from __future__ import annotations
 
@@ -17,8 +21,13 @@ import platform
 import time
 import timeit
 
+import tempfile
+
+import numpy as np
+
 import linearize
-from mpc_wt.run import build_controller
+from mpc_wt.io.discon_export import find_compiler
+from mpc_wt.run import build_controller, export_discon
 from mpc_wt.simulation.loop import simulate_closed_loop
 from mpc_wt.simulation.scenario import Scenario
 
@@ -34,6 +43,11 @@ def main() -> int:
            "python": platform.python_version()}
     runs = {"rosco": ("rosco", {}), "rosco_shipped": ("rosco", {"discon_in": "shipped"}),
             "baseline": ("baseline", {})}
+    tmp = tempfile.TemporaryDirectory(prefix="mpcwt_bench_discon_")
+    if find_compiler() is not None:
+        ex = export_discon(t, "baseline", tmp.name)
+        runs["exported_baseline"] = ("discon", {"discon_library": str(ex.library),
+                                                "discon_in": str(ex.input_file)})
     for key, (kind, opts) in runs.items():
         built, op, wind = build_controller(t, kind, sc, opts)
 
@@ -43,6 +57,10 @@ def main() -> int:
         best = min(timeit.repeat(run, number=1, repeat=3))
         res[key] = {"seconds": best, "real_time_factor": 600.0 / best}
     res["per_call_us"] = (res["rosco"]["seconds"] - res["baseline"]["seconds"]) / 48000 * 1e6
+    for key in ("baseline", "exported_baseline"):
+        if key in runs:
+            res[key]["step_us"] = _step_times(t, p, sc, *runs[key])
+    tmp.cleanup()
     if args.json:
         print(json.dumps(res, indent=1))
         return 0
@@ -51,7 +69,46 @@ def main() -> int:
         print(f"600 s, {key:13s}: {res[key]['seconds']:.2f} s "
               f"({res[key]['real_time_factor']:.0f}x real time)")
     print(f"ROSCO call through ctypes, net of our baseline: {res['per_call_us']:.1f} us")
+    for key in ("baseline", "exported_baseline"):
+        if "step_us" in res.get(key, {}):
+            med, p99, *call = res[key]["step_us"]
+            print(f"step time, {key:17s}: median {med:.1f} us, p99 {p99:.1f} us"
+                  + (f" (the DISCON call alone: median {call[0]:.1f} us, p99 {call[1]:.1f} us)"
+                     if call else ""))
+    if "exported_baseline" not in res:
+        print("no C compiler: the exported library was not timed")
     return 0
+
+
+def _step_times(t, p, sc, kind, opts) -> tuple[float, ...]:
+    """Median and p99 of the controller's step over a 600 s run [us] (the step timed on the
+    instance, which also keeps the baseline off the loop compiled with the plant), and of a
+    library's DISCON call alone."""
+    built, op, wind = build_controller(t, kind, sc, opts)
+    ctl, times, calls = built.controller, [], []
+    inner = ctl.step
+
+    def timed(tt, meas):
+        t0 = time.perf_counter_ns()
+        out = inner(tt, meas)
+        times.append(time.perf_counter_ns() - t0)
+        return out
+    ctl.step = timed
+    if hasattr(ctl, "_fn"):                 # the library's DISCON call alone (ctypes)
+        fn = ctl._fn
+
+        def call(*a):
+            t0 = time.perf_counter_ns()
+            fn(*a)
+            calls.append(time.perf_counter_ns() - t0)
+        ctl._fn = call
+    simulate_closed_loop(p, ctl, wind, 600.0, x0=op.x, u0=op.u,
+                         controller_dt=built.controller_dt)
+    out = []
+    for series in (times, calls):
+        us = np.array(series) / 1e3
+        out += [float(np.median(us)), float(np.percentile(us, 99))] if len(us) else []
+    return tuple(out)
 
 
 if __name__ == "__main__":

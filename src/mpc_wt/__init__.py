@@ -44,7 +44,7 @@ from mpc_wt.errors import (
                                          SynthesisError,
 )
 from mpc_wt.registry.registry import register
-from mpc_wt.run import build_controller, run_controller
+from mpc_wt.run import build_controller, export_discon, run_controller
 from mpc_wt.simulation.loop import simulate_closed_loop
 from mpc_wt.simulation.preview import LidarPreview
 from mpc_wt.simulation.results import ClosedLoopResult, load_series
@@ -61,4 +61,4 @@ __all__ = ["__version__", "controllers", "registry", "DEFAULT_CHANNELS", "assess
            "IBCController", "apc_reference", "tune_coleman_ipc", "tune_ibc", "LidarPreview",
            "simulate_closed_loop", "LQRPIOController", "design_lqr", "design_lqr_family",
            "design_pi_observer", "TSController", "build_ts_model", "design_ts_controller",
-           "design_ts_observer", "WindSpeedEstimator", "tune"]
+           "design_ts_observer", "WindSpeedEstimator", "tune", "export_discon"]

@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import dataclasses
+from pathlib import Path
 from typing import Any, Mapping, Sequence
 
 import lidar
@@ -13,7 +14,7 @@ from mpc_wt.simulation.loop import simulate_closed_loop
 from mpc_wt.simulation.results import ClosedLoopResult
 from mpc_wt.simulation.scenario import FieldMemo, Scenario, lidar_field, make_wind, start_wind
 
-__all__ = ["run_controller", "build_controller", "design_controller"]
+__all__ = ["run_controller", "build_controller", "design_controller", "export_discon"]
 
 
 def _operating_point(turbine: linearize.Turbine, sel: Selection, opts: Sequence[Options],
@@ -250,3 +251,45 @@ def run_controller(turbine: linearize.Turbine, controller: str, scenario: Scenar
     return simulate_closed_loop(params, ctl, wind, scenario.duration, x0=op.x, u0=op.u,
                                 controller_dt=built.controller_dt, preview=built.preview,
                                 progress=progress, meta=meta)
+
+
+def export_discon(turbine: linearize.Turbine, controller: str, out: str | Path,
+                  options: Mapping[str, Any] | None = None, *, build: bool = True,
+                  compiler: str | None = None) -> Any:
+    """Design a controller kind for a turbine and export it as a Bladed-style library.
+
+    Parameters
+    ----------
+    turbine : Turbine
+        The turbine.
+    controller : str
+        The kind (one of :data:`mpc_wt.io.discon_export.EXPORTABLE`).
+    out : path
+        The export folder (created; files of an earlier export are replaced).
+    options : mapping, optional
+        The kind's options, as :func:`mpc_wt.run.design_controller` takes them.
+    build : bool
+        Compile the library now (default); without a compiler the export still writes the
+        sources, and ``note`` says so.
+    compiler : str, optional
+        The C compiler (default :func:`mpc_wt.io.discon_export.find_compiler`).
+
+    Returns
+    -------
+    mpc_wt.io.discon_export.DisconExport
+
+    Raises
+    ------
+    ValueError
+        A kind that does not export (listing those that do), or bad options.
+    ControllerLibraryError
+        The compiler failed.
+    """
+    from mpc_wt.io.discon_export import check_exportable, export_controller
+
+    check_exportable(controller)
+    built, _ = design_controller(turbine, controller, options)
+    opts = ", ".join(f"{k}={v}" for k, v in sorted((options or {}).items()))
+    return export_controller(built.controller, controller, turbine, out, build=build,
+                             compiler=compiler,
+                             source=f"options: {opts}" if opts else "default options")

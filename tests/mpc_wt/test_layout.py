@@ -216,7 +216,7 @@ LAYOUT = {
     "registry": {"registry", "options", "builtin", "context"},
     "simulation": {"scenario", "loop", "compiled", "results", "preview", "solver_timing"},
     "assessment": {"fatigue", "performance", "series", "ultimate", "lidar"},
-    "io": {"gain_tables", "rosco", "openfast_output"},
+    "io": {"gain_tables", "rosco", "openfast_output", "discon_export"},
 }
 
 

@@ -53,12 +53,15 @@ def add_parsers(sub: Any) -> None:
     p.add_argument("--loop-gain", type=float, default=1.0, help="ibc: loop gain at 1P [-]")
     p.set_defaults(func=_design)
 
-    p = sub.add_parser("export", help="export a design's gain table")
+    p = sub.add_parser("export", help="export a design: its gain table (csv, json, mat), a "
+                                      "ROSCO DISCON.IN (rosco) or a Bladed-style controller "
+                                      "library with its C sources (discon)")
     p.add_argument("design", help="design directory (from `mpcwt design`) or gain-table JSON")
-    p.add_argument("--format", required=True, choices=("csv", "json", "mat", "rosco"))
-    p.add_argument("--to", help="output directory (default: the design directory)")
+    p.add_argument("--format", required=True, choices=("csv", "json", "mat", "rosco", "discon"))
+    p.add_argument("--to", "--out", dest="to",
+                   help="output directory (default: the design directory)")
     p.add_argument("--turbine", default=None,
-                   help="rosco: the design's turbine, if it is not a packaged one (a "
+                   help="rosco, discon: the design's turbine, if it is not a packaged one (a "
                         "turbine.yaml or an OpenFAST .fst deck)")
     p.set_defaults(func=_export)
 

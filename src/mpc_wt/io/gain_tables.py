@@ -49,7 +49,7 @@ __all__ = ["SCHEMA_VERSION", "GainTableError", "baseline_table", "lqr_table", "t
 
 SCHEMA_VERSION = 1
 SCHEMA = "mpc-wt gain table"
-FORMATS = ("csv", "json", "mat", "rosco")
+FORMATS = ("csv", "json", "mat", "rosco", "discon")
 
 
 def _unit_ratio(num: str, den: str) -> str:
@@ -442,7 +442,8 @@ def _turbine_of(doc: dict[str, Any], turbine: linearize.Turbine | None) -> linea
             return t
     raise GainTableError(f"the design's turbine {doc['turbine']!r} is not a packaged one "
                          f"{linearize.available_turbines()}: give its turbine (export(..., "
-                         f"turbine=...), mpcwt export --turbine PATH) for the rosco format")
+                         f"turbine=...), mpcwt export --turbine PATH) for the rosco and discon "
+                         f"formats")
 
 
 def _write_rosco(doc: dict[str, Any], out: Path,
@@ -461,6 +462,20 @@ def _write_rosco(doc: dict[str, Any], out: Path,
         base = baseline_table(t, tune_baseline(t, power_fraction=frac))
         return write_rosco_discon(t, base, out, ipc=doc)
     return write_rosco_discon(t, doc, out)
+
+
+def _write_discon(doc: dict[str, Any], out: Path,
+                  turbine: linearize.Turbine | None = None) -> list[Path]:
+    from mpc_wt.io.discon_export import export_design
+
+    t = _turbine_of(doc, turbine)
+    try:
+        ex = export_design(doc, t, out)
+    except ValueError as err:
+        raise GainTableError(str(err)) from None
+    files = [*ex.sources, ex.makefile, ex.input_file]
+    files += [p for p in (ex.library, ex.servodyn) if p is not None]
+    return files
 
 
 def read_rosco(path: str | Path) -> dict[str, Any]:
@@ -505,12 +520,14 @@ def export(doc_or_dir: dict[str, Any] | str | Path, fmt: str,
     ----------
     doc_or_dir : dict or str or Path
         A gain-table document or a design directory.
-    fmt : {"csv", "json", "mat", "rosco"}
-        The format.
+    fmt : {"csv", "json", "mat", "rosco", "discon"}
+        The format (``discon``: a Bladed-style controller library, its C sources, input file
+        and ServoDyn file, :mod:`mpc_wt.io.discon_export`).
     out_dir : str or Path, optional
         Where to write (default the design directory).
     turbine : Turbine, optional
-        For ``rosco``: the design's turbine (default: the packaged turbine of that name).
+        For ``rosco`` and ``discon``: the design's turbine (default: the packaged turbine of
+        that name).
 
     Returns
     -------
@@ -546,4 +563,6 @@ def export(doc_or_dir: dict[str, Any] | str | Path, fmt: str,
         return _write_csv(doc, out)
     if fmt == "mat":
         return _write_mat(doc, out)
+    if fmt == "discon":
+        return _write_discon(doc, out, turbine)
     return _write_rosco(doc, out, turbine)

@@ -1,0 +1,299 @@
+"""Controllers exported as Bladed-style libraries (DISCON): built with the system's C compiler,
+run through our DisconController host and compared step by step with the Python controller
+they came from; sanitizers, two instances, bad input files and measurements."""
+from __future__ import annotations
+
+import ctypes
+import math
+import os
+import shutil
+import subprocess
+import sys
+import textwrap
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import linearize
+from mpc_wt.assessment.fatigue import damage_equivalent_load
+from mpc_wt.controllers.discon import DisconController
+from mpc_wt.errors import ControllerLibraryError
+from mpc_wt.io.discon_export import EXPORTABLE, build_library, find_compiler, servodyn_input
+from mpc_wt.run import export_discon, run_controller
+
+pytestmark = pytest.mark.skipif(find_compiler() is None,
+                                reason="no C compiler ($CC, cc, gcc, clang) to build the "
+                                       "exported library")
+
+_Z = {n: i for i, n in enumerate(linearize.OUTPUT_NAMES)}
+
+
+@pytest.fixture(scope="module")
+def nrel5mw():
+    return linearize.load_turbine("nrel5mw")
+
+
+@pytest.fixture(scope="module")
+def baseline_export(nrel5mw, tmp_path_factory):
+    return export_discon(nrel5mw, "baseline", tmp_path_factory.mktemp("baseline"))
+
+
+def _discon(ex):
+    return {"discon_library": str(ex.library), "discon_in": str(ex.input_file)}
+
+
+@pytest.mark.parametrize("wind", [8.0, 12.0, 18.0])
+def test_baseline_library_runs_as_the_python_controller(nrel5mw, baseline_export, wind):
+    """The same 120 s turbulent case (class A, one seed) with the Python baseline and with its
+    exported library in the loop: pitch demands within 0.01 deg and torque within 0.1 % of
+    rated at every step, DELs of blade flap, shaft torque and tower fore-aft within 0.5 %.
+    (The library sees the measurements rounded to the swap array's float32.)"""
+    kw = dict(duration=120.0, turbulence="A", seed=11)
+    py = run_controller(nrel5mw, "baseline", wind, **kw)
+    lib = run_controller(nrel5mw, "discon", wind, _discon(baseline_export), **kw)
+    assert py.u.shape == lib.u.shape
+    assert np.degrees(np.max(np.abs(py.u[:, :3] - lib.u[:, :3]))) <= 0.01
+    assert np.max(np.abs(py.u[:, 3] - lib.u[:, 3])) <= 1e-3 * nrel5mw.rated_generator_torque
+    for ch, m in (("flap_moment_1", 10.0), ("lss_torque", 4.0), ("tower_base_fa_moment", 4.0)):
+        a = damage_equivalent_load(py.z[:, _Z[ch]], m, duration=120.0)
+        b = damage_equivalent_load(lib.z[:, _Z[ch]], m, duration=120.0)
+        assert abs(b - a) <= 5e-3 * a, ch
+
+
+def test_export_writes_sources_makefile_input_and_servodyn(baseline_export):
+    """The folder holds the sources, a Makefile that builds the same library, the input file
+    with every key the library reads, and a ServoDyn file that openfast-io reads with the
+    library, its input file and the interval set."""
+    ex = baseline_export
+    names = {p.name for p in ex.directory.iterdir()}
+    assert {"discon.c", "input.c", "baseline.c", "mpcwt_discon.h", "Makefile"} <= names
+    assert ex.library is not None and ex.library.is_file()
+    text = ex.input_file.read_text()
+    assert "kind baseline" in text and "format_version 1" in text
+    from openfast_io.FAST_reader import InputReader_OpenFAST
+
+    r = InputReader_OpenFAST()
+    r.FAST_directory = str(ex.servodyn.parent)
+    r.fst_vt["Fst"]["ServoFile"] = ex.servodyn.name
+    r.read_ServoDyn()
+    sd = r.fst_vt["ServoDyn"]
+    assert (sd["PCMode"], sd["VSContrl"], sd["DLL_ProcName"]) == (5, 5, "DISCON")
+    assert Path(sd["DLL_FileName"]) == ex.library.resolve()
+    assert Path(sd["DLL_InFile"]) == ex.input_file.resolve()
+    assert sd["DLL_DT"] == pytest.approx(0.0125)
+
+
+@pytest.mark.skipif(shutil.which("make") is None, reason="no make")
+def test_makefile_builds_the_library(baseline_export, tmp_path):
+    for p in baseline_export.sources + (baseline_export.makefile,):
+        shutil.copy(p, tmp_path / p.name)
+    out = subprocess.run(["make", "-s"], cwd=tmp_path, capture_output=True, text=True)
+    assert out.returncode == 0, out.stderr
+    assert (tmp_path / baseline_export.library.name).is_file()
+
+
+def test_iea15_export_has_its_deck_servodyn(tmp_path):
+    iea = linearize.load_turbine("iea15mw")
+    ex = export_discon(iea, "baseline", tmp_path, build=False)
+    assert ex.library is None and ex.servodyn is not None
+    text = ex.servodyn.read_text()
+    assert '"DISCON"' in text and "PCMode" in text
+
+
+# -- the library alone, through ctypes ------------------------------------------------------
+class _Lib:
+    """The DISCON entry of a library loaded with ctypes (one copy: instances share it)."""
+
+    def __init__(self, path):
+        self.lib = ctypes.CDLL(str(path))
+        self.fn = self.lib.DISCON
+        self.fn.restype = None
+
+    def call(self, swap, infile, outname):
+        fail = ctypes.c_int(0)
+        msg = ctypes.create_string_buffer(1025)
+        out = ctypes.create_string_buffer(outname.encode(), 1025)
+        self.fn(swap.ctypes.data_as(ctypes.POINTER(ctypes.c_float)), ctypes.byref(fail),
+                str(infile).encode(), out, msg)
+        return fail.value, msg.value.decode()
+
+
+def _swap(status, t, gen_speed, pitch=0.05, dt=0.0125, infile="x"):
+    s = np.zeros(3300, np.float32)
+    s[[0, 1, 2, 3, 32, 33, 19, 20]] = (status, t, dt, pitch, pitch, pitch, gen_speed,
+                                       gen_speed / 97.0)
+    s[48], s[49], s[50] = 1025, len(str(infile)) + 1, 1025
+    return s
+
+
+def _copy(lib_path, tmp_path, name):
+    p = tmp_path / name
+    shutil.copy(lib_path, p)
+    return p
+
+
+def test_two_turbines_on_one_copy_keep_their_own_state(baseline_export, tmp_path):
+    """One loaded copy, two root names called in turn, against each run alone on a fresh copy
+    of its own: the demands agree bit for bit."""
+    inp = baseline_export.input_file
+    speeds = {"a": 120.0 + 3.0 * np.sin(np.arange(200) * 0.1),
+              "b": 126.0 + 2.0 * np.cos(np.arange(200) * 0.07)}
+
+    def run(lib, names):
+        out = {n: [] for n in names}
+        for k in range(200):
+            for n in names:
+                s = _swap(0 if k == 0 else 1, k * 0.0125, speeds[n][k], infile=inp)
+                fail, msg = lib.call(s, inp, n)
+                assert fail == 0, msg
+                out[n].append(s[[41, 46]].copy())
+        return {n: np.array(v) for n, v in out.items()}
+
+    both = run(_Lib(_copy(baseline_export.library, tmp_path, "both.so")), ["a", "b"])
+    alone_a = run(_Lib(_copy(baseline_export.library, tmp_path, "a.so")), ["a"])
+    alone_b = run(_Lib(_copy(baseline_export.library, tmp_path, "b.so")), ["b"])
+    assert np.array_equal(both["a"], alone_a["a"])
+    assert np.array_equal(both["b"], alone_b["b"])
+    assert not np.array_equal(both["a"], both["b"])
+
+
+def test_two_hosts_side_by_side(nrel5mw, baseline_export):
+    """Two DisconController hosts (each its own copy) stepped in turn give what each gives
+    alone."""
+    def meas(w):
+        return {"gen_speed": w, "rotor_speed": w / 97.0, "pitch": np.full(3, 0.05),
+                "flap_moment": np.zeros(3), "edge_moment": np.zeros(3)}
+
+    def host():
+        c = DisconController(baseline_export.library, baseline_export.input_file, nrel5mw)
+        c.reset()
+        return c
+
+    a, b = host(), host()
+    wa = 121.0 + np.sin(np.arange(100) * 0.2)
+    wb = 125.0 + np.cos(np.arange(100) * 0.3)
+    pair = [(a.step(k * 0.0125, meas(wa[k]))[0][0], b.step(k * 0.0125, meas(wb[k]))[0][0])
+            for k in range(100)]
+    a.finalize(), b.finalize()
+    solo = host()
+    alone = [solo.step(k * 0.0125, meas(wa[k]))[0][0] for k in range(100)]
+    solo.finalize()
+    assert [p[0] for p in pair] == alone
+
+
+@pytest.mark.parametrize("edit, words", [
+    (lambda t: None, ["cannot open", "missing.in"]),
+    (lambda t: "\n".join(l for l in t.splitlines() if not l.startswith("kp ")),
+     ["'kp'", "missing"]),
+    (lambda t: t.replace("\nki ", "\nki x1.5 # "), ["'ki'", "'x1.5'", "not a finite number"]),
+    (lambda t: t.replace("\nki ", "\nki nan # "), ["'ki'", "'nan'"]),
+    (lambda t: t.replace("kind baseline", "kind turbo"), ["'turbo'", "baseline"]),
+    (lambda t: t.replace("format_version 1", "format_version 7"), ["format_version", "7"]),
+    (lambda t: t.replace("\ndt ", "\ndt 0.05 # "), ["DLL_DT", "0.05", "0.0125"]),
+    (lambda t: t + "kp 1.0\n", ["'kp'", "twice"]),
+])
+def test_bad_input_file_fails_with_the_file_and_key(nrel5mw, baseline_export, tmp_path, edit,
+                                                     words):
+    """A missing or corrupt input file stops the first call with aviFAIL < 0 and a message
+    that names the file and the key."""
+    text = edit(baseline_export.input_file.read_text())
+    path = tmp_path / "missing.in"
+    if text is not None:
+        path = tmp_path / "bad.in"
+        path.write_text(text)
+    ctl = DisconController(baseline_export.library, baseline_export.input_file, nrel5mw)
+    ctl.discon_in = path                      # the host checks the file exists: bypass it
+    ctl.reset()
+    with pytest.raises(ControllerLibraryError) as err:
+        ctl.step(0.0, {"gen_speed": 120.0, "rotor_speed": 1.2, "pitch": np.zeros(3),
+                       "flap_moment": np.zeros(3), "edge_moment": np.zeros(3)})
+    ctl.finalize()
+    msg = str(err.value)
+    assert "aviFAIL = -1" in msg
+    for w in words:
+        assert w in msg, (w, msg)
+    if text is not None:
+        assert "bad.in" in msg
+
+
+def test_non_finite_speed_stops_with_the_record(baseline_export, tmp_path):
+    lib = _Lib(_copy(baseline_export.library, tmp_path, "nan.so"))
+    inp = baseline_export.input_file
+    assert lib.call(_swap(0, 0.0, 120.0, infile=inp), inp, "r")[0] == 0
+    fail, msg = lib.call(_swap(1, 0.0125, math.nan, infile=inp), inp, "r")
+    assert fail < 0 and "record 20" in msg and "0.0125" in msg
+    fail, msg = lib.call(_swap(1, 0.0, 120.0, infile=inp), inp, "never-started")
+    assert fail < 0 and "status 0" in msg
+    assert lib.call(_swap(-1, 0.025, 120.0, infile=inp), inp, "r")[0] == 0
+
+
+def _asan_runtime() -> str | None:
+    cc = find_compiler()
+    if cc is None or sys.platform != "linux":
+        return None
+    out = subprocess.run([cc, "-print-file-name=libasan.so"], capture_output=True, text=True)
+    path = out.stdout.strip()
+    return path if os.path.isabs(path) and os.path.isfile(path) else None
+
+
+@pytest.mark.skipif(_asan_runtime() is None, reason="no AddressSanitizer runtime (libasan)")
+def test_sanitized_library_runs_60_s_clean(baseline_export, tmp_path):
+    """Built with -fsanitize=address,undefined (any report aborts), 60 s of turbulent closed
+    loop in a process that loads the sanitizer runtime first: exit 0, no report."""
+    for p in baseline_export.sources:
+        shutil.copy(p, tmp_path / p.name)
+    lib = build_library(tmp_path, "baseline", sanitize=True, name="libasan_baseline.so")
+    script = textwrap.dedent(f"""
+        import linearize
+        from mpc_wt.run import run_controller
+        t = linearize.load_turbine("nrel5mw")
+        r = run_controller(t, "discon", 15.0, {{"discon_library": {str(lib)!r},
+                           "discon_in": {str(baseline_export.input_file)!r}}},
+                           duration=60.0, turbulence="A", seed=2)
+        print("steps", r.u.shape[0])
+    """)
+    env = dict(os.environ, LD_PRELOAD=_asan_runtime(),
+               ASAN_OPTIONS="detect_leaks=0:abort_on_error=1",
+               UBSAN_OPTIONS="halt_on_error=1:print_stacktrace=1")
+    out = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True,
+                         env=env, timeout=600)
+    assert out.returncode == 0, out.stderr[-3000:]
+    assert "AddressSanitizer" not in out.stderr and "runtime error" not in out.stderr
+    assert "steps 4801" in out.stdout
+
+
+def test_kinds_that_do_not_export_are_named(nrel5mw, tmp_path):
+    with pytest.raises(ValueError, match="baseline"):
+        export_discon(nrel5mw, "ibc", tmp_path)
+    assert "baseline" in EXPORTABLE
+
+
+def test_servodyn_template_without_the_keys(tmp_path, baseline_export):
+    bad = tmp_path / "sd.dat"
+    bad.write_text("ServoDyn\n5 PCMode - x\n")
+    with pytest.raises(ValueError, match="DLL_FileName"):
+        servodyn_input(bad, tmp_path / "o.dat", baseline_export.library,
+                       baseline_export.input_file, 0.0125)
+
+
+def test_cli_design_then_export_discon(tmp_path, capsys):
+    """``mpcwt design baseline`` then ``mpcwt export --format discon``: the library of the
+    saved gains (a derated design keeps its derated rated power); an IBC design is refused with
+    the kinds that export."""
+    from mpc_wt.cli import main
+
+    d = tmp_path / "design"
+    assert main(["design", "baseline", "--power-fraction", "0.8", "--out", str(d)]) == 0
+    assert main(["export", str(d), "--format", "discon", "--out", str(d / "lib")]) == 0
+    assert "libmpcwt_baseline" in capsys.readouterr().out
+    text = (d / "lib" / "mpcwt_baseline.in").read_text()
+    rated = next(float(line.split()[1]) for line in text.splitlines()
+                 if line.startswith("rated_power "))
+    assert rated == pytest.approx(0.8 * 5e6)
+    assert (d / "lib" / "ServoDyn_mpcwt_baseline.dat").is_file()
+    i = tmp_path / "ibc"
+    assert main(["design", "ibc", "--out", str(i)]) == 0
+    assert main(["export", str(i), "--format", "discon"]) != 0
+    err = capsys.readouterr().err
+    assert "'ibc' design does not export" in err and "baseline" in err
