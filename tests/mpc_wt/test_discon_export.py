@@ -39,8 +39,33 @@ def baseline_export(nrel5mw, tmp_path_factory):
     return export_discon(nrel5mw, "baseline", tmp_path_factory.mktemp("baseline"))
 
 
+@pytest.fixture(scope="module")
+def mpc_export(nrel5mw, tmp_path_factory):
+    return export_discon(nrel5mw, "mpc", tmp_path_factory.mktemp("mpc"))
+
+
 def _discon(ex):
-    return {"discon_library": str(ex.library), "discon_in": str(ex.input_file)}
+    return {"discon_library": str(ex.library), "discon_in": str(ex.input_file),
+            "discon_dt": ex.dt}
+
+
+def _compare(turbine, kind, ex, wind, seed=11):
+    """The same 120 s class-A case with the Python controller and with its library: the
+    largest pitch [deg] and torque [fraction of rated] differences, and the two runs."""
+    kw = dict(duration=120.0, turbulence="A", seed=seed)
+    py = run_controller(turbine, kind, wind, **kw)
+    lib = run_controller(turbine, "discon", wind, _discon(ex), **kw)
+    assert py.u.shape == lib.u.shape
+    dp = float(np.degrees(np.max(np.abs(py.u[:, :3] - lib.u[:, :3]))))
+    dq = float(np.max(np.abs(py.u[:, 3] - lib.u[:, 3]))) / turbine.rated_generator_torque
+    return dp, dq, py, lib
+
+
+def _check_dels(py, lib):
+    for ch, m in (("flap_moment_1", 10.0), ("lss_torque", 4.0), ("tower_base_fa_moment", 4.0)):
+        a = damage_equivalent_load(py.z[:, _Z[ch]], m, duration=120.0)
+        b = damage_equivalent_load(lib.z[:, _Z[ch]], m, duration=120.0)
+        assert abs(b - a) <= 5e-3 * a, ch
 
 
 @pytest.mark.parametrize("wind", [8.0, 12.0, 18.0])
@@ -49,19 +74,43 @@ def test_baseline_library_runs_as_the_python_controller(nrel5mw, baseline_export
     exported library in the loop: pitch demands within 0.01 deg and torque within 0.1 % of
     rated at every step, DELs of blade flap, shaft torque and tower fore-aft within 0.5 %.
     (The library sees the measurements rounded to the swap array's float32.)"""
-    kw = dict(duration=120.0, turbulence="A", seed=11)
-    py = run_controller(nrel5mw, "baseline", wind, **kw)
-    lib = run_controller(nrel5mw, "discon", wind, _discon(baseline_export), **kw)
-    assert py.u.shape == lib.u.shape
-    assert np.degrees(np.max(np.abs(py.u[:, :3] - lib.u[:, :3]))) <= 0.01
-    assert np.max(np.abs(py.u[:, 3] - lib.u[:, 3])) <= 1e-3 * nrel5mw.rated_generator_torque
-    for ch, m in (("flap_moment_1", 10.0), ("lss_torque", 4.0), ("tower_base_fa_moment", 4.0)):
-        a = damage_equivalent_load(py.z[:, _Z[ch]], m, duration=120.0)
-        b = damage_equivalent_load(lib.z[:, _Z[ch]], m, duration=120.0)
-        assert abs(b - a) <= 5e-3 * a, ch
+    dp, dq, py, lib = _compare(nrel5mw, "baseline", baseline_export, wind)
+    assert dp <= 0.01 and dq <= 1e-3
+    _check_dels(py, lib)
 
 
-def test_export_writes_sources_makefile_input_and_servodyn(baseline_export):
+@pytest.mark.parametrize("wind", [8.0, 12.0, 18.0])
+def test_mpc_library_runs_as_the_python_controller(nrel5mw, mpc_export, wind):
+    """The scheduled MPC (Kalman estimator, wind schedule with its EKF, trim targets with the
+    baseline's torque schedule, DAQP) exported and run at 10 Hz against the Python MPC: pitch
+    within 0.01 deg and torque within 0.1 % of rated at every step, DELs within 0.5 %. (The
+    QP is solved to DAQP's tolerances in both; the library sees float32 measurements.)"""
+    dp, dq, py, lib = _compare(nrel5mw, "mpc", mpc_export, wind)
+    assert dp <= 0.01 and dq <= 1e-3
+    _check_dels(py, lib)
+    assert not np.any(lib.controller["library_warning"])      # no fallback, no warning
+
+
+def test_mpc_qp_over_budget_takes_the_logged_fallback(nrel5mw, mpc_export, tmp_path, caplog):
+    """A QP time budget no solve can meet: every step takes the fallback (the last plan's
+    rest, then the held command), the library reports it as a warning (aviFAIL = 1) that the
+    host logs, and the run goes on to its end."""
+    text = mpc_export.input_file.read_text().replace("\nqp_time_budget_ms ",
+                                                     "\nqp_time_budget_ms 1e-9 # ")
+    inp = tmp_path / "budget.in"
+    inp.write_text(text)
+    opts = dict(_discon(mpc_export), discon_in=str(inp))
+    with caplog.at_level("WARNING"):
+        r = run_controller(nrel5mw, "discon", 14.0, opts, duration=5.0, turbulence="A", seed=1)
+    assert r.u.shape[0] == 401 and np.all(np.isfinite(r.u))
+    msgs = [rec.getMessage() for rec in caplog.records
+            if rec.name == "mpc_wt.controllers.discon"]
+    assert len(msgs) >= 50 and all("fallback" in m and "budget" in m for m in msgs)
+    assert "fallback 2 (1 so far)" in msgs[0] and "fallback 1 (2 so far)" in msgs[1]
+    assert np.all(r.controller["library_warning"] == 1.0)
+
+
+def test_export_writes_sources_makefile_input_and_servodyn(baseline_export, mpc_export):
     """The folder holds the sources, a Makefile that builds the same library, the input file
     with every key the library reads, and a ServoDyn file that openfast-io reads with the
     library, its input file and the interval set."""
@@ -82,12 +131,15 @@ def test_export_writes_sources_makefile_input_and_servodyn(baseline_export):
     assert Path(sd["DLL_FileName"]) == ex.library.resolve()
     assert Path(sd["DLL_InFile"]) == ex.input_file.resolve()
     assert sd["DLL_DT"] == pytest.approx(0.0125)
+    assert "DLL_DT" in mpc_export.servodyn.read_text() and mpc_export.dt == pytest.approx(0.1)
+    assert (mpc_export.directory / "daqp" / "LICENSE").is_file()
 
 
 @pytest.mark.skipif(shutil.which("make") is None, reason="no make")
 def test_makefile_builds_the_library(baseline_export, tmp_path):
+    (tmp_path / "daqp").mkdir()
     for p in baseline_export.sources + (baseline_export.makefile,):
-        shutil.copy(p, tmp_path / p.name)
+        shutil.copy(p, tmp_path / p.relative_to(baseline_export.directory))
     out = subprocess.run(["make", "-s"], cwd=tmp_path, capture_output=True, text=True)
     assert out.returncode == 0, out.stderr
     assert (tmp_path / baseline_export.library.name).is_file()
@@ -192,6 +244,7 @@ def test_two_hosts_side_by_side(nrel5mw, baseline_export):
     (lambda t: t.replace("format_version 1", "format_version 7"), ["format_version", "7"]),
     (lambda t: t.replace("\ndt ", "\ndt 0.05 # "), ["DLL_DT", "0.05", "0.0125"]),
     (lambda t: t + "kp 1.0\n", ["'kp'", "twice"]),
+    (lambda t: t.replace("\npitch_max ", "\npitch_max -1 # "), ["pitch_max >= pitch_min"]),
 ])
 def test_bad_input_file_fails_with_the_file_and_key(nrel5mw, baseline_export, tmp_path, edit,
                                                      words):
@@ -238,20 +291,26 @@ def _asan_runtime() -> str | None:
 
 
 @pytest.mark.skipif(_asan_runtime() is None, reason="no AddressSanitizer runtime (libasan)")
-def test_sanitized_library_runs_60_s_clean(baseline_export, tmp_path):
-    """Built with -fsanitize=address,undefined (any report aborts), 60 s of turbulent closed
-    loop in a process that loads the sanitizer runtime first: exit 0, no report."""
-    for p in baseline_export.sources:
-        shutil.copy(p, tmp_path / p.name)
-    lib = build_library(tmp_path, "baseline", sanitize=True, name="libasan_baseline.so")
+def test_sanitized_libraries_run_60_s_clean(baseline_export, mpc_export, tmp_path):
+    """The baseline and the MPC built with -fsanitize=address,undefined (any report aborts),
+    60 s of turbulent closed loop each in a process that loads the sanitizer runtime first:
+    exit 0, no report, no warning from the library."""
+    runs = []
+    for which, ex in (("baseline", baseline_export), ("mpc", mpc_export)):
+        d = tmp_path / which
+        (d / "daqp").mkdir(parents=True)
+        for p in ex.sources:
+            shutil.copy(p, d / p.relative_to(ex.directory))
+        lib = build_library(d, which, sanitize=True, name=f"libasan_{which}.so")
+        runs.append({"discon_library": str(lib), "discon_in": str(ex.input_file),
+                     "discon_dt": ex.dt})
     script = textwrap.dedent(f"""
         import linearize
         from mpc_wt.run import run_controller
         t = linearize.load_turbine("nrel5mw")
-        r = run_controller(t, "discon", 15.0, {{"discon_library": {str(lib)!r},
-                           "discon_in": {str(baseline_export.input_file)!r}}},
-                           duration=60.0, turbulence="A", seed=2)
-        print("steps", r.u.shape[0])
+        for opts in {runs!r}:
+            r = run_controller(t, "discon", 15.0, opts, duration=60.0, turbulence="A", seed=2)
+            print("steps", r.u.shape[0], "warnings", int(r.controller["library_warning"].sum()))
     """)
     env = dict(os.environ, LD_PRELOAD=_asan_runtime(),
                ASAN_OPTIONS="detect_leaks=0:abort_on_error=1",
@@ -260,12 +319,17 @@ def test_sanitized_library_runs_60_s_clean(baseline_export, tmp_path):
                          env=env, timeout=600)
     assert out.returncode == 0, out.stderr[-3000:]
     assert "AddressSanitizer" not in out.stderr and "runtime error" not in out.stderr
-    assert "steps 4801" in out.stdout
+    assert out.stdout.count("steps 4801 warnings 0") == 2, out.stdout
 
 
 def test_kinds_that_do_not_export_are_named(nrel5mw, tmp_path):
     with pytest.raises(ValueError, match="baseline"):
         export_discon(nrel5mw, "ibc", tmp_path)
+    with pytest.raises(ValueError, match="LIDAR"):
+        from mpc_wt.io.discon_export import controller_input
+        from mpc_wt.run import design_controller
+        controller_input(design_controller(nrel5mw, "mpc-lidar")[0].controller, "mpc",
+                         nrel5mw)
     assert "baseline" in EXPORTABLE
 
 

@@ -233,6 +233,7 @@ class DisconController(ControllerBase):
         self.signals: dict[str, float] = {}
         self.messages: list[str] = []
         self._status = 0
+        self._warned = False
         self._load()                         # fail early on a bad library
 
     # -- library lifetime --------------------------------------------------------------------
@@ -371,6 +372,7 @@ class DisconController(ControllerBase):
                 os.dup2(self._fds[1], 1)
         else:
             self._fn(self._swap, ctypes.byref(fail), self._infile, self._out, self._msg)
+        self._warned = fail.value > 0
         if fail.value == 0:
             return
         text = self._msg.value.decode(errors="replace").strip()
@@ -402,7 +404,9 @@ class DisconController(ControllerBase):
         Raises
         ------
         ControllerLibraryError
-            If the library sets ``aviFAIL < 0``; the message is the library's.
+            If the library sets ``aviFAIL < 0``; the message is the library's. A warning
+            (``aviFAIL > 0``) is logged, kept in :attr:`messages` and marked in the signal
+            ``library_warning`` (1 at that step), and its demands apply.
         """
         if self._lib is None:
             raise ControllerLibraryError(f"controller library {self.library.name}: step() "
@@ -431,5 +435,6 @@ class DisconController(ControllerBase):
                 f"{torque} N m at t = {t:g} s")
         self._last_pitch, self._last_torque = pitch, torque
         self.signals = {"pitch_command": (pitch[0] + pitch[1] + pitch[2]) / 3.0,
-                        "torque_command": torque, "generator_contactor": contactor}
+                        "torque_command": torque, "generator_contactor": contactor,
+                        "library_warning": float(self._warned)}
         return pitch, torque

@@ -29,6 +29,8 @@ import sys
 from pathlib import Path
 from typing import Any, Mapping, Sequence
 
+import numpy as np
+
 import linearize
 from mpc_wt.errors import ControllerLibraryError
 
@@ -43,7 +45,19 @@ log = logging.getLogger(__name__)
 EXPORTABLE: dict[str, str] = {
     "baseline": "the tuned PI pitch loop and torque law, constant power in region III",
     "baseline-ct": "the baseline with constant torque in region III",
+    "mpc": "Madsen's individual-pitch MPC scheduled from cut-in to cut-out on the estimated "
+           "wind, with its Kalman estimator and the QP solved by DAQP",
+    "mpc-collective": "the scheduled MPC with collective pitch",
 }
+
+#: Library kinds (the input file's ``kind``) of the exported controller kinds.
+_LIBRARY_KIND = {"baseline": "baseline", "baseline-ct": "baseline", "mpc": "mpc",
+                 "mpc-collective": "mpc"}
+
+#: The Kalman filter's measured signals and their codes in the library.
+_SIGNAL_CODES = {"rotor_speed": 0, "gen_speed": 1, "pitch_1": 2, "pitch_2": 3, "pitch_3": 4,
+                 "flap_moment_1": 5, "flap_moment_2": 6, "flap_moment_3": 7,
+                 "tower_fa_acceleration": 8}
 
 #: The swap records the library reads (1-based, as the interface numbers them).
 SWAP_READ: dict[int, str] = {
@@ -62,7 +76,8 @@ SWAP_WRITTEN: dict[int, str] = {
     47: "generator torque demand [N m]", 48: "yaw rate demand (0)",
     55: "pitch override (0: off)", 56: "torque override (0: off)", 65: "logging channels (0)"}
 
-_SOURCES = ("mpcwt_discon.h", "input.c", "baseline.c", "discon.c")
+_SOURCES = ("mpcwt_discon.h", "input.c", "baseline.c", "windest.c", "mpc.c", "discon.c")
+_DAQP = "daqp"
 _CFLAGS = "-O2 -std=c99 -Wall -fPIC -fvisibility=hidden"
 _SANITIZE = "-O1 -g -fno-omit-frame-pointer -fsanitize=address,undefined " \
             "-fno-sanitize-recover=all"
@@ -146,10 +161,10 @@ def find_compiler() -> str | None:
 
 
 def _fmt(v: float) -> str:
-    return repr(float(v))
+    return "0" if v == 0.0 else repr(float(v))
 
 
-def _baseline_entries(ctl: Any) -> list[tuple[str, float, str]]:
+def _baseline_entries(ctl: Any, prefix: str = "") -> list[tuple[str, Any, str]]:
     """The numbers of a :class:`~mpc_wt.controllers.baseline.BaselineController` as input-file
     entries (key, value, unit and meaning)."""
     from mpc_wt.controllers.baseline import BaselineController
@@ -161,7 +176,7 @@ def _baseline_entries(ctl: Any) -> list[tuple[str, float, str]]:
         raise ValueError("a baseline with a power reference or a gain schedule (active power "
                          "control) does not export yet: export the plain design")
     g, tb = ctl.gains, ctl.turbine
-    return [
+    rows = [
         ("dt", ctl.dt, "communication interval [s] (ServoDyn DLL_DT)"),
         ("speed_filter_corner_hz", ctl.wc / (2 * math.pi),
          "generator-speed low-pass corner [Hz]"),
@@ -189,6 +204,127 @@ def _baseline_entries(ctl: Any) -> list[tuple[str, float, str]]:
         ("region3_constant_power", float(ctl.region3 == "constant_power"),
          "1: constant power above rated, 0: constant torque"),
     ]
+    return [(prefix + k, v, doc) for k, v, doc in rows]
+
+
+def _mpc_point(m: Any, k: int, signals: tuple[str, ...]) -> list[tuple[str, Any, str]]:
+    """One grid point of a scheduled MPC: its QP's packed step data, matrices and Kalman
+    filter."""
+    from mpc_wt.controllers.estimator import KalmanEstimator
+
+    if m.formulation != "condensed" or m.backend != "daqp":
+        raise ValueError(f"the MPC exports with the condensed formulation solved by DAQP; grid "
+                         f"point {k} has {m.formulation!r} with {m.backend!r}")
+    est = m.estimator
+    if not isinstance(est, KalmanEstimator) or est.signals != signals:
+        raise ValueError("the MPC exports with its Kalman estimator (estimator='kalman') on "
+                         "the same measured signals at every grid point")
+    nx, nd, nu = m._nx, m._nd, m._nu
+    ny, nb, nz = m._wt.shape[1], len(m._bconst), len(m._z)
+    head = [int(v) for v in m._im[:9]]
+    sizes = [nx, nd, nu, ny, nb, m._map_nv, nz, m._nzd, m._nvu, m.hp, m.hu, m._slack0,
+             len(m.model.outputs), int(m.collective)]
+    if head != [m._nzd, m._slack0, nx, nd, ny, nb, m._map_nv, nu, nz]:
+        raise ValueError(f"grid point {k}: the MPC's packed step data is not laid out as the "
+                         f"library reads it ({head})")
+    z_init = np.zeros(nz)
+    z_init[0] = 1.0
+    p = f"point.{k}."
+    a_gen = np.asarray(m._a_gen_s, float)
+    return [
+        (p + "sizes", np.array(sizes, float),
+         "n_x n_d n_u n_y n_bounds n_v n_z n_z_data n_v_inputs H_p H_u first_slack n_outputs "
+         "collective"),
+        (p + "im", np.asarray(m._im, float), "packed integers: sizes, state index, bound rows, "
+                                             "command columns"),
+        (p + "fc", np.asarray(m._fc, float), "packed constants: x0, d0, bound constants and "
+                                             "signs, input scales, u0"),
+        (p + "wt", np.asarray(m._wt, float).ravel(), "the step's affine map Y, transposed "
+                                                     "(n_z x n_y, row-major)"),
+        (p + "z_init", z_init, "the step data at a reset"),
+        (p + "su", np.asarray(m._su, float), "variable scales"),
+        (p + "u0", np.asarray(m.model.u0, float), "operating point inputs [rad, rad, rad, N m]"),
+        (p + "z0", np.asarray(m.model.z0, float), "operating point outputs"),
+        (p + "x0d0", np.concatenate([m.model.x0, m.model.d0]).astype(float),
+         "operating point states and winds"),
+        (p + "up0", np.asarray(m._up0, float), "previous command deviation at the start"),
+        (p + "h", np.asarray(m._h_s, float).ravel(), "QP Hessian (scaled, row-major)"),
+        (p + "n_box", float(m._n_box), "simple bounds (the first QP rows)"),
+        (p + "a", a_gen.ravel(), "QP general constraint rows (scaled, row-major)"),
+        (p + "limits", np.asarray(m._limits, float), "pitch min, max [rad], torque min, max "
+                                                     "[N m]"),
+        (p + "kalman.n_ny", np.array([est.a.shape[0], len(est.signals)], float),
+         "Kalman filter states and measurements"),
+        (p + "kalman.a", est.a.ravel(), "Kalman A"), (p + "kalman.b", est.b.ravel(), "B"),
+        (p + "kalman.c", est.c.ravel(), "C"), (p + "kalman.d", est.d.ravel(), "D"),
+        (p + "kalman.gain", est.gain.ravel(), "steady-state gain"),
+        (p + "kalman.y0", np.asarray(est.y0, float), "operating point measurements"),
+    ]
+
+
+def _windest_entries(est: Any, prefix: str) -> list[tuple[str, Any, str]]:
+    tx, ty, c, kx, ky = est._spline
+    k = np.concatenate([est._k, [est.settings.speed_std ** 2, 1.0]])
+    return [
+        (prefix + "spline_degrees", np.array([kx, ky], float), "C_P spline degrees"),
+        (prefix + "spline_tx", np.asarray(tx, float), "C_P spline knots in tip-speed ratio"),
+        (prefix + "spline_ty", np.asarray(ty, float), "C_P spline knots in pitch [rad]"),
+        (prefix + "spline_c", np.asarray(c, float), "C_P spline coefficients"),
+        (prefix + "constants", k,
+         "radius [m], air density [kg/m^3], gearbox ratio, inertia [kg m^2], dt [s], process "
+         "noise of speed and wind, speed noise, wind range [m/s], tip-speed ratio range, "
+         "initial variances of speed and wind"),
+    ]
+
+
+def _mpc_entries(ctl: Any) -> list[tuple[str, Any, str]]:
+    """The numbers of a :class:`~mpc_wt.controllers.mpc.ScheduledMPC` as input-file entries."""
+    from mpc_wt.controllers.mpc import ScheduledMPC
+
+    if type(ctl) is not ScheduledMPC:
+        raise ValueError(f"the MPC export takes a ScheduledMPC, got {type(ctl).__name__}")
+    if ctl.wind_source != "estimator":
+        raise ValueError("an MPC scheduled on its LIDAR's measurement does not export yet: "
+                         "export the MPC scheduled on the estimated wind ('mpc')")
+    n = len(ctl._grid)
+    pts = [ctl.controller(k) for k in range(n)]
+    signals = pts[0].estimator.signals
+    unknown = [s for s in signals if s not in _SIGNAL_CODES]
+    if unknown:
+        raise ValueError(f"the Kalman filter measures {unknown}, which the library does not "
+                         f"read from the swap array (it reads {sorted(_SIGNAL_CODES)})")
+    sched = ctl.schedule
+    budget = ctl.settings.time_budget_ms
+    rows: list[tuple[str, Any, str]] = [
+        ("dt", ctl.dt, "controller period [s] (ServoDyn DLL_DT)"),
+        ("n_points", float(n), "designs over the wind"),
+        ("n_outputs", float(len(ctl._z_trim[0])), "performance outputs of each design"),
+        ("power_output", float(ctl._ip), "the generator power's index among them"),
+        ("power_efficiency", ctl._eff, "power / (torque x generator speed) at the trim"),
+        ("target_time_constant", -1.0 if ctl.target_tau is None else float(ctl.target_tau),
+         "low-pass of the wind whose trim the cost tracks [s] (-1: each design's own)"),
+        ("qp_time_budget_ms", 0.0 if budget is None else float(budget),
+         "a QP over this time takes the fallback [ms] (0: no budget)"),
+        ("torque_law", float(ctl._law is not None), "1: the target torque from the baseline's "
+                                                    "schedule"),
+        ("kalman_signals", np.array([_SIGNAL_CODES[s] for s in signals], float),
+         "measured: " + ", ".join(signals)),
+        ("schedule.grid", np.asarray(ctl._grid, float), "the designs' winds [m/s]"),
+        ("schedule.time_constant_hysteresis", np.array([sched.tau, sched.hyst], float),
+         "low-pass of the scheduling wind [s], hysteresis [m/s]"),
+        *_windest_entries(sched.estimator, "schedule.windest."),
+        ("trim_z", np.asarray(ctl._z_trim, float).ravel(), "the trim's outputs over the grid"),
+        ("trim_u", np.asarray(ctl._u_trim, float).ravel(), "the trim's inputs over the grid"),
+    ]
+    if ctl._law is not None:
+        lt = ctl._law
+        rows += _baseline_entries(ctl.torque_law, "law.")
+        rows.append(("law_torque", np.array([lt._a, lt._offset, lt._lo, lt._hi], float),
+                     "speed filter pole, below-rated pitch offset [rad], torque min, max "
+                     "[N m]"))
+    for k, m in enumerate(pts):
+        rows += _mpc_point(m, k, signals)
+    return rows
 
 
 def controller_input(controller: Any, kind: str, turbine: linearize.Turbine,
@@ -216,10 +352,10 @@ def controller_input(controller: Any, kind: str, turbine: linearize.Turbine,
     ValueError
         A kind that does not export, or a controller of another type.
     """
-    if kind not in EXPORTABLE:
-        raise ValueError(f"controller kind {kind!r} does not export as a DISCON library; "
-                         f"the kinds that do: {sorted(EXPORTABLE)}")
-    entries = _baseline_entries(controller)
+    check_exportable(kind)
+    lib_kind = _LIBRARY_KIND[kind]
+    entries = _baseline_entries(controller) if lib_kind == "baseline" else \
+        _mpc_entries(controller)
     from mpc_wt._version import __version__
 
     head = [f"# mpc-wt {__version__}: controller '{kind}' for {turbine.name}",
@@ -228,28 +364,48 @@ def controller_input(controller: Any, kind: str, turbine: linearize.Turbine,
             "# One entry per line: key value [value ...]; '#' starts a comment. Every number",
             "# here is read at the first call: change one and restart the simulation.",
             "format_version 1",
-            f"kind {'baseline'}"]
-    width = max(len(k) for k, _, _ in entries)
-    body = [f"{k:<{width}} {_fmt(v):<24} # {doc}" for k, v, doc in entries]
+            f"kind {lib_kind}"]
+    width = max(len(k) for k, v, _ in entries if np.ndim(v) == 0)
+    body = []
+    for k, v, doc in entries:
+        if np.ndim(v) == 0:
+            body.append(f"{k:<{width}} {_fmt(v):<24} # {doc}")
+        else:
+            body.append(f"# {k}: {doc} ({np.size(v)} values)")
+            body.append(k + " " + " ".join(map(_fmt, np.asarray(v, float).ravel().tolist())))
     return "\n".join(head + body) + "\n"
+
+
+def _source_names() -> list[str]:
+    """The export's source files, relative to its folder: ours, then DAQP's (``daqp/``)."""
+    src = importlib.resources.files("mpc_wt.io") / "discon_c"
+    daqp = sorted(f"{_DAQP}/{p.name}" for p in (src / _DAQP).iterdir()
+                  if p.name.endswith((".c", ".h")) or p.name in ("LICENSE", "README.md"))
+    return list(_SOURCES) + daqp
 
 
 def _copy_sources(directory: Path) -> tuple[Path, ...]:
     src = importlib.resources.files("mpc_wt.io") / "discon_c"
+    (directory / _DAQP).mkdir(exist_ok=True)
     out = []
-    for name in _SOURCES:
+    for name in _source_names():
         target = directory / name
         target.write_text((src / name).read_text())
         out.append(target)
     return tuple(out)
 
 
+def _c_files() -> list[str]:
+    return [n for n in _source_names() if n.endswith(".c")]
+
+
 def _makefile(directory: Path, lib: str) -> Path:
-    srcs = " ".join(n for n in _SOURCES if n.endswith(".c"))
+    srcs = " ".join(_c_files())
     text = (f"# Builds {lib} with the system's C compiler (make CC=... to choose another).\n"
-            f"CC ?= cc\nCFLAGS ?= {_CFLAGS}\nLDLIBS = -lm -lpthread\n\n"
+            f"CC ?= cc\nCFLAGS ?= {_CFLAGS}\nCPPFLAGS += -I. -I{_DAQP}\n"
+            f"LDLIBS = -lm -lpthread\n\n"
             f"{lib}: {srcs} mpcwt_discon.h\n"
-            f"\t$(CC) $(CFLAGS) -shared -o $@ {srcs} $(LDLIBS)\n\n"
+            f"\t$(CC) $(CPPFLAGS) $(CFLAGS) -shared -o $@ {srcs} $(LDLIBS)\n\n"
             f"clean:\n\trm -f {lib}\n")
     path = directory / "Makefile"
     path.write_text(text)
@@ -295,8 +451,8 @@ def build_library(directory: str | Path, kind: str, *, compiler: str | None = No
     flags = (_SANITIZE if sanitize else _CFLAGS).split()
     if sanitize:
         flags += ["-fPIC"]
-    cmd = [cc, *flags, "-shared", "-o", str(lib),
-           *[str(directory / n) for n in _SOURCES if n.endswith(".c")], "-lm"]
+    cmd = [cc, f"-I{directory}", f"-I{directory / _DAQP}", *flags, "-shared", "-o", str(lib),
+           *[str(directory / n) for n in _c_files()], "-lm"]
     if sys.platform != "win32":
         cmd.append("-lpthread")
     proc = subprocess.run(cmd, capture_output=True, text=True, cwd=directory)

@@ -4,7 +4,8 @@
  *
  * avrSWAP(1) is the status: 0 at the first call (read the input file, make the controller,
  * then step), 1 at every later one (step), -1 at the last (free). Errors set aviFAIL = -1 and
- * a message in avcMSG (its length in avrSWAP(49)); the caller stops the run.
+ * a message in avcMSG (its length in avrSWAP(49)); the caller stops the run. A warning (the
+ * MPC's fallback when its QP fails) sets aviFAIL = 1 with its message; the demands apply.
  *
  * One instance per simulation root name (avcOUTNAME, up to MW_MAX_INSTANCES): two turbines
  * that load one copy of the library keep their own state. */
@@ -91,9 +92,11 @@ static mw_ctrl *create(const char *path, const float *swap, char *msg)
     }
     if (strcmp(kind, "baseline") == 0)
         c = mw_baseline_new(&in, msg);
+    else if (strcmp(kind, "mpc") == 0)
+        c = mw_mpc_new(&in, msg);
     else
         mw_msg(msg, "mpc-wt controller: input file '%s': kind '%s' is not one this library "
-               "knows (baseline)", path, kind);
+               "knows (baseline, mpc)", path, kind);
     mw_input_free(&in);
     if (!c) return NULL;
     dt_call = swap[2];
@@ -150,6 +153,7 @@ MW_EXPORT void DISCON(float *avrSWAP, int *aviFAIL, const char *accINFILE, char 
     mw_instance *inst;
     mw_meas m;
     mw_cmd cmd;
+    int rc;
     msg[0] = '\0';
     *aviFAIL = 0;
     root_key(avcOUTNAME, swap_len(avrSWAP, 51, MW_KEY_LEN), key);
@@ -209,10 +213,15 @@ MW_EXPORT void DISCON(float *avrSWAP, int *aviFAIL, const char *accINFILE, char 
         return;
     }
     read_meas(avrSWAP, &m);
-    if (inst->ctrl->step(inst->ctrl, &m, &cmd, msg)) {
+    rc = inst->ctrl->step(inst->ctrl, &m, &cmd, msg);
+    if (rc < 0) {
         *aviFAIL = -1;
         copy_msg(avcMSG, msg_len, msg);
         return;
+    }
+    if (rc > 0) {                                   /* a warning: the command still applies */
+        *aviFAIL = 1;
+        copy_msg(avcMSG, msg_len, msg);
     }
     write_cmd(avrSWAP, &cmd);
 }

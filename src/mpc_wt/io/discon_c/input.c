@@ -215,3 +215,61 @@ int mw_get_word(const mw_input *in, const char *key, char *out, size_t n, char *
     out[k] = '\0';
     return 0;
 }
+
+static const char *prefixed(const char *prefix, const char *key, char *buf, size_t n)
+{
+    snprintf(buf, n, "%s%s", prefix, key);
+    return buf;
+}
+
+int mw_getp(const mw_input *in, const char *prefix, const char *key, double *out, char *msg)
+{
+    char k[256];
+    return mw_get(in, prefixed(prefix, key, k, sizeof(k)), out, msg);
+}
+
+int mw_getp_vec(const mw_input *in, const char *prefix, const char *key, double *out, int n,
+                char *msg)
+{
+    char k[256];
+    return mw_get_vec(in, prefixed(prefix, key, k, sizeof(k)), out, n, msg);
+}
+
+int mw_getp_int(const mw_input *in, const char *prefix, const char *key, int lo, int hi,
+                int *out, char *msg)
+{
+    char k[256];
+    return mw_get_int(in, prefixed(prefix, key, k, sizeof(k)), lo, hi, out, msg);
+}
+
+double *mw_getp_alloc_n(const mw_input *in, const char *prefix, const char *key, int n,
+                        char *msg)
+{
+    char k[256];
+    double *v;
+    prefixed(prefix, key, k, sizeof(k));
+    v = (double *)malloc((size_t)(n > 0 ? n : 1) * sizeof(double));
+    if (!v) {
+        mw_msg(msg, "mpc-wt controller: out of memory reading key '%s' (%d values)", k, n);
+        return NULL;
+    }
+    if (mw_get_vec(in, k, v, n, msg)) {
+        free(v);
+        return NULL;
+    }
+    return v;
+}
+
+double *mw_getp_alloc(const mw_input *in, const char *prefix, const char *key, int *n,
+                      char *msg)
+{
+    char k[256];
+    int c = mw_count(in, prefixed(prefix, key, k, sizeof(k)), msg);
+    if (c < 0) return NULL;
+    if (c == 0) {
+        mw_msg(msg, "mpc-wt controller: input file '%s': key '%s' has no values", in->path, k);
+        return NULL;
+    }
+    *n = c;
+    return mw_getp_alloc_n(in, prefix, key, c, msg);
+}

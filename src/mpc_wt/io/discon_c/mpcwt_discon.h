@@ -66,6 +66,73 @@ struct mw_ctrl {
 
 /* the kinds */
 mw_ctrl *mw_baseline_new(const mw_input *in, char *msg);
+mw_ctrl *mw_mpc_new(const mw_input *in, char *msg);
+
+/* ---- shared parts --------------------------------------------------------------------- */
+/* input keys are "<prefix><name>"; these read one with the prefix */
+int mw_getp(const mw_input *in, const char *prefix, const char *key, double *out, char *msg);
+int mw_getp_vec(const mw_input *in, const char *prefix, const char *key, double *out, int n,
+                char *msg);
+int mw_getp_int(const mw_input *in, const char *prefix, const char *key, int lo, int hi,
+                int *out, char *msg);
+/* a vector of any length, allocated (NULL with msg on failure); n receives its length */
+double *mw_getp_alloc(const mw_input *in, const char *prefix, const char *key, int *n,
+                      char *msg);
+/* the same with exactly n values */
+double *mw_getp_alloc_n(const mw_input *in, const char *prefix, const char *key, int n,
+                        char *msg);
+
+/* the baseline's torque law and PI data (Jonkman's law, regions 1.5, 2, 2.5, 3) */
+typedef struct {
+    double a, w_set, kp, ki, theta_k, dt, p_min, p_max, rate, tq_rate, tq_max;
+    double w_cutin, w_rgn2, w_trans, w_rated, w_sync, slope15, slope25, k_opt, tq_cap;
+    double p_rated, eta, tq_rated, one_deg;
+    int constant_power;
+} mw_law;
+int mw_law_read(const mw_input *in, const char *prefix, mw_law *law, char *msg);
+double mw_law_torque(const mw_law *law, double w, double pitch, double p3);
+
+/* the rotor-effective wind speed's extended Kalman filter (rotor speed, pitch, torque) */
+typedef struct {
+    double *tx, *ty, *c;
+    int ntx, nty, kx, ky;
+    double radius, rho, gear, inertia, dt, q0, q1, r, vmin, vmax, tsr0, tsr1;
+    double p0_speed, p0_wind;
+    double x[2], p[4], u[2];
+    int started;
+} mw_windest;
+int mw_windest_read(const mw_input *in, const char *prefix, mw_windest *e, char *msg);
+void mw_windest_free(mw_windest *e);
+void mw_windest_reset(mw_windest *e);
+double mw_windest_step(mw_windest *e, double rotor_speed, double pitch, double gen_torque);
+
+/* which design of a wind-scheduled controller acts */
+typedef struct {
+    double *grid, *mid;
+    int n;
+    double dt, tau, hyst;
+    double wind, measured;
+    int active, started, switches;
+    mw_windest est;
+} mw_schedule;
+int mw_schedule_read(const mw_input *in, const char *prefix, double dt, mw_schedule *s,
+                     char *msg);
+void mw_schedule_free(mw_schedule *s);
+void mw_schedule_reset(mw_schedule *s);
+/* this step's active index; *switched = 1 on a switch */
+int mw_schedule_update(mw_schedule *s, const mw_meas *m, int *switched);
+
+/* a steady-state Kalman filter on a linear model with the winds as random walks */
+typedef struct {
+    int n, ny, nu;
+    double *a, *b, *c, *d, *gain, *y0, *xa, *work;
+    int started;
+} mw_kalman;
+int mw_kalman_read(const mw_input *in, const char *prefix, int nu, mw_kalman *k, char *msg);
+void mw_kalman_free(mw_kalman *k);
+void mw_kalman_reset(mw_kalman *k);
+/* predict with u (deviation) and correct with y (absolute); -1 on a non-finite y */
+int mw_kalman_update(mw_kalman *k, const double *y, const double *u);
 
 /* helpers */
 void mw_msg(char *msg, const char *fmt, ...);
