@@ -331,7 +331,9 @@ def plot_design(doc: dict[str, Any], path: str | Path) -> Path:
     fig, ax = plt.subplots(figsize=(7, 4))
     scalar = {"baseline": (("kp", "ki"), "PI gain on generator speed [s], [-]"),
               "ibc": (("gain",), "IBC gain [rad/(N m)]"),
-              "coleman-ipc": (("ki",), "IPC integral gain [rad/(N m s)]")}
+              "coleman-ipc": (("ki",), "IPC integral gain [rad/(N m s)]"),
+              "mpc": (("pitch",), "trim pitch the cost tracks [rad]"),
+              "mpc-collective": (("pitch",), "trim pitch the cost tracks [rad]")}
     if doc["kind"] in scalar:
         names, label = scalar[doc["kind"]]
         for c in names:

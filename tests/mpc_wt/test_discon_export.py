@@ -4,6 +4,7 @@ they came from; sanitizers, two instances, bad input files and measurements."""
 from __future__ import annotations
 
 import ctypes
+import json
 import math
 import os
 import shutil
@@ -19,7 +20,8 @@ import linearize
 from mpc_wt.assessment.fatigue import damage_equivalent_load
 from mpc_wt.controllers.discon import DisconController
 from mpc_wt.errors import ControllerLibraryError
-from mpc_wt.io.discon_export import EXPORTABLE, build_library, find_compiler, servodyn_input
+from mpc_wt.io.discon_export import (EXPORTABLE, build_library, find_compiler, library_name,
+                                     servodyn_input)
 from mpc_wt.run import export_discon, run_controller
 
 pytestmark = pytest.mark.skipif(find_compiler() is None,
@@ -361,3 +363,21 @@ def test_cli_design_then_export_discon(tmp_path, capsys):
     assert main(["export", str(i), "--format", "discon"]) != 0
     err = capsys.readouterr().err
     assert "'ibc' design does not export" in err and "baseline" in err
+
+
+def test_cli_design_mpc_then_export_discon(tmp_path, capsys):
+    """``mpcwt design mpc`` writes the grid's trim table and plot; ``mpcwt export --format
+    discon`` builds the MPC again from the design's options and exports it."""
+    from mpc_wt.cli import main
+
+    d = tmp_path / "mpc"
+    assert main(["design", "mpc", "--out", str(d)]) == 0
+    assert (d / "gains.png").stat().st_size > 0
+    doc = json.loads((d / "design.json").read_text())
+    rows = np.array(doc["schedule"]["rows"])
+    assert doc["kind"] == "mpc" and rows[0, 0] == 3.0 and rows[-1, 0] == 25.0
+    assert np.all(rows[:, 5] < 1.0)                  # every Kalman filter stable
+    assert main(["export", str(d), "--format", "discon"]) == 0
+    assert "libmpcwt_mpc" in capsys.readouterr().out
+    assert "kind mpc" in (d / "mpcwt_mpc.in").read_text()
+    assert (d / library_name("mpc")).is_file()

@@ -25,7 +25,7 @@ def add_parsers(sub: Any) -> None:
     from mpc_wt.registry.registry import designs
 
     p = sub.add_parser("design", help="gain synthesis: baseline PI, LQR family, TS by LMIs, "
-                                      "IBC, Coleman IPC")
+                                      "IBC, Coleman IPC; the scheduled MPC's grid")
     p.add_argument("kind", choices=list(designs()))
     add_turbine(p)
     p.add_argument("--out", required=True, help="design directory (design.json, gains.png)")
@@ -111,12 +111,37 @@ def _design(args: argparse.Namespace) -> int:
     return 0
 
 
+def _export_registered(args: argparse.Namespace, turbine: Any) -> list[Path] | None:
+    """``--format discon`` of a design that is built again from its options (the MPC kinds);
+    None for the others."""
+    from mpc_wt.io.gain_tables import design_turbine, load_design
+    from mpc_wt.run import export_discon
+
+    if args.format != "discon":
+        return None
+    try:
+        doc = load_design(args.design)
+    except GainTableError as err:
+        raise UsageError(str(err)) from None
+    if doc["kind"] not in ("mpc", "mpc-collective"):
+        return None
+    p = Path(args.design)
+    out = Path(args.to) if args.to else (p if p.is_dir() else p.parent)
+    ex = export_discon(design_turbine(doc, turbine), doc["kind"], out,
+                       doc["settings"].get("options") or None)
+    if ex.note:
+        print(f"note: {ex.note}")
+    return [*ex.sources[:6], ex.makefile, ex.input_file,
+            *(f for f in (ex.library, ex.servodyn) if f is not None)]
+
+
 def _export(args: argparse.Namespace) -> int:
     from mpc_wt.io.gain_tables import export
 
     turbine = linearize.load_turbine(args.turbine) if args.turbine else None
     try:
-        files = export(args.design, args.format, args.to, turbine)
+        files = _export_registered(args, turbine) or export(args.design, args.format, args.to,
+                                                             turbine)
     except GainTableError as err:
         raise UsageError(str(err)) from None
     print("wrote " + ", ".join(str(f) for f in files))

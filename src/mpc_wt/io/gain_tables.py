@@ -44,7 +44,7 @@ from mpc_wt.controllers.baseline import effective_pi_gains
 from mpc_wt.errors import GainTableError
 
 __all__ = ["SCHEMA_VERSION", "GainTableError", "baseline_table", "lqr_table", "ts_table",
-           "ibc_table", "coleman_ipc_table",
+           "ibc_table", "coleman_ipc_table", "mpc_table", "design_turbine",
            "save_design", "load_design", "export", "read_rosco", "FORMATS"]
 
 SCHEMA_VERSION = 1
@@ -332,6 +332,49 @@ def _check(doc: Any, where: str) -> dict[str, Any]:
     return doc
 
 
+def mpc_table(turbine: linearize.Turbine, ctl: Any, kind: str,
+              options: dict[str, Any] | None = None) -> dict[str, Any]:
+    """A scheduled MPC's design as a table: one row per grid wind with the trim the cost
+    tracks there (pitch, torque, rotor speed, power) and its Kalman filter's spectral radius;
+    the settings hold the kind's options (from which the design is built again) and the
+    MPC's horizon and period.
+
+    Parameters
+    ----------
+    turbine : Turbine
+        The turbine.
+    ctl : ScheduledMPC
+        The design.
+    kind : str
+        Its kind (``mpc``, ``mpc-collective``).
+    options : dict, optional
+        The options it was built with.
+
+    Returns
+    -------
+    dict
+        The gain-table document.
+    """
+    rows = []
+    for k, v in enumerate(ctl._grid):
+        m = ctl.controller(k)
+        z0, outs = m.model.z0, list(m.model.outputs)
+        rows.append([float(v), float(np.mean(m.model.u0[:3])), float(m.model.u0[3]),
+                     float(z0[outs.index("rotor_speed")]), float(z0[outs.index("gen_power")]),
+                     float(m.estimator.spectral_radius) if m.estimator is not None else
+                     float("nan")])
+    st = ctl.settings
+    settings = {"options": dict(options or {}), "dt": st.dt, "horizon": st.horizon,
+                "control_horizon": st.hu, "schedule_time_constant": ctl.schedule.tau,
+                "target_time_constant": ctl.target_tau,
+                "units": {"dt": "s", "schedule_time_constant": "s",
+                          "target_time_constant": "s"}}
+    return _doc(kind, turbine, settings,
+                ["wind_speed", "pitch", "gen_torque", "rotor_speed", "gen_power",
+                 "estimator_spectral_radius"], ["m/s", "rad", "N m", "rad/s", "W", "-"], rows,
+                {})
+
+
 def save_design(doc: dict[str, Any], out_dir: str | Path) -> Path:
     """Write ``design.json`` into ``out_dir`` (created).
 
@@ -433,7 +476,27 @@ def _write_mat(doc: dict[str, Any], out: Path) -> list[Path]:
     return [p]
 
 
-def _turbine_of(doc: dict[str, Any], turbine: linearize.Turbine | None) -> linearize.Turbine:
+def design_turbine(doc: dict[str, Any], turbine: linearize.Turbine | None = None
+                   ) -> linearize.Turbine:
+    """The turbine of a design document: ``turbine`` when given, else the packaged turbine of
+    the document's turbine name.
+
+    Parameters
+    ----------
+    doc : dict
+        A gain-table document.
+    turbine : Turbine, optional
+        The design's turbine, when it is not a packaged one.
+
+    Returns
+    -------
+    Turbine
+
+    Raises
+    ------
+    GainTableError
+        No packaged turbine has that name and none was given.
+    """
     if turbine is not None:
         return turbine
     for name in linearize.available_turbines():
@@ -456,7 +519,7 @@ def _write_rosco(doc: dict[str, Any], out: Path,
                              f"Coleman IPC; a {doc['kind']!r} design has none: export a baseline "
                              f"(`mpcwt design baseline`), derated or not, or a coleman-ipc design "
                              f"for ROSCO, or use csv/json/mat")
-    t = _turbine_of(doc, turbine)
+    t = design_turbine(doc, turbine)
     if doc["kind"] == "coleman-ipc":
         frac = float(doc["settings"].get("power_fraction", 1.0))
         base = baseline_table(t, tune_baseline(t, power_fraction=frac))
@@ -468,7 +531,10 @@ def _write_discon(doc: dict[str, Any], out: Path,
                   turbine: linearize.Turbine | None = None) -> list[Path]:
     from mpc_wt.io.discon_export import export_design
 
-    t = _turbine_of(doc, turbine)
+    if doc["kind"] in ("mpc", "mpc-collective"):
+        raise GainTableError(f"a {doc['kind']!r} design is built again from its options to "
+                             f"export: use mpc_wt.run.export_discon (mpcwt export does)")
+    t = design_turbine(doc, turbine)
     try:
         ex = export_design(doc, t, out)
     except ValueError as err:

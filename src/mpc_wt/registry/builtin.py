@@ -501,12 +501,33 @@ def _mpc(collective: bool, with_lidar: bool) -> Any:
     return build
 
 
+def _design_mpc(collective: bool) -> Any:
+    """The design function of a scheduled MPC kind: its design with the default options, as a
+    table of its grid points (``mpcwt design mpc``; ``mpcwt export --format discon`` builds it
+    again from the table's options)."""
+    kind = "mpc-collective" if collective else "mpc"
+
+    def design(turbine: linearize.Turbine) -> tuple[dict, str]:
+        from mpc_wt.io.gain_tables import mpc_table
+        from mpc_wt.registry.context import DEFAULT_CACHE
+
+        ctx = BuildContext(turbine=turbine, params=linearize.plant_params(turbine),
+                           cache=DEFAULT_CACHE)
+        ctl = _mpc(collective, False)(ctx, MPCOptions()).controller
+        doc = mpc_table(turbine, ctl, kind, options={})
+        n = len(doc["schedule"]["rows"])
+        return doc, f"{n} grid winds {doc['schedule']['rows'][0][0]:g}-" \
+                    f"{doc['schedule']['rows'][-1][0]:g} m/s, horizon {ctl.settings.horizon}"
+    return design
+
+
 _MPC_GROUP = "the MPC controllers"
-register("mpc", MPCOptions, field_components="u", group=_MPC_GROUP,
+register("mpc", MPCOptions, field_components="u", group=_MPC_GROUP, design=_design_mpc(False),
          summary="Madsen's Coleman-weighted individual-pitch MPC, scheduled from cut-in to "
                  "cut-out on the estimated wind, Kalman estimator"
          )(_mpc(False, False))
 register("mpc-collective", MPCOptions, field_components="u", group=_MPC_GROUP,
+         design=_design_mpc(True),
          summary="the scheduled MPC with one collective pitch input")(_mpc(True, False))
 register("mpc-lidar", MPCLidarOptions, field_components="u", group=_MPC_GROUP,
          summary="the individual-pitch MPC with a CW LIDAR's per-blade preview "
