@@ -292,4 +292,5 @@ def export_discon(turbine: linearize.Turbine, controller: str, out: str | Path,
     opts = ", ".join(f"{k}={v}" for k, v in sorted((options or {}).items()))
     return export_controller(built.controller, controller, turbine, out, build=build,
                              compiler=compiler,
-                             source=f"options: {opts}" if opts else "default options")
+                             source=f"options: {opts}" if opts else "default options",
+                             preview=built.preview)

@@ -28,7 +28,8 @@ import numpy as np
 from mpc_wt.controllers.base import ControllerBase
 from mpc_wt.errors import ControllerLibraryError
 
-__all__ = ["DisconController", "SWAP_RECORDS", "SWAP_SIZE", "rosco_library", "rosco_discon"]
+__all__ = ["DisconController", "SWAP_RECORDS", "SWAP_SIZE", "LIDAR_RECORDS", "rosco_library",
+           "rosco_discon"]
 
 log = logging.getLogger(__name__)
 
@@ -68,6 +69,16 @@ SWAP_RECORDS = {
     109: "low-speed-shaft torque [N m]", 110: "rotor thrust [N]", 129: "swap array length",
 }
 _LOG_START = 165
+#: OpenFAST's lidar block of the extended swap array (ServoDyn's BladedInterface_EX: records
+#: 2001-2500), as :class:`DisconController` fills it from a CW LIDAR with three beams.
+LIDAR_RECORDS = {
+    2001: "sensor type (2: continuous-wave)", 2002: "number of beams (3)",
+    2003: "number of pulse gates (1)", 2004: "reference mean wind (0, unset as in OpenFAST)",
+    2005: "beam 1 line-of-sight speed, positive toward the LIDAR [m/s]",
+    2006: "beam 2 line-of-sight speed [m/s]", 2007: "beam 3 line-of-sight speed [m/s]",
+    2008: "beams 1-3 focus point x, upwind of the hub [m] (2008-2010)",
+    2011: "beams 1-3 focus point y from the hub [m] (2011-2013)",
+    2014: "beams 1-3 focus point z from the hub [m] (2014-2016)"}
 
 
 def rosco_library() -> Path:
@@ -197,6 +208,9 @@ class DisconController(ControllerBase):
         Send what the library prints on the process's standard output (ROSCO's banner and
         status lines) to the null device during its calls (default); its ``aviFAIL`` messages
         are kept either way.
+    lidar : lidar.LidarSensor, optional
+        A hub-mounted CW LIDAR (bound to the case's wind by the simulator) whose measurement
+        fills OpenFAST's lidar records at each call (:data:`LIDAR_RECORDS`).
 
     Raises
     ------
@@ -208,7 +222,7 @@ class DisconController(ControllerBase):
     def __init__(self, library: str | Path, discon_in: str | Path, turbine: Any, *,
                  dt: float = 1.0 / 80.0, pitch_control: str = "individual",
                  workdir: str | Path | None = None, root_name: str = "mpcwt_discon",
-                 quiet: bool = True) -> None:
+                 quiet: bool = True, lidar: Any = None) -> None:
         self.library = Path(library).resolve()
         self.discon_in = Path(discon_in).resolve()
         _check_library(self.library)
@@ -225,6 +239,7 @@ class DisconController(ControllerBase):
         self.workdir = Path(workdir) if workdir is not None else None
         self.root_name = root_name
         self.quiet = quiet
+        self.lidar = lidar
         self._fds: tuple[int, int] | None = None
         self._lib: Any = None
         self._copy_dir: str | None = None
@@ -346,7 +361,22 @@ class DisconController(ControllerBase):
     _DYNAMIC = np.array([1, 2, 4, 33, 34, 11, 14, 15, 20, 21, 23, 27, 30, 31, 32, 69, 70, 71,
                          53, 54, 60, 75, 76, 109, 110]) - 1
 
+    def _fill_lidar(self, t: float, meas: dict[str, Any]) -> None:
+        """The lidar records from the LIDAR's measurement at the rotor's azimuth and speed."""
+        m = self.lidar.measure(np.array([t]), np.array([float(meas["azimuth"])]),
+                               float(meas["rotor_speed"]))
+        ang = m.beam_azimuth_rad[0]
+        r = m.radius
+        v = self._view
+        v[2000:2004] = (2.0, 3.0, 1.0, 0.0)
+        v[2004:2007] = m.los[0]
+        v[2007:2010] = self.lidar.focus_distance
+        v[2010:2013] = -r * np.sin(ang)
+        v[2013:2016] = r * np.cos(ang)
+
     def _fill(self, t: float, meas: dict[str, Any]) -> None:
+        if self.lidar is not None:
+            self._fill_lidar(t, meas)
         g = meas.get
         p, f, e = meas["pitch"], meas["flap_moment"], meas["edge_moment"]
         self._view[self._DYNAMIC] = (

@@ -48,11 +48,13 @@ EXPORTABLE: dict[str, str] = {
     "mpc": "Madsen's individual-pitch MPC scheduled from cut-in to cut-out on the estimated "
            "wind, with its Kalman estimator and the QP solved by DAQP",
     "mpc-collective": "the scheduled MPC with collective pitch",
+    "mpc-lidar": "the scheduled MPC with the per-blade preview of a hub-mounted CW LIDAR, read "
+                 "from OpenFAST's lidar records",
 }
 
 #: Library kinds (the input file's ``kind``) of the exported controller kinds.
 _LIBRARY_KIND = {"baseline": "baseline", "baseline-ct": "baseline", "mpc": "mpc",
-                 "mpc-collective": "mpc"}
+                 "mpc-collective": "mpc", "mpc-lidar": "mpc"}
 
 #: The Kalman filter's measured signals and their codes in the library.
 _SIGNAL_CODES = {"rotor_speed": 0, "gen_speed": 1, "pitch_1": 2, "pitch_2": 3, "pitch_3": 4,
@@ -277,15 +279,33 @@ def _windest_entries(est: Any, prefix: str) -> list[tuple[str, Any, str]]:
     ]
 
 
-def _mpc_entries(ctl: Any) -> list[tuple[str, Any, str]]:
-    """The numbers of a :class:`~mpc_wt.controllers.mpc.ScheduledMPC` as input-file entries."""
+def _preview_entries(preview: Any, horizon: int) -> list[tuple[str, Any, str]]:
+    """A :class:`~mpc_wt.simulation.preview.LidarPreview`'s processing as input-file
+    entries (the instrument's cone and focus, the mean wind's averaging, the preview time)."""
+    inst = preview.sensor.instrument
+    if getattr(inst, "noise_std", 0.0) > 0:
+        log.warning("the LIDAR's measurement noise is the simulator's; the library reads "
+                    "whatever the host's LIDAR measures")
+    return [("lidar_preview", 1.0, "1: the LIDAR's per-blade preview (records 2001-2016)"),
+            ("lidar_horizon", float(preview.horizon), "preview steps"),
+            ("lidar", np.array([math.cos(inst.cone_angle_rad), inst.focus_distance,
+                                preview.min_wind, preview.mean_time_constant,
+                                -1.0 if preview.fixed is None else preview.fixed], float),
+             "cos(cone), focus distance [m], lowest mean wind for the preview time [m/s], the "
+             "mean wind's averaging time [s], a fixed preview time [s] (-1: D / measured mean)")]
+
+
+def _mpc_entries(ctl: Any, preview: Any = None) -> list[tuple[str, Any, str]]:
+    """The numbers of a :class:`~mpc_wt.controllers.mpc.ScheduledMPC` (and its LIDAR preview)
+    as input-file entries."""
     from mpc_wt.controllers.mpc import ScheduledMPC
 
     if type(ctl) is not ScheduledMPC:
         raise ValueError(f"the MPC export takes a ScheduledMPC, got {type(ctl).__name__}")
-    if ctl.wind_source != "estimator":
-        raise ValueError("an MPC scheduled on its LIDAR's measurement does not export yet: "
-                         "export the MPC scheduled on the estimated wind ('mpc')")
+    if ctl.wind_source != "estimator" and preview is None:
+        raise ValueError("an MPC scheduled on its LIDAR's measurement exports with its LIDAR "
+                         "preview (export the kind 'mpc-lidar' through mpc_wt.run."
+                         "export_discon)")
     n = len(ctl._grid)
     pts = [ctl.controller(k) for k in range(n)]
     signals = pts[0].estimator.signals
@@ -322,13 +342,15 @@ def _mpc_entries(ctl: Any) -> list[tuple[str, Any, str]]:
         rows.append(("law_torque", np.array([lt._a, lt._offset, lt._lo, lt._hi], float),
                      "speed filter pole, below-rated pitch offset [rad], torque min, max "
                      "[N m]"))
+    rows += _preview_entries(preview, ctl.settings.horizon) if preview is not None else \
+        [("lidar_preview", 0.0, "no LIDAR")]
     for k, m in enumerate(pts):
         rows += _mpc_point(m, k, signals)
     return rows
 
 
 def controller_input(controller: Any, kind: str, turbine: linearize.Turbine,
-                     source: str = "") -> str:
+                     source: str = "", preview: Any = None) -> str:
     """The input file of an exported controller: every number of its design.
 
     Parameters
@@ -341,6 +363,8 @@ def controller_input(controller: Any, kind: str, turbine: linearize.Turbine,
         Its turbine (named in the header).
     source : str
         How it was designed (written as a comment).
+    preview : LidarPreview, optional
+        The design's LIDAR preview (``Built.preview``), for the LIDAR kinds.
 
     Returns
     -------
@@ -355,7 +379,7 @@ def controller_input(controller: Any, kind: str, turbine: linearize.Turbine,
     check_exportable(kind)
     lib_kind = _LIBRARY_KIND[kind]
     entries = _baseline_entries(controller) if lib_kind == "baseline" else \
-        _mpc_entries(controller)
+        _mpc_entries(controller, preview)
     from mpc_wt._version import __version__
 
     head = [f"# mpc-wt {__version__}: controller '{kind}' for {turbine.name}",
@@ -551,7 +575,7 @@ def check_exportable(kind: str) -> None:
 
 def export_controller(controller: Any, kind: str, turbine: linearize.Turbine,
                       out: str | Path, *, build: bool = True, compiler: str | None = None,
-                      source: str = "") -> DisconExport:
+                      source: str = "", preview: Any = None) -> DisconExport:
     """Export a designed controller object as a Bladed-style library
     (:func:`mpc_wt.run.export_discon` designs a kind and calls this).
 
@@ -571,6 +595,8 @@ def export_controller(controller: Any, kind: str, turbine: linearize.Turbine,
         The C compiler.
     source : str
         How it was designed (a comment in the input file).
+    preview : LidarPreview, optional
+        The design's LIDAR preview (the LIDAR kinds).
 
     Returns
     -------
@@ -580,7 +606,7 @@ def export_controller(controller: Any, kind: str, turbine: linearize.Turbine,
     dt = float(getattr(controller, "dt"))
     directory = Path(out)
     directory.mkdir(parents=True, exist_ok=True)
-    text = controller_input(controller, kind, turbine, source)
+    text = controller_input(controller, kind, turbine, source, preview)
     input_file = directory / f"mpcwt_{kind.replace('-', '_')}.in"
     input_file.write_text(text)
     sources = _copy_sources(directory)

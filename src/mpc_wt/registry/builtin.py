@@ -795,6 +795,10 @@ class DisconOptions(Options):
                                 choices=("individual", "collective"))
     discon_dt: float = option(1.0 / 80.0, help="communication interval, a multiple of the "
                               "plant step", unit="s", lo=0.0, lo_open=True, hi=1.0)
+    lidar_records: bool = option(False, help="fill OpenFAST's lidar records (2001-2016) from a "
+                                 "hub-mounted CW LIDAR (the lidar options)", flag="")
+    lidar: LidarOptions = option(LidarOptions(), help="CW LIDAR settings (focus_distance, "
+                                 "noise_std, ...)", flag="")
 
 
 @dataclass(frozen=True)
@@ -818,8 +822,12 @@ def _discon_built(ctx: BuildContext, library: Any, discon_in: Any, opts: Any,
                   kind: str, power_fraction: float = 1.0, **meta: Any) -> Built:
     from mpc_wt.controllers.discon import DisconController
 
+    sensor = None
+    if getattr(opts, "lidar_records", False):
+        sensor = ctx.lidar(opts.lidar.instrument(ctx.turbine), opts.lidar.evolution)
+        meta["lidar"] = {**opts.lidar.given(), "evolution": opts.lidar.evolution}
     ctl = DisconController(library, discon_in, ctx.turbine, dt=opts.discon_dt,
-                           pitch_control=opts.pitch_control)
+                           pitch_control=opts.pitch_control, lidar=sensor)
     return Built(ctl, controller_dt=opts.discon_dt,
                  meta={kind: {"library": str(ctl.library), "discon_in": str(ctl.discon_in),
                               "pitch_control": opts.pitch_control, "dt": opts.discon_dt,

@@ -50,6 +50,7 @@ class LidarPreview:
         if preview_time is not None and not (np.isfinite(preview_time) and preview_time > 0):
             raise ValueError(f"preview_time must be > 0 s, got {preview_time!r}")
         self.fixed = None if preview_time is None else float(preview_time)
+        self.mean_time_constant = float(mean_time_constant)
         self.mean = MeanTracker(mean_time_constant, self.dt)
         self.reset()
 

@@ -38,6 +38,8 @@ static pthread_mutex_t mw_lock = PTHREAD_MUTEX_INITIALIZER;
 typedef struct {
     char key[MW_KEY_LEN];     /* the root name */
     mw_ctrl *ctrl;
+    double t0;                /* the first call's time [s] */
+    long calls;               /* calls since the first */
 } mw_instance;
 
 static mw_instance mw_table[MW_MAX_INSTANCES];
@@ -126,6 +128,16 @@ static void read_meas(const float *s, mw_meas *m)
     m->tower_fa_acc = s[52];
     m->tower_ss_acc = s[53];
     m->azimuth = s[59];
+    m->lidar_type = m->lidar_beams = m->lidar_gates = 0;
+    m->los[0] = m->los[1] = m->los[2] = 0.0;
+    if (s[128] >= 2007.0f) {        /* record 129: the array's length; the lidar block fits */
+        m->lidar_type = (int)s[2000];
+        m->lidar_beams = (int)s[2001];
+        m->lidar_gates = (int)s[2002];
+        m->los[0] = s[2004];
+        m->los[1] = s[2005];
+        m->los[2] = s[2006];
+    }
 }
 
 static void write_cmd(float *s, const mw_cmd *c)
@@ -193,6 +205,8 @@ MW_EXPORT void DISCON(float *avrSWAP, int *aviFAIL, const char *accINFILE, char 
         }
         memcpy(inst->key, key, sizeof(key));
         inst->ctrl = c;
+        inst->t0 = avrSWAP[1];
+        inst->calls = 0;
     }
     MW_UNLOCK();
     if (status < 0) {                               /* the last call */
@@ -213,6 +227,10 @@ MW_EXPORT void DISCON(float *avrSWAP, int *aviFAIL, const char *accINFILE, char 
         return;
     }
     read_meas(avrSWAP, &m);
+    /* the time in double precision: the swap array's float32 time has 61 us steps at 600 s,
+     * the interval is the design's (checked at the first call) */
+    m.t = inst->t0 + (double)inst->calls * inst->ctrl->dt;
+    inst->calls++;
     rc = inst->ctrl->step(inst->ctrl, &m, &cmd, msg);
     if (rc < 0) {
         *aviFAIL = -1;

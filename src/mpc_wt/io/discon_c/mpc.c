@@ -54,9 +54,23 @@ typedef struct {
     mw_kalman kal;
 } mw_point;
 
+/* the LIDAR's per-blade preview: u_hat = v_LOS / cos(cone) per beam, the measured mean wind
+ * (the average while fewer than tau / dt samples have come, then a first-order low-pass), a
+ * ring of the last measurements and the preview of the next H_p steps from the measurements
+ * taken T_p = D / V_m earlier, linear in time between them */
+typedef struct {
+    int on, horizon, cap, n;
+    double cos_cone, focus, min_wind, alpha, fixed, dt;
+    int n_mean;
+    double mean, last;
+    double *t, *u;                /* 2 cap times, 3 x 2 cap winds (each sample twice) */
+    double *blade;                /* horizon x 3 */
+} mw_preview;
+
 typedef struct {
     mw_ctrl base;
     int n, collective, nzo, ip, has_law;
+    mw_preview pv;
     double dt, target_tau, eff, qp_budget_ms;
     double *trim_z, *trim_u, *zt, ut[4];
     int *signals, n_signals;
@@ -72,6 +86,109 @@ typedef struct {
 
 static double dmin(double a, double b) { return a < b ? a : b; }
 static double dmax(double a, double b) { return a > b ? a : b; }
+
+/* ---- the LIDAR preview ---------------------------------------------------------------- */
+static int preview_read(const mw_input *in, double dt, int horizon, mw_preview *p, char *msg)
+{
+    double v[5], longest;
+    if (mw_getp_vec(in, "", "lidar", v, 5, msg)) return -1;
+    p->cos_cone = v[0];
+    p->focus = v[1];
+    p->min_wind = v[2];
+    p->fixed = v[4];
+    if (!(p->cos_cone > 0 && p->cos_cone <= 1) || !(p->focus > 0) || !(p->min_wind > 0)
+        || !(v[3] > 0)) {
+        mw_msg(msg, "mpc-wt mpc: input file '%s': key 'lidar' needs cos(cone) in (0, 1], focus "
+               "distance, minimum wind and mean time constant > 0, got %g %g %g %g", in->path,
+               v[0], v[1], v[2], v[3]);
+        return -1;
+    }
+    p->alpha = dmin(1.0, dt / v[3]);
+    p->dt = dt;
+    p->horizon = horizon;
+    longest = p->fixed > 0 ? p->fixed : p->focus / p->min_wind;
+    p->cap = (int)ceil(longest / dt) + 3;
+    p->t = (double *)calloc((size_t)(2 * p->cap), sizeof(double));
+    p->u = (double *)calloc((size_t)(6 * p->cap), sizeof(double));
+    p->blade = (double *)calloc((size_t)(3 * horizon), sizeof(double));
+    if (!p->t || !p->u || !p->blade) {
+        mw_msg(msg, "mpc-wt mpc: out of memory");
+        return -1;
+    }
+    p->on = 1;
+    return 0;
+}
+
+static void preview_reset(mw_preview *p)
+{
+    p->n = 0;
+    p->n_mean = 0;
+    p->last = -1e300;
+}
+
+/* np.interp on the kept samples (times tk increasing) */
+static double interp(double x, const double *tk, const double *uk, int n)
+{
+    int lo = 0, hi = n - 1;
+    if (x <= tk[0]) return uk[0];
+    if (x >= tk[n - 1]) return uk[n - 1];
+    while (hi - lo > 1) {
+        int m = (lo + hi) / 2;
+        if (tk[m] <= x)
+            lo = m;
+        else
+            hi = m;
+    }
+    return (uk[hi] - uk[lo]) / (tk[hi] - tk[lo]) * (x - tk[lo]) + uk[lo];
+}
+
+/* take this step's measurement and write the preview rows into p->blade; -1 on bad data */
+static int preview_step(mw_preview *p, const mw_meas *m, char *msg)
+{
+    double u[3], x, tp;
+    int i, b, k, n, lo;
+    if (m->lidar_beams != 3 || m->lidar_gates != 1) {
+        mw_msg(msg, "mpc-wt mpc: the LIDAR preview needs 3 beams and 1 pulse gate in the lidar "
+               "records (avrSWAP 2002 and 2003 are %d and %d) at t = %g s", m->lidar_beams,
+               m->lidar_gates, m->t);
+        return -1;
+    }
+    for (b = 0; b < 3; b++) {
+        u[b] = m->los[b] / p->cos_cone;
+        if (!mw_finite(u[b])) {
+            mw_msg(msg, "mpc-wt mpc: LIDAR line-of-sight speed %d (avrSWAP %d) is not finite at "
+                   "t = %g s", b + 1, 2005 + b, m->t);
+            return -1;
+        }
+    }
+    if (!(m->t > p->last)) {
+        mw_msg(msg, "mpc-wt mpc: time %g s is not later than the last LIDAR sample %g s", m->t,
+               p->last);
+        return -1;
+    }
+    x = (u[0] + u[1] + u[2]) / 3.0;
+    p->n_mean++;
+    if (p->n_mean == 1)
+        p->mean = x;
+    else
+        p->mean += dmax(1.0 / p->n_mean, p->alpha) * (x - p->mean);
+    i = p->n % p->cap;
+    p->t[i] = p->t[i + p->cap] = m->t;
+    for (b = 0; b < 3; b++) p->u[b * 2 * p->cap + i] = p->u[b * 2 * p->cap + i + p->cap] = u[b];
+    p->n++;
+    p->last = m->t;
+    n = p->n < p->cap ? p->n : p->cap;
+    lo = p->n >= p->cap ? p->n % p->cap : 0;
+    tp = p->fixed > 0 ? p->fixed : p->focus / dmax(p->mean, p->min_wind);
+    for (k = 0; k < p->horizon; k++) {
+        double tm = m->t + p->dt * (double)(k + 1) - tp;
+        tm = dmin(tm, m->t);
+        tm = dmin(dmax(tm, p->t[lo]), p->t[lo + n - 1]);
+        for (b = 0; b < 3; b++)
+            p->blade[k * 3 + b] = interp(tm, p->t + lo, p->u + b * 2 * p->cap + lo, n);
+    }
+    return 0;
+}
 
 /* ---- one design ------------------------------------------------------------------------ */
 static void point_free(mw_point *p)
@@ -340,7 +457,23 @@ static int point_step(mw_mpc *c, mw_point *p, const mw_meas *m, double *u, char 
     }
     mw_kalman_update(&p->kal, c->y, p->udev);
     for (i = 0; i < nx; i++) z[1 + i] = p->kal.xa[i];
-    for (i = 0; i < p->hp * p->nd; i++) z[p->nzd + i] = p->kal.xa[nx + i % p->nd];
+    if (c->pv.on) {                     /* the LIDAR's per-blade preview, as deviations */
+        const double *fc = p->fc;
+        int r, j, rows = c->pv.horizon;
+        for (i = 0; i < p->hp; i++) {
+            r = i < rows - 1 ? i : rows - 1;
+            if (p->nd == 3) {
+                for (j = 0; j < 3; j++)
+                    z[p->nzd + i * 3 + j] = c->pv.blade[r * 3 + j] - fc[nx + j];
+            } else {
+                double acc = 0.0;
+                for (j = 0; j < 3; j++) acc += c->pv.blade[r * 3 + j];
+                z[p->nzd + i] = acc / 3.0 - fc[nx];
+            }
+        }
+    } else {
+        for (i = 0; i < p->hp * p->nd; i++) z[p->nzd + i] = p->kal.xa[nx + i % p->nd];
+    }
     t0 = now_ms();
     step_map(p, p->has_prev ? p->u_prev : p->up0);
     flag = daqp_update_ldp(DAQP_UPDATE_d, &p->work, &p->prob);
@@ -439,7 +572,14 @@ static int mpc_step(mw_ctrl *self, const mw_meas *m, mw_cmd *out, char *msg)
                "torque (23) or pitch (4, 33, 34) is not finite at t = %g s", m->t);
         return -1;
     }
-    k = mw_schedule_update(&c->sched, m, &switched);
+    if (c->pv.on) {
+        if (preview_step(&c->pv, m, msg)) return -1;
+        k = mw_schedule_update_wind(&c->sched,
+                                    (c->pv.blade[0] + c->pv.blade[1] + c->pv.blade[2]) / 3.0,
+                                    &switched);
+    } else {
+        k = mw_schedule_update(&c->sched, m, &switched);
+    }
     if (switched) {
         point_reset(&c->pt[k]);
         hand_over(&c->pt[k], &c->pt[c->last]);
@@ -487,6 +627,9 @@ static void mpc_destroy(mw_ctrl *self)
     free(c->zt);
     free(c->signals);
     free(c->y);
+    free(c->pv.t);
+    free(c->pv.u);
+    free(c->pv.blade);
     mw_schedule_free(&c->sched);
     free(c);
 }
@@ -536,6 +679,17 @@ static int mpc_read(const mw_input *in, mw_mpc *c, char *msg)
         return -1;
     }
     if (mw_schedule_read(in, "schedule.", c->dt, &c->sched, msg)) return -1;
+    {
+        int lidar;
+        if (mw_get_int(in, "lidar_preview", 0, 1, &lidar, msg)) return -1;
+        if (lidar) {
+            int hp;
+            if (mw_get_int(in, "lidar_horizon", 1, 10000, &hp, msg)
+                || preview_read(in, c->dt, hp, &c->pv, msg))
+                return -1;
+            preview_reset(&c->pv);
+        }
+    }
     if (c->sched.n != c->n) {
         mw_msg(msg, "mpc-wt mpc: input file '%s': key 'schedule.grid' has %d winds, "
                "n_points is %d", in->path, c->sched.n, c->n);
@@ -564,6 +718,11 @@ static int mpc_read(const mw_input *in, mw_mpc *c, char *msg)
         if (c->pt[i].nzo != c->nzo) {
             mw_msg(msg, "mpc-wt mpc: input file '%s': point %d has %d outputs, n_outputs is %d",
                    in->path, i, c->pt[i].nzo, c->nzo);
+            return -1;
+        }
+        if (c->pv.on && c->pt[i].hp > c->pv.horizon) {
+            mw_msg(msg, "mpc-wt mpc: input file '%s': point %d's horizon %d is longer than the "
+                   "LIDAR preview's %d", in->path, i, c->pt[i].hp, c->pv.horizon);
             return -1;
         }
         if (c->pt[i].kal.ny != c->n_signals) {

@@ -49,6 +49,10 @@ typedef struct {
     double tower_ss_acc;   /* record 54 [m/s^2] */
     double azimuth;        /* record 60 [rad] */
     double gen_power;      /* record 15 [W] */
+    /* OpenFAST's lidar block (records 2001-2500): sensor type, beams, pulse gates, then the
+     * line-of-sight speeds and the measurement points' x, y, z */
+    int lidar_type, lidar_beams, lidar_gates;
+    double los[3];         /* records 2005-2007 [m/s] */
 } mw_meas;
 
 typedef struct {
@@ -121,6 +125,8 @@ void mw_schedule_free(mw_schedule *s);
 void mw_schedule_reset(mw_schedule *s);
 /* this step's active index; *switched = 1 on a switch */
 int mw_schedule_update(mw_schedule *s, const mw_meas *m, int *switched);
+/* the same with a wind measured otherwise (the LIDAR's rotor mean) */
+int mw_schedule_update_wind(mw_schedule *s, double wind, int *switched);
 
 /* a steady-state Kalman filter on a linear model with the winds as random walks */
 typedef struct {

@@ -318,10 +318,16 @@ static int bisect_left(const double *a, int n, double x)
 
 int mw_schedule_update(mw_schedule *s, const mw_meas *m, int *switched)
 {
-    double pitch = (m->pitch[0] + m->pitch[1] + m->pitch[2]) / 3.0, w, a;
+    double pitch = (m->pitch[0] + m->pitch[1] + m->pitch[2]) / 3.0;
+    return mw_schedule_update_wind(s, mw_windest_step(&s->est, m->rotor_speed, pitch,
+                                                      m->gen_torque), switched);
+}
+
+int mw_schedule_update_wind(mw_schedule *s, double w, int *switched)
+{
+    double a;
     int k, now;
     *switched = 0;
-    w = mw_windest_step(&s->est, m->rotor_speed, pitch, m->gen_torque);
     s->measured = w;
     if (!s->started) {
         s->wind = w;
