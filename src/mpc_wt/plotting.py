@@ -333,7 +333,8 @@ def plot_design(doc: dict[str, Any], path: str | Path) -> Path:
               "ibc": (("gain",), "IBC gain [rad/(N m)]"),
               "coleman-ipc": (("ki",), "IPC integral gain [rad/(N m s)]"),
               "mpc": (("pitch",), "trim pitch the cost tracks [rad]"),
-              "mpc-collective": (("pitch",), "trim pitch the cost tracks [rad]")}
+              "mpc-collective": (("pitch",), "trim pitch the cost tracks [rad]"),
+              "mpc-lidar": (("pitch",), "trim pitch the cost tracks [rad]")}
     if doc["kind"] in scalar:
         names, label = scalar[doc["kind"]]
         for c in names:

@@ -25,7 +25,8 @@ def add_parsers(sub: Any) -> None:
     from mpc_wt.registry.registry import designs
 
     p = sub.add_parser("design", help="gain synthesis: baseline PI, LQR family, TS by LMIs, "
-                                      "IBC, Coleman IPC; the scheduled MPC's grid")
+                                      "IBC, Coleman IPC; the scheduled MPC's grid (mpc, mpc-collective, "
+                                      "mpc-lidar)")
     p.add_argument("kind", choices=list(designs()))
     add_turbine(p)
     p.add_argument("--out", required=True, help="design directory (design.json, gains.png)")
@@ -123,7 +124,7 @@ def _export_registered(args: argparse.Namespace, turbine: Any) -> list[Path] | N
         doc = load_design(args.design)
     except GainTableError as err:
         raise UsageError(str(err)) from None
-    if doc["kind"] not in ("mpc", "mpc-collective"):
+    if doc["kind"] not in ("mpc", "mpc-collective", "mpc-lidar"):
         return None
     p = Path(args.design)
     out = Path(args.to) if args.to else (p if p.is_dir() else p.parent)

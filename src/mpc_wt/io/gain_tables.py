@@ -346,7 +346,7 @@ def mpc_table(turbine: linearize.Turbine, ctl: Any, kind: str,
     ctl : ScheduledMPC
         The design.
     kind : str
-        Its kind (``mpc``, ``mpc-collective``).
+        Its kind (``mpc``, ``mpc-collective``, ``mpc-lidar``).
     options : dict, optional
         The options it was built with.
 
@@ -531,7 +531,7 @@ def _write_discon(doc: dict[str, Any], out: Path,
                   turbine: linearize.Turbine | None = None) -> list[Path]:
     from mpc_wt.io.discon_export import export_design
 
-    if doc["kind"] in ("mpc", "mpc-collective"):
+    if doc["kind"] in ("mpc", "mpc-collective", "mpc-lidar"):
         raise GainTableError(f"a {doc['kind']!r} design is built again from its options to "
                              f"export: use mpc_wt.run.export_discon (mpcwt export does)")
     t = design_turbine(doc, turbine)

@@ -501,11 +501,11 @@ def _mpc(collective: bool, with_lidar: bool) -> Any:
     return build
 
 
-def _design_mpc(collective: bool) -> Any:
+def _design_mpc(collective: bool, with_lidar: bool = False) -> Any:
     """The design function of a scheduled MPC kind: its design with the default options, as a
     table of its grid points (``mpcwt design mpc``; ``mpcwt export --format discon`` builds it
     again from the table's options)."""
-    kind = "mpc-collective" if collective else "mpc"
+    kind = "mpc-lidar" if with_lidar else "mpc-collective" if collective else "mpc"
 
     def design(turbine: linearize.Turbine) -> tuple[dict, str]:
         from mpc_wt.io.gain_tables import mpc_table
@@ -513,7 +513,8 @@ def _design_mpc(collective: bool) -> Any:
 
         ctx = BuildContext(turbine=turbine, params=linearize.plant_params(turbine),
                            cache=DEFAULT_CACHE)
-        ctl = _mpc(collective, False)(ctx, MPCOptions()).controller
+        opts = MPCLidarOptions() if with_lidar else MPCOptions()
+        ctl = _mpc(collective, with_lidar)(ctx, opts).controller
         doc = mpc_table(turbine, ctl, kind, options={})
         n = len(doc["schedule"]["rows"])
         return doc, f"{n} grid winds {doc['schedule']['rows'][0][0]:g}-" \
@@ -530,7 +531,7 @@ register("mpc-collective", MPCOptions, field_components="u", group=_MPC_GROUP,
          design=_design_mpc(True),
          summary="the scheduled MPC with one collective pitch input")(_mpc(True, False))
 register("mpc-lidar", MPCLidarOptions, field_components="u", group=_MPC_GROUP,
-         summary="the individual-pitch MPC with a CW LIDAR's per-blade preview "
+         design=_design_mpc(False, True), summary="the individual-pitch MPC with a CW LIDAR's per-blade preview "
                  "(range weighting, LOS error and wind evolution on)")(_mpc(False, True))
 
 
