@@ -362,19 +362,21 @@ def _asan_runtime() -> str | None:
 
 
 @pytest.mark.skipif(_asan_runtime() is None, reason="no AddressSanitizer runtime (libasan)")
-def test_sanitized_libraries_run_60_s_clean(baseline_export, mpc_export, tmp_path):
-    """The baseline and the MPC built with -fsanitize=address,undefined (any report aborts),
-    60 s of turbulent closed loop each in a process that loads the sanitizer runtime first:
-    exit 0, no report, no warning from the library."""
+def test_sanitized_libraries_run_60_s_clean(baseline_export, mpc_export, mpc_lidar_export,
+                                             tmp_path):
+    """The baseline, the MPC and the MPC with LIDAR preview built with
+    -fsanitize=address,undefined (any report aborts), 60 s of turbulent closed loop each in a
+    process that loads the sanitizer runtime first: exit 0, no report, no warning from the
+    library."""
     runs = []
-    for which, ex in (("baseline", baseline_export), ("mpc", mpc_export)):
+    for which, ex in (("baseline", baseline_export), ("mpc", mpc_export),
+                      ("mpc-lidar", mpc_lidar_export)):
         d = tmp_path / which
         (d / "daqp").mkdir(parents=True)
         for p in ex.sources:
             shutil.copy(p, d / p.relative_to(ex.directory))
         lib = build_library(d, which, sanitize=True, name=f"libasan_{which}.so")
-        runs.append({"discon_library": str(lib), "discon_in": str(ex.input_file),
-                     "discon_dt": ex.dt})
+        runs.append(dict(_discon(ex), discon_library=str(lib)))
     script = textwrap.dedent(f"""
         import linearize
         from mpc_wt.run import run_controller
@@ -390,7 +392,7 @@ def test_sanitized_libraries_run_60_s_clean(baseline_export, mpc_export, tmp_pat
                          env=env, timeout=600)
     assert out.returncode == 0, out.stderr[-3000:]
     assert "AddressSanitizer" not in out.stderr and "runtime error" not in out.stderr
-    assert out.stdout.count("steps 4801 warnings 0") == 2, out.stdout
+    assert out.stdout.count("steps 4801 warnings 0") == 3, out.stdout
 
 
 def test_kinds_that_do_not_export_are_named(nrel5mw, tmp_path):

@@ -235,6 +235,9 @@ class DisconController(ControllerBase):
         if not (math.isfinite(dt) and dt > 0):
             raise ValueError(f"dt must be finite and > 0 s, got {dt!r}")
         self.turbine, self.dt, self.pitch_control = turbine, float(dt), pitch_control
+        self._tq_hi = float(turbine.generator.max_torque)
+        self._p_lo = float(turbine.pitch_actuator.min_pitch_rad)
+        self._p_hi = float(turbine.pitch_actuator.max_pitch_rad)
         self._own_workdir = workdir is None
         self.workdir = Path(workdir) if workdir is not None else None
         self.root_name = root_name
@@ -445,26 +448,30 @@ class DisconController(ControllerBase):
         self._call(t)
         self._status = 1
         v = self._view
+        # scalar arithmetic: numpy calls on three values cost more than the library's step
         if self.pitch_control == "individual":
-            pitch = v[41:44].astype(float)
+            p = v[41:44].tolist()
         else:
-            pitch = np.full(3, float(v[44]))
+            p = [float(v[44])] * 3
         contactor = float(v[34])
         torque = float(v[46]) if contactor != 0.0 else 0.0
         # the swap array is float32: a demand at a limit may sit one rounding step beyond it
-        hi = self.turbine.generator.max_torque
+        hi = self._tq_hi
         if hi < torque <= hi * (1 + 1e-6):
             torque = hi
-        lo_p, hi_p = self.turbine.pitch_actuator.min_pitch_rad, \
-            self.turbine.pitch_actuator.max_pitch_rad
-        pitch = np.where((pitch < lo_p) & (pitch >= lo_p - 1e-6), lo_p, pitch)
-        pitch = np.where((pitch > hi_p) & (pitch <= hi_p + 1e-6), hi_p, pitch)
-        if not (math.isfinite(pitch[0] + pitch[1] + pitch[2]) and math.isfinite(torque)):
+        lo_p, hi_p = self._p_lo, self._p_hi
+        for i in range(3):
+            if lo_p - 1e-6 <= p[i] < lo_p:
+                p[i] = lo_p
+            elif hi_p < p[i] <= hi_p + 1e-6:
+                p[i] = hi_p
+        if not (math.isfinite(p[0] + p[1] + p[2]) and math.isfinite(torque)):
             raise ControllerLibraryError(
-                f"controller library {self.library.name} returned pitch {pitch} rad, torque "
+                f"controller library {self.library.name} returned pitch {p} rad, torque "
                 f"{torque} N m at t = {t:g} s")
+        pitch = np.array(p)
         self._last_pitch, self._last_torque = pitch, torque
-        self.signals = {"pitch_command": (pitch[0] + pitch[1] + pitch[2]) / 3.0,
+        self.signals = {"pitch_command": (p[0] + p[1] + p[2]) / 3.0,
                         "torque_command": torque, "generator_contactor": contactor,
                         "library_warning": float(self._warned)}
         return pitch, torque
