@@ -118,6 +118,7 @@ class LidarFeedforward(ControllerBase):
         self.tau_act = turbine.pitch_actuator.time_constant
         self.lead_given = lead_s
         self.sample_dt = float(sample_dt)
+        self.mean_time_constant = float(mean_time_constant)
         self._mean = MeanTracker(mean_time_constant, self.sample_dt)
         self.curve_v, self.curve_pitch = static_pitch_curve(turbine, power_W)
         self.reset()

@@ -50,11 +50,13 @@ EXPORTABLE: dict[str, str] = {
     "mpc-collective": "the scheduled MPC with collective pitch",
     "mpc-lidar": "the scheduled MPC with the per-blade preview of a hub-mounted CW LIDAR, read "
                  "from OpenFAST's lidar records",
+    "baseline+lidar-ff": "the baseline with the collective pitch feedforward of a hub-mounted "
+                         "CW LIDAR, read from OpenFAST's lidar records",
 }
 
 #: Library kinds (the input file's ``kind``) of the exported controller kinds.
 _LIBRARY_KIND = {"baseline": "baseline", "baseline-ct": "baseline", "mpc": "mpc",
-                 "mpc-collective": "mpc", "mpc-lidar": "mpc"}
+                 "mpc-collective": "mpc", "mpc-lidar": "mpc", "baseline+lidar-ff": "baseline"}
 
 #: The Kalman filter's measured signals and their codes in the library.
 _SIGNAL_CODES = {"rotor_speed": 0, "gen_speed": 1, "pitch_1": 2, "pitch_2": 3, "pitch_3": 4,
@@ -207,6 +209,32 @@ def _baseline_entries(ctl: Any, prefix: str = "") -> list[tuple[str, Any, str]]:
          "1: constant power above rated, 0: constant torque"),
     ]
     return [(prefix + k, v, doc) for k, v, doc in rows]
+
+
+def _ff_entries(ctl: Any) -> list[tuple[str, Any, str]]:
+    """A :class:`~mpc_wt.controllers.lidar_feedforward.LidarFeedforward` on the baseline: the
+    baseline's law and the feedforward's LIDAR processing, filter, lead and pitch curve."""
+    from mpc_wt.controllers.lidar_feedforward import LidarFeedforward
+
+    if type(ctl) is not LidarFeedforward:
+        raise ValueError(f"the feedforward export takes a LidarFeedforward, got "
+                         f"{type(ctl).__name__}")
+    inst = ctl.sensor.instrument
+    return _baseline_entries(ctl.base) + [
+        ("feedforward", 1.0, "1: the LIDAR's collective pitch feedforward"),
+        ("ff", np.array([math.cos(inst.cone_angle_rad), inst.focus_distance, ctl.sample_dt,
+                         ctl.mean_time_constant, ctl.tau_act,
+                         -1.0 if ctl.lead_given is None else ctl.lead_given, ctl.order], float),
+         "cos(cone), focus distance [m], LIDAR sample period [s], the mean wind's averaging "
+         "time [s], pitch actuator time constant [s], a fixed lead [s] (-1: from the filter), "
+         "filter order"),
+        ("ff_corner_winds", np.asarray(ctl.corner_winds, float), "mean winds of the filter "
+                                                                 "corners [m/s]"),
+        ("ff_corners", np.asarray(ctl.corners, float), "filter corners [rad/s]"),
+        ("ff_curve_winds", np.asarray(ctl.curve_v, float), "winds of the static pitch curve "
+                                                           "[m/s]"),
+        ("ff_curve_pitch", np.asarray(ctl.curve_pitch, float), "static pitch [rad]"),
+    ]
 
 
 def _mpc_point(m: Any, k: int, signals: tuple[str, ...]) -> list[tuple[str, Any, str]]:
@@ -378,8 +406,12 @@ def controller_input(controller: Any, kind: str, turbine: linearize.Turbine,
     """
     check_exportable(kind)
     lib_kind = _LIBRARY_KIND[kind]
-    entries = _baseline_entries(controller) if lib_kind == "baseline" else \
-        _mpc_entries(controller, preview)
+    if kind == "baseline+lidar-ff":
+        entries = _ff_entries(controller)
+    elif lib_kind == "baseline":
+        entries = _baseline_entries(controller) + [("feedforward", 0.0, "no LIDAR feedforward")]
+    else:
+        entries = _mpc_entries(controller, preview)
     from mpc_wt._version import __version__
 
     head = [f"# mpc-wt {__version__}: controller '{kind}' for {turbine.name}",

@@ -7,12 +7,31 @@
 
 #include <math.h>
 #include <stdlib.h>
+#include <string.h>
 
 #define MW_PI 3.14159265358979323846
+
+#define MW_FF_KEEP 4096
+
+/* the LIDAR feedforward (collective): the rotor mean of the beams' u_hat = v_LOS / cos(cone),
+ * sampled every sample_dt, low-passed (first order, or second order with damping 0.7,
+ * discretized exactly at the corner of the measured mean wind), stored under the time it
+ * reaches the rotor (t + D / V_m) and read at t + lead; the static pitch curve of that wind is
+ * the feedforward pitch, whose change enters the PI's integral */
+typedef struct {
+    int on, order, ncorner, ncurve, n_mean, started, len, raised;
+    double cos_cone, focus, alpha, sample_dt, tau_act, lead_given, delay;
+    double *cw, *cc, *cv, *cp;
+    double mean, vf, x[2], next, w_disc, corner, lead, tp, phi[4], gam[2];
+    double *arr, *val;
+    double ff_last;
+    int has_ff_last;
+} mw_ff;
 
 typedef struct {
     mw_ctrl base;
     mw_law law;
+    mw_ff ff;
     /* state */
     double w_filt, integral, last_pitch, last_tq;
     int started;
@@ -80,12 +99,157 @@ int mw_law_read(const mw_input *in, const char *pre, mw_law *c, char *msg)
     return 0;
 }
 
+/* exp(A) of a 3 x 3 matrix: scaling and squaring of its Taylor series (to rounding) */
+static void expm3(const double *a, double *e)
+{
+    double s[9], term[9], tmp[9], norm = 0.0;
+    int i, j, k, l, sq = 0;
+    for (i = 0; i < 9; i++) norm = dmax(norm, fabs(a[i]));
+    while (norm * 3.0 > 0.5) {
+        norm /= 2.0;
+        sq++;
+    }
+    for (i = 0; i < 9; i++) s[i] = a[i] / ldexp(1.0, sq);
+    for (i = 0; i < 9; i++) e[i] = term[i] = (i % 4 == 0) ? 1.0 : 0.0;
+    for (k = 1; k <= 20; k++) {
+        for (i = 0; i < 3; i++)
+            for (j = 0; j < 3; j++) {
+                double acc = 0.0;
+                for (l = 0; l < 3; l++) acc += term[i * 3 + l] * s[l * 3 + j];
+                tmp[i * 3 + j] = acc / k;
+            }
+        for (i = 0; i < 9; i++) {
+            term[i] = tmp[i];
+            e[i] += tmp[i];
+        }
+    }
+    for (k = 0; k < sq; k++) {
+        for (i = 0; i < 3; i++)
+            for (j = 0; j < 3; j++) {
+                double acc = 0.0;
+                for (l = 0; l < 3; l++) acc += e[i * 3 + l] * e[l * 3 + j];
+                tmp[i * 3 + j] = acc;
+            }
+        memcpy(e, tmp, sizeof(tmp));
+    }
+}
+
+static void ff_set_corner(mw_ff *f, double vm)
+{
+    double w;
+    f->tp = f->focus / vm;
+    w = mw_interp(vm, f->cw, f->cc, f->ncorner);
+    if (f->lead_given < 0.0) {
+        double room = f->tp - f->tau_act - f->sample_dt;
+        double need = room > 0 ? f->delay / room : HUGE_VAL;
+        if (w < need) {
+            w = need < HUGE_VAL ? need : w;
+            f->raised++;
+        }
+        f->lead = f->tau_act + f->delay / w;
+    } else {
+        f->lead = f->lead_given;
+    }
+    f->corner = w;
+    if (!(fabs(w - f->w_disc) <= 0.005 * w)) {
+        double a[9] = {0.0, 1.0, 0.0, -w * w, -1.4 * w, w * w, 0.0, 0.0, 0.0}, e[9];
+        int i;
+        for (i = 0; i < 9; i++) a[i] *= f->sample_dt;
+        expm3(a, e);
+        f->phi[0] = e[0];
+        f->phi[1] = e[1];
+        f->phi[2] = e[3];
+        f->phi[3] = e[4];
+        f->gam[0] = e[2];
+        f->gam[1] = e[5];
+        f->w_disc = w;
+    }
+}
+
+/* this step's feedforward pitch [rad]; -1 on bad LIDAR data */
+static int ff_step(mw_ff *f, const mw_meas *m, double *pitch, char *msg)
+{
+    double v;
+    if (m->t >= f->next - 1e-9) {
+        double u, arrival;
+        int b;
+        if (m->lidar_beams != 3 || m->lidar_gates != 1) {
+            mw_msg(msg, "mpc-wt baseline: the LIDAR feedforward needs 3 beams and 1 pulse gate in "
+                   "the lidar records (avrSWAP 2002 and 2003 are %d and %d) at t = %g s",
+                   m->lidar_beams, m->lidar_gates, m->t);
+            return -1;
+        }
+        for (b = 0; b < 3; b++)
+            if (!mw_finite(m->los[b])) {
+                mw_msg(msg, "mpc-wt baseline: LIDAR line-of-sight speed %d (avrSWAP %d) is not "
+                       "finite at t = %g s", b + 1, 2005 + b, m->t);
+                return -1;
+            }
+        u = (m->los[0] / f->cos_cone + m->los[1] / f->cos_cone + m->los[2] / f->cos_cone) / 3.0;
+        f->n_mean++;
+        if (f->n_mean == 1)
+            f->mean = u;
+        else
+            f->mean += dmax(1.0 / f->n_mean, f->alpha) * (u - f->mean);
+        ff_set_corner(f, dmax(f->mean, 0.5));
+        if (!f->started) {
+            f->vf = u;
+            f->x[0] = u;
+            f->x[1] = 0.0;
+            f->started = 1;
+        } else if (f->order == 1) {
+            double a = exp(-f->corner * f->sample_dt);
+            f->vf = a * f->vf + (1.0 - a) * u;
+        } else {
+            double x0 = f->phi[0] * f->x[0] + f->phi[1] * f->x[1] + f->gam[0] * u;
+            double x1 = f->phi[2] * f->x[0] + f->phi[3] * f->x[1] + f->gam[1] * u;
+            f->x[0] = x0;
+            f->x[1] = x1;
+            f->vf = x0;
+        }
+        arrival = m->t + f->tp;
+        if (f->len > 0 && arrival <= f->arr[f->len - 1]) arrival = f->arr[f->len - 1] + 1e-6;
+        f->arr[f->len] = arrival;
+        f->val[f->len] = f->vf;
+        f->len++;
+        if (f->len > MW_FF_KEEP) {               /* keep what is still to arrive */
+            int keep = 0;
+            while (keep < f->len && f->arr[keep] < m->t - 1.0) keep++;
+            memmove(f->arr, f->arr + keep, (size_t)(f->len - keep) * sizeof(double));
+            memmove(f->val, f->val + keep, (size_t)(f->len - keep) * sizeof(double));
+            f->len -= keep;
+        }
+        f->next = m->t + f->sample_dt;
+    }
+    {   /* the filtered wind at t + lead (held at the ends, as mpc-wt's list interpolation) */
+        double x = m->t + f->lead;
+        int k = 0;
+        while (k < f->len && f->arr[k] <= x) k++;
+        if (k == 0)
+            v = f->val[0];
+        else if (k == f->len)
+            v = f->val[f->len - 1];
+        else
+            v = f->val[k - 1] + (f->val[k] - f->val[k - 1]) * (x - f->arr[k - 1])
+                / (f->arr[k] - f->arr[k - 1]);
+    }
+    *pitch = mw_interp(v, f->cv, f->cp, f->ncurve);
+    return 0;
+}
+
 static int baseline_step(mw_ctrl *self, const mw_meas *m, mw_cmd *out, char *msg)
 {
     mw_baseline *b = (mw_baseline *)self;
     const mw_law *c = &b->law;
-    double w = m->gen_speed, pitch_meas, err, gk, lo, hi, p, step, tq;
+    double w = m->gen_speed, pitch_meas, err, gk, lo, hi, p, step, tq, ffd = 0.0;
     int first = !b->started;
+    if (b->ff.on) {
+        double ff;
+        if (ff_step(&b->ff, m, &ff, msg)) return -1;
+        ffd = b->ff.has_ff_last ? ff - b->ff.ff_last : 0.0;
+        b->ff.ff_last = ff;
+        b->ff.has_ff_last = 1;
+    }
     if (!mw_finite(w)) {
         mw_msg(msg, "mpc-wt baseline: measured generator speed (avrSWAP record 20) is not "
                "finite at t = %g s", m->t);
@@ -105,7 +269,7 @@ static int baseline_step(mw_ctrl *self, const mw_meas *m, mw_cmd *out, char *msg
     err = b->w_filt - c->w_set;
     gk = 1.0 / (1.0 + b->last_pitch / c->theta_k);
     if (first) b->integral = (pitch_meas / gk - c->kp * err) / c->ki;
-    b->integral += err * c->dt;
+    b->integral += err * c->dt + ffd / (gk * c->ki);
     lo = c->p_min / (gk * c->ki);
     hi = c->p_max / (gk * c->ki);
     b->integral = dmin(dmax(b->integral, lo), hi);
@@ -128,7 +292,52 @@ static int baseline_step(mw_ctrl *self, const mw_meas *m, mw_cmd *out, char *msg
 
 static void baseline_destroy(mw_ctrl *self)
 {
+    mw_baseline *b = (mw_baseline *)self;
+    free(b->ff.cw);
+    free(b->ff.cc);
+    free(b->ff.cv);
+    free(b->ff.cp);
+    free(b->ff.arr);
+    free(b->ff.val);
     free(self);
+}
+
+static int ff_read(const mw_input *in, mw_ff *f, char *msg)
+{
+    double v[7];
+    int n;
+    if (mw_getp_vec(in, "", "ff", v, 7, msg)) return -1;
+    f->cos_cone = v[0];
+    f->focus = v[1];
+    f->sample_dt = v[2];
+    f->alpha = dmin(1.0, v[2] / v[3]);
+    f->tau_act = v[4];
+    f->lead_given = v[5];
+    f->order = (int)v[6];
+    if (!(f->cos_cone > 0 && f->cos_cone <= 1) || !(f->focus > 0) || !(f->sample_dt > 0)
+        || !(v[3] > 0) || (f->order != 1 && f->order != 2)) {
+        mw_msg(msg, "mpc-wt baseline: input file '%s': key 'ff' needs cos(cone) in (0, 1], "
+               "focus distance, sample period and mean time constant > 0, filter order 1 or 2",
+               in->path);
+        return -1;
+    }
+    f->delay = f->order == 1 ? 1.0 : 1.4;
+    if (!(f->cw = mw_getp_alloc(in, "", "ff_corner_winds", &f->ncorner, msg))
+        || !(f->cc = mw_getp_alloc_n(in, "", "ff_corners", f->ncorner, msg))
+        || !(f->cv = mw_getp_alloc(in, "", "ff_curve_winds", &f->ncurve, msg))
+        || !(f->cp = mw_getp_alloc_n(in, "", "ff_curve_pitch", f->ncurve, msg)))
+        return -1;
+    n = MW_FF_KEEP + 1;
+    f->arr = (double *)calloc((size_t)n, sizeof(double));
+    f->val = (double *)calloc((size_t)n, sizeof(double));
+    if (!f->arr || !f->val) {
+        mw_msg(msg, "mpc-wt baseline: out of memory");
+        return -1;
+    }
+    f->next = -HUGE_VAL;
+    f->w_disc = NAN;
+    f->on = 1;
+    return 0;
 }
 
 mw_ctrl *mw_baseline_new(const mw_input *in, char *msg)
@@ -138,9 +347,13 @@ mw_ctrl *mw_baseline_new(const mw_input *in, char *msg)
         mw_msg(msg, "mpc-wt baseline: out of memory");
         return NULL;
     }
-    if (mw_law_read(in, "", &b->law, msg)) {
-        free(b);
-        return NULL;
+    {
+        int ff = 0;
+        if (mw_law_read(in, "", &b->law, msg) || mw_get_int(in, "feedforward", 0, 1, &ff, msg)
+            || (ff && ff_read(in, &b->ff, msg))) {
+            baseline_destroy(&b->base);
+            return NULL;
+        }
     }
     b->base.dt = b->law.dt;
     b->base.step = baseline_step;

@@ -24,6 +24,21 @@ int mw_finite(double x)
     return !isnan(x) && !isinf(x);
 }
 
+double mw_interp(double x, const double *xs, const double *ys, int n)
+{
+    int lo = 0, hi = n - 1;
+    if (n == 1 || x <= xs[0]) return ys[0];
+    if (x >= xs[n - 1]) return ys[n - 1];
+    while (hi - lo > 1) {
+        int k = (lo + hi) / 2;
+        if (xs[k] <= x)
+            lo = k;
+        else
+            hi = k;
+    }
+    return (ys[hi] - ys[lo]) / (xs[hi] - xs[lo]) * (x - xs[lo]) + ys[lo];
+}
+
 static char *skip_space(char *s)
 {
     while (*s && isspace((unsigned char)*s)) s++;

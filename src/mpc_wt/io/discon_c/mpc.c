@@ -126,22 +126,6 @@ static void preview_reset(mw_preview *p)
     p->last = -1e300;
 }
 
-/* np.interp on the kept samples (times tk increasing) */
-static double interp(double x, const double *tk, const double *uk, int n)
-{
-    int lo = 0, hi = n - 1;
-    if (x <= tk[0]) return uk[0];
-    if (x >= tk[n - 1]) return uk[n - 1];
-    while (hi - lo > 1) {
-        int m = (lo + hi) / 2;
-        if (tk[m] <= x)
-            lo = m;
-        else
-            hi = m;
-    }
-    return (uk[hi] - uk[lo]) / (tk[hi] - tk[lo]) * (x - tk[lo]) + uk[lo];
-}
-
 /* take this step's measurement and write the preview rows into p->blade; -1 on bad data */
 static int preview_step(mw_preview *p, const mw_meas *m, char *msg)
 {
@@ -185,7 +169,7 @@ static int preview_step(mw_preview *p, const mw_meas *m, char *msg)
         tm = dmin(tm, m->t);
         tm = dmin(dmax(tm, p->t[lo]), p->t[lo + n - 1]);
         for (b = 0; b < 3; b++)
-            p->blade[k * 3 + b] = interp(tm, p->t + lo, p->u + b * 2 * p->cap + lo, n);
+            p->blade[k * 3 + b] = mw_interp(tm, p->t + lo, p->u + b * 2 * p->cap + lo, n);
     }
     return 0;
 }

@@ -143,5 +143,7 @@ int mw_kalman_update(mw_kalman *k, const double *y, const double *u);
 /* helpers */
 void mw_msg(char *msg, const char *fmt, ...);
 int mw_finite(double x);
+/* numpy's interp: linear between the points (xs increasing), held beyond the ends */
+double mw_interp(double x, const double *xs, const double *ys, int n);
 
 #endif
