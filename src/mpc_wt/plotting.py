@@ -334,7 +334,8 @@ def plot_design(doc: dict[str, Any], path: str | Path) -> Path:
               "coleman-ipc": (("ki",), "IPC integral gain [rad/(N m s)]"),
               "mpc": (("pitch",), "trim pitch the cost tracks [rad]"),
               "mpc-collective": (("pitch",), "trim pitch the cost tracks [rad]"),
-              "mpc-lidar": (("pitch",), "trim pitch the cost tracks [rad]")}
+              "mpc-lidar": (("pitch",), "trim pitch the cost tracks [rad]"),
+              "baseline+lidar-ff": (("filter_corner",), "feedforward filter corner [rad/s]")}
     if doc["kind"] in scalar:
         names, label = scalar[doc["kind"]]
         for c in names:

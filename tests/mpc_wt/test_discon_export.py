@@ -473,3 +473,18 @@ def test_cli_design_mpc_then_export_discon(tmp_path, capsys):
     assert "libmpcwt_mpc" in capsys.readouterr().out
     assert "kind mpc" in (d / "mpcwt_mpc.in").read_text()
     assert (d / library_name("mpc")).is_file()
+
+
+def test_cli_design_lidar_ff_then_export_discon(tmp_path, capsys):
+    """``mpcwt design baseline+lidar-ff``: the filter corner over wind (rising with the wind,
+    as the LIDAR-rotor coherence bandwidth does) and the static pitch curve; the export builds
+    the feedforward again from the design's options."""
+    from mpc_wt.cli import main
+
+    d = tmp_path / "ff"
+    assert main(["design", "baseline+lidar-ff", "--out", str(d)]) == 0
+    rows = np.array(json.loads((d / "design.json").read_text())["schedule"]["rows"])
+    assert rows[-1, 1] > rows[0, 1] > 0 and rows[-1, 2] > rows[0, 2]
+    assert main(["export", str(d), "--format", "discon"]) == 0
+    assert "kind baseline" in (d / "mpcwt_baseline_lidar_ff.in").read_text()
+    assert "feedforward" in (d / "mpcwt_baseline_lidar_ff.in").read_text()

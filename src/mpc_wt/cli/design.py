@@ -26,7 +26,7 @@ def add_parsers(sub: Any) -> None:
 
     p = sub.add_parser("design", help="gain synthesis: baseline PI, LQR family, TS by LMIs, "
                                       "IBC, Coleman IPC; the scheduled MPC's grid (mpc, mpc-collective, "
-                                      "mpc-lidar)")
+                                      "mpc-lidar); the LIDAR feedforward (baseline+lidar-ff)")
     p.add_argument("kind", choices=list(designs()))
     add_turbine(p)
     p.add_argument("--out", required=True, help="design directory (design.json, gains.png)")
@@ -124,7 +124,7 @@ def _export_registered(args: argparse.Namespace, turbine: Any) -> list[Path] | N
         doc = load_design(args.design)
     except GainTableError as err:
         raise UsageError(str(err)) from None
-    if doc["kind"] not in ("mpc", "mpc-collective", "mpc-lidar"):
+    if doc["kind"] not in ("mpc", "mpc-collective", "mpc-lidar", "baseline+lidar-ff"):
         return None
     p = Path(args.design)
     out = Path(args.to) if args.to else (p if p.is_dir() else p.parent)

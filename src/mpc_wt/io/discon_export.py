@@ -639,7 +639,8 @@ def export_controller(controller: Any, kind: str, turbine: linearize.Turbine,
     directory = Path(out)
     directory.mkdir(parents=True, exist_ok=True)
     text = controller_input(controller, kind, turbine, source, preview)
-    input_file = directory / f"mpcwt_{kind.replace('-', '_')}.in"
+    stem = "mpcwt_" + kind.replace("-", "_").replace("+", "_")
+    input_file = directory / f"{stem}.in"
     input_file.write_text(text)
     sources = _copy_sources(directory)
     lib_name = library_name(kind)
@@ -658,7 +659,7 @@ def export_controller(controller: Any, kind: str, turbine: linearize.Turbine,
         notes.append(f"no OpenFAST deck is packaged for {turbine.name}: set DLL_FileName, "
                      f"DLL_InFile, DLL_ProcName and DLL_DT in your ServoDyn file yourself")
     else:
-        servodyn = servodyn_input(template, directory / f"ServoDyn_mpcwt_{kind}.dat",
+        servodyn = servodyn_input(template, directory / f"ServoDyn_{stem}.dat",
                                   directory / lib_name, input_file, dt)
     for n in notes:
         log.warning("%s", n)

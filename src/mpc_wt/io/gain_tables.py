@@ -44,7 +44,7 @@ from mpc_wt.controllers.baseline import effective_pi_gains
 from mpc_wt.errors import GainTableError
 
 __all__ = ["SCHEMA_VERSION", "GainTableError", "baseline_table", "lqr_table", "ts_table",
-           "ibc_table", "coleman_ipc_table", "mpc_table", "design_turbine",
+           "ibc_table", "coleman_ipc_table", "mpc_table", "lidar_ff_table", "design_turbine",
            "save_design", "load_design", "export", "read_rosco", "FORMATS"]
 
 SCHEMA_VERSION = 1
@@ -375,6 +375,41 @@ def mpc_table(turbine: linearize.Turbine, ctl: Any, kind: str,
                 {})
 
 
+def lidar_ff_table(turbine: linearize.Turbine, ctl: Any, kind: str,
+                   options: dict[str, Any] | None = None) -> dict[str, Any]:
+    """The LIDAR feedforward's design as a table over mean wind: the filter corner of the
+    turbulence model and the static pitch curve the feedforward follows; the settings hold the
+    kind's options (from which it is built again), the baseline's PI gains and the filter.
+
+    Parameters
+    ----------
+    turbine : Turbine
+        The turbine.
+    ctl : LidarFeedforward
+        The design.
+    kind : str
+        Its kind (``baseline+lidar-ff``).
+    options : dict, optional
+        The options it was built with.
+
+    Returns
+    -------
+    dict
+        The gain-table document.
+    """
+    winds = np.asarray(ctl.corner_winds, float)
+    pitch = np.interp(winds, ctl.curve_v, ctl.curve_pitch)
+    rows = [[float(v), float(c), float(p)] for v, c, p in zip(winds, ctl.corners, pitch)]
+    g = ctl.base.gains
+    settings = {"options": dict(options or {}), "kp": g.kp, "ki": g.ki,
+                "filter_order": ctl.order, "sample_dt": ctl.sample_dt,
+                "lead_s": ctl.lead_given, "focus_distance": ctl.sensor.focus_distance,
+                "units": {"kp": "s", "ki": "-", "sample_dt": "s", "lead_s": "s",
+                          "focus_distance": "m"}}
+    return _doc(kind, turbine, settings, ["wind_speed", "filter_corner", "static_pitch"],
+                ["m/s", "rad/s", "rad"], rows, {})
+
+
 def save_design(doc: dict[str, Any], out_dir: str | Path) -> Path:
     """Write ``design.json`` into ``out_dir`` (created).
 
@@ -531,7 +566,7 @@ def _write_discon(doc: dict[str, Any], out: Path,
                   turbine: linearize.Turbine | None = None) -> list[Path]:
     from mpc_wt.io.discon_export import export_design
 
-    if doc["kind"] in ("mpc", "mpc-collective", "mpc-lidar"):
+    if doc["kind"] in ("mpc", "mpc-collective", "mpc-lidar", "baseline+lidar-ff"):
         raise GainTableError(f"a {doc['kind']!r} design is built again from its options to "
                              f"export: use mpc_wt.run.export_discon (mpcwt export does)")
     t = design_turbine(doc, turbine)

@@ -917,8 +917,25 @@ class LidarFFOptions(Options):
                                choices=(1, 2), flag="--ff-filter-order")
 
 
+def _design_lidar_ff(turbine: linearize.Turbine) -> tuple[dict, str]:
+    """The baseline with the LIDAR feedforward, default options, as a table over mean wind
+    (``mpcwt design baseline+lidar-ff``; ``mpcwt export --format discon`` builds it again)."""
+    from mpc_wt.io.gain_tables import lidar_ff_table
+    from mpc_wt.registry.context import DEFAULT_CACHE
+
+    ctx = BuildContext(turbine=turbine, params=linearize.plant_params(turbine),
+                       cache=DEFAULT_CACHE)
+    base = _baseline("constant_power")(ctx, BaselineOptions())
+    ctl = _build_lidar_ff(ctx, LidarFFOptions(), base).controller
+    doc = lidar_ff_table(turbine, ctl, "baseline+lidar-ff", options={})
+    rows = doc["schedule"]["rows"]
+    return doc, (f"filter corner {min(r[1] for r in rows):.3g}-{max(r[1] for r in rows):.3g} "
+                 f"rad/s over {rows[0][0]:g}-{rows[-1][0]:g} m/s")
+
+
 @register("lidar-ff", LidarFFOptions, addon_to=("baseline", "derate"), default_base="baseline",
-          field_components="u", group="the lidar feedforward",
+          field_components="u", group="the lidar feedforward", design=_design_lidar_ff,
+          design_name="baseline+lidar-ff",
           summary="collective pitch feedforward from the CW LIDAR on a baseline "
                   "(baseline+lidar-ff, derate80+lidar-ff)")
 def _build_lidar_ff(ctx: BuildContext, opts: LidarFFOptions, base: Built) -> Built:
