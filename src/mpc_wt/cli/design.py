@@ -113,8 +113,9 @@ def _design(args: argparse.Namespace) -> int:
 
 
 def _export_registered(args: argparse.Namespace, turbine: Any) -> list[Path] | None:
-    """``--format discon`` of a design that is built again from its options (the MPC kinds);
-    None for the others."""
+    """``--format discon`` of a design that is built again from its options (the MPC kinds and
+    the LIDAR feedforward); None for the others."""
+    from mpc_wt.io.discon_export import REBUILT
     from mpc_wt.io.gain_tables import design_turbine, load_design
     from mpc_wt.run import export_discon
 
@@ -124,7 +125,7 @@ def _export_registered(args: argparse.Namespace, turbine: Any) -> list[Path] | N
         doc = load_design(args.design)
     except GainTableError as err:
         raise UsageError(str(err)) from None
-    if doc["kind"] not in ("mpc", "mpc-collective", "mpc-lidar", "baseline+lidar-ff"):
+    if doc["kind"] not in REBUILT:
         return None
     p = Path(args.design)
     out = Path(args.to) if args.to else (p if p.is_dir() else p.parent)
@@ -132,8 +133,7 @@ def _export_registered(args: argparse.Namespace, turbine: Any) -> list[Path] | N
                        doc["settings"].get("options") or None)
     if ex.note:
         print(f"note: {ex.note}")
-    return [*ex.sources[:6], ex.makefile, ex.input_file,
-            *(f for f in (ex.library, ex.servodyn) if f is not None)]
+    return ex.files()
 
 
 def _export(args: argparse.Namespace) -> int:

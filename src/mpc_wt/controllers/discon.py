@@ -210,7 +210,8 @@ class DisconController(ControllerBase):
         are kept either way.
     lidar : lidar.LidarSensor, optional
         A hub-mounted CW LIDAR (bound to the case's wind by the simulator) whose measurement
-        fills OpenFAST's lidar records at each call (:data:`LIDAR_RECORDS`).
+        fills OpenFAST's lidar records (:data:`LIDAR_RECORDS`): taken at the instrument's sample
+        rate and held between samples, as a LIDAR delivers them.
 
     Raises
     ------
@@ -306,6 +307,7 @@ class DisconController(ControllerBase):
         self._status = 0
         self._last_pitch = np.full(3, self.turbine.operation.fine_pitch_rad)
         self._last_torque = 0.0
+        self._lidar_next = -math.inf
         self._settings()
         self.messages = []
         self.signals = {}
@@ -365,7 +367,11 @@ class DisconController(ControllerBase):
                          53, 54, 60, 75, 76, 109, 110]) - 1
 
     def _fill_lidar(self, t: float, meas: dict[str, Any]) -> None:
-        """The lidar records from the LIDAR's measurement at the rotor's azimuth and speed."""
+        """The lidar records from the LIDAR's measurement at the rotor's azimuth and speed, when
+        a sample is due (held in between)."""
+        if t < self._lidar_next - 1e-9:
+            return
+        self._lidar_next = t + 1.0 / self.lidar.instrument.sample_rate
         m = self.lidar.measure(np.array([t]), np.array([float(meas["azimuth"])]),
                                float(meas["rotor_speed"]))
         ang = m.beam_azimuth_rad[0]

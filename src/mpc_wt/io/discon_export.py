@@ -34,7 +34,7 @@ import numpy as np
 import linearize
 from mpc_wt.errors import ControllerLibraryError
 
-__all__ = ["DisconExport", "EXPORTABLE", "export_controller", "export_design", "controller_input",
+__all__ = ["DisconExport", "EXPORTABLE", "REBUILT", "export_controller", "export_design", "controller_input",
            "check_exportable",
            "build_library",
            "find_compiler", "library_name", "servodyn_input", "SWAP_READ", "SWAP_WRITTEN"]
@@ -54,6 +54,11 @@ EXPORTABLE: dict[str, str] = {
                          "CW LIDAR, read from OpenFAST's lidar records",
 }
 
+#: The kinds whose export builds the controller again from the options of their design
+#: (``mpcwt design`` keeps those, not the controller's numbers); the baseline exports from its
+#: gain table.
+REBUILT = frozenset(EXPORTABLE) - {"baseline", "baseline-ct"}
+
 #: Library kinds (the input file's ``kind``) of the exported controller kinds.
 _LIBRARY_KIND = {"baseline": "baseline", "baseline-ct": "baseline", "mpc": "mpc",
                  "mpc-collective": "mpc", "mpc-lidar": "mpc", "baseline+lidar-ff": "baseline"}
@@ -65,11 +70,17 @@ _SIGNAL_CODES = {"rotor_speed": 0, "gen_speed": 1, "pitch_1": 2, "pitch_2": 3, "
 
 #: The swap records the library reads (1-based, as the interface numbers them).
 SWAP_READ: dict[int, str] = {
-    1: "status (0 first call, 1 running, -1 last call)", 2: "time [s]",
+    1: "status (0 first call, 1 running, -1 last call)", 2: "time of the first call [s]",
     3: "communication interval [s] (checked against the design's)",
     4: "blade 1 pitch [rad]", 33: "blade 2 pitch [rad]", 34: "blade 3 pitch [rad]",
-    20: "generator speed [rad/s]", 49: "length of avcMSG", 50: "length of accINFILE",
-    51: "length of avcOUTNAME"}
+    20: "generator speed [rad/s]", 21: "rotor speed [rad/s] (MPC)",
+    23: "measured generator torque [N m] (MPC)",
+    30: "blade 1 root out-of-plane moment [N m] (MPC; 31, 32 blades 2, 3)",
+    53: "tower-top fore-aft acceleration [m/s^2] (MPC)", 49: "length of avcMSG",
+    50: "length of accINFILE", 51: "length of avcOUTNAME",
+    129: "swap array length (the lidar block is read when it reaches record 2007)",
+    2002: "lidar beams (3; the LIDAR kinds)", 2003: "lidar pulse gates (1)",
+    2005: "beam 1 line-of-sight speed [m/s] (2006, 2007 beams 2, 3)"}
 
 #: The swap records the library writes.
 SWAP_WRITTEN: dict[int, str] = {
@@ -124,6 +135,17 @@ class DisconExport:
     dt: float
     note: str = ""
 
+    def files(self) -> list[Path]:
+        """Every file the export wrote: the input file, the library and the ServoDyn file
+        (when made), the Makefile and the sources.
+
+        Returns
+        -------
+        list of Path
+        """
+        made = [f for f in (self.library, self.servodyn) if f is not None]
+        return [self.input_file, *made, self.makefile, *self.sources]
+
 
 def library_name(kind: str) -> str:
     """The file name of an exported library on this platform (``libmpcwt_<kind>.so``,
@@ -138,10 +160,15 @@ def library_name(kind: str) -> str:
     -------
     str
     """
-    stem = "mpcwt_" + kind.replace("-", "_").replace("+", "_")
+    stem = _stem(kind)
     if sys.platform == "win32":
         return stem + ".dll"
     return "lib" + stem + (".dylib" if sys.platform == "darwin" else ".so")
+
+
+def _stem(kind: str) -> str:
+    """The file stem of a kind's export (``mpcwt_baseline_lidar_ff``)."""
+    return "mpcwt_" + kind.replace("-", "_").replace("+", "_")
 
 
 def find_compiler() -> str | None:
@@ -639,7 +666,7 @@ def export_controller(controller: Any, kind: str, turbine: linearize.Turbine,
     directory = Path(out)
     directory.mkdir(parents=True, exist_ok=True)
     text = controller_input(controller, kind, turbine, source, preview)
-    stem = "mpcwt_" + kind.replace("-", "_").replace("+", "_")
+    stem = _stem(kind)
     input_file = directory / f"{stem}.in"
     input_file.write_text(text)
     sources = _copy_sources(directory)

@@ -564,19 +564,16 @@ def _write_rosco(doc: dict[str, Any], out: Path,
 
 def _write_discon(doc: dict[str, Any], out: Path,
                   turbine: linearize.Turbine | None = None) -> list[Path]:
-    from mpc_wt.io.discon_export import export_design
+    from mpc_wt.io.discon_export import REBUILT, export_design
 
-    if doc["kind"] in ("mpc", "mpc-collective", "mpc-lidar", "baseline+lidar-ff"):
+    if doc["kind"] in REBUILT:
         raise GainTableError(f"a {doc['kind']!r} design is built again from its options to "
                              f"export: use mpc_wt.run.export_discon (mpcwt export does)")
     t = design_turbine(doc, turbine)
     try:
-        ex = export_design(doc, t, out)
+        return export_design(doc, t, out).files()
     except ValueError as err:
         raise GainTableError(str(err)) from None
-    files = [*ex.sources, ex.makefile, ex.input_file]
-    files += [p for p in (ex.library, ex.servodyn) if p is not None]
-    return files
 
 
 def read_rosco(path: str | Path) -> dict[str, Any]:

@@ -19,7 +19,7 @@
  * reaches the rotor (t + D / V_m) and read at t + lead; the static pitch curve of that wind is
  * the feedforward pitch, whose change enters the PI's integral */
 typedef struct {
-    int on, order, ncorner, ncurve, n_mean, started, len, raised;
+    int on, order, ncorner, ncurve, n_mean, started, len;
     double cos_cone, focus, alpha, sample_dt, tau_act, lead_given, delay;
     double *cw, *cc, *cv, *cp;
     double mean, vf, x[2], next, w_disc, corner, lead, tp, phi[4], gam[2];
@@ -142,10 +142,7 @@ static void ff_set_corner(mw_ff *f, double vm)
     if (f->lead_given < 0.0) {
         double room = f->tp - f->tau_act - f->sample_dt;
         double need = room > 0 ? f->delay / room : HUGE_VAL;
-        if (w < need) {
-            w = need < HUGE_VAL ? need : w;
-            f->raised++;
-        }
+        if (w < need && need < HUGE_VAL) w = need;
         f->lead = f->tau_act + f->delay / w;
     } else {
         f->lead = f->lead_given;

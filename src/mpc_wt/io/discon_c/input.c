@@ -127,7 +127,6 @@ int mw_input_read(mw_input *in, const char *path, char *msg)
         }
         p = end ? end + 1 : NULL;
     }
-    in->n_lines = n_lines;
     return 0;
 }
 

@@ -81,7 +81,7 @@ typedef struct {
     double law_a, law_offset, law_lo, law_hi, law_w;
     int law_started;
     double target_wind;
-    int target_started, last;
+    int target_started;
 } mw_mpc;
 
 static double dmin(double a, double b) { return a < b ? a : b; }
@@ -548,7 +548,7 @@ static void trim_at(const mw_mpc *c, double wind, double *z, double *u)
 static int mpc_step(mw_ctrl *self, const mw_meas *m, mw_cmd *out, char *msg)
 {
     mw_mpc *c = (mw_mpc *)self;
-    int switched, k, rc, i;
+    int switched, k, rc, i, before = c->sched.active;    /* the design acting until now */
     double u[4];
     if (!mw_finite(m->rotor_speed) || !mw_finite(m->gen_torque)
         || !mw_finite(m->pitch[0] + m->pitch[1] + m->pitch[2]) || !mw_finite(m->gen_speed)) {
@@ -566,9 +566,8 @@ static int mpc_step(mw_ctrl *self, const mw_meas *m, mw_cmd *out, char *msg)
     }
     if (switched) {
         point_reset(&c->pt[k]);
-        hand_over(&c->pt[k], &c->pt[c->last]);
+        hand_over(&c->pt[k], &c->pt[before]);
     }
-    c->last = k;
     if (c->target_tau >= 0.0) {
         double w = c->sched.measured;
         if (!c->target_started) {

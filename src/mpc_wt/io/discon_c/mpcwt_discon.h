@@ -17,7 +17,6 @@
 typedef struct {
     char path[1024];      /* as given, for messages */
     char *text;           /* the whole file, NUL-separated lines */
-    int n_lines;
     char **key;           /* per entry: its key */
     char **val;           /* per entry: the rest of the line (values) */
     int *line;            /* per entry: its line number */
@@ -116,7 +115,7 @@ typedef struct {
     int n;
     double dt, tau, hyst;
     double wind, measured;
-    int active, started, switches;
+    int active, started;
     mw_windest est;
 } mw_schedule;
 int mw_schedule_read(const mw_input *in, const char *prefix, double dt, mw_schedule *s,

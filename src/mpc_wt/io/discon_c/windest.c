@@ -299,7 +299,6 @@ void mw_schedule_reset(mw_schedule *s)
     mw_windest_reset(&s->est);
     s->started = 0;
     s->active = 0;
-    s->switches = 0;
 }
 
 /* the number of midpoints below x (Python's bisect_left) */
@@ -341,7 +340,6 @@ int mw_schedule_update_wind(mw_schedule *s, double w, int *switched)
     now = s->active;
     if (k != now && fabs(s->wind - 0.5 * (s->grid[k] + s->grid[now])) > s->hyst) {
         s->active = k;
-        s->switches++;
         *switched = 1;
     }
     return s->active;
