@@ -127,6 +127,22 @@ def _export_registered(args: argparse.Namespace, turbine: Any) -> list[Path] | N
         raise UsageError(str(err)) from None
     if doc["kind"] not in REBUILT:
         return None
+    if doc["kind"] == "ts":
+        from mpc_wt.controllers.takagi_sugeno.model import (
+            DEFAULT_REDUCTION_GRID,
+            DEFAULT_WIND_GRID,
+        )
+
+        s = doc["settings"]
+        if (list(s.get("wind_grid", [])) != list(DEFAULT_WIND_GRID)
+                or list(s.get("reduction_grid", [])) != list(DEFAULT_REDUCTION_GRID)):
+            raise UsageError(
+                f"{args.design}: this TS design's vertex grid (winds {s.get('wind_grid')}, "
+                f"reductions {s.get('reduction_grid')}) is not the one the controller kind "
+                f"'ts' is built on (winds {list(DEFAULT_WIND_GRID)}, reductions "
+                f"{list(DEFAULT_REDUCTION_GRID)}); design it with the default --wind, or "
+                f"export a TSController built on your grid with "
+                f"mpc_wt.io.discon_export.export_controller")
     p = Path(args.design)
     out = Path(args.to) if args.to else (p if p.is_dir() else p.parent)
     ex = export_discon(design_turbine(doc, turbine), doc["kind"], out,

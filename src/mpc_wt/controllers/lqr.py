@@ -41,7 +41,7 @@ from mpc_wt.errors import SynthesisError
 
 __all__ = ["LQRDesign", "PIObserver", "design_lqr", "design_lqr_family", "design_pi_observer",
            "LQRPIOController", "ScheduledLQRPIO", "SynthesisError", "REGION3_WEIGHTS",
-           "REGION3_SCALES"]
+           "REGION3_SCALES", "PAPER_MEASURED", "TURBINE_MEASURED", "TURBINE_SCALES"]
 
 #: Region-III LQR weights that hold the loop stable with the PI observer (q = 1e3) on the
 #: nonlinear plant: rotor-speed regulation and tower fore-aft damping (``state_weights``).
@@ -55,6 +55,21 @@ REGION2_WEIGHTS = {"tower_fa_velocity": 1.0, **{f"flap_rate_{i}": 0.2 for i in (
 #: Their magnitudes: 0.1 m/s tower-top velocity, 1 m/s flap tip rate, 1 deg of pitch per blade.
 REGION2_SCALES = {"tower_fa_velocity": 0.1, **{f"flap_rate_{i}": 1.0 for i in (1, 2, 3)},
                   **{f"pitch_ref_{i}": math.radians(1.0) for i in (1, 2, 3)}}
+
+
+#: Do et al.'s measured signals (sec. 3.2): generator speed, tower-top fore-aft displacement
+#: and the blades' flap tip displacements (modal states a turbine's controller is not given).
+PAPER_MEASURED = ("gen_speed", "tower_fa_displacement", "flap_1", "flap_2", "flap_3")
+#: What a turbine's controller is given (the Bladed interface's records 20, 53 and 30-32):
+#: generator speed, tower-top fore-aft acceleration and the blade root out-of-plane moments.
+TURBINE_MEASURED = ("gen_speed", "tower_fa_acceleration", "flap_moment_1", "flap_moment_2",
+                    "flap_moment_3")
+#: Their scales for the observer's R = I (``scales``): the magnitudes one metre of tower-top or
+#: flap tip displacement gives on the NREL 5-MW (tower first mode about 4.4 m/s^2 per metre at
+#: its frequency, about 1.7 MN m of root moment per metre of flap), so the two sets weigh the
+#: structure alike.
+TURBINE_SCALES = {"gen_speed": 1.0, "tower_fa_acceleration": 4.4,
+                  **{f"flap_moment_{i}": 1.7e6 for i in (1, 2, 3)}}
 
 
 def _names(model: linearize.LinearModel) -> dict[str, tuple[np.ndarray, str]]:
@@ -278,8 +293,7 @@ class PIObserver:
 
 
 def design_pi_observer(model: linearize.LinearModel, *,
-                       measured: Sequence[str] = ("gen_speed", "tower_fa_displacement",
-                                                  "flap_1", "flap_2", "flap_3"),
+                       measured: Sequence[str] = PAPER_MEASURED,
                        unknown_inputs: np.ndarray | None = None, q: float = 1e3,
                        scales: Mapping[str, float] | None = None) -> PIObserver:
     """PI observer for ``model`` (continuous) from the named measured signals.
@@ -289,7 +303,9 @@ def design_pi_observer(model: linearize.LinearModel, *,
     measured : names of outputs or states that are measured (Do et al.: generator speed, tower
         fore-aft displacement, blade flap displacements).
     unknown_inputs : ndarray (n_x, n_f), optional
-        N of eq 11; default the model's B_d (the unknown inputs are the blade-wind deviations).
+        N of eq 11; default the model's B_d (the unknown inputs are the blade-wind deviations,
+        and a measured output sees them through the model's D_d: root moments and the
+        tower-top acceleration respond to the wind without delay).
     q : float
         Weight of the unknown-input block of Q_obs (eq 16), > 0; q >> 1 gives the high-gain PIO.
     scales : dict of measured name to typical magnitude
@@ -334,7 +350,13 @@ def design_pi_observer(model: linearize.LinearModel, *,
     nf = nmat.shape[1]
     ae = np.block([[model.A, nmat], [np.zeros((nf, nx + nf))]])
     be = np.vstack([model.B_u, np.zeros((nf, model.B_u.shape[1]))])
-    ce = np.hstack([c, np.zeros((len(measured), nf))])
+    # an output the wind moves directly (a root moment, an acceleration) sees the unknown
+    # inputs through D_d when they are the model's disturbances
+    cf = np.zeros((len(measured), nf))
+    if unknown_inputs is None:
+        cf = np.array([model.D_d[model.outputs.index(n)] if names[n][1] == "output"
+                       else np.zeros(nf) for n in measured])
+    ce = np.hstack([c, cf])
     ces = ce / sy[:, None]
     modes = uncontrollable_modes(ae.T, ces.T, discrete=False)
     if modes:

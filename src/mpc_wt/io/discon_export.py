@@ -52,6 +52,11 @@ EXPORTABLE: dict[str, str] = {
                  "from OpenFAST's lidar records",
     "baseline+lidar-ff": "the baseline with the collective pitch feedforward of a hub-mounted "
                          "CW LIDAR, read from OpenFAST's lidar records",
+    "lqr-pio": "Do et al.'s LQR on PI-observer estimates, scheduled from cut-in to cut-out on "
+               "the estimated wind, observing generator speed, tower-top acceleration and the "
+               "blade root moments",
+    "ts": "Clemens et al.'s Takagi-Sugeno controller and wind observer, observing the tower-top "
+          "accelerations and the rotor and generator speeds",
 }
 
 #: The kinds whose export builds the controller again from the options of their design
@@ -61,22 +66,25 @@ REBUILT = frozenset(EXPORTABLE) - {"baseline", "baseline-ct"}
 
 #: Library kinds (the input file's ``kind``) of the exported controller kinds.
 _LIBRARY_KIND = {"baseline": "baseline", "baseline-ct": "baseline", "mpc": "mpc",
-                 "mpc-collective": "mpc", "mpc-lidar": "mpc", "baseline+lidar-ff": "baseline"}
+                 "mpc-collective": "mpc", "mpc-lidar": "mpc", "baseline+lidar-ff": "baseline",
+                 "lqr-pio": "lqr", "ts": "ts"}
 
-#: The Kalman filter's measured signals and their codes in the library.
+#: The measured signals of the Kalman filter (MPC) and the observer (LQR-PIO) and their codes
+#: in the library.
 _SIGNAL_CODES = {"rotor_speed": 0, "gen_speed": 1, "pitch_1": 2, "pitch_2": 3, "pitch_3": 4,
                  "flap_moment_1": 5, "flap_moment_2": 6, "flap_moment_3": 7,
-                 "tower_fa_acceleration": 8}
+                 "tower_fa_acceleration": 8, "tower_ss_acceleration": 9}
 
 #: The swap records the library reads (1-based, as the interface numbers them).
 SWAP_READ: dict[int, str] = {
     1: "status (0 first call, 1 running, -1 last call)", 2: "time of the first call [s]",
     3: "communication interval [s] (checked against the design's)",
     4: "blade 1 pitch [rad]", 33: "blade 2 pitch [rad]", 34: "blade 3 pitch [rad]",
-    20: "generator speed [rad/s]", 21: "rotor speed [rad/s] (MPC)",
-    23: "measured generator torque [N m] (MPC)",
-    30: "blade 1 root out-of-plane moment [N m] (MPC; 31, 32 blades 2, 3)",
-    53: "tower-top fore-aft acceleration [m/s^2] (MPC)", 49: "length of avcMSG",
+    20: "generator speed [rad/s]", 21: "rotor speed [rad/s] (MPC, LQR-PIO, TS)",
+    23: "measured generator torque [N m] (MPC, LQR-PIO)",
+    30: "blade 1 root out-of-plane moment [N m] (MPC, LQR-PIO; 31, 32 blades 2, 3)",
+    53: "tower-top fore-aft acceleration [m/s^2] (MPC, LQR-PIO, TS)",
+    54: "tower-top side-side acceleration [m/s^2] (TS)", 49: "length of avcMSG",
     50: "length of accINFILE", 51: "length of avcOUTNAME",
     129: "swap array length (the lidar block is read when it reaches record 2007)",
     2002: "lidar beams (3; the LIDAR kinds)", 2003: "lidar pulse gates (1)",
@@ -91,7 +99,8 @@ SWAP_WRITTEN: dict[int, str] = {
     47: "generator torque demand [N m]", 48: "yaw rate demand (0)",
     55: "pitch override (0: off)", 56: "torque override (0: off)", 65: "logging channels (0)"}
 
-_SOURCES = ("mpcwt_discon.h", "input.c", "baseline.c", "windest.c", "mpc.c", "discon.c")
+_SOURCES = ("mpcwt_discon.h", "input.c", "baseline.c", "windest.c", "mpc.c", "lqr.c", "ts.c",
+            "discon.c")
 _DAQP = "daqp"
 _CFLAGS = "-O2 -std=c99 -Wall -fPIC -fvisibility=hidden"
 _SANITIZE = "-O1 -g -fno-omit-frame-pointer -fsanitize=address,undefined " \
@@ -364,10 +373,6 @@ def _mpc_entries(ctl: Any, preview: Any = None) -> list[tuple[str, Any, str]]:
     n = len(ctl._grid)
     pts = [ctl.controller(k) for k in range(n)]
     signals = pts[0].estimator.signals
-    unknown = [s for s in signals if s not in _SIGNAL_CODES]
-    if unknown:
-        raise ValueError(f"the Kalman filter measures {unknown}, which the library does not "
-                         f"read from the swap array (it reads {sorted(_SIGNAL_CODES)})")
     sched = ctl.schedule
     budget = ctl.settings.time_budget_ms
     rows: list[tuple[str, Any, str]] = [
@@ -382,7 +387,7 @@ def _mpc_entries(ctl: Any, preview: Any = None) -> list[tuple[str, Any, str]]:
          "a QP over this time takes the fallback [ms] (0: no budget)"),
         ("torque_law", float(ctl._law is not None), "1: the target torque from the baseline's "
                                                     "schedule"),
-        ("kalman_signals", np.array([_SIGNAL_CODES[s] for s in signals], float),
+        ("kalman_signals", _signal_codes(signals, "Kalman filter"),
          "measured: " + ", ".join(signals)),
         ("schedule.grid", np.asarray(ctl._grid, float), "the designs' winds [m/s]"),
         ("schedule.time_constant_hysteresis", np.array([sched.tau, sched.hyst], float),
@@ -401,6 +406,140 @@ def _mpc_entries(ctl: Any, preview: Any = None) -> list[tuple[str, Any, str]]:
         [("lidar_preview", 0.0, "no LIDAR")]
     for k, m in enumerate(pts):
         rows += _mpc_point(m, k, signals)
+    return rows
+
+
+def _signal_codes(signals: Sequence[str], who: str) -> np.ndarray:
+    unknown = [s for s in signals if s not in _SIGNAL_CODES]
+    if unknown:
+        raise ValueError(f"the {who} measures {unknown}, which the library does not read from "
+                         f"the swap array (it reads {sorted(_SIGNAL_CODES)})")
+    return np.array([_SIGNAL_CODES[s] for s in signals], float)
+
+
+def _lqr_point(c: Any, k: int) -> list[tuple[str, Any, str]]:
+    """One design of a scheduled LQR-PIO: its discretized observer, gains and operating
+    point."""
+    law = c._law
+    nx, nf = c._nx, c._nf
+    p = f"point.{k}."
+    return [
+        (p + "sizes", np.array([nx, nf, len(c.obs.measured), c._nu_all, len(c._iu),
+                                2 if c.region == "II" else 3, float(law is not None)], float),
+         "n_x n_f n_y n_u n_gain region has_torque_law"),
+        (p + "ad", c._ad.ravel(), "observer A_d (n_x + n_f square, row-major)"),
+        (p + "bd", c._bd.ravel(), "observer B_d: [u_dev; y - y0] columns (row-major)"),
+        (p + "gain", c._gain.ravel(), "[K K_f] on the estimate (n_gain x (n_x + n_f))"),
+        (p + "gain_inputs", np.asarray(c._iu, float), "the inputs the gain rows command"),
+        (p + "y0", np.asarray(c.obs.y0, float), "operating point measurements"),
+        (p + "u0", np.asarray(c.model.u0, float), "operating point inputs [rad, rad, rad, N m]"),
+        (p + "x0d0", np.concatenate([c.model.x0, np.asarray(c.model.d0)[:nf]]).astype(float),
+         "operating point states and unknown inputs"),
+        (p + "k_opt", 0.0 if c.k_opt is None else float(c.k_opt),
+         "region II torque gain without a torque law [N m s^2/rad^2]"),
+    ]
+
+
+def _lqr_entries(ctl: Any) -> list[tuple[str, Any, str]]:
+    """The numbers of a :class:`~mpc_wt.controllers.lqr.ScheduledLQRPIO` as input-file
+    entries: the wind schedule, the torque law and every design's observer and gains."""
+    from mpc_wt.controllers.lqr import ScheduledLQRPIO
+
+    if type(ctl) is not ScheduledLQRPIO:
+        raise ValueError(f"the LQR-PIO export takes the scheduled design (ScheduledLQRPIO), got "
+                         f"{type(ctl).__name__}: leave design_wind_mps unset")
+    pts = ctl.controllers
+    signals = pts[0].obs.measured
+    if any(c.obs.measured != signals for c in pts):
+        raise ValueError("the LQR-PIO exports with the same measured signals at every design")
+    codes = _signal_codes(signals, "PI observer")
+    sched, c0 = ctl.schedule, pts[0]
+    pa, g = c0.turbine.pitch_actuator, c0.turbine.generator
+    reach = c0._reach if math.isfinite(c0._reach) else -1.0
+    rows: list[tuple[str, Any, str]] = [
+        ("dt", ctl.dt, "controller period [s] (ServoDyn DLL_DT)"),
+        ("n_points", float(len(pts)), "designs over the wind"),
+        ("signals", codes, "measured: " + ", ".join(signals)),
+        ("limits", np.array([pa.min_pitch_rad, pa.max_pitch_rad, g.min_torque, g.max_torque,
+                             reach], float),
+         "pitch min, max [rad], torque min, max [N m], how far a pitch command may lead the "
+         "measured pitch [rad] (-1: no bound)"),
+        ("schedule.grid", np.asarray(ctl.winds, float), "the designs' winds [m/s]"),
+        ("schedule.time_constant_hysteresis", np.array([sched.tau, sched.hyst], float),
+         "low-pass of the scheduling wind [s], hysteresis [m/s]"),
+        *_windest_entries(sched.estimator, "schedule.windest."),
+    ]
+    laws = [c._law for c in pts if c._law is not None]
+    if laws:
+        lt = laws[0]
+        first = _baseline_entries(lt.law, "law.")
+        ref = [v for _, v, _ in first] + [lt._a, lt._offset]
+        for x in laws[1:]:
+            other = [v for _, v, _ in _baseline_entries(x.law, "law.")] + [x._a, x._offset]
+            if not np.allclose(ref, other, rtol=0.0, atol=0.0, equal_nan=True):
+                raise ValueError("the LQR-PIO exports with one torque law for every design")
+        rows += _law_entries(lt)
+    for k, c in enumerate(pts):
+        rows += _lqr_point(c, k)
+    return rows
+
+
+def _law_entries(law: Any) -> list[tuple[str, Any, str]]:
+    """A :class:`~mpc_wt.controllers.baseline.LawTorque` (the baseline's torque schedule in
+    another controller) as input-file entries."""
+    return _baseline_entries(law.law, "law.") + [
+        ("law_torque", np.array([law._a, law._offset, law._lo, law._hi], float),
+         "speed filter pole, below-rated pitch offset [rad], torque min, max [N m]")]
+
+
+def _ts_entries(ctl: Any) -> list[tuple[str, Any, str]]:
+    """The numbers of a :class:`~mpc_wt.controllers.takagi_sugeno.TSController`: its grids,
+    the observer's blended zero-order-hold maps, the vertex equilibria and gains."""
+    from mpc_wt.controllers.takagi_sugeno import TSController
+
+    if type(ctl) is not TSController:
+        raise ValueError(f"the TS export takes a TSController, got {type(ctl).__name__}")
+    if ctl.power_reduction is not None or ctl._v_given is not None:
+        raise ValueError("a TS design with a power reduction over time (apc_frequency) or a "
+                         "given initial wind does not export: the library takes its power "
+                         "from the torque schedule and starts from the measured pitch")
+    ts, gen, pa = ctl.ts, ctl.turbine.generator, ctl.turbine.pitch_actuator
+    codes = _signal_codes(ts.measured, "TS observer")
+    n, nx = ctl._phi.shape[1], len(ts.states)
+    dp0 = float(ts.reduction_grid[0])
+    eq = np.array([ts.blend(ts.membership(float(v), dp0))["u0"][0] for v in ts.wind_grid])
+    order = np.argsort(eq)
+    kk = np.asarray(ctl._K, float)
+    rows: list[tuple[str, Any, str]] = [
+        ("dt", ctl.dt, "controller period [s] (ServoDyn DLL_DT)"),
+        ("sizes", np.array([ts.wind_grid.size, ts.reduction_grid.size, n, len(ts.inputs),
+                            len(ts.measured), kk.shape[2], -1 if ctl._ki is None else ctl._ki,
+                            float(ctl.torque_law is None)], float),
+         "winds, reductions, observer states (x and v), inputs, measurements, gain columns, "
+         "integral state (-1: none), 1: the TS law's torque applied"),
+        ("signals", codes, "measured: " + ", ".join(ts.measured)),
+        ("limits", np.array([pa.min_pitch_rad, pa.max_pitch_rad, gen.min_torque,
+                             gen.max_torque], float), "pitch min, max [rad], torque min, max "
+                                                      "[N m]"),
+        ("rated_power", float(ts.rated_power), "electrical power the torque schedule holds [W]"),
+        ("integral_source", float(-1 if ctl._int_src is None else ctl._int_src),
+         "the measurement whose deviation is integrated (-1: the estimate)"),
+        ("torque_law", float(ctl._law is not None), "1: the generator torque from the "
+                                                    "baseline's schedule"),
+        ("wind_grid", np.asarray(ts.wind_grid, float), "vertex winds [m/s]"),
+        ("reduction_grid", np.asarray(ts.reduction_grid, float), "vertex power reductions [-]"),
+        ("start_pitch", eq[order], "the vertex pitch without reduction, increasing [rad]"),
+        ("start_wind", np.asarray(ts.wind_grid, float)[order], "its wind [m/s]"),
+        ("terms", np.asarray(ctl._terms, float).ravel(),
+         "the observer's terms: vertex i and j (weight h_i h_j; j = -1: h_i)"),
+        ("phi", ctl._phi.ravel(), "each term's state map over a period (row-major)"),
+        ("gamma", ctl._gam.ravel(), "each term's map of [u; y; 1] over a period (row-major)"),
+        ("x0", np.asarray(ts.x0, float).ravel(), f"vertex equilibria ({nx} states each)"),
+        ("u0", np.asarray(ts.u0, float).ravel(), "vertex inputs [rad, N m]"),
+        ("gain", kk.ravel(), "vertex gains K_i (inputs x gain columns, row-major)"),
+    ]
+    if ctl._law is not None:
+        rows += _law_entries(ctl._law)
     return rows
 
 
@@ -437,6 +576,10 @@ def controller_input(controller: Any, kind: str, turbine: linearize.Turbine,
         entries = _ff_entries(controller)
     elif lib_kind == "baseline":
         entries = _baseline_entries(controller) + [("feedforward", 0.0, "no LIDAR feedforward")]
+    elif lib_kind == "lqr":
+        entries = _lqr_entries(controller)
+    elif lib_kind == "ts":
+        entries = _ts_entries(controller)
     else:
         entries = _mpc_entries(controller, preview)
     from mpc_wt._version import __version__

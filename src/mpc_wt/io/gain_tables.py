@@ -44,7 +44,7 @@ from mpc_wt.controllers.baseline import effective_pi_gains
 from mpc_wt.errors import GainTableError
 
 __all__ = ["SCHEMA_VERSION", "GainTableError", "baseline_table", "lqr_table", "ts_table",
-           "ibc_table", "coleman_ipc_table", "mpc_table", "lidar_ff_table", "design_turbine",
+           "ibc_table", "coleman_ipc_table", "mpc_table", "lqr_pio_table", "lidar_ff_table", "design_turbine",
            "save_design", "load_design", "export", "read_rosco", "FORMATS"]
 
 SCHEMA_VERSION = 1
@@ -195,6 +195,42 @@ def lqr_table(turbine: linearize.Turbine, designs: Sequence[Any],
                 "gain_ratio_L2_L1": [ob.gain_ratio for ob in observers] if observers else None,
                 "convention": "u = u0 - K (x - x0); observer per Do et al. eqs 13-16"}
     return _doc("lqr", turbine, settings, cols, units, rows, mats)
+
+
+def lqr_pio_table(turbine: linearize.Turbine, ctl: Any, kind: str = "lqr-pio",
+                  options: dict[str, Any] | None = None) -> dict[str, Any]:
+    """A scheduled LQR-PIO (:class:`~mpc_wt.controllers.lqr.ScheduledLQRPIO`) as a gain table:
+    :func:`lqr_table` of its designs from cut-in to cut-out, with each design's region and the
+    options it was built with (from which ``mpcwt export --format discon`` builds it again).
+
+    Parameters
+    ----------
+    turbine : Turbine
+        The turbine.
+    ctl : ScheduledLQRPIO
+        The design.
+    kind : str
+        Its kind.
+    options : dict, optional
+        The options it was built with.
+
+    Returns
+    -------
+    dict
+        The gain-table document.
+    """
+    pts = ctl.controllers
+    doc = lqr_table(turbine, [c.lqr for c in pts], [c.obs for c in pts])
+    doc["kind"] = kind
+    doc["schedule"]["columns"].append("region")
+    doc["schedule"]["units"].append("-")
+    for row, c in zip(doc["schedule"]["rows"], pts):
+        row.append(2.0 if c.region == "II" else 3.0)
+    doc["settings"].update({
+        "options": dict(options or {}), "dt": ctl.dt,
+        "schedule_time_constant": ctl.schedule.tau, "measured": list(pts[0].obs.measured),
+        "units": {"dt": "s", "schedule_time_constant": "s"}})
+    return doc
 
 
 def ts_table(turbine: linearize.Turbine, ts: Any, controller: Any,

@@ -80,17 +80,23 @@ def _design_ts(turbine: linearize.Turbine, *, winds: Any = None,
                reductions: Any = (0.0, 0.4, 0.8), decay_rate: float = 0.2,
                observer_decay_rate: float = 1.0) -> tuple[dict, str]:
     from mpc_wt.controllers.takagi_sugeno import (
+        TURBINE_MEASURED,
         build_ts_model,
         design_ts_controller,
         design_ts_observer,
     )
+    from mpc_wt.controllers.takagi_sugeno.model import DEFAULT_WIND_GRID
     from mpc_wt.io.gain_tables import ts_table
 
-    grid = (12.0, 14.0, 16.0, 19.0, 22.0, 25.0) if winds is None else winds
-    ts = build_ts_model(turbine, [float(v) for v in grid], list(reductions), progress=True)
+    grid = DEFAULT_WIND_GRID if winds is None else winds
+    ts = build_ts_model(turbine, [float(v) for v in grid], list(reductions),
+                        measured=TURBINE_MEASURED, progress=True)
     ctl = design_ts_controller(ts, decay_rate=decay_rate)
     obs = design_ts_observer(ts, decay_rate=observer_decay_rate)
-    return ts_table(turbine, ts, ctl, obs), (
+    doc = ts_table(turbine, ts, ctl, obs)
+    doc["settings"]["options"] = {"decay_rate": float(decay_rate),
+                                  "observer_decay_rate": float(observer_decay_rate)}
+    return doc, (
         f"{ts.n_vertices} vertices, {ctl.solver} {ctl.solve_time_s:.1f} s + "
         f"{obs.solve_time_s:.1f} s, certificates ok")
 
@@ -594,6 +600,11 @@ class LQRPIOOptions(Options):
                                   unit="m/s", lo=0.1, hi=5.0, flag="")
     schedule_time_constant: float = option(3.0, help="low-pass of the scheduling wind",
                                            unit="s", lo=0.0, hi=600.0, flag="")
+    observer_signals: str = option("turbine", help="the PI observer's measurements: turbine "
+                                   "(generator speed, tower-top fore-aft acceleration, blade "
+                                   "root out-of-plane moments, as a turbine's controller gets "
+                                   "them; exportable) or paper (Do et al.'s tower-top and flap "
+                                   "displacements)", choices=("turbine", "paper"))
     region2_torque: str = option("baseline", help="region-II torque: the baseline's schedule "
                                  "(1.5/2/2.5 on filtered speed, as the PI it is compared with) "
                                  "or Do's bare K_opt Omega_g^2 on raw speed",
@@ -628,8 +639,24 @@ class LQRPIOOptions(Options):
                 {f"pitch_ref_{i}": self.w_pitch for i in (1, 2, 3)})
 
 
+def _design_lqr_pio(turbine: linearize.Turbine) -> tuple[dict, str]:
+    """The scheduled LQR-PIO with the default options, as a table of its designs from cut-in
+    to cut-out (``mpcwt design lqr-pio``; ``mpcwt export --format discon`` builds it again from
+    the table's options)."""
+    from mpc_wt.io.gain_tables import lqr_pio_table
+    from mpc_wt.registry.context import DEFAULT_CACHE
+
+    ctx = BuildContext(turbine=turbine, params=linearize.plant_params(turbine),
+                       cache=DEFAULT_CACHE)
+    ctl = _build_lqr_pio(ctx, LQRPIOOptions()).controller
+    doc = lqr_pio_table(turbine, ctl, "lqr-pio", options={})
+    w = ctl.winds
+    return doc, (f"{w.size} designs {w[0]:g}-{w[-1]:g} m/s observing "
+                 f"{', '.join(ctl.controllers[0].obs.measured)}")
+
+
 @register("lqr-pio", LQRPIOOptions, field_components="u", design=_design_lqr,
-          design_name="lqr",
+          design_name="lqr", more_designs=(("lqr-pio", _design_lqr_pio),),
           summary="Do et al.'s LQR with a PI observer, scheduled from cut-in to cut-out on the "
                   "estimated wind (region II below rated, III above)")
 def _build_lqr_pio(ctx: BuildContext, opts: LQRPIOOptions) -> Built:
@@ -665,8 +692,11 @@ def _lqr_pio_at(turbine: linearize.Turbine, model: linearize.LinearModel, wind: 
     constant torque is capped by that law, as a scheduled design needs in lulls)."""
     from mpc_wt.controllers.baseline import BaselineController
     from mpc_wt.controllers.lqr import (
+        PAPER_MEASURED,
         REGION2_SCALES,
         REGION3_SCALES,
+        TURBINE_MEASURED,
+        TURBINE_SCALES,
         LQRPIOController,
         design_lqr,
         design_pi_observer,
@@ -676,7 +706,12 @@ def _lqr_pio_at(turbine: linearize.Turbine, model: linearize.LinearModel, wind: 
     w, iw = opts.lqr_weights(region)
     lq = design_lqr(model, state_weights=w, input_weights=iw,
                     scales={**REGION2_SCALES, **REGION3_SCALES})
-    return LQRPIOController(model, turbine, lq, design_pi_observer(model, q=opts.observer_q),
+    if opts.observer_signals == "turbine":
+        obs = design_pi_observer(model, q=opts.observer_q, measured=TURBINE_MEASURED,
+                                 scales=TURBINE_SCALES)
+    else:
+        obs = design_pi_observer(model, q=opts.observer_q, measured=PAPER_MEASURED)
+    return LQRPIOController(model, turbine, lq, obs,
                             region=region,
                             k_opt=base.k_opt if region == "II" else None,
                             feedforward=region == "III",
@@ -699,6 +734,12 @@ class TSOptions(Options):
                                lo_open=True, flag="")
     observer_decay_rate: float = option(1.0, help="observer decay rate", unit="1/s", lo=0.0,
                                         lo_open=True, flag="")
+    observer_signals: str = option("turbine", help="the wind observer's measurements: "
+                                   "turbine (tower-top fore-aft and side-side accelerations, "
+                                   "rotor and generator speed, as a turbine's controller gets "
+                                   "them; exportable) or paper (Clemens et al.'s tower-top "
+                                   "displacements in place of the accelerations)",
+                                   choices=("turbine", "paper"))
     generator_torque: str = option("baseline", help="baseline: the baseline's torque "
                                    "schedule (power-optimal tip-speed ratio below rated, "
                                    "constant power above), the TS law setting the pitch; ts: "
@@ -711,19 +752,23 @@ class TSOptions(Options):
 def _build_ts(ctx: BuildContext, opts: TSOptions) -> Built:
     from mpc_wt.controllers.apc import apc_reference
     from mpc_wt.controllers.takagi_sugeno import (
+        CLEMENS_MEASURED,
+        TURBINE_MEASURED,
         TSController,
         build_ts_model,
         design_ts_controller,
         design_ts_observer,
     )
 
+    measured = TURBINE_MEASURED if opts.observer_signals == "turbine" else CLEMENS_MEASURED
+
     def make() -> tuple[Any, Any, Any]:
-        ts0 = build_ts_model(ctx.turbine)
+        ts0 = build_ts_model(ctx.turbine, measured=measured)
         return (ts0, design_ts_controller(ts0, decay_rate=opts.decay_rate),
                 design_ts_observer(ts0, decay_rate=opts.observer_decay_rate))
 
-    ts, c, o = ctx.cache.get(ctx.turbine, ("ts", opts.decay_rate, opts.observer_decay_rate),
-                             make)
+    ts, c, o = ctx.cache.get(ctx.turbine, ("ts", opts.decay_rate, opts.observer_decay_rate,
+                                           measured), make)
     dp = None if opts.apc_frequency is None else apc_reference(
         opts.apc_frequency, amplitude=opts.apc_amplitude, offset=opts.apc_offset)
     law = None

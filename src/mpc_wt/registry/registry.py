@@ -13,10 +13,12 @@ User kinds register with :func:`register`; modules named by ``--plugin`` (comman
 """
 from __future__ import annotations
 
+import dataclasses
+
 import importlib
 import logging
 import re
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any, Callable, Mapping, Sequence
 
 from mpc_wt.errors import OptionsError
@@ -57,6 +59,8 @@ class ControllerKind:
         ``design(turbine, **args) -> (gain-table document, note)`` for ``mpcwt design``.
     design_name : str
         The name under ``mpcwt design`` (default: ``name``).
+    more_designs : tuple of (str, callable)
+        Further design functions under other names (as ``design``).
     group : str
         Words for messages about options this kind shares with its family
         (``the MPC controllers``).
@@ -80,6 +84,7 @@ class ControllerKind:
     pattern_help: str = ""
     design: Callable[..., Any] | None = None
     design_name: str = ""
+    more_designs: tuple[tuple[str, Callable[..., Any]], ...] = ()
     group: str = ""
     field_components: str = "uvw"
 
@@ -405,7 +410,11 @@ def designs() -> dict[str, ControllerKind]:
     dict of str to ControllerKind
         ``design_name`` (or name) -> kind.
     """
-    return {k.design_name or k.name: k for k in kinds().values() if k.design is not None}
+    out = {k.design_name or k.name: k for k in kinds().values() if k.design is not None}
+    for k in kinds().values():
+        for name, fn in k.more_designs:
+            out[name] = replace(k, design=fn, design_name=name, more_designs=())
+    return out
 
 
 def describe() -> list[dict[str, Any]]:

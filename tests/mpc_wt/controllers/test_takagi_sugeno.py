@@ -104,7 +104,7 @@ def test_observer_certificate_holds_and_can_fail(ts, designs) -> None:
     _, obs = designs
     assert obs.certificate.ok, obs.certificate.failures
     for i in range(ts.n_vertices):
-        f = obs.A_aug[i] - obs.L[i] @ obs.C_aug
+        f = obs.A_aug[i] - obs.L[i] @ obs.C_aug[i]
         assert np.linalg.eigvals(f).real.max() <= -obs.decay_rate + 1e-9
     bad = obs.L.copy()
     bad[0] *= 0.0
@@ -138,7 +138,7 @@ def test_bad_design_input(ts) -> None:
 def test_unobservable_wind_is_refused(ts) -> None:
     # a sensor that sees nothing (every mode unobservable)
     blind = dataclasses.replace(ts, measured=("tower_ss_displacement",),
-                                C=np.zeros((1, len(ts.states))))
+                                C=np.zeros((1, len(ts.states))), D=None, E=None, y0=None)
     with pytest.raises(SynthesisError, match="not detectable"):
         design_ts_observer(blind)
 

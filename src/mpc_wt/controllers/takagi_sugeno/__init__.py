@@ -35,7 +35,12 @@ The LMIs are solved in scaled coordinates (states, inputs and outputs divided by
 magnitudes) so that the SDP is well conditioned; the gains are returned in SI units.
 """
 from mpc_wt.controllers.takagi_sugeno.controller import TSController
-from mpc_wt.controllers.takagi_sugeno.model import CLEMENS_MEASURED, TSModel, build_ts_model
+from mpc_wt.controllers.takagi_sugeno.model import (
+    CLEMENS_MEASURED,
+    TURBINE_MEASURED,
+    TSModel,
+    build_ts_model,
+)
 from mpc_wt.controllers.takagi_sugeno.synthesis import (
                                                         Certificate,
                                                         TSControllerDesign,
@@ -48,4 +53,4 @@ from mpc_wt.controllers.takagi_sugeno.synthesis import (
 
 __all__ = ["TSModel", "build_ts_model", "TSControllerDesign", "TSObserverDesign", "Certificate",
            "design_ts_controller", "design_ts_observer", "verify_controller", "verify_observer",
-           "TSController", "CLEMENS_MEASURED"]
+           "TSController", "CLEMENS_MEASURED", "TURBINE_MEASURED"]

@@ -78,21 +78,32 @@ class TSController(ControllerBase):
         self._v_given = None if initial_wind_mps is None else float(initial_wind_mps)
         aa, bb, cc = observer.A_aug, observer.B_aug, observer.C_aug
         nv, n = aa.shape[:2]
-        nu, ny = bb.shape[2], cc.shape[0]
+        nu, ny = bb.shape[2], cc.shape[-2]
         ki = controller.integral_of
         self._ki = None if ki is None else ts.states.index(ki)
         self._int_src = ts.measured.index(ki) if ki in ts.measured else None
-        self._phi = np.empty((nv, n, n))
-        self._gam = np.empty((nv, n, nu + ny + 1))
+        # the observer's terms: one per vertex when the vertices measure alike (weights h_i),
+        # else one per pair of vertices active together (weights h_i h_j: the output
+        # prediction is blended as the plant's measurement is)
+        if ts.common_output:
+            terms = [(i, -1) for i in range(nv)]
+        else:
+            terms = [(i, j) for i in range(nv) for j in range(nv)
+                     if any(i in cell and j in cell for cell in ts.cells())]
+        self._terms = np.array(terms, dtype=np.int64)
+        self._phi = np.empty((len(terms), n, n))
+        self._gam = np.empty((len(terms), n, nu + ny + 1))
         xi0 = np.hstack([ts.x0, ts.v0[:, None]])
-        for i in range(nv):
-            f = aa[i] - observer.L[i] @ cc
-            const = -aa[i] @ xi0[i] - bb[i] @ ts.u0[i]
-            g = np.hstack([bb[i], observer.L[i], const[:, None]])
+        off = ts.output_offset()
+        for k, (i, j) in enumerate(terms):
+            jj = i if j < 0 else j
+            f = aa[i] - observer.L[i] @ cc[jj]
+            const = -aa[i] @ xi0[i] - bb[i] @ ts.u0[i] - observer.L[i] @ off[jj]
+            g = np.hstack([bb[i] - observer.L[i] @ ts.D[jj], observer.L[i], const[:, None]])
             m = np.zeros((n + g.shape[1], n + g.shape[1]))
             m[:n, :n], m[:n, n:] = f, g
             e = scipy.linalg.expm(m * dt)
-            self._phi[i], self._gam[i] = e[:n, :n], e[:n, n:]
+            self._phi[k], self._gam[k] = e[:n, :n], e[:n, n:]
         self.torque_law = torque_law
         self._law = LawTorque(torque_law, dt) if torque_law is not None else None
         self._read = SignalReader(ts.measured)
@@ -133,8 +144,8 @@ class TSController(ControllerBase):
         ts, pa, gen = self.ts, self.turbine.pitch_actuator, self.turbine.generator
         v_seen = float(self.xi[-1])
         q, dp, clipped = _ts_step(
-            self.xi, self._u, y, dp_raw, ts.wind_grid, ts.reduction_grid, self._phi, self._gam,
-            ts.x0, ts.u0, self._K, -1 if self._ki is None else self._ki,
+            self.xi, self._u, y, dp_raw, ts.wind_grid, ts.reduction_grid, self._terms,
+            self._phi, self._gam, ts.x0, ts.u0, self._K, -1 if self._ki is None else self._ki,
             -1 if self._int_src is None else self._int_src, self._q, self.dt,
             pa.min_pitch_rad, pa.max_pitch_rad, gen.min_torque, gen.max_torque,
             self.torque_law is None, self._w)
@@ -158,15 +169,17 @@ class TSController(ControllerBase):
 
 @nb.njit(cache=True, nogil=True)
 def _ts_step(xi: np.ndarray, u: np.ndarray, y: np.ndarray, dp_raw: float, wg: np.ndarray,
-             rg: np.ndarray, phi: np.ndarray, gam: np.ndarray, x0: np.ndarray, u0: np.ndarray,
+             rg: np.ndarray, terms: np.ndarray, phi: np.ndarray, gam: np.ndarray,
+             x0: np.ndarray, u0: np.ndarray,
              kk: np.ndarray, ki: int, src: int, q_prev: float, dt: float, pmin: float,
              pmax: float, tmin: float, tmax: float, own_torque: bool, work: np.ndarray
              ) -> tuple[float, float, bool]:
     """One TS step in place: xi (observer, eq 10, exact ZOH per vertex, blended) and u (PDC
     law, eq 7, clipped to the actuators); returns the integral, the clipped dp and whether the
     premise was clipped. ``own_torque``: the TS torque is applied (else only a saturated pitch
-    holds the integral). ``work`` is (2, N) scratch for the memberships."""
-    nv, n = phi.shape[0], phi.shape[1]
+    holds the integral). ``work`` is (2, N) scratch for the memberships. The observer's term k
+    (``phi[k]``, ``gam[k]``) has weight h_i (``terms[k] = (i, -1)``) or h_i h_j."""
+    nv, n = x0.shape[0], phi.shape[1]
     nu, ny = u.size, y.size
     h = work[0]
     dp, c1 = memberships(wg, rg, xi[n - 1], dp_raw, h)
@@ -175,10 +188,13 @@ def _ts_step(xi: np.ndarray, u: np.ndarray, y: np.ndarray, dp_raw: float, wg: np
     w[nu:nu + ny] = y
     w[nu + ny] = 1.0
     new = np.zeros(n)
-    for i in range(nv):
-        if h[i] == 0.0:
+    for k in range(terms.shape[0]):
+        wk = h[terms[k, 0]]
+        if terms[k, 1] >= 0:
+            wk *= h[terms[k, 1]]
+        if wk == 0.0:
             continue
-        new += h[i] * (phi[i] @ xi + gam[i] @ w)
+        new += wk * (phi[k] @ xi + gam[k] @ w)
     xi[:] = new
     h2 = work[1]
     dp, c2 = memberships(wg, rg, xi[n - 1], dp_raw, h2)

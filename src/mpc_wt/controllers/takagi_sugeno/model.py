@@ -14,17 +14,27 @@ import numpy as np
 import linearize
 from mpc_wt.errors import PremiseError
 
-__all__ = ["CLEMENS_MEASURED", "DEFAULT_SCALES", "TSModel", "build_ts_model"]
+__all__ = ["CLEMENS_MEASURED", "TURBINE_MEASURED", "DEFAULT_SCALES", "DEFAULT_WIND_GRID",
+           "DEFAULT_REDUCTION_GRID", "TSModel", "build_ts_model"]
 
 #: Clemens et al. eq 6: tower side-side and fore-aft displacement, rotor and generator speed.
 CLEMENS_MEASURED = ("tower_ss_displacement", "tower_fa_displacement", "rotor_speed", "gen_speed")
+#: What a turbine's controller is given in their place (the Bladed interface's records 53, 54,
+#: 21 and 20): the tower-top fore-aft and side-side accelerations, rotor and generator speed.
+TURBINE_MEASURED = ("tower_fa_acceleration", "tower_ss_acceleration", "rotor_speed",
+                    "gen_speed")
 
 
 #: Typical magnitudes of the TS model's variables (scaling of the LMIs; SI units).
 DEFAULT_SCALES = {"tower_fa_displacement": 0.1, "tower_fa_velocity": 0.1, "rotor_speed": 0.1,
                   "gen_speed": 0.1 * 97.0, "shaft_torsion": 1e-3, "tower_ss_displacement": 0.02,
                   "tower_ss_velocity": 0.02, "pitch_ref_coll": math.radians(1.0),
-                  "gen_torque_ref": 4e3, "wind": 1.0}
+                  "gen_torque_ref": 4e3, "wind": 1.0, "tower_fa_acceleration": 1.0,
+                  "tower_ss_acceleration": 0.2}
+#: (The accelerations' scales weigh the observer's trust in them: on the NREL 5-MW at 18 m/s
+#: in class-A turbulence, 0.1 and 0.02 m/s^2 made the pitch travel 761 deg per blade in 120 s,
+#: 1 and 0.2 138 deg (the displacements' observer: 97 deg), and 3 and 0.5 let the tower's
+#: fore-aft mode go into a limit cycle.)
 
 
 @nb.njit(cache=True, nogil=True)
@@ -79,10 +89,18 @@ class TSModel:
     A, B, B_d, x0, u0, v0 : ndarray
         Stacked over the N = n_a n_b vertices.
     states, inputs : names
-    C : (n_y, n_x) ndarray
-        Measured rows (``measured`` names).
+    C : (n_y, n_x) or (N, n_y, n_x) ndarray
+        Measured rows (``measured`` names): common to the vertices (measured states) or one
+        per vertex (measured outputs such as an acceleration, whose rows are the model's).
     rated_power : float
         Electrical power at Delta P = 0 [W].
+    D : (N, n_y, n_u) ndarray, optional
+        The measurements' input feedthrough per vertex (default zero).
+    E : (N, n_y) ndarray, optional
+        Their wind feedthrough per vertex (default zero).
+    y0 : (N, n_y) ndarray, optional
+        Their equilibrium values per vertex (default C x0, right for measured states): a
+        measurement is y0_i + C_i (x - x0_i) + D_i (u - u0_i) + E_i (v - v0_i) at vertex i.
     """
 
     wind_grid: np.ndarray
@@ -98,10 +116,26 @@ class TSModel:
     measured: tuple[str, ...]
     C: np.ndarray
     rated_power: float
+    D: Any = None
+    E: Any = None
+    y0: Any = None
     info: dict[str, Any] = field(default_factory=dict, compare=False)
 
     def __post_init__(self) -> None:
-        for n in ("wind_grid", "reduction_grid", "A", "B", "B_d", "x0", "u0", "v0", "C"):
+        nv0 = np.shape(self.A)[0]
+        ny = len(self.measured)
+        c = np.array(self.C, dtype=float)
+        if c.ndim == 2:
+            c = np.broadcast_to(c, (nv0,) + c.shape)
+        defaults = {"C": c,
+                    "D": np.zeros((nv0, ny, np.shape(self.B)[2])) if self.D is None else self.D,
+                    "E": np.zeros((nv0, ny)) if self.E is None else self.E}
+        if self.y0 is None and c.shape[1:] == (ny, np.shape(self.A)[1]):
+            defaults["y0"] = np.einsum("iyx,ix->iy", c, np.asarray(self.x0, float))
+        for n, v in defaults.items():
+            object.__setattr__(self, n, v)
+        for n in ("wind_grid", "reduction_grid", "A", "B", "B_d", "x0", "u0", "v0", "C", "D",
+                  "E", "y0"):
             a = np.array(getattr(self, n), dtype=float)
             a.flags.writeable = False
             object.__setattr__(self, n, a)
@@ -111,11 +145,24 @@ class TSModel:
         nv = self.wind_grid.size * self.reduction_grid.size
         nx, nu = len(self.states), len(self.inputs)
         want = {"A": (nv, nx, nx), "B": (nv, nx, nu), "B_d": (nv, nx), "x0": (nv, nx),
-                "u0": (nv, nu), "v0": (nv,), "C": (len(self.measured), nx)}
+                "u0": (nv, nu), "v0": (nv,), "C": (nv, len(self.measured), nx),
+                "D": (nv, len(self.measured), nu), "E": (nv, len(self.measured)),
+                "y0": (nv, len(self.measured))}
         for n, shp in want.items():
             if getattr(self, n).shape != shp:
                 raise ValueError(f"TSModel.{n} has shape {getattr(self, n).shape}; expected "
                                  f"{shp}")
+
+    @property
+    def common_output(self) -> bool:
+        """Whether every vertex measures alike (measured states: one C, no feedthrough)."""
+        return bool(np.all(self.C == self.C[0]) and not np.any(self.D) and not np.any(self.E))
+
+    def output_offset(self) -> np.ndarray:
+        """(N, n_y) y0_i - C_i x0_i - D_i u0_i - E_i v0_i: a measurement at vertex i is
+        C_i x + D_i u + E_i v + this."""
+        return (self.y0 - np.einsum("iyx,ix->iy", self.C, self.x0)
+                - np.einsum("iyu,iu->iy", self.D, self.u0) - self.E * self.v0[:, None])
 
     @property
     def n_vertices(self) -> int:
@@ -261,12 +308,19 @@ class TSModel:
                 "inputs": list(self.inputs), "measured": list(self.measured),
                 "rated_power": self.rated_power, "A": self.A.tolist(), "B": self.B.tolist(),
                 "B_d": self.B_d.tolist(), "x0": self.x0.tolist(), "u0": self.u0.tolist(),
-                "v0": self.v0.tolist(), "C": self.C.tolist()}
+                "v0": self.v0.tolist(), "C": self.C.tolist(), "D": self.D.tolist(),
+                "E": self.E.tolist(), "y0": self.y0.tolist()}
+
+
+#: The vertex grids of the TS model the controller kind ``ts`` builds: winds [m/s] and power
+#: reductions [-].
+DEFAULT_WIND_GRID = (12.0, 14.0, 16.0, 19.0, 22.0, 25.0)
+DEFAULT_REDUCTION_GRID = (0.0, 0.4, 0.8)
 
 
 def build_ts_model(turbine: linearize.Turbine,
-                   wind_grid: Sequence[float] = (12.0, 14.0, 16.0, 19.0, 22.0, 25.0),
-                   reduction_grid: Sequence[float] = (0.0, 0.4, 0.8), *,
+                   wind_grid: Sequence[float] = DEFAULT_WIND_GRID,
+                   reduction_grid: Sequence[float] = DEFAULT_REDUCTION_GRID, *,
                    measured: Sequence[str] = CLEMENS_MEASURED,
                    progress: bool = False) -> TSModel:
     """The TS model of ``turbine`` at the vertices wind_grid x reduction_grid.
@@ -291,7 +345,8 @@ def build_ts_model(turbine: linearize.Turbine,
     reduction_grid : sequence of float
         Vertex power reductions Delta P in [0, 1) [-].
     measured : sequence of str
-        The measured outputs.
+        The measured states or outputs (default Clemens et al.'s; :data:`TURBINE_MEASURED`
+        is what a turbine's controller is given).
     progress : bool
         Show a progress bar.
 
@@ -311,7 +366,8 @@ def build_ts_model(turbine: linearize.Turbine,
     rated = turbine.operation.rated_power
     cfg = linearize.PlantConfig.clemens()
     params = linearize.plant_params(turbine, cfg)
-    mats: dict[str, list[np.ndarray]] = {k: [] for k in ("A", "B", "B_d", "x0", "u0", "v0")}
+    mats: dict[str, list[np.ndarray]] = {k: [] for k in ("A", "B", "B_d", "x0", "u0", "v0",
+                                                         "C", "D", "E", "y0")}
     model = None
     for v, dp in tqdm(list(itertools.product(va, vb)), desc="TS vertices", unit="vertex",
                       disable=not progress):
@@ -325,12 +381,30 @@ def build_ts_model(turbine: linearize.Turbine,
         mats["x0"].append(model.x0)
         mats["u0"].append(model.u0)
         mats["v0"].append(np.asarray(v))
+        bad = [n for n in measured if n not in model.states and n not in model.outputs]
+        if bad:
+            raise ValueError(f"measured {bad} are neither states nor outputs of the TS model "
+                             f"(states {list(model.states)}, outputs {list(model.outputs)})")
+        for key, val in zip(("C", "D", "E", "y0"), _measurement_rows(model, measured)):
+            mats[key].append(val)
     assert model is not None
-    bad = [n for n in measured if n not in model.states]
-    if bad:
-        raise ValueError(f"measured {bad} are not states of the TS model {list(model.states)}")
-    c = np.array([np.eye(len(model.states))[model.states.index(n)] for n in measured])
     return TSModel(wind_grid=va, reduction_grid=vb, states=model.states, inputs=model.inputs,
-                   measured=tuple(measured), C=c, rated_power=float(rated),
+                   measured=tuple(measured), rated_power=float(rated),
                    info={"turbine": turbine.name, "config": "clemens"},
                    **{k: np.array(v) for k, v in mats.items()})
+
+
+def _measurement_rows(model: linearize.LinearModel, measured: Sequence[str]
+                      ) -> tuple[np.ndarray, ...]:
+    """C, D, E (wind) and y0 rows of the measured names at one vertex: a state's unit row, or
+    an output's rows of the linear model (an acceleration responds to inputs and wind)."""
+    nx, nu = len(model.states), len(model.inputs)
+    rows = []
+    for n in measured:
+        if n in model.states:
+            i = model.states.index(n)
+            rows.append((np.eye(nx)[i], np.zeros(nu), 0.0, model.x0[i]))
+        else:
+            i = model.outputs.index(n)
+            rows.append((model.C_z[i], model.D_u[i], model.D_d[i, 0], model.z0[i]))
+    return tuple(np.array([r[k] for r in rows], dtype=float) for k in range(4))

@@ -464,23 +464,30 @@ def _check_grid(ts: TSModel, pts: list[tuple[float, float]], a: np.ndarray, b: n
 
 
 def _augmented(ts: TSModel, tau_v: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """A~_i, B~_i (eq 9 appended) and C~ of xi = [x; v]."""
+    """A~_i, B~_i (eq 9 appended) and C~_i of xi = [x; v] (stacked over the vertices)."""
     nv, nx = ts.A.shape[:2]
     aa = np.zeros((nv, nx + 1, nx + 1))
     aa[:, :nx, :nx] = ts.A
     aa[:, :nx, nx] = ts.B_d
     aa[:, nx, nx] = -1.0 / tau_v
     bb = np.concatenate([ts.B, np.zeros((nv, 1, ts.B.shape[2]))], axis=1)
-    cc = np.hstack([ts.C, np.zeros((ts.C.shape[0], 1))])
+    cc = np.concatenate([ts.C, ts.E[:, :, None]], axis=2)
     return aa, bb, cc
 
 
 def _observer_mats(ts: TSModel, tau_v: float, sxi: np.ndarray, sy: np.ndarray
                    ) -> tuple[np.ndarray, np.ndarray]:
-    """Scaled A~_i and C~ of the observer design (states and wind by ``sxi``, outputs by ``sy``)."""
+    """Scaled A~_i and C~_i of the observer design (states and wind by ``sxi``, outputs by
+    ``sy``)."""
     aa, _, cc = _augmented(ts, tau_v)
     return (np.array([np.diag(1 / sxi) @ ai @ np.diag(sxi) for ai in aa]),
-            np.diag(1 / sy) @ cc @ np.diag(sxi))
+            np.array([np.diag(1 / sy) @ ci @ np.diag(sxi) for ci in cc]))
+
+
+def _pairs(ts: TSModel) -> list[tuple[int, int]]:
+    """The vertex pairs i < j that are active together (in one cell): the cross conditions of
+    an observer whose measurements differ between vertices."""
+    return sorted({(i, j) for cell in ts.cells() for i in cell for j in cell if i < j})
 
 
 def design_ts_observer(ts: TSModel, *, tau_v: float = 4.0, decay_rate: float = 1.0,
@@ -520,7 +527,8 @@ def design_ts_observer(ts: TSModel, *, tau_v: float = 4.0, decay_rate: float = 1
     sy = _scales(ts.measured, scales)
     a, c = _observer_mats(ts, float(tau_v), sxi, sy)
     _check_detectable(ts, a, c, alpha)
-    prob, pv, nvar = _observer_problem(a, c, alpha, radius, margin)
+    prob, pv, nvar = _observer_problem(a, c, alpha, radius, margin,
+                                       [] if ts.common_output else _pairs(ts))
     t0 = time.perf_counter()
     used, status = _solve(prob, solver)
     dt = time.perf_counter() - t0
@@ -548,7 +556,7 @@ def _check_detectable(ts: TSModel, a: np.ndarray, c: np.ndarray, alpha: float) -
     from mpc_wt.controllers.lqr import uncontrollable_modes
 
     for i, ai in enumerate(a):
-        modes = uncontrollable_modes(ai.T + alpha * np.eye(ai.shape[0]), c.T, discrete=False)
+        modes = uncontrollable_modes(ai.T + alpha * np.eye(ai.shape[0]), c[i].T, discrete=False)
         if modes:
             raise SynthesisError(
                 f"(A~, C~) is not detectable with decay rate {alpha:g} 1/s at vertex {i} "
@@ -559,25 +567,35 @@ def _check_detectable(ts: TSModel, a: np.ndarray, c: np.ndarray, alpha: float) -
 
 
 def _observer_problem(a: np.ndarray, c: np.ndarray, alpha: float, radius: float | None,
-                      margin: float) -> tuple[Any, Any, list[Any]]:
+                      margin: float, pairs: Sequence[tuple[int, int]] = ()
+                      ) -> tuple[Any, Any, list[Any]]:
     """The observer LMIs (Clemens eq 10) with the decay rate and the optional pole disk; the
-    objective bounds the gains' norm."""
+    objective bounds the gains' norm. With measurements that differ between vertices (C~_i),
+    the error e' = sum_i sum_j h_i h_j (A~_i - L_i C~_j) e also needs, for every ``pairs``
+    (i, j) active together, M_ij + M_ji < -4 alpha P (Tanaka and Wang 2001, thm 2.2)."""
     import cvxpy as cp
 
     nv, n = a.shape[:2]
-    ny = c.shape[0]
+    ny = c.shape[1]
     pv = cp.Variable((n, n), symmetric=True)
     nvar = [cp.Variable((n, ny)) for _ in range(nv)]
     t = cp.Variable()
     cons = [pv >> np.eye(n)]
+
+    def lyap(i: int, j: int) -> Any:
+        return a[i].T @ pv + pv @ a[i] - c[j].T @ nvar[i].T - nvar[i] @ c[j]
+
     for i in range(nv):
-        m = a[i].T @ pv + pv @ a[i] - c.T @ nvar[i].T - nvar[i] @ c + 2 * alpha * pv
+        m = lyap(i, i) + 2 * alpha * pv
         cons.append(_sym(m) << -margin * np.eye(n))
         if radius is not None:
-            g = pv @ a[i] - nvar[i] @ c
+            g = pv @ a[i] - nvar[i] @ c[i]
             cons.append(_sym(cp.bmat([[-radius * pv, g], [g.T, -radius * pv]]))
                         << -margin * np.eye(2 * n))
         cons.append(_sym(cp.bmat([[t * np.eye(n), nvar[i]], [nvar[i].T, t * np.eye(ny)]])) >> 0)
+    for i, j in pairs:
+        m = 0.5 * (lyap(i, j) + lyap(j, i)) + 2 * alpha * pv
+        cons.append(_sym(m) << -margin * np.eye(n))
     return cp.Problem(cp.Minimize(t), cons), pv, nvar
 
 
@@ -625,7 +643,7 @@ def verify_observer(ts: TSModel, L: np.ndarray, P: np.ndarray, scale_xi: np.ndar
     nrm = np.linalg.norm(p, 2)
     worst = -np.inf
     for i in range(len(a)):
-        f = a[i] - ls[i] @ c
+        f = a[i] - ls[i] @ c[i]
         e = np.linalg.eigvalsh(f.T @ p + p @ f + 2 * alpha * p).max()
         worst = max(worst, e)
         if e > -margin:
@@ -641,7 +659,7 @@ def verify_observer(ts: TSModel, L: np.ndarray, P: np.ndarray, scale_xi: np.ndar
     pts = _premise_grid(ts, grid_points)
     for v, dp in pts:
         h = ts.membership(v, dp)
-        f = np.tensordot(h, a, axes=1) - np.tensordot(h, ls, axes=1) @ c
+        f = np.tensordot(h, a, axes=1) - np.tensordot(h, ls, axes=1) @ np.tensordot(h, c, axes=1)
         d = np.linalg.eigvals(f).real.max() + alpha
         ly = np.linalg.eigvalsh(f.T @ p + p @ f + 2 * alpha * p).max() / nrm
         wd, wl = max(wd, d), max(wl, ly)

@@ -357,3 +357,47 @@ mw_ctrl *mw_baseline_new(const mw_input *in, char *msg)
     b->base.destroy = baseline_destroy;
     return &b->base;
 }
+
+/* ---- the torque law in another controller -------------------------------------------- */
+int mw_torque_law_read(const mw_input *in, mw_torque_law *t, char *msg)
+{
+    double v[4];
+    if (mw_law_read(in, "law.", &t->law, msg) || mw_getp_vec(in, "", "law_torque", v, 4, msg))
+        return -1;
+    t->a = v[0];
+    t->offset = v[1];
+    t->lo = v[2];
+    t->hi = v[3];
+    t->started = 0;
+    return 0;
+}
+
+double mw_torque_law_step(mw_torque_law *t, double gen_speed, double pitch, double power)
+{
+    double q;
+    t->w = t->started ? t->a * t->w + (1.0 - t->a) * gen_speed : gen_speed;
+    t->started = 1;
+    if (t->w < t->law.w_rgn2) pitch -= t->offset;
+    q = mw_law_torque(&t->law, t->w, pitch, power);
+    return q < t->lo ? t->lo : (q > t->hi ? t->hi : q);
+}
+
+mw_ctrl *mw_ctrl_new(size_t size, const char *who,
+                     int (*step)(mw_ctrl *, const mw_meas *, mw_cmd *, char *),
+                     void (*destroy)(mw_ctrl *),
+                     int (*read)(const mw_input *, mw_ctrl *, char *), const mw_input *in,
+                     char *msg)
+{
+    mw_ctrl *c = (mw_ctrl *)calloc(1, size);
+    if (!c) {
+        mw_msg(msg, "mpc-wt %s: out of memory", who);
+        return NULL;
+    }
+    c->step = step;
+    c->destroy = destroy;
+    if (read(in, c, msg)) {
+        destroy(c);
+        return NULL;
+    }
+    return c;
+}

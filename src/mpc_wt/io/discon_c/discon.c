@@ -96,9 +96,13 @@ static mw_ctrl *create(const char *path, const float *swap, char *msg)
         c = mw_baseline_new(&in, msg);
     else if (strcmp(kind, "mpc") == 0)
         c = mw_mpc_new(&in, msg);
+    else if (strcmp(kind, "lqr") == 0)
+        c = mw_lqr_new(&in, msg);
+    else if (strcmp(kind, "ts") == 0)
+        c = mw_ts_new(&in, msg);
     else
         mw_msg(msg, "mpc-wt controller: input file '%s': kind '%s' is not one this library "
-               "knows (baseline, mpc)", path, kind);
+               "knows (baseline, mpc, lqr, ts)", path, kind);
     mw_input_free(&in);
     if (!c) return NULL;
     dt_call = swap[2];

@@ -287,3 +287,66 @@ double *mw_getp_alloc(const mw_input *in, const char *prefix, const char *key, i
     *n = c;
     return mw_getp_alloc_n(in, prefix, key, c, msg);
 }
+
+/* ---- measured signals --------------------------------------------------------------------- */
+static const char *const signal_names[MW_SIG_COUNT] = {
+    "rotor speed (record 21)", "generator speed (record 20)", "blade 1 pitch (record 4)",
+    "blade 2 pitch (record 33)", "blade 3 pitch (record 34)",
+    "blade 1 flap moment (record 30)", "blade 2 flap moment (record 31)",
+    "blade 3 flap moment (record 32)", "tower-top fore-aft acceleration (record 53)",
+    "tower-top side-side acceleration (record 54)"};
+
+int mw_signals_read(const mw_input *in, const char *key, const char *who, int **codes, int *n,
+                    char *msg)
+{
+    double *v;
+    int i;
+    *codes = NULL;
+    v = mw_getp_alloc(in, "", key, n, msg);
+    if (!v) return -1;
+    *codes = (int *)malloc((size_t)*n * sizeof(int));
+    if (!*codes) {
+        free(v);
+        mw_msg(msg, "mpc-wt %s: out of memory", who);
+        return -1;
+    }
+    for (i = 0; i < *n; i++) {
+        if (v[i] != floor(v[i]) || v[i] < 0 || v[i] >= MW_SIG_COUNT) {
+            mw_msg(msg, "mpc-wt %s: input file '%s': key '%s' value %d is %g, expected a "
+                   "signal code in [0, %d]", who, in->path, key, i + 1, v[i], MW_SIG_COUNT - 1);
+            free(v);
+            return -1;
+        }
+        (*codes)[i] = (int)v[i];
+    }
+    free(v);
+    return 0;
+}
+
+int mw_signals_get(const mw_meas *m, const int *codes, int n, double *y, const char *who,
+                   char *msg)
+{
+    int i;
+    for (i = 0; i < n; i++) {
+        double v;
+        switch (codes[i]) {
+        case MW_SIG_ROTOR_SPEED: v = m->rotor_speed; break;
+        case MW_SIG_GEN_SPEED: v = m->gen_speed; break;
+        case MW_SIG_PITCH1: v = m->pitch[0]; break;
+        case MW_SIG_PITCH2: v = m->pitch[1]; break;
+        case MW_SIG_PITCH3: v = m->pitch[2]; break;
+        case MW_SIG_FLAP1: v = m->flap[0]; break;
+        case MW_SIG_FLAP2: v = m->flap[1]; break;
+        case MW_SIG_FLAP3: v = m->flap[2]; break;
+        case MW_SIG_TOWER_FA_ACC: v = m->tower_fa_acc; break;
+        default: v = m->tower_ss_acc; break;
+        }
+        if (!mw_finite(v)) {
+            mw_msg(msg, "mpc-wt %s: measured %s is not finite at t = %g s", who,
+                   signal_names[codes[i]], m->t);
+            return -1;
+        }
+        y[i] = v;
+    }
+    return 0;
+}

@@ -33,10 +33,6 @@
 /* im's head: sizes (the layout of mpc-wt's packed step data) */
 enum { NZD, SLACK0, NX, ND, NY, NB, NV, NU, NZ, HEAD };
 
-/* measured signals of the Kalman filter, as codes */
-enum { SIG_ROTOR_SPEED, SIG_GEN_SPEED, SIG_PITCH1, SIG_PITCH2, SIG_PITCH3, SIG_FLAP1,
-       SIG_FLAP2, SIG_FLAP3, SIG_TOWER_FA_ACC, SIG_COUNT };
-
 typedef struct {
     int nx, nd, nu, ny, nb, nv, nz, nzd, nvu, hp, hu, slack0, nzo, collective;
     int *im;
@@ -77,9 +73,7 @@ typedef struct {
     double *y;
     mw_point *pt;
     mw_schedule sched;
-    mw_law law;
-    double law_a, law_offset, law_lo, law_hi, law_w;
-    int law_started;
+    mw_torque_law law;
     double target_wind;
     int target_started;
 } mw_mpc;
@@ -407,32 +401,7 @@ static int point_step(mw_mpc *c, mw_point *p, const mw_meas *m, double *u, char 
 {
     int nx = p->nx, nu = p->nu, i, flag, level = 0;
     double *z = p->fb, t0, ms;
-    static const char *names[] = {"rotor speed (record 21)", "generator speed (record 20)",
-                                  "blade 1 pitch (record 4)", "blade 2 pitch (record 33)",
-                                  "blade 3 pitch (record 34)", "blade 1 flap moment (record 30)",
-                                  "blade 2 flap moment (record 31)",
-                                  "blade 3 flap moment (record 32)",
-                                  "tower-top fore-aft acceleration (record 53)"};
-    for (i = 0; i < c->n_signals; i++) {
-        double v = 0.0;
-        switch (c->signals[i]) {
-        case SIG_ROTOR_SPEED: v = m->rotor_speed; break;
-        case SIG_GEN_SPEED: v = m->gen_speed; break;
-        case SIG_PITCH1: v = m->pitch[0]; break;
-        case SIG_PITCH2: v = m->pitch[1]; break;
-        case SIG_PITCH3: v = m->pitch[2]; break;
-        case SIG_FLAP1: v = m->flap[0]; break;
-        case SIG_FLAP2: v = m->flap[1]; break;
-        case SIG_FLAP3: v = m->flap[2]; break;
-        default: v = m->tower_fa_acc; break;
-        }
-        if (!mw_finite(v)) {
-            mw_msg(msg, "mpc-wt mpc: measured %s is not finite at t = %g s",
-                   names[c->signals[i]], m->t);
-            return -1;
-        }
-        c->y[i] = v;
-    }
+    if (mw_signals_get(m, c->signals, c->n_signals, c->y, "mpc", msg)) return -1;
     if (p->has_prev) {
         u_abs(p, p->u_prev, p->udev);
         for (i = 0; i < 4; i++) p->udev[i] -= p->u0[i];
@@ -580,12 +549,7 @@ static int mpc_step(mw_ctrl *self, const mw_meas *m, mw_cmd *out, char *msg)
         trim_at(c, c->target_wind, c->zt, c->ut);
         if (c->has_law) {
             double w_g = m->gen_speed, pitch = (m->pitch[0] + m->pitch[1] + m->pitch[2]) / 3.0;
-            double q;
-            c->law_w = c->law_started ? c->law_a * c->law_w + (1.0 - c->law_a) * w_g : w_g;
-            c->law_started = 1;
-            if (c->law_w < c->law.w_rgn2) pitch -= c->law_offset;
-            q = dmin(dmax(mw_law_torque(&c->law, c->law_w, pitch, c->law.p_rated), c->law_lo),
-                     c->law_hi);
+            double q = mw_torque_law_step(&c->law, w_g, pitch, c->law.law.p_rated);
             c->ut[3] = q;
             c->zt[c->ip] = dmin(c->zt[c->ip], c->eff * q * w_g);
         }
@@ -619,34 +583,19 @@ static void mpc_destroy(mw_ctrl *self)
 
 static int read_signals(const mw_input *in, mw_mpc *c, char *msg)
 {
-    double *v;
-    int n, i;
-    v = mw_getp_alloc(in, "", "kalman_signals", &n, msg);
-    if (!v) return -1;
-    c->signals = (int *)malloc((size_t)n * sizeof(int));
-    c->y = (double *)malloc((size_t)n * sizeof(double));
-    if (!c->signals || !c->y) {
-        free(v);
+    if (mw_signals_read(in, "kalman_signals", "mpc", &c->signals, &c->n_signals, msg))
+        return -1;
+    c->y = (double *)malloc((size_t)c->n_signals * sizeof(double));
+    if (!c->y) {
         mw_msg(msg, "mpc-wt mpc: out of memory");
         return -1;
     }
-    for (i = 0; i < n; i++) {
-        if (v[i] != floor(v[i]) || v[i] < 0 || v[i] >= SIG_COUNT) {
-            mw_msg(msg, "mpc-wt mpc: input file '%s': key 'kalman_signals' value %d is %g, "
-                   "expected a signal code in [0, %d]", in->path, i + 1, v[i], SIG_COUNT - 1);
-            free(v);
-            return -1;
-        }
-        c->signals[i] = (int)v[i];
-    }
-    c->n_signals = n;
-    free(v);
     return 0;
 }
 
-static int mpc_read(const mw_input *in, mw_mpc *c, char *msg)
+static int mpc_read(const mw_input *in, mw_ctrl *self, char *msg)
 {
-    double law[4];
+    mw_mpc *c = (mw_mpc *)self;
     int i;
     if (mw_get(in, "dt", &c->dt, msg) || mw_get_int(in, "n_points", 1, 1000, &c->n, msg)
         || mw_get_int(in, "n_outputs", 1, 1000, &c->nzo, msg)
@@ -687,15 +636,7 @@ static int mpc_read(const mw_input *in, mw_mpc *c, char *msg)
         mw_msg(msg, "mpc-wt mpc: out of memory");
         return -1;
     }
-    if (c->has_law) {
-        if (mw_law_read(in, "law.", &c->law, msg)
-            || mw_getp_vec(in, "", "law_torque", law, 4, msg))
-            return -1;
-        c->law_a = law[0];
-        c->law_offset = law[1];
-        c->law_lo = law[2];
-        c->law_hi = law[3];
-    }
+    if (c->has_law && mw_torque_law_read(in, &c->law, msg)) return -1;
     for (i = 0; i < c->n; i++) {
         if (point_read(in, i, &c->pt[i], msg)) return -1;
         if (c->pt[i].nzo != c->nzo) {
@@ -715,22 +656,11 @@ static int mpc_read(const mw_input *in, mw_mpc *c, char *msg)
             return -1;
         }
     }
+    c->base.dt = c->dt;
     return 0;
 }
 
 mw_ctrl *mw_mpc_new(const mw_input *in, char *msg)
 {
-    mw_mpc *c = (mw_mpc *)calloc(1, sizeof(mw_mpc));
-    if (!c) {
-        mw_msg(msg, "mpc-wt mpc: out of memory");
-        return NULL;
-    }
-    c->base.step = mpc_step;
-    c->base.destroy = mpc_destroy;
-    if (mpc_read(in, c, msg)) {
-        mpc_destroy(&c->base);
-        return NULL;
-    }
-    c->base.dt = c->dt;
-    return &c->base;
+    return mw_ctrl_new(sizeof(mw_mpc), "mpc", mpc_step, mpc_destroy, mpc_read, in, msg);
 }

@@ -59,6 +59,18 @@ typedef struct {
     double torque;         /* demand [N m] */
 } mw_cmd;
 
+/* measured signals an estimator reads, by code (the input file's lists of codes) */
+enum { MW_SIG_ROTOR_SPEED, MW_SIG_GEN_SPEED, MW_SIG_PITCH1, MW_SIG_PITCH2, MW_SIG_PITCH3,
+       MW_SIG_FLAP1, MW_SIG_FLAP2, MW_SIG_FLAP3, MW_SIG_TOWER_FA_ACC, MW_SIG_TOWER_SS_ACC,
+       MW_SIG_COUNT };
+/* read the codes of key (allocated into *codes, *n of them); -1 with msg on a bad code */
+int mw_signals_read(const mw_input *in, const char *key, const char *who, int **codes, int *n,
+                    char *msg);
+/* the signals' values at this step into y; -1 with msg (naming the record) if one is not
+ * finite */
+int mw_signals_get(const mw_meas *m, const int *codes, int n, double *y, const char *who,
+                   char *msg);
+
 /* a controller: its step and how to free it */
 typedef struct mw_ctrl mw_ctrl;
 struct mw_ctrl {
@@ -70,6 +82,8 @@ struct mw_ctrl {
 /* the kinds */
 mw_ctrl *mw_baseline_new(const mw_input *in, char *msg);
 mw_ctrl *mw_mpc_new(const mw_input *in, char *msg);
+mw_ctrl *mw_lqr_new(const mw_input *in, char *msg);
+mw_ctrl *mw_ts_new(const mw_input *in, char *msg);
 
 /* ---- shared parts --------------------------------------------------------------------- */
 /* input keys are "<prefix><name>"; these read one with the prefix */
@@ -94,6 +108,25 @@ typedef struct {
 } mw_law;
 int mw_law_read(const mw_input *in, const char *prefix, mw_law *law, char *msg);
 double mw_law_torque(const mw_law *law, double w, double pitch, double p3);
+
+/* the baseline's torque schedule as another controller's generator torque: the generator
+ * speed low-passed at the law's corner, the pitch counted from the below-rated offset under
+ * region 2, the torque within limits (input keys "law.*" and "law_torque") */
+typedef struct {
+    mw_law law;
+    double a, offset, lo, hi, w;
+    int started;
+} mw_torque_law;
+int mw_torque_law_read(const mw_input *in, mw_torque_law *t, char *msg);
+double mw_torque_law_step(mw_torque_law *t, double gen_speed, double pitch, double power);
+
+/* a controller of `size` bytes (its mw_ctrl first) read by `read`; NULL with msg on failure
+ * (then `destroy` has freed what `read` allocated) */
+mw_ctrl *mw_ctrl_new(size_t size, const char *who,
+                     int (*step)(mw_ctrl *, const mw_meas *, mw_cmd *, char *),
+                     void (*destroy)(mw_ctrl *),
+                     int (*read)(const mw_input *, mw_ctrl *, char *), const mw_input *in,
+                     char *msg);
 
 /* the rotor-effective wind speed's extended Kalman filter (rotor speed, pitch, torque) */
 typedef struct {
