@@ -1,10 +1,10 @@
 """The exported controller libraries through the sign-off beside the Python controllers they
-came from: the baseline and the scheduled MPC exported (``mpc_wt.run.export_discon``, built with
-the system's C compiler), then the NREL 5-MW sign-off's load cases
-(``benchmarks/studies/signoff.yaml``) run for the four side by side, and the sign-off's figures
-compared pair by pair.
+came from: the kinds exported (``mpc_wt.run.export_discon``, built with the system's C
+compiler; default the baseline and the scheduled MPC), then the NREL 5-MW sign-off's load cases
+(``benchmarks/studies/signoff.yaml``) run for each kind and its library side by side, and the
+sign-off's figures compared pair by pair.
 
-Run:  python benchmarks/study_discon_signoff.py OUT_DIR [--workers 2]
+Run:  python benchmarks/study_discon_signoff.py OUT_DIR [--workers 2] [--kinds baseline mpc ...]
 
 Writes OUT_DIR/libs (the exports), OUT_DIR/spec.yaml, the campaign in OUT_DIR/campaign with its
 report, and prints per pair: failed cases, overspeed stops, the largest rotor speed in DLC 1.x,
@@ -25,7 +25,6 @@ import linearize
 from mpc_wt.run import export_discon
 
 HERE = Path(__file__).resolve().parent
-PAIRS = (("baseline", "baseline-library"), ("mpc", "mpc-library"))
 
 
 def _rows(path: Path) -> list[dict[str, str]]:
@@ -33,15 +32,18 @@ def _rows(path: Path) -> list[dict[str, str]]:
         return list(csv.DictReader(f))
 
 
-def _spec(out: Path) -> Path:
+def _spec(out: Path, kinds: list[str]) -> Path:
     t = linearize.load_turbine("nrel5mw")
-    libs = {k: export_discon(t, k, out / "libs" / k) for k in ("baseline", "mpc")}
+    libs = {k: export_discon(t, k, out / "libs" / k) for k in kinds}
     spec = yaml.safe_load((HERE / "studies" / "signoff.yaml").read_text())
     spec["name"] = "signoff-discon"
-    spec["description"] = ("The sign-off's load cases for the baseline and the scheduled MPC "
-                           "and for the libraries exported from them.")
-    spec["controllers"] = [{"name": "baseline", "controller": "baseline"},
-                           {"name": "mpc", "controller": "mpc"}]
+    spec["description"] = (f"The sign-off's load cases for {', '.join(kinds)} and for the "
+                           f"libraries exported from them.")
+    if "baseline" not in kinds:            # the report's changes are against the baseline
+        spec["controllers"] = [{"name": "baseline", "controller": "baseline"}]
+    else:
+        spec["controllers"] = []
+    spec["controllers"] += [{"name": k, "controller": k} for k in kinds]
     for k, ex in libs.items():
         spec["controllers"].append({"name": f"{k}-library", "controller": "discon",
                                     "discon_library": str(ex.library),
@@ -57,7 +59,7 @@ def _spec(out: Path) -> Path:
     return path
 
 
-def _compare(rep: Path) -> list[str]:
+def _compare(rep: Path, kinds: list[str]) -> list[str]:
     so = _rows(rep / "signoff.csv")
     aep = {r["controller"]: float(r["change_pct"]) for r in _rows(rep / "aep.csv")}
     travel = {r["controller"]: float(r["pitch_travel_deg_change_pct"])
@@ -71,7 +73,7 @@ def _compare(rep: Path) -> list[str]:
     lines = ["| pair | failed | stops | max speed DLC 1.x [x rated] | AEP vs baseline [%] | "
              "pitch travel vs baseline [%] | largest lifetime-DEL change [%] | largest "
              "governing-load change [%] |", "|---" * 8 + "|"]
-    for py, lib in PAIRS:
+    for py, lib in ((k, f"{k}-library") for k in kinds):
         cells = []
         for c in (py, lib):
             mine = [r for r in so if r["controller"] == c]
@@ -92,15 +94,17 @@ def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("out", help="output directory")
     ap.add_argument("--workers", type=int, default=2)
+    ap.add_argument("--kinds", nargs="+", default=["baseline", "mpc"],
+                    help="the exportable kinds to compare with their libraries")
     args = ap.parse_args()
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
-    spec = _spec(out)
+    spec = _spec(out, args.kinds)
     camp = out / "campaign"
     subprocess.run([sys.executable, "-m", "mpc_wt.cli", "campaign", "run", str(spec), "--out",
                     str(camp), "--workers", str(args.workers), "--report", "--quiet"],
                    check=True)
-    table = _compare(camp / "report")
+    table = _compare(camp / "report", args.kinds)
     (out / "comparison.md").write_text("\n".join(table) + "\n")
     print("\n".join(table))
     return 0

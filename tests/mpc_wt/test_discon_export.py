@@ -57,6 +57,16 @@ def mpc_lidar_export(nrel5mw, tmp_path_factory):
     return export_discon(nrel5mw, "mpc-lidar", tmp_path_factory.mktemp("mpc_lidar"))
 
 
+@pytest.fixture(scope="module")
+def lqr_export(nrel5mw, tmp_path_factory):
+    return export_discon(nrel5mw, "lqr-pio", tmp_path_factory.mktemp("lqr"))
+
+
+@pytest.fixture(scope="module")
+def ts_export(nrel5mw, tmp_path_factory):
+    return export_discon(nrel5mw, "ts", tmp_path_factory.mktemp("ts"))
+
+
 def _discon(ex):
     opts = {"discon_library": str(ex.library), "discon_in": str(ex.input_file),
             "discon_dt": ex.dt}
@@ -181,6 +191,42 @@ def test_mpc_lidar_library_without_lidar_records_stops(nrel5mw, mpc_lidar_export
     opts = dict(_discon(mpc_lidar_export), lidar_records=False)
     with pytest.raises(ControllerLibraryError, match="3 beams and 1 pulse gate.*2002"):
         run_controller(nrel5mw, "discon", 12.0, opts, duration=1.0)
+
+
+@pytest.mark.parametrize("wind", [8.0, 12.0, 18.0])
+def test_lqr_pio_library_runs_as_the_python_controller(nrel5mw, lqr_export, wind):
+    """The scheduled LQR-PIO (the wind schedule with its EKF, each design's PI observer on
+    generator speed, tower-top acceleration and root moments, the LQR with the unknown-input
+    feedforward, the baseline's torque schedule, the bumpless hand-over) at 80 Hz against the
+    Python controller: pitch within 0.01 deg and torque within 0.1 % of rated at every step,
+    DELs within 0.5 %."""
+    dp, dq, py, lib = _compare(nrel5mw, "lqr-pio", lqr_export, wind)
+    assert dp <= 0.01 and dq <= 1e-3, (dp, dq)
+    _check_dels(py, lib)
+
+
+@pytest.mark.parametrize("wind", [8.0, 12.0, 18.0])
+def test_ts_library_runs_as_the_python_controller(nrel5mw, ts_export, wind):
+    """The Takagi-Sugeno controller (memberships over wind and power reduction, the wind
+    observer's blended zero-order-hold maps on the tower-top accelerations and the speeds, the
+    PDC law with its integral and anti-windup, the start from the measured pitch, the
+    baseline's torque schedule) at 80 Hz against the Python controller: pitch within 0.01 deg
+    and torque within 0.1 % of rated at every step, DELs within 0.5 %."""
+    dp, dq, py, lib = _compare(nrel5mw, "ts", ts_export, wind)
+    assert dp <= 0.01 and dq <= 1e-3, (dp, dq)
+    _check_dels(py, lib)
+
+
+def test_designs_that_know_more_than_measurements_do_not_export(nrel5mw, tmp_path):
+    """The paper's measurement sets (tower-top and flap displacements, which no swap record
+    carries), a TS power reduction over time and a single-point LQR are refused by name."""
+    for kind, opts, words in (
+            ("lqr-pio", {"observer_signals": "paper"}, "flap_1"),
+            ("ts", {"observer_signals": "paper"}, "tower_ss_displacement"),
+            ("ts", {"apc_frequency": 0.1}, "apc_frequency"),
+            ("lqr-pio", {"design_wind_mps": 18.0}, "design_wind_mps")):
+        with pytest.raises(ValueError, match=words):
+            export_discon(nrel5mw, kind, tmp_path / kind, opts, build=False)
 
 
 def test_mpc_qp_over_budget_takes_the_logged_fallback(nrel5mw, mpc_export, tmp_path, caplog):
@@ -362,6 +408,40 @@ def test_bad_input_file_fails_with_the_file_and_key(nrel5mw, baseline_export, tm
         assert "bad.in" in msg
 
 
+@pytest.mark.parametrize("kind, edit, words", [
+    ("lqr-pio", lambda t: t.replace("\npoint.3.sizes ", "\npoint.3.sizes 14 3 5 4 3 7 1 # "),
+     ["'point.3.sizes'", "region 2 or 3"]),
+    ("lqr-pio", lambda t: t.replace("\nsignals ", "\nsignals 1 8 5 6 12 # "),
+     ["'signals'", "value 5 is 12"]),
+    ("lqr-pio", lambda t: "\n".join(l for l in t.splitlines()
+                                     if not l.startswith("point.20.bd ")), ["'point.20.bd'"]),
+    ("ts", lambda t: t.replace("\nterms ", "\nterms 0 # "), ["'terms'", "pairs"]),
+    ("ts", lambda t: t.replace("\nstart_pitch ", "\nstart_pitch 0.3 0.2 0.1 0 0 0 # "),
+     ["'start_pitch'", "must not decrease"]),
+    ("ts", lambda t: t.replace("\nsizes ", "\nsizes 6 3 8 2 4 7 2 0 # "),
+     ["'sizes'", "gain columns"]),
+])
+def test_bad_lqr_and_ts_input_files_name_the_key(nrel5mw, lqr_export, ts_export, tmp_path,
+                                                  kind, edit, words):
+    """A corrupt LQR-PIO or TS input file stops the first call with aviFAIL < 0 and a message
+    naming the file and the key."""
+    ex = lqr_export if kind == "lqr-pio" else ts_export
+    text = edit(ex.input_file.read_text())
+    assert text != ex.input_file.read_text()
+    path = tmp_path / "bad.in"
+    path.write_text(text)
+    ctl = DisconController(ex.library, path, nrel5mw, dt=ex.dt)
+    ctl.reset()
+    with pytest.raises(ControllerLibraryError) as err:
+        ctl.step(0.0, {"gen_speed": 120.0, "rotor_speed": 1.2, "pitch": np.zeros(3),
+                       "flap_moment": np.zeros(3), "edge_moment": np.zeros(3)})
+    ctl.finalize()
+    msg = str(err.value)
+    assert "aviFAIL = -1" in msg and "bad.in" in msg
+    for w in words:
+        assert w in msg, (w, msg)
+
+
 def test_non_finite_speed_stops_with_the_record(baseline_export, tmp_path):
     lib = _Lib(_copy(baseline_export.library, tmp_path, "nan.so"))
     inp = baseline_export.input_file
@@ -384,14 +464,15 @@ def _asan_runtime() -> str | None:
 
 @pytest.mark.skipif(_asan_runtime() is None, reason="no AddressSanitizer runtime (libasan)")
 def test_sanitized_libraries_run_60_s_clean(baseline_export, mpc_export, mpc_lidar_export,
-                                             tmp_path):
-    """The baseline, the MPC and the MPC with LIDAR preview built with
-    -fsanitize=address,undefined (any report aborts), 60 s of turbulent closed loop each in a
-    process that loads the sanitizer runtime first: exit 0, no report, no warning from the
-    library."""
+                                             lqr_export, ts_export, tmp_path):
+    """The baseline, the MPC, the MPC with LIDAR preview, the LQR-PIO and the TS controller
+    built with -fsanitize=address,undefined (any report aborts), 60 s of turbulent closed loop
+    each in a process that loads the sanitizer runtime first: exit 0, no report, no warning
+    from the library."""
     runs = []
     for which, ex in (("baseline", baseline_export), ("mpc", mpc_export),
-                      ("mpc-lidar", mpc_lidar_export)):
+                      ("mpc-lidar", mpc_lidar_export), ("lqr-pio", lqr_export),
+                      ("ts", ts_export)):
         d = tmp_path / which
         (d / "daqp").mkdir(parents=True)
         for p in ex.sources:
@@ -413,7 +494,7 @@ def test_sanitized_libraries_run_60_s_clean(baseline_export, mpc_export, mpc_lid
                          env=env, timeout=600)
     assert out.returncode == 0, out.stderr[-3000:]
     assert "AddressSanitizer" not in out.stderr and "runtime error" not in out.stderr
-    assert out.stdout.count("steps 4801 warnings 0") == 3, out.stdout
+    assert out.stdout.count("steps 4801 warnings 0") == 5, out.stdout
 
 
 def test_kinds_that_do_not_export_are_named(nrel5mw, tmp_path):
@@ -488,3 +569,34 @@ def test_cli_design_lidar_ff_then_export_discon(tmp_path, capsys):
     assert main(["export", str(d), "--format", "discon"]) == 0
     assert "kind baseline" in (d / "mpcwt_baseline_lidar_ff.in").read_text()
     assert "feedforward" in (d / "mpcwt_baseline_lidar_ff.in").read_text()
+
+
+def test_cli_design_lqr_pio_and_ts_then_export_discon(tmp_path, capsys):
+    """``mpcwt design lqr-pio`` tabulates the scheduled designs from cut-in to cut-out (region
+    II below the rated wind, III above) and ``mpcwt design ts`` the TS vertices; both export
+    as libraries built again from the design's options. A TS design on another vertex grid
+    than the kind's is refused with both grids named."""
+    from mpc_wt.cli import main
+
+    d = tmp_path / "lqr"
+    assert main(["design", "lqr-pio", "--out", str(d)]) == 0
+    doc = json.loads((d / "design.json").read_text())
+    rows = np.array(doc["schedule"]["rows"])
+    rated = linearize.rated_wind_speed(linearize.load_turbine("nrel5mw"))
+    assert doc["kind"] == "lqr-pio" and rows[0, 0] == 3.0 and rows[-1, 0] == 25.0
+    assert np.all((rows[:, -1] == 2) == (rows[:, 0] < rated))
+    assert doc["settings"]["measured"][1] == "tower_fa_acceleration"
+    assert main(["export", str(d), "--format", "discon"]) == 0
+    assert "libmpcwt_lqr_pio" in capsys.readouterr().out
+    assert "kind lqr" in (d / "mpcwt_lqr_pio.in").read_text()
+    t = tmp_path / "ts"
+    assert main(["design", "ts", "--out", str(t)]) == 0
+    assert main(["export", str(t), "--format", "discon"]) == 0
+    assert "kind ts" in (t / "mpcwt_ts.in").read_text()
+    doc = json.loads((t / "design.json").read_text())
+    doc["settings"]["wind_grid"] = [12.0, 18.0, 25.0]
+    (t / "design.json").write_text(json.dumps(doc))
+    capsys.readouterr()
+    assert main(["export", str(t), "--format", "discon"]) != 0
+    err = capsys.readouterr().err
+    assert "[12.0, 18.0, 25.0]" in err and "[12.0, 14.0, 16.0, 19.0, 22.0, 25.0]" in err

@@ -41,7 +41,7 @@ from mpc_wt.errors import SynthesisError
 
 __all__ = ["LQRDesign", "PIObserver", "design_lqr", "design_lqr_family", "design_pi_observer",
            "LQRPIOController", "ScheduledLQRPIO", "SynthesisError", "REGION3_WEIGHTS",
-           "REGION3_SCALES", "PAPER_MEASURED", "TURBINE_MEASURED", "TURBINE_SCALES"]
+           "REGION3_SCALES", "PAPER_MEASURED", "TURBINE_MEASURED", "turbine_scales"]
 
 #: Region-III LQR weights that hold the loop stable with the PI observer (q = 1e3) on the
 #: nonlinear plant: rotor-speed regulation and tower fore-aft damping (``state_weights``).
@@ -64,12 +64,35 @@ PAPER_MEASURED = ("gen_speed", "tower_fa_displacement", "flap_1", "flap_2", "fla
 #: generator speed, tower-top fore-aft acceleration and the blade root out-of-plane moments.
 TURBINE_MEASURED = ("gen_speed", "tower_fa_acceleration", "flap_moment_1", "flap_moment_2",
                     "flap_moment_3")
-#: Their scales for the observer's R = I (``scales``): the magnitudes one metre of tower-top or
-#: flap tip displacement gives on the NREL 5-MW (tower first mode about 4.4 m/s^2 per metre at
-#: its frequency, about 1.7 MN m of root moment per metre of flap), so the two sets weigh the
-#: structure alike.
-TURBINE_SCALES = {"gen_speed": 1.0, "tower_fa_acceleration": 4.4,
-                  **{f"flap_moment_{i}": 1.7e6 for i in (1, 2, 3)}}
+
+
+def turbine_scales(model: linearize.LinearModel) -> dict[str, float]:
+    """Scales of :data:`TURBINE_MEASURED` for the observer's R = I (``scales`` of
+    :func:`design_pi_observer`): what one metre of tower-top or flap tip displacement gives in
+    the model (the NREL 5-MW: 4.4 m/s^2 of tower-top acceleration, 1.7 MN m of root moment), so
+    that they weigh the structure as :data:`PAPER_MEASURED`'s displacements (scale 1 m) do.
+
+    Parameters
+    ----------
+    model : LinearModel
+        The model the observer is designed on.
+
+    Returns
+    -------
+    dict of str to float
+        Generator speed 1 rad/s, the acceleration [m/s^2] and the moments [N m].
+    """
+    def gain(output: str, state: str) -> float:
+        return abs(float(model.C_z[model.outputs.index(output), model.states.index(state)]))
+
+    out = {"gen_speed": 1.0,
+           "tower_fa_acceleration": gain("tower_fa_acceleration", "tower_fa_displacement")}
+    out.update({f"flap_moment_{i}": gain(f"flap_moment_{i}", f"flap_{i}") for i in (1, 2, 3)})
+    bad = {k: v for k, v in out.items() if not (math.isfinite(v) and v > 0)}
+    if bad:
+        raise ValueError(f"the model gives no scale for {sorted(bad)} (zero or non-finite "
+                         f"sensitivity to the displacement)")
+    return out
 
 
 def _names(model: linearize.LinearModel) -> dict[str, tuple[np.ndarray, str]]:

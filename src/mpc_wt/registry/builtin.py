@@ -696,10 +696,10 @@ def _lqr_pio_at(turbine: linearize.Turbine, model: linearize.LinearModel, wind: 
         REGION2_SCALES,
         REGION3_SCALES,
         TURBINE_MEASURED,
-        TURBINE_SCALES,
         LQRPIOController,
         design_lqr,
         design_pi_observer,
+        turbine_scales,
     )
 
     region = "II" if wind < linearize.rated_wind_speed(turbine) else "III"
@@ -708,7 +708,7 @@ def _lqr_pio_at(turbine: linearize.Turbine, model: linearize.LinearModel, wind: 
                     scales={**REGION2_SCALES, **REGION3_SCALES})
     if opts.observer_signals == "turbine":
         obs = design_pi_observer(model, q=opts.observer_q, measured=TURBINE_MEASURED,
-                                 scales=TURBINE_SCALES)
+                                 scales=turbine_scales(model))
     else:
         obs = design_pi_observer(model, q=opts.observer_q, measured=PAPER_MEASURED)
     return LQRPIOController(model, turbine, lq, obs,

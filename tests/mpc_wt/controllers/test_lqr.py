@@ -14,10 +14,12 @@ import linearize
 from mpc_wt.controllers.lqr import (
     REGION3_SCALES,
     REGION3_WEIGHTS,
+    TURBINE_MEASURED,
     LQRPIOController,
     design_lqr,
     design_lqr_family,
     design_pi_observer,
+    turbine_scales,
 )
 from mpc_wt.errors import SynthesisError
 
@@ -134,6 +136,40 @@ def test_pi_observer_recovers_a_constant_unknown_input(do_model) -> None:
     xe = -np.linalg.solve(ao, ob.B_e @ u + ob.L @ y)
     np.testing.assert_allclose(xe[nx:], f, rtol=1e-6, atol=1e-9)
     np.testing.assert_allclose(xe[:nx], x_ss, rtol=1e-6, atol=1e-9)
+
+
+def test_pi_observer_on_turbine_measurements_recovers_a_constant_wind(do_model) -> None:
+    """Generator speed, tower-top acceleration and root moments (what a turbine's controller
+    gets), generated from the model's own output equations with the wind's direct part
+    (z = C_z x + D_u u + D_d f): the observer's steady state has the wind deviation and the
+    states exactly. (An observer that left out D_d would read the moments' direct response to
+    the wind as flap deflection.)"""
+    ob = design_pi_observer(do_model, q=1e3, measured=TURBINE_MEASURED,
+                            scales=turbine_scales(do_model))
+    nx = do_model.A.shape[0]
+    f = np.array([0.8, -0.4, 0.3])
+    lq = design_lqr(do_model)
+    acl = do_model.A - do_model.B_u[:, :3] @ lq.K
+    x_ss = -np.linalg.solve(acl, do_model.B_d @ f)
+    u = np.zeros(4)
+    u[:3] = -lq.K @ x_ss
+    rows = [do_model.outputs.index(n) for n in TURBINE_MEASURED]
+    y = do_model.C_z[rows] @ x_ss + do_model.D_u[rows] @ u + do_model.D_d[rows] @ f
+    xe = -np.linalg.solve(ob.A_e - ob.L @ ob.C_e, (ob.B_e - ob.L @ ob.D_e) @ u + ob.L @ y)
+    np.testing.assert_allclose(xe[nx:], f, rtol=1e-6, atol=1e-9)
+    np.testing.assert_allclose(xe[:nx], x_ss, rtol=1e-6, atol=1e-9)
+
+
+def test_turbine_scales_are_the_structures_response(do_model) -> None:
+    """The tower-top acceleration per metre of displacement is the first fore-aft mode's
+    (2 pi f)^2: f = 0.324 Hz for the NREL 5-MW (Jonkman et al. 2009, table 9-1, 0.3240 Hz),
+    within 10 % (the model's tower carries the nacelle's rotary inertia and aerodynamic
+    stiffness)."""
+    s = turbine_scales(do_model)
+    assert s["tower_fa_acceleration"] == pytest.approx((2 * math.pi * 0.324) ** 2, rel=0.1)
+    assert s["flap_moment_1"] > 1e5
+    assert s["flap_moment_2"] == pytest.approx(s["flap_moment_1"], rel=1e-9)
+    assert s["flap_moment_3"] == pytest.approx(s["flap_moment_1"], rel=1e-9)
 
 
 @pytest.mark.parametrize("kwargs, match", [

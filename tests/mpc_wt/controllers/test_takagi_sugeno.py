@@ -14,6 +14,7 @@ import lidar
 import linearize
 from mpc_wt.controllers.apc import apc_reference
 from mpc_wt.controllers.takagi_sugeno import (
+    TURBINE_MEASURED,
     TSController,
     build_ts_model,
     design_ts_controller,
@@ -133,6 +134,31 @@ def test_bad_design_input(ts) -> None:
         design_ts_observer(ts, tau_v=0.0)
     with pytest.raises(ValueError, match="reduction_grid values must be in"):
         build_ts_model(linearize.load_turbine(), (14.0, 16.0), (0.0, 1.0))
+
+
+def test_measured_accelerations_are_the_velocity_equations(turbine) -> None:
+    """With the tower-top accelerations measured (what a turbine's controller gets), each
+    vertex's measurement rows are the tower velocities' rows of its state equation (the
+    acceleration is the velocity's derivative: C = A, D = B, E = B_d rows), and at the vertex
+    equilibrium they read zero (to the trim's residual, 1e-5 m/s^2); the speeds are unit rows. The observer designed on them is
+    certified (with the cross conditions of vertices measuring differently)."""
+    ts = build_ts_model(turbine, wind_grid=(12.0, 18.0, 25.0), reduction_grid=(0.0, 0.8),
+                        measured=TURBINE_MEASURED)
+    assert not ts.common_output
+    for name, vel in (("tower_fa_acceleration", "tower_fa_velocity"),
+                      ("tower_ss_acceleration", "tower_ss_velocity")):
+        r, k = ts.measured.index(name), ts.states.index(vel)
+        for i in range(ts.n_vertices):
+            scale = np.abs(ts.A[i, k]).max()
+            np.testing.assert_allclose(ts.C[i, r], ts.A[i, k], atol=1e-6 * scale)
+            np.testing.assert_allclose(ts.D[i, r], ts.B[i, k],
+                                       atol=1e-6 * np.abs(ts.B[i, k]).max())
+            assert ts.E[i, r] == pytest.approx(ts.B_d[i, k], abs=1e-6 * abs(ts.B_d[i, k]))
+        assert np.all(np.abs(ts.y0[:, r]) < 1e-5)        # m/s^2: the trim's residual
+    r = ts.measured.index("rotor_speed")
+    assert np.all(ts.C[:, r] == np.eye(len(ts.states))[ts.states.index("rotor_speed")])
+    obs = design_ts_observer(ts)
+    assert obs.certificate.ok, obs.certificate.failures
 
 
 def test_unobservable_wind_is_refused(ts) -> None:

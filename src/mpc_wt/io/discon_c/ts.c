@@ -190,11 +190,16 @@ static int read_terms(const mw_input *in, mw_ts *c, char *msg)
     double *t;
     int n, i;
     if (!(t = mw_getp_alloc(in, "", "terms", &n, msg))) return -1;
+    if (n % 2) {
+        mw_msg(msg, "mpc-wt ts: input file '%s': key 'terms' needs pairs of vertex indices, "
+               "got %d values", in->path, n);
+        free(t);
+        return -1;
+    }
     c->nt = n / 2;
-    c->terms = (int *)malloc((size_t)(n > 0 ? n : 1) * sizeof(int));
-    if (!c->terms || n % 2) {
-        mw_msg(msg, n % 2 ? "mpc-wt ts: input file '%s': key 'terms' needs pairs of vertex "
-                            "indices, got %d values" : "mpc-wt ts: out of memory", in->path, n);
+    c->terms = (int *)malloc((size_t)n * sizeof(int));
+    if (!c->terms) {
+        mw_msg(msg, "mpc-wt ts: out of memory");
         free(t);
         return -1;
     }
