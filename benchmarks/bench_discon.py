@@ -7,9 +7,9 @@ Run:  python benchmarks/bench_discon.py [--json]
 Prints best-of-3 wall times of ``simulate_closed_loop`` for 600 s at 18 m/s, IEC class A, seed
 1, NREL 5-MW: ROSCO (the rosco package's libdiscon.so called at 80 Hz through ctypes) with the
 DISCON.IN exported from our baseline and with ROSCO's own NREL-5MW file (which writes a .dbg
-line per call), the baseline and the scheduled MPC exported as libraries by
-:func:`mpc_wt.run.export_discon` (built with the system's C compiler) beside our Python baseline
-and MPC; the real-time factors (floor for ROSCO: 30x), the
+line per call), the baseline, the scheduled MPC, the scheduled LQR-PIO and the TS controller
+exported as libraries by :func:`mpc_wt.run.export_discon` (built with the system's C compiler)
+beside the Python controllers they came from; the real-time factors (floor for ROSCO: 30x), the
 cost of one library call net of our baseline's (the difference over 48,000 calls), and the step
 time (median, p99) of the exported library (through ctypes, as the harness calls it) beside the
 Python controller's ``step`` over the same 600 s.
@@ -45,9 +45,11 @@ def main() -> int:
     runs = {"rosco": ("rosco", {}), "rosco_shipped": ("rosco", {"discon_in": "shipped"}),
             "baseline": ("baseline", {})}
     tmp = tempfile.TemporaryDirectory(prefix="mpcwt_bench_discon_")
-    runs["mpc"] = ("mpc", {})
+    exported = ("baseline", "mpc", "lqr-pio", "ts")
+    for kind in exported[1:]:
+        runs[kind] = (kind, {})
     if find_compiler() is not None:
-        for kind in ("baseline", "mpc"):
+        for kind in exported:
             ex = export_discon(t, kind, f"{tmp.name}/{kind}")
             runs[f"exported_{kind}"] = ("discon", {"discon_library": str(ex.library),
                                                    "discon_in": str(ex.input_file),
@@ -61,7 +63,8 @@ def main() -> int:
         best = min(timeit.repeat(run, number=1, repeat=3))
         res[key] = {"seconds": best, "real_time_factor": 600.0 / best}
     res["per_call_us"] = (res["rosco"]["seconds"] - res["baseline"]["seconds"]) / 48000 * 1e6
-    for key in ("baseline", "exported_baseline", "mpc", "exported_mpc"):
+    steps = [k for kind in exported for k in (kind, f"exported_{kind}")]
+    for key in steps:
         if key in runs:
             res[key]["step_us"] = _step_times(t, p, sc, *runs[key])
     tmp.cleanup()
@@ -73,7 +76,7 @@ def main() -> int:
         print(f"600 s, {key:17s}: {res[key]['seconds']:.2f} s "
               f"({res[key]['real_time_factor']:.0f}x real time)")
     print(f"ROSCO call through ctypes, net of our baseline: {res['per_call_us']:.1f} us")
-    for key in ("baseline", "exported_baseline", "mpc", "exported_mpc"):
+    for key in steps:
         if "step_us" in res.get(key, {}):
             med, p99, *call = res[key]["step_us"]
             print(f"step time, {key:17s}: median {med:.1f} us, p99 {p99:.1f} us"
