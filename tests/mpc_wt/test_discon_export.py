@@ -63,6 +63,11 @@ def lqr_export(nrel5mw, tmp_path_factory):
 
 
 @pytest.fixture(scope="module")
+def ibc_export(nrel5mw, tmp_path_factory):
+    return export_discon(nrel5mw, "ibc", tmp_path_factory.mktemp("ibc"))
+
+
+@pytest.fixture(scope="module")
 def ts_export(nrel5mw, tmp_path_factory):
     return export_discon(nrel5mw, "ts", tmp_path_factory.mktemp("ts"))
 
@@ -215,6 +220,37 @@ def test_ts_library_runs_as_the_python_controller(nrel5mw, ts_export, wind):
     dp, dq, py, lib = _compare(nrel5mw, "ts", ts_export, wind)
     assert dp <= 0.01 and dq <= 1e-3, (dp, dq)
     _check_dels(py, lib)
+
+
+@pytest.mark.parametrize("wind", [8.0, 12.0, 18.0])
+def test_ibc_library_runs_as_the_python_controller(nrel5mw, ibc_export, wind):
+    """Individual blade control on the baseline (the root moments high-passed, the gain
+    scheduled on the mean pitch, band-stopped at 3P, faded in with the low-passed power, the
+    blades' mean removed, limits and rate on the sum) at 80 Hz against the Python controller:
+    pitch within 0.01 deg and torque within 0.1 % of rated at every step, DELs within 0.5 %."""
+    dp, dq, py, lib = _compare(nrel5mw, "ibc", ibc_export, wind)
+    assert dp <= 0.01 and dq <= 1e-3, (dp, dq)
+    _check_dels(py, lib)
+
+
+def test_cli_design_ibc_then_export_discon(tmp_path, capsys):
+    """``mpcwt design ibc`` then ``mpcwt export --format discon`` builds IBC again with the
+    design's loop gain; a design on a derated baseline is refused with its power fraction."""
+    from mpc_wt.cli import main
+
+    d = tmp_path / "ibc"
+    assert main(["design", "ibc", "--loop-gain", "0.8", "--out", str(d)]) == 0
+    assert main(["export", str(d), "--format", "discon"]) == 0
+    text = (d / "mpcwt_ibc.in").read_text()
+    gains = json.loads((d / "design.json").read_text())["schedule"]["rows"]
+    lib = next(line for line in text.splitlines() if line.startswith("ibc_gain "))
+    assert [float(v) for v in lib.split()[1:]] == pytest.approx([r[2] for r in gains],
+                                                                 rel=1e-12)
+    e = tmp_path / "derated"
+    assert main(["design", "ibc", "--power-fraction", "0.8", "--out", str(e)]) == 0
+    capsys.readouterr()
+    assert main(["export", str(e), "--format", "discon"]) != 0
+    assert "power fraction 0.8" in capsys.readouterr().err
 
 
 def test_designs_that_know_more_than_measurements_do_not_export(nrel5mw, tmp_path):
@@ -464,15 +500,15 @@ def _asan_runtime() -> str | None:
 
 @pytest.mark.skipif(_asan_runtime() is None, reason="no AddressSanitizer runtime (libasan)")
 def test_sanitized_libraries_run_60_s_clean(baseline_export, mpc_export, mpc_lidar_export,
-                                             lqr_export, ts_export, tmp_path):
-    """The baseline, the MPC, the MPC with LIDAR preview, the LQR-PIO and the TS controller
-    built with -fsanitize=address,undefined (any report aborts), 60 s of turbulent closed loop
+                                             lqr_export, ts_export, ibc_export, tmp_path):
+    """The baseline, the MPC, the MPC with LIDAR preview, the LQR-PIO, the TS controller and
+    IBC built with -fsanitize=address,undefined (any report aborts), 60 s of turbulent closed loop
     each in a process that loads the sanitizer runtime first: exit 0, no report, no warning
     from the library."""
     runs = []
     for which, ex in (("baseline", baseline_export), ("mpc", mpc_export),
                       ("mpc-lidar", mpc_lidar_export), ("lqr-pio", lqr_export),
-                      ("ts", ts_export)):
+                      ("ts", ts_export), ("ibc", ibc_export)):
         d = tmp_path / which
         (d / "daqp").mkdir(parents=True)
         for p in ex.sources:
@@ -494,12 +530,12 @@ def test_sanitized_libraries_run_60_s_clean(baseline_export, mpc_export, mpc_lid
                          env=env, timeout=600)
     assert out.returncode == 0, out.stderr[-3000:]
     assert "AddressSanitizer" not in out.stderr and "runtime error" not in out.stderr
-    assert out.stdout.count("steps 4801 warnings 0") == 5, out.stdout
+    assert out.stdout.count("steps 4801 warnings 0") == 6, out.stdout
 
 
 def test_kinds_that_do_not_export_are_named(nrel5mw, tmp_path):
     with pytest.raises(ValueError, match="baseline"):
-        export_discon(nrel5mw, "ibc", tmp_path)
+        export_discon(nrel5mw, "coleman-ipc", tmp_path)
     with pytest.raises(ValueError, match="LIDAR"):
         from mpc_wt.io.discon_export import controller_input
         from mpc_wt.run import design_controller
@@ -518,8 +554,8 @@ def test_servodyn_template_without_the_keys(tmp_path, baseline_export):
 
 def test_cli_design_then_export_discon(tmp_path, capsys):
     """``mpcwt design baseline`` then ``mpcwt export --format discon``: the library of the
-    saved gains (a derated design keeps its derated rated power); an IBC design is refused with
-    the kinds that export."""
+    saved gains (a derated design keeps its derated rated power); a Coleman IPC design is
+    refused with the kinds that export."""
     from mpc_wt.cli import main
 
     d = tmp_path / "design"
@@ -531,11 +567,11 @@ def test_cli_design_then_export_discon(tmp_path, capsys):
                  if line.startswith("rated_power "))
     assert rated == pytest.approx(0.8 * 5e6)
     assert (d / "lib" / "ServoDyn_mpcwt_baseline.dat").is_file()
-    i = tmp_path / "ibc"
-    assert main(["design", "ibc", "--out", str(i)]) == 0
+    i = tmp_path / "coleman"
+    assert main(["design", "coleman-ipc", "--out", str(i)]) == 0
     assert main(["export", str(i), "--format", "discon"]) != 0
     err = capsys.readouterr().err
-    assert "'ibc' design does not export" in err and "baseline" in err
+    assert "'coleman-ipc' design does not export" in err and "baseline" in err
 
 
 def test_cli_design_mpc_then_export_discon(tmp_path, capsys):

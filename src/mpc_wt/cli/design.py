@@ -143,6 +143,12 @@ def _export_registered(args: argparse.Namespace, turbine: Any) -> list[Path] | N
                 f"{list(DEFAULT_REDUCTION_GRID)}); design it with the default --wind, or "
                 f"export a TSController built on your grid with "
                 f"mpc_wt.io.discon_export.export_controller")
+    if doc["kind"] == "ibc" and doc["settings"].get("power_fraction", 1.0) != 1.0:
+        raise UsageError(
+            f"{args.design}: this IBC design is on a derated baseline (power fraction "
+            f"{doc['settings']['power_fraction']:g}); the library exports IBC on the full-power "
+            f"baseline: design it without --power-fraction, or export an IBCController on "
+            f"your derated baseline with mpc_wt.io.discon_export.export_controller")
     p = Path(args.design)
     out = Path(args.to) if args.to else (p if p.is_dir() else p.parent)
     ex = export_discon(design_turbine(doc, turbine), doc["kind"], out,

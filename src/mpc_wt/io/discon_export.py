@@ -57,6 +57,9 @@ EXPORTABLE: dict[str, str] = {
                "blade root moments",
     "ts": "Clemens et al.'s Takagi-Sugeno controller and wind observer, observing the tower-top "
           "accelerations and the rotor and generator speeds",
+    "ibc": "Pettas and Cheng's individual blade control on the baseline: each blade's root "
+           "moment filtered, scaled by the gain scheduled on the mean pitch, faded in with the "
+           "power",
 }
 
 #: The kinds whose export builds the controller again from the options of their design
@@ -67,7 +70,7 @@ REBUILT = frozenset(EXPORTABLE) - {"baseline", "baseline-ct"}
 #: Library kinds (the input file's ``kind``) of the exported controller kinds.
 _LIBRARY_KIND = {"baseline": "baseline", "baseline-ct": "baseline", "mpc": "mpc",
                  "mpc-collective": "mpc", "mpc-lidar": "mpc", "baseline+lidar-ff": "baseline",
-                 "lqr-pio": "lqr", "ts": "ts"}
+                 "lqr-pio": "lqr", "ts": "ts", "ibc": "baseline"}
 
 #: The measured signals of the Kalman filter (MPC) and the observer (LQR-PIO) and their codes
 #: in the library.
@@ -82,7 +85,8 @@ SWAP_READ: dict[int, str] = {
     4: "blade 1 pitch [rad]", 33: "blade 2 pitch [rad]", 34: "blade 3 pitch [rad]",
     20: "generator speed [rad/s]", 21: "rotor speed [rad/s] (MPC, LQR-PIO, TS)",
     23: "measured generator torque [N m] (MPC, LQR-PIO)",
-    30: "blade 1 root out-of-plane moment [N m] (MPC, LQR-PIO; 31, 32 blades 2, 3)",
+    30: "blade 1 root out-of-plane moment [N m] (MPC, LQR-PIO, IBC; 31, 32 blades 2, 3)",
+    15: "measured electrical power [W] (IBC)",
     53: "tower-top fore-aft acceleration [m/s^2] (MPC, LQR-PIO, TS)",
     54: "tower-top side-side acceleration [m/s^2] (TS)", 49: "length of avcMSG",
     50: "length of accINFILE", 51: "length of avcOUTNAME",
@@ -99,8 +103,8 @@ SWAP_WRITTEN: dict[int, str] = {
     47: "generator torque demand [N m]", 48: "yaw rate demand (0)",
     55: "pitch override (0: off)", 56: "torque override (0: off)", 65: "logging channels (0)"}
 
-_SOURCES = ("mpcwt_discon.h", "input.c", "baseline.c", "windest.c", "mpc.c", "lqr.c", "ts.c",
-            "discon.c")
+_SOURCES = ("mpcwt_discon.h", "input.c", "baseline.c", "ibc.c", "windest.c", "mpc.c", "lqr.c",
+            "ts.c", "discon.c")
 _DAQP = "daqp"
 _CFLAGS = "-O2 -std=c99 -Wall -fPIC -fvisibility=hidden"
 _SANITIZE = "-O1 -g -fno-omit-frame-pointer -fsanitize=address,undefined " \
@@ -245,6 +249,36 @@ def _baseline_entries(ctl: Any, prefix: str = "") -> list[tuple[str, Any, str]]:
          "1: constant power above rated, 0: constant torque"),
     ]
     return [(prefix + k, v, doc) for k, v, doc in rows]
+
+
+def _ibc_entries(ctl: Any) -> list[tuple[str, Any, str]]:
+    """An :class:`~mpc_wt.controllers.ipc.IBCController` on the baseline: the baseline's law
+    and the IBC's gain schedule, filters (second-order sections and their unit-step states),
+    power fade-in and limits."""
+    from mpc_wt.controllers.ipc import IBCController
+
+    if type(ctl) is not IBCController:
+        raise ValueError(f"the IBC export takes an IBCController, got {type(ctl).__name__}")
+    g = ctl.gains
+    return _baseline_entries(ctl.collective) + [
+        ("feedforward", 0.0, "no LIDAR feedforward"),
+        ("ibc", 1.0, "1: individual blade control on the collective command"),
+        ("ibc_settings", np.array([g.weight_range[0], g.weight_range[1], g.rated_power,
+                                   math.exp(-ctl.dt / ctl.power_tau), ctl.pitch_min,
+                                   ctl.pitch_max, ctl.step_max / ctl.dt,
+                                   float(ctl.remove_collective)], float),
+         "the fade-in's power fractions [-], the power it refers to [W], the power filter's "
+         "pole, pitch min, max [rad], pitch rate [rad/s], 1: the blades' mean removed"),
+        ("ibc_gain_pitch", np.asarray(g.pitch_rad, float), "mean pitch of the gain schedule "
+                                                           "[rad]"),
+        ("ibc_gain", np.asarray(g.gain, float), "gain [rad/(N m)]"),
+        ("ibc_input_sos", ctl._hp.sos.ravel(), "input (high-pass) sections b0 b1 b2 a0 a1 a2"),
+        ("ibc_input_zi", np.asarray(ctl._hp._zi1, float).ravel(),
+         "their state at a unit input's steady state"),
+        ("ibc_output_sos", ctl._bs.sos.ravel(), "output (band-stop, low-pass) sections"),
+        ("ibc_output_zi", np.asarray(ctl._bs._zi1, float).ravel(),
+         "their state at a unit input's steady state"),
+    ]
 
 
 def _ff_entries(ctl: Any) -> list[tuple[str, Any, str]]:
@@ -574,8 +608,11 @@ def controller_input(controller: Any, kind: str, turbine: linearize.Turbine,
     lib_kind = _LIBRARY_KIND[kind]
     if kind == "baseline+lidar-ff":
         entries = _ff_entries(controller)
+    elif kind == "ibc":
+        entries = _ibc_entries(controller)
     elif lib_kind == "baseline":
-        entries = _baseline_entries(controller) + [("feedforward", 0.0, "no LIDAR feedforward")]
+        entries = _baseline_entries(controller) + [("feedforward", 0.0, "no LIDAR feedforward"),
+                                                   ("ibc", 0.0, "no individual blade control")]
     elif lib_kind == "lqr":
         entries = _lqr_entries(controller)
     elif lib_kind == "ts":

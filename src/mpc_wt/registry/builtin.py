@@ -32,7 +32,9 @@ def _design_ibc(turbine: linearize.Turbine, *, power_fraction: float = 1.0,
     from mpc_wt.io.gain_tables import ibc_table
 
     g = tune_ibc(turbine, power_fraction=power_fraction, loop_gain_1p=loop_gain)
-    return ibc_table(turbine, g), (f"{g.gain.size} points, gain margin >= "
+    doc = ibc_table(turbine, g)
+    doc["settings"]["options"] = {"loop_gain_1p": float(loop_gain)}
+    return doc, (f"{g.gain.size} points, gain margin >= "
                                    f"{g.gain_margin.min():.3g}, high-pass {g.highpass_hz:.3g} Hz")
 
 

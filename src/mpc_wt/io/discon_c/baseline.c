@@ -32,6 +32,7 @@ typedef struct {
     mw_ctrl base;
     mw_law law;
     mw_ff ff;
+    mw_ibc ibc;
     /* state */
     double w_filt, integral, last_pitch, last_tq;
     int started;
@@ -284,6 +285,10 @@ static int baseline_step(mw_ctrl *self, const mw_meas *m, mw_cmd *out, char *msg
     b->started = 1;
     out->pitch[0] = out->pitch[1] = out->pitch[2] = p;
     out->torque = tq;
+    if (b->ibc.on) {
+        double pc[3] = {p, p, p};
+        return mw_ibc_step(&b->ibc, m, c->dt, pc, out->pitch, msg);
+    }
     return 0;
 }
 
@@ -296,6 +301,7 @@ static void baseline_destroy(mw_ctrl *self)
     free(b->ff.cp);
     free(b->ff.arr);
     free(b->ff.val);
+    mw_ibc_free(&b->ibc);
     free(self);
 }
 
@@ -345,9 +351,11 @@ mw_ctrl *mw_baseline_new(const mw_input *in, char *msg)
         return NULL;
     }
     {
-        int ff = 0;
+        int ff = 0, ibc = 0;
         if (mw_law_read(in, "", &b->law, msg) || mw_get_int(in, "feedforward", 0, 1, &ff, msg)
-            || (ff && ff_read(in, &b->ff, msg))) {
+            || (ff && ff_read(in, &b->ff, msg))
+            || (mw_has(in, "ibc") && mw_get_int(in, "ibc", 0, 1, &ibc, msg))
+            || (ibc && mw_ibc_read(in, &b->ibc, msg))) {
             baseline_destroy(&b->base);
             return NULL;
         }

@@ -139,6 +139,14 @@ static int find(const mw_input *in, const char *key, char *msg)
     return -1;
 }
 
+int mw_has(const mw_input *in, const char *key)
+{
+    int j;
+    for (j = 0; j < in->n; j++)
+        if (strcmp(in->key[j], key) == 0) return 1;
+    return 0;
+}
+
 int mw_count(const mw_input *in, const char *key, char *msg)
 {
     int j = find(in, key, msg), n = 0;

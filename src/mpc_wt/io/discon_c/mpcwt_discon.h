@@ -120,6 +120,20 @@ typedef struct {
 int mw_torque_law_read(const mw_input *in, mw_torque_law *t, char *msg);
 double mw_torque_law_step(mw_torque_law *t, double gen_speed, double pitch, double power);
 
+/* individual blade control added to a collective command (ibc.c) */
+typedef struct {
+    int on, ng, nhp, nbs, remove_mean, hp_started, bs_started, has_p, has_last;
+    double *gp, *gg, *hp, *hp_zi1, *hp_zi, *bs, *bs_zi1, *bs_zi;
+    double w_lo, w_hi, rated, p_alpha, pmin, pmax, rate, p_filt, last[3];
+} mw_ibc;
+int mw_ibc_read(const mw_input *in, mw_ibc *b, char *msg);
+void mw_ibc_free(mw_ibc *b);
+/* the blades' pitch demands from the collective ones pc; -1 with msg on a non-finite input */
+int mw_ibc_step(mw_ibc *b, const mw_meas *m, double dt, const double *pc, double *out,
+                char *msg);
+/* whether the input file has a key */
+int mw_has(const mw_input *in, const char *key);
+
 /* a controller of `size` bytes (its mw_ctrl first) read by `read`; NULL with msg on failure
  * (then `destroy` has freed what `read` allocated) */
 mw_ctrl *mw_ctrl_new(size_t size, const char *who,
