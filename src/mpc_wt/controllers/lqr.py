@@ -315,6 +315,24 @@ class PIObserver:
         return np.vstack([self.L1, self.L2])
 
 
+def _measurement_rows(model: linearize.LinearModel, measured: Sequence[str], nf: int,
+                      wind_feedthrough: bool) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """C_e, D_e and y0 of the measured names over [x; f]: a state's unit row, an output's
+    model rows; an output the wind moves directly (a root moment, an acceleration) sees the
+    unknown inputs through D_d when they are the model's disturbances (``wind_feedthrough``)."""
+    names = _names(model)
+    out = [names[n][1] == "output" for n in measured]
+    rows = [model.outputs.index(n) if o else -1 for n, o in zip(measured, out)]
+    c = np.array([names[n][0] for n in measured])
+    nu = model.B_u.shape[1]
+    du = np.array([model.D_u[r] if o else np.zeros(nu) for r, o in zip(rows, out)])
+    y0 = np.array([model.z0[r] if o else model.x0[model.states.index(n)]
+                   for n, r, o in zip(measured, rows, out)])
+    cf = np.array([model.D_d[r] if o and wind_feedthrough else np.zeros(nf)
+                   for r, o in zip(rows, out)]).reshape(len(measured), nf)
+    return np.hstack([c, cf]), du, y0
+
+
 def design_pi_observer(model: linearize.LinearModel, *,
                        measured: Sequence[str] = PAPER_MEASURED,
                        unknown_inputs: np.ndarray | None = None, q: float = 1e3,
@@ -360,11 +378,6 @@ def design_pi_observer(model: linearize.LinearModel, *,
     sy = np.array([scales.get(n, 1.0) for n in measured])
     if not np.all(np.isfinite(sy) & (sy > 0)):
         raise ValueError(f"scales must be finite and > 0, got {scales!r}")
-    c = np.array([names[n][0] for n in measured])
-    du = np.array([model.D_u[model.outputs.index(n)] if names[n][1] == "output"
-                   else np.zeros(model.B_u.shape[1]) for n in measured])
-    y0 = np.array([model.z0[model.outputs.index(n)] if names[n][1] == "output"
-                   else model.x0[model.states.index(n)] for n in measured])
     nmat = model.B_d if unknown_inputs is None else np.asarray(unknown_inputs, float)
     nx = model.A.shape[0]
     if nmat.ndim != 2 or nmat.shape[0] != nx:
@@ -373,13 +386,7 @@ def design_pi_observer(model: linearize.LinearModel, *,
     nf = nmat.shape[1]
     ae = np.block([[model.A, nmat], [np.zeros((nf, nx + nf))]])
     be = np.vstack([model.B_u, np.zeros((nf, model.B_u.shape[1]))])
-    # an output the wind moves directly (a root moment, an acceleration) sees the unknown
-    # inputs through D_d when they are the model's disturbances
-    cf = np.zeros((len(measured), nf))
-    if unknown_inputs is None:
-        cf = np.array([model.D_d[model.outputs.index(n)] if names[n][1] == "output"
-                       else np.zeros(nf) for n in measured])
-    ce = np.hstack([c, cf])
+    ce, du, y0 = _measurement_rows(model, measured, nf, unknown_inputs is None)
     ces = ce / sy[:, None]
     modes = uncontrollable_modes(ae.T, ces.T, discrete=False)
     if modes:

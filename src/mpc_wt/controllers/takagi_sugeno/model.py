@@ -159,8 +159,14 @@ class TSModel:
         return bool(np.all(self.C == self.C[0]) and not np.any(self.D) and not np.any(self.E))
 
     def output_offset(self) -> np.ndarray:
-        """(N, n_y) y0_i - C_i x0_i - D_i u0_i - E_i v0_i: a measurement at vertex i is
-        C_i x + D_i u + E_i v + this."""
+        """The measurements' offsets: at vertex i a measurement is C_i x + D_i u + E_i v plus
+        this.
+
+        Returns
+        -------
+        (N, n_y) ndarray
+            y0_i - C_i x0_i - D_i u0_i - E_i v0_i [measurement units].
+        """
         return (self.y0 - np.einsum("iyx,ix->iy", self.C, self.x0)
                 - np.einsum("iyu,iu->iy", self.D, self.u0) - self.E * self.v0[:, None])
 
