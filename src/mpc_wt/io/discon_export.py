@@ -553,8 +553,10 @@ def _ts_entries(ctl: Any) -> list[tuple[str, Any, str]]:
          "integral state (-1: none), 1: the TS law's torque applied"),
         ("signals", codes, "measured: " + ", ".join(ts.measured)),
         ("limits", np.array([pa.min_pitch_rad, pa.max_pitch_rad, gen.min_torque,
-                             gen.max_torque], float), "pitch min, max [rad], torque min, max "
-                                                      "[N m]"),
+                             gen.max_torque,
+                             ctl._reach if math.isfinite(ctl._reach) else -1.0], float),
+         "pitch min, max [rad], torque min, max [N m], how far a pitch command may lead the "
+         "measured pitch [rad] (-1: no bound)"),
         ("rated_power", float(ts.rated_power), "electrical power the torque schedule holds [W]"),
         ("integral_source", float(-1 if ctl._int_src is None else ctl._int_src),
          "the measurement whose deviation is integrated (-1: the estimate)"),

@@ -106,6 +106,11 @@ class TSController(ControllerBase):
             self._phi[k], self._gam[k] = e[:n, :n], e[:n, n:]
         self.torque_law = torque_law
         self._law = LawTorque(torque_law, dt) if torque_law is not None else None
+        # how far a command may lead the measured pitch: a first-order actuator (time
+        # constant tau) then moves at most at its rate
+        pa = turbine.pitch_actuator
+        self._reach = (pa.max_rate_rad_s * pa.time_constant if pa.time_constant > 0
+                       else math.inf)
         self._read = SignalReader(ts.measured)
         self._K = np.ascontiguousarray(controller.K, dtype=float)
         self._w = np.zeros((2, nv))
@@ -143,12 +148,14 @@ class TSController(ControllerBase):
             raise ValueError(f"power_reduction({t:g}) returned {dp_raw!r}")
         ts, pa, gen = self.ts, self.turbine.pitch_actuator, self.turbine.generator
         v_seen = float(self.xi[-1])
+        p = meas["pitch"]
+        pm = (float(p[0]) + float(p[1]) + float(p[2])) / 3.0
         q, dp, clipped = _ts_step(
             self.xi, self._u, y, dp_raw, ts.wind_grid, ts.reduction_grid, self._terms,
             self._phi, self._gam, ts.x0, ts.u0, self._K, -1 if self._ki is None else self._ki,
             -1 if self._int_src is None else self._int_src, self._q, self.dt,
-            pa.min_pitch_rad, pa.max_pitch_rad, gen.min_torque, gen.max_torque,
-            self.torque_law is None, self._w)
+            max(pa.min_pitch_rad, pm - self._reach), min(pa.max_pitch_rad, pm + self._reach),
+            gen.min_torque, gen.max_torque, self.torque_law is None, self._w)
         if clipped:
             self.premise_clipped += 1
             if not self._warned:

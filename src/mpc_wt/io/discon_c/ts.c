@@ -9,8 +9,9 @@
  *     xi <- sum_k w_k (Phi_k xi + Gamma_k [u; y; 1]).
  * The parallel-distributed law (eq 7) then blends the vertex gains at the new estimate,
  *     u = sum_i h_i (u0_i - K_i (x - x0_i) - K_q,i q),
- * q the integral of the rotor speed's deviation (held while an applied input saturates); above
- * the last vertex wind the pitch follows the last cell's slope. The generator torque is the
+ * q the integral of the rotor speed's deviation (held while an applied input saturates), the
+ * pitch kept to what the actuator can follow from the measured pitch; above the last vertex
+ * wind the pitch follows the last cell's slope. The generator torque is the
  * baseline's schedule on the low-passed generator speed (or the TS law's own). The estimate
  * starts at the vertex equilibrium whose pitch is the first measured pitch. */
 #include "mpcwt_discon.h"
@@ -23,7 +24,7 @@
 typedef struct {
     mw_ctrl base;
     int nv, nw, nr, n, nu, ny, nk, nt, ki, src, own_torque, has_law, started;
-    double dt, limits[4], rated_power;
+    double dt, limits[5], rated_power;
     double *wg, *rg, *phi, *gam, *x0, *u0, *kk, *eq_wind, *eq_pitch;
     int *terms, *signals, n_signals;
     /* state and scratch */
@@ -147,7 +148,7 @@ static double law_pdc(mw_ts *c, double *out)
 static int ts_step(mw_ctrl *self, const mw_meas *m, mw_cmd *out, char *msg)
 {
     mw_ts *c = (mw_ts *)self;
-    double raw[2], pitch, torque, q;
+    double raw[2], pitch, torque, q, lo, hi;
     int b;
     if (mw_signals_get(m, c->signals, c->n_signals, c->y, "ts", msg)) return -1;
     if (!mw_finite(m->pitch[0] + m->pitch[1] + m->pitch[2]) || !mw_finite(m->gen_speed)) {
@@ -158,7 +159,14 @@ static int ts_step(mw_ctrl *self, const mw_meas *m, mw_cmd *out, char *msg)
     if (!c->started) start(c, (m->pitch[0] + m->pitch[1] + m->pitch[2]) / 3.0);
     observe(c);
     q = law_pdc(c, raw);
-    pitch = dmin(dmax(raw[0], c->limits[0]), c->limits[1]);
+    lo = c->limits[0];
+    hi = c->limits[1];
+    if (c->limits[4] >= 0.0) {     /* what the actuator can follow from the measured pitch */
+        double pm = (m->pitch[0] + m->pitch[1] + m->pitch[2]) / 3.0;
+        lo = dmax(lo, pm - c->limits[4]);
+        hi = dmin(hi, pm + c->limits[4]);
+    }
+    pitch = dmin(dmax(raw[0], lo), hi);
     torque = dmin(dmax(raw[1], c->limits[2]), c->limits[3]);
     if (pitch != raw[0] || (c->own_torque && torque != raw[1])) q = c->q;   /* anti-windup */
     c->q = q;
@@ -223,7 +231,7 @@ static int ts_read(const mw_input *in, mw_ctrl *self, char *msg)
     double s[8];
     int i, nx;
     if (mw_get(in, "dt", &c->dt, msg) || mw_getp_vec(in, "", "sizes", s, 8, msg)
-        || mw_getp_vec(in, "", "limits", c->limits, 4, msg)
+        || mw_getp_vec(in, "", "limits", c->limits, 5, msg)
         || mw_get(in, "rated_power", &c->rated_power, msg)
         || mw_signals_read(in, "signals", "ts", &c->signals, &c->n_signals, msg))
         return -1;
