@@ -10,6 +10,7 @@ from __future__ import annotations
 import dataclasses
 import math
 from dataclasses import dataclass
+from pathlib import Path
 from typing import Any, Optional
 
 import numpy as np
@@ -906,13 +907,16 @@ def _build_rosco(ctx: BuildContext, opts: RoscoOptions) -> Built:
     from mpc_wt.controllers.discon import rosco_discon, rosco_library
 
     discon_in = opts.discon_in
+    source = {}
     if discon_in == "shipped":
         name = next((v for k, v in _ROSCO_FILES.items() if ctx.turbine.name.startswith(k)),
                     None)
         if name is None:
             raise ValueError(f"rosco: no DISCON.IN shipped for turbine {ctx.turbine.name!r}; "
                              f"give discon_in (--discon-in FILE)")
-        discon_in = str(rosco_discon(name))
+        source = {"shipped_file": str(rosco_discon(name))}
+        discon_in = ctx.cache.get(ctx.turbine, ("rosco-shipped", name),
+                                  lambda: _quiet_copy(rosco_discon(name)))
     elif discon_in is None:
         discon_in = ctx.cache.get(ctx.turbine, ("rosco-export", opts.power_fraction),
                                   lambda: _export_rosco(ctx.turbine, opts.power_fraction))
@@ -920,7 +924,32 @@ def _build_rosco(ctx: BuildContext, opts: RoscoOptions) -> Built:
     return _discon_built(ctx, rosco_library(), discon_in, opts, "rosco",
                          power_fraction=opts.power_fraction if ours else 1.0,
                          design=("ours" if ours else
-                                 "shipped" if opts.discon_in == "shipped" else "file"))
+                                 "shipped" if opts.discon_in == "shipped" else "file"),
+                         **source)
+
+
+def _quiet_copy(discon_in: Path) -> str:
+    """ROSCO's shipped DISCON.IN with ``LoggingLevel`` 0 (its debug file written every call
+    takes about a quarter of a run) and ``PerfFileName`` made absolute, in a folder kept for the
+    process; every control parameter as shipped."""
+    import atexit
+    import shutil
+    import tempfile
+
+    lines = discon_in.read_text().splitlines()
+    for i, line in enumerate(lines):
+        words = line.split()
+        if len(words) >= 3 and words[2] == "LoggingLevel":
+            lines[i] = "0" + line[len(words[0]):]
+        elif len(words) >= 3 and words[2] == "PerfFileName":
+            perf = words[0].strip('"')
+            if not Path(perf).is_absolute():
+                lines[i] = f'"{(discon_in.parent / perf).resolve()}"' + line[len(words[0]):]
+    folder = Path(tempfile.mkdtemp(prefix="mpcwt_rosco_shipped_"))
+    atexit.register(shutil.rmtree, folder, True)
+    out = folder / discon_in.name
+    out.write_text("\n".join(lines) + "\n")
+    return str(out)
 
 
 def _export_rosco(turbine: linearize.Turbine, power_fraction: float) -> str:

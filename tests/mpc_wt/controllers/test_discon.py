@@ -128,7 +128,8 @@ def test_library_stop_keeps_the_run(probe, tmp_path, turbine) -> None:
 
 def test_rosco_holds_rated_power_for_60s() -> None:
     """ROSCO's library with its own NREL-5MW DISCON.IN (constant power, set-point smoothing,
-    wind-speed estimator, peak shaving) on our plant, 60 s at 18 m/s.
+    wind-speed estimator, peak shaving) on our plant, 60 s at 18 m/s (run from a copy that
+    writes no debug file, every control parameter as shipped).
 
     Steady wind: 5 MW within 0.1 % and the generator within 0.1 % of rated speed after 10 s
     (measured 4e-6 and 5e-4). Class A, seed 1: it regulates, mean power within 5 % and speed
@@ -143,7 +144,15 @@ def test_rosco_holds_rated_power_for_60s() -> None:
         w = res.channel("gen_speed")[keep]
         assert np.all(np.abs(w / 122.909 - 1) <= tol_w), turbulence
         assert 0.0 <= res.channel("pitch_1").min() and res.channel("pitch_1").max() < 0.6
-        assert res.meta["rosco"]["discon_in"].endswith("NREL-5MW/DISCON.IN")
+        assert res.meta["rosco"]["shipped_file"].endswith("NREL-5MW/DISCON.IN")
+    # the file run is the shipped one but for no debug file and an absolute performance table
+    import pathlib
+    ran = pathlib.Path(res.meta["rosco"]["discon_in"]).read_text().splitlines()
+    shipped = pathlib.Path(res.meta["rosco"]["shipped_file"]).read_text().splitlines()
+    changed = [(a.split()[2], a.split()[0], b.split()[0]) for a, b in zip(shipped, ran) if a != b]
+    assert len(ran) == len(shipped) and [c[0] for c in changed] == ["LoggingLevel",
+                                                                     "PerfFileName"]
+    assert changed[0][1:] == ("1", "0") and pathlib.Path(changed[1][2].strip('"')).is_file()
 
 
 @pytest.mark.parametrize("what, match", [
