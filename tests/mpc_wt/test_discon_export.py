@@ -254,11 +254,11 @@ def test_cli_design_ibc_then_export_discon(tmp_path, capsys):
 
 
 def test_designs_that_know_more_than_measurements_do_not_export(nrel5mw, tmp_path):
-    """The paper's measurement sets (tower-top and flap displacements, which no swap record
-    carries), a TS power reduction over time and a single-point LQR are refused by name."""
+    """The paper's measurement set (flap displacements, which no swap record carries; TS's
+    tower-top displacements take the same check), a TS power reduction over time and a
+    single-point LQR are refused by name."""
     for kind, opts, words in (
             ("lqr-pio", {"observer_signals": "paper"}, "flap_1"),
-            ("ts", {"observer_signals": "paper"}, "tower_ss_displacement"),
             ("ts", {"apc_frequency": 0.1}, "apc_frequency"),
             ("lqr-pio", {"design_wind_mps": 18.0}, "design_wind_mps")):
         with pytest.raises(ValueError, match=words):
@@ -608,9 +608,9 @@ def test_cli_design_lidar_ff_then_export_discon(tmp_path, capsys):
 
 def test_cli_design_lqr_pio_and_ts_then_export_discon(tmp_path, capsys):
     """``mpcwt design lqr-pio`` tabulates the scheduled designs from cut-in to cut-out (region
-    II below the rated wind, III above) and ``mpcwt design ts`` the TS vertices; both export
-    as libraries built again from the design's options. A TS design on another vertex grid
-    than the kind's is refused with both grids named."""
+    II below the rated wind, III above) and exports as a library built again from the design's
+    options (the TS kind's export is the ``ts_export`` fixture's). A ``mpcwt design ts`` on
+    another vertex grid than the kind's is refused with both grids named."""
     from mpc_wt.cli import main
 
     d = tmp_path / "lqr"
@@ -625,13 +625,11 @@ def test_cli_design_lqr_pio_and_ts_then_export_discon(tmp_path, capsys):
     assert "libmpcwt_lqr_pio" in capsys.readouterr().out
     assert "kind lqr" in (d / "mpcwt_lqr_pio.in").read_text()
     t = tmp_path / "ts"
-    assert main(["design", "ts", "--out", str(t)]) == 0
-    assert main(["export", str(t), "--format", "discon"]) == 0
-    assert "kind ts" in (t / "mpcwt_ts.in").read_text()
+    assert main(["design", "ts", "--wind", "12:25:13", "--reductions", "0", "--out",
+                 str(t)]) == 0
     doc = json.loads((t / "design.json").read_text())
-    doc["settings"]["wind_grid"] = [12.0, 18.0, 25.0]
-    (t / "design.json").write_text(json.dumps(doc))
+    assert doc["settings"]["measured"][0] == "tower_fa_acceleration"
     capsys.readouterr()
     assert main(["export", str(t), "--format", "discon"]) != 0
     err = capsys.readouterr().err
-    assert "[12.0, 18.0, 25.0]" in err and "[12.0, 14.0, 16.0, 19.0, 22.0, 25.0]" in err
+    assert "[12.0, 25.0]" in err and "[12.0, 14.0, 16.0, 19.0, 22.0, 25.0]" in err
