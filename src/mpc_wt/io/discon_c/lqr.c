@@ -181,8 +181,8 @@ static int point_read(const mw_input *in, int k, int n_signals, mw_lqr_point *p,
         || !(p->y0 = mw_getp_alloc_n(in, pre, "y0", p->ny, msg))
         || !(p->u0 = mw_getp_alloc_n(in, pre, "u0", p->nu, msg))
         || !(p->x0d0 = mw_getp_alloc_n(in, pre, "x0d0", n, msg))
-        || !(gi = mw_getp_alloc_n(in, pre, "gain_inputs", p->ng, msg))
-        || mw_getp(in, pre, "k_opt", &p->k_opt, msg))
+        || mw_getp(in, pre, "k_opt", &p->k_opt, msg)
+        || !(gi = mw_getp_alloc_n(in, pre, "gain_inputs", p->ng, msg)))
         return -1;
     p->gi = (int *)malloc((size_t)p->ng * sizeof(int));
     p->xe = (double *)calloc((size_t)n, sizeof(double));
