@@ -37,39 +37,21 @@ def nrel5mw():
     return linearize.load_turbine("nrel5mw")
 
 
-@pytest.fixture(scope="module")
-def baseline_export(nrel5mw, tmp_path_factory):
-    return export_discon(nrel5mw, "baseline", tmp_path_factory.mktemp("baseline"))
+def _export_fixture(kind: str, folder: str):
+    """A module-scoped fixture: ``kind`` exported (and built) for the NREL 5-MW."""
+    @pytest.fixture(scope="module")
+    def exported(nrel5mw, tmp_path_factory):
+        return export_discon(nrel5mw, kind, tmp_path_factory.mktemp(folder))
+    return exported
 
 
-@pytest.fixture(scope="module")
-def mpc_export(nrel5mw, tmp_path_factory):
-    return export_discon(nrel5mw, "mpc", tmp_path_factory.mktemp("mpc"))
-
-
-@pytest.fixture(scope="module")
-def ff_export(nrel5mw, tmp_path_factory):
-    return export_discon(nrel5mw, "baseline+lidar-ff", tmp_path_factory.mktemp("ff"))
-
-
-@pytest.fixture(scope="module")
-def mpc_lidar_export(nrel5mw, tmp_path_factory):
-    return export_discon(nrel5mw, "mpc-lidar", tmp_path_factory.mktemp("mpc_lidar"))
-
-
-@pytest.fixture(scope="module")
-def lqr_export(nrel5mw, tmp_path_factory):
-    return export_discon(nrel5mw, "lqr-pio", tmp_path_factory.mktemp("lqr"))
-
-
-@pytest.fixture(scope="module")
-def ibc_export(nrel5mw, tmp_path_factory):
-    return export_discon(nrel5mw, "ibc", tmp_path_factory.mktemp("ibc"))
-
-
-@pytest.fixture(scope="module")
-def ts_export(nrel5mw, tmp_path_factory):
-    return export_discon(nrel5mw, "ts", tmp_path_factory.mktemp("ts"))
+baseline_export = _export_fixture("baseline", "baseline")
+mpc_export = _export_fixture("mpc", "mpc")
+ff_export = _export_fixture("baseline+lidar-ff", "ff")
+mpc_lidar_export = _export_fixture("mpc-lidar", "mpc_lidar")
+lqr_export = _export_fixture("lqr-pio", "lqr")
+ibc_export = _export_fixture("ibc", "ibc")
+ts_export = _export_fixture("ts", "ts")
 
 
 def _discon(ex):

@@ -928,14 +928,21 @@ def _build_rosco(ctx: BuildContext, opts: RoscoOptions) -> Built:
                          **source)
 
 
-def _quiet_copy(discon_in: Path) -> str:
-    """ROSCO's shipped DISCON.IN with ``LoggingLevel`` 0 (its debug file written every call
-    takes about a quarter of a run) and ``PerfFileName`` made absolute, in a folder kept for the
-    process; every control parameter as shipped."""
+def _process_folder(prefix: str) -> Path:
+    """A temporary folder kept for the process (removed when it exits)."""
     import atexit
     import shutil
     import tempfile
 
+    out = Path(tempfile.mkdtemp(prefix=prefix))
+    atexit.register(shutil.rmtree, out, ignore_errors=True)
+    return out
+
+
+def _quiet_copy(discon_in: Path) -> str:
+    """ROSCO's shipped DISCON.IN with ``LoggingLevel`` 0 (its debug file written every call
+    takes about a quarter of a run) and ``PerfFileName`` made absolute, in a folder kept for the
+    process; every control parameter as shipped."""
     lines = discon_in.read_text().splitlines()
     for i, line in enumerate(lines):
         words = line.split()
@@ -945,9 +952,7 @@ def _quiet_copy(discon_in: Path) -> str:
             perf = words[0].strip('"')
             if not Path(perf).is_absolute():
                 lines[i] = f'"{(discon_in.parent / perf).resolve()}"' + line[len(words[0]):]
-    folder = Path(tempfile.mkdtemp(prefix="mpcwt_rosco_shipped_"))
-    atexit.register(shutil.rmtree, folder, True)
-    out = folder / discon_in.name
+    out = _process_folder("mpcwt_rosco_shipped_") / discon_in.name
     out.write_text("\n".join(lines) + "\n")
     return str(out)
 
@@ -955,16 +960,11 @@ def _quiet_copy(discon_in: Path) -> str:
 def _export_rosco(turbine: linearize.Turbine, power_fraction: float) -> str:
     """Our baseline design as a ROSCO DISCON.IN in a folder kept for the process (removed when
     it exits)."""
-    import atexit
-    import shutil
-    import tempfile
-
     from mpc_wt.controllers.baseline import tune_baseline
     from mpc_wt.io.gain_tables import baseline_table
     from mpc_wt.io.rosco import write_rosco_discon
 
-    out = tempfile.mkdtemp(prefix="mpcwt_rosco_export_")
-    atexit.register(shutil.rmtree, out, ignore_errors=True)
+    out = _process_folder("mpcwt_rosco_export_")
     doc = baseline_table(turbine, tune_baseline(turbine, power_fraction=power_fraction))
     return str(write_rosco_discon(turbine, doc, out)[0])
 

@@ -88,8 +88,7 @@ class TSController(ControllerBase):
         if ts.common_output:
             terms = [(i, -1) for i in range(nv)]
         else:
-            terms = [(i, j) for i in range(nv) for j in range(nv)
-                     if any(i in cell and j in cell for cell in ts.cells())]
+            terms = ts.active_pairs()
         self._terms = np.array(terms, dtype=np.int64)
         self._phi = np.empty((len(terms), n, n))
         self._gam = np.empty((len(terms), n, nu + ny + 1))

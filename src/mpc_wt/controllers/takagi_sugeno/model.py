@@ -196,6 +196,17 @@ class TSModel:
                 out.append(tuple(i * nb + j for i in ia for j in ib))
         return out
 
+    def active_pairs(self) -> list[tuple[int, int]]:
+        """The ordered vertex pairs (i, j), i = j included, that can be active together (in
+        one cell).
+
+        Returns
+        -------
+        list of (int, int)
+            Sorted.
+        """
+        return sorted({(i, j) for cell in self.cells() for i in cell for j in cell})
+
     def check_premise(self, wind: float, reduction: float) -> None:
         """Raise :class:`PremiseError` unless [wind, reduction] lies in the vertex grid.
 

@@ -484,11 +484,6 @@ def _observer_mats(ts: TSModel, tau_v: float, sxi: np.ndarray, sy: np.ndarray
             np.array([np.diag(1 / sy) @ ci @ np.diag(sxi) for ci in cc]))
 
 
-def _pairs(ts: TSModel) -> list[tuple[int, int]]:
-    """The vertex pairs i < j that are active together (in one cell): the cross conditions of
-    an observer whose measurements differ between vertices."""
-    return sorted({(i, j) for cell in ts.cells() for i in cell for j in cell if i < j})
-
 
 def design_ts_observer(ts: TSModel, *, tau_v: float = 4.0, decay_rate: float = 1.0,
                        disk_radius: float | None = 60.0,
@@ -528,7 +523,8 @@ def design_ts_observer(ts: TSModel, *, tau_v: float = 4.0, decay_rate: float = 1
     a, c = _observer_mats(ts, float(tau_v), sxi, sy)
     _check_detectable(ts, a, c, alpha)
     prob, pv, nvar = _observer_problem(a, c, alpha, radius, margin,
-                                       [] if ts.common_output else _pairs(ts))
+                                       [] if ts.common_output else
+                                       [(i, j) for i, j in ts.active_pairs() if i < j])
     t0 = time.perf_counter()
     used, status = _solve(prob, solver)
     dt = time.perf_counter() - t0

@@ -130,21 +130,19 @@ int mw_input_read(mw_input *in, const char *path, char *msg)
     return 0;
 }
 
+/* the entry of key, or -1 (with msg unless msg is NULL) */
 static int find(const mw_input *in, const char *key, char *msg)
 {
     int j;
     for (j = 0; j < in->n; j++)
         if (strcmp(in->key[j], key) == 0) return j;
-    mw_msg(msg, "mpc-wt controller: input file '%s': key '%s' is missing", in->path, key);
+    if (msg) mw_msg(msg, "mpc-wt controller: input file '%s': key '%s' is missing", in->path, key);
     return -1;
 }
 
 int mw_has(const mw_input *in, const char *key)
 {
-    int j;
-    for (j = 0; j < in->n; j++)
-        if (strcmp(in->key[j], key) == 0) return 1;
-    return 0;
+    return find(in, key, NULL) >= 0;
 }
 
 int mw_count(const mw_input *in, const char *key, char *msg)
