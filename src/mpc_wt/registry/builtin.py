@@ -79,14 +79,25 @@ def _design_lqr(turbine: linearize.Turbine, *, winds: Any = None,
     return lqr_table(turbine, designs, obs), note
 
 
+def _ts_observer(turbine: linearize.Turbine, ts: Any, ctl: Any, rate: float | None,
+                 law: Any) -> tuple[Any, Any]:
+    """The TS observer at ``rate`` [1/s], or (None) the fastest whose scheduled loop decays on
+    the whole plant; with that loop's margin (None for a given rate)."""
+    from mpc_wt.controllers.takagi_sugeno import design_ts_observer
+    from mpc_wt.controllers.takagi_sugeno.robustness import design_observer_for_loop
+
+    if rate is not None:
+        return design_ts_observer(ts, decay_rate=rate), None
+    return design_observer_for_loop(ts, ctl, turbine, torque_law=law)
+
+
 def _design_ts(turbine: linearize.Turbine, *, winds: Any = None,
                reductions: Any = (0.0, 0.4, 0.8), decay_rate: float = 0.2,
-               observer_decay_rate: float = 1.0) -> tuple[dict, str]:
+               observer_decay_rate: float | None = None) -> tuple[dict, str]:
     from mpc_wt.controllers.takagi_sugeno import (
         TURBINE_MEASURED,
         build_ts_model,
         design_ts_controller,
-        design_ts_observer,
     )
     from mpc_wt.controllers.takagi_sugeno.model import DEFAULT_WIND_GRID
     from mpc_wt.io.gain_tables import ts_table
@@ -94,14 +105,17 @@ def _design_ts(turbine: linearize.Turbine, *, winds: Any = None,
     grid = DEFAULT_WIND_GRID if winds is None else winds
     ts = build_ts_model(turbine, [float(v) for v in grid], list(reductions),
                         measured=TURBINE_MEASURED, progress=True)
+    from mpc_wt.controllers.baseline import BaselineController, tune_baseline
+
     ctl = design_ts_controller(ts, decay_rate=decay_rate)
-    obs = design_ts_observer(ts, decay_rate=observer_decay_rate)
+    obs, _ = _ts_observer(turbine, ts, ctl, observer_decay_rate,
+                          BaselineController(turbine, tune_baseline(turbine)))
     doc = ts_table(turbine, ts, ctl, obs)
     doc["settings"]["options"] = {"decay_rate": float(decay_rate),
-                                  "observer_decay_rate": float(observer_decay_rate)}
+                                  "observer_decay_rate": float(obs.decay_rate)}
     return doc, (
         f"{ts.n_vertices} vertices, {ctl.solver} {ctl.solve_time_s:.1f} s + "
-        f"{obs.solve_time_s:.1f} s, certificates ok")
+        f"{obs.solve_time_s:.1f} s, certificates ok, observer decay {obs.decay_rate:g} 1/s")
 
 
 # -- baseline family ---------------------------------------------------------------------------
@@ -735,8 +749,10 @@ class TSOptions(Options):
     apc_offset: float = option(0.375, help="mean of Delta P", unit="-", lo=0.0, hi=1.0)
     decay_rate: float = option(0.2, help="controller decay rate", unit="1/s", lo=0.0,
                                lo_open=True, flag="")
-    observer_decay_rate: float = option(1.0, help="observer decay rate", unit="1/s", lo=0.0,
-                                        lo_open=True, flag="")
+    observer_decay_rate: Optional[float] = option(
+        None, help="observer decay rate (default: the fastest of 1, 0.7, 0.5, 0.35, 0.25 whose "
+        "loop, scheduled on the estimated wind, decays on the whole plant's linear models)",
+        unit="1/s", lo=0.0, lo_open=True, flag="")
     observer_signals: str = option("turbine", help="the wind observer's measurements: "
                                    "turbine (tower-top fore-aft and side-side accelerations, "
                                    "rotor and generator speed, as a turbine's controller gets "
@@ -760,25 +776,25 @@ def _build_ts(ctx: BuildContext, opts: TSOptions) -> Built:
         TSController,
         build_ts_model,
         design_ts_controller,
-        design_ts_observer,
     )
 
     measured = TURBINE_MEASURED if opts.observer_signals == "turbine" else CLEMENS_MEASURED
 
-    def make() -> tuple[Any, Any, Any]:
-        ts0 = build_ts_model(ctx.turbine, measured=measured)
-        return (ts0, design_ts_controller(ts0, decay_rate=opts.decay_rate),
-                design_ts_observer(ts0, decay_rate=opts.observer_decay_rate))
-
-    ts, c, o = ctx.cache.get(ctx.turbine, ("ts", opts.decay_rate, opts.observer_decay_rate,
-                                           measured), make)
-    dp = None if opts.apc_frequency is None else apc_reference(
-        opts.apc_frequency, amplitude=opts.apc_amplitude, offset=opts.apc_offset)
     law = None
     if opts.generator_torque == "baseline":
         from mpc_wt.controllers.baseline import BaselineController, tune_baseline
 
         law = BaselineController(ctx.turbine, tune_baseline(ctx.turbine))
+
+    def make() -> tuple[Any, Any, Any]:
+        ts0 = build_ts_model(ctx.turbine, measured=measured)
+        c0 = design_ts_controller(ts0, decay_rate=opts.decay_rate)
+        return (ts0, c0) + _ts_observer(ctx.turbine, ts0, c0, opts.observer_decay_rate, law)[:1]
+
+    ts, c, o = ctx.cache.get(ctx.turbine, ("ts", opts.decay_rate, opts.observer_decay_rate,
+                                           measured, opts.generator_torque), make)
+    dp = None if opts.apc_frequency is None else apc_reference(
+        opts.apc_frequency, amplitude=opts.apc_amplitude, offset=opts.apc_offset)
     ctl = TSController(ts, c, o, ctx.turbine, power_reduction=dp,  # starts from its measurements
                        torque_law=law)
     return Built(ctl, meta={"ts": {"vertices": ts.n_vertices, "decay_rate": c.decay_rate,

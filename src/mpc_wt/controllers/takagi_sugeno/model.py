@@ -14,7 +14,7 @@ import numpy as np
 import linearize
 from mpc_wt.errors import PremiseError
 
-__all__ = ["CLEMENS_MEASURED", "TURBINE_MEASURED", "DEFAULT_SCALES", "DEFAULT_WIND_GRID",
+__all__ = ["turbine_scales", "CLEMENS_MEASURED", "TURBINE_MEASURED", "DEFAULT_SCALES", "DEFAULT_WIND_GRID",
            "DEFAULT_REDUCTION_GRID", "TSModel", "build_ts_model"]
 
 #: Clemens et al. eq 6: tower side-side and fore-aft displacement, rotor and generator speed.
@@ -35,6 +35,37 @@ DEFAULT_SCALES = {"tower_fa_displacement": 0.1, "tower_fa_velocity": 0.1, "rotor
 #: in class-A turbulence, 0.1 and 0.02 m/s^2 made the pitch travel 761 deg per blade in 120 s,
 #: 1 and 0.2 138 deg (the displacements' observer: 97 deg), and 3 and 0.5 let the tower's
 #: fore-aft mode go into a limit cycle.)
+
+
+def turbine_scales(turbine: linearize.Turbine) -> dict[str, float]:
+    """:data:`DEFAULT_SCALES` carried from the NREL 5-MW to ``turbine``: rotor and generator
+    speed, generator torque and shaft torsion in proportion to the turbine's own at rated wind
+    (:func:`mpc_wt.controllers.mpc.turbine_scale_ratios`; the generator speed is the rotor's
+    times the gearbox ratio); displacements, accelerations, angles and the wind keep theirs.
+
+    With the NREL 5-MW's scales the IEA-15's direct-drive generator speed (0.79 rad/s at
+    rated) was scaled by 9.7 rad/s and its torque (19 MN m) by 4 kN m: the observer all but
+    ignored the generator speed, and its drivetrain estimate swung by +-2 rad/s in steady wind.
+
+    Parameters
+    ----------
+    turbine : Turbine
+
+    Returns
+    -------
+    dict of str to float
+        The NREL 5-MW's are :data:`DEFAULT_SCALES` exactly.
+    """
+    from mpc_wt.controllers.mpc import turbine_scale_ratios
+
+    r = turbine_scale_ratios(turbine)
+    out = dict(DEFAULT_SCALES)
+    out["rotor_speed"] *= r["rotor_speed"]
+    out["gen_speed"] = DEFAULT_SCALES["gen_speed"] * r["rotor_speed"] * (
+        turbine.drivetrain.gearbox_ratio / 97.0)
+    out["gen_torque_ref"] *= r["gen_torque_ref"]
+    out["shaft_torsion"] *= r["shaft_torsion"]
+    return out
 
 
 @nb.njit(cache=True, nogil=True)
@@ -101,6 +132,10 @@ class TSModel:
     y0 : (N, n_y) ndarray, optional
         Their equilibrium values per vertex (default C x0, right for measured states): a
         measurement is y0_i + C_i (x - x0_i) + D_i (u - u0_i) + E_i (v - v0_i) at vertex i.
+    scales : dict of name to float, optional
+        The typical magnitudes the designs scale the LMIs with (default
+        :data:`DEFAULT_SCALES`, the NREL 5-MW's; :func:`build_ts_model` carries them to its
+        turbine with :func:`turbine_scales`).
     """
 
     wind_grid: np.ndarray
@@ -119,6 +154,7 @@ class TSModel:
     D: Any = None
     E: Any = None
     y0: Any = None
+    scales: Any = None
     info: dict[str, Any] = field(default_factory=dict, compare=False)
 
     def __post_init__(self) -> None:
@@ -407,6 +443,7 @@ def build_ts_model(turbine: linearize.Turbine,
     assert model is not None
     return TSModel(wind_grid=va, reduction_grid=vb, states=model.states, inputs=model.inputs,
                    measured=tuple(measured), rated_power=float(rated),
+                   scales=turbine_scales(turbine),
                    info={"turbine": turbine.name, "config": "clemens"},
                    **{k: np.array(v) for k, v in mats.items()})
 

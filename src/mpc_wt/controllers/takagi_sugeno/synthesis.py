@@ -128,8 +128,11 @@ class TSObserverDesign:
     margin: float
 
 
-def _scales(names: Sequence[str], scales: Mapping[str, float] | None) -> np.ndarray:
+def _scales(ts: TSModel, names: Sequence[str], scales: Mapping[str, float] | None
+            ) -> np.ndarray:
+    """The typical magnitudes of ``names``: ``scales``, else the model's, else the defaults."""
     s = dict(DEFAULT_SCALES)
+    s.update(ts.scales or {})
     s.update(scales or {})
     out = []
     for n in names:
@@ -256,7 +259,8 @@ def design_ts_controller(ts: TSModel, *, decay_rate: float = 0.2,
         abs(u_j - u_0,j) <= mu_j [SI] for states in the Lyapunov ellipsoid that holds the typical
         deviations (``scales``). Default: the bounds are minimised instead.
     scales : dict of name to typical magnitude [SI]
-        Scaling of states and inputs (default :data:`DEFAULT_SCALES`).
+        Scaling of states and inputs (default: the model's ``scales``, the turbine's typical
+        magnitudes, else :data:`DEFAULT_SCALES`).
     margin : float
         Strictness of the LMIs in scaled units (verified to half of it).
     integral_of : str or None
@@ -284,7 +288,7 @@ def design_ts_controller(ts: TSModel, *, decay_rate: float = 0.2,
     if integral_of is not None and integral_of not in ts.states:
         raise ValueError(f"integral_of must be a state of the TS model {list(ts.states)}, got "
                          f"{integral_of!r}")
-    sx, su = _scales(ts.states, scales), _scales(ts.inputs, scales)
+    sx, su = _scales(ts, ts.states, scales), _scales(ts, ts.inputs, scales)
     if integral_of is not None:
         sx = np.append(sx, sx[ts.states.index(integral_of)] * 1.0)
     mu = _input_bounds(ts, input_bounds, su)
@@ -518,8 +522,8 @@ def design_ts_observer(ts: TSModel, *, tau_v: float = 4.0, decay_rate: float = 1
     if radius is not None and radius <= alpha:
         raise ValueError(f"disk_radius ({radius:g} 1/s) must exceed decay_rate ({alpha:g} 1/s)")
     aa, bb, cc = _augmented(ts, float(tau_v))
-    sxi = _scales(ts.states + ("wind",), scales)
-    sy = _scales(ts.measured, scales)
+    sxi = _scales(ts, ts.states + ("wind",), scales)
+    sy = _scales(ts, ts.measured, scales)
     a, c = _observer_mats(ts, float(tau_v), sxi, sy)
     _check_detectable(ts, a, c, alpha)
     prob, pv, nvar = _observer_problem(a, c, alpha, radius, margin,
