@@ -390,6 +390,30 @@ class _PitchAddOn(ControllerBase):
         self._last = cmd = np.array(out)
         return cmd
 
+    def _limit_collective_first(self, pc: Any, u: tuple[float, float, float],
+                                meas: dict[str, Any]) -> np.ndarray:
+        """As :meth:`_limit`, but the rate is the collective's first: the collective part
+        moves towards ``pc``'s mean by at most the rate step, and the add-on's part of each
+        blade moves by at most what that leaves (the sum then within the limits). A cyclic
+        pitch at 1P of amplitude A needs A Omega of the rate: on the IEA-15 (2 deg/s, 0.79
+        rad/s) a 2.5 deg cyclic needs all of it, and a gust found the collective without rate
+        (1.44 x rated at 13 m/s). Returns the commands (3,) [rad]."""
+        lo_p, hi_p, d = self.pitch_min, self.pitch_max, self.step_max
+        c = (float(pc[0]) + float(pc[1]) + float(pc[2])) / 3.0
+        if self._last is None:
+            p = [float(x) for x in meas["pitch"]]
+            self._c_last = (p[0] + p[1] + p[2]) / 3.0
+            self._a_last = (p[0] - self._c_last, p[1] - self._c_last, p[2] - self._c_last)
+        c_new = min(max(c, self._c_last - d), self._c_last + d)
+        budget = d - abs(c_new - self._c_last)
+        a_new = tuple(min(max(float(pcb) - c + du, a0 - budget), a0 + budget)
+                      for pcb, du, a0 in zip(pc.tolist(), u, self._a_last))
+        out = [min(max(c_new + a, lo_p), hi_p) for a in a_new]
+        self._c_last = c_new
+        self._a_last = tuple(o - c_new for o in out)
+        self._last = cmd = np.array(out)
+        return cmd
+
     def _weight(self, meas: dict[str, Any]) -> float:
         p = float(meas["gen_power"])
         a = math.exp(-self.dt / self.power_tau)
@@ -654,8 +678,8 @@ class ColemanIPCController(_PitchAddOn):
             th_s *= self.gains.max_amplitude_rad / amp
         self._theta_cs = (th_c, th_s)
         pc_, ps_ = w * th_c, w * th_s
-        cmd = self._limit(pc, (pc_ * c1 + ps_ * s1, pc_ * c2 + ps_ * s2, pc_ * c3 + ps_ * s3),
-                          meas)
+        cmd = self._limit_collective_first(
+            pc, (pc_ * c1 + ps_ * s1, pc_ * c2 + ps_ * s2, pc_ * c3 + ps_ * s3), meas)
         self.signals = {**self.collective.signals, "ipc_weight": w,
                         "ipc_tilt_moment": tilt, "ipc_yaw_moment": yaw,
                         "ipc_pitch_cos": pc_, "ipc_pitch_sin": ps_}
