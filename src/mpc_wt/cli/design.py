@@ -34,11 +34,13 @@ def add_parsers(sub: Any) -> None:
                                   "12:25:1, ts 12,14,16,19,22,25) [m/s]")
     p.add_argument("--reductions", default="0,0.4,0.8",
                    help="ts: comma list of vertex power reductions (default 0,0.4,0.8)")
-    p.add_argument("--decay-rate", type=float, default=0.2, help="ts: controller decay [1/s]")
+    p.add_argument("--decay-rate", type=float, default=None,
+                   help="ts: controller decay [1/s] (default: the fastest of 0.2, 0.15, 0.1 "
+                        "whose loop, scheduled on the estimated wind, decays on the whole "
+                        "plant's linear models)")
     p.add_argument("--observer-decay-rate", type=float, default=None,
                    help="ts: observer decay [1/s] (default: the fastest of 1, 0.7, 0.5, 0.35, "
-                        "0.25 whose loop, scheduled on the estimated wind, decays on the "
-                        "whole plant's linear models)")
+                        "0.25 whose loop decays with the controller's)")
     p.add_argument("--weight", action="append",
                    help="lqr: NAME=VALUE weight on a state or output (repeatable; default "
                         "rotor_speed=5, tower_fa_velocity=1)")
@@ -91,7 +93,8 @@ def _design_args(args: argparse.Namespace) -> dict[str, Any]:
             "zeta": _positive("--zeta", args.zeta),
             "loop_gain": _positive("--loop-gain", args.loop_gain), "winds": winds,
             "reductions": floats(args.reductions, "--reductions"),
-            "decay_rate": _positive("--decay-rate", args.decay_rate),
+            "decay_rate": (None if args.decay_rate is None
+                           else _positive("--decay-rate", args.decay_rate)),
             "observer_decay_rate": (None if args.observer_decay_rate is None else _positive(
                 "--observer-decay-rate", args.observer_decay_rate)),
             "weights": number_pairs(args.weight, "--weight") or None,

@@ -79,25 +79,32 @@ def _design_lqr(turbine: linearize.Turbine, *, winds: Any = None,
     return lqr_table(turbine, designs, obs), note
 
 
-def _ts_observer(turbine: linearize.Turbine, ts: Any, ctl: Any, rate: float | None,
-                 law: Any) -> tuple[Any, Any]:
-    """The TS observer at ``rate`` [1/s], or (None) the fastest whose scheduled loop decays on
-    the whole plant; with that loop's margin (None for a given rate)."""
-    from mpc_wt.controllers.takagi_sugeno import design_ts_observer
-    from mpc_wt.controllers.takagi_sugeno.robustness import design_observer_for_loop
+def _ts_designs(turbine: linearize.Turbine, ts: Any, rate: float | None,
+                observer_rate: float | None, law: Any) -> tuple[Any, Any]:
+    """The TS controller and observer at the given decay rates [1/s]; a rate left None is the
+    fastest whose loop, scheduled on the estimated wind, decays on the whole plant
+    (:func:`~mpc_wt.controllers.takagi_sugeno.robustness.design_for_loop`)."""
+    from mpc_wt.controllers.takagi_sugeno import design_ts_controller, design_ts_observer
+    from mpc_wt.controllers.takagi_sugeno.robustness import (
+        design_for_loop,
+        design_observer_for_loop,
+    )
 
-    if rate is not None:
-        return design_ts_observer(ts, decay_rate=rate), None
-    return design_observer_for_loop(ts, ctl, turbine, torque_law=law)
+    if rate is None:
+        kw = {} if observer_rate is None else {"observer_candidates": (observer_rate,)}
+        return design_for_loop(ts, turbine, torque_law=law, **kw)[:2]
+    ctl = design_ts_controller(ts, decay_rate=rate)
+    if observer_rate is not None:
+        return ctl, design_ts_observer(ts, decay_rate=observer_rate)
+    return ctl, design_observer_for_loop(ts, ctl, turbine, torque_law=law)[0]
 
 
 def _design_ts(turbine: linearize.Turbine, *, winds: Any = None,
-               reductions: Any = (0.0, 0.4, 0.8), decay_rate: float = 0.2,
+               reductions: Any = (0.0, 0.4, 0.8), decay_rate: float | None = None,
                observer_decay_rate: float | None = None) -> tuple[dict, str]:
     from mpc_wt.controllers.takagi_sugeno import (
         TURBINE_MEASURED,
         build_ts_model,
-        design_ts_controller,
     )
     from mpc_wt.controllers.takagi_sugeno.model import DEFAULT_WIND_GRID
     from mpc_wt.io.gain_tables import ts_table
@@ -107,15 +114,15 @@ def _design_ts(turbine: linearize.Turbine, *, winds: Any = None,
                         measured=TURBINE_MEASURED, progress=True)
     from mpc_wt.controllers.baseline import BaselineController, tune_baseline
 
-    ctl = design_ts_controller(ts, decay_rate=decay_rate)
-    obs, _ = _ts_observer(turbine, ts, ctl, observer_decay_rate,
-                          BaselineController(turbine, tune_baseline(turbine)))
+    ctl, obs = _ts_designs(turbine, ts, decay_rate, observer_decay_rate,
+                           BaselineController(turbine, tune_baseline(turbine)))
     doc = ts_table(turbine, ts, ctl, obs)
-    doc["settings"]["options"] = {"decay_rate": float(decay_rate),
+    doc["settings"]["options"] = {"decay_rate": float(ctl.decay_rate),
                                   "observer_decay_rate": float(obs.decay_rate)}
     return doc, (
         f"{ts.n_vertices} vertices, {ctl.solver} {ctl.solve_time_s:.1f} s + "
-        f"{obs.solve_time_s:.1f} s, certificates ok, observer decay {obs.decay_rate:g} 1/s")
+        f"{obs.solve_time_s:.1f} s, certificates ok, decay rates {ctl.decay_rate:g} (controller) "
+        f"and {obs.decay_rate:g} 1/s (observer)")
 
 
 # -- baseline family ---------------------------------------------------------------------------
@@ -747,11 +754,13 @@ class TSOptions(Options):
     apc_amplitude: float = option(0.375, help="amplitude of Delta P (fraction of rated)",
                                   unit="-", lo=0.0, hi=1.0)
     apc_offset: float = option(0.375, help="mean of Delta P", unit="-", lo=0.0, hi=1.0)
-    decay_rate: float = option(0.2, help="controller decay rate", unit="1/s", lo=0.0,
-                               lo_open=True, flag="")
+    decay_rate: Optional[float] = option(
+        None, help="controller decay rate (default: the fastest of 0.2, 0.15, 0.1 whose loop, "
+        "scheduled on the estimated wind, decays on the whole plant's linear models)",
+        unit="1/s", lo=0.0, lo_open=True, flag="")
     observer_decay_rate: Optional[float] = option(
         None, help="observer decay rate (default: the fastest of 1, 0.7, 0.5, 0.35, 0.25 whose "
-        "loop, scheduled on the estimated wind, decays on the whole plant's linear models)",
+        "loop decays with the controller's)",
         unit="1/s", lo=0.0, lo_open=True, flag="")
     observer_signals: str = option("turbine", help="the wind observer's measurements: "
                                    "turbine (tower-top fore-aft and side-side accelerations, "
@@ -775,7 +784,6 @@ def _build_ts(ctx: BuildContext, opts: TSOptions) -> Built:
         TURBINE_MEASURED,
         TSController,
         build_ts_model,
-        design_ts_controller,
     )
 
     measured = TURBINE_MEASURED if opts.observer_signals == "turbine" else CLEMENS_MEASURED
@@ -788,8 +796,8 @@ def _build_ts(ctx: BuildContext, opts: TSOptions) -> Built:
 
     def make() -> tuple[Any, Any, Any]:
         ts0 = build_ts_model(ctx.turbine, measured=measured)
-        c0 = design_ts_controller(ts0, decay_rate=opts.decay_rate)
-        return (ts0, c0) + _ts_observer(ctx.turbine, ts0, c0, opts.observer_decay_rate, law)[:1]
+        return (ts0,) + _ts_designs(ctx.turbine, ts0, opts.decay_rate, opts.observer_decay_rate,
+                                    law)
 
     ts, c, o = ctx.cache.get(ctx.turbine, ("ts", opts.decay_rate, opts.observer_decay_rate,
                                            measured, opts.generator_torque), make)
