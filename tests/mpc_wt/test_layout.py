@@ -212,7 +212,7 @@ LAYOUT = {
     "controllers": {"base", "baseline", "baseline_law", "mpc", "qp", "estimator", "lqr",
                     "ipc", "apc", "derating", "lidar_feedforward", "supervisor", "discon",
                     "filters", "wind_estimator", "scheduling"},
-    "controllers/takagi_sugeno": {"model", "synthesis", "controller"},
+    "controllers/takagi_sugeno": {"model", "synthesis", "controller", "robustness"},
     "registry": {"registry", "options", "builtin", "context"},
     "simulation": {"scenario", "loop", "compiled", "results", "preview", "solver_timing"},
     "assessment": {"fatigue", "performance", "series", "ultimate", "lidar"},
