@@ -26,7 +26,7 @@ from mpc_wt.controllers.takagi_sugeno.synthesis import (
     TSObserverDesign,
 )
 
-__all__ = ["LoopMargin", "scheduled_loop_margin", "design_observer_for_loop",
+__all__ = ["LoopMargin", "plant_models", "scheduled_loop_margin", "design_observer_for_loop",
            "design_for_loop", "OBSERVER_DECAY_CANDIDATES", "CONTROLLER_DECAY_CANDIDATES"]
 
 
@@ -125,10 +125,35 @@ def _loop_matrix(ts: TSModel, ctl: TSControllerDesign, obs: TSObserverDesign,
     return z
 
 
+def plant_models(ts: TSModel, turbine: linearize.Turbine,
+                 config: linearize.PlantConfig | None = None) -> list[linearize.LinearModel]:
+    """The whole plant's linear models (MBC, rotor-effective wind, the TS inputs) at the TS
+    model's wind vertices: what :func:`scheduled_loop_margin` closes its loops around, made once
+    for every candidate design.
+
+    Parameters
+    ----------
+    ts : TSModel
+    turbine : Turbine
+    config : PlantConfig, optional
+        The plant (default: every degree of freedom, the simulator's).
+
+    Returns
+    -------
+    list of LinearModel
+        One per wind vertex.
+    """
+    params = linearize.plant_params(turbine, config or linearize.PlantConfig())
+    return [linearize.linearize(turbine, float(v), params=params, disturbance="rotor",
+                                coordinates="mbc").select(inputs=ts.inputs)
+            for v in ts.wind_grid]
+
+
 def scheduled_loop_margin(ts: TSModel, ctl: TSControllerDesign, obs: TSObserverDesign,
                           turbine: linearize.Turbine, *, dt: float = 1.0 / 80.0,
                           torque_law: Any = None,
-                          config: linearize.PlantConfig | None = None) -> LoopMargin:
+                          config: linearize.PlantConfig | None = None,
+                          plants: Any = None) -> LoopMargin:
     """The TS design closed around the whole plant's linear model at each wind vertex (no power
     reduction), with the premise estimated (module docstring).
 
@@ -144,6 +169,8 @@ def scheduled_loop_margin(ts: TSModel, ctl: TSControllerDesign, obs: TSObserverD
         without it the TS torque row.
     config : PlantConfig, optional
         The plant (default: every degree of freedom, the simulator's).
+    plants : list of LinearModel, optional
+        :func:`plant_models` of ``ts`` made before (``config`` is then not used).
 
     Returns
     -------
@@ -160,16 +187,14 @@ def scheduled_loop_margin(ts: TSModel, ctl: TSControllerDesign, obs: TSObserverD
     if ctl.integral_of and ctl.integral_of not in ts.measured:
         raise ValueError(f"the integral's state {ctl.integral_of!r} is not measured "
                          f"({list(ts.measured)})")
-    params = linearize.plant_params(turbine, config or linearize.PlantConfig())
+    if plants is None:
+        plants = plant_models(ts, turbine, config)
     nb, na = ts.reduction_grid.size, ts.wind_grid.size
     decay, freq = [], []
     for a in range(na):
         i = a * nb
         j = i if na == 1 else ((a + 1) * nb if a + 1 < na else (a - 1) * nb)
-        plant = linearize.linearize(turbine, float(ts.wind_grid[a]), params=params,
-                                    disturbance="rotor", coordinates="mbc").select(
-            inputs=ts.inputs)
-        z = _loop_matrix(ts, ctl, obs, plant, i, j, dt, torque_law)
+        z = _loop_matrix(ts, ctl, obs, plants[a], i, j, dt, torque_law)
         lam = np.log(np.linalg.eigvals(z).astype(complex)) / dt
         m = int(np.argmax(lam.real))
         decay.append(float(lam[m].real))
@@ -185,8 +210,8 @@ OBSERVER_DECAY_CANDIDATES = (1.0, 0.7, 0.5, 0.35, 0.25)
 def design_observer_for_loop(ts: TSModel, ctl: TSControllerDesign, turbine: linearize.Turbine,
                              *, torque_law: Any = None, dt: float = 1.0 / 80.0,
                              candidates: tuple[float, ...] = OBSERVER_DECAY_CANDIDATES,
-                             required: float = -0.01, warn: bool = True, **observer: Any
-                             ) -> tuple[TSObserverDesign, LoopMargin]:
+                             required: float = -0.01, warn: bool = True, plants: Any = None,
+                             **observer: Any) -> tuple[TSObserverDesign, LoopMargin]:
     """The fastest TS observer whose scheduled loop on the whole plant decays.
 
     The observer's decay rate sets how fast the wind estimate, and with it the premise and the
@@ -210,6 +235,8 @@ def design_observer_for_loop(ts: TSModel, ctl: TSControllerDesign, turbine: line
         The largest decay accepted [1/s] (negative: every mode decays).
     warn : bool
         Log a warning when no candidate meets ``required``.
+    plants : list of LinearModel, optional
+        :func:`plant_models` of ``ts`` made before.
     **observer
         Further arguments of :func:`design_ts_observer`.
 
@@ -226,9 +253,11 @@ def design_observer_for_loop(ts: TSModel, ctl: TSControllerDesign, turbine: line
     if not candidates:
         raise ValueError("candidates must name at least one observer decay rate [1/s]")
     best: tuple[TSObserverDesign, LoopMargin] | None = None
+    plants = plant_models(ts, turbine) if plants is None else plants
     for rate in candidates:
         obs = design_ts_observer(ts, decay_rate=float(rate), **observer)
-        margin = scheduled_loop_margin(ts, ctl, obs, turbine, dt=dt, torque_law=torque_law)
+        margin = scheduled_loop_margin(ts, ctl, obs, turbine, dt=dt, torque_law=torque_law,
+                                       plants=plants)
         if best is None or margin.worst < best[1].worst:
             best = (obs, margin)
         if margin.worst <= required:
@@ -289,11 +318,12 @@ def design_for_loop(ts: TSModel, turbine: linearize.Turbine, *, torque_law: Any 
         raise ValueError("controller_candidates must name at least one decay rate [1/s]")
     log = logging.getLogger(__name__)
     best: tuple[TSControllerDesign, TSObserverDesign, LoopMargin] | None = None
+    plants = plant_models(ts, turbine)
     for rate in controller_candidates:
         ctl = design_ts_controller(ts, decay_rate=float(rate))
         obs, margin = design_observer_for_loop(ts, ctl, turbine, torque_law=torque_law, dt=dt,
                                                candidates=observer_candidates,
-                                               required=required, warn=False)
+                                               required=required, warn=False, plants=plants)
         if best is None or margin.worst < best[2].worst:
             best = (ctl, obs, margin)
         if margin.worst <= required:
