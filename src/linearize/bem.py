@@ -185,6 +185,11 @@ def _polar_lookup(table, k, alpha, alpha0, dalpha):  # pragma: no cover - compil
     return cl, cd
 
 
+#: :func:`_polar_lookup` for the other compiled modules (unsteady aerodynamics): cl, cd of
+#: airfoil k at alpha [rad] from the sampled table
+polar_lookup = _polar_lookup
+
+
 @nb.njit(**_JIT)
 def _prandtl(r, rtip, rhub, nb_, sphi, tip, hub):  # pragma: no cover - compiled
     """Prandtl tip and hub loss factor F (Hansen 2015, eq 6.35), F >= 1e-10.

@@ -15,11 +15,15 @@ from linearize.bem import (
     locate_cell,
 )
 from linearize.params import n_x
+from linearize.unsteady import HINT_ROWS_UA, UA_ROW, ua_coefficients, ua_update
+
+_ALPHA_ROW, _W_ROW = HINT_ROWS_UA - 2, HINT_ROWS_UA - 1
 
 #: the blades' azimuth spacing [rad]
 TWO_PI_3 = 2.0 * math.pi / 3.0
 
-__all__ = ["evaluate_plant", "sample_wind", "step_kernel"]
+__all__ = ["evaluate_plant", "evaluate_plant_vw", "sample_wind", "sample_inplane", "sample_tower",
+           "step_kernel"]
 
 DENSE_STRIDES = (8,)                   # the strides of a 1-D C-contiguous float64 array
 
@@ -43,7 +47,26 @@ def evaluate_plant(x, u, wind, p, hint, mode):  # pragma: no cover - compiled
     inflow angle, residual slope, axial and tangential induced velocities (NaN: none); the same
     layout is returned.
     ``mode``: bits of :mod:`linearize.bem` (frozen wake, complex step, tight, no limits).
+    The wind has no lateral or vertical component (:func:`evaluate_plant_vw` with them).
     """
+    return evaluate_plant_vw(x, u, wind, (np.zeros((2, 3, p.r.size)), np.zeros((2, 0))), p,
+                             hint, mode)
+
+
+@nb.njit(**_JIT)
+def evaluate_plant_vw(x, u, wind, ext, p, hint, mode):  # pragma: no cover - compiled
+    """:func:`evaluate_plant` with more of the free wind, ``ext`` = (vw, tw): the lateral
+    (+y, to the left looking downwind) and vertical (+z) components at each element, ``vw``
+    (2, 3, n_r) [m/s], and u and v at the tower's drag points, ``tw`` (2, n_q) [m/s] (n_q = 0:
+    no tower drag). The element components are
+    projected on the coned, tilted blade element's normal and tangential directions:
+    normal  u (cos t cos c + sin t sin c cos psi) + w (sin c cos t cos psi - sin t cos c)
+    - v sin c sin psi, tangential (against the blade's motion) v cos psi + w cos t sin psi
+    (and u sin t sin psi), with shaft tilt t, precone c and azimuth psi (Jonkman 2007,
+    NREL/TP-500-41958, the hub and blade coordinate systems; AeroDyn's relative velocity).
+    """
+    vw = ext[0]
+    tw = ext[1]
     dof_fa, dof_ss, dof_dt, dof_gen, dof_flap, dof_pitch = (p.dof[0], p.dof[1], p.dof[2],
                                                             p.dof[3], p.dof[4], p.dof[5])
     dof_edge = p.dof[6]
@@ -51,7 +74,12 @@ def evaluate_plant(x, u, wind, p, hint, mode):  # pragma: no cover - compiled
     nr = p.r.size
     dx = np.zeros(n_x, dtype=x.dtype)
     z = np.zeros(31, dtype=x.dtype)
-    bem = np.empty((4, 3, nr), dtype=x.dtype)
+    bem = np.empty((hint.shape[0], 3, nr), dtype=x.dtype)
+    for k in range(4, hint.shape[0]):
+        for i in range(3):
+            for j in range(nr):
+                bem[k, i, j] = hint[k, i, j]
+    ua_on = p.opt[4] != 0 and mode == 0 and hint.shape[0] >= HINT_ROWS_UA
     xd = x[1]
     wr = x[2]
     wg = x[3]
@@ -83,7 +111,9 @@ def evaluate_plant(x, u, wind, p, hint, mode):  # pragma: no cover - compiled
     fy = 0.0 * wr
     mtilt = 0.0 * wr
     myaw = 0.0 * wr
+    shadow = p.opt[3] != 0 and p.twr_h.size > 1
     mflap_aero = np.zeros(3, dtype=x.dtype)
+    mbody = np.zeros(3, dtype=x.dtype)
     medge_aero = np.zeros(3, dtype=x.dtype)
     gq = np.zeros(3, dtype=x.dtype)
     ge = np.zeros(3, dtype=x.dtype)
@@ -100,9 +130,25 @@ def evaluate_plant(x, u, wind, p, hint, mode):  # pragma: no cover - compiled
         gqi = 0.0 * wr
         for j in range(nr):
             rj = p.r[j]
-            vrel = wind[i, j] - vhub_x - nod * rj * cc * cp
-            vx = vrel * (ct * cc + st * sc * cp) - qd * p.phi_flap[j]
-            vy = (wr + roll) * rj * cc + vrel * st * sp - vhub_y * cp + ed * p.phi_edge[j]
+            uf = wind[i, j]
+            v_tw = 0.0 * uf
+            if shadow:
+                fu, fv = _tower_potential_flow(rj, cp, sp, p)
+                v_tw = fv * uf
+                uf = fu * uf
+            vrel = uf - vhub_x - nod * rj * cc * cp
+            vv = vw[0, i, j] + v_tw
+            # the modes' directions: flapwise cos(th) x + sin(th) e, edgewise cos(th) e -
+            # sin(th) x (x downwind, e the direction of rotation), th = pitch + twist
+            th_s = pitch[i] + p.twist_s[j] if p.opt[5] else 0.0 * pitch[i]
+            cs = np.cos(th_s)
+            ss = np.sin(th_s)
+            vq = qd * p.phi_flap[j]
+            ve = ed * p.phi_edge[j]
+            vx = (vrel * (ct * cc + st * sc * cp) - vq * cs + ve * ss
+                  + vw[1, i, j] * (sc * ct * cp - st * cc) - vv * sc * sp)
+            vy = ((wr + roll) * rj * cc + vrel * st * sp - vhub_y * cp + ve * cs + vq * ss
+                  + vv * cp + vw[1, i, j] * ct * sp)
             npr, tpr, ph, sl, u_ind, v_ind = element_kernel(
                 vx, vy, rj, p.chord[j], p.twist[j] + pitch[i], p.af[j], p.table, p.alpha0,
                 p.dalpha, p.nb, p.rtip, p.rhub, p.flags, p.rho, hint[0, i, j].real,
@@ -111,14 +157,24 @@ def evaluate_plant(x, u, wind, p, hint, mode):  # pragma: no cover - compiled
             bem[1, i, j] = sl
             bem[2, i, j] = u_ind
             bem[3, i, j] = v_ind
+            if ua_on and p.ua[p.af[j], 0] != 0.0:
+                npr, tpr = _ua_loads(npr, tpr, ph, vx - u_ind, vy + v_ind, p.twist[j] + pitch[i],
+                                     i, j, p, hint, bem)
             wj = p.w[j]
             tor_i += tpr * rj * cc * wj
             thr_i += npr * cc * wj
             mf += npr * (rj - p.rhub) * wj
             me += tpr * (rj - p.rhub) * wj
-            gqi += npr * p.phi_flap[j] * wj
-            ge[i] += tpr * p.phi_edge[j] * wj
+            gqi += (npr * cs + tpr * ss) * p.phi_flap[j] * wj
+            ge[i] += (tpr * cs - npr * ss) * p.phi_edge[j] * wj
             fy += -tpr * cp * wj
+        if p.opt[1]:
+            # the blade's own forces normal to it (precone centrifugal, gravity along the
+            # tilted shaft and across the coned blade), on the flap mode and the root moment
+            fn_cf = wr * wr * sc * cc
+            fn_g = p.grav * (st * cc - sc * ct * cp) if p.opt[0] else 0.0 * wr
+            gqi += fn_cf * p.s_phi_r + fn_g * p.g_b
+            mbody[i] = fn_cf * p.i_edge + fn_g * p.s1
         torque += tor_i
         thrust += thr_i
         mflap_aero[i] = mf
@@ -172,9 +228,11 @@ def evaluate_plant(x, u, wind, p, hint, mode):  # pragma: no cover - compiled
     for i in range(3):
         if dof_flap:
             fq[i] = gq[i] - p.c_b * x[13 + i] - kq * x[10 + i]
+    drag_fa, drag_ss, drag_my, drag_mx = _tower_drag(xd, yd, tw, p)
     xdd = 0.0 * wr
     if dof_fa:
-        ft = (thrust * ct * p.hub_fa + mtilt * p.slope_fa - p.c_fa * xd - p.k_fa * x[0])
+        ft = (thrust * ct * p.hub_fa + mtilt * p.slope_fa - p.c_fa * xd - p.k_fa * x[0]
+              + drag_fa)
         if dof_flap:
             ratio = p.m_c / p.m_b
             xdd = (ft - ratio * (fq[0] + fq[1] + fq[2])) / (p.m_fa - 3.0 * p.m_c * ratio)
@@ -186,7 +244,7 @@ def evaluate_plant(x, u, wind, p, hint, mode):  # pragma: no cover - compiled
             qdd[i] = (fq[i] - p.m_c * xdd) / p.m_b
     ydd = 0.0 * wr
     if dof_ss:
-        fss = fy * p.hub_ss - m_react * p.slope_ss - p.c_ss * yd - p.k_ss * x[8]
+        fss = fy * p.hub_ss - m_react * p.slope_ss - p.c_ss * yd - p.k_ss * x[8] + drag_ss
         ydd = fss / p.m_ss
     # derivatives
     if dof_fa:
@@ -222,16 +280,21 @@ def evaluate_plant(x, u, wind, p, hint, mode):  # pragma: no cover - compiled
     for i in range(3):
         psi_i = psi + i * TWO_PI_3
         q = x[10 + i] if dof_flap else 0.0 * x[10 + i]
-        mf = (mflap_aero[i] - p.hub_fa * xdd * p.s1 - qdd[i] * p.s_phi_s
+        # the modes' accelerations out of and in the plane (twisted directions)
+        c_p = np.cos(pitch[i]) if p.opt[5] else 1.0 + 0.0 * pitch[i]
+        s_p = np.sin(pitch[i]) if p.opt[5] else 0.0 * pitch[i]
+        mf = (mflap_aero[i] + mbody[i] - p.hub_fa * xdd * p.s1
+              - qdd[i] * (c_p * p.sfc - s_p * p.sfs) + edd[i] * (s_p * p.sec + c_p * p.ses)
               - omega2 * q * p.s_phi_r)
-        me = medge_aero[i] - dwr * p.i_edge - edd[i] * p.s_phie_s
+        me = (medge_aero[i] - dwr * p.i_edge - edd[i] * (c_p * p.sec - s_p * p.ses)
+              - qdd[i] * (s_p * p.sfc + c_p * p.sfs))
         if p.opt[0]:
             me += p.grav * p.s1 * np.sin(psi_i) * ct
         z[10 + i] = mf
         z[13 + i] = me
     z[16] = (thrust * ct * p.zhub + mtilt + p.fa_static + p.fa_pdelta * x[0]
-             - p.fa_inertia * xdd)
-    z[17] = m_react - fy * p.zhub - p.ss_pdelta * x[8] + p.ss_inertia * ydd
+             - p.fa_inertia * xdd + drag_my)
+    z[17] = m_react - fy * p.zhub - p.ss_pdelta * x[8] + p.ss_inertia * ydd - drag_mx
     z[18] = qs
     tl = 0.0 * wr
     yw = 0.0 * wr
@@ -252,6 +315,105 @@ def evaluate_plant(x, u, wind, p, hint, mode):  # pragma: no cover - compiled
     z[29] = x[0]
     z[30] = x[8]
     return dx, z, bem
+
+
+@nb.njit(**_JIT)
+def _tower_drag(xd, yd, tw, p):  # pragma: no cover - compiled
+    """Drag on the tower (AeroDyn's ``TwrAero``): per unit height 0.5 rho C_d D |V| V with V
+    the free wind (u, v) at the tower's axis less the tower's velocity in its first modes.
+    Returns the generalized forces on the fore-aft and side-side modes [N] and the base
+    moments of the downwind and lateral forces, int f h dh [N m]."""
+    gfa = 0.0 * xd
+    gss = 0.0 * xd
+    mfa = 0.0 * xd
+    mss = 0.0 * xd
+    if p.opt[6] == 0 or tw.shape[1] != p.tq_h.size:
+        return gfa, gss, mfa, mss
+    for k in range(p.tq_h.size):
+        vx = tw[0, k] - xd * p.tq_fa[k]
+        vy = tw[1, k] - yd * p.tq_ss[k]
+        sp = np.sqrt(vx * vx + vy * vy)
+        fx = p.tq_w[k] * sp * vx
+        fy = p.tq_w[k] * sp * vy
+        gfa += fx * p.tq_fa[k]
+        gss += fy * p.tq_ss[k]
+        mfa += fx * p.tq_h[k]
+        mss += fy * p.tq_h[k]
+    return gfa, gss, mfa, mss
+
+
+@nb.njit(**_JIT)
+def sample_tower(t, p, kind, wpar, grid):  # pragma: no cover - compiled
+    """The free wind's u and v at the tower's drag points (on its axis), (2, n_q) [m/s];
+    ``grid``: the u grid and the v-w grid."""
+    nq = p.tq_h.size if p.opt[6] else 0
+    out = np.zeros((2, nq))
+    if nq == 0:
+        return out
+    if kind == 0:
+        for k in range(nq):
+            zz = max(p.tq_h[k], 1e-3)
+            out[0, k] = wpar[0] * (zz / p.zhub) ** wpar[1] if wpar[1] != 0.0 else wpar[0]
+        return out
+    ys = np.zeros((1, nq))
+    zs = np.empty((1, nq))
+    zs[0] = p.tq_h
+    _sample_grid(t, ys, zs, wpar, grid[0], out[0:1])
+    if grid[1].shape[1] > 1 and p.opt[2]:
+        _sample_grid(t, ys, zs, wpar, grid[1][0], out[1:2])
+    return out
+
+
+@nb.njit(**_JIT)
+def _ua_loads(npr, tpr, phi, ua, ut, theta, i, j, p, hint, bem):  # pragma: no cover - compiled
+    """Element (i, j)'s loads with the unsteady airfoil coefficients
+    (:func:`linearize.unsteady.ua_coefficients`) in place of the static ones: the BEM's
+    inflow angle and induction stay (AeroDyn's coupling), the lift and drag follow the states.
+    Leaves the element's alpha and W in ``bem`` for the step's state update."""
+    w = math.sqrt(ua.real * ua.real + ut.real * ut.real)
+    alpha = phi.real - theta.real
+    bem[_ALPHA_ROW, i, j] = alpha
+    bem[_W_ROW, i, j] = w
+    k = p.af[j]
+    cl, cd, valid = ua_coefficients(alpha, w, p.chord[j], hint, i, j, p.ua[k], p.table, k,
+                                    p.alpha0, p.dalpha)
+    if not valid:
+        return npr, tpr
+    q = 0.5 * p.rho * w * w * p.chord[j]
+    s = np.sin(phi)
+    c = np.cos(phi)
+    return q * (cl * c + cd * s) + 0.0 * npr, q * (cl * s - cd * c) + 0.0 * tpr
+
+
+@nb.njit(**_JIT)
+def _tower_potential_flow(r, cp, sp, p):  # pragma: no cover - compiled
+    """Potential flow around the tower at a blade element (AeroDyn's ``TwrPotent = 1``;
+    Moriarty and Hansen 2005, NREL/EL-500-36881, sec. 7): with x downwind of and y across the
+    tower's axis in units of the local tower radius R, the free wind U becomes
+    u = U (1 - (x^2 - y^2) / (x^2 + y^2)^2) and v = -U 2 x y / (x^2 + y^2)^2. The element at
+    radius ``r`` [m] and azimuth (cos, sin) = (``cp``, ``sp``) in its undeflected position (so
+    that the loads stay independent of the displacements, as the trim needs; AeroDyn takes
+    the deflected one); above the tower top or below its base the tower does not act.
+
+    Returns the factors (u / U, v / U)."""
+    cc = math.cos(p.cone)
+    sc = math.sin(p.cone)
+    ct = math.cos(p.tilt)
+    st = math.sin(p.tilt)
+    z = p.zhub + r * cc * cp * ct
+    if z.real > p.twr_h[-1] or z.real < p.twr_h[0]:
+        return 1.0 + 0.0 * z, 0.0 * z
+    k = 0
+    while k < p.twr_h.size - 2 and z.real > p.twr_h[k + 1]:
+        k += 1
+    a = (z - p.twr_h[k]) / (p.twr_h[k + 1] - p.twr_h[k])
+    rad = (1.0 - a) * p.twr_r[k] + a * p.twr_r[k + 1]
+    xt = (p.x_apex + r * (cc * cp * st - sc * ct)) / rad
+    yt = -r * cc * sp / rad
+    d2 = xt * xt + yt * yt
+    if d2.real < 1.0:
+        d2 = 1.0 + 0.0 * d2
+    return 1.0 - (xt * xt - yt * yt) / (d2 * d2), -2.0 * xt * yt / (d2 * d2)
 
 
 # wind kinds: 0 = steady power law (speed, exponent), 1 = grid (t, y, z) trilinear
@@ -286,14 +448,21 @@ def sample_wind(t, psi, p, kind, wpar, grid):  # pragma: no cover - compiled
                 zz = zs[i, j] if zs[i, j] > 1e-3 else 1e-3
                 out[i, j] = v * (zz / p.zhub) ** a if a != 0.0 else v
         return out
+    _sample_grid(t, ys, zs, wpar, grid, out)
+    return out
+
+
+@nb.njit(**_JIT)
+def _sample_grid(t, ys, zs, wpar, grid, out):  # pragma: no cover - compiled
+    """Trilinear interpolation of a (n_t, n_y, n_z) grid at each element into ``out``."""
     t0, dt, y0, dy, z0, dz = wpar[0], wpar[1], wpar[2], wpar[3], wpar[4], wpar[5]
     nt, ny, nz = grid.shape
     if nt == 1:
         it, at = 0, 0.0
     else:
         it, at = locate_cell((t - t0) / dt, nt)
-    for i in range(3):
-        for j in range(nr):
+    for i in range(ys.shape[0]):
+        for j in range(ys.shape[1]):
             iy, ay = locate_cell((ys[i, j] - y0) / dy, ny)
             iz, az = locate_cell((zs[i, j] - z0) / dz, nz)
             acc = 0.0
@@ -307,36 +476,72 @@ def sample_wind(t, psi, p, kind, wpar, grid):  # pragma: no cover - compiled
                 acc += wt * ((1 - ay) * (1 - az) * g[iy, iz] + ay * (1 - az) * g[iy + 1, iz]
                              + (1 - ay) * az * g[iy, iz + 1] + ay * az * g[iy + 1, iz + 1])
             out[i, j] = acc
+
+
+@nb.njit(**_JIT)
+def sample_inplane(t, psi, p, kind, wpar, vw_grid):  # pragma: no cover - compiled
+    """The free wind's lateral and vertical components at each element, (2, 3, n_r) [m/s]:
+    zero for a steady wind, a grid without them (``vw_grid`` of shape (2, 1, 1, 1)) or a
+    plant without in-plane wind."""
+    nr = p.r.size
+    out = np.zeros((2, 3, nr))
+    if kind != 1 or vw_grid.shape[1] == 1 or p.opt[2] == 0:
+        return out
+    ys, zs = _element_positions(psi, p)
+    _sample_grid(t, ys, zs, wpar, vw_grid[0], out[0])
+    _sample_grid(t, ys, zs, wpar, vw_grid[1], out[1])
     return out
+
+
+@nb.njit(**_JIT)
+def _stage(t, x, u, p, kind, wpar, grid, hint):  # pragma: no cover - compiled
+    """The plant at one RK4 stage: the wind at the elements (``grid``: the u grid and the
+    (2, ...) v, w grid) and :func:`evaluate_plant_vw`."""
+    w = sample_wind(t, x[16], p, kind, wpar, grid[0])
+    vw = sample_inplane(t, x[16], p, kind, wpar, grid[1])
+    tw = sample_tower(t, p, kind, wpar, grid)
+    return evaluate_plant_vw(x, u, w, (vw, tw), p, hint, 0)
 
 
 @nb.njit(**_JIT)
 def _rk4(t, x, u, h, p, kind, wpar, grid, hint, dphi):  # pragma: no cover - compiled
     """One RK4 step. ``hint`` seeds the BEM solves; ``dphi`` is each element's change of
     inflow angle over the previous step, used to extrapolate the hints of stages 2 and 4.
+    ``grid``: (u grid, v-w grid), see :func:`sample_wind` and :func:`sample_inplane`.
 
     Returns the new state, the outputs at t, the stage-4 BEM state and the new ``dphi``.
     """
-    w1 = sample_wind(t, x[16], p, kind, wpar, grid)
-    k1, z, ph1 = evaluate_plant(x, u, w1, p, hint, 0)
+    k1, z, ph1 = _stage(t, x, u, p, kind, wpar, grid, hint)
     x2 = x + 0.5 * h * k1
     hint2 = ph1.copy()
     hint2[0] += 0.5 * dphi
-    k2, _, ph2 = evaluate_plant(x2, u, sample_wind(t + 0.5 * h, x2[16], p, kind, wpar, grid), p, hint2,
-                       0)
+    k2, _, ph2 = _stage(t + 0.5 * h, x2, u, p, kind, wpar, grid, hint2)
     x3 = x + 0.5 * h * k2
-    k3, _, ph3 = evaluate_plant(x3, u, sample_wind(t + 0.5 * h, x3[16], p, kind, wpar, grid), p, ph2, 0)
+    k3, _, ph3 = _stage(t + 0.5 * h, x3, u, p, kind, wpar, grid, ph2)
     x4 = x + h * k3
     hint4 = ph3.copy()
     hint4[0] += 0.5 * dphi
-    k4, _, ph4 = evaluate_plant(x4, u, sample_wind(t + h, x4[16], p, kind, wpar, grid), p, hint4, 0)
+    k4, _, ph4 = _stage(t + h, x4, u, p, kind, wpar, grid, hint4)
     xn = x + h / 6.0 * (k1 + 2.0 * k2 + 2.0 * k3 + k4)
+    ua_update(ph4, p)
     new_dphi = ph4[0] - ph1[0]
     for i in range(new_dphi.shape[0]):
         for j in range(new_dphi.shape[1]):
             if new_dphi[i, j] != new_dphi[i, j]:
                 new_dphi[i, j] = 0.0
     return xn, z, ph4, new_dphi
+
+
+@nb.njit(**_JIT)
+def new_hint(p, dt):  # pragma: no cover - compiled
+    """A fresh warm start for a run at plant step ``dt`` [s]: the BEM rows (NaN: no solve
+    yet) and, with unsteady aerodynamics on, the UA state rows (NaN: first step) and dt."""
+    rows = HINT_ROWS_UA if p.opt[4] != 0 else 4
+    hint = np.full((rows, 3, p.r.size), np.nan)
+    if rows > 4:
+        hint[HINT_ROWS_UA - 3] = dt
+        hint[HINT_ROWS_UA - 5:HINT_ROWS_UA - 3] = 0.0
+    return hint
 
 
 @nb.njit(**_JIT)
@@ -375,7 +580,7 @@ def simulate_kernel(x0, u_seq, t0, h, n_steps, p, kind, wpar, grid, lim, rate_tq
     zs = np.empty((n_steps + 1, 31))
     us = np.empty((n_steps + 1, 4))
     x = x0.copy()
-    hint = np.full((4, 3, p.r.size), np.nan)
+    hint = new_hint(p, h)
     dphi = np.zeros((3, p.r.size))
     u = u_seq[0].copy()
     tq = u[3]
@@ -390,8 +595,7 @@ def simulate_kernel(x0, u_seq, t0, h, n_steps, p, kind, wpar, grid, lim, rate_tq
         us[k] = u
         t = t0 + k * h
         if k == n_steps:
-            w = sample_wind(t, x[16], p, kind, wpar, grid)
-            _, z, _ = evaluate_plant(x, u, w, p, hint, 0)
+            _, z, _ = _stage(t, x, u, p, kind, wpar, grid, hint)
             zs[k] = z
             break
         xn, z, hint, dphi = _rk4(t, x, u, h, p, kind, wpar, grid, hint, dphi)

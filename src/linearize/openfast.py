@@ -14,8 +14,12 @@ What is read (OpenFAST sign conventions turned into ours, see ``docs/turbine-for
   tower fore-aft, side-side, blade flap and edge mode shapes; its blade and tower files'
   distributed properties with their adjustment factors applied (``AdjBlMs``, ``AdjFlSt``,
   ``AdjEdSt``, ``AdjTwMa``, ``AdjFASt``, ``AdjSSSt``).
-- AeroDyn 15: air density, the blade nodes (span, chord, twist, airfoil id) and the airfoil
-  polars (first table of each file; the shape coordinates are not read).
+- AeroDyn 15: air density, the blade nodes (span, chord, twist, airfoil id), the airfoil
+  polars (first table of each file; the shape coordinates are not read) with their unsteady-
+  aerodynamics coefficients (``InclUAdata``: ``alpha0``, ``C_nalpha``, ``Cd0``, ``A1``, ``A2``,
+  ``b1``, ``b2``, ``T_p``, ``T_f0``, ``filtCutOff``, ``UACutout``), and the tower's diameter and
+  drag coefficient (``TwrElev``, ``TwrDiam``, ``TwrCd``).
+- ElastoDyn's blade file: also the structural twist (``StrcTwst``).
 - ServoDyn: generator efficiency. ``DISCON.IN``: rated power and speed, minimum speed, fine
   pitch, pitch and torque limits and rates, the pitch actuator's corner frequency.
 
@@ -28,7 +32,7 @@ from __future__ import annotations
 
 import math
 import re
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Sequence
 
@@ -54,6 +58,7 @@ from linearize.turbine import (
     RotorMass,
     TowerStructure,
     Turbine,
+    UAParams,
 )
 
 __all__ = ["load_openfast", "OpenFASTFile", "read_airfoil_polar"]
@@ -315,6 +320,9 @@ class OpenFASTFile:
             head = [t.lower() for t in _TOKEN.findall(self.lines[i])]
             if head and head[0] in ("!", "#"):
                 head = head[1:]
+            # a comment after the column names is not a column
+            head = next((head[:k] for k, t in enumerate(head) if t.startswith(("!", "#"))),
+                        head)
             if all(c in head for c in want):
                 break
         else:
@@ -399,13 +407,15 @@ def read_airfoil_polar(path: str | Path, name: str | None = None,
     starts: list[dict] = []
     for k, vals, i in f.entries:
         if k == "re":
-            starts.append({"re": _num(f, i, vals)})
+            starts.append({"re": _num(f, i, vals), "ua": {}})
         elif k in ("userprop", "ctrl") and starts:
             starts[-1]["prop"] = _num(f, i, vals)
         elif k == "numalf":
             if not starts:
-                starts.append({})
+                starts.append({"ua": {}})
             starts[-1]["numalf"] = (i, _num(f, i, vals))
+        elif starts and "numalf" not in starts[-1]:
+            starts[-1]["ua"][k] = vals[0] if vals else ""
     tables = [t for t in starts if "numalf" in t]
     if not tables:
         raise TurbineFileError(f"{f.path}: key 'NumAlf' not found: not an AirfoilInfo file")
@@ -432,9 +442,39 @@ def read_airfoil_polar(path: str | Path, name: str | None = None,
                 f"{table_mode}; Re = {t.get('re', float('nan')):g} M, UserProp = "
                 f"{t.get('prop', 0.0):g})")
     try:
-        return Polar(name=name or f.path.stem, alpha_rad=np.radians(a), cl=cl, cd=cd), note
+        return Polar(name=name or f.path.stem, alpha_rad=np.radians(a), cl=cl, cd=cd,
+                     ua=_ua_params(tables[pick]["ua"])), note
     except ValueError as err:
         raise TurbineFileError(f"{f.path}: {err}") from err
+
+
+#: AirfoilInfo's UA keys -> (UAParams field, factor to its unit); others keep their defaults
+_UA_KEYS = {"alpha0": ("alpha0_rad", math.pi / 180), "c_nalpha": ("cn_alpha", 1.0),
+            "cd0": ("cd0", 1.0), "a1": ("a1", 1.0), "a2": ("a2", 1.0), "b1": ("b1", 1.0),
+            "b2": ("b2", 1.0), "t_p": ("t_p", 1.0), "t_f0": ("t_f0", 1.0),
+            "filtcutoff": ("filt_cutoff", 1.0), "uacutout": ("cutout_rad", math.pi / 180)}
+
+
+def _ua_params(keys: dict[str, str]) -> UAParams | None:
+    """An AirfoilInfo table's UA coefficients (``InclUAdata`` true, ``C_nalpha`` > 0), with
+    AeroDyn's defaults for the ``"Default"`` entries; None without them."""
+    if _unquote(keys.get("incluadata", "false")).lower() not in ("true", "t"):
+        return None
+    kw: dict[str, float] = {}
+    for key, (fld, scale) in _UA_KEYS.items():
+        raw = _unquote(keys.get(key, "default"))
+        if raw.lower() == "default":
+            continue
+        try:
+            kw[fld] = float(raw) * scale
+        except ValueError:
+            return None
+    if not kw.get("cn_alpha", 0.0) > 0 or "alpha0_rad" not in kw or "cd0" not in kw:
+        return None
+    try:
+        return UAParams(**kw)
+    except ValueError:
+        return None
 
 
 def _num(f: OpenFASTFile, i: int, vals: list[str]) -> float:
@@ -572,6 +612,7 @@ def load_openfast(fst: str | Path | None = None, *, elastodyn: str | Path | None
     twr = OpenFASTFile(tower_file)
     bstruct, bmodes, blade_damp, scale = _blade_structure(bld, rec)
     tstruct, tmodes, fa_damp, ss_damp = _tower_structure(twr, rec)
+    tstruct = _with_tower_diameter(tstruct, ad, geometry, rec)
     blade_aero, polars = _aero(ad, geometry, rec)
     rotor = RotorMass(hub_mass=rec.read("hub mass", ed.number("HubMass", 0), "kg", ed, "HubMass"),
                       hub_inertia=rec.read("hub inertia", ed.number("HubIner", 0), "kg m^2", ed,
@@ -743,9 +784,15 @@ def _blade_structure(bld: OpenFASTFile, rec: _Recorder
     _positive(bld, t, ("BMassDen", "FlpStff", "EdgStff"))
     damp = bld.number("BldFlDmp1", 0, 50) / 100
     rec.read("blade damping ratio", damp, "", bld, "BldFlDmp(1)", "percent")
+    twist = None
+    try:
+        twist = np.radians(bld.table(("BlFract", "StrcTwst"), n)["StrcTwst"])
+    except TurbineFileError:
+        rec.notes.append(f"{bld.path.name}: no StrcTwst column: the blade modes vibrate in and "
+                         f"out of the rotor plane")
     bs = _make(bld, BladeStructure, span_fraction=t["BlFract"],
                mass_per_length=t["BMassDen"] * scale, flap_stiffness=t["FlpStff"] * fl,
-               edge_stiffness=t["EdgStff"] * eg)
+               edge_stiffness=t["EdgStff"] * eg, structural_twist_rad=twist)
     rec.entries.append(ReportEntry("blade structure", f"{n} stations",
                                    f"{bld.path.name} BlFract, BMassDen x AdjBlMs, FlpStff x "
                                    f"AdjFlSt, EdgStff x AdjEdSt"))
@@ -771,6 +818,29 @@ def _tower_structure(twr: OpenFASTFile, rec: _Recorder
                                    f"{twr.path.name} HtFract, TMassDen, TwFAStif, TwSSStif "
                                    f"with the Adj factors"))
     return ts, (_shape(twr, "TwFAM1Sh"), _shape(twr, "TwSSM1Sh")), fa, ss
+
+
+def _with_tower_diameter(ts: TowerStructure, ad: OpenFASTFile, geo: Geometry,
+                         rec: _Recorder) -> TowerStructure:
+    """The tower structure with AeroDyn's tower diameters (``TwrElev``, ``TwrDiam``)
+    interpolated at its stations, when AeroDyn has a tower table (``NumTwrNds`` >= 2)."""
+    if not ad.has("NumTwrNds"):
+        return ts
+    n = ad.integer("NumTwrNds", 0, 100000)
+    if n < 2:
+        return ts
+    t = ad.table(("TwrElev", "TwrDiam", "TwrCd"), n)
+    _positive(ad, t, ("TwrDiam",))
+    h = geo.tower_base_height + ts.height_fraction * (geo.tower_height - geo.tower_base_height)
+    order = np.argsort(t["TwrElev"])
+    d = np.interp(h, t["TwrElev"][order], t["TwrDiam"][order])
+    cd = np.interp(h, t["TwrElev"][order], t["TwrCd"][order])
+    rec.entries.append(ReportEntry("tower outer diameter", f"{d[0]:.4g}..{d[-1]:.4g} m",
+                                   f"{ad.path.name} TwrElev, TwrDiam ({n} nodes), "
+                                   f"interpolated at the tower stations"))
+    rec.entries.append(ReportEntry("tower drag coefficient", f"{cd.min():.4g}..{cd.max():.4g}",
+                                   f"{ad.path.name} TwrCd ({n} nodes)"))
+    return replace(ts, outer_diameter=d, drag_coefficient=cd)
 
 
 def _aero(ad: OpenFASTFile, geo: Geometry, rec: _Recorder

@@ -7,7 +7,10 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
+
 __all__ = ["CHANNEL_MAP", "UNIT_SCALE", "DEFAULT_UNITS", "SI_UNIT", "unit_key",
+           "blade_frame_moment",
            "resolve_channels"]
 
 _RPM = math.pi / 30.0
@@ -23,12 +26,15 @@ _MOMENT = ("kn-m", "knm", "kn·m", "n-m", "nm", "mn-m")
 _ANGLE = ("deg", "rad")
 _SPEED = ("rpm", "rad/s")
 #: OpenFAST channel -> (our channel, allowed units). Earlier entries of one of our channels
-#: win over later ones (RootMyb1 over RootMyc1).
+#: win over later ones. The blade root moments keep their frames: ElastoDyn's c-frame
+#: (``RootMyc``, ``RootMxc``: out of and in the rotor plane) is ours ``flap_moment``,
+#: ``edge_moment``; its b-frame, which pitches with the blade (``RootMyb``, ``RootMxb``:
+#: flapwise and edgewise), is ours ``flapwise_moment``, ``edgewise_moment``.
 CHANNEL_MAP: dict[str, tuple[str, tuple[str, ...]]] = {
-    **{f"RootMyb{b}": (f"flap_moment_{b}", _MOMENT) for b in (1, 2, 3)},
     **{f"RootMyc{b}": (f"flap_moment_{b}", _MOMENT) for b in (1, 2, 3)},
-    **{f"RootMxb{b}": (f"edge_moment_{b}", _MOMENT) for b in (1, 2, 3)},
     **{f"RootMxc{b}": (f"edge_moment_{b}", _MOMENT) for b in (1, 2, 3)},
+    **{f"RootMyb{b}": (f"flapwise_moment_{b}", _MOMENT) for b in (1, 2, 3)},
+    **{f"RootMxb{b}": (f"edgewise_moment_{b}", _MOMENT) for b in (1, 2, 3)},
     **{f"BldPitch{b}": (f"pitch_{b}", _ANGLE) for b in (1, 2, 3)},
     "TwrBsMyt": ("tower_base_fa_moment", _MOMENT),
     "TwrBsMxt": ("tower_base_ss_moment", _MOMENT),
@@ -128,3 +134,33 @@ def resolve_channels(names: list[str] | tuple[str, ...], units: list[str] | tupl
     winner = {j: ours for ours, (_, j) in best.items()}
     return [(winner.get(j, name), UNIT_SCALE.get(unit_key(unit), math.nan))
             for j, (name, unit) in enumerate(zip(names, units))]
+
+
+def blade_frame_moment(name: str, pitch: np.ndarray, flap: np.ndarray,
+                       edge: np.ndarray) -> np.ndarray:
+    """A blade root moment in the frame that pitches with the blade (ElastoDyn's b-frame) from
+    the out-of-plane and in-plane ones (its c-frame), turned by the pitch beta (positive to
+    feather; Jonkman 2007, NREL/TP-500-41958, the blade coordinate systems):
+    flapwise = cos(beta) M_out + sin(beta) M_in, edgewise = cos(beta) M_in - sin(beta) M_out.
+
+    Parameters
+    ----------
+    name : str
+        ``flapwise_moment_i`` or ``edgewise_moment_i``.
+    pitch : ndarray
+        Blade pitch [rad].
+    flap, edge : ndarray
+        Out-of-plane and in-plane root moments [N m].
+
+    Returns
+    -------
+    ndarray
+        [N m]
+    """
+    c, s = np.cos(pitch), np.sin(pitch)
+    if name.startswith("flapwise"):
+        return c * flap + s * edge
+    if name.startswith("edgewise"):
+        return c * edge - s * flap
+    raise KeyError(f"no blade-frame moment {name!r}; allowed flapwise_moment_i, "
+                   f"edgewise_moment_i")

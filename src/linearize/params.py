@@ -19,6 +19,7 @@ from linearize.bem import (
     polar_table_of,
 )
 from linearize.turbine import Turbine, mode_shape
+from linearize.unsteady import UA_PAR
 
 __all__ = ["DOF_NAMES", "STATE_NAMES", "STATE_UNITS", "INPUT_NAMES", "INPUT_UNITS", "OUTPUT_NAMES",
            "OUTPUT_UNITS", "MADSEN_OUTPUTS", "n_x", "n_u", "n_z", "PlantConfig", "PlantParams",
@@ -95,11 +96,38 @@ class PlantConfig:
         Spanwise load integration: element-centre midpoint rule with the element lengths
         (AeroDyn v13 / WT_Perf style) or trapezoid over the element centres with zero load at
         hub and tip (CCBlade style).
+    blade_body_forces : bool
+        The blade's own forces normal to it on the flap mode and in the out-of-plane root
+        moment: the centrifugal force of the coned blade, Omega^2 r cos(c) sin(c) per unit
+        mass, and gravity, g (sin(t) cos(c) - sin(c) cos(t) cos(psi)) with shaft tilt t,
+        precone c and azimuth psi (Jonkman 2007, NREL/TP-500-41958, sec. 3: ElastoDyn's
+        blade kinematics; Hansen 2015, sec. 11.3). Gravity follows ``aero.gravity``; both
+        vanish without cone and tilt. Off by default: the observers of the controllers that
+        read the root moments (LQR-PIO's) were designed on moments without this 1P part
+        (with it, LQR-PIO's pitch travel through rated grows 3.5x); on in :meth:`openfast`.
+    inplane_wind : bool
+        The free wind's lateral and vertical components (a :class:`GridWind` with ``v`` and
+        ``w``) in the blade elements' velocities (AeroDyn's relative wind; Jonkman 2007,
+        NREL/TP-500-41958): the rotor's side force and yaw moment in a lateral gust, the
+        blades' 1P in-plane loading. Without it the plant meets u alone.
+    tower_shadow : bool
+        Potential flow around the tower in front of it (AeroDyn's ``TwrPotent = 1``; Moriarty
+        and Hansen 2005, NREL/EL-500-36881, sec. 7): the wind a blade meets as it passes the
+        tower, on turbines whose data give the tower's outer diameter
+        (``TowerStructure.outer_diameter``). Off by default: a narrow azimuthal feature that
+        the trim's and the linearization's few azimuth samples misrepresent; on in
+        :meth:`openfast`.
     """
 
     dofs: frozenset[str] = frozenset(DOF_NAMES)
     aero: AeroOptions = field(default_factory=AeroOptions)
     integration: str = "midpoint"
+    blade_body_forces: bool = False
+    inplane_wind: bool = True
+    tower_shadow: bool = False
+    unsteady_aero: bool = False
+    twisted_modes: bool = False
+    tower_drag: bool = False
 
     def __post_init__(self) -> None:
         dofs = frozenset(self.dofs)
@@ -128,6 +156,34 @@ class PlantConfig:
         """Do et al. model: tower fore-aft, drivetrain, generator, blade flap, pitch."""
         return cls(frozenset({"tower_fa", "drivetrain", "generator", "blade_flap",
                               "pitch_actuator"}), aero or AeroOptions())
+
+    @classmethod
+    def openfast(cls, *, unsteady_aero: bool = True, tower_drag: bool = True,
+                 tower_shadow: bool = True, twisted_modes: bool = True,
+                 blade_body_forces: bool = True,
+                 dofs: frozenset[str] | None = None) -> "PlantConfig":
+        """Every effect OpenFAST's ElastoDyn and AeroDyn 15 models and the plant has, as the
+        regression case ``5MW_Land_DLL_WTurb`` runs them (AeroDyn's ``UA_Mod = 3``,
+        ``TwrPotent = 1`` and ``TwrAero``; the rest are on by default): for comparisons with
+        OpenFAST runs.
+
+        Parameters
+        ----------
+        unsteady_aero, tower_drag, tower_shadow, twisted_modes, blade_body_forces : bool
+            The effects off by default (the AeroDyn file's ``UA_Mod > 0``, ``TwrAero`` and
+            ``TwrPotent > 0``; ElastoDyn's modes along the principal axes and its blade
+            kinematics).
+        dofs : frozenset of str, optional
+            Degrees of freedom (default: all).
+
+        Returns
+        -------
+        PlantConfig
+        """
+        return cls(frozenset(DOF_NAMES) if dofs is None else frozenset(dofs),
+                   unsteady_aero=unsteady_aero, tower_drag=tower_drag,
+                   tower_shadow=tower_shadow, twisted_modes=twisted_modes,
+                   blade_body_forces=blade_body_forces)
 
     def active_states(self) -> tuple[str, ...]:
         """Names of the states that evolve under this configuration (azimuth excluded).
@@ -168,7 +224,9 @@ _Pack = namedtuple("_Pack", [
     "m_b", "k_b", "k_cf", "c_b", "m_c", "s1", "s_phi_s", "s_phi_r", "i_edge",
     "tau_p", "rate_p", "min_p", "max_p", "min_tq", "max_tq",
     "fa_static", "fa_pdelta", "fa_inertia", "ss_pdelta", "ss_inertia",
-    "phi_edge", "m_e", "k_e", "k_cf_e", "c_e", "s_e", "g_e", "s_phie_s"])
+    "phi_edge", "m_e", "k_e", "k_cf_e", "c_e", "s_e", "g_e", "s_phie_s", "g_b",
+    "twr_h", "twr_r", "x_apex", "ua",
+    "twist_s", "sfc", "sfs", "sec", "ses", "tq_h", "tq_w", "tq_fa", "tq_ss"])
 
 
 @dataclass(frozen=True)
@@ -349,6 +407,7 @@ def plant_params(turbine: Turbine, config: PlantConfig | None = None) -> PlantPa
         weights = 0.5 * (rr[2:] - rr[:-2])
     phi_el = mode_shape(t.mode_shapes.blade_flap1, (b.r - g.hub_radius) / lb)
     edge, edge_pack = _edge_mode(t, s, mu, tension)
+    twisted = _twisted_modes(t, cfg, s, mu, phi, b.r)
     if "blade_edge" in cfg.dofs and not edge:
         raise ValueError("config.dofs has 'blade_edge' but the turbine's mode-shape table has "
                          "no 'blade_edge_1' row; add it or leave the DOF out "
@@ -356,7 +415,16 @@ def plant_params(turbine: Turbine, config: PlantConfig | None = None) -> PlantPa
     tab = polar_table_of(t)
     pa = t.pitch_actuator
     dofs = np.array([d in cfg.dofs for d in DOF_NAMES], dtype=np.int64)
-    opt = np.array([cfg.aero.gravity], dtype=np.int64)
+    opt = np.array([cfg.aero.gravity, cfg.blade_body_forces, cfg.inplane_wind,
+                    cfg.tower_shadow, cfg.unsteady_aero, twisted["on"], 0], dtype=np.int64)
+    drag = _tower_drag_points(t, ht)
+    opt[6] = int(cfg.tower_drag and drag["tq_h"].size > 0)
+    ua = np.array([pol.ua.row() if pol.ua is not None else (0.0,) * len(UA_PAR)
+                   for pol in t.polars], dtype=float)
+    twr_h, twr_r = np.zeros(1), np.zeros(1)
+    if ts.outer_diameter is not None:
+        twr_h = g.tower_base_height + ts.height_fraction * ht
+        twr_r = 0.5 * np.asarray(ts.outer_diameter, dtype=float)
     fa_static = grav * (t.nacelle.mass * g.nacelle_cm_downwind - rotor_mass * g.overhang)
     pack = _Pack(
         dof=dofs, flags=aero_flags(cfg.aero), opt=opt, nb=float(nblade),
@@ -373,7 +441,10 @@ def plant_params(turbine: Turbine, config: PlantConfig | None = None) -> PlantPa
         s_phi_r=s_phi_r, i_edge=i_edge, tau_p=pa.time_constant, rate_p=pa.max_rate_rad_s,
         min_p=pa.min_pitch_rad, max_p=pa.max_pitch_rad, min_tq=t.generator.min_torque,
         max_tq=t.generator.max_torque, fa_static=fa_static, fa_pdelta=pd_fa,
-        fa_inertia=in_fa, ss_pdelta=pd_ss, ss_inertia=in_ss, **edge_pack)
+        fa_inertia=in_fa, ss_pdelta=pd_ss, ss_inertia=in_ss, g_b=m_c,
+        twr_h=twr_h, twr_r=twr_r, x_apex=-g.overhang * math.cos(g.shaft_tilt_rad), ua=ua,
+        twist_s=twisted["twist_s"], sfc=twisted["sfc"], sfs=twisted["sfs"], sec=twisted["sec"],
+        ses=twisted["ses"], **drag, **edge_pack)
     return PlantParams(
         turbine=t, config=cfg, rotor_inertia=rotor_inertia, rotor_mass=rotor_mass,
         blade_mass=blade_mass, tower_fa_modal_mass=m_fa, tower_fa_modal_stiffness=k_fa,
@@ -413,6 +484,51 @@ def _edge_mode(t: Turbine, s: FloatArray, mu: FloatArray,
               "s_e": s_e, "g_e": float(np.trapezoid(mu * phi, s)),
               "s_phie_s": float(np.trapezoid(mu * phi * s, s))}
     return public, kernel
+
+
+#: tower drag: the flexible tower's quadrature points
+N_TOWER_POINTS = 20
+
+
+def _tower_drag_points(t: Turbine, ht: float) -> dict[str, FloatArray]:
+    """The tower-drag quadrature: heights above ground [m] (midpoints of equal segments of the
+    flexible tower), weights 0.5 rho C_d D dh [kg/m], and the fore-aft and side-side mode
+    shapes there (empty when the data have no diameter or drag coefficient)."""
+    ts = t.tower_structure
+    if ts.outer_diameter is None or ts.drag_coefficient is None:
+        empty = np.zeros(0)
+        return {"tq_h": empty, "tq_w": empty, "tq_fa": empty, "tq_ss": empty}
+    x = (np.arange(N_TOWER_POINTS) + 0.5) / N_TOWER_POINTS
+    d = np.interp(x, ts.height_fraction, ts.outer_diameter)
+    cd = np.interp(x, ts.height_fraction, ts.drag_coefficient)
+    return {"tq_h": t.geometry.tower_base_height + x * ht,
+            "tq_w": 0.5 * t.environment.air_density * cd * d * ht / N_TOWER_POINTS,
+            "tq_fa": mode_shape(t.mode_shapes.tower_fa1, x),
+            "tq_ss": mode_shape(t.mode_shapes.tower_ss1, x)}
+
+
+def _twisted_modes(t: Turbine, cfg: PlantConfig, s: FloatArray, mu: FloatArray,
+                   phi: FloatArray, r_el: FloatArray) -> dict[str, Any]:
+    """The kernel's data for modes along the twisted principal axes: the structural twist at
+    each aero element [rad] and the root-moment integrals int m phi s cos/sin(twist) of the flap
+    (sfc, sfs) and edge (sec, ses) modes [kg m]; rotor-plane values when off."""
+    g = t.geometry
+    lb = g.tip_radius - g.hub_radius
+    tw_data = t.blade_structure.structural_twist_rad
+    shape_e = t.mode_shapes.blade_edge1
+    phi_e = mode_shape(shape_e, s / lb) if shape_e is not None else np.zeros_like(s)
+    if not cfg.twisted_modes or tw_data is None:
+        return {"on": False, "twist_s": np.zeros_like(r_el),
+                "sfc": float(np.trapezoid(mu * phi * s, s)), "sfs": 0.0,
+                "sec": float(np.trapezoid(mu * phi_e * s, s)), "ses": 0.0}
+    tw = np.interp(s / lb, t.blade_structure.span_fraction, tw_data)
+    return {"on": True,
+            "twist_s": np.interp((r_el - g.hub_radius) / lb, t.blade_structure.span_fraction,
+                                 tw_data),
+            "sfc": float(np.trapezoid(mu * phi * s * np.cos(tw), s)),
+            "sfs": float(np.trapezoid(mu * phi * s * np.sin(tw), s)),
+            "sec": float(np.trapezoid(mu * phi_e * s * np.cos(tw), s)),
+            "ses": float(np.trapezoid(mu * phi_e * s * np.sin(tw), s))}
 
 
 def structural_frequencies(params: PlantParams, rotor_speed_rad_s: float = 0.0) -> dict[str, float]:

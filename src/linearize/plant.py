@@ -61,6 +61,10 @@ from linearize.kernel import (
     DENSE_STRIDES,
     bad_state,
     evaluate_plant,
+    evaluate_plant_vw,
+    new_hint,
+    sample_inplane,
+    sample_tower,
     sample_wind,
     simulate_kernel,
     step_kernel,
@@ -339,7 +343,7 @@ class PlantStepper:
     def reset(self) -> None:
         """Forget the BEM warm start (a new run)."""
         n_r = self._pack.r.size
-        self._hint = np.full((4, N_BLADE, n_r), np.nan)
+        self._hint = new_hint(self._pack, self.dt)
         self._dphi = np.zeros((N_BLADE, n_r))
         self._into_entry: Any = None
 
@@ -431,8 +435,10 @@ class PlantStepper:
         (n_z,) ndarray
             Outputs.
         """
-        w = sample_wind(t, x[16], self._pack, self._kind, self._wpar, self._grid)
-        return evaluate_plant(x, u, w, self._pack, self._hint, 0)[1]
+        w = sample_wind(t, x[16], self._pack, self._kind, self._wpar, self._grid[0])
+        vw = sample_inplane(t, x[16], self._pack, self._kind, self._wpar, self._grid[1])
+        tw = sample_tower(t, self._pack, self._kind, self._wpar, self._grid)
+        return evaluate_plant_vw(x, u, w, (vw, tw), self._pack, self._hint, 0)[1]
 
     def outside_envelope(self, x: FloatArray) -> int:
         """Index of the first state outside the physical envelope (or non-finite), else -1.

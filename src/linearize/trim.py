@@ -382,7 +382,8 @@ def _equilibrium(p: PlantParams, v: float, omega: float, pitch: float, tg: float
     """Structural displacements that null the (azimuth-averaged) accelerations.
 
     The loads do not depend on displacements, so the accelerations are affine in them and
-    one solve of K delta = M a0 is exact.
+    one solve of K delta = M a is exact; a second one from the displacements found checks it
+    (and removes round-off).
     """
     pk = p.pack
     x = _state(p, omega, pitch)
@@ -391,6 +392,31 @@ def _equilibrium(p: PlantParams, v: float, omega: float, pitch: float, tg: float
     if p.dof("drivetrain"):
         q, _ = _aero(p, v, omega, pitch, shear)
         x[4] = q / pk.k_shaft
+    for _ in range(8):
+        x, dx, z = _displacement_step(p, x, u, v, omega, shear)
+        resid = _residual(dx)
+        if np.all(np.isfinite(dx)) and resid.max() <= 1e-6:
+            return x, u, z
+    k = int(np.argmax(resid)) if np.all(np.isfinite(resid)) else int(np.argmax(~np.isfinite(dx)))
+    raise TrimError(f"trim did not reach equilibrium: d({STATE_NAMES[k]})/dt = {dx[k]!r}")
+
+
+def _residual(dx: FloatArray) -> FloatArray:
+    """Scaled equilibrium residual of the azimuth-averaged derivatives (displacement rates,
+    zero by construction, and the azimuth's rate, the speed, left out)."""
+    scale = np.array([1.0, 1e-2, 1e-3, 1e-1, 1e-3, 1e-3, 1e-3, 1e-3, 1.0, 1e-2, 1.0, 1.0, 1.0,
+                      1e-2, 1e-2, 1e-2, 1.0, 1.0, 1.0, 1.0, 1e-2, 1e-2, 1e-2])
+    resid = np.abs(dx) / scale
+    resid[[0, 8, 10, 11, 12, 16, 17, 18, 19]] = 0.0
+    return resid
+
+
+def _displacement_step(p: PlantParams, x: FloatArray, u: FloatArray, v: float, omega: float,
+                       shear: float) -> tuple[FloatArray, FloatArray, FloatArray]:
+    """One Newton-like step of the displacements from ``x`` (K delta = M a at x), and the
+    azimuth-averaged derivatives and outputs at the new displacements."""
+    pk = p.pack
+    x = x.copy()
     dx0, _ = rotor_average(p, x, u, v, shear)
     if p.dof("tower_fa") or p.dof("blade_flap"):
         kq = pk.k_b + omega**2 * pk.k_cf
@@ -406,27 +432,19 @@ def _equilibrium(p: PlantParams, v: float, omega: float, pitch: float, tg: float
         idx = np.flatnonzero(on)
         delta = np.zeros(4)
         delta[idx] = np.linalg.solve(k[np.ix_(idx, idx)], m[np.ix_(idx, idx)] @ a0[idx])
-        x[0] = delta[0]
-        x[10:13] = delta[1:]
+        x[0] += delta[0]
+        x[10:13] += delta[1:]
     if p.dof("tower_ss"):
-        x[8] = pk.m_ss * dx0[9] / pk.k_ss
+        x[8] += pk.m_ss * dx0[9] / pk.k_ss
     if p.dof("blade_edge"):
-        # edge force per blade (mean over a revolution) from the accelerations at q = 0:
-        # M_e q'' + S_e Omega' = F  =>  F = M_e q'' + S_e Omega'
+        # edge force per blade (mean over a revolution) from the accelerations:
+        # M_e q'' + S_e Omega' = F - K q  =>  K delta = M_e q'' + S_e Omega'
         force = pk.m_e * dx0[20:23].mean() + pk.s_e * dx0[2]
-        x[17:20] = force / (pk.k_e + omega**2 * (pk.k_cf_e - pk.m_e))
+        x[17:20] += force / (pk.k_e + omega**2 * (pk.k_cf_e - pk.m_e))
     dx, z = rotor_average(p, x, u, v, shear)
-    scale = np.array([1.0, 1e-2, 1e-3, 1e-1, 1e-3, 1e-3, 1e-3, 1e-3, 1.0, 1e-2, 1.0, 1.0, 1.0,
-                      1e-2, 1e-2, 1e-2, 1.0, 1.0, 1.0, 1.0, 1e-2, 1e-2, 1e-2])
     dx[13:16] = dx[13:16].mean()   # rotor_average returns a new array
     dx[20:23] = dx[20:23].mean()
-    resid = np.abs(dx) / scale
-    # displacement rates are velocities (zero by construction); the azimuth's is the speed
-    resid[[0, 8, 10, 11, 12, 16, 17, 18, 19]] = 0.0
-    if not np.all(np.isfinite(dx)) or resid.max() > 1e-6:
-        k = int(np.argmax(resid))
-        raise TrimError(f"trim did not reach equilibrium: d({STATE_NAMES[k]})/dt = {dx[k]!r}")
-    return x, u, z
+    return x, dx, z
 
 
 def operating_schedule(turbine: Turbine, wind_mps: FloatArray, power_W: float | None = None,

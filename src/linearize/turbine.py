@@ -23,7 +23,7 @@ from linearize.validate import frozen_array
 
 __all__ = [
     "TurbineFileError", "Geometry", "Operation", "Environment", "RotorMass", "Nacelle",
-    "Drivetrain", "Generator", "PitchActuator", "Damping", "BladeAero", "Polar",
+    "Drivetrain", "Generator", "PitchActuator", "Damping", "BladeAero", "Polar", "UAParams",
     "BladeStructure", "TowerStructure", "ModeShapes", "Turbine",
     "available_turbines", "LoadReport", "ReportEntry",
 ]
@@ -357,6 +357,74 @@ class BladeAero:
 
 
 @dataclass(frozen=True)
+class UAParams:
+    """An airfoil's unsteady-aerodynamics coefficients, AeroDyn's names and defaults
+    (AirfoilInfo ``alpha0``, ``C_nalpha``, ``Cd0``, ``A1``, ``A2``, ``b1``, ``b2``, ``T_p``,
+    ``T_f0``, ``filtCutOff``, ``UACutout``; :mod:`linearize.unsteady`).
+
+    Parameters
+    ----------
+    alpha0_rad : float
+        Zero-lift angle of attack [rad].
+    cn_alpha : float
+        Slope of the attached-flow normal-force line [1/rad], > 0.
+    cd0 : float
+        Drag coefficient at zero lift [-].
+    a1, a2, b1, b2 : float
+        Wagner's indicial-function constants [-] (0.3, 0.7, 0.14, 0.53).
+    t_p, t_f0 : float
+        Leading-edge pressure and trailing-edge separation time constants in semichords [-]
+        (1.7, 3).
+    filt_cutoff : float
+        Reduced frequency of the angle-of-attack low-pass filter [-] (0.5).
+    cutout_rad : float
+        Angle of attack above which the static polar acts [rad] (45 deg).
+    speed_of_sound : float
+        [m/s] (AeroDyn's ``SpdSound``, 335), for the element's Mach number.
+    """
+
+    alpha0_rad: float
+    cn_alpha: float
+    cd0: float
+    a1: float = 0.3
+    a2: float = 0.7
+    b1: float = 0.14
+    b2: float = 0.53
+    t_p: float = 1.7
+    t_f0: float = 3.0
+    filt_cutoff: float = 0.5
+    cutout_rad: float = math.radians(45.0)
+    speed_of_sound: float = 335.0
+
+    def __post_init__(self) -> None:
+        for name in ("alpha0_rad", "cn_alpha", "cd0", "a1", "a2", "b1", "b2", "t_p", "t_f0",
+                     "filt_cutoff", "cutout_rad", "speed_of_sound"):
+            v = float(getattr(self, name))
+            if not math.isfinite(v):
+                raise ValueError(f"UAParams.{name} must be finite, got {v!r}")
+            object.__setattr__(self, name, v)
+        for name in ("cn_alpha", "b1", "b2", "t_p", "t_f0", "filt_cutoff", "cutout_rad",
+                     "speed_of_sound"):
+            if not getattr(self, name) > 0:
+                raise ValueError(f"UAParams.{name} must be > 0, got {getattr(self, name)!r}")
+        if abs(self.alpha0_rad) > math.radians(30.0):
+            raise ValueError(f"UAParams.alpha0_rad must be within +-30 deg, got "
+                             f"{math.degrees(self.alpha0_rad):.3g} deg")
+
+    def row(self) -> tuple[float, ...]:
+        """The kernel's parameter row.
+
+        Returns
+        -------
+        tuple of float
+            In the order of :data:`linearize.unsteady.UA_PAR`, the first 1.0 (UA on).
+        """
+        return (1.0, self.alpha0_rad, self.cn_alpha, self.cd0, self.a1, self.a2, self.b1,
+                self.b2, self.t_p, self.t_f0, self.filt_cutoff, self.cutout_rad,
+                self.speed_of_sound)
+
+
+@dataclass(frozen=True)
 class Polar:
     """Static airfoil polar covering -180..180 deg.
 
@@ -367,12 +435,15 @@ class Polar:
         Angle of attack, strictly increasing, from -pi to pi [rad].
     cl, cd : (n_alpha,) ndarray
         Lift and drag coefficients [-].
+    ua : UAParams, optional
+        Unsteady-aerodynamics coefficients; None: the airfoil acts by its static polar alone.
     """
 
     name: str
     alpha_rad: FloatArray
     cl: FloatArray
     cd: FloatArray
+    ua: UAParams | None = None
 
     def __post_init__(self) -> None:
         _freeze(self, ("alpha_rad", "cl", "cd"))
@@ -402,16 +473,26 @@ class BladeStructure:
         Mass per unit length, scaled [kg/m].
     flap_stiffness, edge_stiffness : (n,) ndarray
         Bending stiffness [N m^2].
+    structural_twist_rad : (n,) ndarray, optional
+        Twist of the principal axes [rad] (ElastoDyn's ``StrcTwst``): the flap and edge modes
+        vibrate along them, pitched with the blade. None: in and out of the rotor plane.
     """
 
     span_fraction: FloatArray
     mass_per_length: FloatArray
     flap_stiffness: FloatArray
     edge_stiffness: FloatArray
+    structural_twist_rad: FloatArray | None = None
 
     def __post_init__(self) -> None:
         _freeze(self, ("span_fraction", "mass_per_length", "flap_stiffness", "edge_stiffness"))
         _check_stations("BladeStructure", self.span_fraction)
+        if self.structural_twist_rad is not None:
+            _freeze(self, ("structural_twist_rad",))
+            tw = self.structural_twist_rad
+            if tw.shape != self.span_fraction.shape or not np.all(np.abs(tw) <= math.pi / 2):
+                raise ValueError(f"BladeStructure.structural_twist_rad must be within +-90 deg at "
+                                 f"each of the {self.span_fraction.size} stations")
 
 
 @dataclass(frozen=True)
@@ -428,16 +509,37 @@ class TowerStructure:
         [kg/m].
     fa_stiffness, ss_stiffness : (n,) ndarray
         Fore-aft and side-side bending stiffness [N m^2].
+    outer_diameter : (n,) ndarray, optional
+        Outer diameter [m] (AeroDyn's ``TwrDiam``), for the tower's potential flow and drag;
+        None when the data have none (the plant then has no tower shadow and no tower drag).
+    drag_coefficient : (n,) ndarray, optional
+        Drag coefficient of the tower's section [-] (AeroDyn's ``TwrCd``); None: no tower drag.
     """
 
     height_fraction: FloatArray
     mass_per_length: FloatArray
     fa_stiffness: FloatArray
     ss_stiffness: FloatArray
+    outer_diameter: FloatArray | None = None
+    drag_coefficient: FloatArray | None = None
 
     def __post_init__(self) -> None:
         _freeze(self, ("height_fraction", "mass_per_length", "fa_stiffness", "ss_stiffness"))
         _check_stations("TowerStructure", self.height_fraction)
+        if self.drag_coefficient is not None:
+            _freeze(self, ("drag_coefficient",))
+            c = self.drag_coefficient
+            if c.shape != self.height_fraction.shape or not np.all(np.isfinite(c)) \
+                    or np.any(c < 0) or np.any(c > 5):
+                raise ValueError(f"TowerStructure.drag_coefficient must be within 0..5 at each "
+                                 f"of the {self.height_fraction.size} stations, got {c!r}")
+        if self.outer_diameter is not None:
+            _freeze(self, ("outer_diameter",))
+            d = self.outer_diameter
+            if d.shape != self.height_fraction.shape or not np.all(np.isfinite(d)) \
+                    or np.any(d <= 0):
+                raise ValueError(f"TowerStructure.outer_diameter must be finite and > 0 m at "
+                                 f"each of the {self.height_fraction.size} stations, got {d!r}")
 
 
 def _check_stations(owner: str, x: FloatArray) -> None:
@@ -853,6 +955,7 @@ def _require(path: Path, col: str, values: FloatArray, ok: Callable[[FloatArray]
 def _read_polars(index_path: Path, base: Path) -> tuple[tuple[Polar, ...], dict[int, int]]:
     """Read the airfoil index; its ``file`` column is relative to the turbine directory."""
     idx = _read_csv(index_path, ("af_id", "name", "file"), text_cols=("name", "file"))
+    ua_cols = _ua_columns(index_path)
     polars = []
     index_of: dict[int, int] = {}
     for k, (af_id, name, file) in enumerate(zip(idx["af_id"], idx["name"], idx["file"])):
@@ -860,11 +963,33 @@ def _read_polars(index_path: Path, base: Path) -> tuple[tuple[Polar, ...], dict[
         tab = _read_csv(p, ("alpha_deg", "cl", "cd"))
         try:
             polars.append(Polar(name=name, alpha_rad=np.radians(tab["alpha_deg"]),
-                                cl=tab["cl"], cd=tab["cd"]))
+                                cl=tab["cl"], cd=tab["cd"], ua=_ua_of(index_path, k, ua_cols)))
         except ValueError as err:
             raise TurbineFileError(f"{p}: {err}") from err
         index_of[int(af_id)] = k
     return tuple(polars), index_of
+
+
+def _ua_columns(path: Path) -> dict[str, Any] | None:
+    """The airfoil index's optional UA columns (all three or none)."""
+    cols = ("ua_alpha0_deg", "ua_Cn_alpha_per_rad", "ua_Cd0")
+    try:
+        return _read_csv(path, cols)
+    except TurbineFileError as err:
+        if "missing columns" in str(err):
+            return None
+        raise
+
+
+def _ua_of(path: Path, k: int, cols: dict[str, Any] | None) -> UAParams | None:
+    """Airfoil k's UA coefficients from the index (None where C_n,alpha is 0: no UA data)."""
+    if cols is None or not cols["ua_Cn_alpha_per_rad"][k] > 0:
+        return None
+    try:
+        return UAParams(alpha0_rad=math.radians(cols["ua_alpha0_deg"][k]),
+                        cn_alpha=cols["ua_Cn_alpha_per_rad"][k], cd0=cols["ua_Cd0"][k])
+    except ValueError as err:
+        raise TurbineFileError(f"{path}: data row {k + 1}: {err}") from err
 
 
 def _read_blade_aero(path: Path, index_of: dict[int, int]) -> BladeAero:
@@ -899,8 +1024,25 @@ def _read_blade_structure(path: Path, scale: float) -> BladeStructure:
     _stations(path, "BlFract", t["BlFract"])
     for c in cols[1:]:
         _require(path, c, t[c], lambda v: v > 0, "> 0")
+    twist = _optional_column(path, "StrcTwst_deg", lambda v: np.abs(v) <= 90, "-90..90 deg")
+    if twist is not None:
+        twist = np.radians(twist)
     return BladeStructure(span_fraction=t["BlFract"], mass_per_length=t["BMassDen_kg_per_m"] * scale,
-                          flap_stiffness=t["FlpStff_Nm2"], edge_stiffness=t["EdgStff_Nm2"])
+                          flap_stiffness=t["FlpStff_Nm2"], edge_stiffness=t["EdgStff_Nm2"],
+                          structural_twist_rad=twist)
+
+
+def _optional_column(path: Path, col: str, ok: Callable[[FloatArray], Any],
+                     allowed: str) -> FloatArray | None:
+    """An optional column of a CSV file, checked (None when the file has no such column)."""
+    try:
+        values = _read_csv(path, (col,))[col]
+    except TurbineFileError as err:
+        if "missing columns" in str(err):
+            return None
+        raise
+    _require(path, col, values, ok, allowed)
+    return values
 
 
 def _read_tower_structure(path: Path) -> TowerStructure:
@@ -909,8 +1051,11 @@ def _read_tower_structure(path: Path) -> TowerStructure:
     _stations(path, "HtFract", t["HtFract"])
     for c in cols[1:]:
         _require(path, c, t[c], lambda v: v > 0, "> 0")
+    diameter = _optional_column(path, "TwrDiam_m", lambda v: v > 0, "> 0")
+    cd = _optional_column(path, "TwrCd", lambda v: (v >= 0) & (v <= 5), "0..5")
     return TowerStructure(height_fraction=t["HtFract"], mass_per_length=t["TMassDen_kg_per_m"],
-                          fa_stiffness=t["TwFAStif_Nm2"], ss_stiffness=t["TwSSStif_Nm2"])
+                          fa_stiffness=t["TwFAStif_Nm2"], ss_stiffness=t["TwSSStif_Nm2"],
+                          outer_diameter=diameter, drag_coefficient=cd)
 
 
 def _read_mode_shapes(path: Path) -> ModeShapes:

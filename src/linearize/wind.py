@@ -39,7 +39,7 @@ def element_wind(params: PlantParams, azimuth_rad: float, hub_speed: float,
     """
     ws = SteadyWind(hub_speed, shear_exponent)
     kind, wpar, grid = ws._kernel_args()
-    return sample_wind(0.0, float(azimuth_rad), params.pack, kind, wpar, grid)
+    return sample_wind(0.0, float(azimuth_rad), params.pack, kind, wpar, grid[0])
 
 
 @dataclass(frozen=True)
@@ -65,9 +65,9 @@ class SteadyWind:
         if not math.isfinite(a) or not -1.0 <= a <= 1.0:
             raise ValueError(f"shear_exponent must be in [-1, 1], got {self.shear_exponent!r}")
 
-    def _kernel_args(self) -> tuple[int, FloatArray, FloatArray]:
+    def _kernel_args(self) -> tuple[int, FloatArray, tuple[FloatArray, FloatArray]]:
         return (0, np.array([float(self.speed), float(self.shear_exponent)]),
-                np.zeros((1, 1, 1), dtype=np.float32))
+                (np.zeros((1, 1, 1), dtype=np.float32), _NO_VW))
 
     def check_covers(self, params: PlantParams, t_end: float) -> None:
         """Steady wind covers any rotor and any duration.
@@ -81,9 +81,15 @@ class SteadyWind:
         """
 
 
+#: the kernel's v-w grid of a wind without lateral and vertical components
+_NO_VW = np.zeros((2, 1, 1, 1), dtype=np.float32)
+_NO_VW.flags.writeable = False
+
+
 @dataclass(frozen=True)
 class GridWind:
-    """Longitudinal wind on a regular (t, y, z) grid in the rotor plane, sampled trilinearly.
+    """Wind on a regular (t, y, z) grid in the rotor plane, sampled trilinearly: the
+    longitudinal component, and optionally the lateral and vertical ones.
 
     Parameters
     ----------
@@ -96,12 +102,17 @@ class GridWind:
     u : (n_t, n_y, n_z) ndarray
         Longitudinal wind speed [m/s], finite and >= 0; kept as float32 (a 600 s turbulent
         field on 32 x 32 points at 20 Hz is 50 MB).
+    v, w : (n_t, n_y, n_z) ndarray, optional
+        Lateral (+y) and vertical (+z) wind speed [m/s], finite; both or neither (kept
+        together as one float32 array). Without them the plant meets u alone.
     """
 
     t: FloatArray
     y: FloatArray
     z: FloatArray
     u: FloatArray
+    v: FloatArray | None = None
+    w: FloatArray | None = None
 
     def __post_init__(self) -> None:
         for name in ("t", "y", "z"):
@@ -123,11 +134,28 @@ class GridWind:
             u = np.array(u, dtype=np.float32, order="C")
         u.flags.writeable = False
         object.__setattr__(self, "u", u)
+        if (self.v is None) != (self.w is None):
+            raise ValueError("GridWind.v and GridWind.w must be given together (or neither)")
+        vw = _NO_VW
+        if self.v is not None:
+            shape = (self.t.size, self.y.size, self.z.size)
+            vw = np.empty((2,) + shape, dtype=np.float32)
+            vw[0] = check_array("GridWind.v", self.v, shape, shape_names="(n_t, n_y, n_z)")
+            vw[1] = check_array("GridWind.w", self.w, shape, shape_names="(n_t, n_y, n_z)")
+            vw.flags.writeable = False
+            object.__setattr__(self, "v", vw[0])
+            object.__setattr__(self, "w", vw[1])
+        object.__setattr__(self, "_vw", vw)
 
-    def _kernel_args(self) -> tuple[int, FloatArray, FloatArray]:
+    @property
+    def has_inplane(self) -> bool:
+        """Whether the grid carries the lateral and vertical components."""
+        return self.v is not None
+
+    def _kernel_args(self) -> tuple[int, FloatArray, tuple[FloatArray, FloatArray]]:
         par = np.array([self.t[0], self.t[1] - self.t[0], self.y[0], self.y[1] - self.y[0],
                         self.z[0], self.z[1] - self.z[0]])
-        return 1, par, self.u
+        return 1, par, (self.u, self._vw)   # type: ignore[attr-defined]
 
     def check_covers(self, params: PlantParams, t_end: float) -> None:
         """Raise if the grid does not cover the rotor disc or the time span.

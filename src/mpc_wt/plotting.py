@@ -650,3 +650,51 @@ def plot_lidar_evaluation(summary: dict[str, Any], curves: dict[str, Any], tip_r
                       curves["lidar_radius"], tip_radius, d / "lidar_scan.png")
     return [str(d / "lidar_coherence.png"), str(d / "lidar_scan.png")]
 
+
+
+def plot_psd_grid(panels: Sequence[tuple[str, str, Sequence[tuple[str, np.ndarray, np.ndarray]]]],
+                  path: str | Path, rotor_hz: float | None = None,
+                  title: str = "") -> Path:
+    """Spectra of several channels, one panel each, several runs overlaid.
+
+    Parameters
+    ----------
+    panels : sequence of (str, str, sequence of (str, ndarray, ndarray))
+        Per panel: the channel's name, its PSD unit (e.g. ``"(kN m)^2/Hz"``), and per run a
+        label, frequencies [Hz] and PSD.
+    path : str or Path
+        The PNG file.
+    rotor_hz : float, optional
+        Rotor frequency 1P [Hz]: 1P, 3P and 6P are marked.
+    title : str
+        Figure title.
+
+    Returns
+    -------
+    Path
+        The PNG file.
+    """
+    plt = pyplot()
+    n = max(len(panels), 1)
+    cols = 2 if n > 1 else 1
+    rows = math.ceil(n / cols)
+    fig, axs = plt.subplots(rows, cols, figsize=(6.0 * cols, 3.0 * rows), dpi=110,
+                            squeeze=False)
+    for ax, (name, unit, runs) in zip(axs.flat, panels):
+        for label, f, p in runs:
+            keep = (f > 0) & (f <= 10.0)
+            ax.loglog(f[keep], np.maximum(p[keep], 1e-30), lw=0.9, label=label)
+        if rotor_hz:
+            for k in (1, 3, 6):
+                ax.axvline(k * rotor_hz, color="0.6", ls=":", lw=0.7)
+        ax.set_title(name, fontsize=9)
+        ax.set_xlabel("frequency [Hz]", fontsize=8)
+        ax.set_ylabel(f"PSD [{unit}]", fontsize=8)
+        ax.grid(alpha=0.3, which="both")
+        ax.legend(fontsize=7)
+    for ax in list(axs.flat)[len(panels):]:
+        ax.set_visible(False)
+    if title:
+        fig.suptitle(title, fontsize=10)
+    fig.tight_layout()
+    return save_figure(fig, path)

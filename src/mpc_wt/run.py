@@ -5,6 +5,8 @@ import dataclasses
 from pathlib import Path
 from typing import Any, Mapping, Sequence
 
+import numpy as np
+
 import lidar
 import linearize
 from mpc_wt.registry.context import DEFAULT_CACHE, BuildContext, Built, DesignCache, design_digest
@@ -14,7 +16,8 @@ from mpc_wt.simulation.loop import simulate_closed_loop
 from mpc_wt.simulation.results import ClosedLoopResult
 from mpc_wt.simulation.scenario import FieldMemo, Scenario, lidar_field, make_wind, start_wind
 
-__all__ = ["run_controller", "build_controller", "design_controller", "export_discon"]
+__all__ = ["run_controller", "build_controller", "design_controller", "export_discon",
+           "run_openfast_case", "CASE_CONTROLLERS"]
 
 
 def _operating_point(turbine: linearize.Turbine, sel: Selection, opts: Sequence[Options],
@@ -294,3 +297,78 @@ def export_discon(turbine: linearize.Turbine, controller: str, out: str | Path,
                              compiler=compiler,
                              source=f"options: {opts}" if opts else "default options",
                              preview=built.preview)
+
+
+#: the controllers :func:`run_openfast_case` runs a case with
+CASE_CONTROLLERS = ("auto", "jonkman", "rosco", "discon")
+
+
+def run_openfast_case(case: Any, controller: str = "auto", *, library: str | Path | None = None,
+                      discon_in: str | Path | None = None, config: Any = None,
+                      dt: float = 1.0 / 80.0, progress: bool = False) -> ClosedLoopResult:
+    """Run mpc-wt's plant through an OpenFAST case: its wind as the rotor meets it, its initial
+    state, its degrees of freedom and aerodynamic options, and its controller.
+
+    Parameters
+    ----------
+    case : mpc_wt.io.openfast_case.OpenFASTCase
+        From :func:`mpc_wt.io.openfast_case.read_openfast_case`.
+    controller : {"auto", "jonkman", "rosco", "discon"}
+        ``jonkman``: the baseline kind with Jonkman's published gains
+        (:func:`mpc_wt.controllers.baseline.jonkman_gains`); ``rosco``: ROSCO's library (the
+        ``rosco`` package's) with the case's ``DISCON.IN``; ``discon``: ``library`` with
+        ``discon_in``; ``auto``: ``rosco`` when ServoDyn names a controller input file, else
+        ``jonkman``.
+    library, discon_in : str or Path, optional
+        For ``discon`` (``discon_in`` defaults to the case's).
+    config : linearize.PlantConfig, optional
+        The plant in place of the case's (:attr:`OpenFASTCase.config`).
+    dt : float
+        Plant and controller step [s].
+    progress : bool
+        Show a progress bar.
+
+    Returns
+    -------
+    ClosedLoopResult
+        ``meta`` holds the case, the controller and the wind's time shift.
+
+    Raises
+    ------
+    ValueError
+        An unknown controller, or ``discon`` without a library or input file.
+    SimulationDivergedError
+        If the run leaves the physical envelope (``.partial`` keeps what was simulated).
+    """
+    from mpc_wt.controllers.baseline import BaselineController, jonkman_gains
+    from mpc_wt.controllers.discon import DisconController, rosco_library
+    from mpc_wt.io.openfast_case import case_grid_wind, describe
+
+    if controller not in CASE_CONTROLLERS:
+        raise ValueError(f"controller must be one of {list(CASE_CONTROLLERS)}, got "
+                         f"{controller!r}")
+    if controller == "auto":
+        controller = "rosco" if case.discon_in is not None else "jonkman"
+    turbine = case.turbine
+    if controller == "jonkman":
+        gains = jonkman_gains()
+        ctl: Any = BaselineController(turbine, gains, dt=dt)
+    else:
+        lib = rosco_library() if controller == "rosco" else library
+        dis = discon_in if discon_in is not None else case.discon_in
+        if lib is None or dis is None:
+            raise ValueError(f"controller {controller!r} needs a library and a controller input "
+                             f"file (library={library!r}, discon_in={dis!r})")
+        ctl = DisconController(lib, dis, turbine, dt=dt, pitch_control="collective")
+    wind, shift = case_grid_wind(case)
+    params = linearize.plant_params(turbine, config or case.config)
+    x0 = case.x0.copy()
+    wg = x0[3]
+    rated = turbine.rated_generator_speed_rad_s
+    tq0 = min(turbine.rated_generator_torque * (wg / rated) ** 2 if wg < rated
+              else turbine.rated_generator_torque, turbine.generator.max_torque)
+    u0 = np.array([x0[5], x0[6], x0[7], tq0])
+    meta = {"controller": controller, "openfast_case": describe(case),
+            "wind_shift_s": shift, "turbine": turbine.name}
+    return simulate_closed_loop(params, ctl, wind, case.duration, x0=x0, u0=u0, dt=dt,
+                                progress=progress, meta=meta)

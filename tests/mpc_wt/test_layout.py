@@ -215,8 +215,8 @@ LAYOUT = {
     "controllers/takagi_sugeno": {"model", "synthesis", "controller", "robustness"},
     "registry": {"registry", "options", "builtin", "context"},
     "simulation": {"scenario", "loop", "compiled", "results", "preview", "solver_timing"},
-    "assessment": {"fatigue", "performance", "series", "ultimate", "lidar"},
-    "io": {"gain_tables", "rosco", "openfast_output", "discon_export"},
+    "assessment": {"fatigue", "performance", "series", "ultimate", "lidar", "compare"},
+    "io": {"gain_tables", "rosco", "openfast_output", "discon_export", "openfast_case"},
 }
 
 

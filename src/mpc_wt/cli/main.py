@@ -17,6 +17,8 @@ export       gain tables: ``export DIR --format csv|json|mat|rosco``
 campaign     load-case campaigns on Dask: ``campaign run SPEC.yaml``, ``status``, ``report``
 tune         design parameters optimized over load cases: ``tune SPEC.yaml --out DIR``
 bench        ``bench mpc``: QP solver comparison
+compare-openfast  an OpenFAST case run on mpc-wt's plant, compared with its output:
+             ``compare-openfast CASE.fst --outb CASE.outb [--wind FILE.bts]``
 
 ``--plugin MODULE`` (before the subcommand, repeatable) imports a module that registers
 controller kinds, which ``simulate`` and campaign specs can then use.
@@ -32,12 +34,12 @@ import sys
 from typing import Sequence
 
 import linearize
-from mpc_wt.cli import campaign, design, runs, steady, wind
+from mpc_wt.cli import campaign, compare, design, runs, steady, wind
 from mpc_wt.errors import CampaignLockedError, ControllerLibraryError, UsageError
 
 __all__ = ["main", "build_parser"]
 
-_GROUPS = (runs, steady, wind, design, campaign)
+_GROUPS = (runs, steady, wind, design, campaign, compare)
 
 
 def build_parser() -> argparse.ArgumentParser:

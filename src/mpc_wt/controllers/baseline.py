@@ -35,7 +35,7 @@ from mpc_wt.controllers.baseline_law import N_STATE, SIGNALS, law_parameters, la
 from mpc_wt.controllers.baseline_law import torque as law_torque
 
 __all__ = ["BaselineGains", "tune_baseline", "tune_baseline_schedule", "BaselineController",
-           "LawTorque", "check_power_fraction", "effective_pi_gains"]
+           "LawTorque", "check_power_fraction", "effective_pi_gains", "jonkman_gains"]
 
 
 def check_power_fraction(value: Any, name: str = "power_fraction") -> float:
@@ -161,6 +161,25 @@ def default_omega_n(turbine: linearize.Turbine) -> float:
         [rad/s]
     """
     return 0.6 * turbine.operation.rated_rotor_speed_rad_s / NREL5MW_RATED_ROTOR_SPEED
+
+
+def jonkman_gains() -> BaselineGains:
+    """Jonkman's baseline controller for the NREL 5-MW as published, its parameter block in
+    DISCON.F90 (OpenFAST r-test ``5MW_Baseline/ServoData/DISCON``; Jonkman et al. 2009,
+    NREL/TP-500-38060, sec. 7): PC_KP = 0.01882681 s, PC_KI = 0.008068634, PC_KK = 0.1099965
+    rad, VS_Rgn2K = 2.332287 N m/(rad/s)^2, PC_RefSpd = 122.9096 rad/s, VS_RtPwr =
+    5,296,610 W mechanical (5 MW electrical at 94.4 %), VS_RtTq = 43,093.55 N m; the
+    report's dP/dtheta = -25.52e6 W/rad behind the gains. The case's controller when an
+    OpenFAST deck runs Jonkman's compiled DLL (which has no input file).
+
+    Returns
+    -------
+    BaselineGains
+    """
+    return BaselineGains(kp=0.01882681, ki=0.008068634, theta_k_rad=0.1099965,
+                         k_opt=2.332287, rated_gen_speed_rad_s=122.9096, rated_torque=43093.55,
+                         rated_power=5.0e6, dpdtheta_0=-25.52e6, omega_n_rad_s=0.6, zeta=0.7,
+                         info={"source": "Jonkman et al. 2009, DISCON.F90 parameter block"})
 
 
 def tune_baseline(turbine: linearize.Turbine, *, omega_n_rad_s: float | None = None,

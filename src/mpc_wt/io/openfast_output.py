@@ -9,7 +9,9 @@ tests check the two against each other.
 
 Channel map (OpenFAST -> ours): :data:`linearize.openfast_channels.CHANNEL_MAP`, shared with the
 ``.lin`` reader; where several channels of a file map to one of ours the earlier entry of the
-map wins (``RootMyb1`` over ``RootMyc1``, ``RtAeroFxh`` over ``RotThrust``). A mapped channel whose unit is not one
+map wins (``RtAeroFxh`` over ``RotThrust``); the blade root moments keep their frames
+(``RootMyc1`` -> ``flap_moment_1``, out of plane; ``RootMyb1`` -> ``flapwise_moment_1``, pitching
+with the blade). A mapped channel whose unit is not one
 the map expects is an error naming channel and unit; channels the map does not know keep their
 OpenFAST names, converted to SI when their unit is in :data:`UNIT_SCALE` (and reported in
 ``unmapped``), else kept as written and listed in ``unconverted``.
@@ -331,7 +333,8 @@ def from_mpcwt_channels(cols: dict[str, np.ndarray]
                         ) -> tuple[dict[str, np.ndarray], dict[str, str]]:
     """Our channels (SI) as OpenFAST channels in OpenFAST's units, for
     :func:`write_openfast_output`: the first OpenFAST name of each of ours in
-    :data:`CHANNEL_MAP` (``flap_moment_1`` -> ``RootMyb1`` in kN-m, ``pitch_1`` ->
+    :data:`CHANNEL_MAP` (``flap_moment_1`` -> ``RootMyc1`` in kN-m, ``flapwise_moment_1`` ->
+    ``RootMyb1``, ``pitch_1`` ->
     ``BldPitch1`` in deg, ``gen_speed`` -> ``GenSpeed`` in rpm, ...). Channels without an
     OpenFAST name are left out.
 

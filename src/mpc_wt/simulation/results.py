@@ -14,6 +14,7 @@ from typing import Any
 import numpy as np
 
 import linearize
+from linearize.openfast_channels import blade_frame_moment
 from mpc_wt._version import __version__
 from mpc_wt.errors import ResultFileError
 
@@ -21,6 +22,10 @@ __all__ = ["ClosedLoopResult", "load_series", "SCHEMA_VERSION"]
 
 SCHEMA_VERSION = 1
 _Z = {n: i for i, n in enumerate(linearize.OUTPUT_NAMES)}
+
+
+#: the blade-frame root moments :meth:`ClosedLoopResult.channel` derives
+_BLADE_FRAME = tuple(f"{k}_moment_{b}" for k in ("flapwise", "edgewise") for b in (1, 2, 3))
 
 
 @dataclass(frozen=True)
@@ -51,10 +56,12 @@ class ClosedLoopResult:
     meta: dict[str, Any] = field(default_factory=dict)
 
     def channel(self, name: str) -> np.ndarray:
-        """A time series by name: output, state, input, controller signal, or the derived
-        ``shaft_bending_blade1``: the rotating low-speed-shaft bending moment in the direction
+        """A time series by name: output, state, input, controller signal, or a derived one:
+        ``shaft_bending_blade1``, the rotating low-speed-shaft bending moment in the direction
         of blade 1 from the blades' flap moments, M_1 - (M_2 + M_3) / 2 [N m] (rotor weight
-        and hub inertia left out).
+        and hub inertia left out); ``flapwise_moment_i`` and ``edgewise_moment_i``, blade i's
+        root moments in the frame that pitches with it (OpenFAST's ``RootMyb``, ``RootMxb``;
+        :func:`blade_frame_moment`).
 
         Parameters
         ----------
@@ -74,6 +81,10 @@ class ClosedLoopResult:
         if name == "shaft_bending_blade1":
             f = self.z[:, _Z["flap_moment_1"]:_Z["flap_moment_3"] + 1]
             return f[:, 0] - 0.5 * (f[:, 1] + f[:, 2])
+        if name in _BLADE_FRAME:
+            return blade_frame_moment(name, self.z[:, _Z[f"pitch_{name[-1]}"]],
+                                      self.z[:, _Z[f"flap_moment_{name[-1]}"]],
+                                      self.z[:, _Z[f"edge_moment_{name[-1]}"]])
         if name in _Z:
             return self.z[:, _Z[name]]
         if name in linearize.STATE_NAMES:
@@ -94,7 +105,7 @@ class ClosedLoopResult:
         """
         return (list(linearize.OUTPUT_NAMES) + [n for n in linearize.STATE_NAMES
                                                 if n not in _Z]
-                + list(linearize.INPUT_NAMES) + ["shaft_bending_blade1"]
+                + list(linearize.INPUT_NAMES) + ["shaft_bending_blade1"] + list(_BLADE_FRAME)
                 + list(self.controller))
 
     def save(self, path: str | Path) -> Path:

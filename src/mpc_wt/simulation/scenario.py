@@ -559,7 +559,10 @@ def _file_wind(turbine: linearize.Turbine, scenario: Scenario
     f = dataclasses.replace(f, t=f.t - f.t[0],
                             meta={**f.meta, "wind_file": str(name),
                                   "file_mean_wind_mps": float(f.mean_speed)})
-    return _grid_wind(f)
+    grid, f = _grid_wind(f)
+    # a wind file's lateral and vertical components reach the plant too (every controller of
+    # a campaign runs on the same file, so all meet them)
+    return dataclasses.replace(grid, v=f.v, w=f.w), f
 
 
 def lidar_field(turbine: linearize.Turbine, scenario: Scenario, field: lidar.WindField,

@@ -57,12 +57,14 @@ def test_reader_agrees_with_openfast_io(tmp_path, series, suffix, fmt) -> None:
 
 
 def test_channels_mapped_to_ours_in_si(tmp_path, series) -> None:
-    """kN-m -> N m, deg -> rad, rpm -> rad/s, kW -> W; unmapped channels keep their names."""
+    """kN-m -> N m, deg -> rad, rpm -> rad/s, kW -> W; unmapped channels keep their names;
+    ElastoDyn's blade-frame root moment (``RootMyb``) is ours flapwise, not out-of-plane."""
     t, ch, units = series
     p = write_openfast_output(tmp_path / "run.outb", t, ch, units)
     tt, cols = load_series(p)
     np.testing.assert_array_equal(tt, t)
-    np.testing.assert_allclose(cols["flap_moment_1"], ch["RootMyb1"] * 1e3, rtol=1e-15)
+    np.testing.assert_allclose(cols["flapwise_moment_1"], ch["RootMyb1"] * 1e3, rtol=1e-15)
+    assert "flap_moment_1" not in cols
     np.testing.assert_allclose(cols["pitch_1"], np.radians(ch["BldPitch1"]), rtol=1e-15)
     np.testing.assert_allclose(cols["gen_speed"], ch["GenSpeed"] * np.pi / 30, rtol=1e-15)
     np.testing.assert_allclose(cols["gen_power"], ch["GenPwr"] * 1e3, rtol=1e-15)
@@ -81,7 +83,7 @@ def test_assess_openfast_run_beside_ours(tmp_path, capsys) -> None:
     nc = res.save(tmp_path / "ours.nc")
     cols = {n: res.channel(n) for n in res.channels()}
     of, units = from_mpcwt_channels(cols)
-    assert {"RootMyb1", "TwrBsMyt", "GenPwr", "BldPitch1"} <= set(of)
+    assert {"RootMyc1", "RootMyb1", "TwrBsMyt", "GenPwr", "BldPitch1"} <= set(of)
     exact = write_openfast_output(tmp_path / "openfast.outb", res.t, of, units)
     packed = write_openfast_output(tmp_path / "packed.outb", res.t, of, units, binary_format=2)
     csv_path = tmp_path / "openfast.csv"

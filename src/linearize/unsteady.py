@@ -1,0 +1,241 @@
+"""Unsteady airfoil aerodynamics: a Beddoes-Leishman-type model in AeroDyn's discrete form,
+acting on each blade element of the time-domain plant.
+
+The model follows the incompressible core of the Beddoes-Leishman model as AeroDyn 15 runs it
+with ``UA_Mod = 3`` (Minnema/Pierce) and ``FLookup = True`` (Damiani and Hayman 2019,
+NREL/TP-5000-66347, "The Unsteady Aerodynamics Module for FAST 8", eqs 1.5-1.56; Leishman and
+Beddoes 1989):
+
+* the angle of attack low-pass filtered at a reduced frequency ``filt_cutoff``
+  (eq 1.8), the attached-flow circulatory lag by Wagner's two-term indicial function with
+  deficiency functions X1, X2 (eqs 1.14-1.15; A1, A2, b1, b2), in the semichords travelled
+  ``ds = 2 W dt / c`` (eq 1.5b), with the Prandtl-Glauert factor beta = sqrt(1 - M^2) of the
+  element's Mach number M = W / a (eqs 1.11-1.13);
+* the non-circulatory (apparent-mass) normal force of the filtered angle-of-attack rate,
+  4 T_alpha (K_alpha - K'_alpha) / M (eqs 1.7-1.11, 1.18), which leads the circulatory lag;
+* the leading-edge pressure lag T_p on the potential normal force (eqs 1.34-1.35) giving the
+  effective separation angle alpha_f;
+* the trailing-edge separation point f' from the static polar by the inverse Kirchhoff
+  relation, lagged by T_f0 (eqs 1.32-1.36), for the normal force and, with its own lookup, for
+  the chordwise force (eq 1.40 with Gonzalez's offset 0.2);
+* normal force C_n = C_n,nc + C_n,alpha alpha_e f'' + C_n,fs (1 - f'') with the fully
+  separated C_n,fs from the static polar, chordwise force C_c = C_c,pot (sqrt(f''_c) - 0.2);
+  lift and drag C_l = C_n cos(alpha) + C_c sin(alpha), C_d = C_n sin(alpha) - C_c cos(alpha)
+  + C_d0 (eqs 1.2, 1.39-1.40);
+* blended to the static polar within 5 deg below ``cutout`` and static above it.
+
+Left out: the pitch-rate terms (the blade does not twist), the pitching moment, the
+leading-edge vortex lift (eqs 1.47-1.55) and the time-constant switching of the full model
+(sigma = 1). In steady flow the model returns the static polar wherever the static normal
+force lies below the attached-flow line C_n,alpha / beta (alpha - alpha0), and that line
+where it lies above: AeroDyn's steady behaviour with the same airfoil data (J. Jonkman, 2020,
+"Incorrect Unsteady Airfoil Aerodynamic Input Parameters", OpenFAST r-test repository: the
+NREL 5-MW's UA coefficients lower the mean lift of the DU21 and DU25 airfoils).
+
+The states are discrete, updated once per plant step (as AeroDyn's), and kept beside the BEM
+warm start: rows ``UA_ROW`` .. of the kernel's ``hint`` array.
+"""
+from __future__ import annotations
+
+import math
+
+import numba as nb
+import numpy as np
+
+from linearize.bem import polar_lookup
+
+__all__ = ["UA_ROW", "N_UA", "HINT_ROWS_UA", "UA_PAR", "ua_coefficients", "ua_update",
+           "ua_steady"]
+
+#: first ``hint`` row of the UA states
+UA_ROW = 4
+#: states per element: filtered alpha, X1, X2, C_n,pot, D_p, f', D_f, f'_c, D_fc, K_alpha,f,
+#: q_f, K'_alpha
+N_UA = 12
+#: the rows of the model's lift and drag less the static polar's (from the last update, held
+#: over the next step), the plant step dt, then the last stage's alpha and W
+_DCL, _DCD = UA_ROW + N_UA, UA_ROW + N_UA + 1
+_DT, _ALPHA, _W = UA_ROW + N_UA + 2, UA_ROW + N_UA + 3, UA_ROW + N_UA + 4
+#: rows of a ``hint`` that carries UA states
+HINT_ROWS_UA = UA_ROW + N_UA + 5
+#: columns of the per-airfoil parameter table: has UA, alpha0, C_n,alpha, C_d0, A1, A2, b1,
+#: b2, T_p, T_f0, filt_cutoff, cutout, speed of sound
+UA_PAR = ("on", "alpha0", "cn_alpha", "cd0", "a1", "a2", "b1", "b2", "t_p", "t_f0",
+          "filt_cutoff", "cutout", "speed_of_sound")
+_GONZALEZ = 0.2
+_JIT = dict(cache=True, error_model="numpy")
+
+
+@nb.njit(**_JIT)
+def _static_cn_cc(table, k, alpha, a0, dalpha, cd0):  # pragma: no cover - compiled
+    cl, cd = polar_lookup(table, k, alpha, a0, dalpha)
+    s, c = math.sin(alpha), math.cos(alpha)
+    return cl * c + (cd - cd0) * s, cl * s - (cd - cd0) * c
+
+
+@nb.njit(**_JIT)
+def _f_lookup(table, k, alpha, par, cna, a0, dalpha):  # pragma: no cover - compiled
+    """Separation point f' of the normal force at alpha (inverse Kirchhoff, eq 1.32a) with the
+    attached-flow slope ``cna``, and the fully separated normal force C_n,fs there."""
+    cn, _ = _static_cn_cc(table, k, alpha, a0, dalpha, par[3])
+    lin = cna * (alpha - par[1])
+    x = 0.0
+    if lin != 0.0 and cn != 0.0:
+        x = cn / lin
+        if x < 0.0:
+            x = 0.0
+    f = (2.0 * math.sqrt(x) - 1.0) ** 2
+    if f >= 1.0:
+        return 1.0, 0.0
+    return f, (cn - lin * f) / (1.0 - f)
+
+
+@nb.njit(**_JIT)
+def _fc_lookup(table, k, alpha, par, cna, a0, dalpha):  # pragma: no cover - compiled
+    """Separation point f'_c of the chordwise force at alpha (eq 1.32b, Gonzalez offset)."""
+    limit = (1.0 + _GONZALEZ) ** 2
+    den = cna * (alpha - par[1]) * math.tan(alpha)
+    if den == 0.0:
+        return limit
+    _, cc = _static_cn_cc(table, k, alpha, a0, dalpha, par[3])
+    v = (cc / den + _GONZALEZ) ** 2
+    return v if v < limit else limit
+
+
+@nb.njit(**_JIT)
+def _chain(alpha, w, chord, dt, par, st, table, k, a0, dalpha):  # pragma: no cover - compiled
+    """One step of the model from the states ``st`` (N_UA,) of the previous step: the
+    coefficients (C_l, C_d) at the current alpha [rad] and relative speed w [m/s], and the new
+    states (written into a fresh array)."""
+    w = max(w, 1e-3)
+    mach = min(w / par[12], 0.7)
+    beta2 = 1.0 - mach * mach
+    beta = math.sqrt(beta2)
+    cna = par[2] / beta
+    ds = 2.0 * w * dt / chord
+    cut = max(1.0, w) * par[10] / (math.pi * chord)
+    lp = math.exp(-2.0 * math.pi * dt * cut)
+    a_prev = st[0]
+    a_filt = lp * a_prev + (1.0 - lp) * alpha
+    da = a_filt - a_prev
+    # non-circulatory normal force of the filtered rate (eqs 1.7-1.11, 1.18)
+    q_cur = da / dt * chord / w
+    q_f = lp * st[10] + (1.0 - lp) * q_cur
+    ka_f = q_f * w / chord
+    k_alpha = 1.0 / ((1.0 - mach) + 0.5 * par[2] * mach * mach * beta
+                     * (par[4] * par[6] + par[5] * par[7]))
+    t_alpha = 0.75 * k_alpha * chord / par[12]
+    et = math.exp(-dt / t_alpha)
+    kp_alpha = st[11] * et + (ka_f - st[9]) * math.sqrt(et)
+    cn_nc = 4.0 * t_alpha * (ka_f - kp_alpha) / mach
+    # circulatory, Wagner (eqs 1.13-1.15)
+    e1, e2 = math.exp(-par[6] * ds * beta2), math.exp(-par[7] * ds * beta2)
+    x1 = st[1] * e1 + par[4] * da * math.sqrt(e1)
+    x2 = st[2] * e2 + par[5] * da * math.sqrt(e2)
+    a_e = a_filt - par[1] - x1 - x2
+    cn_circ = cna * a_e
+    cn_pot = cn_circ + cn_nc
+    ep = math.exp(-ds / par[8])
+    dp = st[4] * ep + (cn_pot - st[3]) * math.sqrt(ep)
+    a_f = (cn_pot - dp) / cna + par[1]
+    fp, _ = _f_lookup(table, k, a_f, par, cna, a0, dalpha)
+    ef = math.exp(-ds / par[9])
+    df = st[6] * ef + (fp - st[5]) * math.sqrt(ef)
+    fpc = _fc_lookup(table, k, a_f, par, cna, a0, dalpha)
+    dfc = st[8] * ef + (fpc - st[7]) * math.sqrt(ef)
+    f2 = min(max(fp - df, 0.0), 1.0)
+    f2c = min(max(fpc - dfc, 0.0), (1.0 + _GONZALEZ) ** 2)
+    _, cn_fs = _f_lookup(table, k, a_e + par[1], par, cna, a0, dalpha)
+    cn = cn_nc + cn_circ * f2 + cn_fs * (1.0 - f2)
+    cc = cn_circ * math.tan(a_e + par[1]) * (math.sqrt(f2c) - _GONZALEZ)
+    s, c = math.sin(alpha), math.cos(alpha)
+    cl = cn * c + cc * s
+    cd = cn * s - cc * c + par[3]
+    new = np.empty(N_UA)
+    new[0] = a_filt
+    new[1] = x1
+    new[2] = x2
+    new[3] = cn_pot
+    new[4] = dp
+    new[5] = fp
+    new[6] = df
+    new[7] = fpc
+    new[8] = dfc
+    new[9] = ka_f
+    new[10] = q_f
+    new[11] = kp_alpha
+    return cl, cd, new
+
+
+@nb.njit(**_JIT)
+def _blend(alpha, cl, cd, par, table, k, a0, dalpha):  # pragma: no cover - compiled
+    """The model's coefficients blended to the static polar near and above the cut-out."""
+    a = abs(alpha)
+    if a <= par[11] - math.radians(5.0):
+        return cl, cd
+    cls, cds = polar_lookup(table, k, alpha, a0, dalpha)
+    if a >= par[11]:
+        return cls, cds
+    w = 0.5 + 0.5 * math.cos(math.pi * (a - par[11] + math.radians(5.0)) / math.radians(5.0))
+    return w * cl + (1.0 - w) * cls, w * cd + (1.0 - w) * cds
+
+
+@nb.njit(**_JIT)
+def _initial(alpha, w, par, table, k, a0, dalpha):  # pragma: no cover - compiled
+    """States of a steady flow at alpha and relative speed w [m/s] (the first step of a run)."""
+    mach = min(max(w, 1e-3) / par[12], 0.7)
+    cna = par[2] / math.sqrt(1.0 - mach * mach)
+    st = np.zeros(N_UA)
+    st[0] = alpha
+    st[3] = cna * (alpha - par[1])
+    st[5], _ = _f_lookup(table, k, alpha, par, cna, a0, dalpha)
+    st[7] = _fc_lookup(table, k, alpha, par, cna, a0, dalpha)
+    return st
+
+
+@nb.njit(**_JIT)
+def ua_coefficients(alpha, w, chord, hint, i, j, par, table, k, a0, dalpha):  # pragma: no cover
+    """(C_l, C_d, valid) of element (i, j) at alpha [rad]: the static polar's plus the model's
+    difference from it at the last update (held over the step, as the model's states are: the
+    model runs once per element and step, in :func:`ua_update`); ``valid`` False (and the
+    static coefficients) before the first update."""
+    cl, cd = polar_lookup(table, k, alpha, a0, dalpha)
+    if hint[UA_ROW, i, j] != hint[UA_ROW, i, j]:
+        return cl, cd, False
+    return cl + hint[_DCL, i, j], cd + hint[_DCD, i, j], True
+
+
+@nb.njit(**_JIT)
+def ua_update(hint, p):  # pragma: no cover - compiled
+    """Advance every element's states one step, from the alpha and W the last stage left in
+    ``hint`` (in place); elements of airfoils without UA data keep NaN states."""
+    if hint.shape[0] < HINT_ROWS_UA:
+        return
+    for i in range(hint.shape[1]):
+        for j in range(hint.shape[2]):
+            k = p.af[j]
+            par = p.ua[k]
+            alpha = hint[_ALPHA, i, j]
+            if par[0] == 0.0 or alpha != alpha:
+                continue
+            if hint[UA_ROW, i, j] != hint[UA_ROW, i, j]:
+                st = _initial(alpha, hint[_W, i, j], par, p.table, k, p.alpha0, p.dalpha)
+            else:
+                st = hint[UA_ROW:UA_ROW + N_UA, i, j]
+            cl, cd, st = _chain(alpha, hint[_W, i, j], p.chord[j], hint[_DT, i, j], par, st,
+                                p.table, k, p.alpha0, p.dalpha)
+            cl, cd = _blend(alpha, cl, cd, par, p.table, k, p.alpha0, p.dalpha)
+            cls, cds = polar_lookup(p.table, k, alpha, p.alpha0, p.dalpha)
+            hint[_DCL, i, j] = cl - cls
+            hint[_DCD, i, j] = cd - cds
+            for s in range(N_UA):
+                hint[UA_ROW + s, i, j] = st[s]
+
+
+@nb.njit(**_JIT)
+def ua_steady(alpha, w, par, table, k, a0, dalpha):  # pragma: no cover - compiled
+    """The model's steady-flow coefficients (C_l, C_d) at alpha [rad] and relative speed w
+    [m/s]: its fixed point."""
+    st = _initial(alpha, w, par, table, k, a0, dalpha)
+    cl, cd, _ = _chain(alpha, w, 1.0, 0.01, par, st, table, k, a0, dalpha)
+    return _blend(alpha, cl, cd, par, table, k, a0, dalpha)

@@ -1,0 +1,133 @@
+"""``mpcwt compare-openfast``: an OpenFAST run reproduced on mpc-wt's plant and compared with
+it, channel by channel (means, standard deviations, DELs) with PSD overlays.
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import math
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+import linearize
+from mpc_wt.errors import UsageError
+
+__all__ = ["add_parsers"]
+
+#: the channels whose PSDs are drawn (when both runs have them), with their unit after scaling
+_PSD = (("flapwise_moment_1", "(kN m)^2/Hz", 1e3), ("edgewise_moment_1", "(kN m)^2/Hz", 1e3),
+        ("lss_torque", "(kN m)^2/Hz", 1e3), ("tower_base_fa_moment", "(kN m)^2/Hz", 1e3),
+        ("tower_base_ss_moment", "(kN m)^2/Hz", 1e3), ("rotor_speed", "(rpm)^2/Hz", math.pi / 30),
+        ("pitch_1", "(deg)^2/Hz", math.pi / 180), ("gen_power", "(kW)^2/Hz", 1e3))
+
+
+def add_parsers(sub: Any) -> None:
+    """Add ``compare-openfast`` to the subcommands.
+
+    Parameters
+    ----------
+    sub : argparse subparsers action
+        Of the top-level parser.
+    """
+    p = sub.add_parser("compare-openfast",
+                       help="run an OpenFAST case on mpc-wt's plant and compare it with the "
+                            "case's OpenFAST output")
+    p.add_argument("fst", help="the case's .fst")
+    p.add_argument("--outb", required=True, help="the case's OpenFAST output (.outb or .out)")
+    p.add_argument("--wind", default=None,
+                   help="the TurbSim .bts the case runs in (default: InflowWind's FileName_BTS)")
+    p.add_argument("--turbine", default=None,
+                   help="turbine name or file, when the deck alone does not make one (a deck "
+                        "with Jonkman's compiled controller has no DISCON.IN)")
+    p.add_argument("--controller", default="auto", choices=("auto", "jonkman", "rosco",
+                                                            "discon"),
+                   help="jonkman: the baseline with Jonkman's published gains; rosco: ROSCO's "
+                        "library with the case's DISCON.IN; discon: --library with "
+                        "--discon-in; auto (default): rosco when ServoDyn names a DISCON.IN")
+    p.add_argument("--library", default=None, help="a controller library, for --controller "
+                                                   "discon")
+    p.add_argument("--discon-in", default=None, help="its input file (default: the case's)")
+    p.add_argument("--plant", default="case", choices=("case", "default"),
+                   help="case (default): the DOFs and aerodynamic effects of the case's "
+                        "ElastoDyn and AeroDyn files; default: mpc-wt's default plant")
+    p.add_argument("--window", nargs=2, type=float, default=None, metavar=("FROM", "TO"),
+                   help="statistics window [s] (default: 10 s to the end)")
+    p.add_argument("--out", default=None,
+                   help="folder for comparison.json, psd.png and our run (ours.nc)")
+    p.add_argument("--json", action="store_true", help="print the rows as JSON")
+    p.set_defaults(func=_compare)
+
+
+def _compare(args: argparse.Namespace) -> int:
+    from mpc_wt.assessment.compare import compare_series
+    from mpc_wt.io.openfast_case import read_openfast_case
+    from mpc_wt.io.openfast_output import read_openfast_output, to_mpcwt_channels
+    from mpc_wt.run import run_openfast_case
+
+    if args.controller == "discon" and args.library is None:
+        raise UsageError("--controller discon needs --library LIB")
+    turbine = linearize.load_turbine(args.turbine) if args.turbine else None
+    case = read_openfast_case(args.fst, wind=args.wind, turbine=turbine)
+    of = read_openfast_output(args.outb)
+    cols_of, _ = to_mpcwt_channels(of, str(args.outb))
+    t_of = of.t
+    config = linearize.PlantConfig() if args.plant == "default" else None
+    res = run_openfast_case(case, args.controller, library=args.library,
+                            discon_in=args.discon_in, config=config, progress=True)
+    ours = {n: res.channel(n) for n in res.channels()}
+    window = tuple(args.window) if args.window else (10.0, None)
+    if window[1] is not None and window[1] > min(t_of[-1], res.t[-1]) + 1e-9:
+        raise UsageError(f"--window: {window[1]:g} s is past the runs' end "
+                         f"{min(t_of[-1], res.t[-1]):g} s")
+    rows = compare_series(t_of, cols_of, res.t, ours, window)
+    if args.json:
+        print(json.dumps(rows, indent=1))
+    else:
+        print(_table(rows, window, res.meta))
+    if args.out:
+        out = Path(args.out)
+        out.mkdir(parents=True, exist_ok=True)
+        res.save(out / "ours.nc")
+        (out / "comparison.json").write_text(json.dumps(
+            {"window_s": list(window), "case": res.meta["openfast_case"],
+             "controller": res.meta["controller"], "rows": rows}, indent=1))
+        png = _plot(t_of, cols_of, res, window, out / "psd.png", Path(args.fst).stem)
+        print(f"wrote {out / 'comparison.json'}, {png}, {out / 'ours.nc'}")
+    return 0
+
+
+def _table(rows: list[dict[str, Any]], window: tuple[float, float | None],
+           meta: dict[str, Any]) -> str:
+    hi = "end" if window[1] is None else f"{window[1]:g} s"
+    lines = [f"OpenFAST vs mpc-wt, {window[0]:g} s to {hi}; controller {meta['controller']}",
+             f"{'channel':24s} {'mean OF':>12s} {'mean ours':>12s} {'d%':>7s} "
+             f"{'std OF':>11s} {'std ours':>11s} {'d%':>7s} {'DEL d%':>7s}"]
+    for r in rows:
+        d = f"{r['del_diff_pct']:7.1f}" if "del_diff_pct" in r else f"{'':7s}"
+        lines.append(f"{r['channel']:24s} {r['mean_ref']:12.5g} {r['mean']:12.5g} "
+                     f"{r['mean_diff_pct']:7.2f} {r['std_ref']:11.4g} {r['std']:11.4g} "
+                     f"{r['std_diff_pct']:7.1f} {d}")
+    return "\n".join(lines)
+
+
+def _plot(t_of: np.ndarray, cols_of: dict[str, np.ndarray], res: Any,
+          window: tuple[float, float | None], path: Path, title: str) -> Path:
+    from mpc_wt.assessment.compare import window_psd
+    from mpc_wt.plotting import plot_psd_grid
+
+    hi = window[1] if window[1] is not None else float(min(t_of[-1], res.t[-1]))
+    panels = []
+    for name, unit, scale in _PSD:
+        if name not in cols_of or name not in res.channels():
+            continue
+        runs = []
+        for label, t, x in (("OpenFAST", t_of, cols_of[name]), ("mpc-wt", res.t,
+                                                                res.channel(name))):
+            f, p = window_psd(t, np.asarray(x) / scale, (window[0], hi))
+            runs.append((label, f, p))
+        panels.append((name, unit, runs))
+    rotor = float(np.mean(res.channel("rotor_speed"))) / (2 * math.pi)
+    return plot_psd_grid(panels, path, rotor_hz=rotor,
+                         title=f"{title}: {window[0]:g}-{hi:g} s")

@@ -1,0 +1,292 @@
+"""An OpenFAST case's run conditions, read from its input files: the turbine, the full-field
+wind and where the rotor meets it, the initial state, the degrees of freedom and the
+aerodynamic options, and the controller it runs; so that mpc-wt's plant can run the same case
+(:func:`mpc_wt.run.run_openfast_case`) and be compared with OpenFAST's output
+(:func:`mpc_wt.assessment.compare.compare_series`).
+
+Read from the ``.fst`` (``TMax``, ``EDFile``, ``AeroFile``, ``ServoFile``, ``InflowFile``), from
+ElastoDyn (the DOF flags and the initial conditions ``RotSpeed``, ``BlPitch``, ``Azimuth``,
+``OoPDefl``, ``IPDefl``, ``TTDspFA``, ``TTDspSS``), from AeroDyn 15 (``UA_Mod``,
+``TwrPotent``, ``TwrAero``), from InflowWind (``WindType = 3``, a TurbSim ``.bts``) and from
+ServoDyn (``DLL_InFile``: a ROSCO ``DISCON.IN``, or none for Jonkman's baseline DLL, whose gains
+are compiled in).
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+import lidar
+import linearize
+from linearize.openfast import OpenFASTFile
+from linearize.openfast_channels import blade_frame_moment
+from mpc_wt.errors import ResultFileError
+
+__all__ = ["OpenFASTCase", "read_openfast_case", "case_grid_wind", "describe",
+           "aeromap_comparison"]
+
+
+@dataclass(frozen=True)
+class OpenFASTCase:
+    """What mpc-wt needs to run an OpenFAST case.
+
+    Parameters
+    ----------
+    fst : Path
+        The case's main file.
+    turbine : linearize.Turbine
+        The turbine (the deck's, or the one given).
+    wind_file : Path or None
+        The TurbSim ``.bts`` the case runs in.
+    duration : float
+        ``TMax`` [s].
+    x0 : (n_x,) ndarray
+        The plant's initial state from ElastoDyn's initial conditions.
+    config : linearize.PlantConfig
+        The degrees of freedom ElastoDyn has and the aerodynamic effects AeroDyn models.
+    discon_in : Path or None
+        ServoDyn's ``DLL_InFile`` when it is a controller input file, else None.
+    notes : tuple of str
+        What was assumed or left out.
+    """
+
+    fst: Path
+    turbine: linearize.Turbine
+    wind_file: Path | None
+    duration: float
+    x0: np.ndarray
+    config: linearize.PlantConfig
+    discon_in: Path | None = None
+    notes: tuple[str, ...] = field(default_factory=tuple)
+
+
+def _path(base: Path, f: OpenFASTFile, key: str) -> Path | None:
+    if not f.has(key):
+        return None
+    name = f.text(key).strip().strip('"').strip("'")
+    if name.lower() in ("unused", "none", ""):
+        return None
+    p = Path(name)
+    return p if p.is_absolute() else (base / p).resolve()
+
+
+def _flag(f: OpenFASTFile, key: str, default: bool = False) -> bool:
+    if not f.has(key):
+        return default
+    return f.text(key).strip().strip('"').lower() in ("true", "t", "1")
+
+
+def _dofs(ed: OpenFASTFile) -> frozenset[str]:
+    """The plant's DOFs from ElastoDyn's flags (first modes; the pitch as commanded)."""
+    on = {"tower_fa": "TwFADOF1", "tower_ss": "TwSSDOF1", "drivetrain": "DrTrDOF",
+          "generator": "GenDOF", "blade_flap": "FlapDOF1", "blade_edge": "EdgeDOF"}
+    return frozenset(d for d, key in on.items() if _flag(ed, key, True))
+
+
+def _initial_state(ed: OpenFASTFile, turbine: linearize.Turbine) -> np.ndarray:
+    x = np.zeros(len(linearize.STATE_NAMES))
+    rpm = math.pi / 30
+    w = ed.number("RotSpeed", 0.0, 100.0) * rpm
+    x[2], x[3] = w, w * turbine.drivetrain.gearbox_ratio
+    for i in range(3):
+        key = f"BlPitch({i + 1})" if ed.has(f"BlPitch({i + 1})") else "BlPitch"
+        x[5 + i] = math.radians(ed.number(key, -180.0, 180.0)) if ed.has(key) else 0.0
+    x[0] = ed.number("TTDspFA") if ed.has("TTDspFA") else 0.0
+    x[8] = ed.number("TTDspSS") if ed.has("TTDspSS") else 0.0
+    x[10:13] = ed.number("OoPDefl") if ed.has("OoPDefl") else 0.0
+    x[17:20] = -ed.number("IPDefl") if ed.has("IPDefl") else 0.0   # ours: toward the leading edge
+    x[16] = math.radians(ed.number("Azimuth")) if ed.has("Azimuth") else 0.0
+    return x
+
+
+def read_openfast_case(fst: str | Path, *, wind: str | Path | None = None,
+                       turbine: linearize.Turbine | None = None) -> OpenFASTCase:
+    """Read an OpenFAST case's run conditions.
+
+    Parameters
+    ----------
+    fst : str or Path
+        The ``.fst`` main file.
+    wind : str or Path, optional
+        The TurbSim ``.bts`` to use in place of InflowWind's ``FileName_BTS`` (a case shipped
+        without its wind file).
+    turbine : linearize.Turbine, optional
+        The turbine, when the deck alone does not make one (Jonkman's baseline DLL has no
+        ``DISCON.IN``, where :func:`linearize.load_openfast` reads the rated point).
+
+    Returns
+    -------
+    OpenFASTCase
+
+    Raises
+    ------
+    ResultFileError
+        Naming the file and what is missing or not supported: no ElastoDyn, a wind type other
+        than a TurbSim full field, no wind file, a deck that needs ``turbine``.
+    """
+    fst = Path(fst).resolve()
+    try:
+        main = OpenFASTFile(fst)
+        base = fst.parent
+        ed_path, ad_path = _path(base, main, "EDFile"), _path(base, main, "AeroFile")
+        if ed_path is None or ad_path is None:
+            raise ResultFileError(f"{fst}: EDFile and AeroFile (AeroDyn 15) are required")
+        ed, ad = OpenFASTFile(ed_path), OpenFASTFile(ad_path)
+        srv_path = _path(base, main, "ServoFile")
+        srv = OpenFASTFile(srv_path) if srv_path is not None else None
+        discon = _path(srv.path.parent, srv, "DLL_InFile") if srv is not None else None
+        if discon is not None and not discon.is_file():
+            discon = None
+        notes: list[str] = []
+        if turbine is None:
+            try:
+                turbine = linearize.load_openfast(fst)
+            except linearize.TurbineFileError as err:
+                raise ResultFileError(f"{fst}: the deck does not make a turbine ({err}); pass "
+                                      f"the turbine (mpcwt compare-openfast --turbine NAME)") \
+                    from None
+        wind_file = Path(wind).resolve() if wind is not None else _inflow_file(main, base)
+        if wind_file is None or not wind_file.is_file():
+            raise ResultFileError(f"{fst}: wind file {wind_file} not found; pass it "
+                                  f"(--wind FILE.bts)")
+        ua = (ad.number("UA_Mod") if ad.has("UA_Mod") else
+              ad.number("UAMod") if ad.has("UAMod") else 0) > 0
+        cfg = linearize.PlantConfig.openfast(
+            unsteady_aero=bool(ua), tower_drag=_flag(ad, "TwrAero"),
+            tower_shadow=(ad.number("TwrPotent") > 0) if ad.has("TwrPotent") else False,
+            dofs=_dofs(ed))
+        notes.append("pitch as the controller commands it (no actuator lag), as ServoDyn "
+                     "applies a DLL's pitch")
+        for key in ("FlapDOF2", "TwFADOF2", "TwSSDOF2", "YawDOF"):
+            if _flag(ed, key):
+                notes.append(f"ElastoDyn {key} is on; the plant has no such DOF")
+        return OpenFASTCase(fst=fst, turbine=turbine, wind_file=wind_file,
+                            duration=main.number("TMax", 0.0, 1e7),
+                            x0=_initial_state(ed, turbine), config=cfg, discon_in=discon,
+                            notes=tuple(notes))
+    except linearize.TurbineFileError as err:
+        raise ResultFileError(str(err)) from None
+
+
+def _inflow_file(main: OpenFASTFile, base: Path) -> Path | None:
+    inflow = _path(base, main, "InflowFile")
+    if inflow is None:
+        return None
+    iw = OpenFASTFile(inflow)
+    kind = int(iw.number("WindType")) if iw.has("WindType") else 0
+    if kind != 3:
+        raise ResultFileError(f"{inflow}: WindType = {kind}; only a TurbSim full field (3) is "
+                              f"supported (pass --wind FILE.bts)")
+    return _path(inflow.parent, iw, "FileName_BTS")
+
+
+def case_grid_wind(case: OpenFASTCase) -> tuple[linearize.GridWind, float]:
+    """The plant's wind for the case: the ``.bts`` field (u, v, w) as the rotor meets it.
+
+    InflowWind carries a full field past the turbine at its mean speed U, its grid's upwind
+    edge starting at the tower: the wind at a point x downwind of the tower at time t is the
+    file's at t + (W/2 - x) / U, W the grid's width. The rotor's apex is OverHang cos(tilt)
+    upwind, so the plant (which samples the field in its rotor plane) reads the file at
+    t + (W/2 + OverHang cos(tilt)) / U.
+
+    Parameters
+    ----------
+    case : OpenFASTCase
+
+    Returns
+    -------
+    wind : linearize.GridWind
+        Times from the shift on, as seen at the rotor.
+    shift : float
+        [s]
+    """
+    f = lidar.WindField.load(case.wind_file)
+    g = case.turbine.geometry
+    u_ref = float(f.mean_speed)
+    shift = (0.5 * (f.y[-1] - f.y[0]) + g.overhang * math.cos(g.shaft_tilt_rad)) / u_ref
+    keep = f.t >= f.t[0] + shift - (f.t[1] - f.t[0])
+    if f.t[-1] - shift < case.duration:
+        raise ResultFileError(f"{case.wind_file}: {f.t[-1] - f.t[0]:.1f} s of wind, less than "
+                              f"the case's {case.duration:g} s plus the {shift:.2f} s the "
+                              f"field takes to reach the rotor")
+    u = np.maximum(f.u[keep], 0.0).astype(np.float32)
+    wind = linearize.GridWind(t=f.t[keep] - f.t[0] - shift, y=f.y, z=f.z, u=u, v=f.v[keep],
+                              w=f.w[keep])
+    return wind, shift
+
+
+def describe(case: OpenFASTCase) -> dict[str, Any]:
+    """The case's conditions for a report.
+
+    Parameters
+    ----------
+    case : OpenFASTCase
+
+    Returns
+    -------
+    dict
+    """
+    c = case.config
+    return {"fst": str(case.fst), "wind_file": str(case.wind_file),
+            "duration_s": case.duration, "dofs": sorted(c.dofs),
+            "unsteady_aero": c.unsteady_aero, "tower_shadow": c.tower_shadow,
+            "tower_drag": c.tower_drag,
+            "rotor_speed_rpm": float(case.x0[2] * 30 / math.pi),
+            "pitch_deg": float(math.degrees(case.x0[5])), "notes": list(case.notes)}
+
+
+def aeromap_comparison(outb: str | Path, turbine: linearize.Turbine,
+                       config: linearize.PlantConfig | None = None) -> list[dict[str, float]]:
+    """An OpenFAST AeroMap's blade-root moments beside the plant's steady ones at its points.
+
+    OpenFAST's AeroMap solves the steady state of the elastic rotor at given rotor speed, wind
+    (or tip-speed ratio) and pitch, without gravity. The plant is put at each point's operating
+    point (:func:`linearize.operating_point`, structure in equilibrium), blade 1 up; points the
+    plant cannot hold (the generator torque out of range) are left out.
+
+    Parameters
+    ----------
+    outb : str or Path
+        The AeroMap's output (channels ``Pitch``, ``TSR``, ``WindSpeed``, ``RotorSpeed``,
+        ``RootMyb1``, ``RootMxb1`` in deg, -, m/s, rpm, kN m).
+    turbine : linearize.Turbine
+    config : linearize.PlantConfig, optional
+        Default: the blade body forces and twisted modes on, gravity off (the AeroMap's).
+
+    Returns
+    -------
+    list of dict
+        Per point: ``pitch_deg``, ``tsr``, ``flapwise_of_kNm``, ``flapwise_kNm``,
+        ``edgewise_of_kNm``, ``edgewise_kNm``.
+    """
+    from mpc_wt.io.openfast_output import read_openfast_output
+
+    of = read_openfast_output(outb)
+    d = {n: of.data[:, i] for i, n in enumerate(of.names)}
+    cfg = config or linearize.PlantConfig(aero=linearize.AeroOptions(gravity=False),
+                                          blade_body_forces=True, twisted_modes=True)
+    params = linearize.plant_params(turbine, cfg)
+    iz = {n: i for i, n in enumerate(linearize.OUTPUT_NAMES)}
+    rows = []
+    for k in range(of.t.size):
+        pitch, wind, rpm = d["Pitch"][k], d["WindSpeed"][k], d["RotorSpeed"][k]
+        try:
+            op = linearize.operating_point(turbine, wind, rpm * math.pi / 30,
+                                           math.radians(pitch), config=cfg)
+        except linearize.TrimError:
+            continue
+        x = op.x.copy()
+        x[16] = 0.0
+        z = linearize.PlantStepper(params, linearize.SteadyWind(wind), 0.0125,
+                                   1.0).outputs(0.0, x, op.u)
+        args = (z[iz["pitch_1"]], z[iz["flap_moment_1"]], z[iz["edge_moment_1"]])
+        rows.append({"pitch_deg": float(pitch), "tsr": float(d["TSR"][k]),
+                     "flapwise_of_kNm": float(d["RootMyb1"][k]),
+                     "flapwise_kNm": float(blade_frame_moment("flapwise_moment_1", *args)) / 1e3,
+                     "edgewise_of_kNm": float(d["RootMxb1"][k]),
+                     "edgewise_kNm": float(blade_frame_moment("edgewise_moment_1", *args)) / 1e3})
+    return rows
