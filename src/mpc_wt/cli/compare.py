@@ -37,7 +37,8 @@ def add_parsers(sub: Any) -> None:
     p.add_argument("fst", help="the case's .fst")
     p.add_argument("--outb", required=True, help="the case's OpenFAST output (.outb or .out)")
     p.add_argument("--wind", default=None,
-                   help="the TurbSim .bts the case runs in (default: InflowWind's FileName_BTS)")
+                   help="the TurbSim .bts the case runs in (default: InflowWind's FileName_BTS, "
+                        "or its steady wind)")
     p.add_argument("--turbine", default=None,
                    help="turbine name or file, when the deck alone does not make one (a deck "
                         "with Jonkman's compiled controller has no DISCON.IN)")

@@ -52,6 +52,9 @@ class OpenFASTCase:
         ServoDyn's ``DLL_InFile`` when it is a controller input file, else None.
     notes : tuple of str
         What was assumed or left out.
+    steady_wind : (float, float) or None
+        InflowWind's steady wind (``WindType = 1``): ``HWindSpeed`` [m/s] and ``PLExp`` [-],
+        when the case runs in one (then ``wind_file`` is None).
     """
 
     fst: Path
@@ -62,6 +65,7 @@ class OpenFASTCase:
     config: linearize.PlantConfig
     discon_in: Path | None = None
     notes: tuple[str, ...] = field(default_factory=tuple)
+    steady_wind: tuple[float, float] | None = None
 
 
 def _path(base: Path, f: OpenFASTFile, key: str) -> Path | None:
@@ -149,8 +153,12 @@ def read_openfast_case(fst: str | Path, *, wind: str | Path | None = None,
                 raise ResultFileError(f"{fst}: the deck does not make a turbine ({err}); pass "
                                       f"the turbine (mpcwt compare-openfast --turbine NAME)") \
                     from None
-        wind_file = Path(wind).resolve() if wind is not None else _inflow_file(main, base)
-        if wind_file is None or not wind_file.is_file():
+        steady = None
+        if wind is not None:
+            wind_file: Path | None = Path(wind).resolve()
+        else:
+            wind_file, steady = _inflow(main, base)
+        if steady is None and (wind_file is None or not wind_file.is_file()):
             raise ResultFileError(f"{fst}: wind file {wind_file} not found; pass it "
                                   f"(--wind FILE.bts)")
         ua = (ad.number("UA_Mod") if ad.has("UA_Mod") else
@@ -167,25 +175,31 @@ def read_openfast_case(fst: str | Path, *, wind: str | Path | None = None,
         return OpenFASTCase(fst=fst, turbine=turbine, wind_file=wind_file,
                             duration=main.number("TMax", 0.0, 1e7),
                             x0=_initial_state(ed, turbine), config=cfg, discon_in=discon,
-                            notes=tuple(notes))
+                            notes=tuple(notes), steady_wind=steady)
     except linearize.TurbineFileError as err:
         raise ResultFileError(str(err)) from None
 
 
-def _inflow_file(main: OpenFASTFile, base: Path) -> Path | None:
+def _inflow(main: OpenFASTFile, base: Path) -> tuple[Path | None, tuple[float, float] | None]:
+    """InflowWind's wind: a TurbSim file (``WindType = 3``) or a steady power-law wind (1)."""
     inflow = _path(base, main, "InflowFile")
     if inflow is None:
-        return None
+        return None, None
     iw = OpenFASTFile(inflow)
     kind = int(iw.number("WindType")) if iw.has("WindType") else 0
+    if kind == 1:
+        return None, (iw.number("HWindSpeed", 0.0, 100.0),
+                      iw.number("PLExp", -1.0, 1.0) if iw.has("PLExp") else 0.0)
     if kind != 3:
-        raise ResultFileError(f"{inflow}: WindType = {kind}; only a TurbSim full field (3) is "
-                              f"supported (pass --wind FILE.bts)")
-    return _path(inflow.parent, iw, "FileName_BTS")
+        raise ResultFileError(f"{inflow}: WindType = {kind}; a steady wind (1) or a TurbSim "
+                              f"full field (3) is supported (pass --wind FILE.bts)")
+    return _path(inflow.parent, iw, "FileName_BTS"), None
 
 
-def case_grid_wind(case: OpenFASTCase) -> tuple[linearize.GridWind, float]:
-    """The plant's wind for the case: the ``.bts`` field (u, v, w) as the rotor meets it.
+def case_grid_wind(case: OpenFASTCase) -> tuple[linearize.GridWind | linearize.SteadyWind,
+                                                  float]:
+    """The plant's wind for the case: the ``.bts`` field (u, v, w) as the rotor meets it, or
+    the case's steady power-law wind (no shift).
 
     InflowWind carries a full field past the turbine at its mean speed U, its grid's upwind
     edge starting at the tower: the wind at a point x downwind of the tower at time t is the
@@ -199,11 +213,13 @@ def case_grid_wind(case: OpenFASTCase) -> tuple[linearize.GridWind, float]:
 
     Returns
     -------
-    wind : linearize.GridWind
+    wind : linearize.GridWind or linearize.SteadyWind
         Times from the shift on, as seen at the rotor.
     shift : float
         [s]
     """
+    if case.steady_wind is not None:
+        return linearize.SteadyWind(*case.steady_wind), 0.0
     f = lidar.WindField.load(case.wind_file)
     g = case.turbine.geometry
     u_ref = float(f.mean_speed)
@@ -232,6 +248,7 @@ def describe(case: OpenFASTCase) -> dict[str, Any]:
     """
     c = case.config
     return {"fst": str(case.fst), "wind_file": str(case.wind_file),
+            "steady_wind": list(case.steady_wind) if case.steady_wind else None,
             "duration_s": case.duration, "dofs": sorted(c.dofs),
             "unsteady_aero": c.unsteady_aero, "tower_shadow": c.tower_shadow,
             "tower_drag": c.tower_drag,
