@@ -3,11 +3,11 @@ parameters optimized over load cases) and ``mpcwt bench mpc``."""
 from __future__ import annotations
 
 import argparse
-import json
 import logging
 from pathlib import Path
 from typing import Any
 
+from mpc_wt.cli.common import to_json
 from mpc_wt.errors import UsageError
 
 __all__ = ["add_parsers"]
@@ -82,7 +82,7 @@ def _bench_mpc(args: argparse.Namespace) -> int:
     if args.steps < 10:
         raise UsageError(f"--steps must be >= 10, got {args.steps}")
     res = run_solver_benchmark(args.steps, progress=not args.json)
-    print(json.dumps(res, indent=1) if args.json else format_table(res))
+    print(to_json(res) if args.json else format_table(res))
     if args.plot:
         plot_solver_times(res, args.plot)
     return 0
@@ -129,11 +129,10 @@ def _status(args: argparse.Namespace) -> int:
         counts = st.counts()
         stray = st.stray_temp_files()
     if args.json:
-        print(json.dumps({"meta": meta, "counts": counts,
-                          "cases": [{"case_id": r.case_id, "status": r.status,
-                                     "error": r.error, "wall_s": r.wall_s,
-                                     "software_version": r.software_version} for r in rows]},
-                         indent=1))
+        print(to_json({"meta": meta, "counts": counts,
+                       "cases": [{"case_id": r.case_id, "status": r.status,
+                                  "error": r.error, "wall_s": r.wall_s,
+                                  "software_version": r.software_version} for r in rows]}))
         return 0
     print(f"campaign {meta.get('name')} in {args.dir}: spec {str(meta.get('spec_hash'))[:12]}, "
           f"last run {meta.get('last_run')}, mpc-wt {meta.get('software_version')}")

@@ -15,10 +15,51 @@ from linearize import OperatingPoint
 from mpc_wt.errors import UsageError
 
 __all__ = ["parse_range", "add_turbine", "schedule", "format_table", "write_points_csv",
-           "cp_surface", "write_surface_csv", "pairs", "floats", "check_suffix"]
+           "cp_surface", "write_surface_csv", "pairs", "floats", "check_suffix", "to_json"]
 
 TURBINE_HELP = ("packaged turbine name (nrel5mw, iea15mw), a turbine.yaml or an OpenFAST .fst "
                 "deck (default nrel5mw)")
+
+
+def _plain(obj: Any) -> Any:
+    """``obj`` with numpy scalars and arrays as Python values and non-finite floats as None."""
+    if isinstance(obj, dict):
+        return {str(k): _plain(v) for k, v in obj.items()}
+    if isinstance(obj, (list, tuple)):
+        return [_plain(v) for v in obj]
+    if isinstance(obj, np.ndarray):
+        return _plain(obj.tolist())
+    if isinstance(obj, (np.bool_, bool)):
+        return bool(obj)
+    if isinstance(obj, (np.integer, int)):
+        return int(obj)
+    if isinstance(obj, (np.floating, float)):
+        v = float(obj)
+        return v if math.isfinite(v) else None
+    if obj is None or isinstance(obj, str):
+        return obj
+    return str(obj)
+
+
+def to_json(obj: Any, indent: int | None = 1) -> str:
+    """Standard JSON text of ``obj``: NaN and infinities (undefined values) as null, numpy
+    values as numbers, anything else unknown as its string.
+
+    Parameters
+    ----------
+    obj : Any
+        Nested dicts, lists, numbers, strings.
+    indent : int or None
+        As :func:`json.dumps`.
+
+    Returns
+    -------
+    str
+        JSON that any strict parser reads.
+    """
+    import json
+
+    return json.dumps(_plain(obj), indent=indent, allow_nan=False)
 
 
 def add_turbine(p: argparse.ArgumentParser) -> None:

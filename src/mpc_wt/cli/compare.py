@@ -4,7 +4,6 @@ it, channel by channel (means, standard deviations, DELs) with PSD overlays.
 from __future__ import annotations
 
 import argparse
-import json
 import math
 from pathlib import Path
 from typing import Any
@@ -12,6 +11,7 @@ from typing import Any
 import numpy as np
 
 import linearize
+from mpc_wt.cli.common import to_json
 from mpc_wt.errors import UsageError
 
 __all__ = ["add_parsers"]
@@ -84,16 +84,16 @@ def _compare(args: argparse.Namespace) -> int:
                          f"{min(t_of[-1], res.t[-1]):g} s")
     rows = compare_series(t_of, cols_of, res.t, ours, window)
     if args.json:
-        print(json.dumps(rows, indent=1))
+        print(to_json(rows))
     else:
         print(_table(rows, window, res.meta))
     if args.out:
         out = Path(args.out)
         out.mkdir(parents=True, exist_ok=True)
         res.save(out / "ours.nc")
-        (out / "comparison.json").write_text(json.dumps(
+        (out / "comparison.json").write_text(to_json(
             {"window_s": list(window), "case": res.meta["openfast_case"],
-             "controller": res.meta["controller"], "rows": rows}, indent=1))
+             "controller": res.meta["controller"], "rows": rows}))
         png = _plot(t_of, cols_of, res, window, out / "psd.png", Path(args.fst).stem)
         print(f"wrote {out / 'comparison.json'}, {png}, {out / 'ours.nc'}")
     return 0

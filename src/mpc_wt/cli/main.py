@@ -50,7 +50,13 @@ def build_parser() -> argparse.ArgumentParser:
     argparse.ArgumentParser
         Every command group's subcommands.
     """
-    ap = argparse.ArgumentParser(prog="mpcwt", description=__doc__.split("\n")[0])
+    from mpc_wt import __version__
+
+    ap = argparse.ArgumentParser(
+        prog="mpcwt", description="mpc-wt: model-based wind-turbine control design. Run the "
+        "main job on a turbine, design and simulate controllers, assess loads, run load-case "
+        "campaigns, export gains and controller libraries, compare with OpenFAST.")
+    ap.add_argument("--version", action="version", version=f"mpcwt (mpc-wt) {__version__}")
     ap.add_argument("--plugin", action="append", default=[], metavar="MODULE",
                     help="import MODULE, which registers controller kinds (repeatable)")
     sub = ap.add_subparsers(dest="command", required=True)

@@ -8,7 +8,6 @@ be given as ``--option NAME=VALUE``; which options a kind takes is checked by th
 from __future__ import annotations
 
 import argparse
-import json
 import math
 import typing
 from pathlib import Path
@@ -19,6 +18,7 @@ import numpy as np
 import lidar
 import linearize
 from mpc_wt.cli.common import (
+    to_json,
     add_turbine,
     cp_surface,
     format_table,
@@ -254,7 +254,7 @@ def _controllers(args: argparse.Namespace) -> int:
 
     rows = describe()
     if args.json:
-        print(json.dumps(rows, indent=1, default=str))
+        print(to_json(rows))
         return 0
     for r in rows:
         head = r["pattern"] or r["name"]
@@ -316,7 +316,7 @@ def _assess(args: argparse.Namespace) -> int:
         for r in rows:
             r["plots"] = made
     if args.json:
-        print(json.dumps(rows, indent=1))
+        print(to_json(rows))
         return 0
     for r in rows:
         print(f"# {r['run']} ({r['duration_s']:.0f} s)")
@@ -394,7 +394,7 @@ def _comparison_runs(turbine: linearize.Turbine, args: argparse.Namespace, out: 
         rows.append(_comparison_row(name, a, cols, res.controller.get("qp_solve_ms"), fname))
         runs.append((name, res.t[keep], cols))
     samplers.clear()
-    (out / "comparison.json").write_text(json.dumps(rows, indent=1))
+    (out / "comparison.json").write_text(to_json(rows))
     made = assess_plots(runs, out) + plot_comparison(runs, out / "comparison.png")
     print(f"# {args.duration:g} s at {args.wind:g} m/s, turbulence {args.turbulence}, seed "
           f"{args.seed}, the same field for all")
@@ -429,8 +429,7 @@ def _steady_outputs(turbine: linearize.Turbine, out: Path) -> None:
     print(f"# rated wind speed {v_rated:.3f} m/s; C_P max {cp_max:.4f} at tip-speed ratio "
           f"{lam_opt:.3f} (fine pitch)")
     write_points_csv(points, out / "operating_points.csv")
-    (out / "operating_points.json").write_text(json.dumps([p.as_dict() for p in points],
-                                                          indent=1))
+    (out / "operating_points.json").write_text(to_json([p.as_dict() for p in points]))
     tsr = np.arange(2.0, 16.0 + 1e-9, 0.25)
     pitch = np.arange(-2.0, 24.0 + 1e-9, 0.5)
     cp = cp_surface(turbine, tsr, pitch)

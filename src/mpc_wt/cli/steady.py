@@ -3,7 +3,6 @@ operation, its linear models and its rotor aerodynamics."""
 from __future__ import annotations
 
 import argparse
-import json
 import math
 from pathlib import Path
 from typing import Any
@@ -12,6 +11,7 @@ import numpy as np
 
 import linearize
 from mpc_wt.cli.common import (
+    to_json,
     add_turbine,
     check_suffix,
     format_table,
@@ -90,7 +90,7 @@ def _trim(args: argparse.Namespace) -> int:
         print(turbine.report)
     points = schedule(turbine, winds, args.power_W, progress=not args.json)
     if args.json:
-        print(json.dumps([p.as_dict() for p in points], indent=1))
+        print(to_json([p.as_dict() for p in points]))
     else:
         print(f"# {turbine.name}")
         print(format_table(points))
@@ -138,7 +138,7 @@ def _compare(args: argparse.Namespace) -> int:
     model = linearize.read_lin(files[0]) if len(files) == 1 else linearize.read_lin_set(files)
     res = compare_with_openfast(linearize.load_turbine(args.turbine), model)
     if args.json:
-        print(json.dumps(res, indent=1))
+        print(to_json(res))
         return 0
     op = res["operating_point"]
     print(f"# {files[0]}{' + %d more' % (len(files) - 1) if len(files) > 1 else ''}: "
@@ -185,7 +185,7 @@ def _linearize(args: argparse.Namespace) -> int:
              "rotor_speed_rpm": m.info["rotor_speed_rpm"], **linearize.sensitivities(m),
              "modes": m.modes()} for m in fam.models]
     if args.json:
-        print(json.dumps(rows, indent=1))
+        print(to_json(rows))
         return 0
     print(f"{'wind [m/s]':>10s} {'pitch [deg]':>11s} {'dP/dpitch [MW/rad]':>18s} "
           f"{'dQ/domega [kNms]':>16s} {'dT/dV [kN s/m]':>14s}  modes [Hz, damping]")

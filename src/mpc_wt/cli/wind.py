@@ -2,11 +2,10 @@
 from __future__ import annotations
 
 import argparse
-import json
 from typing import Any
 
 import linearize
-from mpc_wt.cli.common import add_turbine
+from mpc_wt.cli.common import add_turbine, to_json
 from mpc_wt.errors import UsageError
 
 __all__ = ["add_parsers"]
@@ -136,7 +135,7 @@ def _evaluate(args: argparse.Namespace) -> int:
         res["plots"] = plot_lidar_evaluation(res, curves, turbine.geometry.tip_radius,
                                              args.plots)
     if args.json:
-        print(json.dumps(res, indent=1))
+        print(to_json(res))
     else:
         for k, v in res.items():
             print(f"{k:32s} {v:.4g}" if isinstance(v, float) else f"{k:32s} {v}")

@@ -1,0 +1,63 @@
+"""Every ``--json`` the command line prints is standard JSON (no NaN or Infinity: null where a
+value is undefined), and ``mpcwt --version`` names the installed version."""
+from __future__ import annotations
+
+import json
+import math
+
+import numpy as np
+import pytest
+
+from mpc_wt import __version__
+from mpc_wt.cli.common import to_json
+from mpc_wt.cli.main import main
+
+
+def _strict(text: str):
+    def bad(name: str):
+        raise ValueError(f"not JSON: {name}")
+    return json.loads(text, parse_constant=bad)
+
+
+def test_to_json_writes_undefined_values_as_null() -> None:
+    obj = {"a": math.nan, "b": [math.inf, -np.inf, 1.5], "c": np.float64(2.0),
+           "d": np.arange(2), "e": (np.bool_(True), None)}
+    assert _strict(to_json(obj)) == {"a": None, "b": [None, None, 1.5], "c": 2.0, "d": [0, 1],
+                                     "e": [True, None]}
+
+
+@pytest.mark.parametrize("argv", [["trim", "--wind", "3:5:1", "--json"],
+                                  ["controllers", "--json"]])
+def test_commands_print_standard_json(capsys, argv) -> None:
+    """trim at 3-5 m/s (from cut-in), the controller kinds: each parses with a parser that
+    refuses NaN and Infinity."""
+    code = main(argv)
+    out = capsys.readouterr().out
+    assert code == 0, out
+    _strict(out)
+
+
+def test_assess_prints_standard_json(capsys, tmp_path) -> None:
+    """``assess --json`` of two CSV runs, the first with a still flap moment and a constant
+    power: the second's changes relative to it are undefined (x / 0) and print as null (they
+    printed as NaN)."""
+    t = np.arange(0.0, 60.0, 0.05)
+    runs = {"a": np.c_[t, np.zeros_like(t), np.full_like(t, 5e6)],
+            "b": np.c_[t, 1e6 * np.sin(t), 5e6 + 1e5 * np.sin(0.3 * t)]}
+    for name, data in runs.items():
+        np.savetxt(tmp_path / f"{name}.csv", data, delimiter=",",
+                   header="time,flap_moment_1,gen_power", comments="")
+    assert main(["assess", str(tmp_path / "a.csv"), str(tmp_path / "b.csv"), "--json"]) == 0
+    doc = _strict(capsys.readouterr().out)
+    assert None in list(_values(doc))
+
+
+def _values(obj):
+    if isinstance(obj, dict):
+        for v in obj.values():
+            yield from _values(v)
+    elif isinstance(obj, list):
+        for v in obj:
+            yield from _values(v)
+    else:
+        yield obj
