@@ -46,8 +46,10 @@ def add_parsers(sub: Any) -> None:
     add_turbine(p)
     p.add_argument("--out", default="mpcwt-out", help="output directory (default mpcwt-out)")
     p.add_argument("--wind", type=float, default=18.0, help="wind of the baseline run [m/s]")
-    p.add_argument("--turbulence", choices=("A", "B", "C", "steady"), default="A")
-    p.add_argument("--seed", type=int, default=1)
+    p.add_argument("--turbulence", choices=("A", "B", "C", "steady"), default="A",
+                   help="IEC 61400-1 turbulence category of the field, or steady (default A)")
+    p.add_argument("--seed", type=int, default=1,
+                   help="seed of the turbulent field (default 1)")
     p.add_argument("--duration", type=float, default=600.0,
                    help="length of the closed-loop runs [s] (0 skips them)")
     p.add_argument("--controllers", default="baseline,baseline+lidar-ff,mpc-lidar",
@@ -67,17 +69,20 @@ def _add_simulate(sub: Any) -> None:
     names = [k.pattern_help or k.name for k in kinds().values()]
     p = sub.add_parser("simulate", help="closed-loop simulation on the plant")
     add_turbine(p)
-    p.add_argument("--controller", default="baseline",
+    p.add_argument("--controller", default=None,
                    help=" | ".join(names).replace("%", "%%") + " (+ibc, +coleman-ipc on a "
-                        "baseline); `mpcwt controllers` lists each with its options")
+                        "baseline; default baseline, announced); `mpcwt controllers` lists "
+                        "each with its options")
     w = p.add_mutually_exclusive_group(required=True)
     w.add_argument("--wind", type=float, help="mean hub-height wind of a generated field [m/s]")
     w.add_argument("--wind-file", metavar="FILE",
                    help="the wind from a file instead: TurbSim full-field .bts (or an mpc-wt "
                         ".npz field); the plant starts from the trim at the rotor-disc mean "
                         "of its first 5 s")
-    p.add_argument("--turbulence", choices=("A", "B", "C", "steady"), default="A")
-    p.add_argument("--seed", type=int, default=1)
+    p.add_argument("--turbulence", choices=("A", "B", "C", "steady"), default="A",
+                   help="IEC 61400-1 turbulence category of the field, or steady (default A)")
+    p.add_argument("--seed", type=int, default=1,
+                   help="seed of the turbulent field (default 1)")
     p.add_argument("--duration", type=float, default=None,
                    help="[s] (default 600; with --wind-file the file's length less 20 s, the "
                         "time a LIDAR 54 m ahead needs at 2.7 m/s)")
@@ -111,13 +116,16 @@ def _add_option_flag(g: Any, name: str, meta: dict[str, Any]) -> None:
                 ).replace("%", "%%")
     if meta.get("flag_value") is not None:
         g.add_argument(meta["flag"], dest=f"opt_{name}", action="store_const",
-                       const=meta["flag_value"], default=None, help=helptext)
+                       const=meta["flag_value"], default=None,
+                       help=f"set option {name} to {meta['flag_value']!r} (it does: "
+                            f"{helptext})")
         return
     base = typing.get_args(meta["type"])[0] if typing.get_args(meta["type"]) else meta["type"]
     conv = {float: float, int: int}.get(base, str)
     choices = ["none" if c is None else c for c in meta.get("choices", ())] or None
+    metavar = None if choices else meta["flag"].lstrip("-").upper().replace("-", "_")
     g.add_argument(meta["flag"], dest=f"opt_{name}", type=conv, choices=choices, default=None,
-                   help=helptext)
+                   metavar=metavar, help=helptext)
 
 
 def controller_options(args: argparse.Namespace) -> dict[str, Any]:
@@ -145,6 +153,9 @@ def _simulate(args: argparse.Namespace) -> int:
     from mpc_wt.run import run_controller
 
     naming = cli_naming({k: m["flag"] for k, m in cli_flags().items()})
+    if args.controller is None:
+        args.controller = "baseline"
+        print("controller: baseline (the default; --controller KIND chooses another)")
     opts = controller_options(args)
     try:
         resolve(args.controller).options(opts, naming)
@@ -161,7 +172,7 @@ def _simulate(args: argparse.Namespace) -> int:
     res.save(out)
     p = res.channel("gen_power")
     print(f"wrote {out}: {res.t.size} samples; mean power {p.mean() / 1e6:.3f} MW, "
-          f"gen speed std {res.channel('gen_speed').std():.3f} rad/s")
+          f"generator speed std {res.channel('gen_speed').std() * 30 / math.pi:.2f} rpm")
     return 0
 
 

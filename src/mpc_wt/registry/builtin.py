@@ -209,7 +209,7 @@ class IBCOptions(Options):
     loop_gain_1p: float = option(1.0, help="loop gain at 1P of each blade loop", unit="-",
                                  lo=0.0, lo_open=True, flag="--loop-gain")
     remove_collective: bool = option(True, help="subtract the blades' mean IBC pitch (cyclic "
-                                     "action only); --keep-collective keeps it",
+                                     "action only)",
                                      flag="--keep-collective", flag_value=False)
     min_gain_margin: float = option(2.0, help="smallest gain margin allowed", unit="-",
                                     lo=1.0, lo_open=True, flag="")

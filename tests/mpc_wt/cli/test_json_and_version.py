@@ -61,3 +61,13 @@ def _values(obj):
             yield from _values(v)
     else:
         yield obj
+
+
+def test_simulate_announces_its_default_controller_and_reports_rpm(capsys, tmp_path) -> None:
+    """Leaving out --controller runs the baseline and says so; the summary's speed is in rpm,
+    as the main job's and OpenFAST's are."""
+    assert main(["simulate", "--wind", "12", "--turbulence", "steady", "--duration", "5",
+                 "--out", str(tmp_path / "r.nc")]) == 0
+    out = capsys.readouterr().out
+    assert out.startswith("controller: baseline (the default")
+    assert "generator speed std" in out and out.rstrip().endswith("rpm")
