@@ -329,15 +329,50 @@ def _assess(args: argparse.Namespace) -> int:
     if args.json:
         print(to_json(rows))
         return 0
-    for r in rows:
-        print(f"# {r['run']} ({r['duration_s']:.0f} s)")
-        for name, d in r["channels"].items():
-            print(f"  DEL {name:24s} {d['del']:14.4g}  (m = {d['m']:g})")
-        for k in ("cs1", "cs2", "cs3", "cs4", "cs5", "power_std_W", "energy_Wh",
-                  "pitch_travel_deg"):
-            if k in r:
-                print(f"  {k:28s} {r[k]:14.6g}")
+    print(assess_table(rows))
     return 0
+
+
+#: the scalar results ``assess`` prints: key, label, unit, factor from SI
+_ASSESS_ROWS = (("cs1", "CS1 load semi-axis", "kN m", 1e-3), ("cs2", "CS2 power semi-axis", "kW",
+                                                                1e-3),
+                ("cs3", "CS3 mean load", "kN m", 1e-3), ("cs4", "CS4 mean power", "kW", 1e-3),
+                ("cs5", "CS5 ellipse angle", "deg", 1.0),
+                ("power_std_W", "power std", "kW", 1e-3), ("energy_Wh", "energy", "kWh", 1e-3),
+                ("pitch_travel_deg", "pitch travel", "deg", 1.0))
+
+
+def assess_table(rows: list[dict[str, Any]]) -> str:
+    """``assess``'s results as a table: one line per quantity with its unit, one column per
+    run, and each later run's change against the first [%].
+
+    Parameters
+    ----------
+    rows : list of dict
+        Per run: ``run``, ``duration_s``, ``channels`` ({name: {del, m}}) and the scalars.
+
+    Returns
+    -------
+    str
+    """
+    names = [Path(r["run"]).stem for r in rows]
+    head = f"{'quantity':34s} {'unit':5s}" + "".join(f" {n[:12]:>12s}" for n in names)
+    head += "".join(f" {'d% ' + n[:8]:>12s}" for n in names[1:])
+    lines = [f"{len(rows)} run(s); changes against {names[0]}" if len(rows) > 1 else
+             f"{names[0]}, {rows[0]['duration_s']:.0f} s", head]
+    items = [(f"DEL {c} (m = {d['m']:g})", "kN m", 1e-3, lambda r, c=c: r["channels"].get(
+        c, {}).get("del")) for c, d in rows[0]["channels"].items()]
+    items += [(label, unit, f, lambda r, k=k: r.get(k)) for k, label, unit, f in _ASSESS_ROWS
+              if k in rows[0]]
+    for label, unit, f, get in items:
+        vals = [get(r) for r in rows]
+        cells = "".join(f" {v * f:12.5g}" if v is not None else f" {'-':>12s}" for v in vals)
+        base = vals[0]
+        for v in vals[1:]:
+            ok = base not in (None, 0) and v is not None and math.isfinite(base)
+            cells += f" {100 * (v / base - 1):12.1f}" if ok else f" {'-':>12s}"
+        lines.append(f"{label[:34]:34s} {unit:5s}{cells}")
+    return "\n".join(lines)
 
 
 def _run(args: argparse.Namespace) -> int:

@@ -71,3 +71,20 @@ def test_simulate_announces_its_default_controller_and_reports_rpm(capsys, tmp_p
     out = capsys.readouterr().out
     assert out.startswith("controller: baseline (the default")
     assert "generator speed std" in out and out.rstrip().endswith("rpm")
+
+
+def test_assess_table_has_units_and_changes_against_the_first_run(capsys, tmp_path) -> None:
+    """Two runs, the second's flap moment twice the first's: a DEL scales with the amplitude,
+    so its change is +100 % (by hand); the energy of equal power is unchanged; units shown."""
+    t = np.arange(0.0, 60.0, 0.05)
+    flap = 1e6 * np.sin(t) + 2e5 * np.sin(3.1 * t)
+    for name, k in (("ref", 1.0), ("double", 2.0)):
+        np.savetxt(tmp_path / f"{name}.csv", np.c_[t, k * flap, np.full_like(t, 5e6)],
+                   delimiter=",", header="time,flap_moment_1,gen_power", comments="")
+    assert main(["assess", str(tmp_path / "ref.csv"), str(tmp_path / "double.csv")]) == 0
+    lines = capsys.readouterr().out.splitlines()
+    assert "changes against ref" in lines[0] and "unit" in lines[1]
+    row = next(r for r in lines if r.startswith("DEL flap_moment_1"))
+    assert "kN m" in row and row.split()[-1] == "100.0"
+    energy = next(r for r in lines if r.startswith("energy"))
+    assert "kWh" in energy and energy.split()[-1] == "0.0"
