@@ -411,6 +411,7 @@ def _comparison_row(name: str, a: dict[str, Any], cols: dict[str, np.ndarray],
     return {"controller": name, "power_mean_MW": a["power_mean_W"] / 1e6,
             "power_std_kW": a["power_std_W"] / 1e3,
             "rotor_speed_std_rpm": float(np.std(cols["rotor_speed"])) * 30 / math.pi,
+            "rotor_speed_min_rpm": float(np.min(cols["rotor_speed"])) * 30 / math.pi,
             "pitch_travel_deg": a["pitch_travel_deg"],
             **{f"del_{c}_MNm": a["channels"][c]["del"] / 1e6
                for c in ("flap_moment_1", "tower_base_fa_moment", "shaft_bending_blade1")
@@ -457,8 +458,61 @@ def _comparison_runs(turbine: linearize.Turbine, args: argparse.Namespace, out: 
               f"{r.get('del_flap_moment_1_MNm', float('nan')):9.3f} "
               f"{r.get('del_tower_base_fa_moment_MNm', float('nan')):9.3f} "
               f"{r.get('del_shaft_bending_blade1_MNm', float('nan')):9.3f} {qp:>12s}")
+    min_rpm = turbine.operation.min_rotor_speed_rad_s * 30 / math.pi
+    for line in design_warnings(rows, min_rpm):
+        print(line)
     print(f"# wrote {out}/comparison.json, " + ", ".join(r["file"] for r in rows) + ", "
           + ", ".join(Path(m).name for m in made))
+
+
+#: the limits :func:`design_warnings` holds a design to, against the baseline's run
+PITCH_TRAVEL_LIMIT = 3.0
+POWER_LOSS_LIMIT_PCT = 1.0
+
+
+def design_warnings(rows: list[dict[str, Any]], min_rotor_rpm: float) -> list[str]:
+    """Lines that flag a design a user should not take as it is: pitch travel above
+    :data:`PITCH_TRAVEL_LIMIT` times the baseline's, mean power more than
+    :data:`POWER_LOSS_LIMIT_PCT` % below the baseline's, the rotor below its minimum speed.
+
+    Parameters
+    ----------
+    rows : list of dict
+        The main job's rows (``controller``, ``power_mean_MW``, ``pitch_travel_deg``,
+        ``rotor_speed_min_rpm``); the reference is the row ``baseline``, else the first.
+    min_rotor_rpm : float
+        The turbine's minimum rotor speed [rpm].
+
+    Returns
+    -------
+    list of str
+        One ``warning:`` line per broken limit (none when all hold).
+    """
+    ref = next((r for r in rows if r["controller"] == "baseline"), rows[0])
+    out = []
+    for r in rows:
+        if r is ref:
+            continue
+        name = r["controller"]
+        ratio = (r["pitch_travel_deg"] / ref["pitch_travel_deg"]
+                 if ref["pitch_travel_deg"] > 0 else 0.0)
+        if ratio > PITCH_TRAVEL_LIMIT:
+            out.append(f"warning: {name} moves the pitch {ratio:.1f}x as far as "
+                       f"{ref['controller']} "
+                       f"({r['pitch_travel_deg']:.0f} against {ref['pitch_travel_deg']:.0f} "
+                       f"deg), above {PITCH_TRAVEL_LIMIT:g}x: tune its weights (mpcwt tune) "
+                       f"before taking it")
+        loss = 100.0 * (1.0 - r["power_mean_MW"] / ref["power_mean_MW"])
+        if loss > POWER_LOSS_LIMIT_PCT:
+            out.append(f"warning: {name} makes {loss:.1f} % less mean power than "
+                       f"{ref['controller']} ({r['power_mean_MW']:.3f} against "
+                       f"{ref['power_mean_MW']:.3f} MW)")
+    for r in rows:
+        if r.get("rotor_speed_min_rpm", math.inf) < min_rotor_rpm - 1e-6:
+            out.append(f"warning: {r['controller']} lets the rotor fall to "
+                       f"{r['rotor_speed_min_rpm']:.2f} rpm, below its minimum "
+                       f"{min_rotor_rpm:.2f} rpm")
+    return out
 
 
 def _steady_outputs(turbine: linearize.Turbine, out: Path) -> None:

@@ -88,3 +88,23 @@ def test_assess_table_has_units_and_changes_against_the_first_run(capsys, tmp_pa
     assert "kN m" in row and row.split()[-1] == "100.0"
     energy = next(r for r in lines if r.startswith("energy"))
     assert "kWh" in energy and energy.split()[-1] == "0.0"
+
+
+def test_main_job_warns_of_designs_a_user_should_not_take() -> None:
+    """Worked by hand: against a baseline of 613 deg pitch travel and 5.00 MW, a design with
+    3251 deg (5.3x) and 4.90 MW (2.0 % less) gets both warnings; one with 1800 deg (2.9x) and
+    4.97 MW (0.6 % less) none; a rotor at 6.5 rpm below a 6.9 rpm minimum is flagged."""
+    from mpc_wt.cli.runs import design_warnings
+
+    rows = [{"controller": "baseline", "power_mean_MW": 5.00, "pitch_travel_deg": 613.0,
+             "rotor_speed_min_rpm": 11.0},
+            {"controller": "mpc-lidar", "power_mean_MW": 4.90, "pitch_travel_deg": 3251.0,
+             "rotor_speed_min_rpm": 11.2},
+            {"controller": "tuned", "power_mean_MW": 4.97, "pitch_travel_deg": 1800.0,
+             "rotor_speed_min_rpm": 6.5}]
+    lines = design_warnings(rows, 6.9)
+    assert len(lines) == 3
+    assert "mpc-lidar moves the pitch 5.3x" in lines[0] and "3251 against 613 deg" in lines[0]
+    assert "mpc-lidar makes 2.0 % less mean power" in lines[1]
+    assert "tuned lets the rotor fall to 6.50 rpm, below its minimum 6.90 rpm" in lines[2]
+    assert design_warnings(rows[:1], 6.9) == []
