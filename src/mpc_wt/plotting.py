@@ -20,7 +20,7 @@ def save_figure(fig, path: str | Path) -> Path:  # type: ignore[no-untyped-def]
 
     fig.tight_layout()
     out = Path(path)
-    fig.savefig(out)
+    fig.savefig(out, bbox_inches="tight")
     plt.close(fig)
     return out
 
@@ -35,7 +35,7 @@ def pyplot():  # type: ignore[no-untyped-def]
 
 
 def plot_cp_surface(tsr: np.ndarray, pitch_deg: np.ndarray, cp: np.ndarray, path: str | Path,
-                    title: str = "") -> Path:
+                    title: str = "", optimum: tuple[float, float, float] | None = None) -> Path:
     """Contour plot of C_P(lambda, beta) with its maximum marked; returns the PNG path.
 
     Parameters
@@ -51,6 +51,9 @@ def plot_cp_surface(tsr: np.ndarray, pitch_deg: np.ndarray, cp: np.ndarray, path
         The PNG file.
     title : str
         Title (default a generic one).
+    optimum : (float, float, float), optional
+        The computed optimum (tip-speed ratio, pitch [deg], C_P) to mark and label; default
+        the grid's largest value.
 
     Returns
     -------
@@ -64,10 +67,14 @@ def plot_cp_surface(tsr: np.ndarray, pitch_deg: np.ndarray, cp: np.ndarray, path
     cs = ax.contourf(tsr, pitch_deg, shown, levels=levels, cmap="viridis")
     ax.contour(tsr, pitch_deg, shown, levels=[0.1, 0.2, 0.3, 0.4, 0.45], colors="w",
                linewidths=0.6)
-    i, j = np.unravel_index(int(np.argmax(cp)), cp.shape)
-    ax.plot(tsr[j], pitch_deg[i], "r*", ms=12,
-            label=f"C_P max {cp[i, j]:.3f} at lambda {tsr[j]:.2f}, pitch {pitch_deg[i]:.1f} deg")
-    fig.colorbar(cs, ax=ax, label="C_P [-]")
+    if optimum is None:
+        i, j = np.unravel_index(int(np.argmax(cp)), cp.shape)
+        optimum = (float(tsr[j]), float(pitch_deg[i]), float(cp[i, j]))
+    lam, beta, cp_max = optimum
+    ax.plot(lam, beta, "r*", ms=12,
+            label=f"C_P max {cp_max:.3f} at lambda {lam:.2f}, pitch {beta:.1f} deg")
+    bar = fig.colorbar(cs, ax=ax, label="C_P [-]")
+    bar.set_ticks(np.round(np.linspace(0.0, levels[-1], 6), 2))
     ax.set_xlabel("tip-speed ratio lambda [-]")
     ax.set_ylabel("collective pitch [deg]")
     ax.set_title(title or "Power coefficient C_P(lambda, pitch)")
@@ -76,7 +83,7 @@ def plot_cp_surface(tsr: np.ndarray, pitch_deg: np.ndarray, cp: np.ndarray, path
 
 
 def plot_operating_schedule(points: Sequence[OperatingPoint], path: str | Path,
-                            title: str = "") -> Path:
+                            title: str = "", rated_wind_mps: float | None = None) -> Path:
     """Four panels against wind speed: power, rotor speed, pitch, thrust and generator torque.
 
     Parameters
@@ -87,6 +94,9 @@ def plot_operating_schedule(points: Sequence[OperatingPoint], path: str | Path,
         The PNG file.
     title : str
         Title.
+    rated_wind_mps : float, optional
+        The computed rated wind speed, marked on every panel [m/s] (default: the first
+        region-3 point's wind).
 
     Returns
     -------
@@ -114,11 +124,14 @@ def plot_operating_schedule(points: Sequence[OperatingPoint], path: str | Path,
         ax.set_xlabel("hub-height wind speed [m/s]")
     for ax in axs.flat:
         ax.grid(alpha=0.3)
-    for p in points:
-        if p.region == "3":
-            for ax in axs.flat:
-                ax.axvline(p.wind_mps, color="0.6", lw=0.8, ls=":")
-            break
+    if rated_wind_mps is None:
+        rated_wind_mps = next((p.wind_mps for p in points if p.region == "3"), None)
+    if rated_wind_mps is not None:
+        for ax in axs.flat:
+            ax.axvline(rated_wind_mps, color="0.6", lw=0.8, ls=":")
+        axs[0, 0].annotate(f"rated {rated_wind_mps:.2f} m/s", (rated_wind_mps, 0.05),
+                           xycoords=("data", "axes fraction"), fontsize=7, color="0.4",
+                           xytext=(3, 0), textcoords="offset points")
     fig.suptitle(title or "Steady operating schedule")
     return save_figure(fig, path)
 

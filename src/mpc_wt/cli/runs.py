@@ -534,8 +534,10 @@ def _steady_outputs(turbine: linearize.Turbine, out: Path) -> None:
     pitch = np.arange(-2.0, 24.0 + 1e-9, 0.5)
     cp = cp_surface(turbine, tsr, pitch)
     write_surface_csv(tsr, pitch, cp, out / "cp_surface.csv")
-    plot_cp_surface(tsr, pitch, cp, out / "cp_surface.png", title=f"{turbine.name}: C_P")
+    plot_cp_surface(tsr, pitch, cp, out / "cp_surface.png", title=f"{turbine.name}: C_P",
+                    optimum=(lam_opt, math.degrees(op.fine_pitch_rad), cp_max))
     plot_operating_schedule(points, out / "operating_schedule.png",
-                            title=f"{turbine.name}: steady operating schedule")
+                            title=f"{turbine.name}: steady operating schedule",
+                            rated_wind_mps=v_rated)
     print(f"# wrote {out}/operating_points.csv, operating_points.json, cp_surface.csv, "
           f"cp_surface.png, operating_schedule.png")

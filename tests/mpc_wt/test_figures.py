@@ -1,0 +1,78 @@
+"""The main job's steady figures read as a report's: every axis with its quantity and a unit,
+no text outside the figure, and the marked values the computed ones (rated wind, C_P optimum)."""
+from __future__ import annotations
+
+import math
+import re
+
+import numpy as np
+import pytest
+
+import linearize
+from mpc_wt import plotting
+
+_UNIT = re.compile(r"\[[^\]]+\]")
+
+
+@pytest.fixture()
+def figures(monkeypatch):
+    """Each figure the plotting functions save, kept open for inspection."""
+    kept = []
+    real = plotting.save_figure
+
+    def keep(fig, path):
+        fig.canvas.draw()
+        kept.append(fig)
+        return path
+    monkeypatch.setattr(plotting, "save_figure", keep)
+    yield kept
+    import matplotlib.pyplot as plt
+    for f in kept:
+        plt.close(f)
+    assert real is not None
+
+
+def _check(fig) -> None:
+    renderer = fig.canvas.get_renderer()
+    box = fig.bbox
+    for ax in fig.axes:
+        if not ax.get_visible():
+            continue
+        for label in (ax.get_xlabel(), ax.get_ylabel()):
+            if label:
+                assert _UNIT.search(label), f"axis label without a unit: {label!r}"
+        assert ax.get_ylabel() or ax.get_label() == "<colorbar>", "an axis without a y label"
+    from matplotlib.text import Text
+
+    for text in fig.findobj(Text):
+        if not text.get_visible() or not text.get_text():
+            continue
+        ext = text.get_window_extent(renderer)
+        assert ext.x0 >= box.x0 - 1 and ext.x1 <= box.x1 + 1 and ext.y0 >= box.y0 - 1 \
+            and ext.y1 <= box.y1 + 1, f"text outside the figure: {text.get_text()!r}"
+
+
+def test_operating_schedule_marks_the_computed_rated_wind(figures, turbine, tmp_path) -> None:
+    points = linearize.operating_schedule(turbine, np.arange(4.0, 25.0, 1.0))
+    v_rated = linearize.rated_wind_speed(turbine)
+    plotting.plot_operating_schedule(points, tmp_path / "s.png", rated_wind_mps=v_rated)
+    fig = figures[-1]
+    _check(fig)
+    marks = {round(float(line.get_xdata()[0]), 6) for ax in fig.axes for line in ax.lines
+             if line.get_linestyle() == ":"}
+    assert marks == {round(v_rated, 6)}
+
+
+def test_cp_surface_labels_the_computed_optimum(figures, turbine, tmp_path) -> None:
+    tsr = np.arange(2.0, 16.0 + 1e-9, 0.5)
+    pitch = np.arange(-2.0, 24.0 + 1e-9, 1.0)
+    cp, _ = linearize.steady_coefficients(turbine, tsr[None, :], pitch[:, None])
+    lam, cp_max = linearize.optimal_tsr(turbine, 0.0)
+    plotting.plot_cp_surface(tsr, pitch, cp, tmp_path / "c.png", optimum=(lam, 0.0, cp_max))
+    fig = figures[-1]
+    _check(fig)
+    legend = fig.axes[0].get_legend().get_texts()[0].get_text()
+    assert f"{cp_max:.3f}" in legend and f"lambda {lam:.2f}" in legend
+    ticks = fig.axes[-1].get_yticks()
+    assert all(abs(t * 100 - round(t * 100)) < 1e-9 for t in ticks)   # two decimals at most
+    assert math.isfinite(cp_max)
