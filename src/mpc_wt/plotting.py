@@ -373,9 +373,10 @@ def plot_design(doc: dict[str, Any], path: str | Path) -> Path:
 
 
 def plot_comparison(runs: Sequence[tuple[str, np.ndarray, dict[str, np.ndarray]]],
-                    path: str | Path) -> list[str]:
-    """Rotor speed, collective pitch, blade-1 flap moment and tower-base fore-aft moment of
-    several runs over time, one panel each, as PNG.
+                    path: str | Path, window_s: float = 120.0) -> list[str]:
+    """Electrical power, rotor speed, collective pitch, blade-1 flap moment and tower-base
+    fore-aft moment of several runs, stacked panels over the last ``window_s`` of the runs (a
+    readable stretch), each run's mean and standard deviation over the whole run in its legend.
 
     Parameters
     ----------
@@ -383,33 +384,41 @@ def plot_comparison(runs: Sequence[tuple[str, np.ndarray, dict[str, np.ndarray]]
         Label, time [s] and channels of each run.
     path : str or Path
         The PNG file.
+    window_s : float
+        Length of the stretch shown [s] (the whole run when shorter).
 
     Returns
     -------
     list of str
         The file written.
     """
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    panels = (("rotor_speed", 30 / np.pi, "rotor speed [rpm]"),
-              ("pitch_1", 180 / np.pi, "pitch [deg]"),
-              ("flap_moment_1", 1e-6, "flap moment, blade 1 [MN m]"),
-              ("tower_base_fa_moment", 1e-6, "tower-base fore-aft [MN m]"))
-    fig, axes = plt.subplots(len(panels), 1, figsize=(9, 9), sharex=True)
-    for ax, (ch, scale, label) in zip(axes, panels):
-        for name, t, cols in runs:
-            if ch in cols:
-                ax.plot(t, cols[ch] * scale, lw=0.7, label=name)
-        ax.set_ylabel(label)
-    axes[0].legend(loc="upper right", fontsize=8)
-    axes[-1].set_xlabel("time [s]")
-    fig.tight_layout()
-    p = Path(path)
-    p.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(p, dpi=110)
-    plt.close(fig)
+    plt = pyplot()
+    panels = (("gen_power", 1e-6, "power", "MW"),
+              ("rotor_speed", 30 / np.pi, "rotor speed", "rpm"),
+              ("pitch_1", 180 / np.pi, "pitch", "deg"),
+              ("flap_moment_1", 1e-6, "flap moment, blade 1", "MN m"),
+              ("tower_base_fa_moment", 1e-6, "tower-base fore-aft moment", "MN m"))
+    shown = [p for p in panels if any(p[0] in cols for _, _, cols in runs)]
+    fig, axes = plt.subplots(len(shown), 1, figsize=(9, 1.9 * len(shown) + 0.8), sharex=True,
+                             squeeze=False)
+    t_end = max(float(t[-1]) for _, t, _ in runs)
+    t0 = max(min(float(t[0]) for _, t, _ in runs), t_end - window_s)
+    for ax, (ch, scale, name, unit) in zip(axes[:, 0], shown):
+        for label, t, cols in runs:
+            if ch not in cols:
+                continue
+            x = np.asarray(cols[ch]) * scale
+            keep = t >= t0
+            ax.plot(t[keep], x[keep], lw=0.8,
+                    label=f"{label}: {x.mean():.3g} +- {x.std():.2g} {unit}")
+        ax.set_ylabel(f"{name} [{unit}]", fontsize=8)
+        ax.legend(loc="upper right", fontsize=6.5, framealpha=0.8)
+        ax.grid(alpha=0.3)
+    axes[-1, 0].set_xlabel("time [s]")
+    axes[-1, 0].set_xlim(t0, t_end)
+    fig.suptitle(f"last {t_end - t0:.0f} s shown; legend: mean +- std over each whole run",
+                 fontsize=9)
+    p = save_figure(fig, path)
     return [str(p)]
 
 

@@ -44,8 +44,15 @@ def _check(fig) -> None:
         assert ax.get_ylabel() or ax.get_label() == "<colorbar>", "an axis without a y label"
     from matplotlib.text import Text
 
+    hidden = set()            # labels of ticks outside the view: matplotlib does not draw them
+    for ax in fig.axes:
+        for axis in (ax.xaxis, ax.yaxis):
+            lo, hi = sorted(axis.get_view_interval())
+            for tick in axis.get_major_ticks() + axis.get_minor_ticks():
+                if not lo - 1e-9 * abs(hi - lo) <= tick.get_loc() <= hi + 1e-9 * abs(hi - lo):
+                    hidden.update((id(tick.label1), id(tick.label2)))
     for text in fig.findobj(Text):
-        if not text.get_visible() or not text.get_text():
+        if not text.get_visible() or not text.get_text() or id(text) in hidden:
             continue
         ext = text.get_window_extent(renderer)
         assert ext.x0 >= box.x0 - 1 and ext.x1 <= box.x1 + 1 and ext.y0 >= box.y0 - 1 \
@@ -76,3 +83,20 @@ def test_cp_surface_labels_the_computed_optimum(figures, turbine, tmp_path) -> N
     ticks = fig.axes[-1].get_yticks()
     assert all(abs(t * 100 - round(t * 100)) < 1e-9 for t in ticks)   # two decimals at most
     assert math.isfinite(cp_max)
+
+
+def test_comparison_shows_power_and_a_readable_window(figures, tmp_path) -> None:
+    """Stacked panels with power first, the last 120 s of a 600 s run, each run's mean and
+    std in the legend with its unit."""
+    t = np.arange(0.0, 600.0, 0.05)
+    cols = {"gen_power": 5e6 + 1e5 * np.sin(t), "rotor_speed": 1.2 + 0.01 * np.sin(t),
+            "pitch_1": 0.1 + 0.01 * np.sin(t), "flap_moment_1": 6e6 + 1e6 * np.sin(t),
+            "tower_base_fa_moment": 5e7 + 5e6 * np.sin(t)}
+    plotting.plot_comparison([("a", t, cols), ("b", t, cols)], tmp_path / "c.png")
+    fig = figures[-1]
+    _check(fig)
+    axes = fig.axes
+    assert axes[0].get_ylabel() == "power [MW]" and len(axes) == 5
+    lo, hi = axes[-1].get_xlim()
+    assert hi - lo < 130.0
+    assert "MW" in axes[0].get_legend().get_texts()[0].get_text()
