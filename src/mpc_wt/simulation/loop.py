@@ -345,9 +345,8 @@ def simulate_closed_loop(params: linearize.PlantParams, controller: Any,
         preview.reset()
     loop = _Loop(params, controller, n, dt, x0, u0, preview,
                  _hub_wind(wind, params.turbine.geometry.hub_height))
-    label = str((meta or {}).get("controller", "closed loop"))
-    bar = tqdm(total=n, desc=f"simulate {label}", unit="step", disable=not progress,
-               mininterval=0.5)
+    bar = tqdm(total=n, desc=f"simulate {(meta or {}).get('controller', 'closed loop')}",
+               unit="step", disable=not progress, mininterval=0.5)
     try:
         _advance(loop, stepper, ratio, bar, compiled)
     except _Diverged as d:
