@@ -300,11 +300,25 @@ def _md_signoff(agg: dict[str, Any]) -> list[str]:
             "![sign-off](signoff.png)", ""]
 
 
+def _unit_of(channel: str) -> str:
+    """The SI unit of a result channel (the plant's outputs and states; derived moments N m)."""
+    import linearize
+
+    table = {**dict(zip(linearize.STATE_NAMES, linearize.STATE_UNITS)),
+             **dict(zip(linearize.OUTPUT_NAMES, linearize.OUTPUT_UNITS))}
+    if channel in table:
+        return table[channel]
+    return "N m" if "moment" in channel or channel.startswith("shaft_bending") else "-"
+
+
 def _md_ultimate(agg: dict[str, Any]) -> list[str]:
     """The governing design loads, the per-DLC ultimate loads and the overspeed and pitch-rate
-    demand per DLC."""
+    demand per DLC; every load with its channel's unit."""
     if not agg["ultimate"]:
         return []
+    for rows in (agg["governing"], agg["ultimate"]):
+        for r in rows:
+            r.setdefault("unit", _unit_of(str(r.get("channel", ""))))
     extra = any("extrapolated_max" in r for r in agg["ultimate"])
     md = ["## Ultimate loads", "",
           "Each case's extremes after its transient; characteristic: per mean wind the mean "
@@ -313,16 +327,17 @@ def _md_ultimate(agg: dict[str, Any]) -> list[str]:
           "(IEC 61400-1 ed. 3 table 3: normal 1.35, abnormal 1.1); extrapolated: the 50-year "
           "load of a DLC's maxima (Gumbel per wind, weighted by the wind distribution; factor "
           "1.25). Governing: the largest design load in magnitude over the DLCs.", "",
-          _md(agg["governing"], ["controller", "channel", "design", "side", "dlc", "case",
-                                 "change_pct"],
-              ["controller", "channel", "governing design load", "max/min", "DLC",
+          _md(agg["governing"], ["controller", "channel", "unit", "design", "side", "dlc",
+                                 "case", "change_pct"],
+              ["controller", "channel", "unit", "governing design load", "max/min", "DLC",
                "case of the extreme", "change [%]"]), "",
           "Per DLC (all columns in `ultimate.csv`):", "",
-          _md(agg["ultimate"], ["controller", "dlc", "family", "channel", "max", "max_case",
+          _md(agg["ultimate"], ["controller", "dlc", "family", "channel", "unit", "max",
+                                "max_case",
                                 "characteristic_max", "wind_max", "design_max", "min",
                                 "design_min", *(["extrapolated_max", "design_extrapolated_max"]
                                                 if extra else [])],
-              ["controller", "DLC", "family", "channel", "max", "its case",
+              ["controller", "DLC", "family", "channel", "unit", "max", "its case",
                "characteristic max", "at wind [m/s]", "design max", "min", "design min",
                *(["extrapolated max (50 y)", "design extrapolated"] if extra else [])]), ""]
     if agg["signoff"]:

@@ -2,6 +2,8 @@
 sign-off report (issue 24)."""
 from __future__ import annotations
 
+import re
+
 import math
 
 import numpy as np
@@ -267,8 +269,11 @@ def test_signoff_campaign_end_to_end(tmp_path) -> None:
     rep = make_report(tmp_path)
     text = rep.read_text()
     for head in ("## Sign-off: fatigue and ultimate loads side by side", "## Ultimate loads",
-                 "### Overspeed and pitch-rate demand per DLC", "| 2.3 | EOG (A) |"):
+                 "### Overspeed and pitch-rate demand per DLC", "| 2.3 | EOG (A) |",
+                 "| controller | channel | unit | governing design load |"):
         assert head in text, head
+    # every ultimate load with its unit: the tower-base moment in N m
+    assert re.search(r"\| tower_base_fa_moment \| N m \|", text)
     for f in ("signoff.png", "ultimate.png", "governing.csv", "signoff.csv"):
         assert (rep.parent / f).is_file(), f
 
