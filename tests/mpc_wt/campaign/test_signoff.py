@@ -2,9 +2,8 @@
 sign-off report (issue 24)."""
 from __future__ import annotations
 
-import re
-
 import math
+import re
 
 import numpy as np
 import pytest
