@@ -156,3 +156,24 @@ def test_a_rosco_deck_in_steady_wind_runs_with_rosco_and_lands_on_openfasts_curv
     late = res.t > 40.0
     assert_allclose(res.channel("rotor_speed")[late].mean() * 30 / math.pi, 9.0391, rtol=0.01)
     assert_allclose(res.channel("gen_power")[late].mean(), 1656.1398e3, rtol=0.05)
+
+
+def test_bad_input_is_named(tmp_path) -> None:
+    """A missing case file, a window that runs backwards or holds too few samples, a channel
+    one run lacks, and a GridWind with v but no w: each error names what is wrong."""
+    from mpc_wt.errors import ResultFileError
+
+    with pytest.raises(ResultFileError, match="nope.fst: file not found"):
+        read_openfast_case(tmp_path / "nope.fst", turbine=linearize.load_turbine("nrel5mw"))
+    t = np.arange(0.0, 10.0, 0.1)
+    cols = {"gen_power": np.ones_like(t)}
+    with pytest.raises(ValueError, match="window must run forward, got 5..2 s"):
+        compare_series(t, cols, t, cols, (5.0, 2.0))
+    with pytest.raises(ValueError, match="holds 2 samples"):
+        compare_series(t, cols, t, cols, (9.0, 9.1))
+    with pytest.raises(ValueError, match="channel 'rotor_speed' is not in both runs"):
+        compare_series(t, cols, t, cols, (0.0, None), channels=["rotor_speed"])
+    g = np.zeros((2, 2, 2), np.float32)
+    with pytest.raises(ValueError, match="v and GridWind.w must be given together"):
+        linearize.GridWind(np.array([0.0, 1.0]), np.array([-1.0, 1.0]), np.array([0.0, 1.0]),
+                           g, v=g)
