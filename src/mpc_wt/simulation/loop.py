@@ -345,8 +345,8 @@ def simulate_closed_loop(params: linearize.PlantParams, controller: Any,
         preview.reset()
     loop = _Loop(params, controller, n, dt, x0, u0, preview,
                  _hub_wind(wind, params.turbine.geometry.hub_height))
-    bar = tqdm(total=n, desc=f"simulate {(meta or {}).get('controller', 'closed loop')}",
-               unit="step", disable=not progress, mininterval=0.5)
+    bar = _progress_bar(n, f"simulate {(meta or {}).get('controller', 'closed loop')}",
+                        progress)
     try:
         _advance(loop, stepper, ratio, bar, compiled)
     except _Diverged as d:
@@ -366,6 +366,39 @@ def simulate_closed_loop(params: linearize.PlantParams, controller: Any,
     return loop.result(n + 1, {**(meta or {}), "dt": dt,
                                "controller_dt": cdt, "commands_clipped": loop.clipped,
                                "software_version": __version__})
+
+
+#: whether this process has run a closed loop (its kernels compiled or loaded)
+_WARM = [False]
+
+
+class _Warming:
+    """A progress bar that says the kernels are compiling, without an ETA, until its first
+    update (the first block of steps, after which the kernels are compiled), then shows
+    ``desc`` and the usual rate and ETA."""
+
+    def __init__(self, bar: Any, desc: str) -> None:
+        self._bar, self._desc = bar, desc
+
+    def update(self, k: int) -> None:
+        if not _WARM[0]:
+            _WARM[0] = True
+            self._bar.bar_format = None
+            self._bar.set_description(self._desc, refresh=False)
+        self._bar.update(k)
+
+    def __getattr__(self, name: str) -> Any:
+        return getattr(self._bar, name)
+
+
+def _progress_bar(n: int, desc: str, progress: bool) -> Any:
+    """The run's progress bar: named by what runs; on a process's first run it says
+    "compiling kernels (first run only)" and shows no ETA until the first steps are done."""
+    if _WARM[0] or not progress:
+        return tqdm(total=n, desc=desc, unit="step", disable=not progress, mininterval=0.5)
+    bar = tqdm(total=n, desc="compiling kernels (first run only)", unit="step",
+               mininterval=0.5, bar_format="{desc}: {n_fmt}/{total_fmt} {unit} [{elapsed}]")
+    return _Warming(bar, desc)
 
 
 class _Diverged(Exception):

@@ -161,3 +161,20 @@ def test_hub_wind_reads_the_field_as_linear_interpolation(dt, n, t0, q, seed) ->
     hub = gw.u[:, 2, 2].astype(float)           # the column as stored (float32, issue 23)
     for tq in q:
         assert f(tq) == pytest.approx(np.interp(tq, t, hub), rel=1e-12, abs=1e-12)
+
+
+def test_first_run_says_it_compiles_and_shows_no_eta(monkeypatch) -> None:
+    """A process's first closed loop: the bar says the kernels compile and has no ETA (it would
+    be wrong while numba compiles); after the first block it names the run and shows one."""
+    from mpc_wt.simulation import loop as lp
+
+    monkeypatch.setattr(lp, "_WARM", [False])
+    bar = lp._progress_bar(1600, "simulate baseline", True)
+    assert bar.desc.startswith("compiling kernels (first run only)")
+    assert "remaining" not in bar.bar_format
+    bar.update(800)
+    assert bar.desc.startswith("simulate baseline") and bar.bar_format is None
+    bar.close()
+    again = lp._progress_bar(1600, "simulate mpc", True)
+    assert again.desc.startswith("simulate mpc")
+    again.close()
