@@ -338,7 +338,9 @@ _ASSESS_ROWS = (("cs1", "CS1 load semi-axis", "kN m", 1e-3), ("cs2", "CS2 power 
                                                                 1e-3),
                 ("cs3", "CS3 mean load", "kN m", 1e-3), ("cs4", "CS4 mean power", "kW", 1e-3),
                 ("cs5", "CS5 ellipse angle", "deg", 1.0),
-                ("power_std_W", "power std", "kW", 1e-3), ("energy_Wh", "energy", "kWh", 1e-3),
+                ("power_std_W", "power std", "kW", 1e-3),
+                ("gen_speed_std_rad_s", "generator speed std", "rpm", 30.0 / math.pi),
+                ("energy_Wh", "energy", "kWh", 1e-3),
                 ("pitch_travel_deg", "pitch travel", "deg", 1.0))
 
 
