@@ -133,16 +133,19 @@ def evaluate_plant_vw(x, u, wind, ext, p, hint, mode):  # pragma: no cover - com
             uf = wind[i, j]
             v_tw = 0.0 * uf
             if shadow:
-                fu, fv = _tower_potential_flow(rj, cp, sp, p)
+                fu, fv = _tower_potential_flow(rj, cp, sp, cc, sc, ct, st, p)
                 v_tw = fv * uf
                 uf = fu * uf
             vrel = uf - vhub_x - nod * rj * cc * cp
             vv = vw[0, i, j] + v_tw
             # the modes' directions: flapwise cos(th) x + sin(th) e, edgewise cos(th) e -
             # sin(th) x (x downwind, e the direction of rotation), th = pitch + twist
-            th_s = pitch[i] + p.twist_s[j] if p.opt[5] else 0.0 * pitch[i]
-            cs = np.cos(th_s)
-            ss = np.sin(th_s)
+            if p.opt[5]:
+                cs = np.cos(pitch[i] + p.twist_s[j])
+                ss = np.sin(pitch[i] + p.twist_s[j])
+            else:
+                cs = 1.0 + 0.0 * pitch[i]
+                ss = 0.0 * pitch[i]
             vq = qd * p.phi_flap[j]
             ve = ed * p.phi_edge[j]
             vx = (vrel * (ct * cc + st * sc * cp) - vq * cs + ve * ss
@@ -386,7 +389,7 @@ def _ua_loads(npr, tpr, phi, ua, ut, theta, i, j, p, hint, bem):  # pragma: no c
 
 
 @nb.njit(**_JIT)
-def _tower_potential_flow(r, cp, sp, p):  # pragma: no cover - compiled
+def _tower_potential_flow(r, cp, sp, cc, sc, ct, st, p):  # pragma: no cover - compiled
     """Potential flow around the tower at a blade element (AeroDyn's ``TwrPotent = 1``;
     Moriarty and Hansen 2005, NREL/EL-500-36881, sec. 7): with x downwind of and y across the
     tower's axis in units of the local tower radius R, the free wind U becomes
@@ -395,11 +398,9 @@ def _tower_potential_flow(r, cp, sp, p):  # pragma: no cover - compiled
     that the loads stay independent of the displacements, as the trim needs; AeroDyn takes
     the deflected one); above the tower top or below its base the tower does not act.
 
+    ``cc``, ``sc``, ``ct``, ``st``: cosine and sine of the precone and the shaft tilt.
+
     Returns the factors (u / U, v / U)."""
-    cc = math.cos(p.cone)
-    sc = math.sin(p.cone)
-    ct = math.cos(p.tilt)
-    st = math.sin(p.tilt)
     z = p.zhub + r * cc * cp * ct
     if z.real > p.twr_h[-1] or z.real < p.twr_h[0]:
         return 1.0 + 0.0 * z, 0.0 * z

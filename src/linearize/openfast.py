@@ -273,6 +273,27 @@ class OpenFASTFile:
             return False
         raise TurbineFileError(f"{self.path}: {self.where(key)} = {tok!r}; allowed True/False")
 
+    def file(self, key: str) -> Path | None:
+        """A file named by ``key``, relative to this file's folder unless absolute.
+
+        Parameters
+        ----------
+        key : str
+            The key, as OpenFAST names it.
+
+        Returns
+        -------
+        Path or None
+            The resolved path; None when the key is absent or names no file (``unused``,
+            ``none``, empty).
+        """
+        if not self.has(key):
+            return None
+        name = self.text(key)
+        if name.lower() in ("unused", "none", ""):
+            return None
+        return Path(name) if Path(name).is_absolute() else (self.path.parent / name).resolve()
+
     def integer(self, key: str, lo: int = -(2**31), hi: int = 2**31) -> int:
         """An integer in ``[lo, hi]``.
 
@@ -504,13 +525,6 @@ class _Recorder:
         return value
 
 
-def _resolve(base: Path, f: OpenFASTFile, key: str) -> Path | None:
-    name = f.text(key)
-    if name.lower() in ("unused", "none", ""):
-        return None
-    return (base / name).resolve() if not Path(name).is_absolute() else Path(name)
-
-
 def load_openfast(fst: str | Path | None = None, *, elastodyn: str | Path | None = None,
                   aerodyn: str | Path | None = None, servodyn: str | Path | None = None,
                   discon: str | Path | None = None, name: str | None = None) -> Turbine:
@@ -550,17 +564,16 @@ def load_openfast(fst: str | Path | None = None, *, elastodyn: str | Path | None
     rho_src: tuple[OpenFASTFile, str] | None = None
     if fst is not None:
         main = OpenFASTFile(fst)
-        base = main.path.parent
         _check_main(main)
         if main.has("Gravity"):
             gravity_src = (main, "Gravity")
         if main.has("AirDens"):
             rho_src = (main, "AirDens")
-        elastodyn = elastodyn or _resolve(base, main, "EDFile")
-        aerodyn = aerodyn or (_resolve(base, main, "AeroFile")
+        elastodyn = elastodyn or main.file("EDFile")
+        aerodyn = aerodyn or (main.file("AeroFile")
                               if main.integer("CompAero", 0, 3) == 2 else None)
         if main.integer("CompServo", 0, 1) == 1:
-            servodyn = servodyn or _resolve(base, main, "ServoFile")
+            servodyn = servodyn or main.file("ServoFile")
         fixed_bottom = main.integer("CompSub", 0, 2) == 1
         if main.integer("CompSub", 0, 2) or main.integer("CompHydro", 0, 1):
             notes.append(f"{main.path.name}: CompSub/CompHydro set (fixed-bottom support); the "
@@ -586,7 +599,7 @@ def load_openfast(fst: str | Path | None = None, *, elastodyn: str | Path | None
     ad = OpenFASTFile(aerodyn)
     srv = OpenFASTFile(servodyn) if servodyn is not None else None
     if discon is None and srv is not None and srv.has("DLL_InFile"):
-        p = _resolve(srv.path.parent, srv, "DLL_InFile")
+        p = srv.file("DLL_InFile")
         discon = p if p is not None and p.is_file() else None
     dis = OpenFASTFile(discon) if discon is not None else None
     if gravity_src is None:
@@ -600,8 +613,8 @@ def load_openfast(fst: str | Path | None = None, *, elastodyn: str | Path | None
     _check_aerodyn(ad)
     geometry = _geometry(ed, rec)
     drive = _drivetrain(ed, srv, dis, rec)
-    blade_file = _resolve(ed.path.parent, ed, "BldFile1")
-    tower_file = _resolve(ed.path.parent, ed, "TwrFile")
+    blade_file = ed.file("BldFile1")
+    tower_file = ed.file("TwrFile")
     if blade_file is None or not blade_file.is_file():
         raise TurbineFileError(f"{ed.path}: {ed.where('BldFile1')}: ElastoDyn blade file "
                                f"{blade_file} not found; BeamDyn-only blades are not supported "
@@ -868,7 +881,7 @@ def _aero(ad: OpenFASTFile, geo: Geometry, rec: _Recorder
             rec.notes.append(note)
         polars.append(polar)
     key = "ADBlFile1"
-    bl_path = _resolve(base, ad, key)
+    bl_path = ad.file(key)
     if bl_path is None:
         raise TurbineFileError(f"{ad.path}: {ad.where(key)}: a blade file is required")
     blf = OpenFASTFile(bl_path)

@@ -221,10 +221,10 @@ _Pack = namedtuple("_Pack", [
     "r", "w", "chord", "twist", "af", "phi_flap", "table", "alpha0", "dalpha",
     "ngear", "eta_gen", "j_rot", "j_gen", "k_shaft", "c_shaft",
     "m_fa", "k_fa", "c_fa", "hub_fa", "slope_fa", "m_ss", "k_ss", "c_ss", "hub_ss", "slope_ss",
-    "m_b", "k_b", "k_cf", "c_b", "m_c", "s1", "s_phi_s", "s_phi_r", "i_edge",
+    "m_b", "k_b", "k_cf", "c_b", "m_c", "s1", "s_phi_r", "i_edge",
     "tau_p", "rate_p", "min_p", "max_p", "min_tq", "max_tq",
     "fa_static", "fa_pdelta", "fa_inertia", "ss_pdelta", "ss_inertia",
-    "phi_edge", "m_e", "k_e", "k_cf_e", "c_e", "s_e", "g_e", "s_phie_s", "g_b",
+    "phi_edge", "m_e", "k_e", "k_cf_e", "c_e", "s_e", "g_e", "g_b",
     "twr_h", "twr_r", "x_apex", "ua",
     "twist_s", "sfc", "sfs", "sec", "ses", "tq_h", "tq_w", "tq_fa", "tq_ss"])
 
@@ -352,7 +352,6 @@ def plant_params(turbine: Turbine, config: PlantConfig | None = None) -> PlantPa
     tension = _cumtrapz_from_end(mu * (g.hub_radius + s), s)   # per Omega^2
     k_cf = float(np.trapezoid(tension * dphi**2, s))
     m_c = float(np.trapezoid(mu * phi, s))
-    s_phi_s = float(np.trapezoid(mu * phi * s, s))
     s_phi_r = float(np.trapezoid(mu * phi * (g.hub_radius + s), s))
     i_edge = float(np.trapezoid(mu * s * (g.hub_radius + s), s))
     c_b = 2.0 * t.damping.blade * math.sqrt(k_b * m_b)
@@ -437,7 +436,7 @@ def plant_params(turbine: Turbine, config: PlantConfig | None = None) -> PlantPa
         k_shaft=t.drivetrain.shaft_stiffness, c_shaft=t.drivetrain.shaft_damping,
         m_fa=m_fa, k_fa=k_fa, c_fa=c_fa, hub_fa=hub_fa, slope_fa=slope_fa,
         m_ss=m_ss, k_ss=k_ss, c_ss=c_ss, hub_ss=hub_ss, slope_ss=slope_ss,
-        m_b=m_b, k_b=k_b, k_cf=k_cf, c_b=c_b, m_c=m_c * hub_fa, s1=s1, s_phi_s=s_phi_s,
+        m_b=m_b, k_b=k_b, k_cf=k_cf, c_b=c_b, m_c=m_c * hub_fa, s1=s1,
         s_phi_r=s_phi_r, i_edge=i_edge, tau_p=pa.time_constant, rate_p=pa.max_rate_rad_s,
         min_p=pa.min_pitch_rad, max_p=pa.max_pitch_rad, min_tq=t.generator.min_torque,
         max_tq=t.generator.max_torque, fa_static=fa_static, fa_pdelta=pd_fa,
@@ -464,7 +463,7 @@ def _edge_mode(t: Turbine, s: FloatArray, mu: FloatArray,
     shape = t.mode_shapes.blade_edge1
     b = t.blade
     if shape is None:
-        zero = dict.fromkeys(("m_e", "k_e", "k_cf_e", "c_e", "s_e", "g_e", "s_phie_s"), 0.0)
+        zero = dict.fromkeys(("m_e", "k_e", "k_cf_e", "c_e", "s_e", "g_e"), 0.0)
         return {}, {"phi_edge": np.zeros_like(b.r), **zero}
     g = t.geometry
     lb = g.tip_radius - g.hub_radius
@@ -481,8 +480,7 @@ def _edge_mode(t: Turbine, s: FloatArray, mu: FloatArray,
               "edge_centrifugal_stiffness": k_cf_e, "edge_rotor_coupling": s_e}
     kernel = {"phi_edge": mode_shape(shape, (b.r - g.hub_radius) / lb), "m_e": m_e, "k_e": k_e,
               "k_cf_e": k_cf_e, "c_e": 2.0 * t.damping.blade * math.sqrt(k_e * m_e),
-              "s_e": s_e, "g_e": float(np.trapezoid(mu * phi, s)),
-              "s_phie_s": float(np.trapezoid(mu * phi * s, s))}
+              "s_e": s_e, "g_e": float(np.trapezoid(mu * phi, s))}
     return public, kernel
 
 
@@ -517,14 +515,12 @@ def _twisted_modes(t: Turbine, cfg: PlantConfig, s: FloatArray, mu: FloatArray,
     tw_data = t.blade_structure.structural_twist_rad
     shape_e = t.mode_shapes.blade_edge1
     phi_e = mode_shape(shape_e, s / lb) if shape_e is not None else np.zeros_like(s)
-    if not cfg.twisted_modes or tw_data is None:
-        return {"on": False, "twist_s": np.zeros_like(r_el),
-                "sfc": float(np.trapezoid(mu * phi * s, s)), "sfs": 0.0,
-                "sec": float(np.trapezoid(mu * phi_e * s, s)), "ses": 0.0}
-    tw = np.interp(s / lb, t.blade_structure.span_fraction, tw_data)
-    return {"on": True,
-            "twist_s": np.interp((r_el - g.hub_radius) / lb, t.blade_structure.span_fraction,
-                                 tw_data),
+    on = bool(cfg.twisted_modes and tw_data is not None)
+    frac = t.blade_structure.span_fraction
+    tw = np.interp(s / lb, frac, tw_data) if on else np.zeros_like(s)
+    return {"on": on,
+            "twist_s": (np.interp((r_el - g.hub_radius) / lb, frac, tw_data) if on
+                        else np.zeros_like(r_el)),
             "sfc": float(np.trapezoid(mu * phi * s * np.cos(tw), s)),
             "sfs": float(np.trapezoid(mu * phi * s * np.sin(tw), s)),
             "sec": float(np.trapezoid(mu * phi_e * s * np.cos(tw), s)),

@@ -908,7 +908,10 @@ def _build_section(path: Path, sec: str, d: Any, cls: type) -> Any:
 
 
 def _read_csv(path: Path, required: tuple[str, ...],
-              text_cols: tuple[str, ...] = ()) -> dict[str, Any]:
+              text_cols: tuple[str, ...] = (),
+              optional: tuple[str, ...] = ()) -> dict[str, Any]:
+    """The ``required`` columns of a CSV file, and those of ``optional`` it has (numbers unless
+    in ``text_cols``); an error names the file, the line and the column."""
     if not path.is_file():
         raise TurbineFileError(f"{path}: file not found")
     with path.open(newline="") as fh:
@@ -920,7 +923,7 @@ def _read_csv(path: Path, required: tuple[str, ...],
     if missing:
         raise TurbineFileError(f"{path}: missing columns {missing}; has {header}")
     out: dict[str, Any] = {}
-    for col in required:
+    for col in (*required, *(c for c in optional if c in header)):
         j = header.index(col)
         vals = []
         for i, row in enumerate(rows[1:], start=2):
@@ -954,8 +957,8 @@ def _require(path: Path, col: str, values: FloatArray, ok: Callable[[FloatArray]
 
 def _read_polars(index_path: Path, base: Path) -> tuple[tuple[Polar, ...], dict[int, int]]:
     """Read the airfoil index; its ``file`` column is relative to the turbine directory."""
-    idx = _read_csv(index_path, ("af_id", "name", "file"), text_cols=("name", "file"))
-    ua_cols = _ua_columns(index_path)
+    idx = _read_csv(index_path, ("af_id", "name", "file"), text_cols=("name", "file"),
+                    optional=_UA_COLUMNS)
     polars = []
     index_of: dict[int, int] = {}
     for k, (af_id, name, file) in enumerate(zip(idx["af_id"], idx["name"], idx["file"])):
@@ -963,27 +966,21 @@ def _read_polars(index_path: Path, base: Path) -> tuple[tuple[Polar, ...], dict[
         tab = _read_csv(p, ("alpha_deg", "cl", "cd"))
         try:
             polars.append(Polar(name=name, alpha_rad=np.radians(tab["alpha_deg"]),
-                                cl=tab["cl"], cd=tab["cd"], ua=_ua_of(index_path, k, ua_cols)))
+                                cl=tab["cl"], cd=tab["cd"], ua=_ua_of(index_path, k, idx)))
         except ValueError as err:
             raise TurbineFileError(f"{p}: {err}") from err
         index_of[int(af_id)] = k
     return tuple(polars), index_of
 
 
-def _ua_columns(path: Path) -> dict[str, Any] | None:
-    """The airfoil index's optional UA columns (all three or none)."""
-    cols = ("ua_alpha0_deg", "ua_Cn_alpha_per_rad", "ua_Cd0")
-    try:
-        return _read_csv(path, cols)
-    except TurbineFileError as err:
-        if "missing columns" in str(err):
-            return None
-        raise
+#: the airfoil index's optional UA columns (all three or none)
+_UA_COLUMNS = ("ua_alpha0_deg", "ua_Cn_alpha_per_rad", "ua_Cd0")
 
 
-def _ua_of(path: Path, k: int, cols: dict[str, Any] | None) -> UAParams | None:
-    """Airfoil k's UA coefficients from the index (None where C_n,alpha is 0: no UA data)."""
-    if cols is None or not cols["ua_Cn_alpha_per_rad"][k] > 0:
+def _ua_of(path: Path, k: int, cols: dict[str, Any]) -> UAParams | None:
+    """Airfoil k's UA coefficients from the index (None without the UA columns, or where
+    C_n,alpha is 0: no UA data)."""
+    if not all(c in cols for c in _UA_COLUMNS) or not cols["ua_Cn_alpha_per_rad"][k] > 0:
         return None
     try:
         return UAParams(alpha0_rad=math.radians(cols["ua_alpha0_deg"][k]),
@@ -1020,11 +1017,11 @@ def _stations(path: Path, col: str, x: FloatArray) -> None:
 
 def _read_blade_structure(path: Path, scale: float) -> BladeStructure:
     cols = ("BlFract", "BMassDen_kg_per_m", "FlpStff_Nm2", "EdgStff_Nm2")
-    t = _read_csv(path, cols)
+    t = _read_csv(path, cols, optional=("StrcTwst_deg",))
     _stations(path, "BlFract", t["BlFract"])
     for c in cols[1:]:
         _require(path, c, t[c], lambda v: v > 0, "> 0")
-    twist = _optional_column(path, "StrcTwst_deg", lambda v: np.abs(v) <= 90, "-90..90 deg")
+    twist = _optional(path, t, "StrcTwst_deg", lambda v: np.abs(v) <= 90, "-90..90 deg")
     if twist is not None:
         twist = np.radians(twist)
     return BladeStructure(span_fraction=t["BlFract"], mass_per_length=t["BMassDen_kg_per_m"] * scale,
@@ -1032,27 +1029,24 @@ def _read_blade_structure(path: Path, scale: float) -> BladeStructure:
                           structural_twist_rad=twist)
 
 
-def _optional_column(path: Path, col: str, ok: Callable[[FloatArray], Any],
-                     allowed: str) -> FloatArray | None:
-    """An optional column of a CSV file, checked (None when the file has no such column)."""
-    try:
-        values = _read_csv(path, (col,))[col]
-    except TurbineFileError as err:
-        if "missing columns" in str(err):
-            return None
-        raise
-    _require(path, col, values, ok, allowed)
-    return values
+def _optional(path: Path, t: dict[str, Any], col: str, ok: Callable[[FloatArray], Any],
+              allowed: str) -> FloatArray | None:
+    """An optional column of a table read by :func:`_read_csv`, checked (None when the file
+    has no such column)."""
+    if col not in t:
+        return None
+    _require(path, col, t[col], ok, allowed)
+    return t[col]
 
 
 def _read_tower_structure(path: Path) -> TowerStructure:
     cols = ("HtFract", "TMassDen_kg_per_m", "TwFAStif_Nm2", "TwSSStif_Nm2")
-    t = _read_csv(path, cols)
+    t = _read_csv(path, cols, optional=("TwrDiam_m", "TwrCd"))
     _stations(path, "HtFract", t["HtFract"])
     for c in cols[1:]:
         _require(path, c, t[c], lambda v: v > 0, "> 0")
-    diameter = _optional_column(path, "TwrDiam_m", lambda v: v > 0, "> 0")
-    cd = _optional_column(path, "TwrCd", lambda v: (v >= 0) & (v <= 5), "0..5")
+    diameter = _optional(path, t, "TwrDiam_m", lambda v: v > 0, "> 0")
+    cd = _optional(path, t, "TwrCd", lambda v: (v >= 0) & (v <= 5), "0..5")
     return TowerStructure(height_fraction=t["HtFract"], mass_per_length=t["TMassDen_kg_per_m"],
                           fa_stiffness=t["TwFAStif_Nm2"], ss_stiffness=t["TwSSStif_Nm2"],
                           outer_diameter=diameter, drag_coefficient=cd)

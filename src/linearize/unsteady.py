@@ -74,10 +74,12 @@ def _static_cn_cc(table, k, alpha, a0, dalpha, cd0):  # pragma: no cover - compi
 
 
 @nb.njit(**_JIT)
-def _f_lookup(table, k, alpha, par, cna, a0, dalpha):  # pragma: no cover - compiled
-    """Separation point f' of the normal force at alpha (inverse Kirchhoff, eq 1.32a) with the
-    attached-flow slope ``cna``, and the fully separated normal force C_n,fs there."""
-    cn, _ = _static_cn_cc(table, k, alpha, a0, dalpha, par[3])
+def _separation(table, k, alpha, par, cna, a0, dalpha):  # pragma: no cover - compiled
+    """From one lookup of the static polar at alpha: the separation point f' of the normal
+    force (inverse Kirchhoff, eq 1.32a) with the attached-flow slope ``cna``, the fully
+    separated normal force C_n,fs there, and the separation point f'_c of the chordwise force
+    (eq 1.32b, Gonzalez offset)."""
+    cn, cc = _static_cn_cc(table, k, alpha, a0, dalpha, par[3])
     lin = cna * (alpha - par[1])
     x = 0.0
     if lin != 0.0 and cn != 0.0:
@@ -85,21 +87,17 @@ def _f_lookup(table, k, alpha, par, cna, a0, dalpha):  # pragma: no cover - comp
         if x < 0.0:
             x = 0.0
     f = (2.0 * math.sqrt(x) - 1.0) ** 2
+    cn_fs = 0.0
     if f >= 1.0:
-        return 1.0, 0.0
-    return f, (cn - lin * f) / (1.0 - f)
-
-
-@nb.njit(**_JIT)
-def _fc_lookup(table, k, alpha, par, cna, a0, dalpha):  # pragma: no cover - compiled
-    """Separation point f'_c of the chordwise force at alpha (eq 1.32b, Gonzalez offset)."""
+        f = 1.0
+    else:
+        cn_fs = (cn - lin * f) / (1.0 - f)
     limit = (1.0 + _GONZALEZ) ** 2
-    den = cna * (alpha - par[1]) * math.tan(alpha)
-    if den == 0.0:
-        return limit
-    _, cc = _static_cn_cc(table, k, alpha, a0, dalpha, par[3])
-    v = (cc / den + _GONZALEZ) ** 2
-    return v if v < limit else limit
+    den = lin * math.tan(alpha)
+    fc = limit
+    if den != 0.0:
+        fc = min((cc / den + _GONZALEZ) ** 2, limit)
+    return f, cn_fs, fc
 
 
 @nb.njit(**_JIT)
@@ -138,14 +136,13 @@ def _chain(alpha, w, chord, dt, par, st, table, k, a0, dalpha):  # pragma: no co
     ep = math.exp(-ds / par[8])
     dp = st[4] * ep + (cn_pot - st[3]) * math.sqrt(ep)
     a_f = (cn_pot - dp) / cna + par[1]
-    fp, _ = _f_lookup(table, k, a_f, par, cna, a0, dalpha)
+    fp, _, fpc = _separation(table, k, a_f, par, cna, a0, dalpha)
     ef = math.exp(-ds / par[9])
     df = st[6] * ef + (fp - st[5]) * math.sqrt(ef)
-    fpc = _fc_lookup(table, k, a_f, par, cna, a0, dalpha)
     dfc = st[8] * ef + (fpc - st[7]) * math.sqrt(ef)
     f2 = min(max(fp - df, 0.0), 1.0)
     f2c = min(max(fpc - dfc, 0.0), (1.0 + _GONZALEZ) ** 2)
-    _, cn_fs = _f_lookup(table, k, a_e + par[1], par, cna, a0, dalpha)
+    _, cn_fs, _ = _separation(table, k, a_e + par[1], par, cna, a0, dalpha)
     cn = cn_nc + cn_circ * f2 + cn_fs * (1.0 - f2)
     cc = cn_circ * math.tan(a_e + par[1]) * (math.sqrt(f2c) - _GONZALEZ)
     s, c = math.sin(alpha), math.cos(alpha)
@@ -188,8 +185,7 @@ def _initial(alpha, w, par, table, k, a0, dalpha):  # pragma: no cover - compile
     st = np.zeros(N_UA)
     st[0] = alpha
     st[3] = cna * (alpha - par[1])
-    st[5], _ = _f_lookup(table, k, alpha, par, cna, a0, dalpha)
-    st[7] = _fc_lookup(table, k, alpha, par, cna, a0, dalpha)
+    st[5], _, st[7] = _separation(table, k, alpha, par, cna, a0, dalpha)
     return st
 
 

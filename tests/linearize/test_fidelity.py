@@ -98,11 +98,12 @@ def test_tower_potential_flow_below_the_hub_is_the_cylinder_closed_form(
     d = 5.0191 * math.cos(t) + r * (math.cos(c) * math.sin(t) + math.sin(c) * math.cos(t))
     height = 90.0 - r * math.cos(c) * math.cos(t)
     radius = 0.5 * np.interp(height, [0.0, 85.268, 87.6], [6.0, 3.87, 3.87])
-    fu, fv = _tower_potential_flow(r, -1.0, 0.0, params.pack)
+    trig = (math.cos(c), math.sin(c), math.cos(t), math.sin(t))
+    fu, fv = _tower_potential_flow(r, -1.0, 0.0, *trig, params.pack)
     assert_allclose(fu, 1.0 - (radius / d) ** 2, rtol=2e-3)
     assert abs(fv) < 1e-12
     # above the tower top the tower does not act
-    assert _tower_potential_flow(r, 1.0, 0.0, params.pack) == (1.0, 0.0)
+    assert _tower_potential_flow(r, 1.0, 0.0, *trig, params.pack) == (1.0, 0.0)
 
 
 def test_tower_drag_base_moment_is_the_closed_form_integral(turbine: linearize.Turbine) -> None:

@@ -68,20 +68,8 @@ class OpenFASTCase:
     steady_wind: tuple[float, float] | None = None
 
 
-def _path(base: Path, f: OpenFASTFile, key: str) -> Path | None:
-    if not f.has(key):
-        return None
-    name = f.text(key).strip().strip('"').strip("'")
-    if name.lower() in ("unused", "none", ""):
-        return None
-    p = Path(name)
-    return p if p.is_absolute() else (base / p).resolve()
-
-
-def _flag(f: OpenFASTFile, key: str, default: bool = False) -> bool:
-    if not f.has(key):
-        return default
-    return f.text(key).strip().strip('"').lower() in ("true", "t", "1")
+def _flag(f: OpenFASTFile, key: str, default: bool) -> bool:
+    return f.flag(key) if f.has(key) else default
 
 
 def _dofs(ed: OpenFASTFile) -> frozenset[str]:
@@ -135,14 +123,13 @@ def read_openfast_case(fst: str | Path, *, wind: str | Path | None = None,
     fst = Path(fst).resolve()
     try:
         main = OpenFASTFile(fst)
-        base = fst.parent
-        ed_path, ad_path = _path(base, main, "EDFile"), _path(base, main, "AeroFile")
+        ed_path, ad_path = main.file("EDFile"), main.file("AeroFile")
         if ed_path is None or ad_path is None:
             raise ResultFileError(f"{fst}: EDFile and AeroFile (AeroDyn 15) are required")
         ed, ad = OpenFASTFile(ed_path), OpenFASTFile(ad_path)
-        srv_path = _path(base, main, "ServoFile")
+        srv_path = main.file("ServoFile")
         srv = OpenFASTFile(srv_path) if srv_path is not None else None
-        discon = _path(srv.path.parent, srv, "DLL_InFile") if srv is not None else None
+        discon = srv.file("DLL_InFile") if srv is not None else None
         if discon is not None and not discon.is_file():
             discon = None
         notes: list[str] = []
@@ -157,20 +144,20 @@ def read_openfast_case(fst: str | Path, *, wind: str | Path | None = None,
         if wind is not None:
             wind_file: Path | None = Path(wind).resolve()
         else:
-            wind_file, steady = _inflow(main, base)
+            wind_file, steady = _inflow(main)
         if steady is None and (wind_file is None or not wind_file.is_file()):
             raise ResultFileError(f"{fst}: wind file {wind_file} not found; pass it "
                                   f"(--wind FILE.bts)")
         ua = (ad.number("UA_Mod") if ad.has("UA_Mod") else
               ad.number("UAMod") if ad.has("UAMod") else 0) > 0
         cfg = linearize.PlantConfig.openfast(
-            unsteady_aero=bool(ua), tower_drag=_flag(ad, "TwrAero"),
+            unsteady_aero=bool(ua), tower_drag=_flag(ad, "TwrAero", False),
             tower_shadow=(ad.number("TwrPotent") > 0) if ad.has("TwrPotent") else False,
             dofs=_dofs(ed))
         notes.append("pitch as the controller commands it (no actuator lag), as ServoDyn "
                      "applies a DLL's pitch")
         for key in ("FlapDOF2", "TwFADOF2", "TwSSDOF2", "YawDOF"):
-            if _flag(ed, key):
+            if _flag(ed, key, False):
                 notes.append(f"ElastoDyn {key} is on; the plant has no such DOF")
         return OpenFASTCase(fst=fst, turbine=turbine, wind_file=wind_file,
                             duration=main.number("TMax", 0.0, 1e7),
@@ -180,9 +167,9 @@ def read_openfast_case(fst: str | Path, *, wind: str | Path | None = None,
         raise ResultFileError(str(err)) from None
 
 
-def _inflow(main: OpenFASTFile, base: Path) -> tuple[Path | None, tuple[float, float] | None]:
+def _inflow(main: OpenFASTFile) -> tuple[Path | None, tuple[float, float] | None]:
     """InflowWind's wind: a TurbSim file (``WindType = 3``) or a steady power-law wind (1)."""
-    inflow = _path(base, main, "InflowFile")
+    inflow = main.file("InflowFile")
     if inflow is None:
         return None, None
     iw = OpenFASTFile(inflow)
@@ -193,7 +180,7 @@ def _inflow(main: OpenFASTFile, base: Path) -> tuple[Path | None, tuple[float, f
     if kind != 3:
         raise ResultFileError(f"{inflow}: WindType = {kind}; a steady wind (1) or a TurbSim "
                               f"full field (3) is supported (pass --wind FILE.bts)")
-    return _path(inflow.parent, iw, "FileName_BTS"), None
+    return iw.file("FileName_BTS"), None
 
 
 def case_grid_wind(case: OpenFASTCase) -> tuple[linearize.GridWind | linearize.SteadyWind,
