@@ -41,3 +41,16 @@ def rosco_nrel5mw() -> tuple[np.ndarray, ...]:
     cp = np.array([ln.split() for ln in lines[12:12 + tsr.size]], float)
     ct = np.array([ln.split() for ln in lines[42:42 + tsr.size]], float)
     return pitch, tsr, cp, ct
+
+
+@pytest.fixture(scope="session")
+def rosco_utilities():
+    """ROSCO's Python readers of ``DISCON.IN`` and ``Cp_Ct_Cq.txt`` (``rosco.toolbox.utilities``),
+    a peer of ours. They import WISDEM, which the test extras leave out (about 110 packages):
+    the README's test command installs the rosco wheel without its dependencies, for its
+    compiled library and decks, so tests reading with these are skipped there and run with
+    ``pip install ".[test,rosco]"``. Each such test has a check through ROSCO's compiled
+    library or a fixed-layout parse beside it that always runs."""
+    return pytest.importorskip("rosco.toolbox.utilities",
+                               reason="ROSCO's Python toolbox needs WISDEM: "
+                                      "pip install '.[test,rosco]'")

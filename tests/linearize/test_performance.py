@@ -1,5 +1,6 @@
-"""Issue 19: ROSCO's Cp_Ct_Cq.txt layout, written and read back exactly and read by ROSCO's own
-reader (``rosco.toolbox.utilities.load_from_txt``, a peer implementation)."""
+"""ROSCO's Cp_Ct_Cq.txt layout, written and read back exactly, at ROSCO's line positions, and
+read by ROSCO's own reader (``rosco.toolbox.utilities.load_from_txt``, a peer implementation,
+where it is installed)."""
 from __future__ import annotations
 
 from pathlib import Path
@@ -20,11 +21,30 @@ from linearize import (
 ROSCO_TABLE = Path(__file__).parents[1] / "data" / "Cp_Ct_Cq.NREL5MW.txt"
 
 
-def test_rosco_table_round_trip_is_exact(tmp_path) -> None:
-    """ROSCO's file -> ours -> written -> read: the same floats, and ROSCO's reader reads ours
-    to the same arrays (its pitch in rad, ours kept in deg)."""
-    from rosco.toolbox.utilities import load_from_txt
+def test_rosco_table_round_trip_is_exact(tmp_path, rosco_nrel5mw) -> None:
+    """ROSCO's file -> ours -> written -> read: the same floats as a fixed-layout parse of
+    ROSCO's file (``rosco_nrel5mw``: vectors on lines 5 and 7, C_P and C_T blocks from lines
+    13 and 43), and our written file has that layout (the same parse reads it to the same
+    arrays)."""
+    ref = read_rotor_performance(ROSCO_TABLE)
+    pitch, tsr, cp, ct = rosco_nrel5mw
+    for mine, theirs in ((ref.pitch_deg, pitch), (ref.tsr, tsr), (ref.cp, cp), (ref.ct, ct)):
+        np.testing.assert_array_equal(mine, theirs)
+    out = write_rotor_performance(ref, tmp_path / "Cp_Ct_Cq.txt")
+    back = read_rotor_performance(out)
+    for f in ("pitch_deg", "tsr", "cp", "ct", "cq"):
+        np.testing.assert_array_equal(getattr(back, f), getattr(ref, f))
+    lines = out.read_text().splitlines()
+    np.testing.assert_array_equal(np.array(lines[4].split(), float), pitch)
+    np.testing.assert_array_equal(np.array(lines[6].split(), float), tsr)
+    np.testing.assert_array_equal(np.array([ln.split() for ln in lines[12:38]], float), cp)
+    np.testing.assert_array_equal(np.array([ln.split() for ln in lines[42:68]], float), ct)
 
+
+def test_rosco_table_round_trip_through_roscos_reader(tmp_path, rosco_utilities) -> None:
+    """ROSCO's own reader reads ROSCO's file as ours does, and ours to the same arrays (its
+    pitch in rad, ours kept in deg)."""
+    load_from_txt = rosco_utilities.load_from_txt
     ref = read_rotor_performance(ROSCO_TABLE)
     assert ref.cp.shape == (26, 36) and ref.wind_mps == 11.4
     pitch, tsr, cp, ct, cq = load_from_txt(str(ROSCO_TABLE))

@@ -64,11 +64,10 @@ def test_main_job_steady_part_on_iea15mw(tmp_path: Path, capsys) -> None:
     assert "rated wind speed 10.4" in capsys.readouterr().out
 
 
-def test_cp_surface_rosco_format_is_read_by_rosco(tmp_path: Path) -> None:
+def test_cp_surface_rosco_format_is_read_by_rosco(tmp_path: Path, rosco_utilities) -> None:
     """``mpcwt aero cp-surface --format rosco``: ROSCO's reader takes it; C_P max of the
     IEA-15 at shear 0.2 within 0.02 of the ROSCO table's 0.4704."""
-    from rosco.toolbox.utilities import load_from_txt
-
+    load_from_txt = rosco_utilities.load_from_txt
     out = tmp_path / "Cp_Ct_Cq.txt"
     assert main(["aero", "cp-surface", "--turbine", "iea15mw", "--format", "rosco", "--out",
                  str(out), "--tsr", "3:12:0.5", "--pitch=-2:10:1", "--shear", "0.2"]) == 0
@@ -76,6 +75,27 @@ def test_cp_surface_rosco_format_is_read_by_rosco(tmp_path: Path) -> None:
     assert cp.shape == (tsr.size, pitch.size) == (19, 13)
     assert abs(cp.max() - 0.4704) <= 0.02
     np.testing.assert_allclose(np.degrees(pitch), np.arange(-2.0, 10.5, 1.0), atol=1e-12)
+
+
+def test_cp_surface_rosco_format_has_roscos_layout(tmp_path: Path) -> None:
+    """``mpcwt aero cp-surface --format rosco`` at the line positions of ROSCO's shipped
+    NREL-5MW table (tests/data/Cp_Ct_Cq.NREL5MW.txt: pitch vector on line 5, TSR on line 7,
+    the C_P block from line 13, C_T four lines after C_P's end); C_P max of the IEA-15 at
+    shear 0.2 within 0.02 of the ROSCO table's 0.4704."""
+    out = tmp_path / "Cp_Ct_Cq.txt"
+    assert main(["aero", "cp-surface", "--turbine", "iea15mw", "--format", "rosco", "--out",
+                 str(out), "--tsr", "3:12:0.5", "--pitch=-2:10:1", "--shear", "0.2"]) == 0
+    lines = out.read_text().splitlines()
+    ref = (Path(__file__).parents[1] / "data" / "Cp_Ct_Cq.NREL5MW.txt").read_text().splitlines()
+    assert [ln.startswith("#") for ln in lines[:13]] == [ln.startswith("#") for ln in ref[:13]]
+    np.testing.assert_allclose(np.array(lines[4].split(), float), np.arange(-2.0, 10.5, 1.0))
+    np.testing.assert_allclose(np.array(lines[6].split(), float), np.arange(3.0, 12.25, 0.5))
+    cp = np.array([ln.split() for ln in lines[12:31]], float)
+    assert cp.shape == (19, 13) and abs(cp.max() - 0.4704) <= 0.02
+    assert [ln.strip() for ln in lines[31:35]] == ["", "", lines[33].strip(), ""]
+    assert "Thrust" in lines[33] and "Thrust" in ref[40]
+    ct = np.array([ln.split() for ln in lines[35:54]], float)
+    assert ct.shape == (19, 13) and 0.0 < ct.max() < 1.5
 
 
 def test_cp_surface_rosco_format_needs_out(capsys: pytest.CaptureFixture[str]) -> None:

@@ -1,4 +1,4 @@
-"""Issue 20: Bladed-style controller libraries in the loop (mpc_wt.controllers.discon). The swap array
+"""Bladed-style controller libraries in the loop (mpc_wt.controllers.discon). The swap array
 against the interface's definition (records as OpenFAST's ServoDyn fills them, Bladed User
 Manual appendix A) with a probe library compiled here, ROSCO's own library on our plant, and
 bad input."""
@@ -198,11 +198,46 @@ def test_cli_names_a_missing_library(capsys) -> None:
     assert "/no/lib.so: file not found" in capsys.readouterr().err
 
 
-def test_exported_discon_is_complete_for_roscos_reader(turbine, tmp_path) -> None:
+def _discon_keys(path: Path) -> list[str]:
+    """The parameter names of a ``DISCON.IN``: the first word after the ``!`` of each line
+    with a value before it (ROSCO's layout: ``value ! Name - description``)."""
+    keys = []
+    for line in path.read_text().splitlines():
+        value, bang, note = line.partition("!")
+        if bang and value.strip() and note.split():
+            keys.append(note.split()[0])
+    return keys
+
+
+def test_exported_discon_is_read_by_roscos_library(turbine, tmp_path) -> None:
+    """``export(..., "rosco")`` against ROSCO's compiled reader: the parameter names are those
+    of ROSCO's shipped NREL-5MW file, ROSCO's library starts from ours and regulates (2 s,
+    steady 18 m/s, 5 MW within 1 %), and it refuses the same file with ``VS_Rgn2K`` left out
+    (naming it): its reader checks what ours writes."""
+    from mpc_wt.controllers.baseline import tune_baseline
+    from mpc_wt.io.gain_tables import baseline_table, export
+
+    discon, perf = export(baseline_table(turbine, tune_baseline(turbine)), "rosco", tmp_path)
+    assert sorted(_discon_keys(discon)) == sorted(_discon_keys(rosco_discon()))
+    res = run_controller(turbine, "rosco", Scenario(18.0, "steady", 1, 2.0),
+                         options={"discon_in": str(discon)})
+    assert res.channel("gen_power").mean() == pytest.approx(5e6, rel=0.01)
+    lines = [ln for ln in discon.read_text().splitlines()
+             if ln.partition("!")[2].split()[:1] != ["VS_Rgn2K"]]
+    bad = tmp_path / "missing.IN"
+    bad.write_text("\n".join(lines) + "\n")
+    with pytest.raises(ControllerLibraryError, match="Missing or default values are not "
+                                                     "allowed for VS_Rgn2K"):
+        run_controller(turbine, "rosco", Scenario(18.0, "steady", 1, 2.0),
+                       options={"discon_in": str(bad)})
+
+
+def test_exported_discon_is_complete_for_roscos_reader(turbine, tmp_path,
+                                                       rosco_utilities) -> None:
     """``export(..., "rosco")`` writes every parameter ROSCO 2.10 reads: the key set read by
     ROSCO's own reader (rosco.toolbox.utilities.read_DISCON) equals that of ROSCO's shipped
     NREL-5MW file, and the performance table it names is beside it, in ROSCO's layout."""
-    from rosco.toolbox.utilities import load_from_txt, read_DISCON
+    load_from_txt, read_DISCON = rosco_utilities.load_from_txt, rosco_utilities.read_DISCON
 
     from mpc_wt.controllers.baseline import tune_baseline
     from mpc_wt.io.gain_tables import baseline_table, export
