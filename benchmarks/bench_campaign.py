@@ -1,4 +1,4 @@
-"""Campaign throughput (issue 9): IEC DLC 1.2 for the baseline on this machine.
+"""Campaign throughput: IEC DLC 1.2 for the baseline on this machine.
 
 The spec is benchmarks/studies/dlc12_baseline.yaml: cut-in to cut-out (3-25 m/s) in 2 m/s
 steps, 6 seeds, 600 s after a 60 s transient, class A -- 72 cases. Runs, each into a fresh
@@ -55,7 +55,7 @@ def main() -> int:
     args = ap.parse_args()
     base = load_spec(HERE / "studies" / "dlc12_baseline.yaml").raw
     # the throughput figure is the baseline's DLC 1.2 (72 cases); the spec also runs ROSCO
-    # (issue 20) for its report
+    # for its report
     base["controllers"] = [c for c in base["controllers"] if c == "baseline"]
     if args.duration:
         base["duration"] = args.duration

@@ -4,7 +4,7 @@ Run:  python benchmarks/bench_lidar.py [--peer-python PATH] [--json]
 
 Figures (one core):
 * field_600s_s, field_peak_rss_MB: IEC Kaimal field, 32 x 32 points over 150 m, 600 s at 20 Hz,
-  class A, 18 m/s (issue 4 floor: < 10 s and < 1 GB), generated in a fresh subprocess so that
+  class A, 18 m/s (floor: < 10 s and < 1 GB), generated in a fresh subprocess so that
   the peak resident memory is that of the generation alone;
 * lidar_600s_s: CW LIDAR (41 range points, 3 beams) at 10 Hz over 600 s plus the per-blade
   preview series for every 0.1 s controller step (floor < 2 s);

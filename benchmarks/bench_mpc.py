@@ -1,4 +1,4 @@
-"""MPC solver comparison (issue 6): the QPs of one 3000-step closed-loop run at 18 m/s in class-A
+"""MPC solver comparison: the QPs of one 3000-step closed-loop run at 18 m/s in class-A
 turbulence, solved by our OSQP and DAQP backends, cvxpy with parameters, Clarabel and qpOASES
 (CasADi), with the first-move error against a tight-tolerance reference. See
 ``mpc_wt.simulation.solver_timing`` for what is timed.

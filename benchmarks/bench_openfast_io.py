@@ -1,4 +1,4 @@
-"""OpenFAST I/O speed (issue 19): deck loading, .outb/.out and .lin reading, each beside
+"""OpenFAST I/O speed: deck loading, .outb/.out and .lin reading, each beside
 openfast-io (a dependency of the rosco package) doing the same job in the same run.
 
 Run:  python benchmarks/bench_openfast_io.py [--json]

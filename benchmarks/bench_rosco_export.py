@@ -1,4 +1,4 @@
-"""Proof by running (issue 20): our designs exported as ROSCO DISCON.IN files, run through
+"""Proof by running: our designs exported as ROSCO DISCON.IN files, run through
 ROSCO's compiled library on our plant, against the same designs run by our own controllers.
 
 Run:  python benchmarks/bench_rosco_export.py [--json] [--plot FILE.png]

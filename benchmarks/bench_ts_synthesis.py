@@ -1,4 +1,4 @@
-"""Speed of the TS synthesis (issue 7): LMI controller (7 states + rotor-speed integral = 8) and
+"""Speed of the TS synthesis: LMI controller (7 states + rotor-speed integral = 8) and
 TS wind observer (7 states + wind = 8) by cvxpy, for 8 vertices (4 winds x 2 power reductions)
 and the default 18 (6 x 3), with each installed open-source SDP solver; certificate checked after
 each solve (its time included). Floor: 8 vertices, 8-state model, under 10 s.

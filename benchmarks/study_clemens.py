@@ -1,6 +1,6 @@
 """Clemens et al. on our plant: the TS controller (eq 7) with the TS wind observer (eqs 8-10),
 LMI-designed, regulating rated speed over 12-25 m/s in turbulence, tracking the sinusoidal power
-reference of eq 11 at f_r = 0.05-0.2 Hz, and estimating the rotor-effective wind (issue 7).
+reference of eq 11 at f_r = 0.05-0.2 Hz, and estimating the rotor-effective wind.
 
 Per mean wind (IEC class A, seed 1): rotor speed mean / std / max against rated, and the same
 for the PI baseline on the same wind for context; wind estimate RMS error against the disc mean

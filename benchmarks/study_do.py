@@ -1,6 +1,6 @@
 """Do et al. (2020) region III on our plant: LQR full-state feedback on PI-observer estimates
 (FSF, eqs 9-16) against the PI baseline with constant torque, 18 m/s, IEC class C (12 %), shear
-0.2, 600 s per seed, same seeds for both (issue 7).
+0.2, 600 s per seed, same seeds for both.
 
 Reports CS1 (tower-base fore-aft moment std along its ellipse axis), CS2 (electrical power),
 CS5, and the tower-base DEL (m = 4), each as the mean over seeds and the FSF change against PI,

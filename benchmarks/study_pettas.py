@@ -1,4 +1,4 @@
-"""Retrofit strategies on our plant (issue 8): Pettas and Cheng (2018) -- individual blade
+"""Retrofit strategies on our plant: Pettas and Cheng (2018) -- individual blade
 control, down-regulation to 90 % and 80 %, both combined -- and active power control of the
 baseline (Clemens et al. eq 11, figs. 3 and 8).
 

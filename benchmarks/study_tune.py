@@ -1,4 +1,4 @@
-"""Issue 22: the tuning studies (Do et al. regions III and II, Madsen's MPC) with their timing
+"""The tuning studies (Do et al. regions III and II, Madsen's MPC) with their timing
 and the papers' rows next to ours.
 
 Runs (or resumes) ``mpcwt tune`` on one of ``benchmarks/studies/tune_*.yaml``, prints the wall

@@ -32,7 +32,7 @@ def test_the_readme_is_a_front_page() -> None:
     assert not re.search(r"\b20[0-9]{2}-[01][0-9]-[0-3][0-9]\b", text), "dated history"
 
 
-@pytest.mark.parametrize("folder", ["src", "docs"])
+@pytest.mark.parametrize("folder", ["src", "docs", "tests"])
 def test_no_issue_numbers_in_code_or_docs(folder: str) -> None:
     hits = []
     for path in sorted((ROOT / folder).rglob("*")):

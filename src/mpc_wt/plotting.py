@@ -63,7 +63,9 @@ def plot_cp_surface(tsr: np.ndarray, pitch_deg: np.ndarray, cp: np.ndarray, path
     plt = pyplot()
     fig, ax = plt.subplots(figsize=(7.5, 5.0), dpi=120)
     shown = np.clip(cp, 0.0, None)
-    levels = np.linspace(0.0, max(float(shown.max()), 1e-3), 25)
+    step = 0.02 if shown.max() > 0.1 else 0.002
+    top = step * math.ceil(max(float(shown.max()), 1e-3) / step - 1e-9)
+    levels = np.linspace(0.0, top, int(round(top / step)) + 1)
     cs = ax.contourf(tsr, pitch_deg, shown, levels=levels, cmap="viridis")
     ax.contour(tsr, pitch_deg, shown, levels=[0.1, 0.2, 0.3, 0.4, 0.45], colors="w",
                linewidths=0.6)
@@ -74,7 +76,10 @@ def plot_cp_surface(tsr: np.ndarray, pitch_deg: np.ndarray, cp: np.ndarray, path
     ax.plot(lam, beta, "r*", ms=12,
             label=f"C_P max {cp_max:.3f} at lambda {lam:.2f}, pitch {beta:.1f} deg")
     bar = fig.colorbar(cs, ax=ax, label="C_P [-]")
-    bar.set_ticks(np.round(np.linspace(0.0, levels[-1], 6), 2))
+    from matplotlib.ticker import MaxNLocator
+
+    bar.set_ticks(MaxNLocator(6, steps=[1, 2, 5, 10]).tick_values(0.0, top))
+    bar.ax.set_ylim(0.0, top)
     ax.set_xlabel("tip-speed ratio lambda [-]")
     ax.set_ylabel("collective pitch [deg]")
     ax.set_title(title or "Power coefficient C_P(lambda, pitch)")
@@ -236,12 +241,16 @@ def plot_cs_ellipses(items: list[tuple[str, Any, np.ndarray, np.ndarray]], path:
                 alpha=0.25, color=f"C{k}")
         ex, ey = cs.ellipse()
         ax.plot(ex / 1e6, ey / 1e6, color=f"C{k}", lw=1.6,
-                label=f"{label}: CS1 {cs.cs1 / 1e6:.2f}, CS2 {cs.cs2 / 1e6:.3f}, "
-                      f"CS5 {cs.cs5:.1f} deg")
+                label=f"{label}: CS1 {cs.cs1 / 1e6:.2f} MN m, CS2 {cs.cs2 / 1e6:.3f} MW, "
+                      f"CS5 {cs.cs5:.2g} deg")
         ax.plot(cs.cs3 / 1e6, cs.cs4 / 1e6, "+", color=f"C{k}", ms=10)
     ax.set_xlabel(load_label)
     ax.set_ylabel("generator power [MW]")
     ax.set_title("Covariance ellipses (95 %, s = 5.99), Do et al. 2020")
+    # CS5 is the major axis's angle in the samples' own units (eq. 26): the axes here are
+    # scaled apart, so the drawn tilt is larger than that angle.
+    ax.text(0.01, 0.01, "CS5: major axis to load axis in N m and W (Do et al. eq. 26); "
+            "axes not to the same scale", transform=ax.transAxes, fontsize=7, color="0.35")
     ax.legend(fontsize=7)
     ax.grid(alpha=0.3)
     return save_figure(fig, path)
@@ -410,13 +419,13 @@ def plot_comparison(runs: Sequence[tuple[str, np.ndarray, dict[str, np.ndarray]]
             x = np.asarray(cols[ch]) * scale
             keep = t >= t0
             ax.plot(t[keep], x[keep], lw=0.8,
-                    label=f"{label}: {x.mean():.3g} +- {x.std():.2g} {unit}")
+                    label=f"{label}: {x.mean():#.3g} ± {x.std():#.2g} {unit}")
         ax.set_ylabel(f"{name} [{unit}]", fontsize=8)
         ax.legend(loc="upper right", fontsize=6.5, framealpha=0.8)
         ax.grid(alpha=0.3)
     axes[-1, 0].set_xlabel("time [s]")
     axes[-1, 0].set_xlim(t0, t_end)
-    fig.suptitle(f"last {t_end - t0:.0f} s shown; legend: mean +- std over each whole run",
+    fig.suptitle(f"last {t_end - t0:.0f} s shown; legend: mean ± std over each whole run",
                  fontsize=9)
     p = save_figure(fig, path)
     return [str(p)]

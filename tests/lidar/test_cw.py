@@ -52,7 +52,7 @@ def test_range_weighting_integrates_to_one_and_has_the_half_width() -> None:
     s, wts = lid.range_quadrature(200.0)
     assert_allclose(wts.sum(), 1.0, rtol=1e-14, atol=0)   # the whole weight counts
     # analytic: Lorentzian half-width at half maximum = lambda F^2 / (pi a^2); find the
-    # half-maximum point numerically and compare (issue 4: 1 %)
+    # half-maximum point numerically and compare (bound 1 %)
     f = lid.focus_range
     from scipy.optimize import brentq
 
@@ -61,7 +61,7 @@ def test_range_weighting_integrates_to_one_and_has_the_half_width() -> None:
 
 
 def test_idealized_preview_equals_later_blade_wind(turbulent: WindField) -> None:
-    # issue 4: point measurement, no LOS error, aligned, frozen turbulence -> the preview is the
+    # Point measurement, no LOS error, aligned, frozen turbulence -> the preview is the
     # wind the blade meets T_p later, up to interpolation (here the same trilinear sampler)
     lid = CWLidar(63.0, range_weighting=False, los_error=False)
     t = np.arange(0.0, 300.0, 0.1)
@@ -82,7 +82,7 @@ def test_realistic_lidar_loses_coherence_with_frequency(turbulent: WindField) ->
     f, g = lidar.coherence(m.u_hat[:, 0], later[:, 0], 10.0, nperseg=512)
     ideal = CWLidar(63.0, range_weighting=False, los_error=False).measure(turbulent, t, psi, OMEGA)
     _, g_ideal = lidar.coherence(ideal.u_hat[:, 0], later[:, 0], 10.0, nperseg=512)
-    # issue 4: idealized, the estimate is the later blade wind (coherence 1); with range
+    # Idealized, the estimate is the later blade wind (coherence 1); with range
     # weighting and LOS error it falls with frequency and the bandwidth (coherence 0.5) is
     # reported. The Lorentzian's sharp centre keeps part of the point's high-frequency content,
     # so the fall is gradual (about 0.7 below 0.2 Hz, 0.5 above 3 Hz at 18 m/s, class A).
@@ -104,7 +104,7 @@ def test_lag_of_peak_correlation_is_the_preview_time(turbulent: WindField) -> No
 
 
 def test_lead_angle_is_omega_tp() -> None:
-    # issue 4: about 218 deg at 18 m/s with D = 54 m and 12.1 rpm
+    # About 218 deg at 18 m/s with D = 54 m and 12.1 rpm
     lid = CWLidar(63.0)
     ang = lid.beam_azimuths(np.array([0.3]), np.array([OMEGA]), 18.0)
     lead = (ang[0] - (0.3 + 2 * math.pi * np.arange(3) / 3))
@@ -129,7 +129,7 @@ def test_preview_shape_and_times(turbulent: WindField) -> None:
 
 
 def test_ring_buffer_serves_the_true_later_blade_wind(turbulent: WindField) -> None:
-    """Issue 23: the in-loop preview from the fixed-size ring buffer, pushed one step at a
+    """The in-loop preview from the fixed-size ring buffer, pushed one step at a
     time, is the wind each blade meets T_p later (idealized LIDAR, frozen field: exact to
     1e-6 m/s once a whole T_p is measured), while the buffer never holds more than
     ceil(T_p / dt) + 3 samples (600 pushes, 33 kept)."""

@@ -1,4 +1,4 @@
-"""IEC 61400-1 ed. 3 wind conditions (issue 24): the standard's formulas at sample times,
+"""IEC 61400-1 ed. 3 wind conditions: the standard's formulas at sample times,
 hand-worked magnitudes, ROSCO's pyIECWind as a peer, bad input."""
 from __future__ import annotations
 

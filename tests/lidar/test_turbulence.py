@@ -40,14 +40,14 @@ def test_iec_sigma_and_scales() -> None:
 
 
 def test_turbulence_intensity(many: list[WindField]) -> None:
-    # issue 4: TI within 5 % of the IEC value (averaged over 24 seeds; a single 600 s record
+    # TI within 5 % of the IEC value (averaged over 24 seeds; a single 600 s record
     # scatters by about 7 %)
     ti = np.mean([f.u.std(axis=0).mean() for f in many]) / V
     assert_allclose(ti, 0.16 * (0.75 * V + 5.6) / V, rtol=0.05, atol=0)
 
 
 def test_kaimal_spectrum(many: list[WindField]) -> None:
-    # issue 4: the u spectrum follows Kaimal within 10 % over 0.01-1 Hz (averaged over 24 seeds
+    # The u spectrum follows Kaimal within 10 % over 0.01-1 Hz (averaged over 24 seeds
     # and 9 points, in eight logarithmic bands)
     sig, lk = TurbulenceSpec(V, "A").sigma[0], TurbulenceSpec(V, "A").length_scales[0]
     acc = 0.0
@@ -65,7 +65,7 @@ def test_kaimal_spectrum(many: list[WindField]) -> None:
 
 @pytest.mark.parametrize("sep", [1, 2])
 def test_two_point_coherence(seeds: list[WindField], sep: int) -> None:
-    # issue 4: the coherence between two points follows the IEC model within 0.05 (co-coherence
+    # The coherence between two points follows the IEC model within 0.05 (co-coherence
     # of all horizontal pairs at 10 and 20 m, averaged in frequency bands 0.03-0.5 Hz)
     r = 10.0 * sep
     s11 = s22 = s12 = 0.0
@@ -85,7 +85,7 @@ def test_two_point_coherence(seeds: list[WindField], sep: int) -> None:
 
 
 def test_shear_exponent_recovered(seeds: list[WindField]) -> None:
-    # the mean in double precision: the field is stored as float32 (issue 23), whose own
+    # the mean in double precision: the field is stored as float32, whose own
     # summation would add 1e-6 of rounding
     mean = np.mean([f.u.mean(axis=(0, 1), dtype=np.float64) for f in seeds], axis=0)
     alpha = np.polyfit(np.log(seeds[0].z / 90.0), np.log(mean), 1)[0]
@@ -94,7 +94,7 @@ def test_shear_exponent_recovered(seeds: list[WindField]) -> None:
 
 
 def test_circulant_sampler_matches_the_cholesky_reference() -> None:
-    # issue 4: the fast sampler against the exact Cholesky form. The circulant embedding's
+    # The fast sampler against the exact Cholesky form. The circulant embedding's
     # linear map A (xi -> coefficients) must give the covariance 2 A A^H = L L^T of the
     # reference's Cholesky factor L at every frequency (float32 roots: 1e-6)
     from lidar.turbulence import _cholesky_factor, _distances
@@ -218,7 +218,7 @@ def test_evolution_decorrelates_with_distance(small: WindField) -> None:
     assert_allclose(near.u, small.u, rtol=0, atol=1e-9)      # d = 0: frozen
     assert np.corrcoef(u0, far.u[:, 4, 4])[0, 1] < 0.9
     # the mean of every point kept to the float32 storage's resolution (one ulp at 17 m/s is
-    # 1.9e-6; issue 23 stores fields in single precision; the means in double)
+    # 1.9e-6; fields are stored in single precision; the means in double)
     assert_allclose(far.u.mean(axis=0, dtype=np.float64), small.u.mean(axis=0, dtype=np.float64),
                     rtol=0, atol=2e-6)
     with pytest.raises(ValueError, match="distance must be finite and >= 0"):
@@ -366,7 +366,7 @@ def test_generated_evolved_field_is_the_evolved_generated_field(keep: bool) -> N
 
 
 def test_evolved_fields_peak_at_their_own_size() -> None:
-    """Issue 23 (memory): the upstream field is written over its own spectra, so making it
+    """The upstream field is written over its own spectra, so making it
     allocates (tracemalloc's peak, numpy's buffers included) at most 1.3 times the field
     itself: no second field, no independent field, no spectra beside the series. The same
     for evolving a given field (beyond the given one). Measured: 1.14 and 1.26. The code

@@ -78,7 +78,7 @@ def test_cp_matches_ccblade_table_with_ccblade_options(turbine: linearize.Turbin
     # peaks at about 0.466 at tip-speed ratio 7.5 with precone 2.5 deg, tilt 5 deg and shear
     # exponent 0.2 (the CCBlade NREL 5-MW setup). Matched model options: trapezoidal spanwise
     # integration with zero load at hub and tip (CCBlade), cone, tilt, shear 0.2.
-    # Issue 2 tolerance: 0.01 in C_P, 0.3 in tip-speed ratio.
+    # Tolerance: 0.01 in C_P, 0.3 in tip-speed ratio.
     lam, cp = optimal_tsr(turbine, 0.0, AeroOptions(), shear_exponent=0.2,
                           integration="trapezoid")
     assert abs(cp - 0.466) <= 0.01, cp

@@ -51,7 +51,7 @@ def _output_scales(z0: np.ndarray) -> np.ndarray:
 def test_finite_differences_match_complex_step(turbine: linearize.Turbine,
                                                params: linearize.PlantParams, wind: float,
                                                wake: str) -> None:
-    """Issue 3: every Jacobian entry agrees with an independent derivative (complex step
+    """Every Jacobian entry agrees with an independent derivative (complex step
     through the same kernels, the implicit BEM solve differentiated by the implicit-function
     theorem) to 1e-4 relative or 1e-8 absolute, whichever is looser.
 
@@ -113,7 +113,7 @@ def test_frozen_wake_pitch_sensitivity_matches_report(turbine: linearize.Turbine
     # published: Jonkman et al. (2009) sec. 7.4: dP/dtheta = -25.52e6 W/rad extrapolated to
     # zero pitch, growing linearly with pitch, doubling at theta_K = 6.302336 deg (the
     # baseline's gain-scheduling corner, DISCON PC_KK), from FAST linearizations with frozen
-    # wake. Issue 3: within 15 % over 12-25 m/s.
+    # wake. Bound: within 15 % over 12-25 m/s.
     fam = linearize_family(turbine, np.arange(12.0, 25.5, 1.0), wake="frozen", params=params)
     for m in fam.models:
         pub = -25.52e6 * (1.0 + m.info["pitch_deg"] / 6.302336)
@@ -144,7 +144,7 @@ def test_tower_fore_aft_frequency_from_eig(turbine: linearize.Turbine,
                                            params: linearize.PlantParams) -> None:
     # published: Jonkman et al. (2009) Table 9-1: 1st tower fore-aft 0.3240 Hz (FAST, parked,
     # report value not re-read). Operating at 18 m/s adds aerodynamic stiffness and damping;
-    # issue 3: within 5 %.
+    # Within 5 %.
     m = lin(turbine, 18.0, params=params)
     fa = [md for md in m.modes() if md["name"] == "tower fore-aft"]
     assert len(fa) == 1
@@ -171,7 +171,7 @@ def test_drivetrain_frequency_is_the_two_mass_value(turbine: linearize.Turbine,
 
 def test_drivetrain_frequency_matches_fast(turbine: linearize.Turbine,
                                            params: linearize.PlantParams) -> None:
-    """Issue 18: Jonkman et al. (2009) Table 9-1, 1st drivetrain torsion 0.6205 Hz (FAST),
+    """Jonkman et al. (2009) Table 9-1, 1st drivetrain torsion 0.6205 Hz (FAST),
     computed with the generator locked (RotSpeed = 0, GenDOF = False; J. Jonkman, NREL forum
     "Full-System natural frequencies"): the shaft twisting against the rotor's collective edge
     bending. From eig(A) of the full linear model with the generator-speed state removed
@@ -206,7 +206,7 @@ _STEP_CASES = [(v, kind) for v in (8.0, 12.0, 18.0, 25.0) for kind in ("pitch", 
 def _step_case(turbine: linearize.Turbine, p: linearize.PlantParams, cfg: PlantConfig,
                v: float, kind: str) -> dict[str, float]:
     """Worst error over 20 s of the discretized MBC model, as a fraction of the nonlinear
-    response's peak deviation, for the four outputs of issue 3."""
+    response's peak deviation, for the four outputs compared."""
     dt, dur = 1.0 / 80.0, 20.0
     op = linearize.trim(turbine, v, params=p)
     m = lin(turbine, v, config=cfg, disturbance="rotor", coordinates="mbc", params=p,
@@ -247,7 +247,7 @@ def _step_case(turbine: linearize.Turbine, p: linearize.PlantParams, cfg: PlantC
 def test_linear_model_predicts_nonlinear_steps(turbine: linearize.Turbine, wind: float,
                                                kind: str, cfg_axisym: PlantConfig,
                                                params_ax: linearize.PlantParams) -> None:
-    """Issue 3: 0.5 deg collective pitch, 0.5 m/s wind, 1 % torque steps at 8, 12, 18, 25 m/s:
+    """0.5 deg collective pitch, 0.5 m/s wind, 1 % torque steps at 8, 12, 18, 25 m/s:
     generator speed, electrical power, tower deflection and blade flap moment of the discretized
     model within 5 % of the nonlinear response's peak deviation over 20 s. The rotor is
     periodic in azimuth through the tower's motion (nodding reaches each blade as cos psi_i), so
@@ -468,7 +468,7 @@ def test_nan_jacobian_is_reported(turbine: linearize.Turbine, params: linearize.
 
 
 # --------------------------------------------------------------------------------------------
-# Frozen wake as FAST/OpenFAST define it (issue 18): the induced velocities are held
+# Frozen wake as FAST/OpenFAST define it: the induced velocities are held
 # --------------------------------------------------------------------------------------------
 def _frozen_rotor_loads(turbine, ua, ut, pitch_rad):
     """Thrust and torque of three equal blades from the element equations written out here:
@@ -492,7 +492,7 @@ def test_frozen_wake_holds_the_induced_velocities(turbine: linearize.Turbine, wi
                                                   ) -> None:
     """dT/dV, dQ/dV and dT/dOmega of the frozen-wake model against central differences of the
     element equations with the trim's induced velocities held (computed in this test; no tilt,
-    cone or gravity, so V_x = V and V_y = Omega r). Before issue 18 the factors (1 - a),
+    cone or gravity, so V_x = V and V_y = Omega r). Before the fix the factors (1 - a),
     (1 + a') were held and dT/dV, dQ/dV came out 27-88 % off. Tolerance 2 %: the kernel
     interpolates a resampled polar table, this test the published polar points (measured
     0.75 % at most)."""
@@ -549,7 +549,7 @@ def test_quasi_steady_derivatives_follow_rosco_table_slopes(turbine: linearize.T
 
 
 def test_operating_point_outputs_use_the_trims_inflow(turbine: linearize.Turbine) -> None:
-    """Issue 18: z0 was evaluated with uniform hub-height wind at azimuth 0; with shear 0.2 at
+    """Z0 was evaluated with uniform hub-height wind at azimuth 0; with shear 0.2 at
     18 m/s its aerodynamic torque was 2.9 % and its thrust 3.6 % off the trim's. Now the
     sheared inflow averaged over a revolution: equal to the trim's to the averaging's
     aliasing (1e-5)."""
@@ -562,7 +562,7 @@ def test_operating_point_outputs_use_the_trims_inflow(turbine: linearize.Turbine
 
 
 def test_rigid_drivetrain_has_no_generator_speed_state(turbine: linearize.Turbine) -> None:
-    """Issue 18: with a rigid shaft the generator turns at N = 97 times the rotor, so
+    """With a rigid shaft the generator turns at N = 97 times the rotor, so
     gen_speed was a redundant state (an exact zero, uncontrollable eigenvalue). Now it is not
     a state; the outputs act through the rotor speed: gen_speed = 97 omega_r and, at 18 m/s in
     region 3, d(gen_power)/d(omega_r) = eta T_g N = 0.944 x 43,093.55 N m x 97 (published

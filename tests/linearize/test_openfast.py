@@ -1,4 +1,4 @@
-"""Issue 19: OpenFAST decks as turbines, checked against openfast-io (a peer reader), the
+"""OpenFAST decks as turbines, checked against openfast-io (a peer reader), the
 packaged NREL 5-MW, each deck's ROSCO performance table and the turbines' published schedules
 (``shared/validation/iea15mw/README.md`` gives the sources and the suggested tolerances)."""
 from __future__ import annotations
@@ -41,18 +41,17 @@ def _of_reader(fst: Path):  # openfast-io's reader of the same deck
     r.read_ElastoDyn(os.path.join(r.FAST_directory, r.fst_vt["Fst"]["EDFile"]))
     r.read_AeroDyn()
     r.read_ServoDyn()
-    r.read_DISCON_in()
     return r.fst_vt
 
 
 @pytest.mark.parametrize("key", ["nrel5mw", "iea15mw"])
 def test_deck_values_equal_openfast_io(decks, key) -> None:
     """Our line parser against openfast-io's reader, value by value: geometry (with our sign
-    conventions), masses, drivetrain, efficiencies, DISCON limits, the AeroDyn blade nodes and
-    every airfoil table. Exact equality: both parse the same decimal text."""
+    conventions), masses, drivetrain, efficiencies, the AeroDyn blade nodes and every airfoil
+    table. Exact equality: both parse the same decimal text."""
     t = decks[key]
     v = _of_reader(CASES / DECKS[key][0])
-    ed, dis = v["ElastoDyn"], v["DISCON_in"]
+    ed = v["ElastoDyn"]
     g = t.geometry
     assert g.tip_radius == ed["TipRad"] and g.hub_radius == ed["HubRad"]
     assert math.degrees(g.precone_rad) == pytest.approx(-ed["PreCone(1)"], rel=1e-15)
@@ -65,11 +64,6 @@ def test_deck_values_equal_openfast_io(decks, key) -> None:
     assert (d.gearbox_ratio, d.generator_inertia, d.shaft_stiffness, d.shaft_damping) == (
         ed["GBRatio"], ed["GenIner"], ed["DTTorSpr"], ed["DTTorDmp"])
     assert d.generator_efficiency == pytest.approx(v["ServoDyn"]["GenEff"] / 100, rel=1e-15)
-    assert t.operation.rated_power == dis["VS_RtPwr"]
-    assert t.operation.rated_rotor_speed_rad_s == pytest.approx(dis["PC_RefSpd"] / ed["GBRatio"],
-                                                                rel=1e-15)
-    assert t.generator.max_torque == dis["VS_MaxTq"]
-    assert t.pitch_actuator.max_rate_rad_s == dis["PC_MaxRat"]
     bl = v["AeroDynBlade"]
     bl = bl[0] if isinstance(bl, list) else bl
     r = g.hub_radius + np.asarray(bl["BlSpn"], dtype=float)
@@ -86,6 +80,32 @@ def test_deck_values_equal_openfast_io(decks, key) -> None:
                                    rtol=1e-14, atol=1e-12)
         np.testing.assert_array_equal(polar.cl, np.asarray(tab["Cl"], float))
         np.testing.assert_array_equal(polar.cd, np.asarray(tab["Cd"], float))
+
+
+@pytest.mark.parametrize("key", ["nrel5mw", "iea15mw"])
+def test_deck_discon_limits_equal_roscos_reader(decks, key, rosco_utilities) -> None:
+    """The DISCON limits as ROSCO's own reader reads them from the deck's ``DISCON.IN``."""
+    t = decks[key]
+    fst = CASES / DECKS[key][0]
+    v = _of_reader(fst)
+    dis = rosco_utilities.read_DISCON(str(fst.parent / v["ServoDyn"]["DLL_InFile"]))
+    assert t.operation.rated_power == dis["VS_RtPwr"]
+    assert t.operation.rated_rotor_speed_rad_s == pytest.approx(
+        dis["PC_RefSpd"] / v["ElastoDyn"]["GBRatio"], rel=1e-15)
+    assert t.generator.max_torque == dis["VS_MaxTq"]
+    assert t.pitch_actuator.max_rate_rad_s == dis["PC_MaxRat"]
+
+
+def test_deck_discon_limits_equal_the_published_nrel5mw(decks) -> None:
+    """The NREL 5-MW deck's DISCON limits against NREL/TP-500-38060 (table 1-1 and sec. 7):
+    rated power 5 MW, rated generator speed 1173.7 rpm (rotor 12.1 rpm; the deck's
+    PC_RefSpd 122.9096 rad/s), maximum generator torque 47,402.91 N m (the deck's 47402.9). Its
+    pitch-rate limit, 0.1745 rad/s (10 deg/s), is ROSCO's choice, not the report's 8 deg/s."""
+    t = decks["nrel5mw"]
+    assert t.operation.rated_power == 5e6
+    gen_rpm = t.operation.rated_rotor_speed_rad_s * t.drivetrain.gearbox_ratio * 30 / math.pi
+    assert gen_rpm == pytest.approx(1173.7, abs=0.05)
+    assert t.generator.max_torque == pytest.approx(47402.91, abs=0.05)   # deck: 47402.9
 
 
 def test_deck_report_names_files_keys_and_defaults(decks) -> None:

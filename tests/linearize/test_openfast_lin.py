@@ -1,4 +1,4 @@
-"""Issue 19: OpenFAST .lin files as LinearModels. The parser against openfast-io's
+"""OpenFAST .lin files as LinearModels. The parser against openfast-io's
 FASTLinearizationFile (a peer), the MBC3 of a set against our own MBC transform (our plant
 written in the .lin layout at 8 azimuths), the MBC3 of a public OpenFAST set (the IEA-15
 UMaineSemi linearizations in the rosco wheel) against OpenFAST's own collective-pitch input,

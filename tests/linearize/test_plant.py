@@ -34,7 +34,7 @@ PUBLISHED_HZ = {"tower_fa": 0.3240, "tower_ss": 0.3120, "flap_collective": 0.699
 
 @pytest.mark.parametrize("mode, rtol", [
     # tower: one assumed mode, rotor-nacelle as rigid bodies above the top; side-side lacks the
-    # drivetrain-tower coupling FAST has, hence 5 % (issue 2 floor)
+    # drivetrain-tower coupling FAST has, hence 5 % (the bound asked)
     ("tower_fa", 0.05), ("tower_ss", 0.05),
     # flap: one assumed mode per blade, no edge/torsion coupling: 3 %
     ("flap_collective", 0.03), ("flap_asymmetric", 0.03)])
@@ -49,7 +49,7 @@ def test_first_mode_frequencies_match_fast(params: linearize.PlantParams, mode: 
 # parked rotor with the generator locked (RotSpeed = 0, GenDOF = False), J. Jonkman on the NREL
 # forum, "Full-System natural frequencies" (forums.nrel.gov/t/full-system-natural-frequencies/1462).
 def test_edge_and_locked_drivetrain_modes_match_fast(params: linearize.PlantParams) -> None:
-    """Issue 18: the edge mode shape and EdgStff we ship give the edgewise modes, and with the
+    """The edge mode shape and EdgStff we ship give the edgewise modes, and with the
     blades' edge flexibility the locked-generator drivetrain mode is FAST's 0.6205 Hz; with
     rigid blades it is 0.756 Hz (22 % high), which is why the plant needs the edge DOF.
     Tolerance 5 % (the issue's); measured 1.5 % / 0.55 % (edge) and 1.8 % (drivetrain)."""
@@ -113,7 +113,7 @@ def _rel_drift(res: linearize.SimulationResult, x0: np.ndarray) -> float:
 @pytest.mark.parametrize("wind", [8.0, 18.0])
 def test_600s_at_trim_stays_at_trim(turbine: linearize.Turbine,
                                     params_axisym: linearize.PlantParams, wind: float) -> None:
-    # issue 2: uniform constant wind, trim inputs, azimuth-dependent effects off ->
+    # Uniform constant wind, trim inputs, azimuth-dependent effects off ->
     # relative drift < 1e-6 over 600 s at 80 Hz
     op = trim(turbine, wind, config=params_axisym.config)
     res = rk4_simulate(params_axisym, op.x, op.u, SteadyWind(wind), 600.0)
@@ -123,7 +123,7 @@ def test_600s_at_trim_stays_at_trim(turbine: linearize.Turbine,
 
 def test_with_azimuth_effects_settles_to_1p_periodic_motion(turbine: linearize.Turbine,
                                                             params: linearize.PlantParams) -> None:
-    # issue 2: with tilt, cone, gravity and shear on, the states settle to a 1P-periodic motion
+    # With tilt, cone, gravity and shear on, the states settle to a 1P-periodic motion
     # about the trim point. Check: over the last rotor revolution every state repeats the one
     # before to 1e-3 of its oscillation amplitude, and the mean is the trimmed (azimuth-averaged)
     # equilibrium to 1 % (the nonlinear mean of a periodic response differs from the

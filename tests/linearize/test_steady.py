@@ -1,4 +1,4 @@
-"""Steady rotor coefficients over the whole pitch range asked for (issue 17, defect 1).
+"""Steady rotor coefficients over the whole pitch range asked for.
 
 Aerodynamic tables must cover the pitch asked for: the actuator's minimum (0 deg for the
 NREL 5-MW) belongs to the plant and the controllers, not to C_P(lambda, beta). Checked against
@@ -104,7 +104,7 @@ def _ccblade_setup(turbine: linearize.Turbine) -> linearize.Turbine:
 
 
 def test_cp_ct_surface_reproduces_rosco_table(turbine, rosco_nrel5mw) -> None:
-    """Issue 18: the whole C_P and C_T surface against ROSCO's table (CCBlade) over the
+    """The whole C_P and C_T surface against ROSCO's table (CCBlade) over the
     range its README sets, TSR 3-12, pitch -2..20 deg where C_P > 0, with CCBlade's
     discretization and polar smoothing (``_ccblade_setup``) and its options (trapezoid,
     precone, tilt, shear 0.2). README tolerance |dC_P| <= 0.01, |dC_T| <= 0.02; asserted
@@ -131,7 +131,7 @@ def test_cp_ct_surface_reproduces_rosco_table(turbine, rosco_nrel5mw) -> None:
 
 
 def test_cp_ct_whole_grid_rms_and_max(turbine, rosco_nrel5mw) -> None:
-    """Issue 18: RMS and maximum difference over the issue's whole grid, TSR 2-12 and pitch
+    """RMS and maximum difference over the issue's whole grid, TSR 2-12 and pitch
     -2..25 deg (588 points, C_P down to -5), CCBlade's discretization and polars as above.
 
     Tolerances: RMS 0.005 in C_P and 0.003 in C_T (measured 0.0030 and 0.0014); pointwise

@@ -14,13 +14,13 @@ from linearize import TrimError, operating_schedule, rated_wind_speed, trim
 
 
 def test_rated_wind_speed(turbine: linearize.Turbine) -> None:
-    # published: Jonkman et al. (2009) Table 1-1: rated wind speed 11.4 m/s; issue 2: +-0.3
+    # published: Jonkman et al. (2009) Table 1-1: rated wind speed 11.4 m/s; bound +-0.3
     assert abs(rated_wind_speed(turbine) - 11.4) <= 0.3
 
 
 # published: Jonkman et al. (2009) Table 7-2, steady region-3 pitch of the baseline controller
 # (FAST, frozen wake): 14 m/s 8.70 deg, 18 m/s 14.92 deg, 25 m/s 23.47 deg (report values as
-# recalled, not re-read). Issue 2: within +-1 deg.
+# recalled, not re-read). Bound: within +-1 deg.
 @pytest.mark.parametrize("wind, pitch_deg", [(14.0, 8.70), (18.0, 14.92), (25.0, 23.47)])
 def test_region3_pitch_schedule(turbine: linearize.Turbine, wind: float, pitch_deg: float) -> None:
     op = trim(turbine, wind)
@@ -35,7 +35,7 @@ def test_thrust_at_rated(turbine: linearize.Turbine) -> None:
     # 11.4 m/s (rated). That column is OpenFAST's low-speed-shaft axial force, which carries the
     # rotor weight along the 5 deg tilted shaft: 109,389.842 kg (ED.sum) * 9.80665 * sin 5 deg
     # = 93.5 kN (check: at 3 m/s the table's 171.7 kN minus 93.5 kN is 78.2 kN; ours 76.6 kN).
-    # Issue 2: within 5 %.
+    # Within 5 %.
     published = 805.112e3 - 109389.842 * 9.80665 * math.sin(math.radians(5.0))
     op = trim(turbine, rated_wind_speed(turbine))
     assert_allclose(op.thrust, published, rtol=0.05, atol=0)
@@ -54,7 +54,7 @@ def test_trim_is_an_equilibrium(turbine: linearize.Turbine,
 def test_sheared_trim_holds_each_blade_over_a_revolution(turbine: linearize.Turbine,
                                                          params: linearize.PlantParams,
                                                          wind: float) -> None:
-    """Issue 18: in sheared wind every blade sees the same wind over a revolution, so its mean
+    """In sheared wind every blade sees the same wind over a revolution, so its mean
     flap acceleration over a revolution is zero and the three trim deflections are equal.
 
     Independent check: the plant's right-hand side sampled at 72 azimuths over the full

@@ -80,8 +80,12 @@ def test_cp_surface_labels_the_computed_optimum(figures, turbine, tmp_path) -> N
     _check(fig)
     legend = fig.axes[0].get_legend().get_texts()[0].get_text()
     assert f"{cp_max:.3f}" in legend and f"lambda {lam:.2f}" in legend
-    ticks = fig.axes[-1].get_yticks()
-    assert all(abs(t * 100 - round(t * 100)) < 1e-9 for t in ticks)   # two decimals at most
+    bar = fig.axes[-1]
+    lo, hi = bar.get_ylim()
+    assert lo == 0.0 and cp_max <= hi <= cp_max + 0.02      # the scale ends at the surface's top
+    ticks = [t for t in bar.get_yticks() if lo <= t <= hi]
+    assert len(ticks) >= 4
+    assert all(abs(t * 20 - round(t * 20)) < 1e-9 for t in ticks)     # round steps of 0.05
     assert math.isfinite(cp_max)
 
 
@@ -100,3 +104,27 @@ def test_comparison_shows_power_and_a_readable_window(figures, tmp_path) -> None
     lo, hi = axes[-1].get_xlim()
     assert hi - lo < 130.0
     assert "MW" in axes[0].get_legend().get_texts()[0].get_text()
+
+
+def test_cs_ellipses_show_the_measures_with_units(figures, tmp_path) -> None:
+    """Worked by hand: samples whose covariance is [[5, 2], [2, 2]] x 1e12 (N m, W) have
+    eigenvalues 6 and 1 x 1e12 and major axis (2, 1): CS1 = sqrt(6) MN m = 2.45 MN m,
+    CS2 = 1 MW, CS5 = atan(1/2) = 26.57 deg (Do et al. eqs 21, 25, 26); the legend gives
+    each with its unit."""
+    from mpc_wt.assessment.performance import cs_measures
+
+    n = 4000
+    ph = 2 * np.pi * np.arange(n) / n
+    u, v = np.sqrt(2) * np.sin(ph), np.sqrt(2) * np.cos(ph)   # mean 0, variance 1, uncorrelated
+    load = 1e6 * np.sqrt(5) * u + 4e7
+    power = 1e6 * (2 / np.sqrt(5) * u + np.sqrt(1.2) * v) + 5e6
+    cs = cs_measures(load, power)
+    k = n / (n - 1)                                           # eq. 22 divides by N - 1
+    assert cs.cs1 == pytest.approx(np.sqrt(6e12 * k), rel=1e-9)
+    assert cs.cs2 == pytest.approx(np.sqrt(1e12 * k), rel=1e-9)
+    assert cs.cs5 == pytest.approx(math.degrees(math.atan(0.5)), abs=1e-9)
+    plotting.plot_cs_ellipses([("run", cs, load, power)], tmp_path / "cs.png")
+    fig = figures[-1]
+    _check(fig)
+    text = fig.axes[0].get_legend().get_texts()[0].get_text()
+    assert text == "run: CS1 2.45 MN m, CS2 1.000 MW, CS5 27 deg"

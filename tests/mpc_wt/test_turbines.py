@@ -1,4 +1,4 @@
-"""Issue 19: the other turbines everywhere a turbine is taken: the IEA-15-240-RWT in the main job
+"""The other turbines everywhere a turbine is taken: the IEA-15-240-RWT in the main job
 and a closed loop, OpenFAST decks on the command line, ROSCO tables written by the CLI."""
 from __future__ import annotations
 

@@ -141,7 +141,7 @@ def test_miner_and_lifetime_extension() -> None:
 
 
 def test_cs_measures_match_the_analytic_eigen_decomposition() -> None:
-    # issue 5: correlated Gaussian samples with a known covariance; the samples are whitened
+    # Correlated Gaussian samples with a known covariance; the samples are whitened
     # and recoloured so that their sample covariance is exactly C, then CS1, CS2 and the angle
     # must equal the eigen-decomposition of C to 1e-6
     c = np.array([[4.0e12, 1.5e11], [1.5e11, 2.5e10]])          # load [N m]^2, power [W]^2

@@ -1,4 +1,4 @@
-"""Ultimate-load bookkeeping (issue 24) on synthetic series worked by hand."""
+"""Ultimate-load bookkeeping on synthetic series worked by hand."""
 from __future__ import annotations
 
 import numpy as np

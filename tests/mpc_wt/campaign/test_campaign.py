@@ -270,7 +270,7 @@ def test_report_tables_and_plots(tmp_path):
     assert lss["derate80"]["change_pct"] < 0
     aep = {r["controller"]: r for r in agg["aep"]}
     assert aep["derate80"]["change_pct"] < -3
-    # regulation (issue 21): the rotor-speed std of each case from its own result file,
+    # regulation: the rotor-speed std of each case from its own result file,
     # averaged over seeds and weighted over the two winds as the report says
     from mpc_wt.simulation.results import ClosedLoopResult
     reg = {r["controller"]: r for r in agg["regulation"]}
@@ -291,7 +291,7 @@ def test_report_tables_and_plots(tmp_path):
     for f in ("lifetime_del.csv", "short_term_del.csv", "aep.csv", "del_vs_wind.png",
               "lifetime_del.png", "cs_ellipses.png", "psd.png", "ultimate.csv"):
         assert (Path(rep).parent / f).is_file(), f
-    # ultimate loads (issue 24): the campaign's largest shaft torque and its case, found here
+    # ultimate loads: the campaign's largest shaft torque and its case, found here
     # from the result files themselves; the characteristic value is the larger of the two
     # winds' seed means of the maxima; the design value 1.35 x that
     assert "## Ultimate loads" in text
@@ -385,7 +385,7 @@ def test_aggregate_flags_a_seed_far_above_its_bin_and_weights_lifetime(tmp_path)
 
 
 def test_clemens_convention_weights_bins_by_counted_cycles(tmp_path):
-    """Issue 17, defect 4: with ``del_convention: clemens`` the per-case DEL is an amplitude
+    """A past defect: with ``del_convention: clemens`` the per-case DEL is an amplitude
     over the counted cycles (eq 17) and the lifetime DEL weights each bin by its counted cycles
     (eq 18). Independent check: eq 18 equals the DEL of all bins' cycles pooled with the wind
     probabilities, computed here from the stored series' rainflow cycles."""

@@ -1,5 +1,5 @@
 """Design load cases in campaigns, ultimate loads per DLC, statistical extrapolation and the
-sign-off report (issue 24)."""
+sign-off report."""
 from __future__ import annotations
 
 import math

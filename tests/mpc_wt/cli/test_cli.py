@@ -43,7 +43,7 @@ def test_cp_surface_csv_and_plot(tmp_path: Path, capsys: pytest.CaptureFixture[s
 
 
 def test_run_writes_table_and_plots(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
-    """The main job (issue 21): steady outputs, the linear models, the baseline's gain tables
+    """The main job: steady outputs, the linear models, the baseline's gain tables
     (CSV, JSON, ROSCO), and baseline, baseline + LIDAR feedforward and MPC with LIDAR preview
     on one field, compared in one table (the MPC's QP times in it) and plots."""
     assert main(["run", "--out", str(tmp_path), "--duration", "30"]) == 0
@@ -180,7 +180,7 @@ def test_assess_csv_from_another_tool(tmp_path: Path, capsys: pytest.CaptureFixt
     d = json.loads(capsys.readouterr().out)[0]["channels"]["flap_moment_1"]
     # analytic: 50 cycles of range 2e6 over 100 s, N_eq = 100: DEL = 2e6 (0.5)^(1/4)
     assert d["del"] == pytest.approx(2e6 * 0.5 ** 0.25, rel=0.01)
-    # issue 19: an OpenFAST name without a unit is taken in OpenFAST's (kN-m)
+    # An OpenFAST name without a unit is taken in OpenFAST's (kN-m)
     p.write_text("Time,RootMyc1\n" + "\n".join(f"{a},{b}" for a, b in zip(t, x)))
     assert main(["assess", str(p), "--channels", "flap_moment_1", "--m", "4", "--json"]) == 0
     d = json.loads(capsys.readouterr().out)[0]["channels"]["flap_moment_1"]
@@ -321,7 +321,7 @@ def test_design_ibc_and_export(tmp_path: Path, capsys: pytest.CaptureFixture[str
 
 def test_cp_surface_has_distinct_rows_below_zero_pitch(tmp_path: Path,
                                                       capsys: pytest.CaptureFixture[str]) -> None:
-    """Issue 17, defect 1: the rows below the actuator's 0 deg were copies of the 0 deg row."""
+    """A past defect: the rows below the actuator's 0 deg were copies of the 0 deg row."""
     out = tmp_path / "cp.csv"
     assert main(["aero", "cp-surface", "--pitch=-4:20:1", "--tsr", "6:10:1", "--out",
                  str(out)]) == 0
@@ -337,8 +337,8 @@ def test_cp_surface_has_distinct_rows_below_zero_pitch(tmp_path: Path,
 
 def test_assess_csv_without_known_channels_names_what_it_found(
         tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
-    """Issue 17, defect 6: exit 0 with an empty assessment before; now exit 2 naming the
-    columns found and the channels expected, and --channels takes any numeric column. Issue 19:
+    """A past defect: exit 0 with an empty assessment before; now exit 2 naming the
+    columns found and the channels expected, and --channels takes any numeric column.
     OpenFAST names are channels we know (TwrBsMyt -> tower_base_fa_moment, kN-m -> N m)."""
     p = tmp_path / "field.csv"
     t = np.arange(0, 50, 0.1)
@@ -372,7 +372,7 @@ def test_linearize_at_a_given_operating_point(capsys: pytest.CaptureFixture[str]
 
 
 def test_wind_generate_iec_condition(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
-    """Issue 24: ``mpcwt wind generate --condition eog --mean 13`` writes the deterministic
+    """``mpcwt wind generate --condition eog --mean 13`` writes the deterministic
     field and its plot; the EOG magnitude printed is eq 16's (class I A, z_hub 90 m, D 126 m:
     3.3 * 0.16 (0.75 * 13 + 5.6) / 1.3 = 6.2345 m/s); the field loads back with the gust."""
     import lidar
@@ -398,7 +398,7 @@ def test_wind_generate_iec_condition(tmp_path: Path, capsys: pytest.CaptureFixtu
 
 def test_simulate_iec_event_with_supervisor(tmp_path: Path,
                                             capsys: pytest.CaptureFixture[str]) -> None:
-    """Issue 24: ``mpcwt simulate --condition eog --grid-loss-at`` runs a gust with a grid loss
+    """``mpcwt simulate --condition eog --grid-loss-at`` runs a gust with a grid loss
     under the supervisor: the result records the condition, the trip (state 3, grid loss) at
     the first controller step from 40 s, and zero generator torque after it."""
     from mpc_wt.simulation.results import ClosedLoopResult

@@ -108,3 +108,17 @@ def test_main_job_warns_of_designs_a_user_should_not_take() -> None:
     assert "mpc-lidar makes 2.0 % less mean power" in lines[1]
     assert "tuned lets the rotor fall to 6.50 rpm, below its minimum 6.90 rpm" in lines[2]
     assert design_warnings(rows[:1], 6.9) == []
+
+
+def test_version_names_the_version_in_pyproject(capsys) -> None:
+    """``mpcwt --version`` prints the version that pyproject.toml declares (what pip installed)
+    and exits 0."""
+    import re
+    from pathlib import Path
+
+    text = (Path(__file__).parents[3] / "pyproject.toml").read_text()
+    declared = re.search(r'^version = "([^"]+)"', text, flags=re.M).group(1)
+    with pytest.raises(SystemExit) as stop:
+        main(["--version"])
+    assert stop.value.code == 0
+    assert capsys.readouterr().out.strip() == f"mpcwt (mpc-wt) {declared}"

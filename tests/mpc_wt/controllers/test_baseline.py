@@ -22,7 +22,7 @@ def _field(v: float, turb, seed: int) -> tuple[linearize.GridWind, lidar.WindFie
 def test_gains_match_the_published_baseline(gains) -> None:
     # published: DISCON.F90 (Jonkman's baseline, report sec. 7.4): PC_KP = 0.01882681 s,
     # PC_KI = 0.008068634, PC_KK = 0.1099965 rad (6.302336 deg), dP/dtheta at zero pitch
-    # -25.52e6 W/rad, VS_Rgn2K = 2.332287 N m/(rad/s)^2. Issue 5 asked for 20 %; measured:
+    # -25.52e6 W/rad, VS_Rgn2K = 2.332287 N m/(rad/s)^2. The bound asked is 20 %; measured:
     # KP and KI +4.6 %, theta_K -9.7 %, dP/dtheta_0 -5.0 %, K_opt -2.5 % (our frozen-wake
     # sensitivities are within 8.3 % of the report's, the fit's points differ, and the rotor
     # inertia from the blade table is 0.6 % below the report's). Bounds: the measured value
@@ -44,7 +44,7 @@ def test_pole_placement_formula() -> None:
 
 
 def test_region3_closed_loop(run18: ClosedLoopResult) -> None:
-    # issue 5: 18 m/s, turbulent (class A): rated power held, generator speed std below 5 %
+    # 18 m/s, turbulent (class A): rated power held, generator speed std below 5 %
     # of rated (first 60 s of start-up transient left out). Measured: mean power 0.005 % off
     # 5 MW, speed std 3.5 %; bounds 0.05 % and 4 % (the README states both).
     late = run18.t > 60.0
@@ -66,7 +66,7 @@ def test_no_actuator_limit_violated(run18: ClosedLoopResult, turbine: linearize.
 
 def test_region2_tracks_optimal_tsr(turbine: linearize.Turbine, params: linearize.PlantParams,
                                     gains) -> None:
-    # issue 5: at 8 m/s the turbine tracks the optimal tip-speed ratio (mean within 3 %),
+    # At 8 m/s the turbine tracks the optimal tip-speed ratio (mean within 3 %),
     # here in Do et al.'s region-II turbulence (12 %); the tip-speed ratio uses the rotor-
     # averaged wind. (In class A, 23 % at 8 m/s, the mean is 10 % above optimal: lulls hold the
     # rotor at its minimum speed and gusts are not followed.)
@@ -77,7 +77,7 @@ def test_region2_tracks_optimal_tsr(turbine: linearize.Turbine, params: lineariz
     late = r.t > 60.0
     rews = np.interp(r.t[late], f.t, lidar.rotor_effective_wind(f, 63.0))
     tsr = r.channel("rotor_speed")[late].mean() * 63.0 * math.cos(math.radians(2.5)) / rews.mean()
-    # measured 1.4 % above optimal; bound 2 % (issue 5 asked for 3 %; the README states both)
+    # measured 1.4 % above optimal; bound 2 % (3 % asked; the README states both)
     assert_allclose(tsr, gains.info["tsr_opt"], rtol=0.02)
 
 

@@ -1,4 +1,4 @@
-"""Kalman state and wind estimator (issue 6, item 4): the MPC on measured signals only."""
+"""Kalman state and wind estimator: the MPC on measured signals only."""
 from __future__ import annotations
 
 import math

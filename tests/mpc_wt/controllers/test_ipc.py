@@ -1,4 +1,4 @@
-"""Retrofit strategies (issue 8): IBC and Coleman IPC against the baseline on the plant, derating
+"""Retrofit strategies: IBC and Coleman IPC against the baseline on the plant, derating
 (AEP, shaft loads, rated speed), active power control tracking, the filters, the lifetime
 metrics and the errors on bad input."""
 from __future__ import annotations
@@ -97,7 +97,7 @@ def test_ibc_loop_gain_and_margin_by_python_control(ibc_gains, turbine) -> None:
 
 
 def test_ibc_cuts_the_1p_flap_moment_and_raises_pitch_activity(runs18) -> None:
-    # issue 8: 18 m/s, turbulence with shear; 1P flap content and flap DEL fall, pitch rises
+    # 18 m/s, turbulence with shear; 1P flap content and flap DEL fall, pitch rises
     base, ibc = runs18["baseline"][1], runs18["ibc"][1]
     one_p = ibc["flap_1_harmonics"]["1P"] / base["flap_1_harmonics"]["1P"]
     assert one_p < 0.5
@@ -385,7 +385,7 @@ def _alternating(amplitude: float, n: int, dt: float) -> dict:
 
 
 def test_lifetime_comparison_computes_each_exponent_from_the_cycles() -> None:
-    """Issue 17, defect 3: DELs computed at the channel's m = 4 were re-aggregated at m = 10.
+    """A past defect: DELs computed at the channel's m = 4 were re-aggregated at m = 10.
     Two bins of different cycle content, by hand (ranges, 1 Hz over 100 s):
     A: 100 half cycles of range 2 -> DEL_A(m) = (50 2^m / 100)^(1/m);
     B: 10 half cycles of range 10 -> DEL_B(m) = (5 10^m / 100)^(1/m);

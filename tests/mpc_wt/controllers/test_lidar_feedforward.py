@@ -1,4 +1,4 @@
-"""Issue 21: collective pitch feedforward from the CW LIDAR on the baseline (mpc_wt.controllers.lidar_feedforward)."""
+"""Collective pitch feedforward from the CW LIDAR on the baseline (mpc_wt.controllers.lidar_feedforward)."""
 from __future__ import annotations
 
 import numpy as np

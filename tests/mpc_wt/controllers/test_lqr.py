@@ -1,4 +1,4 @@
-"""Gain synthesis (issue 7, first part): LQR against closed forms and python-control, the PI
+"""Gain synthesis: LQR against closed forms and python-control, the PI
 observer of Do et al. (eqs 13-16), LQR+PIO in the loop, bad input."""
 from __future__ import annotations
 

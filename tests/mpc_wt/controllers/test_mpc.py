@@ -1,4 +1,4 @@
-"""MPC (issue 6, first part): Coleman weighting, LQR limit, constraints, bad input."""
+"""MPC: Coleman weighting, LQR limit, constraints, bad input."""
 from __future__ import annotations
 
 import math
@@ -50,7 +50,7 @@ def model(turbine: linearize.Turbine) -> linearize.LinearModel:
 
 
 def test_long_horizon_converges_to_discrete_lqr(model, turbine: linearize.Turbine) -> None:
-    # issue 6: the unconstrained MPC with a long horizon converges to the discrete LQR gain
+    # The unconstrained MPC with a long horizon converges to the discrete LQR gain
     # with the same weights: cost z'Qz + u'Ru with z = C x + D u gives state weight C'QC,
     # cross term C'QD, input weight R + D'QD (python-control dlqr)
     import control
@@ -155,7 +155,7 @@ def test_daqp_backend_agrees_with_osqp(model, turbine, overspeed: float) -> None
     a, sa = MPC(model, turbine, MPCSettings(backend="osqp")).solve(x)
     b, sb = MPC(model, turbine, MPCSettings(backend="daqp")).solve(x)
     assert sa == sb == "solved"
-    # issue 6: first moves agree within 0.01 deg pitch and 0.1 % of rated torque
+    # First moves agree within 0.01 deg pitch and 0.1 % of rated torque
     assert np.abs(a[0, :3] - b[0, :3]).max() < math.radians(0.01)
     assert abs(a[0, 3] - b[0, 3]) < 0.001 * 43093.55
 
@@ -167,7 +167,7 @@ def test_unknown_backend(model, turbine) -> None:
 
 def test_lidar_preview_reduces_asymmetric_loads(turbine: linearize.Turbine,
                                                 params: linearize.PlantParams, model) -> None:
-    # issue 6: with LIDAR and a perfect preview of a frozen field (idealized CW LIDAR), the
+    # With LIDAR and a perfect preview of a frozen field (idealized CW LIDAR), the
     # tilt and yaw moments and the 1P flap moment fall compared with the same MPC without
     # preview (disturbance held at the mean). Short run: 18 m/s, class A, 60 s after 10 s.
     import lidar
@@ -297,7 +297,7 @@ def test_soft_constraint_bad_arguments(model, turbine, kwargs, match: str) -> No
        soft=st.sampled_from([None, 1.35]))
 def test_sparse_formulation_gives_the_condensed_moves(model, turbine, seed: int, size: float,
                                                       soft: float | None) -> None:
-    # issue 6 item 3: OSQP on the sparse formulation (states as variables, dynamics as
+    # OSQP on the sparse formulation (states as variables, dynamics as
     # equalities) solves the same QP: the first move within 0.01 deg pitch and 0.1 % of rated
     # torque of the condensed one (the issue's agreement tolerance), constraints binding or not
     rng = np.random.default_rng(seed)
@@ -319,7 +319,7 @@ def test_sparse_formulation_gives_the_condensed_moves(model, turbine, seed: int,
 
 
 def test_osqp_without_an_answer_is_resolved_exactly(model, turbine, caplog) -> None:
-    """Issue 18 (found by the property test above): at far-off states (shaft twist 0.06 rad,
+    """At far-off states (shaft twist 0.06 rad,
     12x rated; 4.6 deg pitch error) OSQP can reach its iteration limit on a feasible QP (here
     forced with max_iter = 10, so the test does not hang on OSQP's version). The backend then
     re-solves it with Clarabel (logged); the first move equals DAQP's on the condensed QP (an
@@ -410,7 +410,7 @@ def test_step_rejects_a_state_of_the_wrong_length(model, turbine) -> None:
 @pytest.mark.parametrize("rows", [15, 4, 1])
 def test_step_with_a_preview_equals_the_qp_of_its_deviations(model, turbine, rows: int) -> None:
     """The harness step writes the per-blade preview into the QP data in compiled code
-    (issue 23): its command equals :meth:`MPC.solve` given the preview deviations worked out
+   : its command equals :meth:`MPC.solve` given the preview deviations worked out
     here (a short preview held at its last row to the horizon), for both backends and for
     DAQP through its C interface (the step one compiled call) and through its Python Model."""
     pytest.importorskip("daqp")
@@ -442,7 +442,7 @@ def test_step_with_a_preview_equals_the_qp_of_its_deviations(model, turbine, row
 @given(seed=st.integers(0, 2**31 - 1))
 def test_factored_step_map_equals_the_full_map(model, turbine, seed: int) -> None:
     """The step's affine map is evaluated on the rows it needs (c and one row per distinct
-    bound, issue 23): for random data z the shift and the bounds equal W z from numpy on the
+    bound): for random data z the shift and the bounds equal W z from numpy on the
     full map, condensed and sparse."""
     from mpc_wt.controllers.mpc import _bound_map
 

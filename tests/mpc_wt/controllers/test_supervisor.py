@@ -1,4 +1,4 @@
-"""The supervisory layer (issue 24): shutdown to feather in the expected time, the overspeed
+"""The supervisory layer: shutdown to feather in the expected time, the overspeed
 stop at its limit, the grid loss, bad input."""
 from __future__ import annotations
 

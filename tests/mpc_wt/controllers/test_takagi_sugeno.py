@@ -1,5 +1,5 @@
 """Takagi-Sugeno model, LMI synthesis with its certificate, TS controller + wind observer in the
-loop (Clemens et al. eqs 1-11; issue 7)."""
+loop (Clemens et al. eqs 1-11)."""
 from __future__ import annotations
 
 import dataclasses

@@ -1,4 +1,4 @@
-"""Gain-table export (issue 7, item 6): every format read back, ROSCO DISCON lines, the CLI,
+"""Gain-table export: every format read back, ROSCO DISCON lines, the CLI,
 bad tables."""
 from __future__ import annotations
 
@@ -61,7 +61,7 @@ def _identified_gains(turbine, gains, pitch: float) -> tuple[float, float]:
 @pytest.mark.parametrize("fraction", [1.0, 0.8])
 def test_rosco_schedule_starts_at_fine_pitch_and_matches_the_controller(turbine, tmp_path,
                                                                        fraction) -> None:
-    """Issue 17, defect 2: the schedule started at 12 m/s (0.069 rad), so between fine pitch
+    """A past defect: the schedule started at 12 m/s (0.069 rad), so between fine pitch
     and 0.069 rad ROSCO used 0.59x our gain. The exported table, interpolated as ROSCO does
     (linear, ends held), must give the gains our BaselineController applies, measured from its
     commands, at pitch angles across the range. (Measuring them found a second defect: the

@@ -1,4 +1,4 @@
-"""Issue 19: OpenFAST outputs (.out, .outb, CSV with OpenFAST names) read into assessment, checked
+"""OpenFAST outputs (.out, .outb, CSV with OpenFAST names) read into assessment, checked
 against openfast-io's reader (a peer) and against our own run written in OpenFAST's layout."""
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""The controller registry (issue 16): every kind with typed options, one place per rule, a
+"""The controller registry: every kind with typed options, one place per rule, a
 user-defined kind added by one registration and used by ``mpcwt simulate`` and a campaign."""
 from __future__ import annotations
 
@@ -239,7 +239,7 @@ def test_commands_check_their_arguments_before_working(argv, match, tmp_path: Pa
 
 
 def test_design_weights_reach_the_designs() -> None:
-    """Issue 22's tunable options: the MPC's cost weights (unset ones keep MPCWeights'
+    """The tunable options: the MPC's cost weights (unset ones keep MPCWeights'
     defaults) and the LQR's weights (unset ones keep the region's) are the ones designed with;
     a larger pitch weight gives a smaller LQR gain."""
     from mpc_wt.controllers.mpc import MPCWeights
@@ -285,7 +285,7 @@ def test_lqr_pio_region2_shares_the_baselines_torque_law() -> None:
 
 
 def test_lidar_field_is_made_from_the_seed_not_beside_the_case_field() -> None:
-    """Issue 23 (memory): the built-in kinds have the case's field made with the plant's u
+    """The built-in kinds have the case's field made with the plant's u
     only; a LIDAR's field is made from the case's spec and seed. Evolved, it is
     lidar.evolve_field of the whole case field with the context's evolution stream (the
     path before) to single-precision rounding, 2e-5 m/s; frozen (distance 0), the whole

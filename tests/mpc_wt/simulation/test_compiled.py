@@ -1,4 +1,4 @@
-"""Issue 23: the baseline's closed loop compiled with the plant (mpc_wt.simulation.compiled) is the
+"""The baseline's closed loop compiled with the plant (mpc_wt.simulation.compiled) is the
 Python loop of simulate_closed_loop, operation for operation: the same states, inputs,
 outputs, signals, counts, errors and controller state after the run."""
 from __future__ import annotations

@@ -148,7 +148,7 @@ def test_a_rotor_driven_backwards_is_reported_as_divergence(turbine: linearize.T
 @given(dt=st.floats(0.01, 0.5), n=st.integers(2, 400), t0=st.floats(-5.0, 5.0),
        q=st.lists(st.floats(-10.0, 250.0), min_size=1, max_size=20), seed=st.integers(0, 999))
 def test_hub_wind_reads_the_field_as_linear_interpolation(dt, n, t0, q, seed) -> None:
-    """Issue 23: the hub wind handed to controllers is read by index on a uniform grid; it is
+    """The hub wind handed to controllers is read by index on a uniform grid; it is
     numpy's linear interpolation of the hub column (held at the ends) at any time."""
     from mpc_wt.simulation.loop import _hub_wind
 
@@ -158,7 +158,7 @@ def test_hub_wind_reads_the_field_as_linear_interpolation(dt, n, t0, q, seed) ->
     u = rng.normal(10, 2, (n, 5, 5))
     gw = linearize.GridWind(t=t, y=y, z=z, u=u)
     f = _hub_wind(gw, 90.0)
-    hub = gw.u[:, 2, 2].astype(float)           # the column as stored (float32, issue 23)
+    hub = gw.u[:, 2, 2].astype(float)           # the column as stored (float32)
     for tq in q:
         assert f(tq) == pytest.approx(np.interp(tq, t, hub), rel=1e-12, abs=1e-12)
 

@@ -23,7 +23,7 @@ def test_bench_mpc_json_and_move_errors(capsys: pytest.CaptureFixture[str],
         for key in ("solver", "median_us", "p95_us", "p99_us", "max_us", "max_move_error"):
             assert key in e, (e["solver"], key)
         assert 0 < e["median_us"] <= e["p99_us"] <= e["max_us"]
-        # issue 6 acceptance: the applied first move within 0.01 deg pitch and 0.1 % of rated
+        # acceptance: the applied first move within 0.01 deg pitch and 0.1 % of rated
         # torque of the reference, i.e. max_move_error <= 1
         assert e["max_move_error"] <= 1.0, e
     assert png.stat().st_size > 10_000

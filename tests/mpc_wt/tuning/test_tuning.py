@@ -1,4 +1,4 @@
-"""Issue 22: controller tuning as a constrained, resumable optimization (mpc_wt.tuning)."""
+"""Controller tuning as a constrained, resumable optimization (mpc_wt.tuning)."""
 from __future__ import annotations
 
 import math
