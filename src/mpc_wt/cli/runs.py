@@ -478,7 +478,7 @@ def _comparison_runs(turbine: linearize.Turbine, args: argparse.Namespace, out: 
               f"{r.get('del_tower_base_fa_moment_MNm', float('nan')):9.3f} "
               f"{r.get('del_shaft_bending_blade1_MNm', float('nan')):9.3f} {qp:>12s}")
     min_rpm = turbine.operation.min_rotor_speed_rad_s * 30 / math.pi
-    for line in design_warnings(rows, min_rpm):
+    for line in design_warnings(rows, min_rpm, turbine.operation.rated_power / 1e6):
         print(line)
     print(f"# wrote {out}/comparison.json, " + ", ".join(r["file"] for r in rows) + ", "
           + ", ".join(Path(m).name for m in made))
@@ -487,12 +487,16 @@ def _comparison_runs(turbine: linearize.Turbine, args: argparse.Namespace, out: 
 #: the limits :func:`design_warnings` holds a design to, against the baseline's run
 PITCH_TRAVEL_LIMIT = 3.0
 POWER_LOSS_LIMIT_PCT = 1.0
+#: ... and the mean electrical power's excess over the rated power it may have [%]
+OVERPOWER_LIMIT_PCT = 1.0
 
 
-def design_warnings(rows: list[dict[str, Any]], min_rotor_rpm: float) -> list[str]:
+def design_warnings(rows: list[dict[str, Any]], min_rotor_rpm: float,
+                    rated_power_MW: float | None = None) -> list[str]:
     """Lines that flag a design a user should not take as it is: pitch travel above
     :data:`PITCH_TRAVEL_LIMIT` times the baseline's, mean power more than
-    :data:`POWER_LOSS_LIMIT_PCT` % below the baseline's, the rotor below its minimum speed.
+    :data:`POWER_LOSS_LIMIT_PCT` % below the baseline's or more than
+    :data:`OVERPOWER_LIMIT_PCT` % above the rated power, the rotor below its minimum speed.
 
     Parameters
     ----------
@@ -501,6 +505,8 @@ def design_warnings(rows: list[dict[str, Any]], min_rotor_rpm: float) -> list[st
         ``rotor_speed_min_rpm``); the reference is the row ``baseline``, else the first.
     min_rotor_rpm : float
         The turbine's minimum rotor speed [rpm].
+    rated_power_MW : float, optional
+        The turbine's rated electrical power [MW] (no check without it).
 
     Returns
     -------
@@ -526,6 +532,13 @@ def design_warnings(rows: list[dict[str, Any]], min_rotor_rpm: float) -> list[st
             out.append(f"warning: {name} makes {loss:.1f} % less mean power than "
                        f"{ref['controller']} ({r['power_mean_MW']:.3f} against "
                        f"{ref['power_mean_MW']:.3f} MW)")
+    if rated_power_MW:
+        for r in rows:
+            over = 100.0 * (r["power_mean_MW"] / rated_power_MW - 1.0)
+            if over > OVERPOWER_LIMIT_PCT:
+                out.append(f"warning: {r['controller']} runs the generator {over:.1f} % above "
+                           f"its rated power on average ({r['power_mean_MW']:.3f} against "
+                           f"{rated_power_MW:.3f} MW)")
     for r in rows:
         if r.get("rotor_speed_min_rpm", math.inf) < min_rotor_rpm - 1e-6:
             out.append(f"warning: {r['controller']} lets the rotor fall to "
