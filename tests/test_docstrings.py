@@ -55,9 +55,10 @@ def _missing(obj: Any) -> list[str]:
     out = []
     if any(p not in ("self", "cls") for p in sig.parameters) and "Parameters\n---" not in doc:
         out.append("Parameters")
+    result = "Yields" if inspect.isgeneratorfunction(obj) else "Returns"   # numpydoc's names
     if sig.return_annotation not in (None, "None", inspect.Signature.empty) \
-            and "Returns\n---" not in doc:
-        out.append("Returns")
+            and f"{result}\n---" not in doc:
+        out.append(result)
     return out
 
 

@@ -518,8 +518,8 @@ def linearize_family(turbine: Turbine, wind_mps: Sequence[float] | FloatArray | 
                    dtype=float)
     check_wind_grid(v)
     p = kwargs.pop("params", None) or plant_params(turbine, kwargs.pop("config", None))
-    from tqdm import tqdm
+    from linearize.progress import progress as bar
 
     models = tuple(linearize(turbine, float(w), params=p, **kwargs)
-                   for w in tqdm(v, desc="linearize", unit="op", disable=not progress))
+                   for w in bar(v, "linearize", "op", enabled=progress))
     return LinearModelFamily(v, models)

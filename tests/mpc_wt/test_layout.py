@@ -216,7 +216,8 @@ LAYOUT = {
     "registry": {"registry", "options", "builtin", "context"},
     "simulation": {"scenario", "loop", "compiled", "results", "preview", "solver_timing"},
     "assessment": {"fatigue", "performance", "series", "ultimate", "lidar", "compare"},
-    "io": {"gain_tables", "rosco", "openfast_output", "discon_export", "openfast_case"},
+    "io": {"gain_tables", "rosco", "openfast_output", "discon_export", "openfast_case",
+           "json_text"},
 }
 
 

@@ -33,7 +33,8 @@ from mpc_wt.assessment.performance import (
     pitch_duty,
 )
 
-__all__ = ["DEFAULT_CHANNELS", "assess_series", "reductions", "lifetime_comparison"]
+__all__ = ["DEFAULT_CHANNELS", "TIME_STEP_TOLERANCE", "assess_series", "check_time", "reductions",
+           "lifetime_comparison"]
 
 
 #: Load channels and their default Woehler exponents (10 composite blades, 4 steel elsewhere).
@@ -42,6 +43,53 @@ DEFAULT_CHANNELS = {"flap_moment_1": 10.0, "flap_moment_2": 10.0, "flap_moment_3
                     "tower_base_fa_moment": 4.0, "tower_base_ss_moment": 4.0,
                     "lss_torque": 4.0, "tilt_moment": 4.0, "yaw_moment": 4.0,
                     "shaft_bending_blade1": 4.0}
+
+
+#: how far a time step may differ from the run's median step, relative to it: a text time
+#: column rounded to its last digit (0.0062, 0.0063 for 160 Hz) stays within it, a lost sample
+#: (a step of 2x) or a gap does not
+TIME_STEP_TOLERANCE = 0.1
+
+
+def check_time(t: Any) -> np.ndarray:
+    """A run's time vector: 1-D, finite, at least 2 samples, strictly increasing and uniform
+    (every step within :data:`TIME_STEP_TOLERANCE` of the median step), as the rainflow
+    counts, spectra and energies assume; or an error that says where it is not.
+
+    Parameters
+    ----------
+    t : array_like
+        Time [s].
+
+    Returns
+    -------
+    (n_t,) ndarray
+
+    Raises
+    ------
+    ValueError
+        Naming the first duplicate, backward step or gap, with its time.
+    """
+    t = np.asarray(t, dtype=float)
+    if t.ndim != 1 or t.size < 2:
+        raise ValueError(f"the time must be 1-D with at least 2 samples, got shape {t.shape}")
+    if not np.all(np.isfinite(t)):
+        i = int(np.argmax(~np.isfinite(t)))
+        raise ValueError(f"the time is {float(t[i])!r} at sample {i}")
+    d = np.diff(t)
+    if np.any(d <= 0):
+        i = int(np.argmax(d <= 0))
+        what = "repeats" if d[i] == 0 else "goes back"
+        raise ValueError(f"the time {what} at sample {i + 1}: {t[i]:g} s then {t[i + 1]:g} s; "
+                         f"it must increase strictly")
+    step = float(np.median(d))
+    off = np.abs(d - step) > TIME_STEP_TOLERANCE * step
+    if off.any():
+        i = int(np.argmax(off))
+        raise ValueError(f"the time step is {d[i]:g} s from t = {t[i]:g} s, the run's step "
+                         f"{step:g} s: a gap or an uneven step (allowed within "
+                         f"{TIME_STEP_TOLERANCE:.0%}); resample the run to a uniform step")
+    return t
 
 
 def assess_series(t: np.ndarray, cols: dict[str, np.ndarray],
@@ -77,7 +125,10 @@ def assess_series(t: np.ndarray, cols: dict[str, np.ndarray],
     ------
     KeyError
         Naming a channel that is not among the columns.
+    ValueError
+        If the time is not uniform and increasing (:func:`check_time`).
     """
+    t = check_time(t)
     chans = dict(channels or {k: v for k, v in DEFAULT_CHANNELS.items() if k in cols})
     missing = [c for c in chans if c not in cols]
     if missing:

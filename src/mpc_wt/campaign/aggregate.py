@@ -21,6 +21,7 @@ from mpc_wt.assessment.performance import aep_Wh, pct_change
 from mpc_wt.campaign.signoff import governing_rows, signoff_rows, ultimate_rows
 from mpc_wt.campaign.spec import CampaignSpec, spec_from_dict
 from mpc_wt.campaign.store import CampaignStore, CaseRow
+from mpc_wt.errors import ResultFileError
 
 __all__ = ["OUTLIER_RATIO", "PITCH_METRICS", "RELATIVE_METRICS", "ABSOLUTE_METRICS",
            "relative_metrics", "absolute_metrics", "aggregate"]
@@ -71,9 +72,17 @@ def _load(root: Path) -> tuple[CampaignSpec, list[CaseRow], list[CaseRow]]:
         every = st.rows()
         rows = [r for r in every if r.status == "done" and r.metrics]
         failed = [r for r in every if r.status == "failed"]
+        changed = st.changed_files()
+    if changed:
+        shown = "; ".join(f"{cid} ({why})" for cid, why in changed[:5])
+        more = f" and {len(changed) - 5} more" if len(changed) > 5 else ""
+        raise ResultFileError(
+            f"{root}: {len(changed)} case file(s) do not match the checksum recorded when they "
+            f"were written: {shown}{more}; resuming the campaign (mpcwt campaign run SPEC "
+            f"--out {root}) computes them again")
     if "spec_raw" not in meta:
         raise ValueError(f"{root}: the index holds no spec (was the campaign ever run?)")
-    spec = spec_from_dict(meta["spec_raw"])
+    spec = spec_from_dict(meta["spec_raw"], import_plugins=False)   # runs none of its code
     if not rows:
         raise ValueError(f"{root}: no finished case to report; run the campaign first "
                          f"(mpcwt campaign run SPEC --out {root})")

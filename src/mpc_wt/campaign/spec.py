@@ -22,8 +22,15 @@ from typing import Any, Mapping
 import numpy as np
 import yaml
 
+from mpc_wt.campaign.checksum import file_sha256
 from mpc_wt.errors import SpecError
-from mpc_wt.simulation.scenario import Scenario, check_condition, check_turbulence, is_deterministic
+from mpc_wt.simulation.scenario import (
+    MAX_DURATION_S,
+    Scenario,
+    check_condition,
+    check_turbulence,
+    is_deterministic,
+)
 
 __all__ = ["SpecError", "CampaignSpec", "ControllerSpec", "Case", "LoadCase", "WindFile",
            "DLC_DEFAULTS", "FILE_MARGIN_S", "load_spec", "spec_from_dict"]
@@ -59,8 +66,49 @@ _SUPERVISOR_KEYS = {"overspeed", "shutdown_at", "grid_loss_at", "pitch_rate", "t
 _REPORT_KEYS = {"paper", "notes", "psd_wind", "cs_wind", "sweep", "title"}
 
 
+#: the most seeds per wind a spec may give, and the most cases a campaign may hold (a spec
+#: over them is a mistake, not a study: 100,000 cases of 600 s take months on 2 cores)
+MAX_SEEDS = 1000
+MAX_CASES = 100_000
+
+
 def _fail(key: str, msg: str) -> SpecError:
     return SpecError(f"campaign spec: {key}: {msg}")
+
+
+#: what a name that becomes part of a file or folder name may hold
+NAME_CHARS = "letters, digits and - _ . + (not starting with a dot), at most 100 characters"
+
+
+def check_name(key: str, value: Any, fail: Any = None) -> str:
+    """A name a spec sets that becomes part of a file or folder name (the campaign's, a
+    controller's, a load case's): letters, digits and ``-_.+``, not starting with a dot, at
+    most 100 characters, so that no name reaches outside its output folder.
+
+    Parameters
+    ----------
+    key : str
+        The spec key, for the error.
+    value : Any
+        The name.
+    fail : callable, optional
+        ``fail(key, message) -> Exception`` (default: a campaign spec's).
+
+    Returns
+    -------
+    str
+        The name.
+
+    Raises
+    ------
+    SpecError
+        Naming the key, the value and what is allowed.
+    """
+    text = str(value).strip() if isinstance(value, (str, int, float)) else None
+    if not text or len(text) > 100 or text.startswith(".") or not all(
+            ch.isascii() and (ch.isalnum() or ch in "-_.+") for ch in text):
+        raise (fail or _fail)(key, f"must be a name of {NAME_CHARS}; got {value!r}")
+    return text
 
 
 def _number(key: str, val: Any, lo: float | None = None, hi: float | None = None,
@@ -102,14 +150,16 @@ def _seeds(key: str, val: Any) -> tuple[int, ...]:
     if isinstance(val, bool):
         raise _fail(key, f"must be a count or a list of integers, got {val!r}")
     if isinstance(val, int):
-        if val < 1:
-            raise _fail(key, f"a seed count must be >= 1, got {val}")
+        if not 1 <= val <= MAX_SEEDS:
+            raise _fail(key, f"a seed count must be between 1 and {MAX_SEEDS}, got {val}")
         return tuple(range(1, val + 1))
     if isinstance(val, (list, tuple)) and val:
         if not all(isinstance(s, int) and not isinstance(s, bool) and s >= 0 for s in val):
             raise _fail(key, f"seeds must be integers >= 0, got {list(val)}")
         if len(set(val)) != len(val):
             raise _fail(key, f"repeated seeds {list(val)}")
+        if len(val) > MAX_SEEDS:
+            raise _fail(key, f"at most {MAX_SEEDS} seeds, got {len(val)}")
         return tuple(val)
     raise _fail(key, f"must be a count >= 1 or a non-empty list of integers, got {val!r}")
 
@@ -670,11 +720,13 @@ def turbine_files_hash(turbine: str, base: Path | None = None) -> tuple[str, str
 
 
 def _controller_options(key: str, raw: Mapping[str, Any], run_name: str,
-                        lidar: dict[str, Any]) -> dict[str, Any]:
+                        lidar: dict[str, Any], plugin_kinds: bool = False) -> dict[str, Any]:
     """The entry's controller options, checked by the registry: every key that is not one of
     the campaign's own (name, grid, label) is an option of the kind; ``options:`` holds them
     too, and the groups ``mpc_options`` / ``retrofit_options`` of older specs are flattened.
-    The campaign's ``lidar`` settings are the defaults of a kind that takes ``lidar``."""
+    The campaign's ``lidar`` settings are the defaults of a kind that takes ``lidar``.
+    ``plugin_kinds``: the spec's plugins were not imported (reading a stored campaign), so a
+    kind the registry does not know is taken as a plugin's, its options unchecked."""
     from mpc_wt.errors import OptionsError
     from mpc_wt.registry.registry import resolve
 
@@ -686,7 +738,12 @@ def _controller_options(key: str, raw: Mapping[str, Any], run_name: str,
             opts.update(raw[group])
     opts.update({k: v for k, v in raw.items() if k not in _CONTROLLER_KEYS})
     try:
-        sel = resolve(run_name)
+        try:
+            sel = resolve(run_name)
+        except ValueError:
+            if plugin_kinds:
+                return copy.deepcopy(opts)
+            raise
         if "lidar" in sel.option_names() and (lidar or "lidar" in opts):
             extra = opts.get("lidar", {})
             if not isinstance(extra, Mapping):
@@ -700,23 +757,25 @@ def _controller_options(key: str, raw: Mapping[str, Any], run_name: str,
     return copy.deepcopy(opts)
 
 
-def _controller(i: int, raw: Any, lidar: dict[str, Any]) -> ControllerSpec:
+def _controller(i: int, raw: Any, lidar: dict[str, Any],
+                plugin_kinds: bool = False) -> ControllerSpec:
     key = f"controllers[{i}]"
     if isinstance(raw, str):
         raw = {"name": raw, "controller": raw}
     if not isinstance(raw, Mapping):
         raise _fail(key, f"must be a controller name or a mapping, got {raw!r}")
     name = raw.get("name", raw.get("controller"))
-    if not isinstance(name, str) or not name or not all(
-            ch.isalnum() or ch in "-_.+" for ch in name):
-        raise _fail(f"{key}.name", f"must be a non-empty label of letters, digits and -_.+, "
-                                   f"got {name!r}")
+    if not isinstance(name, str):
+        raise _fail(f"{key}.name", f"must be a name of {NAME_CHARS}; got {name!r}")
+    name = check_name(f"{key}.name", name)
     run_name = str(raw.get("controller", name))
-    opts = _controller_options(key, raw, run_name, lidar)
+    opts = _controller_options(key, raw, run_name, lidar, plugin_kinds)
     dlcs = raw.get("dlcs")
     if dlcs is not None and (not isinstance(dlcs, list) or not dlcs
                              or not all(isinstance(d, (str, int, float)) for d in dlcs)):
         raise _fail(f"{key}.dlcs", f"must be a non-empty list of load case names, got {dlcs!r}")
+    for j, d in enumerate(dlcs or ()):
+        check_name(f"{key}.dlcs[{j}]", d)
     return ControllerSpec(
         name=name, controller=run_name, options=opts,
         dlcs=None if dlcs is None else tuple(str(d) for d in dlcs),
@@ -777,7 +836,7 @@ def _load_case(i: int, raw: Any, top: Mapping[str, Any]) -> LoadCase:
     dlc = raw.get("dlc")
     if not isinstance(dlc, (str, int, float)) or not str(dlc).strip():
         raise _fail(f"{key}.dlc", f"must name the load case, e.g. '1.3', got {dlc!r}")
-    dlc = str(dlc).strip()
+    dlc = check_name(f"{key}.dlc", dlc)
     cond = str(raw.get("condition", "ntm")).lower()
     if cond not in lidar.CONDITIONS:
         raise _fail(f"{key}.condition", f"must be one of {sorted(lidar.CONDITIONS)}, got "
@@ -851,14 +910,6 @@ def _file_load_case(key: str, raw: Mapping[str, Any], top: Mapping[str, Any], dl
         transient=transient, supervisor=sup, extrapolate=extrapolate, wind_files=files)
 
 
-def _file_sha256(path: Path) -> str:
-    h = hashlib.sha256()
-    with path.open("rb") as fh:
-        for block in iter(lambda: fh.read(1 << 20), b""):
-            h.update(block)
-    return h.hexdigest()
-
-
 def _wind_files(key: str, raw: Any, base: Path | None, transient: float,
                 duration: float | None) -> tuple[WindFile, ...]:
     """The entries of ``wind_files``: a path, or {file, wind} to set the file's mean-wind bin
@@ -901,7 +952,7 @@ def _wind_files(key: str, raw: Any, base: Path | None, transient: float,
         if v <= 0:
             raise _fail(k, f"{str(name)!r}: its mean wind {float(f.mean_speed):g} m/s rounds "
                            f"to no bin; give {{file, wind}}")
-        out.append(WindFile(path=str(p), wind_mps=float(v), sha256=_file_sha256(p),
+        out.append(WindFile(path=str(p), wind_mps=float(v), sha256=file_sha256(p),
                             duration=sim, index=i + 1))
     stems = [f.stem for f in out]
     dup = sorted({s for s in stems if stems.count(s) > 1})
@@ -972,12 +1023,15 @@ def _convention(raw: Any) -> str:
     return str(raw)
 
 
-def _plugins(raw: Any) -> tuple[str, ...]:
-    """Modules that register controller kinds, imported here and in every worker."""
+def _plugins(raw: Any, load: bool = True) -> tuple[str, ...]:
+    """Modules that register controller kinds, imported here (unless ``load`` is False) and
+    in every worker."""
     from mpc_wt.registry.registry import load_plugins
 
     if not isinstance(raw, list) or not all(isinstance(m, str) and m for m in raw):
         raise _fail("plugins", f"must be a list of module names, got {raw!r}")
+    if not load:
+        return tuple(raw)
     try:
         load_plugins(raw)
     except ImportError as err:
@@ -1038,9 +1092,48 @@ def _check_controller_grids(ctls: tuple[ControllerSpec, ...],
                                                       f"are {names}")
 
 
+def _controllers(raw: Any, lidar: dict[str, Any], plugin_kinds: bool
+                 ) -> tuple[ControllerSpec, ...]:
+    """The ``controllers`` list, each validated, their names distinct."""
+    if not isinstance(raw, list) or not raw:
+        raise _fail("controllers", "must be a non-empty list")
+    ctls = tuple(_controller(i, c, lidar, plugin_kinds) for i, c in enumerate(raw))
+    names = [c.name for c in ctls]
+    dup = sorted({n for n in names if names.count(n) > 1})
+    if dup:
+        raise _fail("controllers", f"repeated names {dup}; give each a distinct name")
+    return ctls
+
+
+def _check_size(raw: Mapping[str, Any], ctls: tuple[ControllerSpec, ...],
+                load_cases: tuple[LoadCase, ...]) -> None:
+    """At most :data:`MAX_CASES` cases."""
+    n_cases = sum(_n_cases(c, lc) for c in ctls for lc in load_cases
+                  if c.dlcs is None or lc.dlc in c.dlcs)
+    if n_cases > MAX_CASES:
+        raise _fail("load_cases" if "load_cases" in raw else "seeds",
+                    f"the spec makes {n_cases} cases, more than {MAX_CASES}: fewer winds, "
+                    f"seeds or controllers")
+
+
+def _n_cases(c: ControllerSpec, lc: LoadCase) -> int:
+    """How many cases a controller has in a load case (as :meth:`CampaignSpec.cases` makes
+    them), counted without making them."""
+    if lc.wind_files:
+        return len(lc.wind_files)
+    if lc.legacy:
+        return (len(c.turbulence or lc.turbulence) * len(c.winds or lc.winds)
+                * len(c.seeds or lc.seeds))
+    per = len(lc.signs) if lc.deterministic else len(lc.seeds)
+    return len(lc.turbulence) * len(lc.winds) * per
+
+
 def spec_from_dict(raw: Mapping[str, Any], base: Path | None = None,
-                   source: str | None = None) -> CampaignSpec:
+                   source: str | None = None, *, import_plugins: bool = True) -> CampaignSpec:
     """Validate a campaign given as a mapping (the parsed YAML).
+
+    Its ``plugins`` are imported (they register the kinds it names) unless ``import_plugins``
+    is False: then none of its code runs, and unknown kinds' options are taken as given.
 
 
     Parameters
@@ -1051,6 +1144,8 @@ def spec_from_dict(raw: Mapping[str, Any], base: Path | None = None,
         Folder against which relative turbine paths are resolved.
     source : str, optional
         The spec's file, kept for the record.
+    import_plugins : bool
+        Import the spec's plugins (default; False to read a stored campaign).
 
     Returns
     -------
@@ -1074,28 +1169,22 @@ def spec_from_dict(raw: Mapping[str, Any], base: Path | None = None,
     if missing:
         raise _fail(missing[0], f"missing (required: name, winds or load_cases, "
                                 f"controllers; missing {missing})")
-    name = raw["name"]
-    if not isinstance(name, str) or not name.strip():
-        raise _fail("name", f"must be a non-empty string, got {name!r}")
-    plugins = _plugins(raw.get("plugins", []))
+    name = check_name("name", raw["name"])
+    plugins = _plugins(raw.get("plugins", []), import_plugins)
     turbine, thash = turbine_files_hash(str(raw.get("turbine", "nrel5mw")), base)
-    duration = _number("duration", raw.get("duration", 600.0), 0.0, lo_open=True)
+    duration = _number("duration", raw.get("duration", 600.0), 0.0, MAX_DURATION_S,
+                       lo_open=True)
     transient = _number("transient", raw.get("transient", 60.0), 0.0)
     lidar = _lidar("lidar", raw.get("lidar", {}))
-    ctl_raw = raw["controllers"]
-    if not isinstance(ctl_raw, list) or not ctl_raw:
-        raise _fail("controllers", "must be a non-empty list")
-    ctls = tuple(_controller(i, c, lidar) for i, c in enumerate(ctl_raw))
+    ctls = _controllers(raw["controllers"], lidar, bool(plugins) and not import_plugins)
     iec_class = raw.get("iec_class", "I")
     if iec_class not in ("I", "II", "III"):
         raise _fail("iec_class", f"must be 'I', 'II' or 'III' (IEC 61400-1 table 1), got "
                                  f"{iec_class!r}")
     load_cases = _load_cases(raw, duration, transient, turbine, base)
     _check_controller_grids(ctls, load_cases)
+    _check_size(raw, ctls, load_cases)
     names = [c.name for c in ctls]
-    dup = sorted({n for n in names if names.count(n) > 1})
-    if dup:
-        raise _fail("controllers", f"repeated names {dup}; give each a distinct name")
     chans = _channels(raw.get("channels"))
     ref = raw.get("reference", names[0])
     if ref not in names:
@@ -1105,7 +1194,7 @@ def spec_from_dict(raw: Mapping[str, Any], base: Path | None = None,
     if not isinstance(desc, str):
         raise _fail("description", f"must be a string, got {desc!r}")
     return CampaignSpec(
-        name=name.strip(), description=desc, turbine=turbine, turbine_hash=thash,
+        name=name, description=desc, turbine=turbine, turbine_hash=thash,
         duration=duration, transient=transient,
         turbulence=_turbulence("turbulence", raw.get("turbulence", "A")),
         shear_exponent=_number("shear_exponent", raw.get("shear_exponent", 0.2), -1.0, 1.0),

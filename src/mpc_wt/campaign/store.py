@@ -3,7 +3,7 @@
 Layout::
 
     DIR/spec.yaml         the spec of the latest run (as given)
-    DIR/index.sqlite      cases, status, metrics, software version, spec hash
+    DIR/index.sqlite      cases, status, metrics, software version, spec hash, each file's SHA-256
     DIR/cases/ID.nc       one result per case (ClosedLoopResult netCDF, written atomically)
     DIR/cases/ID.partial.nc   what a diverged simulation produced before it stopped
     DIR/report/           tables and plots of ``mpcwt campaign report``
@@ -11,11 +11,15 @@ Layout::
 Only the client writes the index (one writer: an exclusive lock on ``DIR/.lock``); workers
 write case files (temp file + rename), so a killed worker or client leaves at worst a temp
 file, never a half-written result, and the index never names a file that is not complete.
+The index keeps each result file's SHA-256: a file changed or cut short after it was recorded is
+found when the campaign resumes (it is computed again, with a logged reason) and when it is
+reported (refused, naming the files).
 """
 from __future__ import annotations
 
 import fcntl
 import json
+import logging
 import os
 import sqlite3
 import time
@@ -23,8 +27,11 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Iterable
 
+from mpc_wt.campaign.checksum import file_sha256
 from mpc_wt.campaign.spec import CampaignSpec, Case
 from mpc_wt.errors import CampaignLockedError
+
+log = logging.getLogger(__name__)
 
 __all__ = ["CampaignStore", "CampaignLockedError", "CaseRow", "STATUSES"]
 
@@ -55,7 +62,8 @@ CREATE TABLE IF NOT EXISTS cases (
     attempts INTEGER NOT NULL DEFAULT 0,
     wall_s REAL,
     worker TEXT,
-    updated REAL NOT NULL
+    updated REAL NOT NULL,
+    sha256 TEXT
 );
 """
 
@@ -92,6 +100,8 @@ class CaseRow:
         Wall time of the last attempt [s].
     worker : str or None
         host:pid of the last attempt.
+    sha256 : str or None
+        SHA-256 of the result file as it was recorded (None before checksums were kept).
     """
 
     case_id: str
@@ -112,6 +122,7 @@ class CaseRow:
     attempts: int
     wall_s: float | None
     worker: str | None
+    sha256: str | None = None
 
     @property
     def turbulence_value(self) -> str | float:
@@ -166,6 +177,10 @@ class CampaignStore:
         self.db.execute("PRAGMA synchronous=FULL")
         if lock:
             self.db.executescript(_SCHEMA)
+            cols = {r[1] for r in self.db.execute("PRAGMA table_info(cases)")}
+            if "sha256" not in cols:        # an index written before checksums were kept
+                self.db.execute("ALTER TABLE cases ADD COLUMN sha256 TEXT")
+        self._has_sha = "sha256" in {r[1] for r in self.db.execute("PRAGMA table_info(cases)")}
 
     def close(self) -> None:
         """Close the index and release the lock."""
@@ -265,21 +280,60 @@ class CampaignStore:
         return counts
 
     def todo(self) -> list[Case]:
-        """Cases to submit: everything not done, and done cases whose file has gone.
+        """Cases to submit: everything not done, and done cases whose file has gone or no
+        longer matches the SHA-256 recorded with it (logged; the changed file is moved to
+        ``cases/ID.changed.nc`` so that the case is computed again, not reused). A done
+        case recorded before checksums were kept gets its file's checksum now.
 
         Returns
         -------
         list of Case
             In insertion order.
         """
-        out = []
-        for cid, status, file, cj in self.db.execute(
-                "SELECT case_id, status, file, case_json FROM cases WHERE status != 'stale' "
-                "ORDER BY rowid"):
+        out, first_sums = [], []
+        for cid, status, file, cj, sha in self.db.execute(
+                "SELECT case_id, status, file, case_json, sha256 FROM cases "
+                "WHERE status != 'stale' ORDER BY rowid").fetchall():
             if status == "done" and file and (self.root / file).is_file():
-                continue
+                if sha is None:
+                    first_sums.append((file_sha256(self.root / file), cid))
+                    continue
+                if file_sha256(self.root / file) == sha:
+                    continue
+                moved = (self.root / file).with_suffix(".changed.nc")
+                os.replace(self.root / file, moved)
+                log.warning("case %s: %s does not match the checksum recorded when it was "
+                            "written (changed or cut short since); computing the case again "
+                            "(the file is kept as %s)", cid, file, moved.name)
             out.append(Case.from_dict(json.loads(cj)))
+        if first_sums:
+            with self._tx():
+                self.db.executemany("UPDATE cases SET sha256=? WHERE case_id=?", first_sums)
+            log.info("checksums recorded for %d case files written before checksums were kept",
+                     len(first_sums))
         return out
+
+    def changed_files(self) -> list[tuple[str, str]]:
+        """Done cases whose result file is missing or no longer matches its recorded SHA-256
+        (a row that names no file, as an index made by hand, has nothing to check).
+
+        Returns
+        -------
+        list of (str, str)
+            (case id, what is wrong) per such case; empty when every file is as recorded.
+        """
+        if not self._has_sha:
+            return []
+        bad = []
+        for cid, file, sha in self.db.execute(
+                "SELECT case_id, file, sha256 FROM cases WHERE status = 'done' AND file IS NOT "
+                "NULL ORDER BY rowid"):
+            path = self.root / file
+            if not path.is_file():
+                bad.append((cid, f"{file}: missing"))
+            elif sha is not None and file_sha256(path) != sha:
+                bad.append((cid, f"{file}: changed or cut short since it was recorded"))
+        return bad
 
     def mark_submitted(self, case_ids: Iterable[str]) -> None:
         """Record that this client handed the cases to the engine (attempts + 1).
@@ -312,10 +366,10 @@ class CampaignStore:
                 self.db.execute(
                     "UPDATE cases SET status='done', file=?, metrics=?, error=NULL, "
                     "traceback=NULL, software_version=?, spec_hash=?, wall_s=?, worker=?, "
-                    "updated=? WHERE case_id=?",
+                    "updated=?, sha256=? WHERE case_id=?",
                     (outcome["file"], json.dumps(outcome["metrics"]),
                      outcome.get("software_version"), spec_hash, outcome.get("wall_s"),
-                     outcome.get("worker"), now, case_id))
+                     outcome.get("worker"), now, outcome.get("sha256"), case_id))
             else:
                 self.db.execute(
                     "UPDATE cases SET status='failed', error=?, traceback=?, "
@@ -340,7 +394,7 @@ class CampaignStore:
         """
         q = ("SELECT case_id, controller, run_name, wind_mps, seed, turbulence, case_hash, "
              "assess_hash, status, file, metrics, error, traceback, software_version, spec_hash, "
-             "attempts, wall_s, worker FROM cases")
+             "attempts, wall_s, worker" + (", sha256" if self._has_sha else "") + " FROM cases")
         if not include_stale:
             q += " WHERE status != 'stale'"
         out = []

@@ -51,7 +51,17 @@ def case_file(case_id: str) -> str:
     -------
     str
         ``cases/CASE_ID.nc``.
+
+    Raises
+    ------
+    ValueError
+        If the case id is not one file name (a separator, ``..``, or a leading dot): its file
+        would lie outside ``cases/``.
     """
+    if (not case_id or case_id.startswith(".") or "/" in case_id or "\\" in case_id
+            or "\0" in case_id or Path(case_id).name != case_id):
+        raise ValueError(f"case id {case_id!r} is not a file name: its result would lie "
+                         f"outside the campaign's cases/ folder")
     return f"cases/{case_id}.nc"
 
 
@@ -204,7 +214,8 @@ def run_case(case: dict[str, Any], root: str) -> dict[str, Any]:
     -------
     dict
         ``status`` "done" with ``file`` (relative), ``metrics``, ``reused`` (the file already
-        held this case's simulation: only the assessment ran), or "failed" with ``error`` and
+        held this case's simulation: only the assessment ran) and the file's ``sha256``, or
+        "failed" with ``error`` and
         ``traceback``; both with ``wall_s``, ``worker`` (host:pid) and ``software_version``.
     """
     from mpc_wt._version import __version__
@@ -255,8 +266,10 @@ def run_case(case: dict[str, Any], root: str) -> dict[str, Any]:
         metrics.update(_plain(actuator_limit_metrics(
             res.t, cols, load_case_turbine(case["turbine"]).pitch_actuator.max_rate_rad_s,
             case["transient"])))
+        from mpc_wt.campaign.checksum import file_sha256
+
         return {**base, "status": "done", "file": rel, "metrics": metrics, "reused": reused,
-                "wall_s": time.perf_counter() - t0}
+                "sha256": file_sha256(path), "wall_s": time.perf_counter() - t0}
     except Exception as err:  # noqa: BLE001 - every failure is recorded, none stops others
         return {**base, "status": "failed", "error": f"{type(err).__name__}: {err}",
                 "traceback": traceback.format_exc(), "wall_s": time.perf_counter() - t0}

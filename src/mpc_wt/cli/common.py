@@ -4,7 +4,7 @@ from __future__ import annotations
 import argparse
 import csv
 import math
-import sys
+import os
 from pathlib import Path
 from typing import Any, Sequence
 
@@ -13,53 +13,45 @@ import numpy as np
 import linearize
 from linearize import OperatingPoint
 from mpc_wt.errors import UsageError
+from mpc_wt.io.json_text import to_json
 
 __all__ = ["parse_range", "add_turbine", "schedule", "format_table", "write_points_csv",
-           "cp_surface", "write_surface_csv", "pairs", "floats", "check_suffix", "to_json"]
+           "cp_surface", "write_surface_csv", "pairs", "floats", "check_suffix", "check_out_file",
+           "to_json"]
 
 TURBINE_HELP = ("packaged turbine name (nrel5mw, iea15mw), a turbine.yaml or an OpenFAST .fst "
                 "deck (default nrel5mw)")
 
 
-def _plain(obj: Any) -> Any:
-    """``obj`` with numpy scalars and arrays as Python values and non-finite floats as None."""
-    if isinstance(obj, dict):
-        return {str(k): _plain(v) for k, v in obj.items()}
-    if isinstance(obj, (list, tuple)):
-        return [_plain(v) for v in obj]
-    if isinstance(obj, np.ndarray):
-        return _plain(obj.tolist())
-    if isinstance(obj, (np.bool_, bool)):
-        return bool(obj)
-    if isinstance(obj, (np.integer, int)):
-        return int(obj)
-    if isinstance(obj, (np.floating, float)):
-        v = float(obj)
-        return v if math.isfinite(v) else None
-    if obj is None or isinstance(obj, str):
-        return obj
-    return str(obj)
 
-
-def to_json(obj: Any, indent: int | None = 1) -> str:
-    """Standard JSON text of ``obj``: NaN and infinities (undefined values) as null, numpy
-    values as numbers, anything else unknown as its string.
+def check_out_file(flag: str, value: str, suffix: str) -> Path:
+    """An output file named on the command line, checked before any work
+    (:func:`check_suffix`), with ``suffix`` added when it has none.
 
     Parameters
     ----------
-    obj : Any
-        Nested dicts, lists, numbers, strings.
-    indent : int or None
-        As :func:`json.dumps`.
+    flag : str
+        The option, for the message.
+    value : str
+        The path given.
+    suffix : str
+        The one suffix the command writes, e.g. ``".nc"``.
 
     Returns
     -------
-    str
-        JSON that any strict parser reads.
-    """
-    import json
+    Path
+        The path, with ``suffix`` when it had none.
 
-    return json.dumps(_plain(obj), indent=indent, allow_nan=False)
+    Raises
+    ------
+    UsageError
+        Naming the option, the path and what is allowed.
+    """
+    out = Path(value)
+    if out.suffix == "":
+        out = out.with_suffix(suffix)
+    check_suffix(str(out), flag, (suffix,))
+    return out
 
 
 def add_turbine(p: argparse.ArgumentParser) -> None:
@@ -116,7 +108,8 @@ def parse_range(text: str, name: str) -> np.ndarray:
 
 
 def check_suffix(path: str | None, name: str, allowed: Sequence[str]) -> None:
-    """Raise before any work if a file's suffix is not one we can write.
+    """Raise before any work if a file's suffix is not one we can write, it names a folder,
+    or its folder does not exist or is not writable.
 
     Parameters
     ----------
@@ -132,8 +125,19 @@ def check_suffix(path: str | None, name: str, allowed: Sequence[str]) -> None:
     UsageError
         Naming the option, the value and the allowed suffixes.
     """
-    if path is not None and Path(path).suffix.lower() not in allowed:
+    if path is None:
+        return
+    out = Path(path)
+    if out.suffix.lower() not in allowed:
         raise UsageError(f"{name} must end in {', '.join(allowed)}; got {path!r}")
+    if out.is_dir():
+        raise UsageError(f"{name} {path}: is a folder; name a file ending in "
+                         f"{', '.join(allowed)}")
+    folder = out.parent
+    if not folder.is_dir():
+        raise UsageError(f"{name} {path}: the folder {folder} does not exist")
+    if not os.access(folder, os.W_OK):
+        raise UsageError(f"{name} {path}: the folder {folder} is not writable")
 
 
 def schedule(turbine: linearize.Turbine, winds: np.ndarray, power_W: float | None,
@@ -156,11 +160,11 @@ def schedule(turbine: linearize.Turbine, winds: np.ndarray, power_W: float | Non
     list of OperatingPoint
         One per wind.
     """
-    from tqdm import tqdm
+    from linearize.progress import progress as bar
 
     params = linearize.plant_params(turbine)
     return [linearize.trim(turbine, float(v), power_W, params=params)
-            for v in tqdm(winds, desc="trim", unit="pt", disable=not progress, file=sys.stderr)]
+            for v in bar(winds, "trim", "pt", enabled=progress)]
 
 
 _TABLE_COLS = (("wind_mps", "wind [m/s]", "{:8.2f}"), ("region", "region", "{:>6s}"),

@@ -92,9 +92,10 @@ def main(argv: Sequence[str] | None = None) -> int:
     Returns
     -------
     int
-        0 on success, 1 when a campaign finished with failed cases or a tuning found no
-        design that meets its constraints, 2 on a usage or input
-        error (the message names the parameter and the value).
+        0 on success; 1 when a run failed (a simulation diverged, a controller library stopped
+        it), a campaign finished with failed cases or a tuning found no design that meets its
+        constraints; 2 on a usage or input error (the message names the parameter and the
+        value); 130 when interrupted (Ctrl-C).
     """
     logging.basicConfig(level=logging.WARNING, format="%(levelname)s %(name)s: %(message)s")
     argv = list(sys.argv[1:] if argv is None else argv)
@@ -108,6 +109,19 @@ def main(argv: Sequence[str] | None = None) -> int:
     args = build_parser().parse_args(argv)
     try:
         return int(args.func(args))
+    except KeyboardInterrupt:
+        resume = {"campaign": "run the same command again to resume: finished cases are kept",
+                  "tune": "run the same command again to resume: finished trials are kept"}
+        print(f"mpcwt {args.command}: interrupted; "
+              f"{resume.get(args.command, 'nothing was written after the interruption')}",
+              file=sys.stderr)
+        return 130
+    except (linearize.SimulationDivergedError, ControllerLibraryError) as err:
+        if getattr(err, "partial", None) is None and isinstance(err, ControllerLibraryError):
+            print(f"mpcwt {args.command}: error: {err}", file=sys.stderr)
+            return 2                          # the library could not be loaded: input
+        print(f"mpcwt {args.command}: run failed: {err}", file=sys.stderr)
+        return 1
     except _ERRORS as err:
         print(f"mpcwt {args.command}: error: {err}", file=sys.stderr)
         return 2

@@ -20,6 +20,7 @@ import linearize
 from mpc_wt.cli.common import (
     to_json,
     add_turbine,
+    check_out_file,
     cp_surface,
     format_table,
     pairs,
@@ -27,7 +28,7 @@ from mpc_wt.cli.common import (
     write_points_csv,
     write_surface_csv,
 )
-from mpc_wt.errors import UsageError
+from mpc_wt.errors import ControllerLibraryError, UsageError
 
 __all__ = ["add_parsers", "controller_options"]
 
@@ -162,13 +163,19 @@ def _simulate(args: argparse.Namespace) -> int:
     except ValueError as err:
         prefix = "" if hasattr(err, "key") else "--controller: "
         raise UsageError(f"{prefix}{err}") from None
+    out = check_out_file("--out", args.out, ".nc")
     turbine = linearize.load_turbine(args.turbine)
     scenario, sup = _events(args, turbine)
-    res = run_controller(turbine, args.controller, scenario, opts, supervisor=sup,
-                         progress=True, naming=naming)
-    out = Path(args.out)
-    if out.suffix == "":
-        out = out.with_suffix(".nc")
+    try:
+        res = run_controller(turbine, args.controller, scenario, opts, supervisor=sup,
+                             progress=True, naming=naming)
+    except (linearize.SimulationDivergedError, ControllerLibraryError) as err:
+        part = getattr(err, "partial", None)
+        if part is None:
+            raise
+        kept = out.with_suffix(".partial.nc")
+        part.save(kept)
+        raise type(err)(f"{err}; the samples simulated before are in {kept}", part) from None
     res.save(out)
     p = res.channel("gen_power")
     print(f"wrote {out}: {res.t.size} samples; mean power {p.mean() / 1e6:.3f} MW, "
@@ -409,7 +416,7 @@ def _design_outputs(turbine: linearize.Turbine, out: Path) -> None:
 
 
 def _comparison_row(name: str, a: dict[str, Any], cols: dict[str, np.ndarray],
-                    qp: Any, fname: str) -> dict[str, Any]:
+                    qp: Any, fname: str, solver: str | None = None) -> dict[str, Any]:
     return {"controller": name, "power_mean_MW": a["power_mean_W"] / 1e6,
             "power_std_kW": a["power_std_W"] / 1e3,
             "rotor_speed_std_rpm": float(np.std(cols["rotor_speed"])) * 30 / math.pi,
@@ -420,7 +427,7 @@ def _comparison_row(name: str, a: dict[str, Any], cols: dict[str, np.ndarray],
                if c in a["channels"]},
             "qp_median_ms": float(np.median(qp)) if qp is not None else None,
             "qp_p99_ms": float(np.percentile(qp, 99)) if qp is not None else None,
-            "file": fname}
+            "qp_solver": solver, "file": fname}
 
 
 #: Options the main job gives a kind in place of its defaults. The MPC kinds' default weights
@@ -457,7 +464,8 @@ def _comparison_runs(turbine: linearize.Turbine, args: argparse.Namespace, out: 
         keep = res.t >= min(60.0, 0.1 * args.duration)
         cols = {n: res.channel(n)[keep] for n in res.channels()}
         a = assess_series(res.t[keep], cols)
-        rows.append(_comparison_row(name, a, cols, res.controller.get("qp_solve_ms"), fname))
+        rows.append(_comparison_row(name, a, cols, res.controller.get("qp_solve_ms"), fname,
+                                    (res.meta.get("mpc") or {}).get("backend")))
         runs.append((name, res.t[keep], cols))
     samplers.clear()
     (out / "comparison.json").write_text(to_json(rows))
@@ -466,17 +474,17 @@ def _comparison_runs(turbine: linearize.Turbine, args: argparse.Namespace, out: 
           f"{args.seed}, the same field for all")
     print(f"{'controller':20s} {'P mean':>8s} {'P std':>8s} {'speed std':>9s} "
           f"{'pitch':>7s} {'DEL flap':>9s} {'DEL tower':>9s} {'DEL shaft':>9s} "
-          f"{'QP med/p99':>12s}")
+          f"{'QP med/p99':>17s}")
     print(f"{'':20s} {'[MW]':>8s} {'[kW]':>8s} {'[rpm]':>9s} {'[deg]':>7s} {'[MN m]':>9s} "
-          f"{'[MN m]':>9s} {'[MN m]':>9s} {'[ms]':>12s}")
+          f"{'[MN m]':>9s} {'[MN m]':>9s} {'[ms], solver':>17s}")
     for r in rows:
-        qp = (f"{r['qp_median_ms']:.2f}/{r['qp_p99_ms']:.2f}" if r["qp_median_ms"] is not None
-              else "-")
+        qp = (f"{r['qp_median_ms']:.2f}/{r['qp_p99_ms']:.2f} {r['qp_solver'] or ''}".rstrip()
+              if r["qp_median_ms"] is not None else "-")
         print(f"{r['controller']:20s} {r['power_mean_MW']:8.3f} {r['power_std_kW']:8.1f} "
               f"{r['rotor_speed_std_rpm']:9.3f} {r['pitch_travel_deg']:7.0f} "
               f"{r.get('del_flap_moment_1_MNm', float('nan')):9.3f} "
               f"{r.get('del_tower_base_fa_moment_MNm', float('nan')):9.3f} "
-              f"{r.get('del_shaft_bending_blade1_MNm', float('nan')):9.3f} {qp:>12s}")
+              f"{r.get('del_shaft_bending_blade1_MNm', float('nan')):9.3f} {qp:>17s}")
     min_rpm = turbine.operation.min_rotor_speed_rad_s * 30 / math.pi
     for line in design_warnings(rows, min_rpm, turbine.operation.rated_power / 1e6):
         print(line)

@@ -42,6 +42,7 @@ import linearize
 from mpc_wt._version import __version__
 from mpc_wt.controllers.baseline import effective_pi_gains
 from mpc_wt.errors import GainTableError
+from mpc_wt.io.json_text import write_json
 
 __all__ = ["SCHEMA_VERSION", "GainTableError", "baseline_table", "lqr_table", "ts_table",
            "ibc_table", "coleman_ipc_table", "mpc_table", "lqr_pio_table", "lidar_ff_table", "design_turbine",
@@ -464,7 +465,7 @@ def save_design(doc: dict[str, Any], out_dir: str | Path) -> Path:
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     p = out / "design.json"
-    p.write_text(json.dumps(_check(doc, "the design"), indent=1))
+    write_json(p, _check(doc, "the design"))
     return p
 
 
@@ -691,7 +692,7 @@ def export(doc_or_dir: dict[str, Any] | str | Path, fmt: str,
     out.mkdir(parents=True, exist_ok=True)
     if fmt == "json":
         p = out / "gains.json"
-        p.write_text(json.dumps(doc, indent=1))
+        write_json(p, doc)
         return [p]
     if fmt == "csv":
         return _write_csv(doc, out)

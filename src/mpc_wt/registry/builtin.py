@@ -324,7 +324,7 @@ class MPCOptions(Options):
                                     "OSQP)", choices=(None, "osqp", "daqp"))
     formulation: str = option("condensed", help="QP formulation (sparse: OSQP only)",
                               choices=("condensed", "sparse"))
-    horizon: int = option(15, help="H_p = H_u", lo=1)
+    horizon: int = option(15, help="H_p = H_u", lo=1, hi=200)
     estimator: str = option("kalman", help="kalman: states and blade winds estimated from "
                             "measured signals (rotor and generator speed, pitch, flap moments, "
                             "tower-top acceleration); full-state: the plant's true states, an "

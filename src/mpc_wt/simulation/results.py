@@ -211,14 +211,37 @@ def load_series(path: str | Path, time_column: str = "time") -> tuple[np.ndarray
     ------
     ResultFileError
         If the file cannot be read, has no time column, non-numeric cells, an OpenFAST channel
-        with a unit it cannot have, or a suffix other than .nc, .out, .outb, .csv.
+        with a unit it cannot have, or a suffix other than .nc, .out, .outb, .csv; if its time
+        is not uniform and increasing (:func:`check_time`) or a channel is not finite (the
+        message names the file, the channel and the time).
     """
+    from mpc_wt.assessment.series import check_time
+
+    path = Path(path)
+    t, cols = _load_any(path, time_column)
+    try:
+        check_time(t)
+    except ValueError as err:
+        raise ResultFileError(f"{path}: {err}") from None
+    for name, x in cols.items():
+        x = np.asarray(x)
+        if x.shape != t.shape:
+            raise ResultFileError(f"{path}: channel {name!r} has {x.size} samples, the time "
+                                  f"{t.size}")
+        bad = ~np.isfinite(x)
+        if bad.any():
+            i = int(np.argmax(bad))
+            raise ResultFileError(f"{path}: channel {name!r} is {float(x[i])!r} at t = "
+                                  f"{t[i]:g} s (sample {i}); a run's channels must be finite")
+    return t, cols
+
+
+def _load_any(path: Path, time_column: str) -> tuple[np.ndarray, dict[str, np.ndarray]]:
     import logging
 
     from mpc_wt.io.openfast_output import read_openfast_output, to_mpcwt_channels
 
     log = logging.getLogger("mpc_wt.simulation.results")
-    path = Path(path)
     suffix = path.suffix.lower()
     if suffix in (".out", ".outb"):
         series = read_openfast_output(path)

@@ -25,6 +25,12 @@ __all__ = ["Scenario", "check_turbulence", "check_condition", "is_deterministic"
 _EVOLUTION_STREAM = 0x65766F6C
 
 
+#: The longest run a scenario takes [s]: the turbulent field of 3 h on the default grid (32 x 32
+#: points every 0.05 s, u only, float32) takes 0.9 GB stored, several times that while it is
+#: generated, before the LIDAR's own field and the result.
+MAX_DURATION_S = 10800.0
+
+
 @dataclass(frozen=True)
 class Scenario:
     """One load case: mean wind, turbulence, seed, length and shear, and optionally an IEC
@@ -91,6 +97,10 @@ class Scenario:
                 raise ValueError(f"condition must be 'ntm' with a wind_file, got "
                                  f"{self.condition!r}")
         check_positive("duration", self.duration)
+        if self.duration > MAX_DURATION_S:
+            raise ValueError(f"duration must be at most {MAX_DURATION_S:g} s (3 h: a longer "
+                             f"turbulent field takes several GB to make), got "
+                             f"{self.duration:g}; split a longer run")
         check_range("shear_exponent", self.shear_exponent, -1.0, 1.0)
         check_turbulence(self.turbulence)
         if isinstance(self.seed, bool) or not isinstance(self.seed, (int, np.integer)) \

@@ -2,7 +2,6 @@
 from __future__ import annotations
 
 import inspect
-import json
 import logging
 import math
 from pathlib import Path
@@ -10,6 +9,7 @@ from typing import Any, Mapping
 
 import numpy as np
 
+from mpc_wt.io.json_text import write_json
 from mpc_wt.tuning.outcome import REPORT_METRICS, TuneOutcome, pareto_front, write_trials_csv
 from mpc_wt.tuning.spec import TuneSpec
 
@@ -147,7 +147,7 @@ def write_outputs(spec: TuneSpec, outcome: TuneOutcome, out: Path) -> list[Path]
             "objective": best.value, "metrics": best.metrics},
         "tuning": outcome.tuning, "holdout": outcome.holdout,
         "holdout_seeds": list(spec.holdout_seeds)}
-    (out / "best.json").write_text(json.dumps(doc, indent=1))
+    write_json(out / "best.json", doc)
     files.append(out / "best.json")
     png = _plot_pareto(spec, outcome, out / "pareto.png")
     if png:

@@ -14,7 +14,6 @@ from __future__ import annotations
 
 import contextlib
 import fcntl
-import json
 import logging
 import time
 from pathlib import Path
@@ -24,6 +23,7 @@ from mpc_wt.campaign.aggregate import absolute_metrics, relative_metrics
 from mpc_wt.campaign.runner import run_campaign
 from mpc_wt.campaign.store import CampaignStore
 from mpc_wt.errors import CampaignLockedError, TrialFailed
+from mpc_wt.io.json_text import write_json
 from mpc_wt.tuning.optimizer import optimize
 from mpc_wt.tuning.outcome import TuneOutcome
 from mpc_wt.tuning.spec import TuneSpec, load_tune_spec
@@ -115,7 +115,7 @@ def tune(spec: TuneSpec | str | Path, out: str | Path, *, engine: str = "dask",
     out = Path(out)
     t0 = time.perf_counter()
     with _lock(out), _engine(engine, workers, scheduler) as run:
-        (out / "spec.json").write_text(json.dumps(spec.raw, indent=1, default=str))
+        write_json(out / "spec.json", spec.raw)
         root = out / "campaign"
 
         def evaluate(params: dict[str, Any]) -> dict[str, float]:

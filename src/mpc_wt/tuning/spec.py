@@ -41,7 +41,7 @@ from typing import Any, Mapping
 import yaml
 
 from mpc_wt.campaign.aggregate import ABSOLUTE_METRICS, RELATIVE_METRICS
-from mpc_wt.campaign.spec import CampaignSpec, spec_from_dict
+from mpc_wt.campaign.spec import CampaignSpec, check_name, spec_from_dict
 from mpc_wt.errors import SpecError
 from mpc_wt.tuning.optimizer import SAMPLERS, Constraint, Parameter
 
@@ -348,12 +348,14 @@ def tune_spec_from_dict(raw: Mapping[str, Any], base: Path | None = None) -> Tun
     name = raw["name"]
     if not isinstance(name, str) or not name.strip():
         raise _fail("name", f"must be a non-empty string, got {name!r}")
+    check_name("name", name, _fail)
     ctl, ref = raw["controller"], raw["reference"]
     if not isinstance(ctl, Mapping) or "controller" not in ctl or "name" in ctl:
         raise _fail("controller", f"must be a mapping with `controller` (the kind) and its "
                                   f"fixed options, no name; got {ctl!r}")
     if not isinstance(ref, Mapping) or "name" not in ref or "controller" not in ref:
         raise _fail("reference", f"must be a mapping with `name` and `controller`, got {ref!r}")
+    check_name("reference.name", ref["name"], _fail)
     camp = {k: raw[k] for k in _CAMPAIGN_KEYS if k in raw}
     camp["winds"] = raw["winds"]
     params = _parameters(raw["parameters"])

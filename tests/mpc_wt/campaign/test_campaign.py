@@ -568,3 +568,41 @@ def test_the_runner_hands_out_long_cases_first_and_a_scenarios_controllers_toget
     pairs = [(c.scenario.wind_mps, c.scenario.seed, c.controller) for c in order[2:]]
     assert pairs == [(v, s, k) for v in (6.0, 13.0) for s in (1, 2)
                      for k in ("baseline", "coleman-ipc")]
+
+
+def test_changed_or_cut_files_are_found_by_checksum_and_computed_again(tmp_path, caplog):
+    """Two finished cases: one file's flap moment scaled by 3 in place (still a valid file),
+    the other cut to 800 kB. The report refuses, naming both; resuming computes both again
+    (logged), moves the changed files aside, and the report then equals the first one's DELs
+    (the simulation is deterministic)."""
+    import logging
+
+    from mpc_wt.campaign.report import make_report
+    from mpc_wt.errors import ResultFileError
+
+    spec = _spec(winds=[12, 16])
+    run_campaign(spec, tmp_path, engine="serial", progress=False)
+    with CampaignStore(tmp_path) as st_:
+        rows = {r.case_id: r for r in st_.rows()}
+    assert all(r.sha256 and len(r.sha256) == 64 for r in rows.values())
+    before = {k: r.metrics["channels"]["flap_moment_1"]["del"] for k, r in rows.items()}
+    scaled, cut = (tmp_path / rows[k].file for k in sorted(rows))
+    import linearize
+
+    res = ClosedLoopResult.load(scaled)
+    res.z[:, linearize.OUTPUT_NAMES.index("flap_moment_1")] *= 3.0
+    res.save(scaled)
+    data = cut.read_bytes()
+    cut.write_bytes(data[:800_000] if len(data) > 800_000 else data[: len(data) // 2])
+    with pytest.raises(ResultFileError, match=r"2 case file\(s\) do not match the checksum") as e:
+        make_report(tmp_path)
+    assert all(k in str(e.value) for k in rows)
+    with caplog.at_level(logging.WARNING, logger="mpc_wt.campaign.store"):
+        s = run_campaign(spec, tmp_path, engine="serial", progress=False)
+    assert (s.submitted, s.done, s.reused) == (2, 2, 0)
+    assert sum("does not match the checksum" in m for m in caplog.messages) == 2
+    assert scaled.with_suffix(".changed.nc").is_file() and cut.with_suffix(".changed.nc").is_file()
+    with CampaignStore(tmp_path) as st_:
+        again = {r.case_id: r.metrics["channels"]["flap_moment_1"]["del"] for r in st_.rows()}
+    assert again == before
+    make_report(tmp_path)

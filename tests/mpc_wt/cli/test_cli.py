@@ -60,6 +60,17 @@ def test_run_writes_table_and_plots(tmp_path: Path, capsys: pytest.CaptureFixtur
     assert [r["controller"] for r in rows] == ["baseline", "baseline+lidar-ff", "mpc-lidar"]
     assert rows[2]["qp_median_ms"] > 0 and rows[0]["qp_median_ms"] is None
     assert "mpc-lidar" in out and "QP med/p99" in out
+    # the MPC line names its solver: DAQP, the default, is a core dependency
+    assert rows[2]["qp_solver"] == "daqp"
+    assert next(ln for ln in out.splitlines() if ln.startswith("mpc-lidar ")).endswith(" daqp")
+    assert "main job's weights.pitch_rate=0.035" in out
+    # every JSON file it wrote is standard JSON (no NaN or Infinity)
+    def refuse(name):
+        raise ValueError(f"not JSON: {name}")
+    written = sorted(tmp_path.rglob("*.json"))
+    assert len(written) >= 3
+    for f in written:
+        json.loads(f.read_text(), parse_constant=refuse)
     pts = json.loads((tmp_path / "operating_points.json").read_text())
     assert pts[0]["wind_mps"] == 3.0 and pts[-1]["wind_mps"] == 25.0
 

@@ -1,9 +1,12 @@
-"""Every ``--json`` the command line prints is standard JSON (no NaN or Infinity: null where a
-value is undefined), and ``mpcwt --version`` names the installed version."""
+"""The command line as a user meets it: every ``--json`` is standard JSON (no NaN or Infinity:
+null where a value is undefined), ``mpcwt --version`` names the installed version, the main
+job's warnings, ``assess`` with units and changes, and runs whose time or channels ``assess``
+refuses, named by file, channel and time."""
 from __future__ import annotations
 
 import json
 import math
+import re
 
 import numpy as np
 import pytest
@@ -131,3 +134,45 @@ def test_version_names_the_version_in_pyproject(capsys) -> None:
         main(["--version"])
     assert stop.value.code == 0
     assert capsys.readouterr().out.strip() == f"mpcwt (mpc-wt) {declared}"
+
+
+def _csv(path, t, flap):
+    np.savetxt(path, np.c_[t, flap, np.full_like(t, 5e6)], delimiter=",",
+               header="time,flap_moment_1,gen_power", comments="")
+    return str(path)
+
+
+@pytest.mark.parametrize("make, match", [
+    (lambda t: np.r_[t[:100], t[100:] + 25.0],
+     r"the time step is 25.05 s from t = 4.95 s, the run's step 0.05 s: a gap"),
+    (lambda t: np.r_[t[:50], t[49:-1]], r"the time repeats at sample 50: 2.45 s then 2.45 s"),
+    (lambda t: np.r_[t[:50], t[48:-2]], r"the time goes back at sample 50: 2.45 s then 2.4 s"),
+])
+def test_assess_refuses_a_time_that_is_not_uniform(capsys, tmp_path, make, match) -> None:
+    """A 25 s gap, a repeated and a backward time stamp: exit 2 naming the file and where
+    (they were counted as if continuous)."""
+    t = np.arange(0.0, 60.0, 0.05)
+    path = _csv(tmp_path / "run.csv", make(t), 1e6 * np.sin(t))
+    assert main(["assess", path]) == 2
+    err = capsys.readouterr().err
+    assert path in err and re.search(match, err), err
+
+
+def test_assess_names_the_file_and_channel_of_a_nan(capsys, tmp_path) -> None:
+    t = np.arange(0.0, 60.0, 0.05)
+    flap = 1e6 * np.sin(t)
+    flap[300] = np.nan
+    path = _csv(tmp_path / "run.csv", t, flap)
+    assert main(["assess", path]) == 2
+    err = capsys.readouterr().err
+    assert f"{path}: channel 'flap_moment_1' is nan at t = 15 s (sample 300)" in err, err
+
+
+def test_a_time_rounded_to_its_last_digit_is_taken() -> None:
+    """160 Hz written with 4 decimals (steps 0.0062 and 0.0063) is uniform within the
+    tolerance; the assessment runs."""
+    from mpc_wt.assessment.series import assess_series
+
+    t = np.round(np.arange(0, 4000) / 160.0, 4)
+    a = assess_series(t, {"flap_moment_1": np.sin(t)})
+    assert a["duration_s"] == pytest.approx(t[-1])

@@ -90,7 +90,7 @@ def test_names_resolve_to_base_preset_and_addons(name, base, preset, addons) -> 
     ("baseline", {"gian": 1}, r"gian: unknown option of controller 'baseline'; allowed: "
                               r"\['omega_n_rad_s', 'zeta'\]"),
     ("apc", {}, "controller 'apc' needs apc_frequency"),
-    ("mpc", {"horizon": 0}, "horizon must be >= 1, got 0"),
+    ("mpc", {"horizon": 0}, "horizon must be >= 1 and <= 200, got 0"),
     ("mpc", {"horizon": 2.5}, "horizon must be an integer, got 2.5"),
     ("mpc", {"backend": "gurobi"}, "backend must be one of None, 'osqp', 'daqp'"),
     ("ts", {"horizon": 5}, "apply to the MPC controllers only, not to controller 'ts'"),
@@ -216,7 +216,7 @@ def test_option_class_for_users_validates_its_fields() -> None:
     (["design", "lqr", "--observer-q=-5"], "--observer-q must be >= 0, got -5.0"),
     (["wind", "generate", "--mean", "18", "--out", "field.txt"], "--out must end in .bts, .npz"),
     (["simulate", "--controller", "mpc", "--horizon", "0", "--wind", "18"],
-     "horizon must be >= 1, got 0"),
+     "horizon must be >= 1 and <= 200, got 0"),
 ])
 def test_commands_check_their_arguments_before_working(argv, match, tmp_path: Path,
                                                        capsys: pytest.CaptureFixture[str],

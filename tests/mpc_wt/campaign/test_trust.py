@@ -1,0 +1,105 @@
+"""Reading a campaign runs none of its code: ``mpcwt campaign report`` and ``status`` of a
+campaign whose spec names a plugin do not import the plugin (a module that leaves a marker file
+when imported), where ``mpcwt campaign run`` does."""
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+import textwrap
+from pathlib import Path
+
+import pytest
+
+PLUGIN = textwrap.dedent('''
+    """A plugin that leaves a marker when it is imported."""
+    import os
+    from pathlib import Path
+
+    Path(os.environ["MPCWT_TEST_MARKER"]).write_text("imported")
+''')
+
+
+def _cli(args: list[str], env: dict[str, str]) -> subprocess.CompletedProcess:
+    code = f"from mpc_wt.cli.main import main; raise SystemExit(main({args!r}))"
+    return subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                          env=env, timeout=300)
+
+
+def test_report_and_status_do_not_import_the_specs_plugins(tmp_path: Path) -> None:
+    (tmp_path / "plug").mkdir()
+    (tmp_path / "plug" / "trust_plugin.py").write_text(PLUGIN)
+    marker = tmp_path / "imported.txt"
+    spec = tmp_path / "spec.yaml"
+    spec.write_text(textwrap.dedent("""
+        name: trust
+        duration: 10
+        transient: 0
+        winds: [18]
+        seeds: 1
+        turbulence: steady
+        plugins: [trust_plugin]
+        controllers: [baseline]
+        channels: {tower_base_fa_moment: 4}
+    """))
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join(
+        [str(tmp_path / "plug"), os.environ.get("PYTHONPATH", "")]),
+        "MPCWT_TEST_MARKER": str(marker)}
+    camp = tmp_path / "camp"
+    run = _cli(["campaign", "run", str(spec), "--out", str(camp), "--engine", "serial"], env)
+    assert run.returncode == 0, run.stderr[-2000:]
+    assert marker.read_text() == "imported"           # running a spec runs its plugins
+    marker.unlink()
+    for args in (["campaign", "report", str(camp)], ["campaign", "status", str(camp)]):
+        done = _cli(args, env)
+        assert done.returncode == 0, done.stderr[-2000:]
+        assert not marker.exists(), f"{args[1]} imported the spec's plugin"
+    assert "baseline" in (camp / "report" / "report.md").read_text()
+
+
+@pytest.mark.parametrize("opts", [{"extra_pitch_deg": "a"}])
+def test_a_stored_specs_unknown_kind_is_read_as_given(opts) -> None:
+    """Without importing plugins, a kind the registry does not know is a plugin's: its
+    options are kept as given, not checked; with the import asked for, the plugin must be
+    importable."""
+    from mpc_wt.campaign import SpecError, spec_from_dict
+
+    raw = {"name": "p", "winds": [18], "seeds": 1, "plugins": ["not_imported_here"],
+           "controllers": [{"name": "h", "controller": "some-plugin-kind", **opts}]}
+    spec = spec_from_dict(raw, import_plugins=False)
+    assert spec.controllers[0].options == opts
+    with pytest.raises(SpecError, match="plugins"):
+        spec_from_dict(raw)
+
+
+def _inc(x: int) -> int:
+    return x + 1
+
+
+def test_the_local_cluster_is_closed_to_other_clients() -> None:
+    """The campaigns' local Dask cluster speaks TLS with certificates of its own: its client
+    runs a task; a client without them (another process attaching to the address, over TLS or
+    plain TCP) is refused; the scheduler serves no dashboard page on the loopback interface."""
+    import urllib.error
+    import urllib.request
+
+    distributed = pytest.importorskip("distributed")
+    from mpc_wt.campaign.runner import local_cluster
+
+    cluster = local_cluster(1)
+    try:
+        addr = cluster.scheduler_address
+        assert addr.startswith("tls://127.0.0.1:")
+        with distributed.Client(cluster) as client:
+            assert client.submit(_inc, 1).result(timeout=60) == 2
+        for other in (addr, addr.replace("tls://", "tcp://")):
+            with pytest.raises(Exception):
+                distributed.Client(other, timeout="5s")
+        ports = [s.getsockname()[1] for s in cluster.scheduler.http_server._sockets.values()]
+        assert ports and 8787 not in ports
+        for port in ports:
+            with pytest.raises(urllib.error.HTTPError) as err:
+                urllib.request.urlopen(f"http://127.0.0.1:{port}/status", timeout=5)
+            assert err.value.code == 404
+    finally:
+        cluster.close()
