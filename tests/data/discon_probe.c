@@ -1,8 +1,10 @@
 /* A Bladed-style test controller for tests/mpc_wt/controllers/test_discon.py: it appends every record it
  * receives (1..130) to <OUTNAME>.swap.csv, counts its calls in a global (one count per loaded
  * copy), answers fixed demands, and stops the run (aviFAIL = -1) at t >= 0.5 s when its input
- * file is named PROBE_STOP.IN. */
+ * file is named PROBE_STOP.IN; with PROBE_EXIT.IN it prints a line and calls exit(3) there, with
+ * PROBE_CRASH.IN it prints a line and writes through a null pointer (a segfault). */
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 static int calls = 0;
@@ -28,5 +30,15 @@ void DISCON(float *swap, int *fail, const char *infile, char *outname, char *msg
     if (strstr(infile, "PROBE_STOP.IN") && swap[1] >= 0.5f) {
         *fail = -1;
         strcpy(msg, "probe: stop requested by its input file");
+    }
+    if (strstr(infile, "PROBE_EXIT.IN") && swap[1] >= 0.5f) {
+        printf("probe: giving up at t = %.2f s\n", swap[1]);
+        fflush(stdout);
+        exit(3);
+    }
+    if (strstr(infile, "PROBE_CRASH.IN") && swap[1] >= 0.5f) {
+        printf("probe: about to crash\n");
+        fflush(stdout);
+        *(volatile int *)0 = 1;
     }
 }

@@ -354,7 +354,8 @@ def aggregate(root: str | Path) -> dict[str, Any]:
     dict
         ``spec``, ``rows`` (finished cases), ``short_term``, ``per_wind``, ``lifetime``,
         ``aep``, ``pitch``, ``cs``, ``extension`` (of the fatigue load cases), ``ultimate``,
-        ``governing``, ``signoff`` (:mod:`.signoff`; every load case), ``fatigue_rows``
+        ``governing``, ``signoff`` (:mod:`.signoff`; every load case), ``failed`` (each failed
+        case with the first line of its error), ``fatigue_rows``
         (the finished cases of the fatigue load cases), ``sweep``,
         ``incomplete`` and ``outliers``.
 
@@ -367,6 +368,9 @@ def aggregate(root: str | Path) -> dict[str, Any]:
     out: dict[str, Any] = {"spec": spec, "rows": rows, "short_term": [], "per_wind": [],
                            "lifetime": [], "aep": [], "pitch": [], "regulation": [], "cs": [],
                            "extension": [], "sweep": [], "incomplete": [], "outliers": []}
+    out["failed"] = [{"case_id": r.case_id, "controller": r.controller, "wind_mps": r.wind_mps,
+                      "reason": (r.error or "unknown error").strip().splitlines()[0][:400]}
+                     for r in failed]
     out["ultimate"] = ultimate_rows(spec, rows)
     out["governing"] = governing_rows(spec, out["ultimate"])
     out["signoff"] = signoff_rows(spec, rows, failed) if not spec.load_cases[0].legacy else []

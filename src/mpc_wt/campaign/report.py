@@ -199,6 +199,11 @@ def _md_head(agg: dict[str, Any], paper: list[dict[str, Any]]) -> list[str]:
     if agg["incomplete"]:
         md += ["**Incomplete:** " + "; ".join(agg["incomplete"]) + " (failed or not run; "
                "`mpcwt campaign status` lists them).", ""]
+    if agg.get("failed"):
+        md += ["## Failed cases", "", "Left out of every table; `mpcwt campaign status DIR "
+               "--failed` prints their tracebacks.", "",
+               _md(agg["failed"], ["case_id", "controller", "wind_mps", "reason"],
+                   ["case", "controller", "wind [m/s]", "reason"]), ""]
     if paper:
         md += ["## Ours next to the paper", "",
                _md(paper, ["what", "controller", "wind", "turbulence", "paper", "ours",

@@ -15,6 +15,7 @@ import dataclasses
 import hashlib
 import json
 import math
+import os
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Mapping
@@ -1240,6 +1241,47 @@ def _paper_row(key: str, p: Any, names: list[str], chans: Mapping[str, float]) -
         _number(f"{key}.value", p.get("value"))
     if p["metric"] in ("del_change_pct", "cs_change_pct", "value") and "wind" not in p:
         raise _fail(f"{key}.wind", f"metric {p['metric']!r} is per mean wind: give wind [m/s]")
+
+
+def foreign_code(path: str | Path) -> list[str]:
+    """The code a spec would run that another user wrote: the spec file itself, the plugin
+    modules beside it (``NAME.py`` in its folder) and the controller libraries it names
+    (``discon_library``), each owned by neither the current user nor root. Read with a safe
+    YAML loader; nothing of the spec runs.
+
+    Parameters
+    ----------
+    path : str or Path
+        The spec (a campaign's or a tuning's).
+
+    Returns
+    -------
+    list of str
+        ``"FILE (owner uid N)"`` per such file; empty when all are the user's or root's.
+    """
+    path = Path(path)
+    try:
+        raw = yaml.safe_load(path.read_text())
+    except (OSError, yaml.YAMLError):
+        return []                   # load_spec names what is wrong with the file
+    files = [path]
+    if isinstance(raw, Mapping):
+        plugins = raw.get("plugins") or []
+        files += [path.parent / f"{m}.py" for m in plugins if isinstance(m, str)]
+        ctls = [raw.get("controller")] + list(raw.get("controllers") or [])
+        files += [Path(c["discon_library"]) if Path(c["discon_library"]).is_absolute()
+                  else path.parent / c["discon_library"] for c in ctls
+                  if isinstance(c, Mapping) and isinstance(c.get("discon_library"), str)]
+    me = os.getuid() if hasattr(os, "getuid") else None
+    out = []
+    for f in files:
+        try:
+            uid = f.stat().st_uid
+        except OSError:
+            continue
+        if me is not None and uid not in (me, 0):
+            out.append(f"{f} (owner uid {uid})")
+    return out
 
 
 def load_spec(path: str | Path) -> CampaignSpec:

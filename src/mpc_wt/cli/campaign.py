@@ -46,6 +46,9 @@ def add_parsers(sub: Any) -> None:
     q.add_argument("--report", action="store_true", help="write the report when all cases "
                                                          "finished")
     q.add_argument("--quiet", action="store_true", help="no progress bar")
+    q.add_argument("--trust", action="store_true",
+                   help="run a spec, plugins or libraries that another user wrote (they are "
+                        "code; see the docs' Security page)")
     q.set_defaults(func=_run)
     q = camp.add_parser("status", help="cases done, failed, pending of a campaign directory")
     q.add_argument("dir")
@@ -68,6 +71,9 @@ def add_parsers(sub: Any) -> None:
     q.add_argument("--scheduler", default=None,
                    help="address of a running Dask scheduler, tcp://HOST:PORT")
     q.add_argument("--engine", choices=("dask", "processes", "serial"), default="dask")
+    q.add_argument("--trust", action="store_true",
+                   help="run a spec, plugins or libraries that another user wrote (they are "
+                        "code; see the docs' Security page)")
     q.add_argument("--quiet", action="store_true", help="no progress bar")
     q.set_defaults(func=_tune)
 
@@ -88,6 +94,20 @@ def _bench_mpc(args: argparse.Namespace) -> int:
     return 0
 
 
+def _check_trust(args: argparse.Namespace) -> None:
+    """Refuse, before anything of it runs, a spec whose code another user wrote, unless
+    ``--trust``."""
+    from mpc_wt.campaign.spec import foreign_code
+
+    found = foreign_code(args.spec)
+    if found and not args.trust:
+        raise UsageError(f"{args.spec}: written by another user: {'; '.join(found)}. A spec's "
+                         f"plugins and controller libraries are code that runs with your "
+                         f"rights; read them, then give --trust to run them")
+    if found:
+        log.warning("running code another user wrote (--trust): %s", "; ".join(found))
+
+
 def _run(args: argparse.Namespace) -> int:
     from mpc_wt.campaign.runner import run_campaign
     from mpc_wt.campaign.spec import load_spec
@@ -95,6 +115,7 @@ def _run(args: argparse.Namespace) -> int:
     if args.scheduler and args.workers:
         raise UsageError("give --workers (local cluster) or --scheduler (running cluster), "
                          "not both")
+    _check_trust(args)
     spec = load_spec(args.spec)
     out = Path(args.out) if args.out else Path("campaigns") / spec.name
     if args.engine == "dask":
@@ -188,6 +209,7 @@ def _tune(args: argparse.Namespace) -> int:
                          "not both")
     if args.trials is not None and args.trials < 1:
         raise UsageError(f"--trials must be >= 1, got {args.trials}")
+    _check_trust(args)
     spec = load_tune_spec(args.spec)
     out = Path(args.out) if args.out else Path("tunings") / spec.name
     if args.engine == "dask":

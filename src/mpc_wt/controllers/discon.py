@@ -6,18 +6,25 @@ measurements and settings before each call and from which it reads the demands a
 (Bladed User Manual, appendix A; the records as ServoDyn fills them, :data:`SWAP_RECORDS`).
 ``avrSWAP(1)`` is the status: 0 on the first call, 1 on every later one, -1 on the last.
 
-Each :class:`DisconController` loads its own copy of the library (copied to a private temporary
-folder): libraries keep their state in globals (ROSCO refuses a second initialization of one
-loaded copy, "This ROSCO dynamic library has already been loaded"), so two controllers, or two
-runs in one process, must not share one.
+Each :class:`DisconController` runs the library in a child process of its own, started anew
+for every run (:mod:`mpc_wt.controllers.discon_child`): a library that calls ``exit()``, aborts
+or crashes ends that process, and the run fails with the library's last output as its reason
+while the simulation's process goes on. Libraries keep their state in globals (ROSCO refuses a
+second initialization, "This ROSCO dynamic library has already been loaded"), which a fresh
+process also gives. With ``isolate=False`` the library is loaded in the simulation's process
+instead (a private copy of the file per controller): faster per call, but nothing contains it.
 """
 from __future__ import annotations
 
+import contextlib
 import ctypes
 import logging
 import math
+import mmap
 import os
 import shutil
+import struct
+import subprocess
 import sys
 import tempfile
 from pathlib import Path
@@ -152,15 +159,12 @@ def _check_library(path: Path) -> None:
 _PRELOADED: set[str] = set()
 
 
-def _preload_dependencies(original: Path) -> None:
-    """Load the libraries a wheel bundles beside ``original`` ($ORIGIN-relative RPATH, e.g.
-    ROSCO's ``rosco.libs/libgfortran-*.so``) once, globally, so that a copy of ``original`` in
-    another folder finds them by their sonames. Only these runtime dependencies are shared
-    between copies; the controller's own globals are not."""
+def _dependency_libs(original: Path) -> list[Path]:
+    """The libraries a wheel bundles beside ``original`` ($ORIGIN-relative RPATH, e.g. ROSCO's
+    ``rosco.libs/libgfortran-*.so``), which a copy of ``original`` elsewhere (or a child
+    process) must load first to find them by their sonames."""
     import re
 
-    # unbuffered Fortran units, so that a quiet controller's redirect catches what is printed
-    os.environ.setdefault("GFORTRAN_UNBUFFERED_PRECONNECTED", "y")
     data = original.read_bytes()
     dirs = []
     for m in re.finditer(rb"\$(?:ORIGIN|\{ORIGIN\})([^\x00:]*)", data):
@@ -168,8 +172,16 @@ def _preload_dependencies(original: Path) -> None:
         d = (original.parent / rest).resolve()
         if d.is_dir() and d != original.parent.resolve():
             dirs.append(d)
-    libs = [f for d in dirs for f in sorted(d.iterdir())
-            if ".so" in f.name and str(f) not in _PRELOADED]
+    return [f for d in dirs for f in sorted(d.iterdir()) if ".so" in f.name]
+
+
+def _preload_dependencies(original: Path) -> None:
+    """Load :func:`_dependency_libs` of ``original`` once, globally, in this process. Only
+    these runtime dependencies are shared between copies; the controller's own globals are
+    not."""
+    # unbuffered Fortran units, so that a quiet controller's redirect catches what is printed
+    os.environ.setdefault("GFORTRAN_UNBUFFERED_PRECONNECTED", "y")
+    libs = [f for f in _dependency_libs(original) if str(f) not in _PRELOADED]
     for _ in range(3):                       # dependencies among them: retry in passes
         left = []
         for f in libs:
@@ -181,6 +193,127 @@ def _preload_dependencies(original: Path) -> None:
         if not left or len(left) == len(libs):
             break
         libs = left
+
+
+_CHILD = Path(__file__).with_name("discon_child.py")
+
+
+def _read_exact(fd: int, n: int) -> bytes | None:
+    """``n`` bytes from ``fd``, or None when the other end closed first."""
+    parts, got = [], 0
+    while got < n:
+        chunk = os.read(fd, n - got)
+        if not chunk:
+            return None
+        parts.append(chunk)
+        got += len(chunk)
+    return b"".join(parts)
+
+
+class _ChildLibrary:
+    """A controller library loaded in a child process (:mod:`.discon_child`); what it prints
+    goes to a log whose last lines become the reason when it ends its process."""
+
+    def __init__(self, library: Path, infile: str, outname: str) -> None:
+        self.library = library
+        self.alive = True
+        fd, self.log = tempfile.mkstemp(prefix="mpcwt_discon_", suffix=".log")
+        os.close(fd)
+        fd, shared = tempfile.mkstemp(prefix="mpcwt_discon_", suffix=".swap")
+        try:
+            os.ftruncate(fd, SWAP_SIZE * 4)
+            self._mem = mmap.mmap(fd, SWAP_SIZE * 4)
+        finally:
+            os.close(fd)
+        self._swap = np.frombuffer(self._mem, dtype=np.float32)
+        env = {**os.environ, "GFORTRAN_UNBUFFERED_PRECONNECTED": "y"}
+        self.proc = subprocess.Popen(
+            [sys.executable, "-I", str(_CHILD), str(library), self.log, shared, infile, outname,
+             str(SWAP_SIZE), str(_MSG_LEN), str(_OUT_LEN),
+             *(str(f) for f in _dependency_libs(library))],
+            stdin=subprocess.PIPE, stdout=subprocess.PIPE, env=env)
+        assert self.proc.stdin is not None and self.proc.stdout is not None
+        self._w, self._r = self.proc.stdin.fileno(), self.proc.stdout.fileno()
+        head = _read_exact(self._r, 2)
+        with contextlib.suppress(OSError):       # both have it mapped (or the child failed)
+            os.unlink(shared)
+        if head == b"NO":
+            n = struct.unpack("<i", _read_exact(self._r, 4) or b"\0\0\0\0")[0]
+            why = (_read_exact(self._r, n) or b"").decode(errors="replace")
+            self.close()
+            if "DISCON" in why and "undefined symbol" in why:
+                raise ControllerLibraryError(f"controller library {library}: no symbol "
+                                             f"'DISCON' (not a Bladed-style controller)")
+            raise ControllerLibraryError(f"controller library {library}: cannot be loaded: "
+                                         f"{why}")
+        if head != b"OK":
+            raise self.died("while it was loaded")
+
+    def call(self, view: np.ndarray, t: float) -> tuple[int, str]:
+        """One call: the swap array into the shared map, a byte to the child, its
+        ``aviFAIL`` and message back, the swap array out of the map."""
+        self._swap[:] = view
+        try:
+            os.write(self._w, b"c")
+        except OSError:                               # a broken pipe: the child has gone
+            raise self.died(f"at t = {t:g} s") from None
+        head = _read_exact(self._r, 8)
+        if head is None:
+            raise self.died(f"at t = {t:g} s")
+        fail, n = struct.unpack("<ii", head)
+        text = _read_exact(self._r, n) if n else b""
+        if text is None:
+            raise self.died(f"at t = {t:g} s")
+        view[:] = self._swap
+        return fail, text.decode(errors="replace").strip()
+
+    def died(self, when: str) -> ControllerLibraryError:
+        """The error for a child that ended: its exit status or signal and its last output."""
+        try:
+            code = self.proc.wait(timeout=10)
+        except subprocess.TimeoutExpired:
+            self.proc.kill()
+            code = self.proc.wait()
+        how = (f"killed by signal {-code} ({_signal_name(-code)})" if code < 0
+               else f"exit status {code}")
+        try:
+            tail = Path(self.log).read_text(errors="replace").strip().splitlines()[-5:]
+        except OSError:
+            tail = []
+        last = " | ".join(tail)[-600:] or "(nothing printed)"
+        self.close()
+        return ControllerLibraryError(f"controller library {self.library.name} ended its "
+                                      f"process {when} ({how}); its last output: {last}")
+
+    def close(self) -> None:
+        """End the child (its standard input closed; killed if it does not stop) and remove
+        its log."""
+        self.alive = False
+        if self.proc.poll() is None:
+            try:
+                self.proc.stdin.close()          # type: ignore[union-attr]
+                self.proc.wait(timeout=10)
+            except (OSError, subprocess.TimeoutExpired):
+                self.proc.kill()
+                self.proc.wait()
+        for f in (self.proc.stdin, self.proc.stdout):
+            try:
+                f.close()                         # type: ignore[union-attr]
+            except OSError:
+                pass
+        with contextlib.suppress(OSError):
+            os.unlink(self.log)
+        with contextlib.suppress(BufferError, ValueError):
+            self._mem.close()
+
+
+def _signal_name(num: int) -> str:
+    import signal
+
+    try:
+        return signal.Signals(num).name
+    except ValueError:
+        return "unknown"
 
 
 class DisconController(ControllerBase):
@@ -212,6 +345,11 @@ class DisconController(ControllerBase):
         A hub-mounted CW LIDAR (bound to the case's wind by the simulator) whose measurement
         fills OpenFAST's lidar records (:data:`LIDAR_RECORDS`): taken at the instrument's sample
         rate and held between samples, as a LIDAR delivers them.
+    isolate : bool
+        Run the library in a child process, a new one per run (default): a library that ends
+        its process fails the run with its exit status and last output instead of ending the
+        simulation's process. False loads it in this process (a private copy per controller;
+        faster per call, uncontained).
 
     Raises
     ------
@@ -223,7 +361,7 @@ class DisconController(ControllerBase):
     def __init__(self, library: str | Path, discon_in: str | Path, turbine: Any, *,
                  dt: float = 1.0 / 80.0, pitch_control: str = "individual",
                  workdir: str | Path | None = None, root_name: str = "mpcwt_discon",
-                 quiet: bool = True, lidar: Any = None) -> None:
+                 quiet: bool = True, lidar: Any = None, isolate: bool = True) -> None:
         self.library = Path(library).resolve()
         self.discon_in = Path(discon_in).resolve()
         _check_library(self.library)
@@ -244,6 +382,7 @@ class DisconController(ControllerBase):
         self.root_name = root_name
         self.quiet = quiet
         self.lidar = lidar
+        self.isolate = bool(isolate)
         self._fds: tuple[int, int] | None = None
         self._lib: Any = None
         self._copy_dir: str | None = None
@@ -253,7 +392,10 @@ class DisconController(ControllerBase):
         self.messages: list[str] = []
         self._status = 0
         self._warned = False
-        self._load()                         # fail early on a bad library
+        if self.isolate:                     # fail early on a bad library, in a child
+            _ChildLibrary(self.library, str(self.discon_in), "mpcwt_check").close()
+        else:
+            self._load()
 
     # -- library lifetime --------------------------------------------------------------------
     def _load(self) -> None:
@@ -280,6 +422,9 @@ class DisconController(ControllerBase):
         self._lib, self._fn = lib, fn
 
     def _unload(self) -> None:
+        if isinstance(self._lib, _ChildLibrary):
+            self._lib.close()
+            self._lib = None
         if self._lib is not None:
             handle = self._lib._handle
             self._lib = None
@@ -294,7 +439,7 @@ class DisconController(ControllerBase):
 
     def reset(self) -> None:
         """A fresh copy of the library (its globals start over) and the first-call status."""
-        if self._lib is None or self._status != 0:
+        if not self.isolate and (self._lib is None or self._status != 0):
             self._load()
         if self._own_workdir:
             if self.workdir is not None:        # a run that was never finalized
@@ -309,13 +454,17 @@ class DisconController(ControllerBase):
         self._last_torque = 0.0
         self._lidar_next = -math.inf
         self._settings()
+        if self.isolate:                     # a new process: the library's globals start over
+            self._unload()
+            self._lib = _ChildLibrary(self.library, self._infile.decode(),
+                                      self._outname.decode())
         self.messages = []
         self.signals = {}
 
     def finalize(self) -> None:
         """The library's last call (status -1), then unload it; its files stay in
         ``workdir`` when one was given."""
-        if self._lib is not None and self._status == 1:
+        if self._lib is not None and self._status == 1 and getattr(self._lib, "alive", True):
             self._view[0] = -1.0
             try:
                 self._call(float(self._view[1]))
@@ -397,6 +546,10 @@ class DisconController(ControllerBase):
             g("lss_torque", 0.0), g("thrust", 0.0))
 
     def _call(self, t: float) -> None:
+        if isinstance(self._lib, _ChildLibrary):
+            fail_value, text = self._lib.call(self._view, t)
+            self._report(t, fail_value, text)
+            return
         fail = ctypes.c_int(0)
         self._msg[0] = b"\0"
         ctypes.memmove(self._out, self._outname + b"\0", len(self._outname) + 1)
@@ -411,14 +564,17 @@ class DisconController(ControllerBase):
                 os.dup2(self._fds[1], 1)
         else:
             self._fn(self._swap, ctypes.byref(fail), self._infile, self._out, self._msg)
-        self._warned = fail.value > 0
-        if fail.value == 0:
+        self._report(t, fail.value, self._msg.value.decode(errors="replace").strip())
+
+    def _report(self, t: float, fail: int, text: str) -> None:
+        """The library's ``aviFAIL``: < 0 stops the run with its message, > 0 is a warning."""
+        self._warned = fail > 0
+        if fail == 0:
             return
-        text = self._msg.value.decode(errors="replace").strip()
-        if fail.value < 0:
+        if fail < 0:
             raise ControllerLibraryError(
                 f"controller library {self.library.name} stopped the run at t = {t:g} s "
-                f"(aviFAIL = {fail.value}): {text or '(no message)'}")
+                f"(aviFAIL = {fail}): {text or '(no message)'}")
         if text:
             self.messages.append(f"t = {t:g} s: {text}")
             log.warning("%s at t = %g s: %s", self.library.name, t, text)

@@ -199,6 +199,30 @@ def _wait(pred, timeout: float, what: str) -> None:
         time.sleep(0.2)
 
 
+def _campaign_cli(tmp_path: Path, raw: dict) -> tuple[Path, Path, Path, list[str]]:
+    """The spec written to a file, the campaign folder, its index and the client's command."""
+    spec_path = tmp_path / f"{raw['name']}.yaml"
+    spec_path.write_text(yaml.safe_dump(raw))
+    out = tmp_path / "camp"
+    return spec_path, out, out / "index.sqlite", [
+        sys.executable, "-m", "mpc_wt.cli", "campaign", "run", str(spec_path), "--out",
+        str(out), "--quiet"]
+
+
+def _kill_a_worker_then_the_client(cmd: list[str], client, db: Path, after: int) -> None:
+    """Start the campaign client ``cmd``; once a case is done SIGKILL one worker of
+    ``client``'s cluster, once ``after`` are done SIGKILL the client."""
+    first = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT)
+    try:
+        _wait(lambda: _done(db) >= 1, 240, "the first case")
+        pids = client.run(os.getpid)
+        os.kill(next(iter(pids.values())), signal.SIGKILL)     # a worker, mid-case
+        _wait(lambda: _done(db) >= after, 240, f"{after} cases after the worker kill")
+    finally:
+        first.kill()                                            # the client, mid-campaign
+        first.wait()
+
+
 def test_killed_worker_and_killed_client_lose_nothing_duplicate_nothing(tmp_path):
     """A real LocalCluster (2 worker processes, loopback); the campaign client is a separate
     process. One worker is killed (SIGKILL) mid-campaign, then the client is killed and
@@ -207,25 +231,12 @@ def test_killed_worker_and_killed_client_lose_nothing_duplicate_nothing(tmp_path
 
     winds = [6, 9, 12, 15, 18, 21]
     raw = {**BASE, "name": "kill", "duration": 60, "winds": winds, "seeds": 2}
-    spec_path = tmp_path / "kill.yaml"
-    spec_path.write_text(yaml.safe_dump(raw))
+    spec_path, out, db, cmd = _campaign_cli(tmp_path, raw)
     n_cases = len(winds) * 2
-    out = tmp_path / "camp"
-    db = out / "index.sqlite"
-    cmd = [sys.executable, "-m", "mpc_wt.cli", "campaign", "run", str(spec_path),
-           "--out", str(out), "--quiet"]
     with LocalCluster(n_workers=2, threads_per_worker=1, processes=True, host="127.0.0.1",
                       dashboard_address=None) as cluster, Client(cluster) as client:
         cmd += ["--scheduler", cluster.scheduler_address]
-        first = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT)
-        try:
-            _wait(lambda: _done(db) >= 1, 240, "the first case")
-            pids = client.run(os.getpid)
-            os.kill(next(iter(pids.values())), signal.SIGKILL)     # a worker, mid-case
-            _wait(lambda: _done(db) >= 4, 240, "four cases after the worker kill")
-        finally:
-            first.kill()                                            # the client, mid-campaign
-            first.wait()
+        _kill_a_worker_then_the_client(cmd, client, db, 4)
         before = _done(db)
         assert before < n_cases, "the client finished before it was killed: lengthen the cases"
         second = subprocess.run(cmd, capture_output=True, text=True, timeout=600)
@@ -606,3 +617,73 @@ def test_changed_or_cut_files_are_found_by_checksum_and_computed_again(tmp_path,
         again = {r.case_id: r.metrics["channels"]["flap_moment_1"]["del"] for r in st_.rows()}
     assert again == before
     make_report(tmp_path)
+
+
+def test_fault_injection_campaign(tmp_path):
+    """Twelve short cases on a real LocalCluster (2 workers) with a separate client process:
+    one case's library calls exit(3), one's crashes (SIGSEGV); a worker is killed (SIGKILL)
+    mid-campaign, then the client, which is started again; then one finished file is cut to
+    half and another's flap moment tripled in place, and the campaign resumed. Every case is in
+    the index exactly once; the two library cases failed, named with their exit status or
+    signal and their last output, and nothing else failed; the two changed files were computed
+    again (equal to the first results); the report is made and lists the failed cases."""
+    import shutil as sh
+
+    from distributed import Client, LocalCluster
+
+    import linearize
+    from mpc_wt.campaign.report import make_report
+
+    cc = sh.which("gcc") or sh.which("cc")
+    if cc is None:
+        pytest.skip("no C compiler")
+    probe = tmp_path / "libprobe.so"
+    subprocess.run([cc, "-shared", "-fPIC", "-O1", "-o", str(probe),
+                    str(Path(__file__).parents[2] / "data" / "discon_probe.c")], check=True)
+    for name in ("PROBE_EXIT.IN", "PROBE_CRASH.IN"):
+        (tmp_path / name).write_text("x\n")
+    libs = [{"name": n, "controller": "discon", "discon_library": str(probe),
+             "discon_in": str(tmp_path / f), "winds": [12], "seeds": [1]}
+            for n, f in (("exits", "PROBE_EXIT.IN"), ("crashes", "PROBE_CRASH.IN"))]
+    raw = {**BASE, "name": "faults", "duration": 45, "winds": [8, 11, 14, 17, 20],
+           "seeds": 2, "controllers": ["baseline", *libs]}
+    spec_path, out, db, cmd = _campaign_cli(tmp_path, raw)
+    n_cases = 12
+    with LocalCluster(n_workers=2, threads_per_worker=1, processes=True, host="127.0.0.1",
+                      dashboard_address=None) as cluster, Client(cluster) as client:
+        cmd += ["--scheduler", cluster.scheduler_address]
+        _kill_a_worker_then_the_client(cmd, client, db, 3)
+        assert _done(db) < n_cases - 2, "the client finished before it was killed"
+        second = subprocess.run(cmd, capture_output=True, text=True, timeout=600)
+        assert second.returncode == 1, second.stdout + second.stderr   # two failed cases
+        con = sqlite3.connect(db)
+        done = dict(con.execute("SELECT case_id, file FROM cases WHERE status='done'"))
+        before = {cid: ClosedLoopResult.load(out / f).channel("flap_moment_1")
+                  for cid, f in done.items()}
+        cut, scaled = sorted(done)[:2]
+        data = (out / done[cut]).read_bytes()
+        (out / done[cut]).write_bytes(data[: len(data) // 2])
+        res = ClosedLoopResult.load(out / done[scaled])
+        res.z[:, linearize.OUTPUT_NAMES.index("flap_moment_1")] *= 3.0
+        res.save(out / done[scaled])
+        third = subprocess.run(cmd, capture_output=True, text=True, timeout=600)
+        assert third.returncode == 1, third.stdout + third.stderr
+    rows = con.execute("SELECT case_id, status, error, file FROM cases").fetchall()
+    ids = [r[0] for r in rows]
+    assert len(ids) == len(set(ids)) == n_cases
+    assert set(ids) == {c.case_id for c in load_spec(spec_path).cases()}
+    failed = {r[0]: r[2] for r in rows if r[1] == "failed"}
+    assert sorted(failed) == ["crashes__A__v12__s1", "exits__A__v12__s1"]
+    assert "exit status 3" in failed["exits__A__v12__s1"]
+    assert "probe: giving up at t = 0.50 s" in failed["exits__A__v12__s1"]
+    assert "killed by signal 11 (SIGSEGV)" in failed["crashes__A__v12__s1"]
+    assert "probe: about to crash" in failed["crashes__A__v12__s1"]
+    for cid, status, _, f in rows:
+        if status == "done":
+            again = ClosedLoopResult.load(out / f).channel("flap_moment_1")
+            np.testing.assert_array_equal(again, before[cid])
+    assert (out / done[cut]).with_suffix(".changed.nc").is_file()
+    text = (Path(make_report(out)).parent / "report.md").read_text()
+    section = text[text.index("## Failed cases"):]
+    assert "exits__A__v12__s1" in section and "exit status 3" in section
+    assert "crashes__A__v12__s1" in section and "SIGSEGV" in section

@@ -103,3 +103,30 @@ def test_the_local_cluster_is_closed_to_other_clients() -> None:
             assert err.value.code == 404
     finally:
         cluster.close()
+
+
+@pytest.mark.skipif(not hasattr(os, "geteuid") or os.geteuid() != 0,
+                    reason="making a file of another user needs root")
+def test_a_spec_another_user_wrote_runs_only_with_trust(tmp_path: Path, capsys) -> None:
+    """A spec file owned by another user (uid 65534) is refused before any of it runs, naming
+    the file and its owner; ``--trust`` runs it; a plugin beside the spec that another user
+    wrote is named too."""
+    from mpc_wt.cli.main import main
+
+    spec = tmp_path / "spec.yaml"
+    spec.write_text("name: foreign\nduration: 10\ntransient: 0\nwinds: [12]\nseeds: 1\n"
+                    "turbulence: steady\ncontrollers: [baseline]\n")
+    os.chown(spec, 65534, 65534)
+    argv = ["campaign", "run", str(spec), "--out", str(tmp_path / "c"), "--engine", "serial",
+            "--quiet"]
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    assert f"{spec}: written by another user: {spec} (owner uid 65534)" in err
+    assert "--trust" in err and not (tmp_path / "c").exists()
+    assert main(argv + ["--trust"]) == 0
+    os.chown(spec, 0, 0)
+    (tmp_path / "their_plugin.py").write_text("x = 1\n")
+    os.chown(tmp_path / "their_plugin.py", 65534, 65534)
+    spec.write_text(spec.read_text() + "plugins: [their_plugin]\n")
+    assert main(argv) == 2
+    assert "their_plugin.py (owner uid 65534)" in capsys.readouterr().err

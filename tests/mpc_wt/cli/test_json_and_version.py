@@ -30,7 +30,8 @@ def test_to_json_writes_undefined_values_as_null() -> None:
 
 
 @pytest.mark.parametrize("argv", [["trim", "--wind", "3:5:1", "--json"],
-                                  ["controllers", "--json"]])
+                                  ["controllers", "--json"],
+                                  ["linearize", "--wind", "12", "--frozen-wake", "--json"]])
 def test_commands_print_standard_json(capsys, argv) -> None:
     """trim at 3-5 m/s (from cut-in), the controller kinds: each parses with a parser that
     refuses NaN and Infinity."""
@@ -53,6 +54,30 @@ def test_assess_prints_standard_json(capsys, tmp_path) -> None:
     assert main(["assess", str(tmp_path / "a.csv"), str(tmp_path / "b.csv"), "--json"]) == 0
     doc = _strict(capsys.readouterr().out)
     assert None in list(_values(doc))
+
+
+#: where mpc-wt calls json.dump(s) itself, and why that is not output a user reads as JSON
+_INTERNAL_JSON = {
+    "io/json_text.py": "the writer every JSON output goes through",
+    "campaign/spec.py": "hashes of a case's inputs",
+    "tuning/spec.py": "hashes of a trial's parameters",
+    "campaign/store.py": "the index's own columns (read back by mpc-wt, printed via to_json)",
+    "simulation/results.py": "the netCDF file's metadata attribute",
+}
+
+
+def test_every_json_output_goes_through_the_standard_writer() -> None:
+    """Every other module writes or prints JSON with ``to_json`` / ``write_json`` (which
+    refuse NaN and Infinity): a scan of the sources for ``json.dump``."""
+    from pathlib import Path
+
+    import mpc_wt
+
+    root = Path(mpc_wt.__file__).parent
+    found = {str(f.relative_to(root)) for f in root.rglob("*.py")
+             if "json.dump" in f.read_text()}
+    assert found <= set(_INTERNAL_JSON), sorted(found - set(_INTERNAL_JSON))
+    assert "io/json_text.py" in found
 
 
 def _values(obj):

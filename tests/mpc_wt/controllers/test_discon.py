@@ -8,6 +8,7 @@ import csv
 import math
 import shutil
 import subprocess
+import tempfile
 from pathlib import Path
 
 import numpy as np
@@ -124,6 +125,55 @@ def test_library_stop_keeps_the_run(probe, tmp_path, turbine) -> None:
                        r"\(aviFAIL = -1\): probe: stop requested") as exc:
         simulate_closed_loop(p, ctl, linearize.SteadyWind(12.0), 2.0, x0=op.x, u0=op.u)
     assert exc.value.partial.t[-1] == pytest.approx(0.4875)
+
+
+@pytest.mark.parametrize("infile, how, said", [
+    ("PROBE_EXIT.IN", r"exit status 3", r"probe: giving up at t = 0.50 s"),
+    ("PROBE_CRASH.IN", r"killed by signal 11 \(SIGSEGV\)", r"probe: about to crash"),
+])
+def test_a_library_that_ends_its_process_fails_the_run_only(probe, tmp_path, turbine,
+                                                             monkeypatch, infile, how,
+                                                             said) -> None:
+    """A library that calls exit() or crashes at 0.5 s ends its child process, not this one:
+    the run fails naming the exit status or signal and the library's last output, the samples
+    before are kept, a second run of the same controller starts a new child and fails the same
+    way, and no temporary file or folder is left."""
+    monkeypatch.setenv("TMPDIR", str(tmp_path / "tmp"))
+    (tmp_path / "tmp").mkdir()
+    tempfile.tempdir = None                      # read TMPDIR again
+    try:
+        (tmp_path / infile).write_text("x\n")
+        p = linearize.plant_params(turbine)
+        op = linearize.trim(turbine, 12.0, params=p)
+        ctl = DisconController(probe, tmp_path / infile, turbine)
+        for _ in range(2):
+            with pytest.raises(ControllerLibraryError,
+                               match=rf"ended its process at t = 0.5 s \({how}\); its last "
+                                     rf"output: {said}") as exc:
+                simulate_closed_loop(p, ctl, linearize.SteadyWind(12.0), 2.0, x0=op.x,
+                                     u0=op.u)
+            assert exc.value.partial.t[-1] == pytest.approx(0.4875)
+        assert list((tmp_path / "tmp").iterdir()) == []
+    finally:
+        tempfile.tempdir = None
+
+
+def test_runs_leave_no_temporary_files(tmp_path) -> None:
+    """``mpcwt simulate`` with ROSCO as shipped and as exported from our design, each in its
+    own process as a user runs it: afterwards the temporary folder holds nothing."""
+    import os
+    import sys
+
+    env = {**os.environ, "TMPDIR": str(tmp_path / "tmp")}
+    (tmp_path / "tmp").mkdir()
+    for extra in (["--discon-in", "shipped"], []):
+        done = subprocess.run(
+            [sys.executable, "-c", "from mpc_wt.cli.main import main; raise SystemExit(main())",
+             "simulate", "--controller", "rosco", *extra, "--wind", "12", "--turbulence",
+             "steady", "--duration", "1", "--out", str(tmp_path / "r.nc")],
+            capture_output=True, text=True, env=env, timeout=600)
+        assert done.returncode == 0, done.stderr[-2000:]
+        assert list((tmp_path / "tmp").iterdir()) == []
 
 
 def test_rosco_holds_rated_power_for_60s() -> None:
