@@ -7,6 +7,7 @@ upstream distance x_up at time t is the field at ``t + x_up / mean_speed``.
 from __future__ import annotations
 
 import json
+import zipfile
 import math
 import struct
 from dataclasses import dataclass, field
@@ -283,6 +284,9 @@ class WindField:
                                hub_height=float(d["hub_height"]), meta=meta)
         except FieldFileError:
             raise
+        except zipfile.BadZipFile as err:
+            raise FieldFileError(f"{path}: not a complete .npz file (cut short or another "
+                                 f"format: {err})") from err
         except (ValueError, KeyError, OSError, EOFError) as err:
             raise FieldFileError(f"{path}: {err}") from err
         raise FieldFileError(f"{path}: suffix must be .npz or .bts, got {path.suffix!r}")

@@ -5,9 +5,10 @@ from __future__ import annotations
 
 from linearize import SimulationDivergedError
 
-__all__ = ["UsageError", "OptionsError", "SpecError", "CampaignLockedError", "GainTableError",
-           "ResultFileError", "PremiseError", "SynthesisError", "SimulationDivergedError",
-           "QPSetupError", "ControllerLibraryError", "TrialFailed", "CaseDataError"]
+__all__ = ["UsageError", "OptionsError", "SpecError", "CampaignLockedError", "CampaignIndexError",
+           "GainTableError", "ResultFileError", "PremiseError", "SynthesisError",
+           "SimulationDivergedError", "QPSetupError", "ControllerLibraryError", "TrialFailed",
+           "CaseDataError"]
 
 
 class UsageError(ValueError):
@@ -37,6 +38,11 @@ class SpecError(ValueError):
 
 class CampaignLockedError(RuntimeError):
     """Another client is running the same campaign directory."""
+
+
+class CampaignIndexError(ValueError):
+    """A campaign's ``index.sqlite`` that is not an SQLite database, or that cannot be opened
+    or written (a full disk, a read-only folder)."""
 
 
 class GainTableError(ValueError):

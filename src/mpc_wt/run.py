@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import dataclasses
+import logging
 from pathlib import Path
 from typing import Any, Mapping, Sequence
 
@@ -17,7 +18,9 @@ from mpc_wt.simulation.results import ClosedLoopResult
 from mpc_wt.simulation.scenario import FieldMemo, Scenario, lidar_field, make_wind, start_wind
 
 __all__ = ["run_controller", "build_controller", "design_controller", "export_discon",
-           "run_openfast_case", "CASE_CONTROLLERS"]
+           "run_openfast_case", "run_warnings", "CASE_CONTROLLERS", "VALIDITY_SIGNALS"]
+
+log = logging.getLogger(__name__)
 
 
 def _operating_point(turbine: linearize.Turbine, sel: Selection, opts: Sequence[Options],
@@ -251,9 +254,54 @@ def run_controller(turbine: linearize.Turbine, controller: str, scenario: Scenar
 
         ctl = Supervisor(ctl, turbine, **dict(supervisor))
         meta["supervisor"] = {k: v for k, v in dict(supervisor).items() if v is not None}
-    return simulate_closed_loop(params, ctl, wind, scenario.duration, x0=op.x, u0=op.u,
-                                controller_dt=built.controller_dt, preview=built.preview,
-                                progress=progress, meta=meta)
+    return _warned(simulate_closed_loop(
+        params, ctl, wind, scenario.duration, x0=op.x, u0=op.u, controller_dt=built.controller_dt,
+        preview=built.preview, progress=progress, meta=meta), controller)
+
+
+def _warned(res: ClosedLoopResult, controller: str) -> ClosedLoopResult:
+    """``res`` with its :func:`run_warnings` in ``meta["run_warnings"]``, each logged."""
+    res.meta["run_warnings"] = run_warnings(res)
+    for w in res.meta["run_warnings"]:
+        log.warning("%s: %s", controller, w)
+    return res
+
+
+#: controller signals that flag a step outside the design's validity: signal -> what it means
+VALIDITY_SIGNALS = {
+    "premise_clipped": "the TS premise (estimated wind, power reduction) left the vertex grid "
+                       "and was clipped to it",
+    "qp_fallback": "the MPC's QP failed or ran over its time budget and the fallback command "
+                   "was applied",
+    "library_warning": "the controller library warned (aviFAIL > 0)",
+}
+
+
+def run_warnings(res: Any) -> list[str]:
+    """Where a run left its controller's validity, one line each, with how often: commands the
+    actuators' limits clipped, and the steps a controller flagged (:data:`VALIDITY_SIGNALS`).
+
+    Parameters
+    ----------
+    res : ClosedLoopResult
+
+    Returns
+    -------
+    list of str
+        Empty when the run stayed within them.
+    """
+    out = []
+    clipped = int(res.meta.get("commands_clipped", 0) or 0)
+    if clipped:
+        out.append(f"{clipped} commands beyond the actuators' limits were clipped")
+    for name, what in VALIDITY_SIGNALS.items():
+        sig = res.controller.get(name)
+        if sig is None:
+            continue
+        n = int(np.count_nonzero(np.asarray(sig) != 0))
+        if n:
+            out.append(f"{what} in {n} of {len(sig)} steps ({100.0 * n / len(sig):.1f} %)")
+    return out
 
 
 def export_discon(turbine: linearize.Turbine, controller: str, out: str | Path,

@@ -128,3 +128,25 @@ def test_cs_ellipses_show_the_measures_with_units(figures, tmp_path) -> None:
     _check(fig)
     text = fig.axes[0].get_legend().get_texts()[0].get_text()
     assert text == "run: CS1 2.45 MN m, CS2 1.000 MW, CS5 27 deg"
+
+
+def test_the_main_jobs_assessment_figures(figures, tmp_path) -> None:
+    """``cs_ellipses.png`` and ``psd_flap_moment_1.png`` as the main job makes them, from two
+    runs: each axis with a unit, no text outside, the 1P mark at the rotor's frequency."""
+    t = np.arange(0.0, 300.0, 0.0125)
+    rng = np.random.default_rng(3)
+    runs = []
+    for name, a in (("one", 1.0), ("two", 0.6)):
+        cols = {"tower_base_fa_moment": 3e7 + 8e6 * a * rng.standard_normal(t.size),
+                "gen_power": 5e6 + 4e4 * rng.standard_normal(t.size),
+                "flap_moment_1": 6e6 + 2e6 * a * np.sin(2 * np.pi * 0.2 * t),
+                "rotor_speed": np.full(t.size, 2 * np.pi * 0.2)}
+        runs.append((name, t, cols))
+    made = plotting.assess_plots(runs, tmp_path)
+    assert [p.split("/")[-1] for p in made] == ["cs_ellipses.png", "psd_flap_moment_1.png"]
+    assert len(figures) == 2
+    for fig in figures:
+        _check(fig)
+    marks = [txt.get_text() for txt in figures[1].axes[0].texts]
+    assert marks == ["1P", "3P", "6P"]
+    assert figures[1].axes[0].texts[0].get_position()[0] == pytest.approx(0.2)

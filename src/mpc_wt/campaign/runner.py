@@ -223,8 +223,34 @@ def _write_spec(spec: CampaignSpec, out: Path, store: CampaignStore) -> None:
 
         (out / "spec.yaml").write_text(yaml.safe_dump(spec.raw, sort_keys=False))
     store.set_meta(name=spec.name, spec_hash=spec.spec_hash, software_version=__version__,
-                   spec_raw=spec.resolved_raw(),
+                   spec_raw=spec.resolved_raw(), code=spec_code(spec),
                    reference=spec.reference, last_run=time.strftime("%Y-%m-%dT%H:%M:%S"))
+
+
+def spec_code(spec: CampaignSpec) -> dict[str, Any]:
+    """The code a campaign runs besides mpc-wt, as the index names it: each plugin module's
+    file and each controller library's path with its SHA-256.
+
+    Parameters
+    ----------
+    spec : CampaignSpec
+
+    Returns
+    -------
+    dict
+        ``plugins`` {module: file}, ``libraries`` {path: sha256}.
+    """
+    import sys
+
+    from mpc_wt.campaign.checksum import file_sha256
+
+    plugins = {m: getattr(sys.modules.get(m), "__file__", None) for m in spec.plugins}
+    libs = {}
+    for c in spec.controllers:
+        lib = c.options.get("discon_library")
+        if isinstance(lib, str) and Path(lib).is_file():
+            libs[lib] = file_sha256(Path(lib))
+    return {"plugins": plugins, "libraries": libs}
 
 
 def _failed(case_id: str, err: BaseException, tb: str | None = None) -> dict[str, Any]:

@@ -354,6 +354,8 @@ class Case:
         Hashes of the simulation and the assessment inputs.
     plugins : tuple of str
         Modules that register controller kinds, imported by the worker.
+    plugin_folder : str or None
+        The spec's folder, where its plugins are looked for first.
     del_convention : str
         The DEL convention of the assessment (:data:`mpc_wt.assessment.fatigue.DEL_CONVENTIONS`).
     dlc : str
@@ -378,6 +380,7 @@ class Case:
     case_hash: str
     assess_hash: str
     plugins: tuple[str, ...] = ()
+    plugin_folder: str | None = None
     del_convention: str = "range-1hz"
     dlc: str = "1.2"
     supervisor: dict[str, Any] | None = None
@@ -492,6 +495,8 @@ class CampaignSpec:
         The spec's file.
     plugins : tuple of str
         Modules that register controller kinds.
+    plugin_folder : str or None
+        The spec's folder: its plugins and relative library paths are resolved there.
     del_convention : str
         The DEL convention (``range-1hz``, default; ``clemens``; ``pcrunch``): DEL per case and
         the lifetime DEL's weights (Clemens eq 18 weights bins by their counted cycles).
@@ -522,6 +527,7 @@ class CampaignSpec:
     raw: dict[str, Any]
     source: str | None = None
     plugins: tuple[str, ...] = ()
+    plugin_folder: str | None = None
     del_convention: str = "range-1hz"
     load_cases: tuple[LoadCase, ...] = ()
     iec_class: str = "I"
@@ -642,6 +648,7 @@ class CampaignSpec:
                 transient=lc.transient, turbine=self.turbine,
                 turbine_hash=self.turbine_hash, channels=dict(self.channels),
                 case_hash=_digest(sim), assess_hash=_digest(a), plugins=self.plugins,
+                plugin_folder=self.plugin_folder,
                 del_convention=self.del_convention, dlc=lc.dlc,
                 supervisor=copy.deepcopy(sup), family=lc.family, fatigue=lc.fatigue))
         return out
@@ -663,7 +670,8 @@ class CampaignSpec:
                                   duration=f.duration, wind_file=f.path),
                 transient=lc.transient, turbine=self.turbine, turbine_hash=self.turbine_hash,
                 channels=dict(self.channels), case_hash=_digest(sim), assess_hash=_digest(a),
-                plugins=self.plugins, del_convention=self.del_convention, dlc=lc.dlc,
+                plugins=self.plugins, plugin_folder=self.plugin_folder,
+                del_convention=self.del_convention, dlc=lc.dlc,
                 supervisor=copy.deepcopy(sup), family=lc.family, fatigue=lc.fatigue,
                 bin_wind_mps=f.wind_mps))
         return out
@@ -1024,9 +1032,9 @@ def _convention(raw: Any) -> str:
     return str(raw)
 
 
-def _plugins(raw: Any, load: bool = True) -> tuple[str, ...]:
-    """Modules that register controller kinds, imported here (unless ``load`` is False) and
-    in every worker."""
+def _plugins(raw: Any, load: bool = True, base: Path | None = None) -> tuple[str, ...]:
+    """Modules that register controller kinds, looked for first in the spec's folder ``base``
+    and imported here (unless ``load`` is False) and in every worker."""
     from mpc_wt.registry.registry import load_plugins
 
     if not isinstance(raw, list) or not all(isinstance(m, str) and m for m in raw):
@@ -1034,7 +1042,7 @@ def _plugins(raw: Any, load: bool = True) -> tuple[str, ...]:
     if not load:
         return tuple(raw)
     try:
-        load_plugins(raw)
+        load_plugins(raw, base)
     except ImportError as err:
         raise _fail("plugins", str(err)) from err
     return tuple(raw)
@@ -1093,11 +1101,18 @@ def _check_controller_grids(ctls: tuple[ControllerSpec, ...],
                                                       f"are {names}")
 
 
-def _controllers(raw: Any, lidar: dict[str, Any], plugin_kinds: bool
-                 ) -> tuple[ControllerSpec, ...]:
-    """The ``controllers`` list, each validated, their names distinct."""
+def _controllers(raw: Any, lidar: dict[str, Any], plugin_kinds: bool,
+                 base: Path | None = None) -> tuple[ControllerSpec, ...]:
+    """The ``controllers`` list, each validated, their names distinct; relative library and
+    input-file paths (``discon_library``, ``discon_in``) resolved against the spec's folder
+    ``base``."""
     if not isinstance(raw, list) or not raw:
         raise _fail("controllers", "must be a non-empty list")
+    if base is not None:
+        raw = [{**c, **{k: str((base / c[k]).resolve()) for k in ("discon_library", "discon_in")
+                        if isinstance(c.get(k), str) and c[k] != "shipped"
+                        and not Path(c[k]).expanduser().is_absolute()}}
+               if isinstance(c, Mapping) else c for c in raw]
     ctls = tuple(_controller(i, c, lidar, plugin_kinds) for i, c in enumerate(raw))
     names = [c.name for c in ctls]
     dup = sorted({n for n in names if names.count(n) > 1})
@@ -1171,13 +1186,13 @@ def spec_from_dict(raw: Mapping[str, Any], base: Path | None = None,
         raise _fail(missing[0], f"missing (required: name, winds or load_cases, "
                                 f"controllers; missing {missing})")
     name = check_name("name", raw["name"])
-    plugins = _plugins(raw.get("plugins", []), import_plugins)
+    plugins = _plugins(raw.get("plugins", []), import_plugins, base)
     turbine, thash = turbine_files_hash(str(raw.get("turbine", "nrel5mw")), base)
     duration = _number("duration", raw.get("duration", 600.0), 0.0, MAX_DURATION_S,
                        lo_open=True)
     transient = _number("transient", raw.get("transient", 60.0), 0.0)
     lidar = _lidar("lidar", raw.get("lidar", {}))
-    ctls = _controllers(raw["controllers"], lidar, bool(plugins) and not import_plugins)
+    ctls = _controllers(raw["controllers"], lidar, bool(plugins) and not import_plugins, base)
     iec_class = raw.get("iec_class", "I")
     if iec_class not in ("I", "II", "III"):
         raise _fail("iec_class", f"must be 'I', 'II' or 'III' (IEC 61400-1 table 1), got "
@@ -1207,6 +1222,7 @@ def spec_from_dict(raw: Mapping[str, Any], base: Path | None = None,
         lifetime_years=_number("lifetime_years", raw.get("lifetime_years", 20.0), 0.0,
                                lo_open=True),
         reference=ref, report=report, raw=raw, source=source, plugins=plugins,
+        plugin_folder=str(base) if base is not None and plugins else None,
         del_convention=_convention(raw.get("del_convention", "range-1hz")))
 
 

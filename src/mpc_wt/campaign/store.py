@@ -29,7 +29,7 @@ from typing import Any, Iterable
 
 from mpc_wt.campaign.checksum import file_sha256
 from mpc_wt.campaign.spec import CampaignSpec, Case
-from mpc_wt.errors import CampaignLockedError
+from mpc_wt.errors import CampaignIndexError, CampaignLockedError
 
 log = logging.getLogger(__name__)
 
@@ -171,20 +171,28 @@ class CampaignStore:
             self._lock_fh = fh
         elif not (self.root / "index.sqlite").is_file():
             raise FileNotFoundError(f"{self.root}: not a campaign directory (no index.sqlite)")
-        self.db = sqlite3.connect(self.root / "index.sqlite", timeout=30.0,
-                                  isolation_level=None)
-        self.db.execute("PRAGMA journal_mode=WAL")
-        self.db.execute("PRAGMA synchronous=FULL")
-        if lock:
-            self.db.executescript(_SCHEMA)
-            cols = {r[1] for r in self.db.execute("PRAGMA table_info(cases)")}
-            if "sha256" not in cols:        # an index written before checksums were kept
-                self.db.execute("ALTER TABLE cases ADD COLUMN sha256 TEXT")
-        self._has_sha = "sha256" in {r[1] for r in self.db.execute("PRAGMA table_info(cases)")}
+        index = self.root / "index.sqlite"
+        try:
+            self.db = sqlite3.connect(index, timeout=30.0, isolation_level=None)
+            self.db.execute("PRAGMA journal_mode=WAL")
+            self.db.execute("PRAGMA synchronous=FULL")
+            if lock:
+                self.db.executescript(_SCHEMA)
+                cols = {r[1] for r in self.db.execute("PRAGMA table_info(cases)")}
+                if "sha256" not in cols:    # an index written before checksums were kept
+                    self.db.execute("ALTER TABLE cases ADD COLUMN sha256 TEXT")
+            self._has_sha = "sha256" in {r[1] for r in
+                                         self.db.execute("PRAGMA table_info(cases)")}
+        except sqlite3.DatabaseError as err:       # not a database, disk full, read-only ...
+            self.close()
+            raise CampaignIndexError(f"{index}: cannot be used as a campaign index: {err} "
+                                     f"(a damaged index: move it away and run the campaign "
+                                     f"again; its finished case files are reused)") from None
 
     def close(self) -> None:
         """Close the index and release the lock."""
-        self.db.close()
+        if getattr(self, "db", None) is not None:
+            self.db.close()
         if self._lock_fh is not None:
             fcntl.flock(self._lock_fh, fcntl.LOCK_UN)
             self._lock_fh.close()

@@ -242,7 +242,7 @@ def run_case(case: dict[str, Any], root: str) -> dict[str, Any]:
             from mpc_wt.registry.registry import load_plugins
             from mpc_wt.run import run_controller
 
-            load_plugins(case.get("plugins", ()))
+            load_plugins(case.get("plugins", ()), case.get("plugin_folder"))
             try:
                 res = run_controller(load_case_turbine(case["turbine"]), case["run_name"],
                                      Scenario(**case["scenario"]), case["options"],

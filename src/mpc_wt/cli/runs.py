@@ -180,6 +180,8 @@ def _simulate(args: argparse.Namespace) -> int:
     p = res.channel("gen_power")
     print(f"wrote {out}: {res.t.size} samples; mean power {p.mean() / 1e6:.3f} MW, "
           f"generator speed std {res.channel('gen_speed').std() * 30 / math.pi:.2f} rpm")
+    for w in res.meta.get("run_warnings", []):
+        print(f"warning: {w}")
     return 0
 
 

@@ -18,7 +18,9 @@ import dataclasses
 import importlib
 import logging
 import re
+import sys
 from dataclasses import dataclass, field, replace
+from pathlib import Path
 from typing import Any, Callable, Mapping, Sequence
 
 from mpc_wt.errors import OptionsError
@@ -452,13 +454,16 @@ def cli_flags() -> dict[str, dict[str, Any]]:
     return out
 
 
-def load_plugins(modules: Sequence[str] = ()) -> list[str]:
+def load_plugins(modules: Sequence[str] = (), folder: str | Path | None = None) -> list[str]:
     """Import modules that register controller kinds (and the entry-point plugins).
 
     Parameters
     ----------
     modules : sequence of str
         Importable module names (``my_controllers``).
+    folder : str or Path, optional
+        A folder searched first (a campaign spec's: its plugins are resolved beside it, in
+        whatever folder the command runs).
 
     Returns
     -------
@@ -475,10 +480,15 @@ def load_plugins(modules: Sequence[str] = ()) -> list[str]:
     for mod in modules:
         if mod in _PLUGINS_LOADED:
             continue
+        path = [str(folder)] if folder is not None else []
+        sys.path[:0] = path
         try:
             importlib.import_module(mod)
         except ImportError as err:
             raise ImportError(f"controller plugin {mod!r} does not import: {err}") from err
+        finally:
+            if path and sys.path[:1] == path:
+                del sys.path[0]
         _PLUGINS_LOADED.add(mod)
         done.append(mod)
     return done

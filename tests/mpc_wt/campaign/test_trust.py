@@ -130,3 +130,48 @@ def test_a_spec_another_user_wrote_runs_only_with_trust(tmp_path: Path, capsys) 
     spec.write_text(spec.read_text() + "plugins: [their_plugin]\n")
     assert main(argv) == 2
     assert "their_plugin.py (owner uid 65534)" in capsys.readouterr().err
+
+
+def test_plugins_and_libraries_are_resolved_beside_the_spec_and_named(tmp_path: Path,
+                                                                      monkeypatch) -> None:
+    """A spec whose plugin module sits beside it and whose library path is relative to it runs
+    from another folder (neither on Python's path nor the working folder), and the index names
+    the plugin's file and the library with its SHA-256."""
+    import hashlib
+    import shutil as sh
+
+    from mpc_wt.campaign import CampaignStore, load_spec, run_campaign
+
+    cc = sh.which("gcc") or sh.which("cc")
+    if cc is None:
+        pytest.skip("no C compiler")
+    home = tmp_path / "study"
+    (home / "lib").mkdir(parents=True)
+    subprocess.run([cc, "-shared", "-fPIC", "-O1", "-o", str(home / "lib" / "libprobe.so"),
+                    str(Path(__file__).parents[2] / "data" / "discon_probe.c")], check=True)
+    (home / "PROBE.IN").write_text("x\n")
+    (home / "beside_plugin.py").write_text('"""registers nothing"""\nVALUE = 42\n')
+    (home / "spec.yaml").write_text(textwrap.dedent("""
+        name: beside
+        duration: 10
+        transient: 0
+        winds: [12]
+        seeds: 1
+        turbulence: steady
+        plugins: [beside_plugin]
+        controllers:
+          - {name: probe, controller: discon, discon_library: lib/libprobe.so,
+             discon_in: PROBE.IN}
+    """))
+    elsewhere = tmp_path / "elsewhere"
+    elsewhere.mkdir()
+    monkeypatch.chdir(elsewhere)
+    spec = load_spec(home / "spec.yaml")
+    assert spec.controllers[0].options["discon_library"] == str(home / "lib" / "libprobe.so")
+    s = run_campaign(spec, elsewhere / "camp", engine="serial", progress=False)
+    assert s.done == 1, s.failures
+    with CampaignStore(elsewhere / "camp") as st_:
+        code = st_.meta()["code"]
+    assert code["plugins"] == {"beside_plugin": str(home / "beside_plugin.py")}
+    lib = home / "lib" / "libprobe.so"
+    assert code["libraries"] == {str(lib): hashlib.sha256(lib.read_bytes()).hexdigest()}

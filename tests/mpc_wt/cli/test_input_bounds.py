@@ -86,3 +86,53 @@ def test_a_diverged_simulate_writes_its_samples_and_exits_1(capsys, monkeypatch,
     assert "run failed: simulation diverged" in err and str(kept) in err
     assert ClosedLoopResult.load(kept).t.size == before.t.size
     assert not out.exists()
+
+
+def test_a_garbage_index_and_a_cut_field_file_are_one_line_errors(capsys, tmp_path) -> None:
+    """They were tracebacks (sqlite3.DatabaseError, zipfile.BadZipFile)."""
+    import numpy as np
+
+    camp = tmp_path / "camp"
+    camp.mkdir()
+    (camp / "index.sqlite").write_text("garbage, not a database\n")
+    for cmd in ("status", "report"):
+        assert main(["campaign", cmd, str(camp)]) == 2
+        assert (f"{camp / 'index.sqlite'}: cannot be used as a campaign index: file is not a "
+                f"database") in capsys.readouterr().err
+    np.savez(tmp_path / "f.npz", a=np.zeros(1000))
+    cut = tmp_path / "cut.npz"
+    cut.write_bytes((tmp_path / "f.npz").read_bytes()[:300])
+    assert main(["lidar", "evaluate", "--field", str(cut)]) == 2
+    assert f"{cut}: not a complete .npz file" in capsys.readouterr().err
+
+
+def test_ctrl_c_exits_130_with_how_to_resume(capsys, monkeypatch, tmp_path) -> None:
+    import mpc_wt.campaign.runner
+
+    def interrupted(*a, **k):
+        raise KeyboardInterrupt
+    monkeypatch.setattr(mpc_wt.campaign.runner, "run_campaign", interrupted)
+    spec = tmp_path / "s.yaml"
+    spec.write_text("name: s\nduration: 10\nwinds: [12]\nseeds: 1\ncontrollers: [baseline]\n")
+    assert main(["campaign", "run", str(spec), "--out", str(tmp_path / "c"), "--engine",
+                 "serial"]) == 130
+    assert ("interrupted; run the same command again to resume: finished cases are kept"
+            in capsys.readouterr().err)
+
+
+def test_a_run_outside_its_validity_says_so(capsys, tmp_path) -> None:
+    """TS at cut-out in class-A turbulence: its premise leaves the vertex grid (the estimated
+    wind above 25 m/s) in a share of the steps; the run's result counts it, the command line
+    prints it. A baseline run at 12 m/s has no such line."""
+    from mpc_wt import ClosedLoopResult
+
+    out = tmp_path / "ts.nc"
+    assert main(["simulate", "--controller", "ts", "--wind", "25", "--duration", "30",
+                 "--out", str(out)]) == 0
+    text = capsys.readouterr().out
+    warns = ClosedLoopResult.load(out).meta["run_warnings"]
+    assert len(warns) == 1 and "TS premise" in warns[0] and "steps (" in warns[0]
+    assert f"warning: {warns[0]}" in text
+    assert main(["simulate", "--wind", "12", "--duration", "10", "--out",
+                 str(tmp_path / "b.nc")]) == 0
+    assert "warning:" not in capsys.readouterr().out
