@@ -274,6 +274,8 @@ VALIDITY_SIGNALS = {
     "qp_fallback": "the MPC's QP failed or ran over its time budget and the fallback command "
                    "was applied",
     "library_warning": "the controller library warned (aviFAIL > 0)",
+    "schedule_outside": "the scheduling wind lay more than 1 m/s beyond the designs' grid (the "
+                        "nearest design acted outside its range)",
 }
 
 

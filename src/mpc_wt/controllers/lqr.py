@@ -676,5 +676,6 @@ class ScheduledLQRPIO(ControllerBase):
         out = ctl.step(t, meas)
         self.signals = dict(ctl.signals, schedule_wind=float(self.schedule.wind or math.nan),
                             schedule_grid_wind=float(self.winds[k]),
-                            region=2.0 if ctl.region == "II" else 3.0)
+                            region=2.0 if ctl.region == "II" else 3.0,
+                            schedule_outside=float(self.schedule.outside))
         return out

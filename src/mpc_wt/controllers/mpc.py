@@ -1460,5 +1460,6 @@ class ScheduledMPC(ControllerBase):
         u = ctl.step(t, meas)
         self.signals = dict(ctl.signals, schedule_wind=float(self.schedule.wind or math.nan),
                             schedule_grid_wind=float(self.family.wind_mps[k]),
-                            target_wind=float(self.target_wind or math.nan))
+                            target_wind=float(self.target_wind or math.nan),
+                            schedule_outside=float(self.schedule.outside))
         return u

@@ -104,6 +104,16 @@ class WindSchedule:
         self.active: int | None = None
         self.switches = 0
 
+    #: how far beyond the grid's ends the scheduling wind may lie before :attr:`outside` [m/s]
+    OUTSIDE_MARGIN = 1.0
+
+    @property
+    def outside(self) -> bool:
+        """Whether the low-passed scheduling wind lies more than :attr:`OUTSIDE_MARGIN` beyond
+        the grid's ends: the acting design is then the nearest, used outside its range."""
+        return self.wind is not None and not (
+            self.grid[0] - self.OUTSIDE_MARGIN <= self.wind <= self.grid[-1] + self.OUTSIDE_MARGIN)
+
     def measured_wind(self, meas: dict[str, Any]) -> float:
         """This step's scheduling wind before the low-pass [m/s].
 
