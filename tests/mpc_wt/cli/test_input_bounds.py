@@ -136,3 +136,24 @@ def test_a_run_outside_its_validity_says_so(capsys, tmp_path) -> None:
     assert main(["simulate", "--wind", "12", "--duration", "10", "--out",
                  str(tmp_path / "b.nc")]) == 0
     assert "warning:" not in capsys.readouterr().out
+
+
+def test_ctrl_c_in_tune_exits_130_with_how_to_resume(capsys, monkeypatch, tmp_path) -> None:
+    import yaml
+
+    import mpc_wt.tuning.run
+
+    def interrupted(*a, **k):
+        raise KeyboardInterrupt
+    monkeypatch.setattr(mpc_wt.tuning.run, "tune", interrupted)
+    spec = tmp_path / "t.yaml"
+    spec.write_text(yaml.safe_dump({
+        "name": "t", "duration": 40, "transient": 10, "turbulence": "A", "winds": [18],
+        "seeds": [1], "holdout_seeds": [2], "channels": {"tower_base_fa_moment": 4},
+        "controller": {"controller": "baseline"},
+        "reference": {"name": "ref", "controller": "baseline"},
+        "parameters": {"omega_n_rad_s": {"low": 0.3, "high": 1.0}},
+        "objective": [{"metric": "del:tower_base_fa_moment", "weight": 1}], "trials": 3}))
+    assert main(["tune", str(spec), "--out", str(tmp_path / "tn"), "--engine", "serial"]) == 130
+    assert ("mpcwt tune: interrupted; run the same command again to resume: finished trials "
+            "are kept" in capsys.readouterr().err)
