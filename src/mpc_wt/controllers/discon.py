@@ -338,9 +338,11 @@ class DisconController(ControllerBase):
     root_name : str
         The simulation root name given to the library.
     quiet : bool
-        Send what the library prints on the process's standard output (ROSCO's banner and
-        status lines) to the null device during its calls (default); its ``aviFAIL`` messages
-        are kept either way.
+        In this process (``isolate=False``): send what the library prints on the process's
+        standard output (ROSCO's banner and status lines) to the null device during its calls
+        (default). In a child process what it prints goes to a temporary log, whose last
+        lines become the reason if it ends its process. Its ``aviFAIL`` messages are kept
+        either way.
     lidar : lidar.LidarSensor, optional
         A hub-mounted CW LIDAR (bound to the case's wind by the simulator) whose measurement
         fills OpenFAST's lidar records (:data:`LIDAR_RECORDS`): taken at the instrument's sample
