@@ -15,6 +15,7 @@ there breaks the pool and the cases in flight are recorded failed (rerun them).
 from __future__ import annotations
 
 import concurrent.futures as cf
+import contextlib
 import logging
 import os
 import time
@@ -244,10 +245,16 @@ def spec_code(spec: CampaignSpec) -> dict[str, Any]:
 
     from mpc_wt.campaign.checksum import file_sha256
 
+    from mpc_wt.controllers.discon import rosco_library
+    from mpc_wt.errors import ControllerLibraryError
+
     plugins = {m: getattr(sys.modules.get(m), "__file__", None) for m in spec.plugins}
     libs = {}
     for c in spec.controllers:
         lib = c.options.get("discon_library")
+        if c.controller == "rosco":              # the rosco package's compiled controller
+            with contextlib.suppress(ControllerLibraryError):
+                lib = str(rosco_library())
         if isinstance(lib, str) and Path(lib).is_file():
             libs[lib] = file_sha256(Path(lib))
     return {"plugins": plugins, "libraries": libs}

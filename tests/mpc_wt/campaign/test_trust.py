@@ -175,3 +175,18 @@ def test_plugins_and_libraries_are_resolved_beside_the_spec_and_named(tmp_path: 
     assert code["plugins"] == {"beside_plugin": str(home / "beside_plugin.py")}
     lib = home / "lib" / "libprobe.so"
     assert code["libraries"] == {str(lib): hashlib.sha256(lib.read_bytes()).hexdigest()}
+
+
+def test_the_index_names_roscos_library_with_its_checksum() -> None:
+    """The ``rosco`` kind runs the rosco package's library: the code the index names."""
+    import hashlib
+
+    from mpc_wt.campaign import spec_from_dict
+    from mpc_wt.campaign.runner import spec_code
+    from mpc_wt.controllers.discon import rosco_library
+
+    spec = spec_from_dict({"name": "r", "winds": [12], "seeds": 1,
+                           "controllers": [{"name": "r", "controller": "rosco"}, "baseline"]})
+    lib = rosco_library()
+    assert spec_code(spec) == {"plugins": {}, "libraries": {
+        str(lib): hashlib.sha256(lib.read_bytes()).hexdigest()}}
