@@ -1109,16 +1109,26 @@ def _controllers(raw: Any, lidar: dict[str, Any], plugin_kinds: bool,
     if not isinstance(raw, list) or not raw:
         raise _fail("controllers", "must be a non-empty list")
     if base is not None:
-        raw = [{**c, **{k: str((base / c[k]).resolve()) for k in ("discon_library", "discon_in")
-                        if isinstance(c.get(k), str) and c[k] != "shipped"
-                        and not Path(c[k]).expanduser().is_absolute()}}
-               if isinstance(c, Mapping) else c for c in raw]
+        raw = [_beside(base, c) for c in raw]
     ctls = tuple(_controller(i, c, lidar, plugin_kinds) for i, c in enumerate(raw))
     names = [c.name for c in ctls]
     dup = sorted({n for n in names if names.count(n) > 1})
     if dup:
         raise _fail("controllers", f"repeated names {dup}; give each a distinct name")
     return ctls
+
+
+def _beside(base: Path, entry: Any) -> Any:
+    """A controller entry with its relative ``discon_library`` and ``discon_in`` taken from
+    the spec's folder ``base`` (``shipped`` and absolute paths as given)."""
+    if not isinstance(entry, Mapping):
+        return entry
+    out = dict(entry)
+    for k in ("discon_library", "discon_in"):
+        v = out.get(k)
+        if isinstance(v, str) and v != "shipped" and not Path(v).expanduser().is_absolute():
+            out[k] = str((base / v).resolve())
+    return out
 
 
 def _check_size(raw: Mapping[str, Any], ctls: tuple[ControllerSpec, ...],

@@ -78,7 +78,7 @@ def _plugins(argv: Sequence[str]) -> list[str]:
 
 _ERRORS = (UsageError, linearize.TurbineFileError, linearize.TrimError, FileNotFoundError,
            ValueError, KeyError, ImportError, linearize.LinearizationError,
-           CampaignLockedError, ControllerLibraryError)
+           CampaignLockedError)
 
 
 def main(argv: Sequence[str] | None = None) -> int:

@@ -303,6 +303,7 @@ class _ChildLibrary:
                 pass
         with contextlib.suppress(OSError):
             os.unlink(self.log)
+        self._swap = np.empty(0, np.float32)      # release the map's buffer, then close it
         with contextlib.suppress(BufferError, ValueError):
             self._mem.close()
 
