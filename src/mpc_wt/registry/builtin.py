@@ -926,9 +926,55 @@ _ROSCO_FILES = {"NREL 5-MW": "NREL-5MW", "IEA-15-240-RWT": "IEA-15-240-RWT"}
 
 def _rosco_operating_point(turbine: linearize.Turbine, sc: Scenario, opts: RoscoOptions
                            ) -> linearize.OperatingPoint:
-    if opts.discon_in is None and opts.power_fraction < 1.0:
-        return _derated_trim(turbine, sc, opts)     # type: ignore[arg-type]
-    return linearize.trim(turbine, start_wind(turbine, sc))
+    if opts.discon_in is None:
+        if opts.power_fraction < 1.0:
+            return _derated_trim(turbine, sc, opts)     # type: ignore[arg-type]
+        return linearize.trim(turbine, start_wind(turbine, sc))
+    op = linearize.trim(turbine, start_wind(turbine, sc))
+    if opts.discon_in == "shipped":
+        from mpc_wt.controllers.discon import rosco_discon
+
+        name = next((v for k, v in _ROSCO_FILES.items() if turbine.name.startswith(k)), None)
+        if name is None:
+            return op
+        path = rosco_discon(name)
+    else:
+        path = Path(opts.discon_in)
+    return _file_start(turbine, op, path)
+
+
+def _file_start(turbine: linearize.Turbine, op: linearize.OperatingPoint, path: Path
+                ) -> linearize.OperatingPoint:
+    """Where a ROSCO file's own below-rated law holds the rotor, so the run starts in its
+    equilibrium rather than in our schedule's.
+
+    A TSR-tracking file (``VS_ControlMode`` 2-4) holds the generator speed at
+    ``VS_TSRopt * v / WE_BladeRadius * WE_GearboxRatio`` within ``VS_MinOMSpd..VS_RefSpd``;
+    ROSCO's shipped NREL 5-MW file allows 34.6 rad/s (3.4 rpm at the rotor), where our schedule
+    (and the turbine's definition) keeps 6.9 rpm. Started at ours, its torque controller brakes
+    the rotor at full torque rate (3.9 MN m and 0.23 x rated rotor speed at 3 m/s). Above the
+    file's rated speed, or for any other law, or where no equilibrium exists at that speed,
+    the trim is kept (it is the file's region-3 point too)."""
+    from mpc_wt.io.gain_tables import read_rosco
+
+    try:
+        f = read_rosco(path)
+        mode = int(f["VS_ControlMode"])
+        tsr, lo, hi = (float(f[k]) for k in ("VS_TSRopt", "VS_MinOMSpd", "VS_RefSpd"))
+        radius, gear = float(f["WE_BladeRadius"]), float(f["WE_GearboxRatio"])
+    except (OSError, KeyError, ValueError, TypeError):
+        return op
+    if mode not in (2, 3, 4) or min(tsr, lo, hi, radius, gear) <= 0:
+        return op
+    gen = min(max(tsr * op.wind_mps / radius * gear, lo), hi)
+    omega = gen / turbine.drivetrain.gearbox_ratio
+    if gen >= hi * (1 - 1e-6) or abs(omega - op.rotor_speed_rad_s) <= 1e-3 * omega:
+        return op
+    try:
+        return linearize.operating_point(turbine, op.wind_mps, omega, op.pitch_rad,
+                                         shear_exponent=op.shear_exponent)
+    except linearize.TrimError:
+        return op
 
 
 @register("rosco", RoscoOptions, field_components="u", operating_point=_rosco_operating_point,

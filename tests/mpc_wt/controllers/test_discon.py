@@ -344,3 +344,20 @@ def test_exported_coleman_ipc_through_rosco_acts_as_ours(turbine, tmp_path) -> N
         out[name] = (a["channels"]["flap_moment_1"]["del"], a["pitch_travel_deg"])
     assert abs(out["rosco"][0] / out["coleman-ipc"][0] - 1) <= 0.10
     assert abs(out["rosco"][1] / out["coleman-ipc"][1] - 1) <= 0.20
+
+
+def test_roscos_shipped_file_starts_in_its_own_equilibrium(turbine) -> None:
+    """ROSCO with its shipped NREL-5MW file at 3 m/s (steady, 30 s). The file tracks
+    VS_TSRopt = 7.5 down to VS_MinOMSpd = 34.64 rad/s at the generator, so its own rotor speed
+    at 3 m/s is 7.5 * 3 / 63 = 0.3571 rad/s (by hand from the file's numbers), half the
+    NREL 5-MW schedule's 6.9 rpm = 0.7226 rad/s. Started at our schedule's speed, ROSCO braked
+    the rotor at full torque rate (3.9 MN m on the shaft, down to 0.23 x rated speed): the
+    host's start, not ROSCO's law. The run starts where the file holds the rotor: speed within
+    1 % of 0.3571 rad/s throughout and no shaft-torque transient (peak within 10 % of the
+    mean)."""
+    res = run_controller(turbine, "rosco", Scenario(3.0, "steady", 1, 30.0),
+                         options={"discon_in": "shipped"})
+    w, q = res.channel("rotor_speed"), res.channel("lss_torque")
+    assert w.min() == pytest.approx(7.5 * 3.0 / 63.0, rel=0.01)
+    assert w.max() == pytest.approx(7.5 * 3.0 / 63.0, rel=0.01)
+    assert q.max() <= 1.1 * q[res.t >= 10.0].mean()
