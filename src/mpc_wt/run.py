@@ -276,12 +276,15 @@ VALIDITY_SIGNALS = {
     "library_warning": "the controller library warned (aviFAIL > 0)",
     "schedule_outside": "the scheduling wind lay more than 1 m/s beyond the designs' grid (the "
                         "nearest design acted outside its range)",
+    "estimator_outside": "the wind estimate was held at an end of the estimator's range or lay "
+                         "at a tip-speed ratio beyond its C_P table",
 }
 
 
 def run_warnings(res: Any) -> list[str]:
     """Where a run left its controller's validity, one line each, with how often: commands the
-    actuators' limits clipped, and the steps a controller flagged (:data:`VALIDITY_SIGNALS`).
+    actuators' limits clipped, steps with the generator torque pinned at its maximum, and the
+    steps a controller flagged (:data:`VALIDITY_SIGNALS`).
 
     Parameters
     ----------
@@ -296,6 +299,10 @@ def run_warnings(res: Any) -> list[str]:
     clipped = int(res.meta.get("commands_clipped", 0) or 0)
     if clipped:
         out.append(f"{clipped} commands beyond the actuators' limits were clipped")
+    pinned = int(res.meta.get("torque_pinned_steps", 0) or 0)
+    if pinned:
+        out.append(f"the generator torque sat at its maximum in {pinned} of {len(res.t)} steps "
+                   f"({100.0 * pinned / len(res.t):.1f} %)")
     for name, what in VALIDITY_SIGNALS.items():
         sig = res.controller.get(name)
         if sig is None:

@@ -677,5 +677,6 @@ class ScheduledLQRPIO(ControllerBase):
         self.signals = dict(ctl.signals, schedule_wind=float(self.schedule.wind or math.nan),
                             schedule_grid_wind=float(self.winds[k]),
                             region=2.0 if ctl.region == "II" else 3.0,
-                            schedule_outside=float(self.schedule.outside))
+                            schedule_outside=float(self.schedule.outside),
+                            estimator_outside=float(self.schedule.estimator_outside))
         return out

@@ -1461,5 +1461,6 @@ class ScheduledMPC(ControllerBase):
         self.signals = dict(ctl.signals, schedule_wind=float(self.schedule.wind or math.nan),
                             schedule_grid_wind=float(self.family.wind_mps[k]),
                             target_wind=float(self.target_wind or math.nan),
-                            schedule_outside=float(self.schedule.outside))
+                            schedule_outside=float(self.schedule.outside),
+                            estimator_outside=float(self.schedule.estimator_outside))
         return u

@@ -103,6 +103,7 @@ class WindSchedule:
         self.measured: float | None = None      # this step's wind before the low-pass
         self.active: int | None = None
         self.switches = 0
+        self._from_estimator = False
 
     #: how far beyond the grid's ends the scheduling wind may lie before :attr:`outside` [m/s]
     OUTSIDE_MARGIN = 1.0
@@ -113,6 +114,12 @@ class WindSchedule:
         the grid's ends: the acting design is then the nearest, used outside its range."""
         return self.wind is not None and not (
             self.grid[0] - self.OUTSIDE_MARGIN <= self.wind <= self.grid[-1] + self.OUTSIDE_MARGIN)
+
+    @property
+    def estimator_outside(self) -> bool:
+        """Whether this step's scheduling wind came from the wind estimator and the estimate
+        left its validity (:attr:`WindSpeedEstimator.outside`)."""
+        return self._from_estimator and self.estimator.outside
 
     def measured_wind(self, meas: dict[str, Any]) -> float:
         """This step's scheduling wind before the low-pass [m/s].
@@ -126,7 +133,9 @@ class WindSchedule:
         -------
         float
         """
-        if self.source == "preview" and meas.get("preview") is not None:
+        self._from_estimator = not (self.source == "preview"
+                                    and meas.get("preview") is not None)
+        if not self._from_estimator:
             return float(meas["preview"].rotor[0])
         return self.estimator.step_measurements(meas)
 

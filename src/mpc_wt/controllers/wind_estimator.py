@@ -243,6 +243,20 @@ class WindSpeedEstimator:
         """The current rotor-effective wind estimate [m/s] (None before the first step)."""
         return None if self.x is None else float(self.x[1])
 
+    @property
+    def outside(self) -> bool:
+        """Whether the estimate left the estimator's validity at the last step: held at an end
+        of its wind range (:attr:`wind_range`, half cut-in to 1.5 x cut-out), or at a
+        tip-speed ratio beyond its C_P table's (where the table is extrapolated)."""
+        if self.x is None:
+            return False
+        k = self._k
+        w, v = float(self.x[0]), float(self.x[1])
+        if v <= k[_VMIN] * (1 + 1e-9) or v >= k[_VMAX] * (1 - 1e-9):
+            return True
+        tsr = w * self.radius / v
+        return not k[_TSR0] <= tsr <= k[_TSR1]
+
     def aero_torque(self, wind: float, rotor_speed: float, pitch: float
                     ) -> tuple[float, float, float]:
         """The aerodynamic torque of the C_P table and its partial derivatives.

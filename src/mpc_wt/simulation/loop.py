@@ -328,7 +328,8 @@ def simulate_closed_loop(params: linearize.PlantParams, controller: Any,
     -------
     ClosedLoopResult
         ``round(duration / dt) + 1`` samples; ``meta`` gains ``dt``, ``controller_dt``,
-        ``commands_clipped`` and ``software_version``.
+        ``commands_clipped``, ``torque_pinned_steps`` (plant steps with the generator torque at
+        its maximum) and ``software_version``.
 
     Raises
     ------
@@ -363,8 +364,11 @@ def simulate_closed_loop(params: linearize.PlantParams, controller: Any,
         finalize = getattr(controller, "finalize", None)
         if callable(finalize):
             finalize()
+    pinned = int(np.count_nonzero(loop.us[:, 3] >= params.turbine.generator.max_torque
+                                  * (1.0 - 1e-6)))
     return loop.result(n + 1, {**(meta or {}), "dt": dt,
                                "controller_dt": cdt, "commands_clipped": loop.clipped,
+                               "torque_pinned_steps": pinned,
                                "software_version": __version__})
 
 

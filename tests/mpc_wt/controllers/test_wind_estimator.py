@@ -177,3 +177,21 @@ def test_compiled_spline_is_fitpacks(x: float, y: float, kx: int, ky: int) -> No
     v, d = _spline2(tx, ty, c, kx, ky, x, y)
     assert v == pytest.approx(float(s.ev(x, y)), abs=1e-12)
     assert d == pytest.approx(float(s.ev(x, y, dx=1)), abs=1e-11)
+
+
+def test_says_when_it_leaves_its_validity(turbine, estimator) -> None:
+    """At the trim at 12 m/s the estimate lies inside its range and table: not outside. A
+    generator torque no wind in half cut-in .. 1.5 x cut-out can balance at fine pitch and
+    rated speed (the generator's maximum torque with the rotor feathered to 90 deg: the
+    aerodynamic torque is then small at any wind) holds the estimate at an end of the range:
+    outside."""
+    op = linearize.trim(turbine, 12.0)
+    estimator.reset()
+    assert not estimator.outside
+    for _ in range(5):
+        estimator.step(op.rotor_speed_rad_s, op.pitch_rad, op.gen_torque)
+    assert not estimator.outside
+    estimator.reset()
+    estimator.step(op.rotor_speed_rad_s, math.radians(90.0), turbine.generator.max_torque)
+    lo, hi = estimator.wind_range
+    assert estimator.estimate in (lo, hi) and estimator.outside

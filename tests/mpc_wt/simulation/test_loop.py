@@ -178,3 +178,25 @@ def test_first_run_says_it_compiles_and_shows_no_eta(monkeypatch) -> None:
     again = lp._progress_bar(1600, "simulate mpc", True)
     assert again.desc.startswith("simulate mpc")
     again.close()
+
+
+def test_torque_pinned_at_its_maximum_is_counted(turbine: linearize.Turbine,
+                                                 params: linearize.PlantParams) -> None:
+    """A controller asking for twice the generator's maximum torque at 14 m/s for 2 s: the
+    applied torque climbs from the trim's at the generator's rate limit and sits at the
+    maximum from then on. By hand: sample k holds the trim's torque plus k rate steps, so the
+    samples from ceil((max - trim) / (rate * dt)) on, of 161, are pinned; the run's warnings
+    say so."""
+    from mpc_wt.run import run_warnings
+
+    op = linearize.trim(turbine, 14.0)
+    g = turbine.generator
+    r = simulate_closed_loop(params, _Fixed(op.pitch_rad, 2.0 * g.max_torque),
+                             linearize.SteadyWind(14.0), 2.0, x0=op.x, u0=op.u)
+    climb = math.ceil((g.max_torque - op.gen_torque) / (g.max_torque_rate / 80.0))
+    assert r.meta["torque_pinned_steps"] == 161 - climb
+    assert any(w.startswith("the generator torque sat at its maximum in "
+                            f"{161 - climb} of 161 steps") for w in run_warnings(r))
+    calm = simulate_closed_loop(params, _Fixed(op.pitch_rad, op.gen_torque),
+                                linearize.SteadyWind(14.0), 1.0, x0=op.x, u0=op.u)
+    assert calm.meta["torque_pinned_steps"] == 0 and run_warnings(calm) == []
