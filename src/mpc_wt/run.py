@@ -13,6 +13,7 @@ import linearize
 from mpc_wt.registry.context import DEFAULT_CACHE, BuildContext, Built, DesignCache, design_digest
 from mpc_wt.registry.options import Options
 from mpc_wt.registry.registry import API_NAMING, Naming, Selection, resolve
+from mpc_wt.simulation.memory import check_run_memory, estimate_run_memory
 from mpc_wt.simulation.loop import simulate_closed_loop
 from mpc_wt.simulation.results import ClosedLoopResult
 from mpc_wt.simulation.scenario import FieldMemo, Scenario, lidar_field, make_wind, start_wind
@@ -151,7 +152,12 @@ def build_controller(turbine: linearize.Turbine, controller: str, scenario: Scen
     op = _operating_point(turbine, sel, opts, scenario)
     built, new = _design(turbine, sel, opts, cache, params)
     needs = set().union(*(k.field_components for k in (sel.base, *sel.addons)))
-    wind, field = make_wind(turbine, scenario, "".join(c for c in "uvw" if c in needs),
+    comps = "".join(c for c in "uvw" if c in needs)
+    lidars = len(built.sensors) + (built.preview is not None)
+    check_run_memory(estimate_run_memory(turbine, scenario, components=len(comps),
+                                         lidar_fields=lidars),
+                     what=f"a {scenario.duration:g} s run of {controller}")
+    wind, field = make_wind(turbine, scenario, comps,
                             samplers=samplers, fields=fields)
     for sensor in built.sensors:
         sensor.bind(lidar_field(turbine, scenario, field, sensor.distance, samplers, fields))

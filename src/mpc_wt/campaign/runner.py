@@ -142,6 +142,8 @@ def run_campaign(spec: CampaignSpec, out: str | Path, *, workers: int | None = N
                  summary.skipped, len(todo), sync)
         if not todo:
             return summary
+        if scheduler is None:
+            _check_memory(todo, n_workers)
         bar = _Bar(len(todo), spec.name, progress)
         spec_hash = spec.spec_hash
 
@@ -199,6 +201,33 @@ def submission_order(cases: list[Any]) -> list[Any]:
                 int(sc.sign), str(sc.wind_file or ""),
                 float(sc.shear_exponent), i)
     return [c for _, c in sorted(enumerate(cases), key=key)]
+
+
+def _check_memory(todo: list[Case], processes: int) -> None:
+    """Refuse a campaign whose largest case, once per worker, would not fit in the memory
+    available (:mod:`mpc_wt.simulation.memory`; a LIDAR's field counted for every kind whose
+    name says LIDAR)."""
+    from mpc_wt.campaign.task import load_case_turbine
+    from mpc_wt.registry import resolve
+    from mpc_wt.simulation.memory import check_run_memory, estimate_run_memory
+
+    worst, name = None, ""
+    for turbine in {c.turbine for c in todo}:
+        cases = [c for c in todo if c.turbine == turbine]
+        big = max(cases, key=lambda c: c.scenario.duration)
+        try:
+            sel = resolve(big.run_name)
+            comps = set().union(*(k.field_components for k in (sel.base, *sel.addons)))
+        except ValueError:
+            comps = set("uvw")
+        m = estimate_run_memory(load_case_turbine(turbine), big.scenario,
+                                components=len(comps), lidar_fields=int(any(
+                                    "lidar" in c.run_name for c in cases)))
+        if worst is None or m.total > worst.total:
+            worst, name = m, big.case_id
+    if worst is not None:
+        check_run_memory(worst, what=f"the campaign's largest case ({name})",
+                         processes=processes)
 
 
 def _check_engine(engine: str, scheduler: str | None, workers: int | None) -> int:

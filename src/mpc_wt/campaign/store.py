@@ -17,6 +17,7 @@ reported (refused, naming the files).
 """
 from __future__ import annotations
 
+import contextlib
 import fcntl
 import json
 import logging
@@ -437,19 +438,38 @@ class CampaignStore:
         return sorted(self.cases_dir.glob(".*.tmp")) if self.cases_dir.is_dir() else []
 
     def _tx(self) -> "_Tx":
-        return _Tx(self.db)
+        return _Tx(self.db, self.root / "index.sqlite")
 
 
 class _Tx:
-    """BEGIN IMMEDIATE ... COMMIT (ROLLBACK on error): one durable commit per call."""
+    """BEGIN IMMEDIATE ... COMMIT (ROLLBACK on error): one durable commit per call. An index
+    that cannot be written (a full disk, a read-only folder) raises
+    :class:`~mpc_wt.errors.CampaignIndexError` naming it; the commits before are kept."""
 
-    def __init__(self, db: sqlite3.Connection) -> None:
-        self.db = db
+    def __init__(self, db: sqlite3.Connection, index: Path) -> None:
+        self.db, self.index = db, index
+
+    def _failed(self, err: sqlite3.Error) -> CampaignIndexError:
+        return CampaignIndexError(
+            f"{self.index}: cannot be written: {err} (free space or make it writable, then "
+            f"run the same command again to resume: every case recorded before is kept)")
 
     def __enter__(self) -> sqlite3.Connection:
-        self.db.execute("BEGIN IMMEDIATE")
+        try:
+            self.db.execute("BEGIN IMMEDIATE")
+        except sqlite3.OperationalError as err:
+            raise self._failed(err) from None
         return self.db
 
-    def __exit__(self, et: Any, ev: Any, tb: Any) -> None:
-        self.db.execute("ROLLBACK" if et else "COMMIT")
+    def __exit__(self, et: Any, ev: Any, tb: Any) -> bool:
+        try:
+            self.db.execute("ROLLBACK" if et else "COMMIT")
+        except sqlite3.OperationalError as err:
+            if et is None:
+                with contextlib.suppress(sqlite3.Error):
+                    self.db.execute("ROLLBACK")
+                raise self._failed(err) from None
+        if et is not None and issubclass(et, sqlite3.OperationalError):
+            raise self._failed(ev) from None
+        return False
 

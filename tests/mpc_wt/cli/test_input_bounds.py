@@ -157,3 +157,48 @@ def test_ctrl_c_in_tune_exits_130_with_how_to_resume(capsys, monkeypatch, tmp_pa
     assert main(["tune", str(spec), "--out", str(tmp_path / "tn"), "--engine", "serial"]) == 130
     assert ("mpcwt tune: interrupted; run the same command again to resume: finished trials "
             "are kept" in capsys.readouterr().err)
+
+
+def test_memory_is_estimated_before_a_run(capsys, monkeypatch, tmp_path) -> None:
+    """A 3 h turbulent run on the IEA-15 (a 56 x 56 field every 0.05 s: 3.6 GB stored, by hand
+    216001 x 56 x 56 x 4 B) on a machine with 2 GB available is refused before the field is
+    made, naming the estimate, its parts and what is available (exit 2); a 2 s run passes."""
+    import mpc_wt.simulation.memory as memory
+    import mpc_wt.simulation.scenario as scenario
+
+    monkeypatch.setattr(memory, "available_memory", lambda: 2e9)
+
+    def refuse(*a, **k):
+        raise AssertionError("the wind field was made before memory was checked")
+    monkeypatch.setattr(scenario, "make_wind", refuse)
+    import mpc_wt.run
+    monkeypatch.setattr(mpc_wt.run, "make_wind", refuse)
+    assert main(["simulate", "--turbine", "iea15mw", "--wind", "12", "--duration", "10800",
+                 "--out", str(tmp_path / "x.nc")]) == 2
+    err = capsys.readouterr().err
+    assert "a 10800 s run of baseline needs about" in err and "more than the 2.00 GB available" \
+        in err and "shorten the duration" in err
+    m = memory.estimate_run_memory(linearize.load_turbine("iea15mw"),
+                                   scenario.Scenario(12.0, "A", 1, 10800.0))
+    assert m.field >= 216001 * 56 * 56 * 4
+    monkeypatch.undo()
+    monkeypatch.setattr(memory, "available_memory", lambda: 2e9)
+    assert main(["simulate", "--wind", "12", "--duration", "2", "--out",
+                 str(tmp_path / "y.nc")]) == 0
+
+
+def test_a_campaign_that_would_not_fit_is_refused(monkeypatch, tmp_path) -> None:
+    """A campaign of 1 h cases on 2 workers with 1 GB available: refused before any case
+    runs, naming the largest case and the worker count; nothing is recorded as failed."""
+    import mpc_wt.simulation.memory as memory
+    from mpc_wt.campaign import run_campaign
+    from mpc_wt.campaign.store import CampaignStore
+
+    monkeypatch.setattr(memory, "available_memory", lambda: 1e9)
+    spec = spec_from_dict({**BASE, "duration": 3600})
+    with pytest.raises(memory.RunTooLargeError, match=r"the campaign's largest case "
+                                                      r"\(baseline__A__v14__s1\) needs about "
+                                                      r"2 x .* run fewer workers"):
+        run_campaign(spec, tmp_path / "c", workers=2, engine="processes", progress=False)
+    with CampaignStore(tmp_path / "c") as store:
+        assert store.counts().get("failed", 0) == 0 and store.counts().get("done", 0) == 0
