@@ -361,3 +361,26 @@ def test_roscos_shipped_file_starts_in_its_own_equilibrium(turbine) -> None:
     assert w.min() == pytest.approx(7.5 * 3.0 / 63.0, rel=0.01)
     assert w.max() == pytest.approx(7.5 * 3.0 / 63.0, rel=0.01)
     assert q.max() <= 1.1 * q[res.t >= 10.0].mean()
+
+
+def test_roscos_runtime_exit_on_a_missing_table_fails_the_run_only(turbine, tmp_path) -> None:
+    """ROSCO's shipped NREL-5MW DISCON.IN with ``PerfFileName`` naming a file that does not
+    exist: ROSCO's Fortran runtime ends its process ("Cannot open file"). The run fails with
+    that process's exit and ROSCO's last output, this process goes on, and a second run with the
+    shipped file works."""
+    lines = rosco_discon().read_text().splitlines()
+    for i, line in enumerate(lines):
+        words = line.split()
+        if len(words) >= 3 and words[2] == "PerfFileName":
+            lines[i] = '"no_such_table.txt"' + line[len(words[0]):]
+    bad = tmp_path / "DISCON.IN"
+    bad.write_text("\n".join(lines) + "\n")
+    with pytest.raises(ControllerLibraryError, match=r"ended its process at t = 0 s .*its last "
+                                                     r"output: .*no_such_table") as exc:
+        run_controller(turbine, "rosco", Scenario(12.0, "steady", 1, 2.0),
+                       options={"discon_in": str(bad)})
+    assert "Fortran runtime error: Cannot open file" in str(exc.value)
+    assert "exit status 2" in str(exc.value)
+    res = run_controller(turbine, "rosco", Scenario(12.0, "steady", 1, 2.0),
+                         options={"discon_in": "shipped"})
+    assert res.t[-1] == pytest.approx(2.0)
