@@ -7,7 +7,7 @@ import logging
 from pathlib import Path
 from typing import Any
 
-from mpc_wt.cli.common import to_json
+from mpc_wt.cli.common import check_out_folder, to_json
 from mpc_wt.errors import UsageError
 
 __all__ = ["add_parsers"]
@@ -115,6 +115,7 @@ def _run(args: argparse.Namespace) -> int:
     if args.scheduler and args.workers:
         raise UsageError("give --workers (local cluster) or --scheduler (running cluster), "
                          "not both")
+    check_out_folder("--out", args.out)
     _check_trust(args)
     spec = load_spec(args.spec)
     out = Path(args.out) if args.out else Path("campaigns") / spec.name
@@ -185,6 +186,7 @@ def _status(args: argparse.Namespace) -> int:
 def _report(args: argparse.Namespace) -> int:
     from mpc_wt.campaign.report import make_report
 
+    check_out_folder("--out", args.out)
     rep = make_report(args.dir, out=args.out)
     print(f"report {rep}")
     return 0
@@ -209,6 +211,7 @@ def _tune(args: argparse.Namespace) -> int:
                          "not both")
     if args.trials is not None and args.trials < 1:
         raise UsageError(f"--trials must be >= 1, got {args.trials}")
+    check_out_folder("--out", args.out)
     _check_trust(args)
     spec = load_tune_spec(args.spec)
     out = Path(args.out) if args.out else Path("tunings") / spec.name

@@ -54,6 +54,38 @@ def check_out_file(flag: str, value: str, suffix: str) -> Path:
     return out
 
 
+def check_out_folder(flag: str, value: str | Path | None) -> Path | None:
+    """An output folder named on the command line, checked before any work: it may exist (as a
+    folder) or not yet; a file of that name is refused.
+
+    Parameters
+    ----------
+    flag : str
+        The option, for the message.
+    value : str or Path or None
+        The path given (None: the command's default, not checked here).
+
+    Returns
+    -------
+    Path or None
+
+    Raises
+    ------
+    UsageError
+        Naming the option and the path.
+    """
+    if value is None:
+        return None
+    out = Path(value)
+    if out.exists() and not out.is_dir():
+        raise UsageError(f"{flag} {value}: is a file; the command writes a folder there: name "
+                         f"a new folder or an existing one")
+    for parent in out.parents:
+        if parent.exists() and not parent.is_dir():
+            raise UsageError(f"{flag} {value}: {parent} is a file, not a folder")
+    return out
+
+
 def add_turbine(p: argparse.ArgumentParser) -> None:
     """Add ``--turbine`` to a parser.
 

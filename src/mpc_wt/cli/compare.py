@@ -11,7 +11,7 @@ from typing import Any
 import numpy as np
 
 import linearize
-from mpc_wt.cli.common import to_json
+from mpc_wt.cli.common import check_out_folder, to_json
 from mpc_wt.errors import UsageError
 
 __all__ = ["add_parsers"]
@@ -69,6 +69,7 @@ def _compare(args: argparse.Namespace) -> int:
 
     if args.controller == "discon" and args.library is None:
         raise UsageError("--controller discon needs --library LIB")
+    check_out_folder("--out", args.out)
     turbine = linearize.load_turbine(args.turbine) if args.turbine else None
     case = read_openfast_case(args.fst, wind=args.wind, turbine=turbine)
     of = read_openfast_output(args.outb)

@@ -8,7 +8,7 @@ from pathlib import Path
 from typing import Any
 
 import linearize
-from mpc_wt.cli.common import add_turbine, floats, number_pairs, parse_range
+from mpc_wt.cli.common import add_turbine, check_out_folder, floats, number_pairs, parse_range
 from mpc_wt.errors import GainTableError, UsageError
 
 __all__ = ["add_parsers"]
@@ -107,6 +107,7 @@ def _design(args: argparse.Namespace) -> int:
     from mpc_wt.plotting import plot_design
     from mpc_wt.registry.registry import designs
 
+    check_out_folder("--out", args.out)
     kind = designs()[args.kind]
     every = _design_args(args)
     wanted = inspect.signature(kind.design).parameters
@@ -167,6 +168,7 @@ def _export_registered(args: argparse.Namespace, turbine: Any) -> list[Path] | N
 def _export(args: argparse.Namespace) -> int:
     from mpc_wt.io.gain_tables import export
 
+    check_out_folder("--to", args.to)
     turbine = linearize.load_turbine(args.turbine) if args.turbine else None
     try:
         files = _export_registered(args, turbine) or export(args.design, args.format, args.to,

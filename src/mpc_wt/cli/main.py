@@ -78,7 +78,8 @@ def _plugins(argv: Sequence[str]) -> list[str]:
 
 _ERRORS = (UsageError, linearize.TurbineFileError, linearize.TrimError, FileNotFoundError,
            ValueError, KeyError, ImportError, linearize.LinearizationError,
-           CampaignLockedError)
+           CampaignLockedError, PermissionError, FileExistsError, NotADirectoryError,
+           IsADirectoryError)
 
 
 def main(argv: Sequence[str] | None = None) -> int:
@@ -125,3 +126,6 @@ def main(argv: Sequence[str] | None = None) -> int:
     except _ERRORS as err:
         print(f"mpcwt {args.command}: error: {err}", file=sys.stderr)
         return 2
+    except OSError as err:                    # a full disk, a lost mount: the run failed
+        print(f"mpcwt {args.command}: run failed: {err}", file=sys.stderr)
+        return 1

@@ -21,6 +21,7 @@ from mpc_wt.cli.common import (
     to_json,
     add_turbine,
     check_out_file,
+    check_out_folder,
     cp_surface,
     format_table,
     pairs,
@@ -387,8 +388,8 @@ def assess_table(rows: list[dict[str, Any]]) -> str:
 
 
 def _run(args: argparse.Namespace) -> int:
+    out = check_out_folder("--out", args.out)
     turbine = linearize.load_turbine(args.turbine)
-    out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     _steady_outputs(turbine, out)
     _design_outputs(turbine, out)

@@ -202,3 +202,28 @@ def test_a_campaign_that_would_not_fit_is_refused(monkeypatch, tmp_path) -> None
         run_campaign(spec, tmp_path / "c", workers=2, engine="processes", progress=False)
     with CampaignStore(tmp_path / "c") as store:
         assert store.counts().get("failed", 0) == 0 and store.counts().get("done", 0) == 0
+
+
+@pytest.mark.parametrize("argv", [
+    ["campaign", "run", "SPEC", "--out", "FILE", "--engine", "serial"],
+    ["design", "baseline", "--out", "FILE"],
+    ["run", "--out", "FILE"],
+    ["run", "--out", "FILE/sub"],
+    ["export", "DESIGN", "--format", "csv", "--to", "FILE"],
+    ["tune", "SPEC", "--out", "FILE"],
+])
+def test_an_output_folder_that_is_a_file_is_refused_first(capsys, no_simulation, tmp_path,
+                                                          argv) -> None:
+    """Every command that writes a folder, given an existing file as it: one line naming the
+    option and the path, exit 2, before any work (formerly a FileExistsError or
+    NotADirectoryError traceback after the design)."""
+    (tmp_path / "f").write_text("mine\n")
+    spec = tmp_path / "s.yaml"
+    spec.write_text("name: s\nduration: 10\nwinds: [12]\nseeds: 1\ncontrollers: [baseline]\n")
+    sub = {"FILE": str(tmp_path / "f"), "SPEC": str(spec), "DESIGN": str(tmp_path)}
+    args = [next((a.replace(k, v) for k, v in sub.items() if a.startswith(k)), a) for a in argv]
+    assert main(args) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and str(tmp_path / "f") in err[0]
+    assert "is a file" in err[0]
+    assert (tmp_path / "f").read_text() == "mine\n"
