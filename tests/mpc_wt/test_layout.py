@@ -215,7 +215,7 @@ LAYOUT = {
                     "filters", "wind_estimator", "scheduling"},
     "controllers/takagi_sugeno": {"model", "synthesis", "controller", "robustness"},
     "registry": {"registry", "options", "builtin", "context"},
-    "simulation": {"scenario", "loop", "compiled", "results", "preview", "solver_timing"},
+    "simulation": {"scenario", "loop", "compiled", "results", "preview", "solver_timing", "memory"},
     "assessment": {"fatigue", "performance", "series", "ultimate", "lidar", "compare"},
     "io": {"gain_tables", "rosco", "openfast_output", "discon_export", "openfast_case",
            "json_text"},

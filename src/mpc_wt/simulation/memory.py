@@ -41,7 +41,7 @@ class RunTooLargeError(ValueError):
 class RunMemory:
     """An estimate of one run's peak memory [B].
 
-    Attributes
+    Parameters
     ----------
     field : float
         Wind fields at their peak while generated.
