@@ -38,7 +38,7 @@ from mpc_wt.controllers.takagi_sugeno import (
 from mpc_wt.controllers.wind_estimator import WindSpeedEstimator
 from mpc_wt.errors import (
                                          OptionsError,
-                                         ResultFileError,
+                                         ResultFileError, RunTooLargeError,
                                          SimulationDivergedError,
                                          SpecError,
                                          SynthesisError,
@@ -55,7 +55,8 @@ __all__ = ["__version__", "controllers", "registry", "DEFAULT_CHANNELS", "assess
            "cs_measures", "damage_equivalent_load", "lifetime_del", "reductions",
            "BaselineController", "BaselineGains", "tune_baseline", "tune_baseline_schedule",
            "Scenario", "register", "run_controller", "build_controller", "OptionsError",
-           "ResultFileError", "SimulationDivergedError", "SpecError", "SynthesisError",
+           "ResultFileError", "RunTooLargeError", "SimulationDivergedError", "SpecError",
+           "SynthesisError",
            "KalmanEstimator", "MPC", "MPCSettings", "MPCWeights", "ScheduledMPC", "BACKENDS",
            "default_backend", "ClosedLoopResult", "load_series", "ColemanIPCController",
            "IBCController", "apc_reference", "tune_coleman_ipc", "tune_ibc", "LidarPreview",

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 from linearize import SimulationDivergedError
 
-__all__ = ["UsageError", "OptionsError", "SpecError", "CampaignLockedError", "CampaignIndexError",
+__all__ = ["RunTooLargeError", "UsageError", "OptionsError", "SpecError", "CampaignLockedError", "CampaignIndexError",
            "GainTableError", "ResultFileError", "PremiseError", "SynthesisError",
            "SimulationDivergedError", "QPSetupError", "ControllerLibraryError", "TrialFailed",
            "CaseDataError"]
@@ -43,6 +43,10 @@ class CampaignLockedError(RuntimeError):
 class CampaignIndexError(ValueError):
     """A campaign's ``index.sqlite`` that is not an SQLite database, or that cannot be opened
     or written (a full disk, a read-only folder)."""
+
+
+class RunTooLargeError(ValueError):
+    """A run or campaign whose estimated memory exceeds what the machine has available."""
 
 
 class GainTableError(ValueError):

@@ -142,8 +142,7 @@ def run_campaign(spec: CampaignSpec, out: str | Path, *, workers: int | None = N
                  summary.skipped, len(todo), sync)
         if not todo:
             return summary
-        if scheduler is None:
-            _check_memory(todo, n_workers)
+        _check_memory(todo, n_workers if scheduler is None else 0)
         bar = _Bar(len(todo), spec.name, progress)
         spec_hash = spec.spec_hash
 
@@ -206,7 +205,9 @@ def submission_order(cases: list[Any]) -> list[Any]:
 def _check_memory(todo: list[Case], processes: int) -> None:
     """Refuse a campaign whose largest case, once per worker, would not fit in the memory
     available (:mod:`mpc_wt.simulation.memory`; a LIDAR's field counted for every kind whose
-    name says LIDAR)."""
+    name says LIDAR); nothing is checked for ``processes`` 0 (a cluster elsewhere)."""
+    if processes < 1:
+        return
     from mpc_wt.campaign.task import load_case_turbine
     from mpc_wt.registry import resolve
     from mpc_wt.simulation.memory import check_run_memory, estimate_run_memory

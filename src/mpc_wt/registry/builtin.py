@@ -291,6 +291,10 @@ class MPCWeightOptions(Options):
                                           lo=0.0)
     pitch_ref: Optional[float] = option(None, help="input " + _MW, unit="-", lo=0.0)
     gen_torque_ref: Optional[float] = option(None, help="input " + _MW, unit="-", lo=0.0)
+    pitch_ref_rate: Optional[float] = option(None, help="the pitch input's change per step "
+                                             + _MW, unit="-", lo=0.0)
+    gen_torque_ref_rate: Optional[float] = option(None, help="the torque input's change per "
+                                                  "step " + _MW, unit="-", lo=0.0)
 
     def weights(self, defaults: dict[str, float] | None = None) -> Any:
         """The cost weights.
@@ -312,8 +316,29 @@ class MPCWeightOptions(Options):
         given = {**(defaults or {}),
                  **{k: v for k, v in self.to_dict().items() if v is not None}}
         ins = {k: given.pop(k) for k in ("pitch_ref", "gen_torque_ref") if k in given}
+        rate = {k[:-5]: given.pop(k) for k in ("pitch_ref_rate", "gen_torque_ref_rate")
+                if k in given}
         return MPCWeights(outputs={**w.outputs, **given}, inputs={**w.inputs, **ins},
-                          rate=dict(w.rate), scales=dict(w.scales))
+                          rate={**w.rate, **rate}, scales=dict(w.scales))
+
+    def over(self, weights: Any) -> Any:
+        """``weights`` with the set options in place of theirs.
+
+        Parameters
+        ----------
+        weights : MPCWeights
+
+        Returns
+        -------
+        MPCWeights
+        """
+        given = {k: v for k, v in self.to_dict().items() if v is not None}
+        ins = {k: given.pop(k) for k in ("pitch_ref", "gen_torque_ref") if k in given}
+        rate = {k[:-5]: given.pop(k) for k in ("pitch_ref_rate", "gen_torque_ref_rate")
+                if k in given}
+        return dataclasses.replace(weights, outputs={**weights.outputs, **given},
+                                   inputs={**weights.inputs, **ins},
+                                   rate={**weights.rate, **rate})
 
 
 @dataclass(frozen=True)
@@ -355,6 +380,10 @@ class MPCOptions(Options):
                                           unit="-", lo=0.5, hi=2.0)
     weights: MPCWeightOptions = option(MPCWeightOptions(), help="cost weights (gen_power, "
                                        "flap_moment, rotor_speed, ...)", flag="")
+    below_rated_weights: MPCWeightOptions = option(
+        MPCWeightOptions(), help="the scheduled designs' weights below rated wind where they "
+        "differ from weights (default: weights without the flap moment's, and those of "
+        "BELOW_RATED_WEIGHTS)", flag="")
     time_budget_ms: Optional[float] = option(None, help="wall time a QP may take; a slower "
                                              "solve takes the logged fallback (default none: "
                                              "reproducible runs, the solver's iteration limit "
@@ -432,6 +461,9 @@ class MPCLidarOptions(MPCOptions):
 #: seed 1; held-out seeds 3-4: power -0.2 %, pitch travel 2.6x and the largest rotor speed
 #: +1.0 % against the baseline). Madsen's single-point design keeps the paper's.
 ENVELOPE_WEIGHTS = {"pitch_rate": 0.0235, "flap_moment": 0.1024}
+#: The scheduled designs' weights below rated wind in place of theirs above (no flap
+#: moment's: the pitch rests at fine pitch there).
+BELOW_RATED_WEIGHTS = {"flap_moment": 0.0}
 #: The scheduled designs' soft rotor-speed limit (a fraction of rated), tuned with them.
 ENVELOPE_SPEED_LIMIT = 1.028
 
@@ -505,8 +537,9 @@ def _mpc(collective: bool, with_lidar: bool) -> Any:
                                wind_estimator=_wind_estimator(ctx, settings.dt),
                                time_constant=opts.schedule_time_constant,
                                torque_law=law, below_rated=settings.replace(
-                                   weights=dataclasses.replace(settings.weights, outputs={
-                                       **settings.weights.outputs, "flap_moment": 0.0})))
+                                   weights=opts.below_rated_weights.over(
+                                       MPCWeightOptions(**BELOW_RATED_WEIGHTS).over(
+                                           settings.weights))))
             grid = [float(fam.wind_mps[0]), float(fam.wind_mps[-1])]
         else:
             v = _check_design_wind(ctx.turbine, opts.design_wind_mps)

@@ -174,6 +174,11 @@ class _Loop:
             return
         self.u[3] += min(max(self.u_tq - self.u[3], -self.rate), self.rate)
 
+    def pinned(self) -> int:
+        """Plant steps with the applied generator torque at its maximum."""
+        top = self.params.turbine.generator.max_torque * (1.0 - 1e-6)
+        return int(np.count_nonzero(self.us[:, 3] >= top))
+
     def result(self, k: int, meta: dict[str, Any]) -> ClosedLoopResult:
         """The first ``k`` samples as a result."""
         self.flush_signals()
@@ -361,15 +366,18 @@ def simulate_closed_loop(params: linearize.PlantParams, controller: Any,
                                      f".partial)", loop.result(loop.k_done, meta or {})) from None
     finally:
         bar.close()
-        finalize = getattr(controller, "finalize", None)
-        if callable(finalize):
-            finalize()
-    pinned = int(np.count_nonzero(loop.us[:, 3] >= params.turbine.generator.max_torque
-                                  * (1.0 - 1e-6)))
+        _finalize(controller)
     return loop.result(n + 1, {**(meta or {}), "dt": dt,
                                "controller_dt": cdt, "commands_clipped": loop.clipped,
-                               "torque_pinned_steps": pinned,
+                               "torque_pinned_steps": loop.pinned(),
                                "software_version": __version__})
+
+
+def _finalize(controller: Any) -> None:
+    """A controller's last call (a Bladed-style library's), if it has one."""
+    finalize = getattr(controller, "finalize", None)
+    if callable(finalize):
+        finalize()
 
 
 #: whether this process has run a closed loop (its kernels compiled or loaded)

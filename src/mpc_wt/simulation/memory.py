@@ -16,6 +16,7 @@ import os
 from dataclasses import dataclass
 
 import linearize
+from mpc_wt.errors import RunTooLargeError
 from mpc_wt.simulation.scenario import Scenario, field_grid
 
 __all__ = ["RunMemory", "estimate_run_memory", "available_memory", "check_run_memory",
@@ -31,10 +32,6 @@ BASE_BYTES = 450e6
 FIELD_PEAK = 2.0
 #: Result columns per plant step: states, inputs, outputs and up to 60 controller signals.
 RESULT_COLUMNS = len(linearize.STATE_NAMES) + 4 + 31 + 60
-
-
-class RunTooLargeError(ValueError):
-    """A run or campaign whose estimated memory exceeds what the machine has available."""
 
 
 @dataclass(frozen=True)
@@ -96,8 +93,14 @@ def estimate_run_memory(turbine: linearize.Turbine, scenario: Scenario, *,
 
 
 def available_memory() -> float | None:
-    """The memory available to new work now [B] (Linux ``MemAvailable``, else the free
-    physical pages), or None where neither is known."""
+    """The memory available to new work now.
+
+    Returns
+    -------
+    float or None
+        [B]: Linux's ``MemAvailable``, else the free physical pages; None where neither is
+        known.
+    """
     try:
         with open("/proc/meminfo") as fh:
             for line in fh:
