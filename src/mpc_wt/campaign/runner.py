@@ -95,7 +95,7 @@ def _dask_import() -> Any:
 
 
 def run_campaign(spec: CampaignSpec, out: str | Path, *, workers: int | None = None,
-                 scheduler: str | None = None, engine: str = "dask", progress: bool = True,
+                 scheduler: Any = None, engine: str = "dask", progress: bool = True,
                  on_result: Callable[[str, dict[str, Any]], None] | None = None) -> RunSummary:
     """Run every case of ``spec`` that is not finished in the campaign directory ``out``.
 
@@ -107,8 +107,10 @@ def run_campaign(spec: CampaignSpec, out: str | Path, *, workers: int | None = N
         Campaign directory (created). Must be visible to every worker (shared file system).
     workers : int, optional
         Worker processes of a local cluster or pool (default: the cores of this machine).
-    scheduler : str, optional
-        Address of a running Dask scheduler (``tcp://HOST:PORT``); ``workers`` is then ignored.
+    scheduler : str or distributed.LocalCluster, optional
+        Address of a running Dask scheduler (``tcp://HOST:PORT``), or a cluster of this process
+        (:func:`local_cluster`, whose TLS credentials the client takes from it); ``workers`` is
+        then ignored.
     engine : {"dask", "processes", "serial"}
         Dask (default), a plain process pool, or this process.
     progress : bool
@@ -231,13 +233,13 @@ def _check_memory(todo: list[Case], processes: int) -> None:
                          processes=processes)
 
 
-def _check_engine(engine: str, scheduler: str | None, workers: int | None) -> int:
+def _check_engine(engine: str, scheduler: Any, workers: int | None) -> int:
     """Check the engine settings; the number of worker processes."""
     if engine not in ENGINES:
         raise ValueError(f"engine must be one of {ENGINES}, got {engine!r}")
     if scheduler is not None and engine != "dask":
         raise ValueError(f"scheduler {scheduler!r} needs engine='dask', got {engine!r}")
-    if scheduler is not None and not str(scheduler).startswith(("tcp://", "tls://",
+    if isinstance(scheduler, str) and not scheduler.startswith(("tcp://", "tls://",
                                                                 "inproc://", "ws://")):
         raise ValueError(f"scheduler must be an address like tcp://HOST:PORT, got {scheduler!r}")
     return 1 if engine == "serial" else worker_count(workers)
@@ -354,15 +356,17 @@ def local_cluster(n: int) -> Any:
                                     scheduler_kwargs={"dashboard_address": "127.0.0.1:0"})
 
 
-def _run_dask(todo: list[Any], root: str, n: int, scheduler: str | None,
+def _run_dask(todo: list[Any], root: str, n: int, scheduler: Any,
               commit: Callable[..., None], bar: "_Bar") -> None:
     distributed = _dask_import()
     cluster = None
     if scheduler is None:
         cluster = local_cluster(n)
         client = distributed.Client(cluster)
-    else:
+    elif isinstance(scheduler, str):
         client = distributed.Client(scheduler, timeout="30s")
+    else:                                   # a cluster of this process: its credentials
+        client = distributed.Client(scheduler)
     try:
         futs = {}
         for i, c in enumerate(todo):

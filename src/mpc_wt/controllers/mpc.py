@@ -194,6 +194,10 @@ class MPCSettings:
         feasible, and the QP is always feasible. None (default): no constraint.
     slack_weight, slack_linear : float
         Quadratic and linear slack penalties (defaults 1e4 and 1e3), > 0.
+    max_torque : float or None
+        The QP's upper bound on the generator torque [N m] (default None: the generator's
+        maximum). At the rated torque the MPC cannot hold the rotor with torque beyond rated
+        power: above rated speed it must pitch, as a region-3 controller does.
     estimator : None, "kalman" or KalmanEstimator
         None (default): full-state information from the harness (``meas["state"]``), as in the
         paper. "kalman": a :class:`~mpc_wt.controllers.estimator.KalmanEstimator` on the same model estimates
@@ -227,6 +231,7 @@ class MPCSettings:
     max_rotor_speed: float | None = None
     slack_weight: float = 1e4
     slack_linear: float = 1e3
+    max_torque: float | None = None
     estimator: Any = None
     estimator_settings: dict[str, Any] = field(default_factory=dict)
     time_budget_ms: float | None = None
@@ -253,6 +258,8 @@ class MPCSettings:
                              f"{v!r}")
         check_number("slack_weight", self.slack_weight, lo=0.0, lo_open=True)
         check_number("slack_linear", self.slack_linear, lo=0.0, lo_open=True)
+        if self.max_torque is not None:
+            check_number("max_torque", self.max_torque, lo=0.0, lo_open=True, unit="N m")
         if self.time_budget_ms is not None:
             check_number("time_budget_ms", self.time_budget_ms, lo=0.0, lo_open=True,
                          unit="ms")
@@ -479,7 +486,8 @@ class MPC(ControllerBase):
         self.backend = st.resolved_backend
         self.turbine = turbine
         pa, gen = turbine.pitch_actuator, turbine.generator
-        self._limits = (pa.min_pitch_rad, pa.max_pitch_rad, gen.min_torque, gen.max_torque)
+        q_hi = gen.max_torque if st.max_torque is None else min(st.max_torque, gen.max_torque)
+        self._limits = (pa.min_pitch_rad, pa.max_pitch_rad, gen.min_torque, q_hi)
         self.dt = st.dt
         self.hp, self.hu = st.horizon, st.hu
         self.w = st.weights
@@ -707,14 +715,14 @@ class MPC(ControllerBase):
         opts.update(solver_options)
         self._daqp_opts = dict(solver_options)
         u0 = self.model.u0
+        q_hi = max(self._limits[3], float(u0[3]))     # never below the operating point's torque
         if self.collective:
             lo_u = np.tile([pa.min_pitch_rad - u0[0], gen.min_torque - u0[3]], hu)
-            hi_u = np.tile([pa.max_pitch_rad - u0[0], gen.max_torque - u0[3]], hu)
+            hi_u = np.tile([pa.max_pitch_rad - u0[0], q_hi - u0[3]], hu)
         else:
             lo_u = np.tile(np.r_[np.full(3, pa.min_pitch_rad) - u0[:3], gen.min_torque - u0[3]],
                            hu)
-            hi_u = np.tile(np.r_[np.full(3, pa.max_pitch_rad) - u0[:3], gen.max_torque - u0[3]],
-                           hu)
+            hi_u = np.tile(np.r_[np.full(3, pa.max_pitch_rad) - u0[:3], q_hi - u0[3]], hu)
         trate = np.full(hu, gen.max_torque_rate * self.dt)
         prate_lim = np.full(len(self._prate_rows), pa.max_rate_rad_s)
         big = 1e20                                     # "no bound" on slacks and speed rows

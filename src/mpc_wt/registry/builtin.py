@@ -378,6 +378,13 @@ class MPCOptions(Options):
                                           "speed, a fraction of rated (default 1.028 for the "
                                           "scheduled designs, none for design_wind_mps)",
                                           unit="-", lo=0.5, hi=2.0)
+    torque_limit: Optional[float] = option(
+        None, help="the QP's upper bound on the generator torque, a fraction of rated torque "
+        "(default: the generator's maximum)", unit="-", lo=0.5, hi=2.0, flag="")
+    below_rated_speed_limit: Optional[float] = option(
+        None, help="the scheduled designs' soft rotor-speed limit below rated wind, a fraction "
+        "of rated (default speed_limit when that is given, else 1.028)", unit="-", lo=0.5,
+        hi=2.0, flag="")
     weights: MPCWeightOptions = option(MPCWeightOptions(), help="cost weights (gen_power, "
                                        "flap_moment, rotor_speed, ...)", flag="")
     below_rated_weights: MPCWeightOptions = option(
@@ -464,6 +471,8 @@ ENVELOPE_WEIGHTS = {"pitch_rate": 0.0235, "flap_moment": 0.1024}
 #: The scheduled designs' weights below rated wind in place of theirs above (no flap
 #: moment's: the pitch rests at fine pitch there).
 BELOW_RATED_WEIGHTS = {"flap_moment": 0.0}
+#: The soft rotor-speed limit of the scheduled designs below rated wind (a fraction of rated).
+BELOW_RATED_SPEED_LIMIT = 1.028
 #: The scheduled designs' soft rotor-speed limit (a fraction of rated), tuned with them.
 ENVELOPE_SPEED_LIMIT = 1.028
 
@@ -514,6 +523,26 @@ def _check_design_wind(turbine: linearize.Turbine, v: float) -> float:
     return float(v)
 
 
+def _rated_torque(turbine: linearize.Turbine) -> float:
+    """Rated electrical power over the generator's efficiency and rated speed [N m]."""
+    op, dt = turbine.operation, turbine.drivetrain
+    return op.rated_power / (dt.generator_efficiency * dt.gearbox_efficiency
+                             * op.rated_rotor_speed_rad_s * dt.gearbox_ratio)
+
+
+def _below_rated(ctx: BuildContext, opts: MPCOptions, settings: Any) -> Any:
+    """The scheduled designs' settings below rated wind: their weights
+    (:data:`BELOW_RATED_WEIGHTS` and the options' ``below_rated_weights`` over the others) and
+    soft speed limit (``below_rated_speed_limit``, default :data:`BELOW_RATED_SPEED_LIMIT`)."""
+    weights = opts.below_rated_weights.over(MPCWeightOptions(**BELOW_RATED_WEIGHTS).over(
+        settings.weights))
+    limit = opts.below_rated_speed_limit
+    if limit is None:
+        limit = BELOW_RATED_SPEED_LIMIT if opts.speed_limit is None else opts.speed_limit
+    return settings.replace(weights=weights, max_rotor_speed=limit
+                            * ctx.turbine.operation.rated_rotor_speed_rad_s)
+
+
 def _mpc(collective: bool, with_lidar: bool) -> Any:
     def build(ctx: BuildContext, opts: MPCOptions) -> Built:
         from mpc_wt.controllers.mpc import MPC, ScheduledMPC
@@ -526,6 +555,8 @@ def _mpc(collective: bool, with_lidar: bool) -> Any:
         if limit is not None:
             settings = settings.replace(
                 max_rotor_speed=limit * ctx.turbine.operation.rated_rotor_speed_rad_s)
+        if opts.torque_limit is not None:
+            settings = settings.replace(max_torque=opts.torque_limit * _rated_torque(ctx.turbine))
         if opts.design_wind_mps is None:
             fam = _envelope_family(ctx, "madsen", opts.schedule_step)
             from mpc_wt.controllers.baseline import BaselineController, tune_baseline
@@ -536,10 +567,7 @@ def _mpc(collective: bool, with_lidar: bool) -> Any:
                                wind_source="preview" if with_lidar else "estimator",
                                wind_estimator=_wind_estimator(ctx, settings.dt),
                                time_constant=opts.schedule_time_constant,
-                               torque_law=law, below_rated=settings.replace(
-                                   weights=opts.below_rated_weights.over(
-                                       MPCWeightOptions(**BELOW_RATED_WEIGHTS).over(
-                                           settings.weights))))
+                               torque_law=law, below_rated=_below_rated(ctx, opts, settings))
             grid = [float(fam.wind_mps[0]), float(fam.wind_mps[-1])]
         else:
             v = _check_design_wind(ctx.turbine, opts.design_wind_mps)

@@ -60,7 +60,7 @@ def _engine(engine: str, workers: int | None, scheduler: str | None
 
     cluster = local_cluster(worker_count(workers))
     try:
-        yield {"engine": "dask", "workers": None, "scheduler": cluster.scheduler_address}
+        yield {"engine": "dask", "workers": None, "scheduler": cluster}
     finally:
         cluster.close()
 

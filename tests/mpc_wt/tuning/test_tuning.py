@@ -327,3 +327,15 @@ def test_relative_and_absolute_metrics_hand_worked() -> None:
     assert ab["pitch_rate_limit_hits"] == pytest.approx(2.5, rel=1e-12)
     with pytest.raises(ValueError, match="share no wind with finished cases"):
         relative_metrics(spec, [row("c", 1, 2.0, 3.0, 1)], "c")
+
+
+def test_tune_on_its_own_local_cluster(tmp_path: Path) -> None:
+    """The default engine: the tuning starts one local Dask cluster (TLS, closed to other
+    processes) for all its trials, and its client connects with that cluster's credentials
+    (a plain client was refused: "TLS expects a ssl_context"). Two trials on one worker."""
+    from mpc_wt.tuning.run import tune
+    from mpc_wt.tuning.spec import tune_spec_from_dict
+
+    spec = tune_spec_from_dict(_spec_raw(trials=2, holdout_seeds=[]))
+    res = tune(spec, tmp_path / "tune", engine="dask", workers=1, progress=False)
+    assert len(res.result.completed) == 2 and res.result.best is not None
