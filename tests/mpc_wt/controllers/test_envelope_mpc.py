@@ -163,3 +163,45 @@ def test_cost_scales_follow_the_turbine() -> None:
     assert w.scales["gen_power"] == pytest.approx(3.0 * w0.scales["gen_power"])
     assert w.scales["pitch_rate"] == w0.scales["pitch_rate"]
     assert w0.for_turbine(five) == w0
+
+
+def test_the_torque_bound_and_the_torque_rate_weight_act(turbine, tmp_path) -> None:
+    """The 10-14 m/s step of the test above, three designs. With ``torque_limit: 1.0`` no
+    torque command exceeds the rated torque, 5 MW / (0.944 x 122.91 rad/s) = 43.09 kN m by
+    hand (without it the command reaches the generator's 47.4 kN m maximum). A torque-rate
+    weight of 10 (a 4 kN m move per step weighs as much as the scaled power error) moves the
+    torque less in total than none (measured 0.89 of it: the torque law's target, not the
+    rate, sets most of the torque's path)."""
+    t = np.arange(0.0, 200.0, 0.05)
+    wind = np.where((t >= 60.0) & (t < 120.0), 14.0, 10.0)
+    path = _uniform_file(tmp_path / "step.npz", turbine, t, wind)
+    sc = Scenario(wind_file=path, duration=180.0, shear_exponent=0.0)
+    travel, peak = {}, {}
+    for name, opts in (("free", {}), ("bound", {"torque_limit": 1.0}),
+                       ("rate", {"weights": {"gen_torque_ref_rate": 10.0}})):
+        res = run_controller(turbine, "mpc", sc, options=opts)
+        q = res.channel("gen_torque_ref")[res.t >= 5.0]
+        travel[name], peak[name] = np.abs(np.diff(q)).sum(), q.max()
+    assert peak["bound"] <= 5e6 / (0.944 * 122.90967) * (1 + 1e-6)
+    assert peak["free"] > 5e6 / (0.944 * 122.90967) * 1.02
+    assert travel["rate"] < 0.95 * travel["free"]
+
+
+def test_below_rated_designs_take_their_own_weights_and_limit(turbine) -> None:
+    """``below_rated_weights`` and ``below_rated_speed_limit`` set the designs at grid winds
+    below rated (11.40 m/s for the NREL 5-MW) and leave those above as ``weights`` and
+    ``speed_limit`` say; the rate weights land in the cost's rate terms."""
+    opts = {"weights": {"rotor_speed": 0.5, "gen_torque_ref_rate": 0.2},
+            "below_rated_weights": {"rotor_speed": 0.1, "gen_torque_ref": 2.0},
+            "speed_limit": 1.08, "below_rated_speed_limit": 1.01}
+    built, _, _ = build_controller(turbine, "mpc", Scenario(12.0, "steady", 1, 1.0), opts)
+    ctl = built.controller
+    rated_speed = turbine.operation.rated_rotor_speed_rad_s
+    for k, v in enumerate(ctl.family.wind_mps):
+        mpc = ctl.controller(k)
+        below = v < linearize.rated_wind_speed(turbine)
+        assert mpc.w.outputs["rotor_speed"] == (0.1 if below else 0.5)
+        assert mpc.w.inputs["gen_torque_ref"] == (2.0 if below else 0.01)
+        assert mpc.w.outputs["flap_moment"] == (0.0 if below else pytest.approx(0.1024))
+        assert mpc.w.rate["gen_torque_ref"] == 0.2
+        assert mpc.max_rotor_speed == pytest.approx((1.01 if below else 1.08) * rated_speed)
