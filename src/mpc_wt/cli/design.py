@@ -55,7 +55,7 @@ def add_parsers(sub: Any) -> None:
     p.add_argument("--power-fraction", type=float, default=1.0,
                    help="baseline, ibc, coleman-ipc: tune for a derated turbine at this "
                         "fraction of rated power, in (0, 1]")
-    p.add_argument("--loop-gain", type=float, default=1.0, help="ibc: loop gain at 1P [-]")
+    p.add_argument("--loop-gain", type=float, default=0.6, help="ibc: loop gain at 1P [-]")
     p.set_defaults(func=_design)
 
     p = sub.add_parser("export", help="export a design: its gain table (csv, json, mat), a "

@@ -313,7 +313,7 @@ _FROM_DESIGN = {
     "PRC_WindSpeeds": "unused table", "PRC_GenSpeeds": "rated generator speed",
     "PS_BldPitchMin_N": "unused table", "PS_WindSpeeds": "unused table",
     "PS_BldPitchMin": "fine pitch", "IPC_Vramp": "rated wind", "IPC_KI": "design",
-    "IPC_aziOffset": "design",
+    "IPC_aziOffset": "design", "IPC_IntSat": "design's largest cyclic amplitude",
 }
 
 
@@ -414,6 +414,9 @@ def rosco_values(turbine: linearize.Turbine, doc: dict[str, Any],
         # ours: theta_cs = -K_I R(-phi) int M_cs; ROSCO: theta_cs = K_I R(-phi_R) int M_cs
         # (its offset enters the inverse transform only), so phi_R = phi - pi
         phi = float(np.median(r[:, cols.index("azimuth_offset")]))
+        amp = ipc["settings"].get("max_amplitude_rad")
+        if amp is not None:           # ROSCO clamps each integrator; ours the amplitude
+            out["IPC_IntSat"] = float(amp)
         out.update({"IPC_ControlMode": 1,
                     "IPC_KI": [float(np.median(r[:, cols.index("ki")])), 0.0],
                     "IPC_aziOffset": [math.remainder(phi - math.pi, 2.0 * math.pi), 0.0]})

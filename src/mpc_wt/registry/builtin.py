@@ -206,7 +206,7 @@ register("derate", DerateOptions, field_components="u", pattern=r"derate(\d+(?:\
 class IBCOptions(Options):
     """Individual blade control (Pettas and Cheng sec. 3.1; :func:`mpc_wt.controllers.ipc.tune_ibc`)."""
 
-    loop_gain_1p: float = option(1.0, help="loop gain at 1P of each blade loop", unit="-",
+    loop_gain_1p: float = option(0.6, help="loop gain at 1P of each blade loop", unit="-",
                                  lo=0.0, lo_open=True, flag="--loop-gain")
     remove_collective: bool = option(True, help="subtract the blades' mean IBC pitch (cyclic "
                                      "action only)",
@@ -251,7 +251,7 @@ class ColemanIPCOptions(Options):
 
     crossover_rad_s: float = option(0.2, help="crossover of the integral loops", unit="rad/s",
                                     lo=0.0, lo_open=True, flag="")
-    max_amplitude_deg: float = option(5.0, help="largest cyclic pitch amplitude", unit="deg",
+    max_amplitude_deg: float = option(2.0, help="largest cyclic pitch amplitude", unit="deg",
                                       lo=0.0, lo_open=True, flag="")
     weight_range: tuple[float, ...] = option((0.8, 0.95), help="power fractions of the fade-in",
                                              unit="-", lo=0.0, flag="")

@@ -67,8 +67,8 @@ def test_ibc_gains_meet_their_design(ibc_gains, turbine) -> None:
 def test_ibc_loop_gain_and_margin_by_python_control(ibc_gains, turbine) -> None:
     """The designed loops checked outside the design code: each blade loop k F(z) (-G(z)) built
     with python-control from the linear model (pitch_ref_1 -> flap_moment_1, discretized at
-    the gains' dt) and the exported filters; its magnitude at rated 1P is the target 1 (or
-    less where the margin rule lowered it) and python-control's gain margin (frequency domain,
+    the gains' dt) and the exported filters; its magnitude at rated 1P is the target, the
+    default loop gain 0.6 (or less where the margin rule lowered it) and python-control's gain margin (frequency domain,
     not the design's closed-loop-pole bisection) is at least 2 and equals the reported one."""
     import control
 
@@ -89,7 +89,7 @@ def test_ibc_loop_gain_and_margin_by_python_control(ibc_gains, turbine) -> None:
         # 1e-6: the same model evaluated two ways; 2 %: frequency-domain margin from
         # python-control's crossover search against the design's bisection (tolerance 1 %)
         assert mag == pytest.approx(g.loop_gain_1p[i], rel=1e-6)
-        assert mag <= 1.0 + 1e-9 and (mag > 0.999 or g.gain_margin[i] < 2.0 * 1.02)
+        assert mag <= 0.6 + 1e-9 and (mag > 0.6 * 0.999 or g.gain_margin[i] < 2.0 * 1.02)
         if math.isinf(g.gain_margin[i]):         # no -180 deg crossing: python-control's
             assert gm > 1e3                       # frequency grid sees a huge margin
         else:
@@ -97,13 +97,14 @@ def test_ibc_loop_gain_and_margin_by_python_control(ibc_gains, turbine) -> None:
 
 
 def test_ibc_cuts_the_1p_flap_moment_and_raises_pitch_activity(runs18) -> None:
-    # 18 m/s, turbulence with shear; 1P flap content and flap DEL fall, pitch rises
+    # 18 m/s, turbulence with shear; 1P flap content and flap DEL fall, pitch rises (with the
+    # default loop gain 0.6: pitch-rate std 1.76x the baseline's; 1.0 gave over 2x)
     base, ibc = runs18["baseline"][1], runs18["ibc"][1]
     one_p = ibc["flap_1_harmonics"]["1P"] / base["flap_1_harmonics"]["1P"]
     assert one_p < 0.5
     assert ibc["channels"]["flap_moment_1"]["del"] < 0.95 * base["channels"]["flap_moment_1"]["del"]
     assert ibc["pitch_travel_deg"] > 2.0 * base["pitch_travel_deg"]
-    assert ibc["pitch_rate_std_degps"] > 2.0 * base["pitch_rate_std_degps"]
+    assert ibc["pitch_rate_std_degps"] > 1.5 * base["pitch_rate_std_degps"]
     # the collective loop still holds the operating point
     assert abs(ibc["power_mean_W"] / base["power_mean_W"] - 1) < 0.01
 
