@@ -205,6 +205,10 @@ class ControllerSpec:
         Text for the report.
     dlcs : tuple of str, optional
         The load cases this controller runs (default all of the spec's ``load_cases``).
+    design_hash : str, optional
+        SHA-256 over every option of the kind as it resolves now, its defaults included (None
+        for a plugin's kind read without its plugin): a case computed under other defaults (an
+        upgrade that changed them) is computed again.
     """
 
     name: str
@@ -215,6 +219,7 @@ class ControllerSpec:
     turbulence: tuple[str | float, ...] | None = None
     label: str | None = None
     dlcs: tuple[str, ...] | None = None
+    design_hash: str | None = None
 
 
 @dataclass(frozen=True)
@@ -366,6 +371,10 @@ class Case:
         Partial safety factor family of the load case.
     fatigue : bool
         The case enters the fatigue tables.
+    bin_wind_mps : float, optional
+        A wind file's bin wind [m/s].
+    design_hash : str, optional
+        :attr:`ControllerSpec.design_hash` of its controller.
     """
 
     case_id: str
@@ -387,6 +396,7 @@ class Case:
     family: str = "N"
     fatigue: bool = True
     bin_wind_mps: float | None = None
+    design_hash: str | None = None
 
     @property
     def wind_mps(self) -> float:
@@ -650,7 +660,8 @@ class CampaignSpec:
                 case_hash=_digest(sim), assess_hash=_digest(a), plugins=self.plugins,
                 plugin_folder=self.plugin_folder,
                 del_convention=self.del_convention, dlc=lc.dlc,
-                supervisor=copy.deepcopy(sup), family=lc.family, fatigue=lc.fatigue))
+                supervisor=copy.deepcopy(sup), family=lc.family, fatigue=lc.fatigue,
+                design_hash=c.design_hash))
         return out
 
     def _file_cases(self, c: ControllerSpec, lc: LoadCase, a: dict[str, Any],
@@ -673,7 +684,7 @@ class CampaignSpec:
                 plugins=self.plugins, plugin_folder=self.plugin_folder,
                 del_convention=self.del_convention, dlc=lc.dlc,
                 supervisor=copy.deepcopy(sup), family=lc.family, fatigue=lc.fatigue,
-                bin_wind_mps=f.wind_mps))
+                bin_wind_mps=f.wind_mps, design_hash=c.design_hash))
         return out
 
 
@@ -751,19 +762,19 @@ def _controller_options(key: str, raw: Mapping[str, Any], run_name: str,
             sel = resolve(run_name)
         except ValueError:
             if plugin_kinds:
-                return copy.deepcopy(opts)
+                return copy.deepcopy(opts), None
             raise
         if "lidar" in sel.option_names() and (lidar or "lidar" in opts):
             extra = opts.get("lidar", {})
             if not isinstance(extra, Mapping):
                 raise _fail(f"{key}.lidar", f"must be a mapping, got {extra!r}")
             opts["lidar"] = {**lidar, **extra}
-        sel.options(opts)
+        resolved = sel.options(opts)
     except OptionsError as err:
         raise _fail(f"{key}.{err.key}", str(err)) from err
     except ValueError as err:
         raise _fail(f"{key}.controller", str(err)) from err
-    return copy.deepcopy(opts)
+    return copy.deepcopy(opts), _digest([o.to_dict() for o in resolved])
 
 
 def _controller(i: int, raw: Any, lidar: dict[str, Any],
@@ -778,7 +789,7 @@ def _controller(i: int, raw: Any, lidar: dict[str, Any],
         raise _fail(f"{key}.name", f"must be a name of {NAME_CHARS}; got {name!r}")
     name = check_name(f"{key}.name", name)
     run_name = str(raw.get("controller", name))
-    opts = _controller_options(key, raw, run_name, lidar, plugin_kinds)
+    opts, design = _controller_options(key, raw, run_name, lidar, plugin_kinds)
     dlcs = raw.get("dlcs")
     if dlcs is not None and (not isinstance(dlcs, list) or not dlcs
                              or not all(isinstance(d, (str, int, float)) for d in dlcs)):
@@ -792,7 +803,7 @@ def _controller(i: int, raw: Any, lidar: dict[str, Any],
         seeds=_seeds(f"{key}.seeds", raw["seeds"]) if "seeds" in raw else None,
         turbulence=(_turbulence(f"{key}.turbulence", raw["turbulence"])
                     if "turbulence" in raw else None),
-        label=str(raw["label"]) if "label" in raw else None)
+        label=str(raw["label"]) if "label" in raw else None, design_hash=design)
 
 
 def _lidar(key: str, raw: Any) -> dict[str, Any]:

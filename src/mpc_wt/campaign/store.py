@@ -232,8 +232,10 @@ class CampaignStore:
     def sync(self, spec: CampaignSpec) -> dict[str, int]:
         """Bring the index in line with ``spec`` in one transaction.
 
-        New cases are added as pending; a case whose simulation inputs changed (case hash)
-        goes back to pending (its old file is overwritten when it reruns); a case no longer in
+        New cases are added as pending; a case whose simulation inputs changed (case hash),
+        or whose controller kind resolves its options differently now (its defaults changed
+        with the software: design hash; logged), goes back to pending (its old file is
+        overwritten when it reruns); a case no longer in
         the spec becomes ``stale`` (kept). Returns the counts of each action.
 
         Parameters
@@ -244,15 +246,17 @@ class CampaignStore:
         Returns
         -------
         dict of str to int
-            Counts of ``added``, ``invalidated``, ``stale``, ``reassess``.
+            Counts of ``added``, ``invalidated``, ``stale``, ``reassess``, ``kept`` and
+            ``redesigned`` (computed under other defaults of its kind: computed again).
         """
         cases = spec.cases()
         ids = {c.case_id for c in cases}
         now = time.time()
-        counts = {"added": 0, "invalidated": 0, "reassess": 0, "kept": 0, "stale": 0}
+        counts = {"added": 0, "invalidated": 0, "reassess": 0, "kept": 0, "stale": 0,
+                  "redesigned": 0}
         with self._tx():
             old = {r[0]: r for r in self.db.execute(
-                "SELECT case_id, case_hash, assess_hash, status FROM cases")}
+                "SELECT case_id, case_hash, assess_hash, status, case_json FROM cases")}
             for c in cases:
                 row = old.get(c.case_id)
                 cj = json.dumps(c.to_dict(), sort_keys=True)
@@ -264,13 +268,16 @@ class CampaignStore:
                         (c.case_id, c.controller, c.run_name, c.wind_mps, c.seed,
                          str(c.turbulence), c.case_hash, c.assess_hash, cj, now))
                     counts["added"] += 1
-                elif row[1] != c.case_hash:
+                elif row[1] != c.case_hash or _redesigned(row[4], c):
                     self.db.execute(
                         "UPDATE cases SET status='pending', case_hash=?, assess_hash=?, "
                         "case_json=?, run_name=?, metrics=NULL, error=NULL, traceback=NULL, "
                         "updated=? WHERE case_id=?",
                         (c.case_hash, c.assess_hash, cj, c.run_name, now, c.case_id))
-                    counts["invalidated"] += 1
+                    if row[1] == c.case_hash:
+                        counts["redesigned"] += 1
+                    else:
+                        counts["invalidated"] += 1
                 elif row[2] != c.assess_hash:
                     self.db.execute("UPDATE cases SET assess_hash=?, case_json=?, updated=?, "
                                     "status=CASE WHEN status='done' THEN 'pending' ELSE status "
@@ -280,7 +287,15 @@ class CampaignStore:
                     if row[3] == "stale":
                         self.db.execute("UPDATE cases SET status='pending' WHERE case_id=?",
                                         (c.case_id,))
+                    if c.design_hash is not None and json.loads(row[4]).get(
+                            "design_hash") is None:          # recorded before designs were
+                        self.db.execute("UPDATE cases SET case_json=? WHERE case_id=?",
+                                        (cj, c.case_id))
                     counts["kept"] += 1
+            if counts["redesigned"]:
+                log.warning("%d cases were computed under other defaults of their controller "
+                            "kind (the software changed them since): they are computed again",
+                            counts["redesigned"])
             for cid, r in old.items():
                 if cid not in ids and r[3] != "stale":
                     self.db.execute("UPDATE cases SET status='stale', updated=? WHERE case_id=?",
@@ -439,6 +454,15 @@ class CampaignStore:
 
     def _tx(self) -> "_Tx":
         return _Tx(self.db, self.root / "index.sqlite")
+
+
+def _redesigned(case_json: str, case: Case) -> bool:
+    """Whether a stored case was computed with other resolved options (its kind's defaults
+    changed since) than ``case`` has now; False where either does not know."""
+    if case.design_hash is None:
+        return False
+    before = json.loads(case_json).get("design_hash")
+    return before is not None and before != case.design_hash
 
 
 class _Tx:

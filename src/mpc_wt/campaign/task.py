@@ -234,7 +234,9 @@ def run_case(case: dict[str, Any], root: str) -> dict[str, Any]:
         if path.is_file():
             try:
                 old = ClosedLoopResult.load(path)
-                if old.meta.get("campaign_case", {}).get("case_hash") == case["case_hash"]:
+                made = old.meta.get("campaign_case", {})
+                if (made.get("case_hash") == case["case_hash"]
+                        and made.get("design_hash") == case.get("design_hash")):
                     res, reused = old, True
             except ResultFileError:
                 res = None
@@ -257,6 +259,7 @@ def run_case(case: dict[str, Any], root: str) -> dict[str, Any]:
                 raise
             res.meta["campaign_case"] = {"case_id": case["case_id"],
                                          "case_hash": case["case_hash"],
+                                         "design_hash": case.get("design_hash"),
                                          "worker": base["worker"]}
             path.parent.mkdir(parents=True, exist_ok=True)
             res.save(path)

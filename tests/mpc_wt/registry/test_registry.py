@@ -65,13 +65,14 @@ def test_registry_lists_every_kind_with_its_options() -> None:
     assert {o["name"] for o in rows["mpc"]["options"]} == {
         "backend", "formulation", "horizon", "estimator", "design_wind_mps", "schedule_step",
         "schedule_time_constant", "speed_limit", "kalman_wind_std", "kalman_flap_std",
-        "weights", "time_budget_ms"}
+        "weights", "time_budget_ms", "torque_limit", "below_rated_speed_limit",
+        "below_rated_weights"}
     assert rows["ibc"]["addon_to"] == ["baseline", "derate"]
     assert rows["derate"]["pattern"].startswith("derateNN")
     horizon = next(o for o in rows["mpc"]["options"] if o["name"] == "horizon")
     assert horizon["default"] == 15 and horizon["type"] == "int"
     # the options classes document themselves (numpydoc Parameters from the metadata)
-    assert "loop_gain_1p : float, default 1.0" in IBCOptions.__doc__
+    assert "loop_gain_1p : float, default 0.6" in IBCOptions.__doc__
 
 
 @pytest.mark.parametrize("name, base, preset, addons", [
