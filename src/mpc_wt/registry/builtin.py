@@ -976,7 +976,16 @@ def _discon_built(ctx: BuildContext, library: Any, discon_in: Any, opts: Any,
                  power_fraction=power_fraction)
 
 
+def _discon_operating_point(turbine: linearize.Turbine, sc: Scenario, opts: DisconOptions
+                            ) -> linearize.OperatingPoint:
+    """The trim, or for a ROSCO-style input file with a TSR-tracking law the point where that
+    law holds the rotor (:func:`_file_start`)."""
+    op = linearize.trim(turbine, start_wind(turbine, sc))
+    return _file_start(turbine, op, Path(opts.discon_in))
+
+
 @register("discon", DisconOptions, field_components="u",
+          operating_point=_discon_operating_point,
           summary="any Bladed-style controller library (DISCON) with its input file")
 def _build_discon(ctx: BuildContext, opts: DisconOptions) -> Built:
     return _discon_built(ctx, opts.discon_library, opts.discon_in, opts, "discon")

@@ -354,13 +354,16 @@ def test_roscos_shipped_file_starts_in_its_own_equilibrium(turbine) -> None:
     the rotor at full torque rate (3.9 MN m on the shaft, down to 0.23 x rated speed): the
     host's start, not ROSCO's law. The run starts where the file holds the rotor: speed within
     1 % of 0.3571 rad/s throughout and no shaft-torque transient (peak within 10 % of the
-    mean)."""
-    res = run_controller(turbine, "rosco", Scenario(3.0, "steady", 1, 30.0),
-                         options={"discon_in": "shipped"})
-    w, q = res.channel("rotor_speed"), res.channel("lss_torque")
-    assert w.min() == pytest.approx(7.5 * 3.0 / 63.0, rel=0.01)
-    assert w.max() == pytest.approx(7.5 * 3.0 / 63.0, rel=0.01)
-    assert q.max() <= 1.1 * q[res.t >= 10.0].mean()
+    mean), with the ``rosco`` kind and with the ``discon`` kind given ROSCO's library and the
+    same file (a copy that writes its debug file: slower, the same law)."""
+    for kind, opts in (("rosco", {"discon_in": "shipped"}),
+                       ("discon", {"discon_library": str(rosco_library()),
+                                   "discon_in": str(rosco_discon())})):
+        res = run_controller(turbine, kind, Scenario(3.0, "steady", 1, 30.0), options=opts)
+        w, q = res.channel("rotor_speed"), res.channel("lss_torque")
+        assert w.min() == pytest.approx(7.5 * 3.0 / 63.0, rel=0.01), kind
+        assert w.max() == pytest.approx(7.5 * 3.0 / 63.0, rel=0.01), kind
+        assert q.max() <= 1.1 * q[res.t >= 10.0].mean(), kind
 
 
 def test_roscos_runtime_exit_on_a_missing_table_fails_the_run_only(turbine, tmp_path) -> None:
