@@ -108,9 +108,8 @@ def run_campaign(spec: CampaignSpec, out: str | Path, *, workers: int | None = N
     workers : int, optional
         Worker processes of a local cluster or pool (default: the cores of this machine).
     scheduler : str or distributed.LocalCluster, optional
-        Address of a running Dask scheduler (``tcp://HOST:PORT``), or a cluster of this process
-        (:func:`local_cluster`, whose TLS credentials the client takes from it); ``workers`` is
-        then ignored.
+        A running Dask scheduler's address (``tcp://HOST:PORT``) or a :func:`local_cluster`
+        (its TLS credentials go to the client); ``workers`` is then ignored.
     engine : {"dask", "processes", "serial"}
         Dask (default), a plain process pool, or this process.
     progress : bool
@@ -144,7 +143,7 @@ def run_campaign(spec: CampaignSpec, out: str | Path, *, workers: int | None = N
                  summary.skipped, len(todo), sync)
         if not todo:
             return summary
-        _check_memory(todo, n_workers if scheduler is None else 0)
+        _check_memory(todo, 0 if scheduler else n_workers)
         bar = _Bar(len(todo), spec.name, progress)
         spec_hash = spec.spec_hash
 
@@ -164,18 +163,24 @@ def run_campaign(spec: CampaignSpec, out: str | Path, *, workers: int | None = N
         store.mark_submitted(c.case_id for c in todo)
         root = str(out.resolve())
         try:
-            if engine == "serial":
-                for c in todo:
-                    bar.running(1)
-                    commit(c.case_id, run_case(c.to_dict(), root))
-            elif engine == "processes":
-                _run_pool(todo, root, n_workers, commit, bar)
-            else:
-                _run_dask(todo, root, n_workers, scheduler, commit, bar)
+            _dispatch(engine, todo, root, n_workers, scheduler, commit, bar)
         finally:
             bar.close()
             summary.wall_s = time.perf_counter() - t_start
         return summary
+
+
+def _dispatch(engine: str, todo: list[Any], root: str, n_workers: int, scheduler: Any,
+              commit: Callable[..., None], bar: "_Bar") -> None:
+    """Run the cases on the engine, committing each as it finishes."""
+    if engine == "serial":
+        for c in todo:
+            bar.running(1)
+            commit(c.case_id, run_case(c.to_dict(), root))
+    elif engine == "processes":
+        _run_pool(todo, root, n_workers, commit, bar)
+    else:
+        _run_dask(todo, root, n_workers, scheduler, commit, bar)
 
 
 def submission_order(cases: list[Any]) -> list[Any]:
