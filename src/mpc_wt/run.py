@@ -151,8 +151,7 @@ def build_controller(turbine: linearize.Turbine, controller: str, scenario: Scen
     opts = sel.options(options, naming)
     op = _operating_point(turbine, sel, opts, scenario)
     built, new = _design(turbine, sel, opts, cache, params)
-    needs = set().union(*(k.field_components for k in (sel.base, *sel.addons)))
-    comps = "".join(c for c in "uvw" if c in needs)
+    comps = sel.field_components
     lidars = len(built.sensors) + (built.preview is not None)
     check_run_memory(estimate_run_memory(turbine, scenario, components=len(comps),
                                          lidar_fields=lidars),

@@ -224,10 +224,9 @@ def _check_memory(todo: list[Case], processes: int) -> None:
         cases = [c for c in todo if c.turbine == turbine]
         big = max(cases, key=lambda c: c.scenario.duration)
         try:
-            sel = resolve(big.run_name)
-            comps = set().union(*(k.field_components for k in (sel.base, *sel.addons)))
+            comps = resolve(big.run_name).field_components
         except ValueError:
-            comps = set("uvw")
+            comps = "uvw"
         m = estimate_run_memory(load_case_turbine(turbine), big.scenario,
                                 components=len(comps), lidar_fields=int(any(
                                     "lidar" in c.run_name for c in cases)))

@@ -260,6 +260,9 @@ class CampaignStore:
             for c in cases:
                 row = old.get(c.case_id)
                 cj = json.dumps(c.to_dict(), sort_keys=True)
+                # the design hash it was computed under (None: recorded before designs were)
+                before = None if row is None else json.loads(row[4]).get("design_hash")
+                redesigned = None not in (before, c.design_hash) and before != c.design_hash
                 if row is None:
                     self.db.execute(
                         "INSERT INTO cases (case_id, controller, run_name, wind_mps, seed, "
@@ -268,16 +271,13 @@ class CampaignStore:
                         (c.case_id, c.controller, c.run_name, c.wind_mps, c.seed,
                          str(c.turbulence), c.case_hash, c.assess_hash, cj, now))
                     counts["added"] += 1
-                elif row[1] != c.case_hash or _redesigned(row[4], c):
+                elif row[1] != c.case_hash or redesigned:
                     self.db.execute(
                         "UPDATE cases SET status='pending', case_hash=?, assess_hash=?, "
                         "case_json=?, run_name=?, metrics=NULL, error=NULL, traceback=NULL, "
                         "updated=? WHERE case_id=?",
                         (c.case_hash, c.assess_hash, cj, c.run_name, now, c.case_id))
-                    if row[1] == c.case_hash:
-                        counts["redesigned"] += 1
-                    else:
-                        counts["invalidated"] += 1
+                    counts["invalidated" if row[1] != c.case_hash else "redesigned"] += 1
                 elif row[2] != c.assess_hash:
                     self.db.execute("UPDATE cases SET assess_hash=?, case_json=?, updated=?, "
                                     "status=CASE WHEN status='done' THEN 'pending' ELSE status "
@@ -287,8 +287,7 @@ class CampaignStore:
                     if row[3] == "stale":
                         self.db.execute("UPDATE cases SET status='pending' WHERE case_id=?",
                                         (c.case_id,))
-                    if c.design_hash is not None and json.loads(row[4]).get(
-                            "design_hash") is None:          # recorded before designs were
+                    if before is None and c.design_hash is not None:
                         self.db.execute("UPDATE cases SET case_json=? WHERE case_id=?",
                                         (cj, c.case_id))
                     counts["kept"] += 1
@@ -454,15 +453,6 @@ class CampaignStore:
 
     def _tx(self) -> "_Tx":
         return _Tx(self.db, self.root / "index.sqlite")
-
-
-def _redesigned(case_json: str, case: Case) -> bool:
-    """Whether a stored case was computed with other resolved options (its kind's defaults
-    changed since) than ``case`` has now; False where either does not know."""
-    if case.design_hash is None:
-        return False
-    before = json.loads(case_json).get("design_hash")
-    return before is not None and before != case.design_hash
 
 
 class _Tx:

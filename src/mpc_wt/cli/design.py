@@ -9,6 +9,7 @@ from typing import Any
 
 import linearize
 from mpc_wt.cli.common import add_turbine, check_out_folder, floats, number_pairs, parse_range
+from mpc_wt.controllers.ipc import IBC_LOOP_GAIN
 from mpc_wt.errors import GainTableError, UsageError
 
 __all__ = ["add_parsers"]
@@ -55,7 +56,8 @@ def add_parsers(sub: Any) -> None:
     p.add_argument("--power-fraction", type=float, default=1.0,
                    help="baseline, ibc, coleman-ipc: tune for a derated turbine at this "
                         "fraction of rated power, in (0, 1]")
-    p.add_argument("--loop-gain", type=float, default=0.6, help="ibc: loop gain at 1P [-]")
+    p.add_argument("--loop-gain", type=float, default=IBC_LOOP_GAIN,
+                   help="ibc: loop gain at 1P [-]")
     p.set_defaults(func=_design)
 
     p = sub.add_parser("export", help="export a design: its gain table (csv, json, mat), a "

@@ -16,6 +16,7 @@ from typing import Any, Optional
 import numpy as np
 
 import linearize
+from mpc_wt.controllers.ipc import COLEMAN_MAX_AMPLITUDE_DEG, IBC_LOOP_GAIN
 from mpc_wt.registry.context import BuildContext, Built
 from mpc_wt.registry.options import REQUIRED, Options, option
 from mpc_wt.registry.registry import register
@@ -28,7 +29,7 @@ __all__ = ["BaselineOptions", "DerateOptions", "APCOptions", "IBCOptions", "Cole
 
 # -- designs behind `mpcwt design` ------------------------------------------------------------
 def _design_ibc(turbine: linearize.Turbine, *, power_fraction: float = 1.0,
-                loop_gain: float = 1.0) -> tuple[dict, str]:
+                loop_gain: float = IBC_LOOP_GAIN) -> tuple[dict, str]:
     from mpc_wt.controllers.ipc import tune_ibc
     from mpc_wt.io.gain_tables import ibc_table
 
@@ -206,7 +207,8 @@ register("derate", DerateOptions, field_components="u", pattern=r"derate(\d+(?:\
 class IBCOptions(Options):
     """Individual blade control (Pettas and Cheng sec. 3.1; :func:`mpc_wt.controllers.ipc.tune_ibc`)."""
 
-    loop_gain_1p: float = option(0.6, help="loop gain at 1P of each blade loop", unit="-",
+    loop_gain_1p: float = option(IBC_LOOP_GAIN, help="loop gain at 1P of each blade loop",
+                                 unit="-",
                                  lo=0.0, lo_open=True, flag="--loop-gain")
     remove_collective: bool = option(True, help="subtract the blades' mean IBC pitch (cyclic "
                                      "action only)",
@@ -251,7 +253,8 @@ class ColemanIPCOptions(Options):
 
     crossover_rad_s: float = option(0.2, help="crossover of the integral loops", unit="rad/s",
                                     lo=0.0, lo_open=True, flag="")
-    max_amplitude_deg: float = option(2.0, help="largest cyclic pitch amplitude", unit="deg",
+    max_amplitude_deg: float = option(COLEMAN_MAX_AMPLITUDE_DEG,
+                                      help="largest cyclic pitch amplitude", unit="deg",
                                       lo=0.0, lo_open=True, flag="")
     weight_range: tuple[float, ...] = option((0.8, 0.95), help="power fractions of the fade-in",
                                              unit="-", lo=0.0, flag="")
@@ -312,14 +315,7 @@ class MPCWeightOptions(Options):
         """
         from mpc_wt.controllers.mpc import MPCWeights
 
-        w = MPCWeights()
-        given = {**(defaults or {}),
-                 **{k: v for k, v in self.to_dict().items() if v is not None}}
-        ins = {k: given.pop(k) for k in ("pitch_ref", "gen_torque_ref") if k in given}
-        rate = {k[:-5]: given.pop(k) for k in ("pitch_ref_rate", "gen_torque_ref_rate")
-                if k in given}
-        return MPCWeights(outputs={**w.outputs, **given}, inputs={**w.inputs, **ins},
-                          rate={**w.rate, **rate}, scales=dict(w.scales))
+        return self.over(_placed(MPCWeights(), defaults or {}))
 
     def over(self, weights: Any) -> Any:
         """``weights`` with the set options in place of theirs.
@@ -332,13 +328,18 @@ class MPCWeightOptions(Options):
         -------
         MPCWeights
         """
-        given = {k: v for k, v in self.to_dict().items() if v is not None}
-        ins = {k: given.pop(k) for k in ("pitch_ref", "gen_torque_ref") if k in given}
-        rate = {k[:-5]: given.pop(k) for k in ("pitch_ref_rate", "gen_torque_ref_rate")
-                if k in given}
-        return dataclasses.replace(weights, outputs={**weights.outputs, **given},
-                                   inputs={**weights.inputs, **ins},
-                                   rate={**weights.rate, **rate})
+        return _placed(weights, {k: v for k, v in self.to_dict().items() if v is not None})
+
+
+def _placed(weights: Any, given: dict[str, float]) -> Any:
+    """``weights`` (MPCWeights) with ``given`` in place: option names of inputs and input
+    rates (``*_rate``) to theirs, the others to the outputs'."""
+    given = dict(given)
+    ins = {k: given.pop(k) for k in ("pitch_ref", "gen_torque_ref") if k in given}
+    rate = {k[:-5]: given.pop(k) for k in ("pitch_ref_rate", "gen_torque_ref_rate")
+            if k in given}
+    return dataclasses.replace(weights, outputs={**weights.outputs, **given},
+                               inputs={**weights.inputs, **ins}, rate={**weights.rate, **rate})
 
 
 @dataclass(frozen=True)
@@ -523,13 +524,6 @@ def _check_design_wind(turbine: linearize.Turbine, v: float) -> float:
     return float(v)
 
 
-def _rated_torque(turbine: linearize.Turbine) -> float:
-    """Rated electrical power over the generator's efficiency and rated speed [N m]."""
-    op, dt = turbine.operation, turbine.drivetrain
-    return op.rated_power / (dt.generator_efficiency * dt.gearbox_efficiency
-                             * op.rated_rotor_speed_rad_s * dt.gearbox_ratio)
-
-
 def _below_rated(ctx: BuildContext, opts: MPCOptions, settings: Any) -> Any:
     """The scheduled designs' settings below rated wind: their weights
     (:data:`BELOW_RATED_WEIGHTS` and the options' ``below_rated_weights`` over the others) and
@@ -556,7 +550,8 @@ def _mpc(collective: bool, with_lidar: bool) -> Any:
             settings = settings.replace(
                 max_rotor_speed=limit * ctx.turbine.operation.rated_rotor_speed_rad_s)
         if opts.torque_limit is not None:
-            settings = settings.replace(max_torque=opts.torque_limit * _rated_torque(ctx.turbine))
+            settings = settings.replace(max_torque=opts.torque_limit
+                                        * ctx.turbine.rated_generator_torque)
         if opts.design_wind_mps is None:
             fam = _envelope_family(ctx, "madsen", opts.schedule_step)
             from mpc_wt.controllers.baseline import BaselineController, tune_baseline
@@ -918,6 +913,11 @@ def _build_apc(ctx: BuildContext, opts: APCOptions) -> Built:
 
 
 # -- Bladed-style libraries: ROSCO and any DISCON ---------------------------------------------
+_ISOLATE = ("run the library in a child process of its own, so that a library that exits or "
+            "crashes fails the case only (about 0.1 ms per call); false loads it in this "
+            "process, uncontained")
+
+
 @dataclass(frozen=True)
 class DisconOptions(Options):
     """Any Bladed-style controller library (``DISCON``) in the loop (:mod:`mpc_wt.controllers.discon`)."""
@@ -933,9 +933,7 @@ class DisconOptions(Options):
                                  "hub-mounted CW LIDAR (the lidar options)", flag="")
     lidar: LidarOptions = option(LidarOptions(), help="CW LIDAR settings (focus_distance, "
                                  "noise_std, ...)", flag="")
-    isolate: bool = option(True, help="run the library in a child process of its own, so that "
-                           "a library that exits or crashes fails the case only (about 0.1 ms "
-                           "per call); false loads it in this process, uncontained", flag="")
+    isolate: bool = option(True, help=_ISOLATE, flag="")
 
 
 @dataclass(frozen=True)
@@ -953,9 +951,7 @@ class RoscoOptions(Options):
                                 choices=("individual", "collective"))
     discon_dt: float = option(1.0 / 80.0, help="communication interval, a multiple of the "
                               "plant step", unit="s", lo=0.0, lo_open=True, hi=1.0)
-    isolate: bool = option(True, help="run the library in a child process of its own, so that "
-                           "a library that exits or crashes fails the case only (about 0.1 ms "
-                           "per call); false loads it in this process, uncontained", flag="")
+    isolate: bool = option(True, help=_ISOLATE, flag="")
 
 
 def _discon_built(ctx: BuildContext, library: Any, discon_in: Any, opts: Any,
@@ -994,6 +990,11 @@ def _build_discon(ctx: BuildContext, opts: DisconOptions) -> Built:
 _ROSCO_FILES = {"NREL 5-MW": "NREL-5MW", "IEA-15-240-RWT": "IEA-15-240-RWT"}
 
 
+def _shipped_name(turbine: linearize.Turbine) -> str | None:
+    """The name of the ROSCO deck shipped for this turbine, or None."""
+    return next((v for k, v in _ROSCO_FILES.items() if turbine.name.startswith(k)), None)
+
+
 def _rosco_operating_point(turbine: linearize.Turbine, sc: Scenario, opts: RoscoOptions
                            ) -> linearize.OperatingPoint:
     if opts.discon_in is None:
@@ -1004,7 +1005,7 @@ def _rosco_operating_point(turbine: linearize.Turbine, sc: Scenario, opts: Rosco
     if opts.discon_in == "shipped":
         from mpc_wt.controllers.discon import rosco_discon
 
-        name = next((v for k, v in _ROSCO_FILES.items() if turbine.name.startswith(k)), None)
+        name = _shipped_name(turbine)
         if name is None:
             return op
         path = rosco_discon(name)
@@ -1056,8 +1057,7 @@ def _build_rosco(ctx: BuildContext, opts: RoscoOptions) -> Built:
     discon_in = opts.discon_in
     source = {}
     if discon_in == "shipped":
-        name = next((v for k, v in _ROSCO_FILES.items() if ctx.turbine.name.startswith(k)),
-                    None)
+        name = _shipped_name(ctx.turbine)
         if name is None:
             raise ValueError(f"rosco: no DISCON.IN shipped for turbine {ctx.turbine.name!r}; "
                              f"give discon_in (--discon-in FILE)")

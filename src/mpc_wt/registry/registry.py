@@ -263,6 +263,11 @@ class Selection:
         """The base, then the add-ons."""
         return (self.base, *self.addons)
 
+    @property
+    def field_components(self) -> str:
+        """The wind components any part reads from the case's field, in ``"uvw"`` order."""
+        return "".join(c for c in "uvw" if any(c in k.field_components for k in self.parts))
+
     def option_names(self) -> set[str]:
         """Every option any part takes.
 

@@ -31,7 +31,7 @@ BASE_BYTES = 450e6
 #: Peak over stored size of a field while it is generated (measured 1.6-1.9).
 FIELD_PEAK = 2.0
 #: Result columns per plant step: states, inputs, outputs and up to 60 controller signals.
-RESULT_COLUMNS = len(linearize.STATE_NAMES) + 4 + 31 + 60
+RESULT_COLUMNS = len(linearize.STATE_NAMES) + 4 + len(linearize.OUTPUT_NAMES) + 60
 
 
 @dataclass(frozen=True)
