@@ -40,9 +40,11 @@ import linearize
 from linearize.validate import check_number
 from mpc_wt.controllers.base import ControllerBase
 from mpc_wt.controllers.baseline import LawTorque
+from mpc_wt.controllers.filters import SOSFilterBank, filter_sos
 from mpc_wt.controllers.qp import check_backend, daqp_update_solve, default_backend, make_backend
 
-__all__ = ["coleman_weight", "MPCWeights", "MPCSettings", "MPC", "ScheduledMPC"]
+__all__ = ["coleman_weight", "MPCWeights", "MPCSettings", "MPC", "ScheduledMPC",
+           "drivetrain_frequency"]
 
 log = logging.getLogger(__name__)
 
@@ -966,6 +968,10 @@ class MPC(ControllerBase):
         """Forget the previous plan and command."""
         self._plan: np.ndarray | None = None
         self._u_prev: np.ndarray | None = None
+        #: the generator torque applied over the last step when it differs from the command
+        #: (a filter after the MPC, :class:`ScheduledMPC`'s torque notch) [N m]: the
+        #: estimator's input; None: the command
+        self.applied_torque: float | None = None
         self.qp_backend.reset()
         self._last_slack = 0.0
         self.fallbacks = 0                  # steps that took the fallback since the reset
@@ -1174,6 +1180,8 @@ class MPC(ControllerBase):
         if self.estimator is not None:
             u_dev = (np.zeros(len(self.model.u0)) if self._u_prev is None
                      else self._u_abs(self._u_prev) - self.model.u0)
+            if self.applied_torque is not None:
+                u_dev[3] = self.applied_torque - self.model.u0[3]
             xe, dhat = self.estimator.update(self.estimator.measurement(meas), u_dev)
             z[1:1 + nx] = xe
             dprev = dhat
@@ -1259,6 +1267,7 @@ class MPC(ControllerBase):
         if other._u_prev is not None:
             du = other._u_abs(other._u_prev) - self.model.u0
             self._u_prev = np.array([du[0], du[3]]) if self.collective else du
+        self.applied_torque = other.applied_torque
         if other.estimator is not None and self.estimator is not None:
             offset = (np.concatenate([other.model.x0, other.model.d0])
                       - np.concatenate([self.model.x0, self.model.d0]))
@@ -1270,6 +1279,37 @@ class MPC(ControllerBase):
         if self._plan is None:
             return None
         return (self._plan * self._su[:self._nvu]).reshape(self.hu, self._nu)
+
+
+def drivetrain_frequency(turbine: linearize.Turbine, wind_mps: float | None = None) -> float:
+    """The drivetrain's torsion mode of the turbine's full linearization (every degree of
+    freedom of the plant, the blades' edgewise ones among them) [Hz].
+
+    Parameters
+    ----------
+    turbine : Turbine
+        The turbine.
+    wind_mps : float, optional
+        Mean wind of the operating point [m/s] (default: rated).
+
+    Returns
+    -------
+    float
+        Natural frequency of the mode named "drivetrain torsion"
+        (:meth:`linearize.LinearModel.modes`) [Hz].
+
+    Raises
+    ------
+    ValueError
+        If the linearization has no such mode.
+    """
+    v = linearize.rated_wind_speed(turbine) if wind_mps is None else float(wind_mps)
+    modes = [m for m in linearize.linearize(turbine, v).modes()
+             if m["name"] == "drivetrain torsion"]
+    if not modes:
+        raise ValueError(f"the turbine's linearization at {v:g} m/s has no drivetrain torsion "
+                         "mode (a rigid drivetrain?)")
+    return float(modes[0]["frequency_Hz"])
 
 
 class ScheduledMPC(ControllerBase):
@@ -1317,6 +1357,19 @@ class ScheduledMPC(ControllerBase):
         torque gives there.
     below_rated : MPCSettings, optional
         Settings of the designs at grid winds below rated (default: ``settings``).
+    torque_notch_hz : float or None
+        Centre of a band-stop (notch) filter on the generator-torque command [Hz], below the
+        Nyquist frequency (default None: no filter). The designs' models (Madsen's degrees of
+        freedom, rigid blades in the edgewise direction) put the drivetrain's free-free
+        torsion mode at the rigid-blade frequency (2.22 Hz for the NREL 5-MW), the plant's
+        blades couple with it and bring it down (1.76 Hz): commands the designs make against
+        their mode excite the plant's. The notch at the plant's mode
+        (:func:`drivetrain_frequency`) keeps the commands out of it; its output is held to the
+        generator's torque limits and rate (a filtered ramp overshoots the rate), and the
+        estimator is given the torque so applied. The filter's state lives here, across the
+        designs' switches.
+    torque_notch_q : float
+        The notch's quality factor (bandwidth centre / Q) [-], > 0 (default 2).
     """
 
     def __init__(self, family: linearize.LinearModelFamily, turbine: linearize.Turbine,
@@ -1324,7 +1377,8 @@ class ScheduledMPC(ControllerBase):
                  time_constant: float = 30.0, hysteresis: float = 0.25,
                  wind_estimator: Any = None, prebuild: bool = True,
                  target_time_constant: float | None = 10.0, torque_law: Any = None,
-                 below_rated: MPCSettings | None = None) -> None:
+                 below_rated: MPCSettings | None = None, torque_notch_hz: float | None = None,
+                 torque_notch_q: float = 2.0) -> None:
         from mpc_wt.controllers.scheduling import SCHEDULE_SOURCES, WindSchedule
 
         if wind_source not in SCHEDULE_SOURCES:
@@ -1354,6 +1408,11 @@ class ScheduledMPC(ControllerBase):
         m0 = family.models[0]
         self._eff = float(m0.z0[m0.outputs.index("gen_power")]
                           / (m0.u0[3] * m0.x0[m0.states.index("gen_speed")]))
+        self.torque_notch_hz, self.torque_notch_q = torque_notch_hz, float(torque_notch_q)
+        self._notch: SOSFilterBank | None = None
+        if torque_notch_hz is not None:
+            self._notch = SOSFilterBank(filter_sos(1.0 / st.dt, notch_hz=(torque_notch_hz,),
+                                                   notch_q=torque_notch_q), 1)
         if prebuild:
             for k in range(len(family.wind_mps)):
                 self.controller(k)
@@ -1398,6 +1457,9 @@ class ScheduledMPC(ControllerBase):
         self.target_wind: float | None = None
         if self._law is not None:
             self._law.reset()
+        if self._notch is not None:
+            self._notch.reset()
+        self._q_applied: float | None = None
         self.signals: dict[str, float] = {}
 
     def _target(self, meas: dict[str, Any]) -> tuple[np.ndarray, np.ndarray]:
@@ -1466,6 +1528,14 @@ class ScheduledMPC(ControllerBase):
                 self.target_wind += a * (w - self.target_wind)
             ctl.set_target(*self._target(meas))
         u = ctl.step(t, meas)
+        if self._notch is not None:
+            _, _, q_lo, q_hi = ctl._limits
+            q = min(max(float(self._notch.step(u[1])[0]), q_lo), q_hi)
+            if self._q_applied is not None:         # the generator's rate stays hard
+                dq = self.turbine.generator.max_torque_rate * self.dt
+                q = min(max(q, self._q_applied - dq), self._q_applied + dq)
+            ctl.applied_torque = self._q_applied = q
+            u = (u[0], q)
         self.signals = dict(ctl.signals, schedule_wind=float(self.schedule.wind or math.nan),
                             schedule_grid_wind=float(self.family.wind_mps[k]),
                             target_wind=float(self.target_wind or math.nan),

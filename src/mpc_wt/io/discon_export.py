@@ -436,6 +436,17 @@ def _mpc_entries(ctl: Any, preview: Any = None) -> list[tuple[str, Any, str]]:
         rows.append(("law_torque", np.array([lt._a, lt._offset, lt._lo, lt._hi], float),
                      "speed filter pole, below-rated pitch offset [rad], torque min, max "
                      "[N m]"))
+    notch = ctl._notch
+    rows.append(("torque_notch", float(notch is not None),
+                 "1: a notch on the torque command (the estimator is given the filtered torque)"))
+    if notch is not None:
+        rows += [("torque_notch_sos", notch.sos.ravel(),
+                  f"its sections b0 b1 b2 a0 a1 a2 (centre {ctl.torque_notch_hz:.6g} Hz, Q "
+                  f"{ctl.torque_notch_q:g})"),
+                 ("torque_notch_zi", np.asarray(notch._zi1, float).ravel(),
+                  "their state at a unit input's steady state"),
+                 ("torque_notch_rate", float(ctl.turbine.generator.max_torque_rate),
+                  "the filtered torque's largest rate [N m/s]")]
     rows += _preview_entries(preview, ctl.settings.horizon) if preview is not None else \
         [("lidar_preview", 0.0, "no LIDAR")]
     for k, m in enumerate(pts):

@@ -8,6 +8,7 @@ loop, :mod:`mpc_wt.controllers.discon`).
 from __future__ import annotations
 
 import dataclasses
+import logging
 import math
 from dataclasses import dataclass
 from pathlib import Path
@@ -21,6 +22,8 @@ from mpc_wt.registry.context import BuildContext, Built
 from mpc_wt.registry.options import REQUIRED, Options, option
 from mpc_wt.registry.registry import register
 from mpc_wt.simulation.scenario import Scenario, start_wind
+
+log = logging.getLogger(__name__)
 
 __all__ = ["BaselineOptions", "DerateOptions", "APCOptions", "IBCOptions", "ColemanIPCOptions",
            "MPCOptions", "MPCWeightOptions", "LidarOptions", "MPCLidarOptions", "LQRPIOOptions", "TSOptions",
@@ -396,6 +399,13 @@ class MPCOptions(Options):
                                              "solve takes the logged fallback (default none: "
                                              "reproducible runs, the solver's iteration limit "
                                              "is the budget)", unit="ms", lo=0.0, lo_open=True)
+    torque_notch_hz: Optional[float] = option(
+        None, help="centre of the scheduled designs' notch on the generator-torque command "
+        "(default: the drivetrain torsion mode of the turbine's full linearization at rated "
+        "wind, when below 0.8 x the controller's Nyquist frequency; 0: no notch)", unit="Hz",
+        lo=0.0, flag="")
+    torque_notch_q: float = option(2.0, help="the torque notch's quality factor (bandwidth = "
+                                   "centre / Q)", unit="-", lo=0.0, lo_open=True, flag="")
 
 
 _CW = "lidar.CWLidar setting (unset: its default)"
@@ -524,6 +534,38 @@ def _check_design_wind(turbine: linearize.Turbine, v: float) -> float:
     return float(v)
 
 
+#: The default torque notch is left out when the drivetrain mode lies above this fraction of
+#: the controller's Nyquist frequency (a stiff or direct drive: the designs' commands do not
+#: reach it).
+NOTCH_NYQUIST_SHARE = 0.8
+
+
+def _torque_notch(ctx: BuildContext, opts: MPCOptions, dt: float) -> Optional[float]:
+    """The scheduled MPC's torque-notch centre [Hz] from the options (None: no notch)."""
+    from mpc_wt.controllers.mpc import drivetrain_frequency
+
+    nyquist = 0.5 / dt
+    f = opts.torque_notch_hz
+    if f is not None:
+        if f == 0.0:
+            return None
+        if f >= nyquist:
+            raise ValueError(f"torque_notch_hz = {f:g} Hz must be below the controller's "
+                             f"Nyquist frequency {nyquist:g} Hz (0: no notch)")
+        return float(f)
+    try:
+        f = ctx.cache.get(ctx.turbine, ("drivetrain-mode",),
+                          lambda: drivetrain_frequency(ctx.turbine))
+    except ValueError as err:
+        log.info("MPC: no torque notch (%s)", err)
+        return None
+    if f >= NOTCH_NYQUIST_SHARE * nyquist:
+        log.info("MPC: no torque notch: the drivetrain mode at %.3g Hz is above %g x the "
+                 "controller's Nyquist frequency %g Hz", f, NOTCH_NYQUIST_SHARE, nyquist)
+        return None
+    return float(f)
+
+
 def _below_rated(ctx: BuildContext, opts: MPCOptions, settings: Any) -> Any:
     """The scheduled designs' settings below rated wind: their weights
     (:data:`BELOW_RATED_WEIGHTS` and the options' ``below_rated_weights`` over the others) and
@@ -562,7 +604,9 @@ def _mpc(collective: bool, with_lidar: bool) -> Any:
                                wind_source="preview" if with_lidar else "estimator",
                                wind_estimator=_wind_estimator(ctx, settings.dt),
                                time_constant=opts.schedule_time_constant,
-                               torque_law=law, below_rated=_below_rated(ctx, opts, settings))
+                               torque_law=law, below_rated=_below_rated(ctx, opts, settings),
+                               torque_notch_hz=_torque_notch(ctx, opts, settings.dt),
+                               torque_notch_q=opts.torque_notch_q)
             grid = [float(fam.wind_mps[0]), float(fam.wind_mps[-1])]
         else:
             v = _check_design_wind(ctx.turbine, opts.design_wind_mps)
@@ -574,6 +618,7 @@ def _mpc(collective: bool, with_lidar: bool) -> Any:
             "horizon": settings.horizon, "backend": settings.resolved_backend, "dt": cdt,
             "formulation": settings.formulation, "estimator": opts.estimator,
             "design_winds_mps": grid, "schedule_step_mps": opts.schedule_step,
+            "torque_notch_hz": getattr(ctl, "torque_notch_hz", None),
             **({"idealization": FULL_STATE} if opts.estimator == "full-state" else {})}}
         preview = None
         if with_lidar:
