@@ -408,3 +408,24 @@ def test_ts_at_cut_out_holds_rated_power_and_says_its_premise_was_clipped() -> N
     assert abs(p[res.t > 30.0].mean() / rated - 1) < 0.01
     assert p.max() < 1.1 * rated
     assert any("TS premise" in w for w in res.meta["run_warnings"])
+
+
+def test_a_runaway_blade_does_not_drag_the_collective_command(turbine) -> None:
+    """Blade 1 runs away towards fine pitch at 20 s (25 m/s, class A, seed 4; the protection
+    stops the turbine 1 s later): in that second the TS law's collective command for the
+    healthy blades must not follow the faulty one down. The command may lead the measured
+    pitch only as far as the actuator can follow, counted from the blade farthest each way;
+    counted from the three blades' mean, the runaway pulled the healthy blades 2.2-2.6 deg
+    towards fine in every seed of the sign-off (and raised the governing edgewise load by
+    10.7 %). Measured: the healthy blades do not move towards fine (0.000 deg; counted from
+    the mean, -2.05 deg)."""
+    from mpc_wt.run import run_controller
+
+    res = run_controller(turbine, "ts", Scenario(25.0, "A", 4, 30.0),
+                         supervisor={"pitch_fault_at": 20.0, "pitch_fault": "runaway"})
+    i0, i1 = np.searchsorted(res.t, [19.95, 20.99])
+    for name in ("pitch_2", "pitch_3"):
+        p = res.channel(name)
+        assert np.degrees(p[i0:i1 + 1].min() - p[i0]) >= -0.5, name
+    p1 = res.channel("pitch_1")
+    assert np.degrees(p1[i0] - p1[i1]) > 5.0          # the fault did run away

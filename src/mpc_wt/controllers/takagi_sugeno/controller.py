@@ -147,13 +147,18 @@ class TSController(ControllerBase):
             raise ValueError(f"power_reduction({t:g}) returned {dp_raw!r}")
         ts, pa, gen = self.ts, self.turbine.pitch_actuator, self.turbine.generator
         v_seen = float(self.xi[-1])
+        # the command within what the actuator can follow from the measured pitch, counted
+        # from the blades farthest each way: one blade that runs away or seizes must not
+        # drag the others' collective command with it
         p = meas["pitch"]
-        pm = (float(p[0]) + float(p[1]) + float(p[2])) / 3.0
+        p_lo = min(float(p[0]), float(p[1]), float(p[2]))
+        p_hi = max(float(p[0]), float(p[1]), float(p[2]))
         q, dp, clipped = _ts_step(
             self.xi, self._u, y, dp_raw, ts.wind_grid, ts.reduction_grid, self._terms,
             self._phi, self._gam, ts.x0, ts.u0, self._K, -1 if self._ki is None else self._ki,
             -1 if self._int_src is None else self._int_src, self._q, self.dt,
-            max(pa.min_pitch_rad, pm - self._reach), min(pa.max_pitch_rad, pm + self._reach),
+            max(pa.min_pitch_rad, p_lo - self._reach),
+            min(pa.max_pitch_rad, p_hi + self._reach),
             gen.min_torque, gen.max_torque, self.torque_law is None, self._w)
         if clipped:
             self.premise_clipped += 1

@@ -162,9 +162,12 @@ static int ts_step(mw_ctrl *self, const mw_meas *m, mw_cmd *out, char *msg)
     lo = c->limits[0];
     hi = c->limits[1];
     if (c->limits[4] >= 0.0) {     /* what the actuator can follow from the measured pitch */
-        double pm = (m->pitch[0] + m->pitch[1] + m->pitch[2]) / 3.0;
-        lo = dmax(lo, pm - c->limits[4]);
-        hi = dmin(hi, pm + c->limits[4]);
+        /* from the blades farthest each way: one blade that runs away or seizes must not
+         * drag the others' collective command with it */
+        double pmin = dmin(m->pitch[0], dmin(m->pitch[1], m->pitch[2]));
+        double pmax = dmax(m->pitch[0], dmax(m->pitch[1], m->pitch[2]));
+        lo = dmax(lo, pmin - c->limits[4]);
+        hi = dmin(hi, pmax + c->limits[4]);
     }
     pitch = dmin(dmax(raw[0], lo), hi);
     torque = dmin(dmax(raw[1], c->limits[2]), c->limits[3]);
