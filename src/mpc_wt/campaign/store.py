@@ -254,6 +254,7 @@ class CampaignStore:
         now = time.time()
         counts = {"added": 0, "invalidated": 0, "reassess": 0, "kept": 0, "stale": 0,
                   "redesigned": 0}
+        unrecorded = 0
         with self._tx():
             old = {r[0]: r for r in self.db.execute(
                 "SELECT case_id, case_hash, assess_hash, status, case_json FROM cases")}
@@ -290,7 +291,13 @@ class CampaignStore:
                     if before is None and c.design_hash is not None:
                         self.db.execute("UPDATE cases SET case_json=? WHERE case_id=?",
                                         (cj, c.case_id))
+                        unrecorded += row[3] == "done"
                     counts["kept"] += 1
+            if unrecorded:
+                log.warning("%d finished cases carry no record of the defaults their controller "
+                            "kinds had (computed by a version that did not record them): they "
+                            "are kept and take today's; remove their files from cases/ to "
+                            "compute them under today's defaults", unrecorded)
             if counts["redesigned"]:
                 log.warning("%d cases were computed under other defaults of their controller "
                             "kind (the software changed them since): they are computed again",

@@ -1,7 +1,7 @@
 """A campaign resumed after the software changed a controller kind's defaults computes that
 kind's cases again (a case's design hash covers every option as the kind resolves it, defaults
 included), says so in the log, and leaves the other kinds' cases alone; an index written before
-designs were hashed takes the current hash without computing anything again."""
+designs were hashed takes the current hash without computing anything again, and says so."""
 from __future__ import annotations
 
 import json
@@ -72,8 +72,10 @@ def test_changed_defaults_compute_the_kinds_cases_again(probe_kind, tmp_path, ca
     assert third.submitted == 0
 
 
-def test_an_index_without_design_hashes_takes_them_without_recomputing(probe_kind,
-                                                                       tmp_path) -> None:
+def test_an_index_without_design_hashes_takes_them_without_recomputing(probe_kind, tmp_path,
+                                                                       caplog) -> None:
+    """Cases from a version that recorded no design are kept (their defaults are unknown) and
+    the log says how many, and how to compute them again."""
     probe_kind(0.0)
     out = tmp_path / "c"
     run_campaign(spec_from_dict(RAW), out, engine="serial", progress=False)
@@ -82,8 +84,11 @@ def test_an_index_without_design_hashes_takes_them_without_recomputing(probe_kin
             d = json.loads(cj)
             d.pop("design_hash", None)
             st.db.execute("UPDATE cases SET case_json=? WHERE case_id=?", (json.dumps(d), cid))
-    again = run_campaign(spec_from_dict(RAW), out, engine="serial", progress=False)
+    with caplog.at_level(logging.WARNING):
+        again = run_campaign(spec_from_dict(RAW), out, engine="serial", progress=False)
     assert again.submitted == 0
+    assert "2 finished cases carry no record of the defaults" in caplog.text
+    assert "remove their files from cases/" in caplog.text
     with CampaignStore(out) as st:
         hashes = [json.loads(cj).get("design_hash")
                   for (cj,) in st.db.execute("SELECT case_json FROM cases")]
