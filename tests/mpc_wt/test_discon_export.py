@@ -7,6 +7,7 @@ import ctypes
 import json
 import math
 import os
+import re
 import shutil
 import subprocess
 import sys
@@ -565,8 +566,9 @@ def test_cli_design_then_export_discon(tmp_path, capsys):
 
 
 def test_cli_design_mpc_then_export_discon(tmp_path, capsys):
-    """``mpcwt design mpc`` writes the grid's trim table and plot; ``mpcwt export --format
-    discon`` builds the MPC again from the design's options and exports it."""
+    """``mpcwt design mpc`` writes the grid's trim table and plot, and the torque notch;
+    ``mpcwt export --format discon`` builds the MPC again from the design's options and
+    exports it, notch included."""
     from mpc_wt.cli import main
 
     d = tmp_path / "mpc"
@@ -576,9 +578,14 @@ def test_cli_design_mpc_then_export_discon(tmp_path, capsys):
     rows = np.array(doc["schedule"]["rows"])
     assert doc["kind"] == "mpc" and rows[0, 0] == 3.0 and rows[-1, 0] == 25.0
     assert np.all(rows[:, 5] < 1.0)                  # every Kalman filter stable
+    # the notch on the torque command at the drivetrain mode (1.76 Hz on the NREL 5-MW)
+    assert 1.6 < doc["settings"]["torque_notch_hz"] < 1.9
+    assert doc["settings"]["torque_notch_q"] == 2.0
     assert main(["export", str(d), "--format", "discon"]) == 0
     assert "libmpcwt_mpc" in capsys.readouterr().out
-    assert "kind mpc" in (d / "mpcwt_mpc.in").read_text()
+    text = (d / "mpcwt_mpc.in").read_text()
+    assert "kind mpc" in text
+    assert re.search(r"^torque_notch\s+1(\.0)?\s", text, re.M)
     assert (d / library_name("mpc")).is_file()
 
 

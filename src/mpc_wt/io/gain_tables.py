@@ -373,8 +373,8 @@ def mpc_table(turbine: linearize.Turbine, ctl: Any, kind: str,
               options: dict[str, Any] | None = None) -> dict[str, Any]:
     """A scheduled MPC's design as a table: one row per grid wind with the trim the cost
     tracks there (pitch, torque, rotor speed, power) and its Kalman filter's spectral radius;
-    the settings hold the kind's options (from which the design is built again) and the
-    MPC's horizon and period.
+    the settings hold the kind's options (from which the design is built again), the MPC's
+    horizon and period, and the notch on its torque command (centre, None: none; Q).
 
     Parameters
     ----------
@@ -404,8 +404,9 @@ def mpc_table(turbine: linearize.Turbine, ctl: Any, kind: str,
     settings = {"options": dict(options or {}), "dt": st.dt, "horizon": st.horizon,
                 "control_horizon": st.hu, "schedule_time_constant": ctl.schedule.tau,
                 "target_time_constant": ctl.target_tau,
+                "torque_notch_hz": ctl.torque_notch_hz, "torque_notch_q": ctl.torque_notch_q,
                 "units": {"dt": "s", "schedule_time_constant": "s",
-                          "target_time_constant": "s"}}
+                          "target_time_constant": "s", "torque_notch_hz": "Hz"}}
     return _doc(kind, turbine, settings,
                 ["wind_speed", "pitch", "gen_torque", "rotor_speed", "gen_power",
                  "estimator_spectral_radius"], ["m/s", "rad", "N m", "rad/s", "W", "-"], rows,
