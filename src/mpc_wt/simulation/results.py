@@ -3,6 +3,7 @@ read by mpc-wt, openable without it) and :func:`load_series`, which reads a run 
 any CSV with a time column -- as time and named channels for assessment."""
 from __future__ import annotations
 
+import contextlib
 import csv
 import json
 import os
@@ -22,6 +23,18 @@ __all__ = ["ClosedLoopResult", "load_series", "SCHEMA_VERSION"]
 
 SCHEMA_VERSION = 1
 _Z = {n: i for i, n in enumerate(linearize.OUTPUT_NAMES)}
+
+
+def _in_process() -> Any:
+    """Writing in this process whatever Dask's global scheduler says: xarray asks Dask for its
+    scheduler even for NumPy data, and a ``distributed.Client`` that failed to connect leaves
+    the config naming the distributed scheduler with no client, which made every later write
+    in the process fail."""
+    try:
+        import dask
+    except ImportError:                   # pragma: no cover - dask is a dependency
+        return contextlib.nullcontext()
+    return dask.config.set(scheduler="sync")
 
 
 #: the blade-frame root moments :meth:`ClosedLoopResult.channel` derives
@@ -141,7 +154,8 @@ class ClosedLoopResult:
         # a name of this writer's own: two writers of one case (a retried task) never share it
         tmp = path.with_name(f".{path.name}.{os.getpid()}.{uuid.uuid4().hex[:8]}.tmp")
         try:
-            ds.to_netcdf(tmp, engine="scipy")
+            with _in_process():
+                ds.to_netcdf(tmp, engine="scipy")
             tmp.replace(path)
         finally:
             tmp.unlink(missing_ok=True)

@@ -23,6 +23,18 @@ def test_result_round_trip(run18: ClosedLoopResult, tmp_path: Path) -> None:
         assert ds["gen_power"].attrs["units"] == "W" and ds["time"].attrs["units"] == "s"
 
 
+def test_a_stale_dask_scheduler_does_not_stop_a_save(run18: ClosedLoopResult,
+                                                      tmp_path: Path) -> None:
+    """A ``distributed.Client`` that failed to connect leaves Dask's config naming the
+    distributed scheduler with no client; xarray asks for it even for NumPy data. A result is
+    still written (it failed every later case of a serial campaign in that process)."""
+    import dask
+
+    with dask.config.set(scheduler="dask.distributed"):
+        p = run18.save(tmp_path / "run.nc")
+    assert_allclose(ClosedLoopResult.load(p).z, run18.z, rtol=0, atol=0)
+
+
 def test_broken_result_files(run18: ClosedLoopResult, tmp_path: Path) -> None:
     p = run18.save(tmp_path / "run.nc")
     raw = p.read_bytes()
