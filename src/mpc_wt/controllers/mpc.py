@@ -1413,6 +1413,7 @@ class ScheduledMPC(ControllerBase):
         if torque_notch_hz is not None:
             self._notch = SOSFilterBank(filter_sos(1.0 / st.dt, notch_hz=(torque_notch_hz,),
                                                    notch_q=torque_notch_q), 1)
+        self._dq = turbine.generator.max_torque_rate * st.dt  # the torque's largest step
         if prebuild:
             for k in range(len(family.wind_mps)):
                 self.controller(k)
@@ -1459,7 +1460,6 @@ class ScheduledMPC(ControllerBase):
             self._law.reset()
         if self._notch is not None:
             self._notch.reset()
-        self._q_applied: float | None = None
         self.signals: dict[str, float] = {}
 
     def _target(self, meas: dict[str, Any]) -> tuple[np.ndarray, np.ndarray]:
@@ -1531,10 +1531,10 @@ class ScheduledMPC(ControllerBase):
         if self._notch is not None:
             _, _, q_lo, q_hi = ctl._limits
             q = min(max(float(self._notch.step(u[1])[0]), q_lo), q_hi)
-            if self._q_applied is not None:         # the generator's rate stays hard
-                dq = self.turbine.generator.max_torque_rate * self.dt
-                q = min(max(q, self._q_applied - dq), self._q_applied + dq)
-            ctl.applied_torque = self._q_applied = q
+            last = ctl.applied_torque           # handed over on a switch
+            if last is not None:                # the generator's rate stays hard
+                q = min(max(q, last - self._dq), last + self._dq)
+            ctl.applied_torque = q
             u = (u[0], q)
         self.signals = dict(ctl.signals, schedule_wind=float(self.schedule.wind or math.nan),
                             schedule_grid_wind=float(self.family.wind_mps[k]),

@@ -494,7 +494,7 @@ BELOW_RATED_SPEED_LIMIT = 1.028
 ENVELOPE_SPEED_LIMIT = 1.028
 
 
-def _mpc_settings(opts: MPCOptions, collective: bool, preview: bool = True) -> Any:
+def _mpc_settings(opts: MPCOptions, collective: bool, preview: bool) -> Any:
     from mpc_wt.controllers.mpc import MPCSettings
 
     defaults = None

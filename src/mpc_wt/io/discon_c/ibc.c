@@ -13,25 +13,22 @@
 static double dmin(double a, double b) { return a < b ? a : b; }
 static double dmax(double a, double b) { return a > b ? a : b; }
 
-/* one sample of each blade through a cascade; zi (n x 2 x 3) in place, started at x's steady
- * state (zi1 per unit input) on the first call */
-static void sos_step(const double *sos, const double *zi1, int n, double *zi, int *started,
-                     const double *x, double *y)
+void mw_sos_step(mw_sos *f, const double *x, double *y)
 {
-    int c, k;
-    if (!*started) {
-        for (k = 0; k < n; k++)
-            for (c = 0; c < 3; c++) {
-                zi[(k * 2 + 0) * 3 + c] = zi1[k * 2 + 0] * x[c];
-                zi[(k * 2 + 1) * 3 + c] = zi1[k * 2 + 1] * x[c];
+    int c, k, nch = f->nch;
+    if (!f->started) {
+        for (k = 0; k < f->n; k++)
+            for (c = 0; c < nch; c++) {
+                f->zi[(k * 2 + 0) * nch + c] = f->zi1[k * 2 + 0] * x[c];
+                f->zi[(k * 2 + 1) * nch + c] = f->zi1[k * 2 + 1] * x[c];
             }
-        *started = 1;
+        f->started = 1;
     }
-    for (c = 0; c < 3; c++) {
+    for (c = 0; c < nch; c++) {
         double v = x[c];
-        for (k = 0; k < n; k++) {
-            const double *s = sos + 6 * k;
-            double *z0 = zi + (k * 2 + 0) * 3 + c, *z1 = zi + (k * 2 + 1) * 3 + c;
+        for (k = 0; k < f->n; k++) {
+            const double *s = f->sos + 6 * k;
+            double *z0 = f->zi + (k * 2 + 0) * nch + c, *z1 = f->zi + (k * 2 + 1) * nch + c;
             double out = s[0] * v + *z0;
             *z0 = s[1] * v - s[4] * out + *z1;
             *z1 = s[2] * v - s[5] * out;
@@ -39,6 +36,35 @@ static void sos_step(const double *sos, const double *zi1, int n, double *zi, in
         }
         y[c] = v;
     }
+}
+
+int mw_sos_read(const mw_input *in, const char *who, const char *key, const char *zkey,
+                int nch, mw_sos *f, char *msg)
+{
+    int c;
+    f->nch = nch;
+    f->started = 0;
+    if (!(f->sos = mw_getp_alloc(in, "", key, &c, msg))) return -1;
+    if (c % 6 || c == 0) {
+        mw_msg(msg, "mpc-wt %s: input file '%s': key '%s' needs second-order sections of 6 "
+               "values, got %d values", who, in->path, key, c);
+        return -1;
+    }
+    f->n = c / 6;
+    if (!(f->zi1 = mw_getp_alloc_n(in, "", zkey, f->n * 2, msg))) return -1;
+    f->zi = (double *)calloc((size_t)(f->n * 2 * nch), sizeof(double));
+    if (!f->zi) {
+        mw_msg(msg, "mpc-wt %s: out of memory", who);
+        return -1;
+    }
+    return 0;
+}
+
+void mw_sos_free(mw_sos *f)
+{
+    free(f->sos);
+    free(f->zi1);
+    free(f->zi);
 }
 
 int mw_ibc_step(mw_ibc *b, const mw_meas *m, double dt, const double *pc, double *out,
@@ -56,9 +82,9 @@ int mw_ibc_step(mw_ibc *b, const mw_meas *m, double dt, const double *pc, double
     b->has_p = 1;
     w = dmin(dmax((b->p_filt / b->rated - b->w_lo) / (b->w_hi - b->w_lo), 0.0), 1.0);
     k = mw_interp((pc[0] + pc[1] + pc[2]) / 3.0, b->gp, b->gg, b->ng);
-    sos_step(b->hp, b->hp_zi1, b->nhp, b->hp_zi, &b->hp_started, m->flap, hp);
+    mw_sos_step(&b->hp, m->flap, hp);
     for (i = 0; i < 3; i++) hp[i] *= k;
-    sos_step(b->bs, b->bs_zi1, b->nbs, b->bs_zi, &b->bs_started, hp, u);
+    mw_sos_step(&b->bs, hp, u);
     for (i = 0; i < 3; i++) u[i] *= w;
     if (b->remove_mean) {
         mean = (u[0] + u[1] + u[2]) / 3.0;
@@ -73,26 +99,6 @@ int mw_ibc_step(mw_ibc *b, const mw_meas *m, double dt, const double *pc, double
     return 0;
 }
 
-static int read_sos(const mw_input *in, const char *key, const char *zkey, double **sos,
-                    double **zi1, double **zi, int *n, char *msg)
-{
-    int c;
-    if (!(*sos = mw_getp_alloc(in, "", key, &c, msg))) return -1;
-    if (c % 6) {
-        mw_msg(msg, "mpc-wt ibc: input file '%s': key '%s' needs second-order sections of 6 "
-               "values, got %d values", in->path, key, c);
-        return -1;
-    }
-    *n = c / 6;
-    if (!(*zi1 = mw_getp_alloc_n(in, "", zkey, *n * 2, msg))) return -1;
-    *zi = (double *)calloc((size_t)*n * 6, sizeof(double));
-    if (!*zi) {
-        mw_msg(msg, "mpc-wt ibc: out of memory");
-        return -1;
-    }
-    return 0;
-}
-
 int mw_ibc_read(const mw_input *in, mw_ibc *b, char *msg)
 {
     double v[8];
@@ -101,10 +107,8 @@ int mw_ibc_read(const mw_input *in, mw_ibc *b, char *msg)
     if (mw_getp_vec(in, "", "ibc_settings", v, 8, msg)
         || !(b->gp = mw_getp_alloc(in, "", "ibc_gain_pitch", &b->ng, msg))
         || !(b->gg = mw_getp_alloc_n(in, "", "ibc_gain", b->ng, msg))
-        || read_sos(in, "ibc_input_sos", "ibc_input_zi", &b->hp, &b->hp_zi1, &b->hp_zi, &b->nhp,
-                    msg)
-        || read_sos(in, "ibc_output_sos", "ibc_output_zi", &b->bs, &b->bs_zi1, &b->bs_zi,
-                    &b->nbs, msg))
+        || mw_sos_read(in, "ibc", "ibc_input_sos", "ibc_input_zi", 3, &b->hp, msg)
+        || mw_sos_read(in, "ibc", "ibc_output_sos", "ibc_output_zi", 3, &b->bs, msg))
         return -1;
     b->w_lo = v[0];
     b->w_hi = v[1];
@@ -136,10 +140,6 @@ void mw_ibc_free(mw_ibc *b)
 {
     free(b->gp);
     free(b->gg);
-    free(b->hp);
-    free(b->hp_zi1);
-    free(b->hp_zi);
-    free(b->bs);
-    free(b->bs_zi1);
-    free(b->bs_zi);
+    mw_sos_free(&b->hp);
+    mw_sos_free(&b->bs);
 }

@@ -78,9 +78,9 @@ typedef struct {
     mw_torque_law law;
     double target_wind;
     int target_started;
-    /* the notch on the torque command: sections, their state per unit input, their state */
-    int has_notch, n_notch, notch_started, has_q_applied;
-    double *notch_sos, *notch_zi1, *notch_zi, torque_rate, q_applied;
+    int has_notch;                /* the notch on the torque command, its largest rate */
+    mw_sos notch;
+    double torque_rate;
 } mw_mpc;
 
 static double dmin(double a, double b) { return a < b ? a : b; }
@@ -522,26 +522,6 @@ static void trim_at(const mw_mpc *c, double wind, double *z, double *u)
         u[j] = (1.0 - a) * c->trim_u[i * 4 + j] + a * c->trim_u[(i + 1) * 4 + j];
 }
 
-/* one sample through the torque notch's sections (transposed direct form II), started at the
- * steady state of its first input (scipy's sosfilt_zi) */
-static double notch_step(mw_mpc *c, double x)
-{
-    int k;
-    double v = x;
-    if (!c->notch_started) {
-        for (k = 0; k < 2 * c->n_notch; k++) c->notch_zi[k] = c->notch_zi1[k] * x;
-        c->notch_started = 1;
-    }
-    for (k = 0; k < c->n_notch; k++) {
-        const double *s = c->notch_sos + 6 * k;
-        double *z = c->notch_zi + 2 * k, out = s[0] * v + z[0];
-        z[0] = s[1] * v - s[4] * out + z[1];
-        z[1] = s[2] * v - s[5] * out;
-        v = out;
-    }
-    return v;
-}
-
 static int mpc_step(mw_ctrl *self, const mw_meas *m, mw_cmd *out, char *msg)
 {
     mw_mpc *c = (mw_mpc *)self;
@@ -587,12 +567,14 @@ static int mpc_step(mw_ctrl *self, const mw_meas *m, mw_cmd *out, char *msg)
     if (rc < 0) return rc;
     if (c->has_notch) {             /* within the torque limits and the generator's rate */
         mw_point *p = &c->pt[k];
-        u[3] = dmin(dmax(notch_step(c, u[3]), p->limits[2]), p->limits[3]);
-        if (c->has_q_applied)
-            u[3] = dmin(dmax(u[3], c->q_applied - c->torque_rate * c->dt),
-                        c->q_applied + c->torque_rate * c->dt);
-        c->q_applied = p->applied_torque = u[3];
-        c->has_q_applied = p->has_applied = 1;
+        double q;
+        mw_sos_step(&c->notch, &u[3], &q);
+        q = dmin(dmax(q, p->limits[2]), p->limits[3]);
+        if (p->has_applied)         /* the last applied torque (handed over on a switch) */
+            q = dmin(dmax(q, p->applied_torque - c->torque_rate * c->dt),
+                     p->applied_torque + c->torque_rate * c->dt);
+        u[3] = p->applied_torque = q;
+        p->has_applied = 1;
     }
     for (i = 0; i < 3; i++) out->pitch[i] = u[i];
     out->torque = u[3];
@@ -614,9 +596,7 @@ static void mpc_destroy(mw_ctrl *self)
     free(c->pv.t);
     free(c->pv.u);
     free(c->pv.blade);
-    free(c->notch_sos);
-    free(c->notch_zi1);
-    free(c->notch_zi);
+    mw_sos_free(&c->notch);
     mw_schedule_free(&c->sched);
     free(c);
 }
@@ -679,25 +659,12 @@ static int mpc_read(const mw_input *in, mw_ctrl *self, char *msg)
     if (c->has_law && mw_torque_law_read(in, &c->law, msg)) return -1;
     if (mw_get_int(in, "torque_notch", 0, 1, &c->has_notch, msg)) return -1;
     if (c->has_notch) {
-        int nv;
-        if (!(c->notch_sos = mw_getp_alloc(in, "", "torque_notch_sos", &nv, msg))) return -1;
-        if (nv % 6 || nv == 0) {
-            mw_msg(msg, "mpc-wt mpc: input file '%s': key 'torque_notch_sos' needs second-order "
-                   "sections of 6 values, got %d values", in->path, nv);
+        if (mw_sos_read(in, "mpc", "torque_notch_sos", "torque_notch_zi", 1, &c->notch, msg)
+            || mw_get(in, "torque_notch_rate", &c->torque_rate, msg))
             return -1;
-        }
-        c->n_notch = nv / 6;
-        if (mw_get(in, "torque_notch_rate", &c->torque_rate, msg)) return -1;
         if (!(c->torque_rate > 0)) {
             mw_msg(msg, "mpc-wt mpc: input file '%s': key 'torque_notch_rate' must be > 0 N m/s, "
                    "got %g", in->path, c->torque_rate);
-            return -1;
-        }
-        if (!(c->notch_zi1 = mw_getp_alloc_n(in, "", "torque_notch_zi", 2 * c->n_notch, msg)))
-            return -1;
-        c->notch_zi = (double *)calloc((size_t)(2 * c->n_notch), sizeof(double));
-        if (!c->notch_zi) {
-            mw_msg(msg, "mpc-wt mpc: out of memory");
             return -1;
         }
     }

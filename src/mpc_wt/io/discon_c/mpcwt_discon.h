@@ -120,10 +120,24 @@ typedef struct {
 int mw_torque_law_read(const mw_input *in, mw_torque_law *t, char *msg);
 double mw_torque_law_step(mw_torque_law *t, double gen_speed, double pitch, double power);
 
+/* second-order sections in transposed direct form II on nch signals, started at the steady
+ * state of their first input (scipy's sosfilt_zi) (ibc.c) */
+typedef struct {
+    int n, nch, started;
+    double *sos, *zi1, *zi;       /* n x 6; n x 2 per unit input; n x 2 x nch */
+} mw_sos;
+/* the sections from `key` (6 values each) and their unit-input state from `zkey`; -1 with msg */
+int mw_sos_read(const mw_input *in, const char *who, const char *key, const char *zkey,
+                int nch, mw_sos *f, char *msg);
+/* one sample of each of the nch signals */
+void mw_sos_step(mw_sos *f, const double *x, double *y);
+void mw_sos_free(mw_sos *f);
+
 /* individual blade control added to a collective command (ibc.c) */
 typedef struct {
-    int on, ng, nhp, nbs, remove_mean, hp_started, bs_started, has_p, has_last;
-    double *gp, *gg, *hp, *hp_zi1, *hp_zi, *bs, *bs_zi1, *bs_zi;
+    int on, ng, remove_mean, has_p, has_last;
+    double *gp, *gg;
+    mw_sos hp, bs;
     double w_lo, w_hi, rated, p_alpha, pmin, pmax, rate, p_filt, last[3];
 } mw_ibc;
 int mw_ibc_read(const mw_input *in, mw_ibc *b, char *msg);
