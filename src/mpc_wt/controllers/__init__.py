@@ -37,6 +37,7 @@ from mpc_wt.controllers.lqr import (
 from mpc_wt.controllers.mpc import (MPC, MPCSettings, MPCWeights, ScheduledMPC,
                                     drivetrain_frequency)
 from mpc_wt.controllers.qp import BACKENDS, default_backend
+from mpc_wt.controllers.scheduling import RegionFloor, WindSchedule, envelope_winds, region3_wind
 from mpc_wt.controllers.supervisor import Supervisor, TorqueLawGuard
 from mpc_wt.controllers.takagi_sugeno import (
     TSController,
@@ -69,7 +70,8 @@ __all__ = ["apc_reference", "Controller", "ControllerBase", "BaselineController"
            "KalmanEstimator", "ColemanIPCController", "IBCController", "tune_coleman_ipc",
            "tune_ibc", "LidarFeedforward", "LQRPIOController", "design_lqr",
            "design_lqr_family", "design_pi_observer", "MPC", "MPCSettings", "MPCWeights",
-           "ScheduledMPC", "drivetrain_frequency", "BACKENDS", "default_backend", "Supervisor",
+           "ScheduledMPC", "drivetrain_frequency", "RegionFloor", "WindSchedule",
+           "envelope_winds", "region3_wind", "BACKENDS", "default_backend", "Supervisor",
            "TorqueLawGuard",
            "TSController", "build_ts_model", "design_ts_controller", "design_ts_observer",
            "WindEstimatorSettings", "WindSpeedEstimator", "REGISTRY_NAMES", *REGISTRY_NAMES]

@@ -1370,6 +1370,14 @@ class ScheduledMPC(ControllerBase):
         designs' switches.
     torque_notch_q : float
         The notch's quality factor (bandwidth centre / Q) [-], > 0 (default 2).
+    region_floor : RegionFloor or bool, optional
+        Choose the design also by the operating region the measurements tell
+        (:class:`~mpc_wt.controllers.scheduling.RegionFloor`: the measured collective pitch
+        read on the trim's pitch curve, and a rotor above rated speed): True makes it from
+        the family (:meth:`RegionFloor.from_family`); default none. With a floor the cost's
+        speed, power and torque target follow the floored wind (past rated: rated speed and
+        power), the pitch target the wind itself (so that a pitch held above fine never
+        becomes its own target).
     """
 
     def __init__(self, family: linearize.LinearModelFamily, turbine: linearize.Turbine,
@@ -1378,8 +1386,8 @@ class ScheduledMPC(ControllerBase):
                  wind_estimator: Any = None, prebuild: bool = True,
                  target_time_constant: float | None = 10.0, torque_law: Any = None,
                  below_rated: MPCSettings | None = None, torque_notch_hz: float | None = None,
-                 torque_notch_q: float = 2.0) -> None:
-        from mpc_wt.controllers.scheduling import SCHEDULE_SOURCES, WindSchedule
+                 torque_notch_q: float = 2.0, region_floor: Any = None) -> None:
+        from mpc_wt.controllers.scheduling import SCHEDULE_SOURCES, RegionFloor, WindSchedule
 
         if wind_source not in SCHEDULE_SOURCES:
             raise ValueError(f"wind_source must be 'estimator' or 'preview', got {wind_source!r}")
@@ -1387,9 +1395,17 @@ class ScheduledMPC(ControllerBase):
         self.settings = st
         self.family, self.turbine = family, turbine
         self.wind_source = wind_source
+        if region_floor is True:
+            region_floor = RegionFloor.from_family(family, turbine)
+        elif region_floor is False:
+            region_floor = None
+        elif region_floor is not None and not isinstance(region_floor, RegionFloor):
+            raise ValueError(f"region_floor must be a RegionFloor, True, False or None, got "
+                             f"{region_floor!r}")
+        self.region_floor: RegionFloor | None = region_floor
         self.schedule = WindSchedule(family.wind_mps, turbine, st.dt, source=wind_source,
                                      time_constant=time_constant, hysteresis=hysteresis,
-                                     estimator=wind_estimator)
+                                     estimator=wind_estimator, floor=region_floor)
         self.dt = st.dt
         self._ctl: dict[int, MPC] = {}
         # the trim over the grid: the target at the measured wind
@@ -1456,6 +1472,7 @@ class ScheduledMPC(ControllerBase):
         for c in self._ctl.values():
             c.reset()
         self.target_wind: float | None = None
+        self.pitch_target_wind: float | None = None
         if self._law is not None:
             self._law.reset()
         if self._notch is not None:
@@ -1468,6 +1485,9 @@ class ScheduledMPC(ControllerBase):
         there (so that a rotor slower than the trim is never asked to hold the trim's power,
         which is how a power-tracking MPC stalls the rotor in a lull)."""
         z, u = self.trim_at(self.target_wind)          # type: ignore[arg-type]
+        if self.pitch_target_wind != self.target_wind:
+            u = u.copy()
+            u[:3] = self.trim_at(self.pitch_target_wind)[1][:3]   # type: ignore[arg-type]
         if self._law is None:
             return z, u
         w = float(meas["gen_speed"])
@@ -1520,12 +1540,14 @@ class ScheduledMPC(ControllerBase):
         """
         k, ctl = self.schedule.acting(meas, self.controller)
         if self.target_tau is not None:
-            w = float(self.schedule.measured)        # type: ignore[arg-type]
+            w = float(self.schedule.floored)         # type: ignore[arg-type]
+            wp = float(self.schedule.measured)       # type: ignore[arg-type]
             if self.target_wind is None:
-                self.target_wind = w
+                self.target_wind, self.pitch_target_wind = w, wp
             else:
                 a = 1.0 if self.target_tau == 0 else min(1.0, self.dt / self.target_tau)
                 self.target_wind += a * (w - self.target_wind)
+                self.pitch_target_wind += a * (wp - self.pitch_target_wind)  # type: ignore
             ctl.set_target(*self._target(meas))
         u = ctl.step(t, meas)
         if self._notch is not None:
@@ -1539,6 +1561,9 @@ class ScheduledMPC(ControllerBase):
         self.signals = dict(ctl.signals, schedule_wind=float(self.schedule.wind or math.nan),
                             schedule_grid_wind=float(self.family.wind_mps[k]),
                             target_wind=float(self.target_wind or math.nan),
+                            schedule_floor=float(self.schedule.floored is not None
+                                                 and self.schedule.floored
+                                                 > self.schedule.measured),
                             schedule_outside=float(self.schedule.outside),
                             estimator_outside=float(self.schedule.estimator_outside))
         return u

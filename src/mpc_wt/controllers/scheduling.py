@@ -6,6 +6,18 @@ pitch and generator torque) or, for a controller with a LIDAR, the rotor mean of
 own measurements; either one is low-passed (first order, ``time_constant``) so that the
 schedule follows the mean wind, not the gusts. At the first step the schedule starts at the
 grid wind nearest the first estimate: nothing of the case is known before it.
+
+Near rated wind the aerodynamic torque is flat in pitch: the power coefficient has its maximum
+at fine pitch, so a linearization at the rated trim (pitch at fine) sees almost no pitch
+sensitivity (the NREL 5-MW's rotor-speed response to collective pitch is 0.068 1/s per rad at
+rated wind against 0.44 at 12 m/s, where the trim pitch is 3.9 deg), and a design made on it
+commands large pitch moves whose effect the plant multiplies once the blades leave fine pitch.
+Which design fits is told by the pitch the turbine is at, not only by the wind: a
+:class:`RegionFloor` raises the scheduling wind to what the measured collective pitch says
+(the trim's pitch curve read backwards) and, while the rotor runs above rated speed, to the
+first design inside region 3; and :func:`envelope_winds` can put that first design where the
+trim has left fine pitch (``region3_pitch``) instead of at rated wind. The same idea is the
+baseline's gain schedule on the measured pitch (Jonkman et al. 2009, sec. 7.4).
 """
 from __future__ import annotations
 
@@ -19,15 +31,58 @@ import linearize
 from linearize.validate import check_number
 from mpc_wt.controllers.wind_estimator import WindEstimatorSettings, WindSpeedEstimator
 
-__all__ = ["WindSchedule", "envelope_winds", "SCHEDULE_SOURCES"]
+__all__ = ["WindSchedule", "RegionFloor", "envelope_winds", "region3_wind", "SCHEDULE_SOURCES"]
 
 #: Where a schedule's wind comes from.
 SCHEDULE_SOURCES = ("estimator", "preview")
 
 
-def envelope_winds(turbine: linearize.Turbine, step: float = 1.0) -> np.ndarray:
+def region3_wind(turbine: linearize.Turbine, pitch_rad: float, *,
+                 config: linearize.PlantConfig | None = None) -> float:
+    """The wind above rated at which the trim's collective pitch reaches ``pitch_rad`` above
+    fine pitch (bisection on :func:`linearize.trim`).
+
+    Parameters
+    ----------
+    turbine : Turbine
+    pitch_rad : float
+        Pitch above fine pitch [rad], > 0, below the trim's pitch at cut-out.
+    config : PlantConfig, optional
+        The plant configuration of the trim (the designs').
+
+    Returns
+    -------
+    float
+        [m/s], rounded to 0.01 m/s.
+
+    Raises
+    ------
+    ValueError
+        If ``pitch_rad`` is not positive or the trim does not reach it by cut-out wind.
+    """
+    check_number("pitch_rad", pitch_rad, lo=0.0, lo_open=True, unit="rad")
+    fine = turbine.operation.fine_pitch_rad
+
+    def excess(v: float) -> float:
+        return linearize.trim(turbine, v, config=config).pitch_rad - fine - pitch_rad
+
+    lo, hi = linearize.rated_wind_speed(turbine, config=config), turbine.operation.cut_out_wind
+    if excess(hi) <= 0.0:
+        raise ValueError(f"pitch_rad = {pitch_rad:g} rad: the trim's pitch at cut-out "
+                         f"({hi:g} m/s) does not reach it")
+    from scipy.optimize import brentq
+
+    return round(float(brentq(excess, lo, hi, xtol=1e-3)), 2)
+
+
+def envelope_winds(turbine: linearize.Turbine, step: float = 1.0, *,
+                   region3_pitch: float | None = None,
+                   config: linearize.PlantConfig | None = None) -> np.ndarray:
     """The grid of a design over the whole operating envelope: cut-in to cut-out every
-    ``step``, with the rated wind speed added (where the regions meet).
+    ``step``, with the rated wind speed added (where the regions meet) or, with
+    ``region3_pitch``, the wind where the trim's pitch has left fine pitch by that much
+    (:func:`region3_wind`) in its place: the first design above rated then sees the pitch
+    sensitivity of the pitch moves it will make, not the flat torque of fine pitch.
 
     Parameters
     ----------
@@ -35,6 +90,10 @@ def envelope_winds(turbine: linearize.Turbine, step: float = 1.0) -> np.ndarray:
         Its operating range and rated wind.
     step : float
         Grid spacing [m/s], > 0.
+    region3_pitch : float, optional
+        Pitch above fine pitch of the first design above rated [rad], > 0.
+    config : PlantConfig, optional
+        The designs' plant configuration (for ``region3_pitch``'s trim).
 
     Returns
     -------
@@ -45,9 +104,120 @@ def envelope_winds(turbine: linearize.Turbine, step: float = 1.0) -> np.ndarray:
     op = turbine.operation
     grid = np.arange(op.cut_in_wind, op.cut_out_wind + 1e-9, step)
     rated = linearize.rated_wind_speed(turbine)
-    if op.cut_in_wind < rated < op.cut_out_wind and np.min(np.abs(grid - rated)) > 0.05:
+    if not op.cut_in_wind < rated < op.cut_out_wind:
+        return grid
+    if region3_pitch is not None:
+        v3 = region3_wind(turbine, region3_pitch, config=config)
+        grid = grid[(grid <= rated) | (grid >= v3 + 0.05)]     # none between rated and v3
+        return np.sort(np.append(grid[np.abs(grid - v3) > 0.05], v3))
+    if np.min(np.abs(grid - rated)) > 0.05:
         grid = np.sort(np.append(grid, round(rated, 2)))
     return grid
+
+
+class RegionFloor:
+    """The least design wind that the measured operating region allows: above rated the
+    trim's collective pitch rises with the wind, so a measured collective pitch above fine
+    pitch says the turbine is at least at the wind whose trim has that pitch (the pitch curve
+    read backwards), and a rotor above rated speed says it is past rated wind however the
+    wind estimate lags. :class:`WindSchedule` takes the larger of its scheduling wind and this
+    floor before its low-pass.
+
+    Parameters
+    ----------
+    winds, pitches : (n,) array
+        The trim's pitch curve above rated: winds [m/s] and collective pitches [rad], both
+        increasing (e.g. a design family's grid points above rated, :meth:`from_family`).
+    pitch_threshold : float
+        A measured collective pitch above this [rad] counts (fine pitch + a margin).
+    rated_speed : float
+        Rated rotor speed [rad/s].
+    speed_margin : float
+        A rotor speed above ``speed_margin`` x rated counts [-], >= 1 (default 1.01).
+    region3_wind : float, optional
+        The floor while the rotor runs above rated speed [m/s] (default ``winds[0]``).
+    """
+
+    def __init__(self, winds: Any, pitches: Any, pitch_threshold: float, rated_speed: float,
+                 speed_margin: float = 1.01, region3_wind: float | None = None) -> None:
+        w, p = np.asarray(winds, dtype=float), np.asarray(pitches, dtype=float)
+        if w.ndim != 1 or w.size < 1 or w.shape != p.shape or not np.all(np.isfinite(w)) \
+                or not np.all(np.isfinite(p)) or np.any(np.diff(w) <= 0) \
+                or np.any(np.diff(p) <= 0):
+            raise ValueError(f"winds and pitches must be increasing finite arrays of one shape, "
+                             f"got {winds!r} and {pitches!r}")
+        self.winds, self.pitches = w, p
+        self.pitch_threshold = check_number("pitch_threshold", pitch_threshold, unit="rad")
+        self.rated_speed = check_number("rated_speed", rated_speed, lo=0.0, lo_open=True,
+                                        unit="rad/s")
+        self.speed_margin = check_number("speed_margin", speed_margin, lo=1.0)
+        self.region3_wind = float(w[0]) if region3_wind is None else check_number(
+            "region3_wind", region3_wind, lo=0.0, lo_open=True, unit="m/s")
+
+    #: the default margin above fine pitch [rad] (0.3 deg: above the pitch's noise at fine)
+    PITCH_MARGIN = math.radians(0.3)
+
+    @classmethod
+    def from_family(cls, family: Any, turbine: linearize.Turbine,
+                    pitch_margin: float | None = None, speed_margin: float = 1.01
+                    ) -> "RegionFloor":
+        """The floor of a design family: its grid winds above rated wind and their trims'
+        collective pitch.
+
+        Parameters
+        ----------
+        family : LinearModelFamily
+        turbine : Turbine
+            Fine pitch, rated wind and rotor speed.
+        pitch_margin : float, optional
+            Above fine pitch [rad] (default :attr:`PITCH_MARGIN`).
+        speed_margin : float
+            Above rated rotor speed [-] (default 1.01).
+
+        Returns
+        -------
+        RegionFloor
+
+        Raises
+        ------
+        ValueError
+            If the family has no design above rated wind.
+        """
+        rated = linearize.rated_wind_speed(turbine)
+        winds = np.asarray(family.wind_mps, dtype=float)
+        pitch = np.array([float(np.mean(m.u0[:3])) for m in family.models])
+        keep = winds > rated + 0.01
+        if not np.any(keep):
+            raise ValueError(f"the family's winds {winds.tolist()} have none above rated "
+                             f"({rated:.3g} m/s): no region floor")
+        w, p = winds[keep], pitch[keep]
+        mono = np.concatenate([[True], np.diff(p) > 0])         # the rising part of the curve
+        w, p = w[np.cumprod(mono).astype(bool)], p[np.cumprod(mono).astype(bool)]
+        margin = cls.PITCH_MARGIN if pitch_margin is None else pitch_margin
+        return cls(w, p, turbine.operation.fine_pitch_rad + margin,
+                   turbine.operation.rated_rotor_speed_rad_s, speed_margin)
+
+    def floor(self, pitch: float, rotor_speed: float) -> float:
+        """The floor [m/s] at a measured collective pitch [rad] and rotor speed [rad/s]; -inf
+        when neither says region 3.
+
+        Parameters
+        ----------
+        pitch : float
+            Mean of the three measured pitches [rad].
+        rotor_speed : float
+            [rad/s]
+
+        Returns
+        -------
+        float
+        """
+        f = -math.inf
+        if pitch > self.pitch_threshold:
+            f = float(np.interp(pitch, self.pitches, self.winds))
+        if rotor_speed > self.speed_margin * self.rated_speed:
+            f = max(f, self.region3_wind)
+        return f
 
 
 class WindSchedule:
@@ -71,12 +241,17 @@ class WindSchedule:
         Beyond the midpoint between grid winds before a switch [m/s] (default 0.25).
     estimator : WindSpeedEstimator or WindEstimatorSettings, optional
         The wind estimator (at ``dt``), or its tuning.
+    floor : RegionFloor, optional
+        The least wind the measured pitch and rotor speed allow (default none): the
+        scheduling wind is the larger of the two before the low-pass; :attr:`measured` stays
+        the wind itself, :attr:`floored` is the larger.
     """
 
     def __init__(self, grid: Any, turbine: linearize.Turbine, dt: float, *,
                  source: str = "estimator", time_constant: float = 30.0,
                  hysteresis: float = 0.25,
-                 estimator: WindSpeedEstimator | WindEstimatorSettings | None = None) -> None:
+                 estimator: WindSpeedEstimator | WindEstimatorSettings | None = None,
+                 floor: RegionFloor | None = None) -> None:
         g = np.asarray(grid, dtype=float)
         if g.ndim != 1 or g.size < 1 or not np.all(np.isfinite(g)) or np.any(np.diff(g) <= 0):
             raise ValueError(f"grid must be increasing finite mean winds [m/s], got {grid!r}")
@@ -94,6 +269,7 @@ class WindSchedule:
             self.estimator = estimator
         else:
             self.estimator = WindSpeedEstimator(turbine, dt, estimator)
+        self.floor = floor
         self.reset()
 
     def reset(self) -> None:
@@ -101,6 +277,7 @@ class WindSchedule:
         self.estimator.reset()
         self.wind: float | None = None
         self.measured: float | None = None      # this step's wind before the low-pass
+        self.floored: float | None = None       # the same, raised to the region floor
         self.active: int | None = None
         self.switches = 0
         self._from_estimator = False
@@ -159,6 +336,11 @@ class WindSchedule:
         if not math.isfinite(w):
             raise ValueError(f"scheduling wind is not finite ({w!r})")
         self.measured = w
+        if self.floor is not None:
+            p = meas["pitch"]
+            w = max(w, self.floor.floor((float(p[0]) + float(p[1]) + float(p[2])) / 3.0,
+                                        float(meas["rotor_speed"])))
+        self.floored = w
         if self.wind is None:
             self.wind = w
             self.active = bisect.bisect_left(self._mid, w)      # the nearest grid wind

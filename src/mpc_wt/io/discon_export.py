@@ -427,6 +427,7 @@ def _mpc_entries(ctl: Any, preview: Any = None) -> list[tuple[str, Any, str]]:
         ("schedule.time_constant_hysteresis", np.array([sched.tau, sched.hyst], float),
          "low-pass of the scheduling wind [s], hysteresis [m/s]"),
         *_windest_entries(sched.estimator, "schedule.windest."),
+        *_floor_entries(sched.floor, "schedule."),
         ("trim_z", np.asarray(ctl._z_trim, float).ravel(), "the trim's outputs over the grid"),
         ("trim_u", np.asarray(ctl._u_trim, float).ravel(), "the trim's inputs over the grid"),
     ]
@@ -452,6 +453,22 @@ def _mpc_entries(ctl: Any, preview: Any = None) -> list[tuple[str, Any, str]]:
     for k, m in enumerate(pts):
         rows += _mpc_point(m, k, signals)
     return rows
+
+
+def _floor_entries(floor: Any, pre: str) -> list[tuple[str, Any, str]]:
+    """A schedule's region floor (:class:`~mpc_wt.controllers.scheduling.RegionFloor`)."""
+    if floor is None:
+        return [(pre + "region_floor", 0.0, "0: the designs chosen by the measured wind alone")]
+    return [(pre + "region_floor", 1.0, "1: at least the design the measured pitch and rotor "
+                                        "speed tell"),
+            (pre + "floor_winds", np.asarray(floor.winds, float),
+             "the trim's pitch curve above rated: winds [m/s]"),
+            (pre + "floor_pitches", np.asarray(floor.pitches, float),
+             "... and their collective pitch [rad]"),
+            (pre + "floor_limits", np.array([floor.pitch_threshold,
+                                             floor.speed_margin * floor.rated_speed,
+                                             floor.region3_wind], float),
+             "a pitch above [rad], a rotor speed above [rad/s], the design wind then [m/s]")]
 
 
 def _signal_codes(signals: Sequence[str], who: str) -> np.ndarray:

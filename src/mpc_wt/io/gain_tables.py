@@ -374,7 +374,9 @@ def mpc_table(turbine: linearize.Turbine, ctl: Any, kind: str,
     """A scheduled MPC's design as a table: one row per grid wind with the trim the cost
     tracks there (pitch, torque, rotor speed, power) and its Kalman filter's spectral radius;
     the settings hold the kind's options (from which the design is built again), the MPC's
-    horizon and period, and the notch on its torque command (centre, None: none; Q).
+    horizon and period, the notch on its torque command (centre, None: none; Q), and its
+    region floor (the pitch above which and the rotor speed above which the measurements
+    choose a design inside region 3, and that design's wind; None: none).
 
     Parameters
     ----------
@@ -405,8 +407,14 @@ def mpc_table(turbine: linearize.Turbine, ctl: Any, kind: str,
                 "control_horizon": st.hu, "schedule_time_constant": ctl.schedule.tau,
                 "target_time_constant": ctl.target_tau,
                 "torque_notch_hz": ctl.torque_notch_hz, "torque_notch_q": ctl.torque_notch_q,
+                "region_floor": None if ctl.region_floor is None else {
+                    "pitch_above": ctl.region_floor.pitch_threshold,
+                    "rotor_speed_above": ctl.region_floor.speed_margin
+                    * ctl.region_floor.rated_speed,
+                    "region3_wind": ctl.region_floor.region3_wind},
                 "units": {"dt": "s", "schedule_time_constant": "s",
-                          "target_time_constant": "s", "torque_notch_hz": "Hz"}}
+                          "target_time_constant": "s", "torque_notch_hz": "Hz",
+                          "region_floor": "rad, rad/s, m/s"}}
     return _doc(kind, turbine, settings,
                 ["wind_speed", "pitch", "gen_torque", "rotor_speed", "gen_power",
                  "estimator_spectral_radius"], ["m/s", "rad", "N m", "rad/s", "W", "-"], rows,

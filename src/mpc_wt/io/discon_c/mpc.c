@@ -70,13 +70,13 @@ typedef struct {
     int n, collective, nzo, ip, has_law;
     mw_preview pv;
     double dt, target_tau, eff, qp_budget_ms;
-    double *trim_z, *trim_u, *zt, ut[4];
+    double *trim_z, *trim_u, *zt, *zp, ut[4];
     int *signals, n_signals;
     double *y;
     mw_point *pt;
     mw_schedule sched;
     mw_torque_law law;
-    double target_wind;
+    double target_wind, pitch_target_wind;
     int target_started;
     int has_notch;                /* the notch on the torque command, its largest rate */
     mw_sos notch;
@@ -537,7 +537,7 @@ static int mpc_step(mw_ctrl *self, const mw_meas *m, mw_cmd *out, char *msg)
         if (preview_step(&c->pv, m, msg)) return -1;
         k = mw_schedule_update_wind(&c->sched,
                                     (c->pv.blade[0] + c->pv.blade[1] + c->pv.blade[2]) / 3.0,
-                                    &switched);
+                                    m, &switched);
     } else {
         k = mw_schedule_update(&c->sched, m, &switched);
     }
@@ -546,15 +546,23 @@ static int mpc_step(mw_ctrl *self, const mw_meas *m, mw_cmd *out, char *msg)
         hand_over(&c->pt[k], &c->pt[before]);
     }
     if (c->target_tau >= 0.0) {
-        double w = c->sched.measured;
+        /* speed, power and torque from the floored wind, the pitch from the wind itself */
+        double w = c->sched.floored, wp = c->sched.measured;
         if (!c->target_started) {
             c->target_wind = w;
+            c->pitch_target_wind = wp;
             c->target_started = 1;
         } else {
             double a = c->target_tau == 0.0 ? 1.0 : dmin(1.0, c->dt / c->target_tau);
             c->target_wind += a * (w - c->target_wind);
+            c->pitch_target_wind += a * (wp - c->pitch_target_wind);
         }
         trim_at(c, c->target_wind, c->zt, c->ut);
+        if (c->pitch_target_wind != c->target_wind) {
+            double up[4];
+            trim_at(c, c->pitch_target_wind, c->zp, up);
+            for (i = 0; i < 3; i++) c->ut[i] = up[i];
+        }
         if (c->has_law) {
             double w_g = m->gen_speed, pitch = (m->pitch[0] + m->pitch[1] + m->pitch[2]) / 3.0;
             double q = mw_torque_law_step(&c->law, w_g, pitch, c->law.law.p_rated);
@@ -591,6 +599,7 @@ static void mpc_destroy(mw_ctrl *self)
     free(c->trim_z);
     free(c->trim_u);
     free(c->zt);
+    free(c->zp);
     free(c->signals);
     free(c->y);
     free(c->pv.t);
@@ -651,8 +660,9 @@ static int mpc_read(const mw_input *in, mw_ctrl *self, char *msg)
         || !(c->trim_u = mw_getp_alloc_n(in, "", "trim_u", c->n * 4, msg)))
         return -1;
     c->zt = (double *)calloc((size_t)c->nzo, sizeof(double));
+    c->zp = (double *)calloc((size_t)c->nzo, sizeof(double));
     c->pt = (mw_point *)calloc((size_t)c->n, sizeof(mw_point));
-    if (!c->zt || !c->pt) {
+    if (!c->zt || !c->zp || !c->pt) {
         mw_msg(msg, "mpc-wt mpc: out of memory");
         return -1;
     }

@@ -175,9 +175,14 @@ typedef struct {
     double *grid, *mid;
     int n;
     double dt, tau, hyst;
-    double wind, measured;
+    double wind, measured, floored;
     int active, started;
     mw_windest est;
+    /* the region floor: the trim's pitch curve above rated (winds, pitches), the pitch above
+       which it counts [rad], the rotor speed above which it counts [rad/s] and the design
+       wind then [m/s] */
+    int has_floor, n_floor;
+    double *floor_w, *floor_p, floor_pitch, floor_speed, floor_wind3;
 } mw_schedule;
 int mw_schedule_read(const mw_input *in, const char *prefix, double dt, mw_schedule *s,
                      char *msg);
@@ -185,8 +190,8 @@ void mw_schedule_free(mw_schedule *s);
 void mw_schedule_reset(mw_schedule *s);
 /* this step's active index; *switched = 1 on a switch */
 int mw_schedule_update(mw_schedule *s, const mw_meas *m, int *switched);
-/* the same with a wind measured otherwise (the LIDAR's rotor mean) */
-int mw_schedule_update_wind(mw_schedule *s, double wind, int *switched);
+/* the same with a wind measured otherwise (the LIDAR's rotor mean); m for the region floor */
+int mw_schedule_update_wind(mw_schedule *s, double wind, const mw_meas *m, int *switched);
 
 /* a steady-state Kalman filter on a linear model with the winds as random walks */
 typedef struct {

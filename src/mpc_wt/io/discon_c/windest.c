@@ -250,6 +250,47 @@ double mw_windest_step(mw_windest *e, double rotor_speed, double pitch, double g
 }
 
 /* ---- the schedule ------------------------------------------------------------------- */
+static int schedule_floor_read(const mw_input *in, const char *pre, mw_schedule *s, char *msg)
+{
+    double v[3];
+    int i;
+    s->floor_w = mw_getp_alloc(in, pre, "floor_winds", &s->n_floor, msg);
+    if (!s->floor_w) return -1;
+    s->floor_p = mw_getp_alloc_n(in, pre, "floor_pitches", s->n_floor, msg);
+    if (!s->floor_p || mw_getp_vec(in, pre, "floor_limits", v, 3, msg)) return -1;
+    for (i = 1; i < s->n_floor; i++) {
+        if (!(s->floor_w[i] > s->floor_w[i - 1] && s->floor_p[i] > s->floor_p[i - 1])) {
+            mw_msg(msg, "mpc-wt controller: input file '%s': keys '%sfloor_winds' and "
+                   "'%sfloor_pitches' must both increase (value %d)", in->path, pre, pre, i + 1);
+            return -1;
+        }
+    }
+    s->floor_pitch = v[0];
+    s->floor_speed = v[1];
+    s->floor_wind3 = v[2];
+    return 0;
+}
+
+/* the least design wind the measured collective pitch and rotor speed allow (-inf: none) */
+static double schedule_floor(const mw_schedule *s, double pitch, double rotor_speed)
+{
+    double f = -HUGE_VAL;
+    if (pitch > s->floor_pitch) {
+        int n = s->n_floor, i = 0;
+        if (pitch <= s->floor_p[0]) {
+            f = s->floor_w[0];
+        } else if (pitch >= s->floor_p[n - 1]) {
+            f = s->floor_w[n - 1];
+        } else {                                           /* numpy.interp */
+            while (s->floor_p[i + 1] < pitch) i++;
+            f = s->floor_w[i] + (pitch - s->floor_p[i]) / (s->floor_p[i + 1] - s->floor_p[i])
+                * (s->floor_w[i + 1] - s->floor_w[i]);
+        }
+    }
+    if (rotor_speed > s->floor_speed) f = dmax(f, s->floor_wind3);
+    return f;
+}
+
 int mw_schedule_read(const mw_input *in, const char *pre, double dt, mw_schedule *s, char *msg)
 {
     char sub[64];
@@ -282,6 +323,12 @@ int mw_schedule_read(const mw_input *in, const char *pre, double dt, mw_schedule
         mw_schedule_free(s);
         return -1;
     }
+    snprintf(sub, sizeof(sub), "%sregion_floor", pre);
+    if (mw_has(in, sub) && (mw_getp_int(in, pre, "region_floor", 0, 1, &s->has_floor, msg)
+                            || (s->has_floor && schedule_floor_read(in, pre, s, msg)))) {
+        mw_schedule_free(s);
+        return -1;
+    }
     mw_schedule_reset(s);
     return 0;
 }
@@ -290,7 +337,9 @@ void mw_schedule_free(mw_schedule *s)
 {
     free(s->grid);
     free(s->mid);
-    s->grid = s->mid = NULL;
+    free(s->floor_w);
+    free(s->floor_p);
+    s->grid = s->mid = s->floor_w = s->floor_p = NULL;
     mw_windest_free(&s->est);
 }
 
@@ -319,15 +368,19 @@ int mw_schedule_update(mw_schedule *s, const mw_meas *m, int *switched)
 {
     double pitch = (m->pitch[0] + m->pitch[1] + m->pitch[2]) / 3.0;
     return mw_schedule_update_wind(s, mw_windest_step(&s->est, m->rotor_speed, pitch,
-                                                      m->gen_torque), switched);
+                                                      m->gen_torque), m, switched);
 }
 
-int mw_schedule_update_wind(mw_schedule *s, double w, int *switched)
+int mw_schedule_update_wind(mw_schedule *s, double w, const mw_meas *m, int *switched)
 {
     double a;
     int k, now;
     *switched = 0;
     s->measured = w;
+    if (s->has_floor && m)
+        w = dmax(w, schedule_floor(s, (m->pitch[0] + m->pitch[1] + m->pitch[2]) / 3.0,
+                                   m->rotor_speed));
+    s->floored = w;
     if (!s->started) {
         s->wind = w;
         s->active = bisect_left(s->mid, s->n - 1, w);
