@@ -136,10 +136,18 @@ class RegionFloor:
         A rotor speed above ``speed_margin`` x rated counts [-], >= 1 (default 1.01).
     region3_wind : float, optional
         The floor while the rotor runs above rated speed [m/s] (default ``winds[0]``).
+    pitch_min_speed : float
+        The pitch counts only while the rotor runs above this fraction of rated speed [-]
+        (default 0.95): in region 3 the rotor is held near rated speed, while a pitched rotor
+        far below it is in a lull or a direction change (an extreme coherent gust with
+        direction change at 9.4 m/s let a region-3 design brake the rotor to a stop), or,
+        on rotors whose trim pitches below rated (the IEA-15 at 3-7 m/s, 0.66 x rated), in
+        region 1.5.
     """
 
     def __init__(self, winds: Any, pitches: Any, pitch_threshold: float, rated_speed: float,
-                 speed_margin: float = 1.01, region3_wind: float | None = None) -> None:
+                 speed_margin: float = 1.01, region3_wind: float | None = None,
+                 pitch_min_speed: float = 0.95) -> None:
         w, p = np.asarray(winds, dtype=float), np.asarray(pitches, dtype=float)
         if w.ndim != 1 or w.size < 1 or w.shape != p.shape or not np.all(np.isfinite(w)) \
                 or not np.all(np.isfinite(p)) or np.any(np.diff(w) <= 0) \
@@ -153,6 +161,8 @@ class RegionFloor:
         self.speed_margin = check_number("speed_margin", speed_margin, lo=1.0)
         self.region3_wind = float(w[0]) if region3_wind is None else check_number(
             "region3_wind", region3_wind, lo=0.0, lo_open=True, unit="m/s")
+        self.pitch_min_speed = check_number("pitch_min_speed", pitch_min_speed, lo=0.0,
+                                            hi=self.speed_margin)
 
     #: the default margin above fine pitch [rad] (0.3 deg: above the pitch's noise at fine)
     PITCH_MARGIN = math.radians(0.3)
@@ -199,7 +209,7 @@ class RegionFloor:
 
     def floor(self, pitch: float, rotor_speed: float) -> float:
         """The floor [m/s] at a measured collective pitch [rad] and rotor speed [rad/s]; -inf
-        when neither says region 3.
+        when neither says region 3 (the pitch counts above ``pitch_min_speed`` x rated speed).
 
         Parameters
         ----------
@@ -213,7 +223,7 @@ class RegionFloor:
         float
         """
         f = -math.inf
-        if pitch > self.pitch_threshold:
+        if pitch > self.pitch_threshold and rotor_speed > self.pitch_min_speed * self.rated_speed:
             f = float(np.interp(pitch, self.pitches, self.winds))
         if rotor_speed > self.speed_margin * self.rated_speed:
             f = max(f, self.region3_wind)

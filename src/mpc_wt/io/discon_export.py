@@ -466,9 +466,11 @@ def _floor_entries(floor: Any, pre: str) -> list[tuple[str, Any, str]]:
             (pre + "floor_pitches", np.asarray(floor.pitches, float),
              "... and their collective pitch [rad]"),
             (pre + "floor_limits", np.array([floor.pitch_threshold,
+                                             floor.pitch_min_speed * floor.rated_speed,
                                              floor.speed_margin * floor.rated_speed,
                                              floor.region3_wind], float),
-             "a pitch above [rad], a rotor speed above [rad/s], the design wind then [m/s]")]
+             "a pitch above [rad] with the rotor above [rad/s]; a rotor speed above [rad/s] "
+             "and the design wind then [m/s]")]
 
 
 def _signal_codes(signals: Sequence[str], who: str) -> np.ndarray:

@@ -409,6 +409,8 @@ def mpc_table(turbine: linearize.Turbine, ctl: Any, kind: str,
                 "torque_notch_hz": ctl.torque_notch_hz, "torque_notch_q": ctl.torque_notch_q,
                 "region_floor": None if ctl.region_floor is None else {
                     "pitch_above": ctl.region_floor.pitch_threshold,
+                    "pitch_counts_above_rotor_speed": ctl.region_floor.pitch_min_speed
+                    * ctl.region_floor.rated_speed,
                     "rotor_speed_above": ctl.region_floor.speed_margin
                     * ctl.region_floor.rated_speed,
                     "region3_wind": ctl.region_floor.region3_wind},

@@ -88,6 +88,21 @@ def test_an_extreme_gust_at_rated_wind_keeps_the_rotor_below_1p2_rated(turbine) 
     assert peak < 1.2, f"rotor speed peaked at {peak:.3f} x rated"
 
 
+@pytest.mark.parametrize("sign", [1, -1])
+def test_a_gust_with_direction_change_below_rated_does_not_stall_the_rotor(turbine,
+                                                                            sign) -> None:
+    """IEC ECD at 9.4 m/s (class I, both directions) with the sign-off's LIDAR: the rotor keeps
+    turning (measured lowest 0.78 rad/s, 0.62 x rated). The direction change cuts the wind
+    the rotor and the LIDAR see; a region floor that read the pitch whatever the rotor speed
+    kept a region-3 design acting and braked the rotor to a stop 35 s after the gust."""
+    opts = {"lidar": {"evolution": True, "focus_distance": 54.0, "los_error": True,
+                      "range_weighting": True}}
+    res = run_controller(turbine, "mpc-lidar", Scenario(
+        9.4, "A", 0, 120.0, condition="ecd", iec_class="I", event_at=70.0,
+        shear_exponent=0.2, sign=sign), options=opts)
+    assert res.channel("rotor_speed").min() > 0.5 * turbine.operation.rated_rotor_speed_rad_s
+
+
 def test_a_failed_qp_takes_the_logged_fallback_and_the_run_goes_on(turbine, monkeypatch,
                                                                    caplog) -> None:
     """Every QP from 10 s to 11 s fails (forced): the MPC applies the rest of its last plan,
@@ -171,15 +186,16 @@ def test_the_torque_bound_and_the_torque_rate_weight_act(turbine, tmp_path) -> N
     """The 10-14 m/s step of the test above, three designs. With ``torque_limit: 1.0`` no
     torque command exceeds the rated torque, 5 MW / (0.944 x 122.91 rad/s) = 43.09 kN m by
     hand (without it the command reaches the generator's 47.4 kN m maximum). A torque-rate
-    weight of 10 (a 4 kN m move per step weighs as much as the scaled power error) moves the
-    torque less in total than none (measured 0.89 of it: the torque law's target, not the
-    rate, sets most of the torque's path)."""
+    weight of 10 in every design (a 4 kN m move per step weighs as much as the scaled power
+    error) moves the torque less in total than none in any (measured 0.89 of it: the torque
+    law's target, not the rate, sets most of the torque's path)."""
     t = np.arange(0.0, 200.0, 0.05)
     wind = np.where((t >= 60.0) & (t < 120.0), 14.0, 10.0)
     path = _uniform_file(tmp_path / "step.npz", turbine, t, wind)
     sc = Scenario(wind_file=path, duration=180.0, shear_exponent=0.0)
     travel, peak = {}, {}
-    for name, opts in (("free", {}), ("bound", {"torque_limit": 1.0}),
+    none = {"below_rated_weights": {"gen_torque_ref_rate": 0.0}}   # no rate weight anywhere
+    for name, opts in (("free", none), ("bound", {**none, "torque_limit": 1.0}),
                        ("rate", {"weights": {"gen_torque_ref_rate": 10.0}})):
         res = run_controller(turbine, "mpc", sc, options=opts)
         q = res.channel("gen_torque_ref")[res.t >= 5.0]
@@ -192,7 +208,8 @@ def test_the_torque_bound_and_the_torque_rate_weight_act(turbine, tmp_path) -> N
 def test_below_rated_designs_take_their_own_weights_and_limit(turbine) -> None:
     """``below_rated_weights`` and ``below_rated_speed_limit`` set the designs at grid winds
     below rated (11.40 m/s for the NREL 5-MW) and leave those above as ``weights`` and
-    ``speed_limit`` say; the rate weights land in the cost's rate terms."""
+    ``speed_limit`` say; the rate weights land in the cost's rate terms (below rated the
+    designs' own torque-rate weight, 10, unless ``below_rated_weights`` sets one)."""
     opts = {"weights": {"rotor_speed": 0.5, "gen_torque_ref_rate": 0.2},
             "below_rated_weights": {"rotor_speed": 0.1, "gen_torque_ref": 2.0},
             "speed_limit": 1.08, "below_rated_speed_limit": 1.01}
@@ -205,7 +222,8 @@ def test_below_rated_designs_take_their_own_weights_and_limit(turbine) -> None:
         assert mpc.w.outputs["rotor_speed"] == (0.1 if below else 0.5)
         assert mpc.w.inputs["gen_torque_ref"] == (2.0 if below else 0.01)
         assert mpc.w.outputs["flap_moment"] == 0.0          # no preview: no cyclic pitch
-        assert mpc.w.rate["gen_torque_ref"] == 0.2
+        # BELOW_RATED_WEIGHTS's torque-rate weight below rated where below_rated_weights sets none
+        assert mpc.w.rate["gen_torque_ref"] == (10.0 if below else 0.2)
         assert mpc.max_rotor_speed == pytest.approx((1.01 if below else 1.08) * rated_speed)
 
 

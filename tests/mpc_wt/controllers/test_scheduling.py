@@ -55,6 +55,7 @@ def _floor() -> RegionFloor:
     (4.0, 1.0, 13.0),        # halfway up the curve: halfway between 12 and 14 m/s
     (10.0, 1.0, 14.0),       # beyond the curve: its last wind
     (4.0, 1.02, 13.0),       # both: the larger
+    (4.0, 0.94, -math.inf),  # pitched, the rotor below 0.95 x rated: a lull, no floor
 ])
 def test_the_floor_reads_the_pitch_curve_backwards(pitch_deg, speed, expected) -> None:
     assert _floor().floor(_D(pitch_deg), speed) == pytest.approx(expected)

@@ -179,10 +179,10 @@ typedef struct {
     int active, started;
     mw_windest est;
     /* the region floor: the trim's pitch curve above rated (winds, pitches), the pitch above
-       which it counts [rad], the rotor speed above which it counts [rad/s] and the design
-       wind then [m/s] */
+       which it counts [rad] while the rotor runs above floor_pitch_speed [rad/s], the rotor
+       speed above which the design wind is at least floor_wind3 [rad/s, m/s] */
     int has_floor, n_floor;
-    double *floor_w, *floor_p, floor_pitch, floor_speed, floor_wind3;
+    double *floor_w, *floor_p, floor_pitch, floor_pitch_speed, floor_speed, floor_wind3;
 } mw_schedule;
 int mw_schedule_read(const mw_input *in, const char *prefix, double dt, mw_schedule *s,
                      char *msg);

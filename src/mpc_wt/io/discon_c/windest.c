@@ -252,12 +252,12 @@ double mw_windest_step(mw_windest *e, double rotor_speed, double pitch, double g
 /* ---- the schedule ------------------------------------------------------------------- */
 static int schedule_floor_read(const mw_input *in, const char *pre, mw_schedule *s, char *msg)
 {
-    double v[3];
+    double v[4];
     int i;
     s->floor_w = mw_getp_alloc(in, pre, "floor_winds", &s->n_floor, msg);
     if (!s->floor_w) return -1;
     s->floor_p = mw_getp_alloc_n(in, pre, "floor_pitches", s->n_floor, msg);
-    if (!s->floor_p || mw_getp_vec(in, pre, "floor_limits", v, 3, msg)) return -1;
+    if (!s->floor_p || mw_getp_vec(in, pre, "floor_limits", v, 4, msg)) return -1;
     for (i = 1; i < s->n_floor; i++) {
         if (!(s->floor_w[i] > s->floor_w[i - 1] && s->floor_p[i] > s->floor_p[i - 1])) {
             mw_msg(msg, "mpc-wt controller: input file '%s': keys '%sfloor_winds' and "
@@ -266,8 +266,9 @@ static int schedule_floor_read(const mw_input *in, const char *pre, mw_schedule 
         }
     }
     s->floor_pitch = v[0];
-    s->floor_speed = v[1];
-    s->floor_wind3 = v[2];
+    s->floor_pitch_speed = v[1];
+    s->floor_speed = v[2];
+    s->floor_wind3 = v[3];
     return 0;
 }
 
@@ -275,7 +276,7 @@ static int schedule_floor_read(const mw_input *in, const char *pre, mw_schedule 
 static double schedule_floor(const mw_schedule *s, double pitch, double rotor_speed)
 {
     double f = -HUGE_VAL;
-    if (pitch > s->floor_pitch) {
+    if (pitch > s->floor_pitch && rotor_speed > s->floor_pitch_speed) {
         int n = s->n_floor, i = 0;
         if (pitch <= s->floor_p[0]) {
             f = s->floor_w[0];
