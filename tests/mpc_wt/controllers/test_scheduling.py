@@ -38,6 +38,7 @@ from hypothesis import given, settings, strategies as st  # noqa: E402
 
 import linearize  # noqa: E402
 from mpc_wt.controllers.scheduling import RegionFloor, envelope_winds, region3_wind  # noqa: E402
+from mpc_wt.controllers.wind_estimator import WindSpeedEstimator  # noqa: E402
 
 _D = math.radians
 
@@ -76,12 +77,23 @@ def test_a_floor_refuses_a_speed_margin_below_one() -> None:
         RegionFloor([12.0], [0.05], 0.005, 1.0, speed_margin=0.9)
 
 
+_ESTIMATORS: dict[int, WindSpeedEstimator] = {}
+
+
+def _estimator(turbine: linearize.Turbine) -> WindSpeedEstimator:
+    """One wind estimator per turbine object, made once: its C_P table takes seconds."""
+    if id(turbine) not in _ESTIMATORS:
+        _ESTIMATORS[id(turbine)] = WindSpeedEstimator(turbine, 0.1)
+    return _ESTIMATORS[id(turbine)]
+
+
 @settings(max_examples=200, deadline=None)
 @given(w=st.floats(2.0, 30.0), pitch=st.floats(-0.05, 0.5), speed=st.floats(0.5, 1.5))
 def test_the_floored_wind_is_never_below_the_measured_one(turbine, w, pitch, speed) -> None:
     """Property: the schedule's floored wind is the larger of its wind and the floor, and its
     measured wind stays the wind itself."""
-    s = WindSchedule([4.0, 12.0, 14.0, 25.0], turbine, 0.1, time_constant=0.0, floor=_floor())
+    s = WindSchedule([4.0, 12.0, 14.0, 25.0], turbine, 0.1, time_constant=0.0, floor=_floor(),
+                     estimator=_estimator(turbine))
     s.measured_wind = lambda meas: w
     s.update({"pitch": [pitch] * 3, "rotor_speed": speed})
     assert s.measured == w
