@@ -1402,7 +1402,6 @@ class ScheduledMPC(ControllerBase):
         elif region_floor is not None and not isinstance(region_floor, RegionFloor):
             raise ValueError(f"region_floor must be a RegionFloor, True, False or None, got "
                              f"{region_floor!r}")
-        self.region_floor: RegionFloor | None = region_floor
         self.schedule = WindSchedule(family.wind_mps, turbine, st.dt, source=wind_source,
                                      time_constant=time_constant, hysteresis=hysteresis,
                                      estimator=wind_estimator, floor=region_floor)
@@ -1455,6 +1454,11 @@ class ScheduledMPC(ControllerBase):
                 st = self.below_rated
             self._ctl[k] = MPC(self.family.models[k], self.turbine, st)
         return self._ctl[k]
+
+    @property
+    def region_floor(self) -> Any:
+        """The schedule's :class:`~mpc_wt.controllers.scheduling.RegionFloor` (None: none)."""
+        return self.schedule.floor
 
     @property
     def switches(self) -> int:

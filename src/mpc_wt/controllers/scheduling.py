@@ -201,8 +201,8 @@ class RegionFloor:
             raise ValueError(f"the family's winds {winds.tolist()} have none above rated "
                              f"({rated:.3g} m/s): no region floor")
         w, p = winds[keep], pitch[keep]
-        mono = np.concatenate([[True], np.diff(p) > 0])         # the rising part of the curve
-        w, p = w[np.cumprod(mono).astype(bool)], p[np.cumprod(mono).astype(bool)]
+        rising = np.cumprod(np.concatenate([[True], np.diff(p) > 0])).astype(bool)
+        w, p = w[rising], p[rising]                     # the rising part of the curve
         margin = cls.PITCH_MARGIN if pitch_margin is None else pitch_margin
         return cls(w, p, turbine.operation.fine_pitch_rad + margin,
                    turbine.operation.rated_rotor_speed_rad_s, speed_margin)

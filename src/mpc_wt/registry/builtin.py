@@ -541,13 +541,10 @@ def _envelope_family(ctx: BuildContext, config: str, step: float,
     from mpc_wt.controllers.scheduling import envelope_winds
 
     conf = {"madsen": linearize.PlantConfig.madsen, "do": linearize.PlantConfig.do}[config]
-    if region3_pitch_deg > 0.0:
-        grid = ctx.cache.get(ctx.turbine, ("envelope-grid", config, step, region3_pitch_deg),
-                             lambda: envelope_winds(ctx.turbine, step,
-                                                    region3_pitch=math.radians(region3_pitch_deg),
-                                                    config=conf()))
-    else:
-        grid = envelope_winds(ctx.turbine, step)
+    r3 = math.radians(region3_pitch_deg) if region3_pitch_deg > 0.0 else None
+    grid = ctx.cache.get(ctx.turbine, ("envelope-grid", config, step, r3),
+                         lambda: envelope_winds(ctx.turbine, step, region3_pitch=r3,
+                                                config=conf()))
     return ctx.cache.get(ctx.turbine, ("family", config, tuple(grid)),
                          lambda: linearize.linearize_family(ctx.turbine, grid, config=conf()))
 

@@ -70,7 +70,7 @@ typedef struct {
     int n, collective, nzo, ip, has_law;
     mw_preview pv;
     double dt, target_tau, eff, qp_budget_ms;
-    double *trim_z, *trim_u, *zt, *zp, ut[4];
+    double *trim_z, *trim_u, *zt, ut[4];
     int *signals, n_signals;
     double *y;
     mw_point *pt;
@@ -507,7 +507,7 @@ static void trim_at(const mw_mpc *c, double wind, double *z, double *u)
     int n = c->n, i = 0, j;
     double a;
     if (n == 1) {
-        memcpy(z, c->trim_z, (size_t)c->nzo * sizeof(double));
+        if (z) memcpy(z, c->trim_z, (size_t)c->nzo * sizeof(double));
         memcpy(u, c->trim_u, 4 * sizeof(double));
         return;
     }
@@ -516,7 +516,7 @@ static void trim_at(const mw_mpc *c, double wind, double *z, double *u)
     if (i < 0) i = 0;
     if (i > n - 2) i = n - 2;
     a = dmin(dmax((wind - g[i]) / (g[i + 1] - g[i]), 0.0), 1.0);
-    for (j = 0; j < c->nzo; j++)
+    for (j = 0; z && j < c->nzo; j++)              /* z NULL: the inputs only */
         z[j] = (1.0 - a) * c->trim_z[i * c->nzo + j] + a * c->trim_z[(i + 1) * c->nzo + j];
     for (j = 0; j < 4; j++)
         u[j] = (1.0 - a) * c->trim_u[i * 4 + j] + a * c->trim_u[(i + 1) * 4 + j];
@@ -560,7 +560,7 @@ static int mpc_step(mw_ctrl *self, const mw_meas *m, mw_cmd *out, char *msg)
         trim_at(c, c->target_wind, c->zt, c->ut);
         if (c->pitch_target_wind != c->target_wind) {
             double up[4];
-            trim_at(c, c->pitch_target_wind, c->zp, up);
+            trim_at(c, c->pitch_target_wind, NULL, up);
             for (i = 0; i < 3; i++) c->ut[i] = up[i];
         }
         if (c->has_law) {
@@ -599,7 +599,6 @@ static void mpc_destroy(mw_ctrl *self)
     free(c->trim_z);
     free(c->trim_u);
     free(c->zt);
-    free(c->zp);
     free(c->signals);
     free(c->y);
     free(c->pv.t);
@@ -660,9 +659,8 @@ static int mpc_read(const mw_input *in, mw_ctrl *self, char *msg)
         || !(c->trim_u = mw_getp_alloc_n(in, "", "trim_u", c->n * 4, msg)))
         return -1;
     c->zt = (double *)calloc((size_t)c->nzo, sizeof(double));
-    c->zp = (double *)calloc((size_t)c->nzo, sizeof(double));
     c->pt = (mw_point *)calloc((size_t)c->n, sizeof(mw_point));
-    if (!c->zt || !c->zp || !c->pt) {
+    if (!c->zt || !c->pt) {
         mw_msg(msg, "mpc-wt mpc: out of memory");
         return -1;
     }
