@@ -18,7 +18,7 @@ import math
 import os
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Mapping
+from typing import Any, Mapping, Sequence
 
 import numpy as np
 import yaml
@@ -61,9 +61,13 @@ DLC_DEFAULTS: dict[str, tuple[str, bool]] = {
     "2.4": ("N", True), "3.2": ("N", False), "3.3": ("N", False), "4.2": ("N", False),
     "5.1": ("N", False)}
 #: The supervisor's settings a spec may give (:class:`mpc_wt.controllers.supervisor.Supervisor`); the
-#: times are counted from the end of the case's transient.
+#: times are counted from the end of the case's transient. ``pitch_fault_azimuth_deg`` may be a
+#: list: the load case's seeds take its azimuths in turn.
 _SUPERVISOR_KEYS = {"overspeed", "shutdown_at", "grid_loss_at", "pitch_rate", "torque_ramp_s",
-                    "pitch_fault_at", "pitch_fault", "pitch_fault_blade", "fault_detect_s"}
+                    "pitch_fault_at", "pitch_fault", "pitch_fault_blade", "fault_detect_s",
+                    "pitch_fault_azimuth_deg"}
+#: The supervisor settings that may be given one per seed.
+_PER_SEED_KEYS = ("pitch_fault_azimuth_deg",)
 _REPORT_KEYS = {"paper", "notes", "psd_wind", "cs_wind", "sweep", "title"}
 
 
@@ -626,10 +630,10 @@ class CampaignSpec:
                   ) -> list[Case]:
         """The cases of one controller in one load case."""
         a = assess if lc.transient == self.transient else {**assess, "transient": lc.transient}
-        sup = ({k: (lc.transient + x if k.endswith("_at") else x)
-                for k, x in lc.supervisor.items()} if lc.supervisor else None)
+        sup_all = ({k: (lc.transient + x if k.endswith("_at") else x)
+                    for k, x in lc.supervisor.items()} if lc.supervisor else None)
         if lc.wind_files:
-            return self._file_cases(c, lc, a, sup)
+            return self._file_cases(c, lc, a, _seed_supervisor(sup_all, 0, (0,)))
         if lc.legacy:
             grid = [(t, v, s, 1) for t in c.turbulence or lc.turbulence
                     for v in c.winds or lc.winds for s in c.seeds or lc.seeds]
@@ -639,6 +643,7 @@ class CampaignSpec:
             grid = [(t, v, s, 1) for t in lc.turbulence for v in lc.winds for s in lc.seeds]
         out = []
         for turb, v, seed, sign in grid:
+            sup = _seed_supervisor(sup_all, seed, c.seeds or lc.seeds)
             sim = {"turbine": self.turbine_hash, "controller": c.controller,
                    "options": c.options, "wind_mps": v, "seed": seed, "turbulence": turb,
                    "duration": lc.duration + lc.transient,
@@ -830,6 +835,18 @@ def _keys_of(key: str, raw: Any, allowed: set[str]) -> None:
         raise _fail(f"{key}.{sorted(extra)[0]}", f"unknown key; allowed: {sorted(allowed)}")
 
 
+def _seed_supervisor(sup: dict[str, Any] | None, seed: int, seeds: Sequence[int]
+                     ) -> dict[str, Any] | None:
+    """A load case's supervisor settings for one of its seeds: a per-seed list
+    (:data:`_PER_SEED_KEYS`) gives the seed's entry, the seeds taking the list in turn."""
+    if not sup:
+        return sup
+    seeds = list(seeds)
+    i = seeds.index(seed) if seed in seeds else 0
+    return {k: (v[i % len(v)] if k in _PER_SEED_KEYS and isinstance(v, list) else v)
+            for k, v in sup.items()}
+
+
 def _supervisor(key: str, raw: Any, turbine: str) -> dict[str, Any]:
     """Supervisor settings (:data:`_SUPERVISOR_KEYS`), checked by
     :class:`mpc_wt.controllers.supervisor.Supervisor` itself on the campaign's turbine."""
@@ -839,12 +856,28 @@ def _supervisor(key: str, raw: Any, turbine: str) -> dict[str, Any]:
     if raw is None:
         return {}
     _keys_of(key, raw, _SUPERVISOR_KEYS)
+    raw = dict(raw)
+    per_seed = {}
+    for k in _PER_SEED_KEYS:
+        v = raw.get(k)
+        if isinstance(v, (list, tuple)):
+            if not v:
+                raise _fail(f"{key}.{k}", "must be a value or a non-empty list (one per seed "
+                                          "in turn), got []")
+            per_seed[k] = list(v)
+            raw[k] = v[0]
+    tb = load_case_turbine(turbine)
     try:
-        Supervisor.check_settings(load_case_turbine(turbine), **dict(raw))
+        Supervisor.check_settings(tb, **raw)
+        for k, vs in per_seed.items():
+            for v in vs[1:]:
+                Supervisor.check_settings(tb, **{**raw, k: v})
     except (TypeError, ValueError) as err:
         raise _fail(key, str(err)) from err
-    return {k: (v if v is None or k == "pitch_fault" else
-                int(v) if k == "pitch_fault_blade" else float(v)) for k, v in raw.items()}
+    out = {k: (v if v is None or k == "pitch_fault" else
+               int(v) if k == "pitch_fault_blade" else float(v)) for k, v in raw.items()}
+    out.update({k: [float(x) for x in vs] for k, vs in per_seed.items()})
+    return out
 
 
 def _load_case(i: int, raw: Any, top: Mapping[str, Any]) -> LoadCase:

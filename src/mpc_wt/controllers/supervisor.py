@@ -22,6 +22,12 @@ and shutdown sequence in the loop. :class:`Supervisor` wraps any controller (``r
   until the protection detects the fault ``fault_detect_s`` later (a command-versus-measured
   pitch deviation check; our assumed delay); the protection then stops the turbine as in a
   normal shutdown, with the healthy blades to feather and the faulty one held where it is.
+  With ``pitch_fault_azimuth_deg`` the fault comes at the first step from ``pitch_fault_at`` on
+  at which the faulty blade reaches that azimuth (0 = up, in the direction of rotation): the
+  loads of the stop depend on where the faulty blade is when it comes (the edgewise gravity
+  load adds to the unbalanced rotor's), so a comparison of controllers fixes it rather than
+  leaving it to each rotor's phase at a fixed time. A rotor that has not brought the blade there
+  within :data:`AZIMUTH_WAIT_S` (a rotor nearly at rest) takes the fault then (logged).
 
 The state and the trip time are recorded (signals ``supervisor_state``: 0 running, 1
 shutdown, 2 overspeed stop, 3 grid loss, 4 pitch-fault stop; ``supervisor_trip_time``); the
@@ -29,6 +35,7 @@ wrapped controller's signals are held at their last values after the trip.
 """
 from __future__ import annotations
 
+import logging
 import math
 from typing import Any
 
@@ -37,13 +44,19 @@ import numpy as np
 import linearize
 from mpc_wt.controllers.base import ControllerBase
 
-__all__ = ["Supervisor", "STATES", "TorqueLawGuard"]
+_log = logging.getLogger(__name__)
+
+__all__ = ["Supervisor", "STATES", "TorqueLawGuard", "AZIMUTH_WAIT_S"]
 
 #: Supervisor states and their codes in the signal ``supervisor_state``.
 STATES = {"running": 0, "shutdown": 1, "overspeed": 2, "grid_loss": 3, "pitch_fault": 4}
 
 #: The kinds of pitch fault on one blade.
 PITCH_FAULTS = ("seized", "runaway")
+
+#: The longest wait for the faulty blade to reach ``pitch_fault_azimuth_deg`` [s]: three
+#: revolutions at a fifth of the NREL 5-MW's rated speed.
+AZIMUTH_WAIT_S = 30.0
 
 
 def _opt_time(name: str, value: Any) -> float | None:
@@ -83,6 +96,10 @@ class Supervisor(ControllerBase):
         The faulty blade, 1-3.
     fault_detect_s : float
         Time from the fault to the protection's stop [s] (default 1 s, our assumption).
+    pitch_fault_azimuth_deg : float, optional
+        The faulty blade's azimuth at which the fault comes, the first time from
+        ``pitch_fault_at`` on [deg, 0 = up, in the direction of rotation, 0-360) (None: at
+        ``pitch_fault_at`` itself).
     """
 
     def __init__(self, controller: Any, turbine: linearize.Turbine, *,
@@ -90,7 +107,8 @@ class Supervisor(ControllerBase):
                  grid_loss_at: float | None = None, pitch_rate: float | None = None,
                  torque_ramp_s: float = 5.0, pitch_fault_at: float | None = None,
                  pitch_fault: str = "seized", pitch_fault_blade: int = 1,
-                 fault_detect_s: float = 1.0) -> None:
+                 fault_detect_s: float = 1.0,
+                 pitch_fault_azimuth_deg: float | None = None) -> None:
         self.controller = controller
         pa = turbine.pitch_actuator
         if overspeed is not None and not (math.isfinite(float(overspeed))
@@ -123,6 +141,17 @@ class Supervisor(ControllerBase):
             raise ValueError(f"fault_detect_s must be a finite time >= 0 s, got "
                              f"{fault_detect_s!r}")
         self.fault_detect_s = det
+        az = pitch_fault_azimuth_deg
+        if az is not None:
+            try:
+                az = float(az)
+            except (TypeError, ValueError):
+                az = math.nan
+            if not (math.isfinite(az) and 0.0 <= az < 360.0):
+                raise ValueError(f"pitch_fault_azimuth_deg must be an azimuth in [0, 360) deg "
+                                 f"(or None: at pitch_fault_at), got "
+                                 f"{pitch_fault_azimuth_deg!r}")
+        self.fault_azimuth = None if az is None else math.radians(az)
         self.fine = pa.min_pitch_rad
         self.max_rate = pa.max_rate_rad_s
         self.feather = pa.max_pitch_rad
@@ -159,6 +188,11 @@ class Supervisor(ControllerBase):
         self._torque0 = 0.0
         self._inner: dict[str, float] = {}
         self._fault_pitch: float | None = None      # the faulty blade's pitch at the fault
+        #: when the fault came [s] (None: not yet)
+        self.fault_time: float | None = (self.pitch_fault_at if self.fault_azimuth is None
+                                         else None)
+        self._az_left: float | None = None          # azimuth still to go to the fault [rad]
+        self._az_prev = 0.0
         self.signals: dict[str, float] = {"supervisor_state": 0.0,
                                           "supervisor_trip_time": math.nan}
 
@@ -171,8 +205,7 @@ class Supervisor(ControllerBase):
             self.state = "overspeed"
         elif self.shutdown_at is not None and t >= self.shutdown_at:
             self.state = "shutdown"
-        elif self.pitch_fault_at is not None and \
-                t >= self.pitch_fault_at + self.fault_detect_s:
+        elif self.fault_time is not None and t >= self.fault_time + self.fault_detect_s:
             self.state = "pitch_fault"
         else:
             return
@@ -183,6 +216,9 @@ class Supervisor(ControllerBase):
     def step(self, t: float, meas: dict[str, Any]) -> tuple[np.ndarray, float]:
         # the wrapped controller's commands while running, the stop sequence after a trip
         # (parameters and returns: ControllerBase.step)
+        if self.state == "running" and self.fault_time is None and \
+                self.pitch_fault_at is not None and t >= self.pitch_fault_at:
+            self._await_azimuth(t, meas)
         if self.state == "running":
             self._trip(t, meas)
         if self.state == "running":
@@ -190,7 +226,7 @@ class Supervisor(ControllerBase):
             self._inner = dict(getattr(self.controller, "signals", {}))
             self.signals = {**self._inner, "supervisor_state": 0.0,
                             "supervisor_trip_time": math.nan}
-            if self.pitch_fault_at is not None and t >= self.pitch_fault_at:
+            if self.fault_time is not None and t >= self.fault_time:
                 pitch = np.array(pitch, dtype=float)
                 pitch[self.fault_blade] = self._faulty(t, meas)
             return pitch, tq
@@ -207,14 +243,34 @@ class Supervisor(ControllerBase):
                         "supervisor_trip_time": self.trip_time}
         return pitch, tq
 
+    def _await_azimuth(self, t: float, meas: dict[str, Any]) -> None:
+        """Count the faulty blade's way to ``pitch_fault_azimuth_deg``; set
+        :attr:`fault_time` when it gets there (or when the wait runs out)."""
+        assert self.fault_azimuth is not None and self.pitch_fault_at is not None
+        psi = float(meas["azimuth"]) + self.fault_blade * 2.0 * math.pi / 3.0
+        if self._az_left is None:
+            self._az_left = (self.fault_azimuth - psi) % (2.0 * math.pi)
+        else:
+            step = (psi - self._az_prev + math.pi) % (2.0 * math.pi) - math.pi
+            self._az_left -= step
+        self._az_prev = psi
+        if self._az_left <= 0.0:
+            self.fault_time = t
+        elif t - self.pitch_fault_at >= AZIMUTH_WAIT_S:
+            self.fault_time = t
+            _log.warning("pitch fault: blade %d did not reach %.0f deg azimuth within %.0f s "
+                         "of pitch_fault_at; the fault comes at t = %.2f s",
+                         self.fault_blade + 1, math.degrees(self.fault_azimuth),
+                         AZIMUTH_WAIT_S, t)
+
     def _faulty(self, t: float, meas: dict[str, Any]) -> float:
         """The faulty blade's pitch command after the fault (before the protection acts)."""
-        assert self.pitch_fault_at is not None
+        assert self.fault_time is not None
         if self._fault_pitch is None:
             self._fault_pitch = float(meas["pitch"][self.fault_blade])
         if self.pitch_fault == "seized":
             return self._fault_pitch
-        return max(self.fine, self._fault_pitch - self.max_rate * (t - self.pitch_fault_at))
+        return max(self.fine, self._fault_pitch - self.max_rate * (t - self.fault_time))
 
     def finalize(self) -> None:
         """Pass the harness's last call on to the wrapped controller."""

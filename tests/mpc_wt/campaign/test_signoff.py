@@ -174,6 +174,24 @@ def test_a_pitch_fault_load_case() -> None:
                            "supervisor": {"pitch_fault_at": 20.0, "pitch_fault": "jammed"}}])
 
 
+def test_a_pitch_fault_azimuth_per_seed() -> None:
+    """A list of fault azimuths is taken by the load case's seeds in turn (the fourth seed of
+    three azimuths the first again), each case's settings hold its own (and its hash differs);
+    a bad entry is named with the list's key."""
+    spec = _spec(load_cases=[{"dlc": "2.1", "winds": [25.0], "seeds": 4, "duration": 60.0,
+                              "supervisor": {"pitch_fault_at": 20.0, "pitch_fault": "runaway",
+                                             "pitch_fault_azimuth_deg": [0, 120, 240]}}],
+                 controllers=["baseline"])
+    cases = spec.cases()
+    assert [c.supervisor["pitch_fault_azimuth_deg"] for c in cases] == [0.0, 120.0, 240.0, 0.0]
+    assert len({c.case_hash for c in cases}) == 4
+    with pytest.raises(SpecError, match=r"load_cases\[0\].supervisor.*pitch_fault_azimuth_deg"
+                                        r" must be an azimuth.*got 400"):
+        _spec(load_cases=[{"dlc": "2.1", "winds": [25.0], "seeds": 2,
+                           "supervisor": {"pitch_fault_at": 20.0,
+                                          "pitch_fault_azimuth_deg": [0, 400]}}])
+
+
 @pytest.mark.parametrize("over, key, what", [
     ({"load_cases": [{"dlc": "1.4", "condition": "gust", "winds": [10]}]},
      r"load_cases\[0\].condition", "must be one of"),

@@ -96,6 +96,10 @@ def test_grid_loss_drops_the_torque_at_once(turbine, steady18) -> None:
     (dict(pitch_fault_at=5.0, pitch_fault_blade=4), r"pitch_fault_blade must be 1, 2 or 3"),
     (dict(pitch_fault_at=-2.0), r"pitch_fault_at must be a finite time >= 0 s"),
     (dict(fault_detect_s=math.inf), r"fault_detect_s must be a finite time >= 0 s, got inf"),
+    (dict(pitch_fault_at=5.0, pitch_fault_azimuth_deg=360.0),
+     r"pitch_fault_azimuth_deg must be an azimuth in \[0, 360\) deg.*got 360.0"),
+    (dict(pitch_fault_at=5.0, pitch_fault_azimuth_deg="up"),
+     r"pitch_fault_azimuth_deg must be an azimuth.*got 'up'"),
 ])
 def test_bad_settings_are_named(turbine, kwargs, match) -> None:
     with pytest.raises(ValueError, match=match):
@@ -132,6 +136,28 @@ def test_pitch_fault_on_one_blade_and_the_protection(turbine, steady18, fault) -
         assert np.ptp(p2[t > 3.5]) < math.radians(0.05)
     assert p1[-1] > theta + math.radians(25.0)           # the healthy blades feather
     assert res.channel("gen_torque")[t > 7.0 + 2 * dt].max() == pytest.approx(0.0, abs=1.0)
+
+
+@pytest.mark.parametrize("blade, target", [(1, 0.0), (2, 90.0), (3, 250.0)])
+def test_a_pitch_fault_at_an_azimuth(turbine, steady18, blade, target) -> None:
+    """With ``pitch_fault_azimuth_deg`` the fault waits for the faulty blade: it comes at the
+    first step from ``pitch_fault_at`` on at which that blade (blade k at blade 1's azimuth
+    + (k - 1) x 120 deg) has reached the azimuth, so within one step's turn past it (rated
+    speed 1.27 rad/s x 12.5 ms = 0.9 deg), and less than a revolution (4.9 s at 18 m/s) after
+    ``pitch_fault_at``; the protection then trips fault_detect_s later."""
+    op, wind = steady18
+    sup = Supervisor(BaselineController(turbine), turbine, pitch_fault_at=2.0,
+                     pitch_fault="seized", pitch_fault_blade=blade, fault_detect_s=1.0,
+                     pitch_fault_azimuth_deg=target)
+    res = _run(turbine, sup, wind, op, 9.0)
+    assert sup.fault_time is not None and 2.0 <= sup.fault_time < 2.0 + 2 * math.pi / 1.2
+    t = res.t
+    k = int(np.searchsorted(t, sup.fault_time - 1e-9))
+    psi = np.degrees(res.channel("azimuth")[k] + (blade - 1) * 2 * math.pi / 3) % 360.0
+    passed = (psi - target) % 360.0
+    assert passed < 1.0, (psi, target)
+    assert res.controller["supervisor_trip_time"][-1] == pytest.approx(sup.fault_time + 1.0,
+                                                                      abs=res.meta["dt"])
 
 
 class _MaxTorque:
