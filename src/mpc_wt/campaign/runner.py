@@ -28,7 +28,7 @@ from mpc_wt.campaign.spec import CampaignSpec
 from mpc_wt.campaign.store import CampaignStore
 from mpc_wt.campaign.task import run_case
 
-__all__ = ["run_campaign", "RunSummary", "ENGINES", "submission_order"]
+__all__ = ["run_campaign", "RunSummary", "ENGINES", "submission_order", "check_designs"]
 
 log = logging.getLogger(__name__)
 
@@ -135,6 +135,7 @@ def run_campaign(spec: CampaignSpec, out: str | Path, *, workers: int | None = N
     with CampaignStore(out, lock=True) as store:
         _write_spec(spec, out, store)
         sync = store.sync(spec)
+        sync["redesigned"] = sync.get("redesigned", 0) + check_designs(spec, store)
         todo = submission_order(store.todo())
         total = len(spec.cases())
         summary = RunSummary(total=total, skipped=total - len(todo), submitted=len(todo),
@@ -168,6 +169,86 @@ def run_campaign(spec: CampaignSpec, out: str | Path, *, workers: int | None = N
             bar.close()
             summary.wall_s = time.perf_counter() - t_start
         return summary
+
+
+def _recorded_design(path: Path) -> str | None:
+    """The design digest a result file records (its ``meta_json``; None if it records none or
+    cannot be read). Reads the header only."""
+    import json
+
+    from scipy.io import netcdf_file
+
+    try:
+        f = netcdf_file(path, "r", mmap=True)
+        try:
+            raw = f._attributes.get("meta_json", b"{}")
+        finally:
+            f.close()
+        meta = json.loads(raw.decode() if isinstance(raw, bytes) else raw)
+    except (OSError, ValueError, TypeError):
+        return None
+    design = meta.get("design") or {}
+    return design.get("digest") if isinstance(design, dict) else None
+
+
+def check_designs(spec: CampaignSpec, store: CampaignStore) -> int:
+    """Send back the finished cases whose controller the package designs differently today.
+
+    A case's hash covers its controller's options with every default written out, but not a
+    default that lives in code (a cost weight of the kind, a candidate list of a design
+    check): a new version that changes one would keep the old results. Each controller with
+    finished cases is designed once here (as its workers will) and the design's digest
+    (:func:`~mpc_wt.registry.context.design_digest`) compared with the one each finished case's
+    file records; a case whose design differs is computed again, its file kept as
+    ``cases/ID.redesigned.nc`` (logged). A controller that cannot be designed here keeps its
+    cases (logged).
+
+    Parameters
+    ----------
+    spec : CampaignSpec
+    store : CampaignStore
+        The campaign's index, synced with ``spec``.
+
+    Returns
+    -------
+    int
+        The cases sent back.
+    """
+    done = {r.case_id: r for r in store.rows() if r.status == "done" and r.file}
+    if not done:
+        return 0
+    by: dict[str, list[Any]] = {}
+    for c in spec.cases():
+        if c.case_id in done:
+            by.setdefault(c.controller, []).append(c)
+    redo: list[str] = []
+    for name, cases in by.items():
+        recorded = {c.case_id: _recorded_design(store.root / done[c.case_id].file)
+                    for c in cases}
+        if not any(recorded.values()):
+            continue
+        first = cases[0]
+        try:
+            from mpc_wt.campaign.task import load_case_turbine
+            from mpc_wt.registry.registry import load_plugins
+            from mpc_wt.run import design_controller
+
+            load_plugins(first.plugins, first.plugin_folder)
+            built, _ = design_controller(load_case_turbine(first.turbine), first.run_name,
+                                         first.options)
+            now = built.meta["design"]["digest"]
+        except Exception as err:       # a design that fails here fails in its cases too
+            log.warning("controller %s could not be designed to check the design of its %d "
+                        "finished cases (%s); they are kept", name, len(cases), err)
+            continue
+        stale = [cid for cid, d in recorded.items() if d is not None and d != now]
+        if stale:
+            log.warning("controller %s: %d finished cases were computed with another design "
+                        "than this version makes from the same options (a default of the kind "
+                        "changed); computing them again (their files kept as "
+                        "cases/ID.redesigned.nc)", name, len(stale))
+            redo += stale
+    return store.redo(redo, "redesigned") if redo else 0
 
 
 def _dispatch(engine: str, todo: list[Any], root: str, n_workers: int, scheduler: Any,

@@ -343,6 +343,36 @@ class CampaignStore:
                      len(first_sums))
         return out
 
+    def redo(self, case_ids: Iterable[str], suffix: str) -> int:
+        """Done cases to compute again: each result file is kept as ``cases/ID.SUFFIX.nc``
+        (nothing computed is lost) and the case goes back to pending.
+
+        Parameters
+        ----------
+        case_ids : iterable of str
+            The cases.
+        suffix : str
+            Letters naming why, e.g. ``redesigned``.
+
+        Returns
+        -------
+        int
+            The cases sent back.
+        """
+        if not suffix.isalpha():
+            raise ValueError(f"suffix must be letters, got {suffix!r}")
+        ids = list(case_ids)
+        now = time.time()
+        with self._tx():
+            for cid in ids:
+                row = self.db.execute("SELECT file FROM cases WHERE case_id=?", (cid,)).fetchone()
+                if row is not None and row[0] and (self.root / row[0]).is_file():
+                    os.replace(self.root / row[0],
+                               (self.root / row[0]).with_suffix(f".{suffix}.nc"))
+                self.db.execute("UPDATE cases SET status='pending', metrics=NULL, error=NULL, "
+                                "traceback=NULL, updated=? WHERE case_id=?", (now, cid))
+        return len(ids)
+
     def changed_files(self) -> list[tuple[str, str]]:
         """Done cases whose result file is missing or no longer matches its recorded SHA-256
         (a row that names no file, as an index made by hand, has nothing to check).

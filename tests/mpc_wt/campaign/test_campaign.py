@@ -688,3 +688,70 @@ def test_fault_injection_campaign(tmp_path):
     section = text[text.index("## Failed cases"):]
     assert "exits__A__v12__s1" in section and "exit status 3" in section
     assert "crashes__A__v12__s1" in section and "SIGSEGV" in section
+
+
+KIND_WITH_A_CODE_DEFAULT = '''
+import dataclasses
+from mpc_wt.controllers import Built, Options, register
+from mpc_wt.controllers.baseline import BaselineController, tune_baseline
+
+#: a default that lives in code, not in an option: no case hash covers it
+GAIN_SCALE = 1.0
+
+@dataclasses.dataclass(frozen=True)
+class NoOptions(Options):
+    pass
+
+@register("pi-code-default", NoOptions, summary="the baseline PI, its gains x GAIN_SCALE")
+def build(ctx, opts):
+    g = tune_baseline(ctx.turbine)
+    g = dataclasses.replace(g, kp=g.kp * GAIN_SCALE, ki=g.ki * GAIN_SCALE)
+    return Built(BaselineController(ctx.turbine, g))
+'''
+
+
+def test_a_default_changed_in_code_computes_the_cases_again(tmp_path, monkeypatch, caplog):
+    """A kind whose design takes a default from code (its PI gains x GAIN_SCALE): after that
+    default changes (as a new version would change it), resuming the campaign designs the
+    controller, finds that its digest differs from the one the finished cases' files record,
+    and computes them again, the old files kept as ID.redesigned.nc; the new files record the
+    new design and their pitch differs. With the default as it was, a resume computes
+    nothing."""
+    import importlib
+    import logging
+
+    from mpc_wt.registry import registry
+    from mpc_wt.registry.context import DEFAULT_CACHE
+
+    (tmp_path / "code_default_kind.py").write_text(KIND_WITH_A_CODE_DEFAULT)
+    monkeypatch.syspath_prepend(str(tmp_path))
+    try:
+        spec = spec_from_dict({"name": "code-default", "duration": 10, "transient": 0,
+                               "winds": [18], "seeds": [1, 2], "turbulence": "A",
+                               "plugins": ["code_default_kind"],
+                               "controllers": [{"name": "pi", "controller": "pi-code-default"}],
+                               "channels": {"tower_base_fa_moment": 4}})
+        out = tmp_path / "c"
+        s = run_campaign(spec, out, engine="serial", progress=False)
+        assert (s.done, s.failed) == (2, 0)
+        s = run_campaign(spec, out, engine="serial", progress=False)
+        assert (s.submitted, s.sync["redesigned"]) == (0, 0)
+        monkeypatch.setattr(importlib.import_module("code_default_kind"), "GAIN_SCALE", 2.0)
+        DEFAULT_CACHE.clear()                   # as in the new version's fresh process
+        with caplog.at_level(logging.WARNING, logger="mpc_wt.campaign.runner"):
+            s = run_campaign(spec, out, engine="serial", progress=False)
+        assert (s.submitted, s.done, s.sync["redesigned"]) == (2, 2, 2)
+        assert "computed with another design" in caplog.text
+        kept = sorted((out / "cases").glob("*.redesigned.nc"))
+        assert len(kept) == 2
+        for old_file in kept:
+            old = ClosedLoopResult.load(old_file)
+            new = ClosedLoopResult.load(old_file.with_name(
+                old_file.name.replace(".redesigned.nc", ".nc")))
+            assert new.meta["design"]["digest"] != old.meta["design"]["digest"]
+            assert np.max(np.abs(new.u[:, 0] - old.u[:, 0])) > 1e-6
+    finally:
+        registry._KINDS.pop("pi-code-default", None)
+        registry._PLUGINS_LOADED.discard("code_default_kind")
+        sys.modules.pop("code_default_kind", None)
+        DEFAULT_CACHE.clear()
