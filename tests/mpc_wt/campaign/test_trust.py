@@ -80,6 +80,7 @@ def test_the_local_cluster_is_closed_to_other_clients() -> None:
     """The campaigns' local Dask cluster speaks TLS with certificates of its own: its client
     runs a task; a client without them (another process attaching to the address, over TLS or
     plain TCP) is refused; the scheduler serves no dashboard page on the loopback interface."""
+    import gc
     import urllib.error
     import urllib.request
 
@@ -99,6 +100,10 @@ def test_the_local_cluster_is_closed_to_other_clients() -> None:
             # outer setting restores this process's
             with dask.config.set(scheduler="sync"), pytest.raises(Exception):
                 distributed.Client(other, timeout="5s")
+            # the failed client is collected here: collected while the next one starts its
+            # event loop, its __del__ stops that loop under the loop's own lock (the suite
+            # hung once in that deadlock inside distributed 2026.8)
+            gc.collect()
         ports = [s.getsockname()[1] for s in cluster.scheduler.http_server._sockets.values()]
         assert ports and 8787 not in ports
         for port in ports:
