@@ -143,6 +143,7 @@ def run_campaign(spec: CampaignSpec, out: str | Path, *, workers: int | None = N
         log.info("campaign %s: %d cases, %d finished, %d to run (%s)", spec.name, total,
                  summary.skipped, len(todo), sync)
         if not todo:
+            summary.wall_s = time.perf_counter() - t_start    # the check of what is done
             return summary
         _check_memory(todo, 0 if scheduler else n_workers)
         bar = _Bar(len(todo), spec.name, progress)

@@ -736,6 +736,7 @@ def test_a_default_changed_in_code_computes_the_cases_again(tmp_path, monkeypatc
         assert (s.done, s.failed) == (2, 0)
         s = run_campaign(spec, out, engine="serial", progress=False)
         assert (s.submitted, s.sync["redesigned"]) == (0, 0)
+        assert s.wall_s > 0.0          # the resume's own work (designing, reading headers)
         monkeypatch.setattr(importlib.import_module("code_default_kind"), "GAIN_SCALE", 2.0)
         DEFAULT_CACHE.clear()                   # as in the new version's fresh process
         with caplog.at_level(logging.WARNING, logger="mpc_wt.campaign.runner"):
