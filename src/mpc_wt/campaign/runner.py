@@ -173,22 +173,10 @@ def run_campaign(spec: CampaignSpec, out: str | Path, *, workers: int | None = N
 
 
 def _recorded_design(path: Path) -> str | None:
-    """The design digest a result file records (its ``meta_json``; None if it records none or
-    cannot be read). Reads the header only."""
-    import json
+    """The design digest a result file records (None if it records none or cannot be read)."""
+    from mpc_wt.simulation.results import ClosedLoopResult
 
-    from scipy.io import netcdf_file
-
-    try:
-        f = netcdf_file(path, "r", mmap=True)
-        try:
-            raw = f._attributes.get("meta_json", b"{}")
-        finally:
-            f.close()
-        meta = json.loads(raw.decode() if isinstance(raw, bytes) else raw)
-    except (OSError, ValueError, TypeError):
-        return None
-    design = meta.get("design") or {}
+    design = (ClosedLoopResult.read_meta(path) or {}).get("design")
     return design.get("digest") if isinstance(design, dict) else None
 
 
@@ -215,6 +203,10 @@ def check_designs(spec: CampaignSpec, store: CampaignStore) -> int:
     int
         The cases sent back.
     """
+    from mpc_wt.campaign.task import load_case_turbine
+    from mpc_wt.registry.registry import load_plugins
+    from mpc_wt.run import design_controller
+
     done = {r.case_id: r for r in store.rows() if r.status == "done" and r.file}
     if not done:
         return 0
@@ -230,10 +222,6 @@ def check_designs(spec: CampaignSpec, store: CampaignStore) -> int:
             continue
         first = cases[0]
         try:
-            from mpc_wt.campaign.task import load_case_turbine
-            from mpc_wt.registry.registry import load_plugins
-            from mpc_wt.run import design_controller
-
             load_plugins(first.plugins, first.plugin_folder)
             built, _ = design_controller(load_case_turbine(first.turbine), first.run_name,
                                          first.options)

@@ -857,20 +857,17 @@ def _supervisor(key: str, raw: Any, turbine: str) -> dict[str, Any]:
         return {}
     _keys_of(key, raw, _SUPERVISOR_KEYS)
     raw = dict(raw)
-    per_seed = {}
-    for k in _PER_SEED_KEYS:
-        v = raw.get(k)
-        if isinstance(v, (list, tuple)):
-            if not v:
-                raise _fail(f"{key}.{k}", "must be a value or a non-empty list (one per seed "
-                                          "in turn), got []")
-            per_seed[k] = list(v)
-            raw[k] = v[0]
+    per_seed = {k: list(raw.pop(k)) for k in _PER_SEED_KEYS
+                if isinstance(raw.get(k), (list, tuple))}
+    for k, vs in per_seed.items():
+        if not vs:
+            raise _fail(f"{key}.{k}", "must be a value or a non-empty list (one per seed in "
+                                      "turn), got []")
     tb = load_case_turbine(turbine)
     try:
         Supervisor.check_settings(tb, **raw)
         for k, vs in per_seed.items():
-            for v in vs[1:]:
+            for v in vs:
                 Supervisor.check_settings(tb, **{**raw, k: v})
     except (TypeError, ValueError) as err:
         raise _fail(key, str(err)) from err

@@ -161,6 +161,31 @@ class ClosedLoopResult:
             tmp.unlink(missing_ok=True)
         return path
 
+    @staticmethod
+    def read_meta(path: str | Path) -> dict[str, Any] | None:
+        """The metadata of a result written by :meth:`save`, from the file's header alone (a
+        few ms where :meth:`load` reads every channel).
+
+        Returns
+        -------
+        dict or None
+            The ``meta`` :meth:`load` would give; None for a file that cannot be read or
+            holds none.
+        """
+        from scipy.io import netcdf_file
+
+        try:
+            f = netcdf_file(path, "r", mmap=True)
+            try:
+                raw = getattr(f, "meta_json", None)
+            finally:
+                f.close()
+            meta = None if raw is None else json.loads(
+                raw.decode() if isinstance(raw, bytes) else raw)
+        except (OSError, ValueError, TypeError):
+            return None
+        return meta if isinstance(meta, dict) else None
+
     @classmethod
     def load(cls, path: str | Path) -> "ClosedLoopResult":
         """Read a result written by :meth:`save`.
