@@ -1,9 +1,23 @@
-"""Shared command line of the paper studies: run length, discarded transient, output folder."""
+"""Shared parts of the studies: the paper studies' command line (run length, discarded
+transient, output folder) and an iterator with a length for the progress bars."""
 from __future__ import annotations
 
 import argparse
 from pathlib import Path
-from typing import Callable
+from typing import Any, Callable
+
+
+class Sized:
+    """An iterator with a length, for the progress bar's total."""
+
+    def __init__(self, it: Any, n: int) -> None:
+        self.it, self.n = it, n
+
+    def __len__(self) -> int:
+        return self.n
+
+    def __iter__(self) -> Any:
+        return iter(self.it)
 
 
 def study_args(doc: str, default_out: str,

@@ -16,9 +16,9 @@ from __future__ import annotations
 import argparse
 import json
 from concurrent.futures import ProcessPoolExecutor
-from typing import Any
 
 import numpy as np
+from _study import Sized
 
 #: The channels compared and their Woehler exponents (the sign-off's).
 CHANNELS = {"tower_base_fa_moment": 4, "tower_base_ss_moment": 4, "lss_torque": 4,
@@ -51,19 +51,6 @@ def _case(job: tuple) -> tuple:
     return job, out
 
 
-class _Sized:
-    """An iterator with a length, for the progress bar's total."""
-
-    def __init__(self, it: Any, n: int) -> None:
-        self.it, self.n = it, n
-
-    def __len__(self) -> int:
-        return self.n
-
-    def __iter__(self) -> Any:
-        return iter(self.it)
-
-
 def main() -> int:
     from linearize.progress import progress
     from mpc_wt.assessment.fatigue import lifetime_del, wind_bin_probabilities
@@ -87,7 +74,7 @@ def main() -> int:
     jobs += [(k, o, args.eog_wind, 0, args.duration, args.transient, True) for k, o in settings]
     res: dict[tuple, dict] = {}
     with ProcessPoolExecutor(args.workers) as pool:
-        for job, out in progress(_Sized(pool.map(_case, jobs), len(jobs)),
+        for job, out in progress(Sized(pool.map(_case, jobs), len(jobs)),
                                  "TS observer study", "run"):
             res[job[:4] + (job[6],)] = out
     p = wind_bin_probabilities(winds, "rayleigh", mean=10.0)

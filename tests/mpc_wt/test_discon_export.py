@@ -220,6 +220,21 @@ def test_ibc_library_runs_as_the_python_controller(nrel5mw, ibc_export, wind):
     _check_dels(py, lib)
 
 
+def test_ibc_library_holds_the_amplitude_as_the_python_controller(nrel5mw, tmp_path):
+    """IBC with its largest pitch per blade at 0.3 deg (the clamp acting most of the time at
+    18 m/s): the library's pitch within 0.01 deg of the Python controller's at every step, and
+    no blade's IBC part beyond 0.3 deg."""
+    opts = {"max_amplitude_deg": 0.3}
+    ex = export_discon(nrel5mw, "ibc", tmp_path / "ibc03", opts)
+    kw = dict(duration=120.0, turbulence="A", seed=11, fields=_FIELDS)
+    py = run_controller(nrel5mw, "ibc", 18.0, opts, **kw)
+    lib = run_controller(nrel5mw, "discon", 18.0, _discon(ex), **kw)
+    dp = float(np.degrees(np.max(np.abs(py.u[:, :3] - lib.u[:, :3]))))
+    assert dp <= 0.01, dp
+    ibc = np.degrees(np.abs([py.channel(f"ibc_pitch_{b}") for b in (1, 2, 3)]))
+    assert ibc.max() <= 0.3 + 1e-9 and np.mean(ibc > 0.3 - 1e-6) > 0.2
+
+
 def test_cli_design_ibc_then_export_discon(tmp_path, capsys):
     """``mpcwt design ibc`` then ``mpcwt export --format discon`` builds IBC again with the
     design's loop gain; a design on a derated baseline is refused with its power fraction."""

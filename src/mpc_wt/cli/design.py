@@ -56,8 +56,9 @@ def add_parsers(sub: Any) -> None:
     p.add_argument("--power-fraction", type=float, default=1.0,
                    help="baseline, ibc, coleman-ipc: tune for a derated turbine at this "
                         "fraction of rated power, in (0, 1]")
-    p.add_argument("--loop-gain", type=float, default=IBC_LOOP_GAIN,
-                   help="ibc: loop gain at 1P [-]")
+    p.add_argument("--loop-gain", type=float, default=None,
+                   help=f"ibc: loop gain at 1P [-] (default {IBC_LOOP_GAIN:g}, less on pitch "
+                        "drives too slow for a 2 deg cyclic at half their rate)")
     p.set_defaults(func=_design)
 
     p = sub.add_parser("export", help="export a design: its gain table (csv, json, mat), a "
@@ -93,7 +94,8 @@ def _design_args(args: argparse.Namespace) -> dict[str, Any]:
             "omega_n_rad_s": (None if args.omega_n is None
                               else _positive("--omega-n", args.omega_n)),
             "zeta": _positive("--zeta", args.zeta),
-            "loop_gain": _positive("--loop-gain", args.loop_gain), "winds": winds,
+            "loop_gain": (None if args.loop_gain is None
+                          else _positive("--loop-gain", args.loop_gain)), "winds": winds,
             "reductions": floats(args.reductions, "--reductions"),
             "decay_rate": (None if args.decay_rate is None
                            else _positive("--decay-rate", args.decay_rate)),

@@ -50,17 +50,76 @@ from mpc_wt.controllers.base import ControllerBase
 from mpc_wt.controllers.baseline import BaselineController, check_power_fraction
 from mpc_wt.controllers.filters import SOSFilterBank, filter_sos
 
-__all__ = ["IBC_LOOP_GAIN", "COLEMAN_MAX_AMPLITUDE_DEG", "IBCGains", "tune_ibc",
+__all__ = ["IBC_LOOP_GAIN", "COLEMAN_MAX_AMPLITUDE_DEG", "CYCLIC_RATE_FRACTION",
+           "cyclic_amplitude_limit_deg", "ibc_loop_gain", "IBCGains", "tune_ibc",
            "IBCController", "ColemanIPCGains", "tune_coleman_ipc", "ColemanIPCController"]
 
-#: The default loop gain at 1P of each IBC blade loop: chosen so that IBC's pitch travel over
-#: the sign-off's DLC 1.2 stays within 3x the baseline's (1.0 cut the lifetime flap DEL by 16 %
-#: at 3.7x the travel; 0.6 by about 11 % at about 2.7x; benchmarks/RESULTS.md).
+#: The default loop gain at 1P of each IBC blade loop where the pitch drives are fast enough:
+#: chosen so that IBC's pitch travel over the sign-off's DLC 1.2 stays within 3x the
+#: baseline's on the NREL 5-MW (1.0 cut the lifetime flap DEL by 16 % at 3.7x the travel; 0.6
+#: by about 11 % at about 2.7x; benchmarks/RESULTS.md). On slower drives it falls with the
+#: cyclic amplitude they allow (:func:`ibc_loop_gain`).
 IBC_LOOP_GAIN = 0.6
-#: The default largest cyclic pitch amplitude of the Coleman IPC [deg]: it bounds the cyclic
-#: pitch's travel to keep it within 3x the baseline's over the sign-off's DLC 1.2 (5 deg left
-#: the integrators free: 3.5x).
+#: The largest cyclic pitch amplitude of the Coleman IPC by default [deg]: it bounds the cyclic
+#: pitch's travel to keep it within 3x the baseline's over the sign-off's DLC 1.2 on the NREL
+#: 5-MW (5 deg left the integrators free: 3.5x). A turbine with slow pitch drives gets less
+#: (:func:`cyclic_amplitude_limit_deg`).
 COLEMAN_MAX_AMPLITUDE_DEG = 2.0
+#: The fraction of the pitch actuator's largest rate a cyclic pitch at rated 1P may take by
+#: default: a cyclic of amplitude A at 1P moves at up to A Omega.
+CYCLIC_RATE_FRACTION = 0.5
+
+
+def ibc_loop_gain(turbine: linearize.Turbine) -> float:
+    """The default 1P loop gain of IBC's blade loops on a turbine: :data:`IBC_LOOP_GAIN` times
+    the fraction of the 2 deg cyclic amplitude its pitch drives allow
+    (:func:`cyclic_amplitude_limit_deg`). The proportional loops pass the flap moment's
+    turbulence above 1P to the pitch as well, and most of their travel is there (on the
+    IEA-15 at 17 m/s the IBC pitch's travel above 1.3P was 3.5x that at 1P): the amplitude's
+    clamp alone took 5 % off it. 0.6 on the NREL 5-MW; 0.38 on the IEA-15-240-RWT.
+
+    Parameters
+    ----------
+    turbine : Turbine
+
+    Returns
+    -------
+    float
+        [-]
+    """
+    return IBC_LOOP_GAIN * cyclic_amplitude_limit_deg(turbine) / COLEMAN_MAX_AMPLITUDE_DEG
+
+
+def cyclic_amplitude_limit_deg(turbine: linearize.Turbine,
+                               rate_fraction: float = CYCLIC_RATE_FRACTION,
+                               cap_deg: float = COLEMAN_MAX_AMPLITUDE_DEG) -> float:
+    """The default largest cyclic pitch amplitude of a turbine [deg]: ``cap_deg``, or less
+    where a cyclic of that amplitude at rated 1P would take more than ``rate_fraction`` of the
+    pitch actuator's largest rate (its rate is A Omega).
+
+    On the NREL 5-MW (8 deg/s, 1.27 rad/s) half the rate allows 3.2 deg and the cap of 2 deg
+    holds; on the IEA-15-240-RWT (2 deg/s, 0.79 rad/s) it allows 1.26 deg. With 2 deg there the
+    Coleman IPC moved its blades 3.9x as far as the baseline over the sign-off's DLC 1.2 (the
+    bound is 3x), and a cyclic of 2.5 deg needs all of the drive's rate.
+
+    Parameters
+    ----------
+    turbine : Turbine
+    rate_fraction : float
+        Fraction of the actuator's largest rate, in (0, 1].
+    cap_deg : float
+        The amplitude where the actuator is fast enough [deg], > 0.
+
+    Returns
+    -------
+    float
+        [deg]
+    """
+    check_number("rate_fraction", rate_fraction, lo=0.0, lo_open=True, hi=1.0)
+    check_number("cap_deg", cap_deg, lo=0.0, lo_open=True, unit="deg")
+    rate = turbine.pitch_actuator.max_rate_rad_s
+    return min(float(cap_deg),
+               math.degrees(rate_fraction * rate / turbine.operation.rated_rotor_speed_rad_s))
 
 
 def _region3_winds(turbine: linearize.Turbine, step: float = 2.0) -> np.ndarray:
@@ -112,6 +171,9 @@ class IBCGains:
         Derating fraction the gains were tuned at [-].
     lowpass_hz : float or None
         Corner of a second-order Butterworth low-pass on the output [Hz] (None: none).
+    max_amplitude_rad : float
+        Largest IBC pitch of each blade, either way [rad] (inf: none); the controller clamps
+        each blade's IBC pitch to it after the blades' mean is taken out.
     """
 
     pitch_rad: np.ndarray
@@ -128,9 +190,13 @@ class IBCGains:
     rated_power: float
     power_fraction: float = 1.0
     lowpass_hz: float | None = None
+    max_amplitude_rad: float = math.inf
     info: dict[str, Any] = field(default_factory=dict, compare=False)
 
     def __post_init__(self) -> None:
+        if not self.max_amplitude_rad > 0:
+            raise ValueError(f"max_amplitude_rad must be > 0 rad (inf: none), got "
+                             f"{self.max_amplitude_rad!r}")
         for n in ("pitch_rad", "gain", "wind_mps", "gain_margin", "loop_gain_1p"):
             arr = np.array(getattr(self, n), dtype=float)
             arr.flags.writeable = False
@@ -205,10 +271,11 @@ def _blade_model(turbine: linearize.Turbine, v: float, p_w: float | None,
 
 
 def tune_ibc(turbine: linearize.Turbine, *, winds: Any = None, dt: float = 1.0 / 80.0,
-             loop_gain_1p: float = IBC_LOOP_GAIN, min_gain_margin: float = 2.0,
+             loop_gain_1p: float | None = None, min_gain_margin: float = 2.0,
              highpass_hz: float | None = None, notch_harmonics: Sequence[int] = (3,),
              notch_q: float = 1.0, weight_range: tuple[float, float] = (0.8, 0.95),
-             power_fraction: float = 1.0, lowpass_hz: float | None = None) -> IBCGains:
+             power_fraction: float = 1.0, lowpass_hz: float | None = None,
+             max_amplitude_deg: float | None = None) -> IBCGains:
     """Tune the individual blade controller on our linear models (Pettas and Cheng sec. 3.1).
 
     Parameters
@@ -218,8 +285,8 @@ def tune_ibc(turbine: linearize.Turbine, *, winds: Any = None, dt: float = 1.0 /
         m/s above rated to cut-out.
     dt : float
         Controller period [s] (the harness runs the baseline at the plant rate, 1/80 s).
-    loop_gain_1p : float
-        Target loop gain abs(L(1P)) of each blade loop [-].
+    loop_gain_1p : float, optional
+        Target loop gain abs(L(1P)) of each blade loop [-]; default :func:`ibc_loop_gain`.
     min_gain_margin : float
         Smallest gain margin allowed (the gain is lowered to meet it) [-] (2 = 6 dB).
     highpass_hz : float, optional
@@ -235,6 +302,9 @@ def tune_ibc(turbine: linearize.Turbine, *, winds: Any = None, dt: float = 1.0 /
     lowpass_hz : float, optional
         Second-order low-pass corner on the output [Hz] (not in the paper; it limits the pitch
         acceleration the loops ask for above 3P).
+    max_amplitude_deg : float, optional
+        Largest IBC pitch of each blade either way [deg] (not in the paper); default
+        :func:`cyclic_amplitude_limit_deg` (less on slow pitch drives).
 
     Returns
     -------
@@ -250,6 +320,7 @@ def tune_ibc(turbine: linearize.Turbine, *, winds: Any = None, dt: float = 1.0 /
         If a blade loop is unstable even at the smallest gain tried.
     """
     frac = check_power_fraction(power_fraction)
+    loop_gain_1p, amp = _ibc_drive_defaults(turbine, loop_gain_1p, max_amplitude_deg)
     harm = _check_ibc_args(dt, loop_gain_1p, min_gain_margin, notch_harmonics)
     wr = check_weight_range(weight_range)
     om = turbine.operation.rated_rotor_speed_rad_s
@@ -264,22 +335,31 @@ def tune_ibc(turbine: linearize.Turbine, *, winds: Any = None, dt: float = 1.0 /
     zf = np.exp(1j * om * dt)
     f1 = complex(signal.sosfreqz(filt, worN=[f1p], fs=fs)[1][0])
     params = linearize.plant_params(turbine)
-    pitch, k_out, gm_out, l1p = [], [], [], []
+    rows = []                                  # (pitch, gain, gain margin, 1P loop gain)
     for w in v:
         m = _blade_model(turbine, float(w), p_w, params)
-        k, gm, lg = _ibc_gain(m, dt, zf, f1, f_sys, loop_gain_1p, min_gain_margin)
-        pitch.append(m.info["pitch_deg"] * math.pi / 180)
-        k_out.append(k)
-        gm_out.append(gm)
-        l1p.append(lg)
+        rows.append((math.radians(m.info["pitch_deg"]),
+                     *_ibc_gain(m, dt, zf, f1, f_sys, loop_gain_1p, min_gain_margin)))
+    pitch, k_out, gm_out, l1p = (np.asarray(c, float) for c in zip(*rows))
     order = np.argsort(pitch)
-    return IBCGains(pitch_rad=np.asarray(pitch)[order], gain=np.asarray(k_out)[order],
-                    wind_mps=v[order], gain_margin=np.asarray(gm_out)[order],
-                    loop_gain_1p=np.asarray(l1p)[order], dt=dt, rotor_speed_rad_s=om,
+    return IBCGains(pitch_rad=pitch[order], gain=k_out[order], wind_mps=v[order],
+                    gain_margin=gm_out[order], loop_gain_1p=l1p[order], dt=dt,
+                    rotor_speed_rad_s=om,
                     highpass_hz=hp, notch_harmonics=harm, notch_q=notch_q,
                     weight_range=wr, rated_power=p_rated, power_fraction=frac,
-                    lowpass_hz=lowpass_hz, info={"target_loop_gain_1p": loop_gain_1p,
+                    lowpass_hz=lowpass_hz, max_amplitude_rad=math.radians(amp),
+                    info={"target_loop_gain_1p": loop_gain_1p,
                           "min_gain_margin": min_gain_margin})
+
+
+def _ibc_drive_defaults(turbine: linearize.Turbine, loop_gain_1p: float | None,
+                        max_amplitude_deg: float | None) -> tuple[float, float]:
+    """The loop gain and the largest IBC pitch [deg], each given or the turbine's default."""
+    gain = ibc_loop_gain(turbine) if loop_gain_1p is None else loop_gain_1p
+    amp = (cyclic_amplitude_limit_deg(turbine) if max_amplitude_deg is None
+           else check_number("max_amplitude_deg", max_amplitude_deg, lo=0.0, lo_open=True,
+                             hi=20.0, unit="deg"))
+    return gain, amp
 
 
 def _check_ibc_args(dt: float, loop_gain_1p: float, min_gain_margin: float,
@@ -484,6 +564,8 @@ class IBCController(_PitchAddOn):
         if self.remove_collective:
             mean = (u1 + u2 + u3) / 3.0
             u1, u2, u3 = u1 - mean, u2 - mean, u3 - mean
+        a = self.gains.max_amplitude_rad
+        u1, u2, u3 = min(max(u1, -a), a), min(max(u2, -a), a), min(max(u3, -a), a)
         cmd = self._limit(pc, (u1, u2, u3), meas)
         self.signals = {**self.collective.signals, "ibc_weight": w, "ibc_gain": k,
                         "ibc_pitch_1": u1, "ibc_pitch_2": u2, "ibc_pitch_3": u3}
@@ -566,7 +648,7 @@ def _rot(phi: float) -> np.ndarray:
 
 def tune_coleman_ipc(turbine: linearize.Turbine, *, winds: Any = None,
                      crossover_rad_s: float = 0.2,
-                     max_amplitude_deg: float = COLEMAN_MAX_AMPLITUDE_DEG,
+                     max_amplitude_deg: float | None = None,
                      weight_range: tuple[float, float] = (0.8, 0.95),
                      power_fraction: float = 1.0) -> ColemanIPCGains:
     """Tune the Coleman-frame integral IPC on the MBC linear models.
@@ -584,8 +666,8 @@ def tune_coleman_ipc(turbine: linearize.Turbine, *, winds: Any = None,
         Region-III winds of the schedule [m/s] (default every 2 m/s above rated).
     crossover_rad_s : float
         Crossover of the integral loops [rad/s].
-    max_amplitude_deg : float
-        Largest cyclic pitch amplitude [deg].
+    max_amplitude_deg : float, optional
+        Largest cyclic pitch amplitude [deg]; default :func:`cyclic_amplitude_limit_deg`.
     weight_range : (float, float)
         Power fractions of the fade-in [-].
     power_fraction : float
@@ -599,6 +681,8 @@ def tune_coleman_ipc(turbine: linearize.Turbine, *, winds: Any = None,
     frac = check_power_fraction(power_fraction)
     if not crossover_rad_s > 0:
         raise ValueError(f"crossover_rad_s must be > 0, got {crossover_rad_s!r}")
+    if max_amplitude_deg is None:
+        max_amplitude_deg = cyclic_amplitude_limit_deg(turbine)
     if not 0 < max_amplitude_deg <= 20:
         raise ValueError(f"max_amplitude_deg must be in (0, 20] deg, got {max_amplitude_deg!r}")
     wr = check_weight_range(weight_range)

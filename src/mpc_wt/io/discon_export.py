@@ -266,9 +266,11 @@ def _ibc_entries(ctl: Any) -> list[tuple[str, Any, str]]:
         ("ibc_settings", np.array([g.weight_range[0], g.weight_range[1], g.rated_power,
                                    math.exp(-ctl.dt / ctl.power_tau), ctl.pitch_min,
                                    ctl.pitch_max, ctl.step_max / ctl.dt,
-                                   float(ctl.remove_collective)], float),
+                                   float(ctl.remove_collective),
+                                   min(g.max_amplitude_rad, 1e300)], float),
          "the fade-in's power fractions [-], the power it refers to [W], the power filter's "
-         "pole, pitch min, max [rad], pitch rate [rad/s], 1: the blades' mean removed"),
+         "pole, pitch min, max [rad], pitch rate [rad/s], 1: the blades' mean removed, each "
+         "blade's largest IBC pitch [rad] (1e300: none)"),
         ("ibc_gain_pitch", np.asarray(g.pitch_rad, float), "mean pitch of the gain schedule "
                                                            "[rad]"),
         ("ibc_gain", np.asarray(g.gain, float), "gain [rad/(N m)]"),

@@ -315,6 +315,7 @@ def ibc_table(turbine: linearize.Turbine, gains: Any) -> dict[str, Any]:
                 "weight_range": list(gains.weight_range), "rated_power": gains.rated_power,
                 "power_fraction": gains.power_fraction,
                 "rotor_speed_rad_s": gains.rotor_speed_rad_s,
+                "max_amplitude_rad": min(gains.max_amplitude_rad, 1e300),
                 "convention": "theta_i = theta_collective + w(P) BS(K(theta_mean) HP(M_flap_i)) "
                               "(Pettas and Cheng sec. 3.1); gain margin 1e300: none"}
     return _doc("ibc", turbine, settings,

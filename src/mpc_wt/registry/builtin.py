@@ -17,7 +17,7 @@ from typing import Any, Optional
 import numpy as np
 
 import linearize
-from mpc_wt.controllers.ipc import COLEMAN_MAX_AMPLITUDE_DEG, IBC_LOOP_GAIN
+from mpc_wt.controllers.ipc import IBC_LOOP_GAIN
 from mpc_wt.registry.context import BuildContext, Built
 from mpc_wt.registry.options import REQUIRED, Options, option
 from mpc_wt.registry.registry import register
@@ -32,13 +32,13 @@ __all__ = ["BaselineOptions", "DerateOptions", "APCOptions", "IBCOptions", "Cole
 
 # -- designs behind `mpcwt design` ------------------------------------------------------------
 def _design_ibc(turbine: linearize.Turbine, *, power_fraction: float = 1.0,
-                loop_gain: float = IBC_LOOP_GAIN) -> tuple[dict, str]:
+                loop_gain: float | None = None) -> tuple[dict, str]:
     from mpc_wt.controllers.ipc import tune_ibc
     from mpc_wt.io.gain_tables import ibc_table
 
     g = tune_ibc(turbine, power_fraction=power_fraction, loop_gain_1p=loop_gain)
     doc = ibc_table(turbine, g)
-    doc["settings"]["options"] = {"loop_gain_1p": float(loop_gain)}
+    doc["settings"]["options"] = {"loop_gain_1p": float(g.info["target_loop_gain_1p"])}
     return doc, (f"{g.gain.size} points, gain margin >= "
                                    f"{g.gain_margin.min():.3g}, high-pass {g.highpass_hz:.3g} Hz")
 
@@ -210,9 +210,10 @@ register("derate", DerateOptions, field_components="u", pattern=r"derate(\d+(?:\
 class IBCOptions(Options):
     """Individual blade control (Pettas and Cheng sec. 3.1; :func:`mpc_wt.controllers.ipc.tune_ibc`)."""
 
-    loop_gain_1p: float = option(IBC_LOOP_GAIN, help="loop gain at 1P of each blade loop",
-                                 unit="-",
-                                 lo=0.0, lo_open=True, flag="--loop-gain")
+    loop_gain_1p: Optional[float] = option(None, help="loop gain at 1P of each blade loop "
+                                           f"(default {IBC_LOOP_GAIN:g}, less on pitch drives "
+                                           "too slow for a 2 deg cyclic at half their rate)",
+                                           unit="-", lo=0.0, lo_open=True, flag="--loop-gain")
     remove_collective: bool = option(True, help="subtract the blades' mean IBC pitch (cyclic "
                                      "action only)",
                                      flag="--keep-collective", flag_value=False)
@@ -229,6 +230,11 @@ class IBCOptions(Options):
                                              unit="-", lo=0.0, flag="")
     lowpass_hz: Optional[float] = option(None, help="output low-pass corner", unit="Hz",
                                          lo=0.0, lo_open=True, flag="")
+    max_amplitude_deg: Optional[float] = option(None, help="largest IBC pitch of each blade "
+                                                "(default 2 deg, or less where a cyclic of it "
+                                                "at rated 1P would take more than half the "
+                                                "actuator's rate)", unit="deg", lo=0.0,
+                                                lo_open=True, hi=20.0, flag="")
 
 
 @register("ibc", IBCOptions, field_components="u", addon_to=("baseline", "derate"),
@@ -256,9 +262,11 @@ class ColemanIPCOptions(Options):
 
     crossover_rad_s: float = option(0.2, help="crossover of the integral loops", unit="rad/s",
                                     lo=0.0, lo_open=True, flag="")
-    max_amplitude_deg: float = option(COLEMAN_MAX_AMPLITUDE_DEG,
-                                      help="largest cyclic pitch amplitude", unit="deg",
-                                      lo=0.0, lo_open=True, flag="")
+    max_amplitude_deg: Optional[float] = option(None, help="largest cyclic pitch amplitude "
+                                                "(default 2 deg, or less where the cyclic "
+                                                "at rated 1P would take more than half the "
+                                                "actuator's rate)", unit="deg",
+                                                lo=0.0, lo_open=True, flag="")
     weight_range: tuple[float, ...] = option((0.8, 0.95), help="power fractions of the fade-in",
                                              unit="-", lo=0.0, flag="")
 
@@ -749,7 +757,8 @@ class LQRPIOOptions(Options):
     w_flap_rate: Optional[float] = option(None, help="LQR weight on each blade's flap tip rate "
                                           "(scale 1 m/s; default 0 in region III, 0.2 in II)",
                                           unit="-", lo=0.0)
-    w_pitch: float = option(1.0, help="LQR input weight on each blade's pitch (scale 1 deg)",
+    w_pitch: float = option(1.0, help="LQR input weight on each blade's pitch (scale 1 deg "
+                            "x the square root of the pitch drives' rate over 8 deg/s)",
                             unit="-", lo=0.0, lo_open=True)
     design_wind_mps: Optional[float] = option(None, help="one design at this mean wind (Do et "
                                               "al.'s single point); default: designs from "
@@ -844,6 +853,15 @@ def _build_lqr_pio(ctx: BuildContext, opts: LQRPIOOptions) -> Built:
         "regions": "II below, III above " + f"{rated:.2f} m/s"}})
 
 
+#: The scheduled LQR's pitch scale goes with the pitch drives' largest rate to this power
+#: (:func:`mpc_wt.controllers.mpc.pitch_drive_scale_ratio`): 0.5 deg on the IEA-15-240-RWT
+#: (2 deg/s), 1 deg on the NREL 5-MW. On the IEA-15, seeds 11-12 of class B (not the
+#: sign-off's), the weight x 1 / 2 / 4 gave 4.56x / 3.34x / 2.86x the baseline's pitch travel;
+#: in the sign-off's IEA-15 subset x 1 / 4 / 8 gave 4.94x / 3.50x / 3.34x, the largest rotor
+#: speed 1.160 / 1.165 / 1.199 x rated.
+LQR_PITCH_SCALE_EXPONENT = 0.5
+
+
 def _lqr_pio_at(turbine: linearize.Turbine, model: linearize.LinearModel, wind: float,
                 opts: LQRPIOOptions, base: Any, stall_guard: bool = False) -> Any:
     """Do et al.'s LQR-PIO at one grid wind: region II below the rated wind, III above (the
@@ -861,10 +879,14 @@ def _lqr_pio_at(turbine: linearize.Turbine, model: linearize.LinearModel, wind: 
         turbine_scales,
     )
 
+    from mpc_wt.controllers.mpc import pitch_drive_scale_ratio
+
     region = "II" if wind < linearize.rated_wind_speed(turbine) else "III"
     w, iw = opts.lqr_weights(region)
-    lq = design_lqr(model, state_weights=w, input_weights=iw,
-                    scales={**REGION2_SCALES, **REGION3_SCALES})
+    scales = {**REGION2_SCALES, **REGION3_SCALES}
+    r = pitch_drive_scale_ratio(turbine, LQR_PITCH_SCALE_EXPONENT)   # slower drives: dearer
+    scales.update({k: v * r for k, v in scales.items() if k.startswith("pitch_ref_")})
+    lq = design_lqr(model, state_weights=w, input_weights=iw, scales=scales)
     if opts.observer_signals == "turbine":
         obs = design_pi_observer(model, q=opts.observer_q, measured=TURBINE_MEASURED,
                                  scales=turbine_scales(model))

@@ -167,8 +167,11 @@ def test_cost_scales_follow_the_turbine() -> None:
     """The MPC's default scales are the NREL 5-MW's typical magnitudes; for another turbine
     they follow its rated values: on the IEA-15-240-RWT the power scale is 3x (15 MW against
     5 MW, both published ratings) and the rotor-speed scale 7.56 / 12.1 rpm = 0.625x (the
-    published rated speeds), while angles keep theirs; for the NREL 5-MW nothing changes."""
-    from mpc_wt.controllers.mpc import MPCWeights, turbine_scale_ratios
+    published rated speeds); the pitch rate's scale goes with the pitch drives' largest rates
+    (2 deg/s against 8, both published) to the power 0.25: 0.25 ** 0.25 = 0.707x, and the
+    LQR's pitch scale to the power 0.5: 0.5x; angles keep theirs; for the NREL 5-MW nothing
+    changes."""
+    from mpc_wt.controllers.mpc import MPCWeights, pitch_drive_scale_ratio, turbine_scale_ratios
 
     five, fifteen = linearize.load_turbine("nrel5mw"), linearize.load_turbine("iea15mw")
     assert set(turbine_scale_ratios(five).values()) == {1.0}
@@ -178,7 +181,14 @@ def test_cost_scales_follow_the_turbine() -> None:
     w0 = MPCWeights()
     w = w0.for_turbine(fifteen)
     assert w.scales["gen_power"] == pytest.approx(3.0 * w0.scales["gen_power"])
-    assert w.scales["pitch_rate"] == w0.scales["pitch_rate"]
+    assert r["pitch_rate"] == pytest.approx(0.25 ** 0.25, rel=1e-3)
+    assert w.scales["pitch_rate"] == pytest.approx(0.25 ** 0.25 * w0.scales["pitch_rate"],
+                                                   rel=1e-3)
+    assert pitch_drive_scale_ratio(fifteen, 0.5) == pytest.approx(0.5, rel=1e-3)
+    assert pitch_drive_scale_ratio(five, 0.5) == 1.0
+    with pytest.raises(ValueError, match="exponent"):
+        pitch_drive_scale_ratio(fifteen, -1.0)
+    assert w.scales["pitch"] == w0.scales["pitch"]
     assert w0.for_turbine(five) == w0
 
 

@@ -144,6 +144,51 @@ def test_coleman_ipc_gives_the_collective_the_rate_first(turbine) -> None:
     assert_allclose(np.degrees(cmd), [12.1 + 0.04 + 0.06, 9.14, 9.14], atol=1e-12)
 
 
+def test_the_cyclic_amplitude_follows_the_pitch_drives(turbine) -> None:
+    """Hand-worked from published data: a cyclic pitch of amplitude A at 1P moves at A Omega.
+    The NREL 5-MW's drives reach 8 deg/s and its rotor turns at 12.1 rpm (1.267 rad/s): half
+    the rate allows 3.16 deg, so the 2 deg cap holds. The IEA-15-240-RWT's reach 2 deg/s at
+    7.56 rpm (0.792 rad/s): 1.26 deg. Both IPC designs take it by default, and IBC's loop
+    gain falls in proportion: 0.6 x 1.26 / 2 = 0.38 on the IEA-15, 0.6 on the NREL 5-MW."""
+    from mpc_wt.controllers.ipc import cyclic_amplitude_limit_deg, ibc_loop_gain
+
+    iea = linearize.load_turbine("iea15mw")
+    assert cyclic_amplitude_limit_deg(turbine) == 2.0
+    assert cyclic_amplitude_limit_deg(iea) == pytest.approx(0.5 * 2.0 / (7.56 * math.pi / 30),
+                                                            rel=2e-3)
+    assert cyclic_amplitude_limit_deg(turbine, rate_fraction=0.2) == pytest.approx(
+        0.2 * 8.0 / (12.1 * math.pi / 30), rel=2e-3)
+    a = math.radians(cyclic_amplitude_limit_deg(iea))
+    assert tune_coleman_ipc(iea, winds=[14.0]).max_amplitude_rad == pytest.approx(a)
+    assert tune_ibc(iea, winds=[14.0]).max_amplitude_rad == pytest.approx(a)
+    assert ibc_loop_gain(turbine) == 0.6
+    assert ibc_loop_gain(iea) == pytest.approx(0.6 * 0.5 * 2.0 / (7.56 * math.pi / 30) / 2.0,
+                                               rel=2e-3)
+    assert tune_ibc(iea, winds=[14.0]).info["target_loop_gain_1p"] == ibc_loop_gain(iea)
+    assert tune_ibc(turbine, winds=[14.0], max_amplitude_deg=1.5).max_amplitude_rad == \
+        pytest.approx(math.radians(1.5))
+    with pytest.raises(ValueError, match="rate_fraction"):
+        cyclic_amplitude_limit_deg(turbine, rate_fraction=1.5)
+    with pytest.raises(ValueError, match="max_amplitude_deg"):
+        tune_ibc(turbine, winds=[14.0], max_amplitude_deg=-1.0)
+
+
+def test_ibc_holds_each_blade_within_its_amplitude(turbine) -> None:
+    """With the loop gain at 3 (five times the default) and the amplitude at 0.5 deg, the
+    IBC pitch of every blade stays within +-0.5 deg and reaches it (the clamp acts), at 18
+    m/s in turbulence; the same design without the bound goes beyond."""
+    sc = Scenario(18.0, "A", 1, 60.0, shear_exponent=0.2)
+    peak = {}
+    for amp in (0.5, 20.0):
+        res = run_controller(turbine, "ibc", sc, options={"loop_gain_1p": 3.0,
+                                                          "min_gain_margin": 1.05,
+                                                          "max_amplitude_deg": amp})
+        peak[amp] = max(np.abs(np.degrees(res.channel(f"ibc_pitch_{b}"))).max()
+                        for b in (1, 2, 3))
+    assert peak[0.5] <= 0.5 + 1e-9 and peak[0.5] > 0.5 - 1e-6
+    assert peak[20.0] > 0.6
+
+
 @pytest.mark.slow
 def test_coleman_ipc_on_the_iea15_leaves_the_collective_its_rate() -> None:
     """The IEA-15 (2 deg/s drives, 1P 0.126 Hz): a 2.5 deg cyclic pitch needs all of the rate.

@@ -73,7 +73,8 @@ def test_registry_lists_every_kind_with_its_options() -> None:
     horizon = next(o for o in rows["mpc"]["options"] if o["name"] == "horizon")
     assert horizon["default"] == 15 and horizon["type"] == "int"
     # the options classes document themselves (numpydoc Parameters from the metadata)
-    assert "loop_gain_1p : float, default 0.6" in IBCOptions.__doc__
+    assert "min_gain_margin : float, default 2.0" in IBCOptions.__doc__
+    assert "loop_gain_1p : Optional[float], default None" in IBCOptions.__doc__
 
 
 @pytest.mark.parametrize("name, base, preset, addons", [

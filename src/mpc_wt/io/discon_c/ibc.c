@@ -1,7 +1,8 @@
 /* Individual blade control on the baseline (Pettas and Cheng 2018, fig. 3): each blade's root
  * out-of-plane moment high-passed, times the gain scheduled on the mean collective pitch,
  * band-stopped (and low-passed) at the rotor harmonics, faded in with the low-passed electrical
- * power, less the blades' mean (cyclic action only), added to the collective command within
+ * power, less the blades' mean (cyclic action only), each blade's within its largest amplitude,
+ * added to the collective command within
  * the pitch limits and rate. The filters are second-order sections in transposed direct form
  * II, started at the steady state of their first input (scipy's sosfilt_zi). */
 #include "mpcwt_discon.h"
@@ -90,6 +91,7 @@ int mw_ibc_step(mw_ibc *b, const mw_meas *m, double dt, const double *pc, double
         mean = (u[0] + u[1] + u[2]) / 3.0;
         for (i = 0; i < 3; i++) u[i] -= mean;
     }
+    for (i = 0; i < 3; i++) u[i] = dmin(dmax(u[i], -b->amp), b->amp);
     for (i = 0; i < 3; i++) {
         double prev = b->has_last ? b->last[i] : m->pitch[i], d = b->rate * dt;
         double v = dmin(dmax(pc[i] + u[i], b->pmin), b->pmax);
@@ -101,10 +103,10 @@ int mw_ibc_step(mw_ibc *b, const mw_meas *m, double dt, const double *pc, double
 
 int mw_ibc_read(const mw_input *in, mw_ibc *b, char *msg)
 {
-    double v[8];
+    double v[9];
     int i;
     memset(b, 0, sizeof(*b));
-    if (mw_getp_vec(in, "", "ibc_settings", v, 8, msg)
+    if (mw_getp_vec(in, "", "ibc_settings", v, 9, msg)
         || !(b->gp = mw_getp_alloc(in, "", "ibc_gain_pitch", &b->ng, msg))
         || !(b->gg = mw_getp_alloc_n(in, "", "ibc_gain", b->ng, msg))
         || mw_sos_read(in, "ibc", "ibc_input_sos", "ibc_input_zi", 3, &b->hp, msg)
@@ -118,11 +120,14 @@ int mw_ibc_read(const mw_input *in, mw_ibc *b, char *msg)
     b->pmax = v[5];
     b->rate = v[6];
     b->remove_mean = v[7] != 0.0;
+    b->amp = v[8];
     if (!(b->w_hi > b->w_lo) || !(b->rated > 0) || !(b->p_alpha >= 0 && b->p_alpha < 1)
-        || !(b->pmax >= b->pmin) || !(b->rate > 0) || (v[7] != 0.0 && v[7] != 1.0)) {
+        || !(b->pmax >= b->pmin) || !(b->rate > 0) || (v[7] != 0.0 && v[7] != 1.0)
+        || !(b->amp > 0)) {
         mw_msg(msg, "mpc-wt ibc: input file '%s': key 'ibc_settings' needs the weight's power "
                "fractions increasing, rated power > 0, power filter pole in [0, 1), pitch min "
-               "<= max, a rate > 0 and the mean removal 0 or 1", in->path);
+               "<= max, a rate > 0, the mean removal 0 or 1 and a largest amplitude > 0",
+               in->path);
         return -1;
     }
     for (i = 1; i < b->ng; i++) {

@@ -138,7 +138,7 @@ typedef struct {
     int on, ng, remove_mean, has_p, has_last;
     double *gp, *gg;
     mw_sos hp, bs;
-    double w_lo, w_hi, rated, p_alpha, pmin, pmax, rate, p_filt, last[3];
+    double w_lo, w_hi, rated, p_alpha, pmin, pmax, rate, amp, p_filt, last[3];
 } mw_ibc;
 int mw_ibc_read(const mw_input *in, mw_ibc *b, char *msg);
 void mw_ibc_free(mw_ibc *b);
