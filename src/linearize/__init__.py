@@ -45,6 +45,7 @@ from linearize.plant import PlantStepper, SimulationResult, plant_outputs, plant
 from linearize.steady import optimal_tsr, rotor_average, steady_coefficients
 from linearize.trim import (
     OperatingPoint,
+    max_torque_pitch,
     operating_point,
     operating_schedule,
     rated_wind_speed,
@@ -60,7 +61,7 @@ __all__ = [
     "element_wind",
     "plant_outputs", "plant_params", "plant_rhs", "rk4_simulate", "structural_frequencies",
     "optimal_tsr", "rotor_average", "steady_coefficients", "OperatingPoint", "TrimError",
-    "operating_point",
+    "operating_point", "max_torque_pitch",
     "operating_schedule", "rated_wind_speed", "trim", "Turbine", "TurbineFileError",
     "available_turbines",
     "load_turbine", "LinearizationError", "LinearModel", "LinearModelFamily",

@@ -35,7 +35,7 @@ from linearize.turbine import Turbine
 from linearize.validate import check_finite_scalar
 
 __all__ = ["TrimError", "OperatingPoint", "trim", "operating_point", "operating_schedule",
-           "rated_wind_speed"]
+           "rated_wind_speed", "max_torque_pitch"]
 
 
 @dataclass(frozen=True)
@@ -186,6 +186,40 @@ def _best_pitch(p: PlantParams, v: float, omega: float, fine: float, shear: floa
                           bounds=(fine, fine + math.radians(30.0)), method="bounded",
                           options={"xatol": 1e-9})
     return float(res.x)
+
+
+def max_torque_pitch(turbine: Turbine, wind_mps: float, rotor_speed_rad_s: float, *,
+                     config: PlantConfig | None = None, shear_exponent: float = 0.0,
+                     params: PlantParams | None = None) -> tuple[float, float]:
+    """The pitch between fine pitch and 30 deg above it that maximizes the rigid rotor's
+    azimuth-averaged aerodynamic torque at a steady wind and rotor speed, and that torque: the
+    pitch :func:`trim` holds in region 1.5 of a turbine whose rotor would brake at fine pitch,
+    at any rotor speed (a minimum-pitch schedule's point).
+
+    Parameters
+    ----------
+    turbine : Turbine
+    wind_mps : float
+        Hub-height wind [m/s], > 0.
+    rotor_speed_rad_s : float
+        Rotor speed [rad/s], > 0.
+    config, shear_exponent, params
+        As :func:`trim`.
+
+    Returns
+    -------
+    pitch_rad, aero_torque : float
+        [rad], [N m] (low-speed shaft).
+    """
+    v = check_finite_scalar("wind_mps", wind_mps)
+    om = check_finite_scalar("rotor_speed_rad_s", rotor_speed_rad_s)
+    if not (v > 0 and om > 0):
+        raise ValueError(f"wind_mps and rotor_speed_rad_s must be > 0, got {v!r} m/s and "
+                         f"{om!r} rad/s")
+    p = params if params is not None else plant_params(turbine, config)
+    fine = turbine.operation.fine_pitch_rad
+    b = _best_pitch(p, v, om, fine, float(shear_exponent))
+    return b, _aero(p, v, om, b, float(shear_exponent))[0]
 
 
 def trim(turbine: Turbine, wind_mps: float, power_W: float | None = None, *,

@@ -321,6 +321,17 @@ def test_makefile_builds_the_library(baseline_export, tmp_path):
     assert (tmp_path / baseline_export.library.name).is_file()
 
 
+def test_iea15_baseline_library_holds_the_minimum_pitch_schedule(tmp_path):
+    """The IEA-15's baseline at 5 m/s (class A, 120 s): the minimum-pitch schedule holds the
+    pitch 2.5-3.9 deg above fine, and the library's pitch demands are within 0.01 deg and its
+    torque within 0.1 % of rated of the Python controller's at every step."""
+    iea = linearize.load_turbine("iea15mw")
+    ex = export_discon(iea, "baseline", tmp_path / "iea")
+    dp, dq, py, lib = _compare(iea, "baseline", ex, 5.0)
+    assert dp <= 0.01 and dq <= 1e-3, (dp, dq)
+    assert math.degrees(float(np.mean(py.u[:, 0]))) > 2.0
+
+
 def test_iea15_export_has_its_deck_servodyn(tmp_path):
     iea = linearize.load_turbine("iea15mw")
     ex = export_discon(iea, "baseline", tmp_path, build=False)
@@ -421,6 +432,10 @@ def test_two_hosts_side_by_side(nrel5mw, baseline_export):
     (lambda t: t.replace("\ndt ", "\ndt 0.05 # "), ["DLL_DT", "0.05", "0.0125"]),
     (lambda t: t + "kp 1.0\n", ["'kp'", "twice"]),
     (lambda t: t.replace("\npitch_max ", "\npitch_max -1 # "), ["pitch_max >= pitch_min"]),
+    (lambda t: t.replace("\nmin_pitch_offsets ", "\nmin_pitch_offsets 0 -0.1 # "),
+     ["min_pitch_offsets", "increasing", ">= 0 rad"]),
+    (lambda t: t.replace("\nmin_pitch_offsets ", "\nmin_pitch_offsets 0.1 0 0 # "),
+     ["min_pitch_offsets", "as many values", "got 2 and 3"]),
 ])
 def test_bad_input_file_fails_with_the_file_and_key(nrel5mw, baseline_export, tmp_path, edit,
                                                      words):

@@ -5,6 +5,12 @@ mpc-wt from its own linear models.
   cut-in speed), 2 (K omega_g^2 with K from the optimal C_P), 2.5 (straight line to rated
   torque at rated speed with a slip), 3 (constant power, or constant torque), on the filtered
   generator speed; torque rate limited.
+* Minimum pitch: on a turbine whose rotor would brake at fine pitch at its minimum speed (the
+  trim's region 1.5 pitch, :func:`linearize.trim`; the IEA-15-240-RWT), the PI's lower limit
+  is the pitch that maximizes the aerodynamic torque at the steady point of region 1.5's torque
+  line, scheduled on the filtered generator speed (:func:`min_pitch_schedule`), as ROSCO's
+  minimum-pitch table does on its wind estimate. The NREL 5-MW keeps fine pitch (Jonkman's
+  baseline).
 * Collective pitch: PI on the filtered generator-speed error, gain-scheduled
   GK(theta) = 1 / (1 + theta / theta_K), with anti-windup (the integral is held so that the
   command stays within the pitch limits), rate-limited command.
@@ -31,11 +37,24 @@ import numpy as np
 
 import linearize
 from mpc_wt.controllers.base import ControllerBase
-from mpc_wt.controllers.baseline_law import N_STATE, SIGNALS, law_parameters, law_step
+from mpc_wt.controllers.baseline_law import (
+    N_STATE,
+    SIGNALS,
+    law_parameters,
+    law_step,
+    min_pitch_offset,
+)
 from mpc_wt.controllers.baseline_law import torque as law_torque
 
 __all__ = ["BaselineGains", "tune_baseline", "tune_baseline_schedule", "BaselineController",
-           "LawTorque", "check_power_fraction", "effective_pi_gains", "jonkman_gains"]
+           "LawTorque", "check_power_fraction", "effective_pi_gains", "jonkman_gains",
+           "min_pitch_schedule"]
+
+#: Region 1.5 of the torque law runs from the minimum rotor speed to this factor above it on
+#: the generator (the NREL 5-MW's 670 to 871 rpm; Jonkman et al. 2009, sec. 7.3).
+REGION15_SPAN = 1.3
+#: Breakpoints of the minimum-pitch schedule over region 1.5's speeds.
+MIN_PITCH_POINTS = 9
 
 
 def check_power_fraction(value: Any, name: str = "power_fraction") -> float:
@@ -119,6 +138,10 @@ class BaselineGains:
     power_fraction : float
         Fraction of the turbine's rated power this design was tuned for (1: normal operation;
         < 1: derated, ``rated_power`` and ``rated_torque`` already lowered) [-].
+    min_pitch_speeds, min_pitch_offsets : tuple of float
+        The minimum-pitch schedule: filtered generator speeds [rad/s] (increasing) and the
+        pitch above fine pitch that the PI may not go below there [rad], interpolated, held
+        beyond the ends (:func:`min_pitch_schedule`); empty: fine pitch throughout.
     """
 
     kp: float
@@ -133,6 +156,20 @@ class BaselineGains:
     zeta: float = 0.7
     power_fraction: float = 1.0
     info: dict[str, Any] = field(default_factory=dict, compare=False)
+    min_pitch_speeds: tuple[float, ...] = ()
+    min_pitch_offsets: tuple[float, ...] = ()
+
+    def __post_init__(self) -> None:
+        sp = tuple(float(x) for x in self.min_pitch_speeds)
+        off = tuple(float(x) for x in self.min_pitch_offsets)
+        if len(sp) != len(off) or (sp and (len(sp) < 2 or not all(math.isfinite(x) for x in sp + off)
+                                           or any(b <= a for a, b in zip(sp, sp[1:]))
+                                           or min(off) < 0.0)):
+            raise ValueError(f"min_pitch_speeds and min_pitch_offsets must be equally long (0 or "
+                             f">= 2 points), the speeds finite and increasing, the offsets finite "
+                             f"and >= 0 rad; got {sp!r} and {off!r}")
+        object.__setattr__(self, "min_pitch_speeds", sp)
+        object.__setattr__(self, "min_pitch_offsets", off)
 
 
 #: The NREL 5-MW's rated rotor speed, 12.1 rpm [rad/s]: the report's PI design (0.6 rad/s)
@@ -248,13 +285,89 @@ def tune_baseline(turbine: linearize.Turbine, *, omega_n_rad_s: float | None = N
     r = turbine.geometry.tip_radius * math.cos(turbine.geometry.precone_rad)
     rho = turbine.environment.air_density
     k_opt = 0.5 * rho * math.pi * r**5 * cp / lam**3 / n**3
+    sp, off = min_pitch_schedule(turbine, k_opt, params=params, tsr_opt=lam)
     return BaselineGains(kp=kp, ki=ki, theta_k_rad=theta_k, k_opt=k_opt,
                          rated_gen_speed_rad_s=turbine.rated_generator_speed_rad_s,
                          rated_torque=frac * turbine.rated_generator_torque,
                          rated_power=frac * turbine.operation.rated_power, dpdtheta_0=intercept,
                          omega_n_rad_s=omega_n_rad_s, zeta=zeta, power_fraction=frac,
                          info={"wake": wake, "inertia_lss": j, "tsr_opt": lam, "cp_max": cp,
-                               "fit_winds": v.tolist()})
+                               "fit_winds": v.tolist()},
+                         min_pitch_speeds=sp, min_pitch_offsets=off)
+
+
+def min_pitch_schedule(turbine: linearize.Turbine, k_opt: float, *,
+                       n_points: int = MIN_PITCH_POINTS,
+                       params: linearize.PlantParams | None = None,
+                       tsr_opt: float | None = None
+                       ) -> tuple[tuple[float, ...], tuple[float, ...]]:
+    """The baseline's minimum-pitch schedule over region 1.5 of its torque law.
+
+    Only where the trim pitches at cut-in (:func:`linearize.trim`: the rotor at its minimum
+    speed and fine pitch would brake, as the IEA-15-240-RWT's at 5 rpm and 3 m/s); otherwise
+    empty (fine pitch, Jonkman's NREL 5-MW baseline). Region 1.5's torque line
+    T(w) = K w_2^2 (w - w_1) / (w_2 - w_1) between the minimum generator speed w_1 and
+    w_2 = 1.3 w_1 (Jonkman et al. 2009, sec. 7.3) holds the rotor where the aerodynamic torque
+    equals N T(w). At each of ``n_points`` speeds on the line the schedule's pitch is the one
+    that maximizes the aerodynamic torque (:func:`linearize.max_torque_pitch`) at the wind where
+    that largest torque equals N T(w); the steady torque scales with V^2 at a given tip-speed
+    ratio and pitch, so one table over the tip-speed ratio serves every speed. The last point,
+    w_2, is fine pitch, where region 2's optimal tip-speed ratio begins. At the torque-maximizing
+    pitch the torque's pitch sensitivity is zero, so the schedule feeds nothing back through
+    the speed to first order.
+
+    Parameters
+    ----------
+    turbine : Turbine
+    k_opt : float
+        The region-2 torque gain [N m/(rad/s)^2].
+    n_points : int
+        Breakpoints, >= 3.
+    params : PlantParams, optional
+        Prebuilt plant parameters of ``turbine``.
+    tsr_opt : float, optional
+        The optimal tip-speed ratio at fine pitch (default :func:`linearize.optimal_tsr`).
+
+    Returns
+    -------
+    speeds, offsets : tuple of float
+        Filtered generator speeds [rad/s] and the pitch above fine pitch [rad]; both empty
+        where the trim keeps fine pitch.
+    """
+    if int(n_points) < 3:
+        raise ValueError(f"n_points must be >= 3, got {n_points!r}")
+    if not (math.isfinite(k_opt) and k_opt > 0):
+        raise ValueError(f"k_opt must be finite and > 0 N m/(rad/s)^2, got {k_opt!r}")
+    op = turbine.operation
+    p = params if params is not None else linearize.plant_params(turbine)
+    fine = op.fine_pitch_rad
+    if not linearize.trim(turbine, op.cut_in_wind, params=p).pitch_rad > fine + 1e-9:
+        return (), ()                               # the trim keeps fine pitch at cut-in
+    n = turbine.drivetrain.gearbox_ratio
+    w1 = op.min_rotor_speed_rad_s * n
+    w2 = REGION15_SPAN * w1
+    slope = k_opt * w2**2 / (w2 - w1)
+    r = turbine.geometry.tip_radius * math.cos(turbine.geometry.precone_rad)
+    q_ref = 0.5 * turbine.environment.air_density * math.pi * r**5
+    # the steady aerodynamic torque scales with V^2 at a given tip-speed ratio and pitch, so
+    # the largest torque over pitch is Q* = q_ref Omega^2 g(lambda) with one g for all speeds
+    om = op.min_rotor_speed_rad_s
+    lam_opt = (linearize.optimal_tsr(turbine, math.degrees(fine))[0] if tsr_opt is None
+               else float(tsr_opt))
+    lam = np.geomspace(0.8 * lam_opt, om * r / (0.5 * op.cut_in_wind), 24)
+    best = [linearize.max_torque_pitch(turbine, om * r / x, om, params=p) for x in lam]
+    g = np.array([q for _, q in best]) / (q_ref * om**2)
+    theta = np.array([b for b, _ in best])
+    keep = np.r_[True, np.diff(g) < 0]                 # decreasing in lambda
+    lam, g, theta = lam[keep], g[keep], theta[keep]
+    speeds = np.linspace(w1, w2, int(n_points))
+    offsets = []
+    for w in speeds[:-1]:
+        c = n * slope * (w - w1) / (q_ref * (w / n) ** 2)
+        x = float(np.interp(c, g[::-1], lam[::-1]))     # clamped at the table's ends
+        offsets.append(max(0.0, float(np.interp(x, lam, theta)) - fine))
+    offsets.append(0.0)
+    return tuple(float(x) for x in speeds), tuple(offsets)
 
 
 def tune_baseline_schedule(turbine: linearize.Turbine,
@@ -373,7 +486,7 @@ class BaselineController(ControllerBase):
         # region 1.5 runs from the minimum rotor speed to 30 % above it on the generator (the
         # NREL 5-MW's 670 and 871 rpm)
         self.w_cutin = turbine.operation.min_rotor_speed_rad_s * n
-        self.w_rgn2 = 1.3 * self.w_cutin
+        self.w_rgn2 = REGION15_SPAN * self.w_cutin
         self.w_rated = 0.99 * g.rated_gen_speed_rad_s
         self.w_sync = self.w_rated / (1.0 + 0.01 * slip_pct)
         self.slope25 = g.rated_power / turbine.drivetrain.generator_efficiency / self.w_rated \
@@ -388,6 +501,11 @@ class BaselineController(ControllerBase):
         self.tq_cap = g.rated_power / turbine.drivetrain.generator_efficiency / self.w_rated
         if self.w_trans > self.w_rated:
             self.w_trans = self.w_rated
+        #: the minimum-pitch schedule: filtered generator speeds [rad/s] and pitch above fine
+        #: pitch [rad] (the design's; two zero offsets over region 1.5 where it has none)
+        self.min_pitch_speeds: tuple[float, ...] = (g.min_pitch_speeds or
+                                                    (self.w_cutin, self.w_rgn2))
+        self.min_pitch_offsets: tuple[float, ...] = g.min_pitch_offsets or (0.0, 0.0)
         self._par = law_parameters(self)
         self._cmd, self._sig = np.zeros(4), np.zeros(len(SIGNALS))
         self.reset()
@@ -402,6 +520,22 @@ class BaselineController(ControllerBase):
         self.pitch_feedforward: float | None = None
         self._ff_last: float | None = None
         self.signals: dict[str, float] = {}
+
+    def min_pitch(self, w_filt: float) -> float:
+        """The PI's lower pitch limit at a filtered generator speed: fine pitch plus the
+        minimum-pitch schedule's offset (:func:`min_pitch_schedule`) [rad].
+
+        Parameters
+        ----------
+        w_filt : float
+            Filtered generator speed [rad/s].
+
+        Returns
+        -------
+        float
+            [rad]
+        """
+        return self.pitch_min + float(min_pitch_offset(float(w_filt), self._par))
 
     @property
     def started(self) -> bool:
@@ -525,8 +659,8 @@ class BaselineController(ControllerBase):
             cmd, tq, err = self._scheduled_step(w, pitch_meas, p_ref)
         if p_ref is not None:
             self.signals["power_reference"] = p_ref
-            self.signals["apc_saturated"] = float(cmd <= self.pitch_min + 1e-9
-                                                  and err < 0.0)
+            p_lo = self.pitch_min + float(min_pitch_offset(float(self._st[0]), self._par))
+            self.signals["apc_saturated"] = float(cmd <= p_lo + 1e-9 and err < 0.0)
         return np.array((cmd, cmd, cmd)), tq
 
     def _scheduled_step(self, w: float, pitch_meas: float, p_ref: float | None
@@ -559,12 +693,14 @@ class BaselineController(ControllerBase):
             eta = self.turbine.drivetrain.generator_efficiency
             ff = (p_ref - self._p_ref_last) / eta / dpdt
             self._p_ref_last = p_ref
+        off = float(min_pitch_offset(w_filt, self._par))
+        p_lo = self.pitch_min + off
         integral = min(max(float(st[1]) + ki * err * self.dt + ff + self._ff_step(),
-                           self.pitch_min), self.pitch_max)
-        cmd = min(max(kp * err + integral, self.pitch_min), self.pitch_max)
+                           p_lo), self.pitch_max)
+        cmd = min(max(kp * err + integral, p_lo), self.pitch_max)
         step = self.rate * self.dt
         cmd = min(max(cmd, last_pitch - step), last_pitch + step)
-        tq = min(self.torque(w_filt, cmd, p_ref), self.tq_max)
+        tq = min(self.torque(w_filt, cmd - off, p_ref), self.tq_max)
         if not first:
             d = self.tq_rate * self.dt
             tq = min(max(tq, float(st[3]) - d), float(st[3]) + d)

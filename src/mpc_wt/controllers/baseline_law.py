@@ -4,7 +4,9 @@ parameter vector.
 The law of Jonkman's baseline (NREL/TP-500-38060, sec. 7): a first-order low-pass on the
 generator speed; a PI on the filtered speed error with the gain schedule
 GK = 1 / (1 + theta / theta_K) applied at the previous command, the integral kept within the
-pitch limits (anti-windup) and a bumpless start at the measured pitch; the pitch-rate limit; the
+pitch limits (anti-windup) and a bumpless start at the measured pitch; the lower pitch limit
+raised by the minimum-pitch schedule on the filtered speed (region 3 of the torque law then
+counts from that minimum); the pitch-rate limit; the
 torque law of regions 1.5, 2, 2.5 and 3 (constant power or constant torque) capped at the
 maximum torque, and its rate limit. :class:`~mpc_wt.controllers.baseline.BaselineController`
 runs it from Python at each step (:func:`law_step`); the closed loop compiled with the plant
@@ -19,7 +21,8 @@ from typing import Any
 import numba as nb
 import numpy as np
 
-__all__ = ["SIGNALS", "N_STATE", "N_PARAMS", "law_parameters", "law_step", "torque", "law"]
+__all__ = ["SIGNALS", "N_STATE", "N_PARAMS", "law_parameters", "law_step", "torque", "law",
+           "min_pitch_offset"]
 
 _JIT = dict(cache=True, error_model="numpy")
 
@@ -30,9 +33,10 @@ SIGNALS = ("gen_speed_filtered", "speed_error", "pitch_integral", "gain_schedule
 # parameter vector layout
 (_A, _W_RATED_SET, _KP, _KI, _THETA_K, _DT, _P_MIN, _P_MAX, _RATE, _TQ_RATE, _TQ_MAX,
  _W_CUTIN, _W_RGN2, _W_TRANS, _W_RATED, _W_SYNC, _SLOPE15, _SLOPE25, _K_OPT, _TQ_CAP,
- _P_RATED, _ETA, _TQ_RATED, _CONST_POWER, _ONE_DEG, _I_GEN_SPEED) = range(26)
-#: length of the parameter vector
-N_PARAMS = 26
+ _P_RATED, _ETA, _TQ_RATED, _CONST_POWER, _ONE_DEG, _I_GEN_SPEED, _N_MIN_PITCH) = range(27)
+#: length of the parameter vector's fixed part; the minimum-pitch schedule's speeds and offsets
+#: follow it (``par[_N_MIN_PITCH]`` points each)
+N_PARAMS = 27
 
 # state vector layout: filtered speed, integral, last pitch, last torque, started (0 / 1)
 _W_FILT, _INTEGRAL, _LAST_PITCH, _LAST_TQ, _STARTED = range(5)
@@ -52,10 +56,16 @@ def law_parameters(ctl: Any, gen_speed_index: int = -1) -> np.ndarray:
 
     Returns
     -------
-    (N_PARAMS,) ndarray
+    (N_PARAMS + 2 k,) ndarray
+        The fixed part, then the minimum-pitch schedule's k speeds [rad/s] and offsets above
+        the minimum pitch [rad] (the controller's ``min_pitch_speeds``, ``min_pitch_offsets``).
     """
     g = ctl.gains
-    par = np.empty(N_PARAMS)
+    ws, offs = np.array(ctl.min_pitch_speeds, float), np.array(ctl.min_pitch_offsets, float)
+    k = ws.size
+    par = np.empty(N_PARAMS + 2 * k)
+    par[_N_MIN_PITCH] = k
+    par[N_PARAMS:N_PARAMS + k], par[N_PARAMS + k:] = ws, offs
     par[[_A, _W_RATED_SET, _KP, _KI, _THETA_K, _DT, _P_MIN, _P_MAX, _RATE, _TQ_RATE]] = (
         ctl.filter_pole, g.rated_gen_speed_rad_s, g.kp, g.ki, g.theta_k_rad, ctl.dt,
         ctl.pitch_min, ctl.pitch_max, ctl.rate, ctl.tq_rate)
@@ -89,6 +99,14 @@ def torque(w, pitch, p3, par):  # pragma: no cover - compiled
 
 
 @nb.njit(**_JIT)
+def min_pitch_offset(w, par):  # pragma: no cover - compiled
+    """The minimum-pitch schedule's pitch above the minimum [rad] at filtered generator speed
+    ``w`` [rad/s], held beyond the schedule's ends."""
+    k = int(par[_N_MIN_PITCH])
+    return np.interp(w, par[N_PARAMS:N_PARAMS + k], par[N_PARAMS + k:N_PARAMS + 2 * k])
+
+
+@nb.njit(**_JIT)
 def law_step(w, pitch_meas, ff, p3, st, par, cmd, sig):  # pragma: no cover - compiled
     """One step of the law: measured generator speed ``w`` [rad/s] and mean pitch [rad], the
     change of an add-on's feedforward pitch since the last step ``ff`` [rad] (it enters the
@@ -107,14 +125,16 @@ def law_step(w, pitch_meas, ff, p3, st, par, cmd, sig):  # pragma: no cover - co
     if first:                                   # bumpless start at the measured pitch
         st[_INTEGRAL] = (pitch_meas / gk - kp * err) / ki
     st[_INTEGRAL] += err * dt + ff / (gk * ki)
-    lo, hi = par[_P_MIN] / (gk * ki), par[_P_MAX] / (gk * ki)
+    off = min_pitch_offset(st[_W_FILT], par)
+    p_lo = par[_P_MIN] + off
+    lo, hi = p_lo / (gk * ki), par[_P_MAX] / (gk * ki)
     st[_INTEGRAL] = min(max(st[_INTEGRAL], lo), hi)
     p = gk * (kp * err + ki * st[_INTEGRAL])
-    p = min(max(p, par[_P_MIN]), par[_P_MAX])
+    p = min(max(p, p_lo), par[_P_MAX])
     step = par[_RATE] * dt
     p = min(max(p, st[_LAST_PITCH] - step), st[_LAST_PITCH] + step)
     st[_LAST_PITCH] = p
-    tq = min(torque(st[_W_FILT], p, p3, par), par[_TQ_MAX])
+    tq = min(torque(st[_W_FILT], p - off, p3, par), par[_TQ_MAX])
     if st[_STARTED] == 1.0:
         d = par[_TQ_RATE] * dt
         tq = min(max(tq, st[_LAST_TQ] - d), st[_LAST_TQ] + d)

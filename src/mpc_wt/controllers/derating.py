@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import math
-from typing import Any, Mapping, Sequence
+from typing import Any, Callable, Mapping, Sequence
 
 import numpy as np
 
@@ -20,10 +20,11 @@ __all__ = ["steady_power_curve", "aep_change"]
 def steady_power_curve(turbine: linearize.Turbine, gains: BaselineGains,
                        winds: Any) -> dict[str, np.ndarray]:
     """Steady electrical power and rotor speed of the baseline torque law with ``gains``
-    (normal or derated) in uniform steady wind, pitch at fine pitch below rated.
+    (normal or derated) in uniform steady wind, below rated at fine pitch or the design's
+    minimum-pitch schedule (:func:`~mpc_wt.controllers.baseline.min_pitch_schedule`).
 
-    Below rated, the rotor speed solves Q_aero(V, Omega, fine pitch) = N T_law(N Omega), with
-    C_P from :func:`linearize.steady_coefficients`; where the aerodynamic torque exceeds the law
+    Below rated, the rotor speed solves Q_aero(V, Omega, theta_min(N Omega)) = N T_law(N Omega),
+    with C_P from :func:`linearize.steady_coefficients`; where the aerodynamic torque exceeds the law
     at rated speed, the pitch loop holds rated speed and the power is the (derated) rated power.
 
     Returns
@@ -53,12 +54,12 @@ def steady_power_curve(turbine: linearize.Turbine, gains: BaselineGains,
     rproj = turbine.geometry.tip_radius * math.cos(turbine.geometry.precone_rad)
     rho = turbine.environment.air_density
     lam = np.linspace(0.5, 25.0, 400)
-    cp, _ = linearize.steady_coefficients(turbine, lam, math.degrees(op.fine_pitch_rad))
     fine = op.fine_pitch_rad
     w_top = ctl.w_rated / n
+    cp_at = _cp_below_rated(turbine, ctl, lam)
 
     def resid(om: float, vv: float) -> float:
-        q = 0.5 * rho * math.pi * rproj**2 * vv**3 * float(np.interp(om * rproj / vv, lam, cp)) / om
+        q = 0.5 * rho * math.pi * rproj**2 * vv**3 * cp_at(om * rproj / vv, om) / om
         return q - n * ctl.torque(om * n, fine)
 
     power, speed, region = [], [], []
@@ -82,6 +83,27 @@ def steady_power_curve(turbine: linearize.Turbine, gains: BaselineGains,
                       else "1.5")
     return {"wind_mps": v, "power_W": np.asarray(power), "rotor_speed_rad_s": np.asarray(speed),
             "region": np.asarray(region)}
+
+
+def _cp_below_rated(turbine: linearize.Turbine, ctl: BaselineController, lam: np.ndarray
+                    ) -> Callable[[float, float], float]:
+    """C_P(tip-speed ratio, rotor speed [rad/s]) below rated: at fine pitch, or at the
+    controller's minimum-pitch schedule on the generator speed (a cubic table over tip-speed
+    ratio and pitch)."""
+    fine = turbine.operation.fine_pitch_rad
+    n = turbine.drivetrain.gearbox_ratio
+    offs = np.asarray(ctl.min_pitch_offsets, float)
+    if not np.any(offs > 0):
+        cp_fine, _ = linearize.steady_coefficients(turbine, lam, math.degrees(fine))
+        return lambda x, om: float(np.interp(x, lam, cp_fine))
+    from scipy.interpolate import RegularGridInterpolator
+
+    lam2 = np.linspace(float(lam[0]), float(lam[-1]), 200)
+    pit = np.linspace(fine, fine + float(offs.max()), 13)
+    grid, _ = linearize.steady_coefficients(turbine, lam2[:, None], np.degrees(pit)[None, :])
+    table = RegularGridInterpolator((lam2, pit), grid, method="cubic", bounds_error=False,
+                                    fill_value=None)
+    return lambda x, om: float(table((x, ctl.min_pitch(om * n))))
 
 
 def aep_change(turbine: linearize.Turbine, fractions: Sequence[float] = (0.9, 0.8), *,

@@ -248,6 +248,12 @@ def _baseline_entries(ctl: Any, prefix: str = "") -> list[tuple[str, Any, str]]:
         ("region3_constant_power", float(ctl.region3 == "constant_power"),
          "1: constant power above rated, 0: constant torque"),
     ]
+    rows += [
+        ("min_pitch_speeds", np.array(ctl.min_pitch_speeds, float),
+         "minimum-pitch schedule: filtered generator speeds [rad/s]"),
+        ("min_pitch_offsets", np.array(ctl.min_pitch_offsets, float),
+         "minimum-pitch schedule: pitch above pitch_min [rad]"),
+    ]
     return [(prefix + k, v, doc) for k, v, doc in rows]
 
 
@@ -539,10 +545,11 @@ def _lqr_entries(ctl: Any) -> list[tuple[str, Any, str]]:
     if laws:
         lt = laws[0]
         first = _baseline_entries(lt.law, "law.")
-        ref = [v for _, v, _ in first] + [lt._a, lt._offset]
+        ref = np.concatenate([np.atleast_1d(v) for _, v, _ in first] + [[lt._a, lt._offset]])
         for x in laws[1:]:
-            other = [v for _, v, _ in _baseline_entries(x.law, "law.")] + [x._a, x._offset]
-            if not np.allclose(ref, other, rtol=0.0, atol=0.0, equal_nan=True):
+            other = np.concatenate([np.atleast_1d(v) for _, v, _ in
+                                    _baseline_entries(x.law, "law.")] + [[x._a, x._offset]])
+            if ref.shape != other.shape or not np.array_equal(ref, other, equal_nan=True):
                 raise ValueError("the LQR-PIO exports with one torque law for every design")
         rows += _law_entries(lt)
     for k, c in enumerate(pts):
@@ -947,7 +954,9 @@ def export_design(doc: Mapping[str, Any], turbine: linearize.Turbine, out: str |
                           rated_gen_speed_rad_s=s["rated_gen_speed_rad_s"],
                           rated_torque=s["rated_torque"], rated_power=s["rated_power"],
                           dpdtheta_0=math.nan, omega_n_rad_s=s.get("omega_n_rad_s", 0.6),
-                          zeta=s.get("zeta", 0.7), power_fraction=s.get("power_fraction", 1.0))
+                          zeta=s.get("zeta", 0.7), power_fraction=s.get("power_fraction", 1.0),
+                          min_pitch_speeds=tuple(s.get("min_pitch_speeds_rad_s", ())),
+                          min_pitch_offsets=tuple(s.get("min_pitch_offsets_rad", ())))
     ctl = BaselineController(turbine, gains)
     return export_controller(ctl, "baseline", turbine, out, build=build, compiler=compiler,
                              source=f"from the design of omega_n {gains.omega_n_rad_s:g} rad/s, "

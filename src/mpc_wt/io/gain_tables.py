@@ -127,6 +127,8 @@ def baseline_table(turbine: linearize.Turbine, gains: Any,
                 "max_torque_rate": turbine.generator.max_torque_rate,
                 "min_gen_speed_rad_s": op.min_rotor_speed_rad_s
                 * turbine.drivetrain.gearbox_ratio,
+                "min_pitch_speeds_rad_s": list(gains.min_pitch_speeds),
+                "min_pitch_offsets_rad": list(gains.min_pitch_offsets),
                 "units": {"kp": "s", "ki": "-", "theta_k_rad": "rad",
                           "k_opt": "N m/(rad/s)^2", "rated_torque": "N m", "rated_power": "W"}}
     return _doc("baseline", turbine, settings,

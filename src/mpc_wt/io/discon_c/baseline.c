@@ -58,6 +58,39 @@ double mw_law_torque(const mw_law *c, double w, double pitch, double p3)
     return dmin(dmin(tq, c->tq_cap), p3 / c->eta / dmax(w, 1e-6));
 }
 
+/* the minimum-pitch schedule: keys min_pitch_speeds [rad/s] (2..MW_MIN_PITCH_MAX, increasing)
+ * and min_pitch_offsets [rad] (as many, >= 0) */
+static int read_min_pitch(const mw_input *in, const char *pre, mw_law *c, char *msg)
+{
+    int n = 0, m = 0, i, bad = 0;
+    double *w = mw_getp_alloc(in, pre, "min_pitch_speeds", &n, msg), *off;
+    if (!w) return -1;
+    off = mw_getp_alloc(in, pre, "min_pitch_offsets", &m, msg);
+    if (!off) {
+        free(w);
+        return -1;
+    }
+    if (n != m || n < 2 || n > MW_MIN_PITCH_MAX) bad = 1;
+    for (i = 0; !bad && i < n; i++)
+        if (!mw_finite(w[i]) || !mw_finite(off[i]) || off[i] < 0.0 || (i > 0 && !(w[i] > w[i - 1])))
+            bad = 1;
+    if (bad) {
+        mw_msg(msg, "mpc-wt baseline: input file '%s': %smin_pitch_speeds and %smin_pitch_offsets "
+               "must hold as many values, 2 to %d, the speeds finite and increasing, the offsets "
+               "finite and >= 0 rad (got %d and %d values)", in->path, pre, pre, MW_MIN_PITCH_MAX,
+               n, m);
+        free(w);
+        free(off);
+        return -1;
+    }
+    c->mp_n = n;
+    memcpy(c->mp_w, w, (size_t)n * sizeof(double));
+    memcpy(c->mp_off, off, (size_t)n * sizeof(double));
+    free(w);
+    free(off);
+    return 0;
+}
+
 int mw_law_read(const mw_input *in, const char *pre, mw_law *c, char *msg)
 {
     double corner_hz, cp;
@@ -97,7 +130,12 @@ int mw_law_read(const mw_input *in, const char *pre, mw_law *c, char *msg)
     c->a = exp(-2.0 * MW_PI * corner_hz * c->dt);
     c->constant_power = cp != 0.0;
     c->one_deg = MW_PI / 180.0;
-    return 0;
+    return read_min_pitch(in, pre, c, msg);
+}
+
+double mw_law_min_pitch_offset(const mw_law *c, double w)
+{
+    return mw_interp(w, c->mp_w, c->mp_off, c->mp_n);
 }
 
 /* exp(A) of a 3 x 3 matrix: scaling and squaring of its Taylor series (to rounding) */
@@ -239,7 +277,7 @@ static int baseline_step(mw_ctrl *self, const mw_meas *m, mw_cmd *out, char *msg
 {
     mw_baseline *b = (mw_baseline *)self;
     const mw_law *c = &b->law;
-    double w = m->gen_speed, pitch_meas, err, gk, lo, hi, p, step, tq, ffd = 0.0;
+    double w = m->gen_speed, pitch_meas, err, gk, lo, hi, p, step, tq, off, p_lo, ffd = 0.0;
     int first = !b->started;
     if (b->ff.on) {
         double ff;
@@ -268,15 +306,17 @@ static int baseline_step(mw_ctrl *self, const mw_meas *m, mw_cmd *out, char *msg
     gk = 1.0 / (1.0 + b->last_pitch / c->theta_k);
     if (first) b->integral = (pitch_meas / gk - c->kp * err) / c->ki;
     b->integral += err * c->dt + ffd / (gk * c->ki);
-    lo = c->p_min / (gk * c->ki);
+    off = mw_law_min_pitch_offset(c, b->w_filt);
+    p_lo = c->p_min + off;
+    lo = p_lo / (gk * c->ki);
     hi = c->p_max / (gk * c->ki);
     b->integral = dmin(dmax(b->integral, lo), hi);
     p = gk * (c->kp * err + c->ki * b->integral);
-    p = dmin(dmax(p, c->p_min), c->p_max);
+    p = dmin(dmax(p, p_lo), c->p_max);
     step = c->rate * c->dt;
     p = dmin(dmax(p, b->last_pitch - step), b->last_pitch + step);
     b->last_pitch = p;
-    tq = dmin(mw_law_torque(c, b->w_filt, p, c->p_rated), c->tq_max);
+    tq = dmin(mw_law_torque(c, b->w_filt, p - off, c->p_rated), c->tq_max);
     if (!first) {
         double d = c->tq_rate * c->dt;
         tq = dmin(dmax(tq, b->last_tq - d), b->last_tq + d);

@@ -100,14 +100,20 @@ double *mw_getp_alloc_n(const mw_input *in, const char *prefix, const char *key,
                         char *msg);
 
 /* the baseline's torque law and PI data (Jonkman's law, regions 1.5, 2, 2.5, 3) */
+#define MW_MIN_PITCH_MAX 64
 typedef struct {
     double a, w_set, kp, ki, theta_k, dt, p_min, p_max, rate, tq_rate, tq_max;
     double w_cutin, w_rgn2, w_trans, w_rated, w_sync, slope15, slope25, k_opt, tq_cap;
     double p_rated, eta, tq_rated, one_deg;
     int constant_power;
+    /* the minimum-pitch schedule: filtered generator speeds and pitch above p_min */
+    int mp_n;
+    double mp_w[MW_MIN_PITCH_MAX], mp_off[MW_MIN_PITCH_MAX];
 } mw_law;
 int mw_law_read(const mw_input *in, const char *prefix, mw_law *law, char *msg);
 double mw_law_torque(const mw_law *law, double w, double pitch, double p3);
+/* the minimum-pitch schedule's pitch above p_min at filtered generator speed w [rad] */
+double mw_law_min_pitch_offset(const mw_law *law, double w);
 
 /* the baseline's torque schedule as another controller's generator torque: the generator
  * speed low-passed at the law's corner, the pitch counted from the below-rated offset under
