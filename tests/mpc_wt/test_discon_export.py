@@ -209,6 +209,41 @@ def test_ts_library_runs_as_the_python_controller(nrel5mw, ts_export, wind):
     _check_dels(py, lib)
 
 
+def test_ts_library_holds_a_minimum_pitch_schedule_as_the_python_controller(nrel5mw, tmp_path):
+    """TS on a torque law with a minimum-pitch schedule (0.8 deg above fine pitch over the
+    whole speed range, so that it acts on the NREL 5-MW at 7 m/s, where the trim is at fine
+    pitch; below the 1 deg at which the torque schedule reads region 3): the pitch rises from the trim's to the schedule's at the drives' rate, and the
+    library's pitch and torque follow the Python controller's at every step (within 0.01 deg
+    and 0.1 % of rated)."""
+    import dataclasses
+
+    from mpc_wt.controllers.baseline import BaselineController, LawTorque
+    from mpc_wt.io.discon_export import export_controller
+    from mpc_wt.run import build_controller
+    from mpc_wt.simulation.loop import simulate_closed_loop
+    from mpc_wt.simulation.scenario import Scenario
+
+    built, _, _ = build_controller(nrel5mw, "ts", Scenario(7.0, duration=30.0))
+    ctl = built.controller
+    law = ctl.torque_law
+    g = dataclasses.replace(law.gains, min_pitch_speeds=(law.w_cutin, law.w_rated),
+                            min_pitch_offsets=(math.radians(0.8), math.radians(0.8)))
+    ctl.torque_law = BaselineController(nrel5mw, g)
+    ctl._law = LawTorque(ctl.torque_law, ctl.dt)
+    ex = export_controller(ctl, "ts", nrel5mw, tmp_path / "ts_min_pitch")
+    lib = DisconController(ex.library, ex.input_file, nrel5mw)
+    op = linearize.trim(nrel5mw, 7.0)
+    params = linearize.plant_params(nrel5mw)
+    runs = [simulate_closed_loop(params, c, linearize.SteadyWind(7.0), 30.0, x0=op.x, u0=op.u)
+            for c in (ctl, lib)]
+    lib.finalize()
+    py, cc = runs
+    assert abs(math.degrees(py.u[-1, 0]) - 0.8) < 0.05
+    dp = float(np.degrees(np.max(np.abs(py.u[:, :3] - cc.u[:, :3]))))
+    dq = float(np.max(np.abs(py.u[:, 3] - cc.u[:, 3]))) / nrel5mw.rated_generator_torque
+    assert dp <= 0.01 and dq <= 1e-3, (dp, dq)
+
+
 @pytest.mark.parametrize("wind", [8.0, 12.0, 18.0])
 def test_ibc_library_runs_as_the_python_controller(nrel5mw, ibc_export, wind):
     """Individual blade control on the baseline (the root moments high-passed, the gain

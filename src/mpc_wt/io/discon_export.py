@@ -450,8 +450,9 @@ def _mpc_entries(ctl: Any, preview: Any = None) -> list[tuple[str, Any, str]]:
                  "1: a notch on the torque command (the estimator is given the filtered torque)"))
     if notch is not None:
         rows += [("torque_notch_sos", notch.sos.ravel(),
-                  f"its sections b0 b1 b2 a0 a1 a2 (centre {ctl.torque_notch_hz:.6g} Hz, Q "
-                  f"{ctl.torque_notch_q:g})"),
+                  f"its sections b0 b1 b2 a0 a1 a2 (centres "
+                  f"{', '.join(f'{f:.6g}' for f in (ctl.torque_notch_hz, ctl.tower_notch_hz) if f is not None)}"
+                  f" Hz, Q {ctl.torque_notch_q:g})"),
                  ("torque_notch_zi", np.asarray(notch._zi1, float).ravel(),
                   "their state at a unit input's steady state"),
                  ("torque_notch_rate", float(ctl.turbine.generator.max_torque_rate),

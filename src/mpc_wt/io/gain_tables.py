@@ -410,6 +410,7 @@ def mpc_table(turbine: linearize.Turbine, ctl: Any, kind: str,
                 "control_horizon": st.hu, "schedule_time_constant": ctl.schedule.tau,
                 "target_time_constant": ctl.target_tau,
                 "torque_notch_hz": ctl.torque_notch_hz, "torque_notch_q": ctl.torque_notch_q,
+                "tower_notch_hz": ctl.tower_notch_hz,
                 "region_floor": None if ctl.region_floor is None else {
                     "pitch_above": ctl.region_floor.pitch_threshold,
                     "pitch_counts_above_rotor_speed": ctl.region_floor.pitch_min_speed
@@ -419,7 +420,7 @@ def mpc_table(turbine: linearize.Turbine, ctl: Any, kind: str,
                     "region3_wind": ctl.region_floor.region3_wind},
                 "units": {"dt": "s", "schedule_time_constant": "s",
                           "target_time_constant": "s", "torque_notch_hz": "Hz",
-                          "region_floor": "rad, rad/s, m/s"}}
+                          "tower_notch_hz": "Hz", "region_floor": "rad, rad/s, m/s"}}
     return _doc(kind, turbine, settings,
                 ["wind_speed", "pitch", "gen_torque", "rotor_speed", "gen_power",
                  "estimator_spectral_radius"], ["m/s", "rad", "N m", "rad/s", "W", "-"], rows,

@@ -332,3 +332,26 @@ def test_lqr_pio_rides_through_an_eog_at_rated() -> None:
     w = res.channel("rotor_speed") / t.operation.rated_rotor_speed_rad_s
     assert 0.8 < w.min() and w.max() < 1.2
     assert res.meta["run_warnings"] == []
+
+
+def test_the_scheduled_lqr_weights_follow_the_pitch_drives() -> None:
+    """The scheduled LQR-PIO's default rotor-speed weight (region III) goes with the inverse
+    square root of the pitch drives' rate over 8 deg/s and its tower fore-aft weight with that
+    ratio itself: on the NREL 5-MW (8 deg/s) exactly Do et al.'s defaults as before (10 and
+    1), on the IEA-15-240-RWT (2 deg/s) 20 and 0.25. Weights set as options, and the
+    single-point design, are left as given."""
+    from mpc_wt.registry.builtin import LQRPIOOptions
+
+    five, fifteen = linearize.load_turbine("nrel5mw"), linearize.load_turbine("iea15mw")
+    opts = LQRPIOOptions()
+    for region in ("II", "III"):
+        assert opts.lqr_weights(region, five) == opts.lqr_weights(region)
+    w3, _ = opts.lqr_weights("III", fifteen)
+    assert w3["rotor_speed"] == pytest.approx(20.0, rel=1e-3)
+    assert w3["tower_fa_velocity"] == pytest.approx(0.25, rel=1e-3)
+    w2, _ = opts.lqr_weights("II", fifteen)
+    assert "rotor_speed" not in w2 and w2["tower_fa_velocity"] == pytest.approx(0.25, rel=1e-3)
+    given = LQRPIOOptions(w_rotor_speed=3.0, w_tower_fa_velocity=0.7)
+    assert given.lqr_weights("III", fifteen)[0] == {"rotor_speed": 3.0, "tower_fa_velocity": 0.7}
+    single = LQRPIOOptions(design_wind_mps=18.0)
+    assert single.lqr_weights("III", fifteen) == single.lqr_weights("III")

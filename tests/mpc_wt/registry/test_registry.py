@@ -66,8 +66,8 @@ def test_registry_lists_every_kind_with_its_options() -> None:
         "backend", "formulation", "horizon", "estimator", "design_wind_mps", "schedule_step",
         "schedule_time_constant", "speed_limit", "kalman_wind_std", "kalman_flap_std",
         "weights", "time_budget_ms", "torque_limit", "below_rated_speed_limit",
-        "below_rated_weights", "torque_notch_hz", "torque_notch_q", "region_floor",
-        "region3_pitch_deg"}
+        "below_rated_weights", "torque_notch_hz", "torque_notch_q", "tower_notch",
+        "region_floor", "region3_pitch_deg"}
     assert rows["ibc"]["addon_to"] == ["baseline", "derate"]
     assert rows["derate"]["pattern"].startswith("derateNN")
     horizon = next(o for o in rows["mpc"]["options"] if o["name"] == "horizon")
