@@ -13,6 +13,8 @@ from the design where it has them, and the comment of each line says so ("mpc-wt
   our K, rated values and limits; a derated design exports its derated power and torque;
 - the generator-speed low-pass of our baseline (first order, 0.25 Hz); no set-point smoothing,
   no peak shaving, no wind-speed estimator (``WE_Mode`` 0), as our baseline has none;
+- a design with a minimum-pitch schedule (the IEA-15's) turns on ROSCO's minimum-pitch table
+  (``PS_Mode`` 1) with the trim's region-1.5 pitch over wind, read on the hub wind;
 - the wind-speed estimator's data that ROSCO reads in any mode: blade radius, gearbox, the
   drivetrain inertia of our plant, air density, the performance table (written beside) and the
   first-order rotor poles dQ/dOmega / J over wind from our linear models.
@@ -305,14 +307,16 @@ _FROM_DESIGN = {
     "WE_FOPoles_N": "wind grid", "WE_FOPoles_v": "wind grid",
     "WE_FOPoles": "dQ/dOmega / J of the linear models", "SD_MaxGenSpd": "1.2 x rated speed",
     "IPC_ControlMode": "design", "SS_Mode": "no set-point smoothing in the baseline",
-    "PS_Mode": "no peak shaving in the baseline", "WE_Mode": "no wind-speed estimator needed",
+    "PS_Mode": "the design's minimum-pitch schedule (1), or none (0); no peak shaving",
+    "WE_Mode": "hub-height wind, for the minimum-pitch table (no estimator in the baseline)",
     "LoggingLevel": "no debug files", "F_LPFType": "first order, as the baseline",
     "VS_FBP_n": "unused table", "VS_FBP_U": "unused table", "VS_FBP_Omega": "unused table",
     "VS_FBP_Tau": "unused table", "PRC_Table_n": "unused table", "PRC_R_Table": "unused table",
     "PRC_Pitch_Table": "unused table", "PRC_n": "unused table",
     "PRC_WindSpeeds": "unused table", "PRC_GenSpeeds": "rated generator speed",
-    "PS_BldPitchMin_N": "unused table", "PS_WindSpeeds": "unused table",
-    "PS_BldPitchMin": "fine pitch", "IPC_Vramp": "rated wind", "IPC_KI": "design",
+    "PS_BldPitchMin_N": "minimum-pitch table",
+    "PS_WindSpeeds": "minimum-pitch table: region 1.5 of the trim",
+    "PS_BldPitchMin": "the trim's pitch in region 1.5 with a minimum-pitch schedule, else fine", "IPC_Vramp": "rated wind", "IPC_KI": "design",
     "IPC_aziOffset": "design", "IPC_IntSat": "design's largest cyclic amplitude",
 }
 
@@ -408,6 +412,10 @@ def rosco_values(turbine: linearize.Turbine, doc: dict[str, Any],
         "PS_BldPitchMin": [fine, fine], "SD_MaxGenSpd": 1.2 * rated_gen,
         "IPC_Vramp": [0.8 * v_rated, v_rated],
     }
+    table = _min_pitch_table(turbine, st)
+    if table is not None:
+        out.update({"PS_Mode": 1, "PS_BldPitchMin_N": table[0].size,
+                    "PS_WindSpeeds": table[0], "PS_BldPitchMin": table[1]})
     if ipc is not None:
         cols = ipc["schedule"]["columns"]
         r = np.asarray(ipc["schedule"]["rows"], dtype=float)
@@ -421,6 +429,27 @@ def rosco_values(turbine: linearize.Turbine, doc: dict[str, Any],
                     "IPC_KI": [float(np.median(r[:, cols.index("ki")])), 0.0],
                     "IPC_aziOffset": [math.remainder(phi - math.pi, 2.0 * math.pi), 0.0]})
     return out
+
+
+def _min_pitch_table(turbine: linearize.Turbine, st: dict[str, Any]
+                     ) -> tuple[np.ndarray, np.ndarray] | None:
+    """ROSCO's minimum-pitch table (``PS_BldPitchMin`` over ``PS_WindSpeeds``) for a design
+    with a minimum-pitch schedule: ROSCO holds the minimum rotor speed with its torque PI in
+    region 1.5, as the trim does, so the table is the trim's pitch there (the torque-maximizing
+    pitch at minimum speed, :func:`linearize.trim`), then fine pitch to cut-out. None for a
+    design without a schedule."""
+    if not st.get("min_pitch_offsets_rad"):
+        return None
+    op = turbine.operation
+    fine = op.fine_pitch_rad
+    winds, pitch = [], []
+    for v in np.linspace(op.cut_in_wind, linearize.rated_wind_speed(turbine), 30):
+        tp = linearize.trim(turbine, float(v))
+        winds.append(float(v))
+        pitch.append(max(tp.pitch_rad, fine) if tp.region == "1.5" else fine)
+        if tp.region != "1.5":
+            break
+    return np.r_[winds, op.cut_out_wind], np.r_[pitch, fine]
 
 
 def _fmt(v: Any) -> str:
