@@ -417,17 +417,25 @@ def rosco_values(turbine: linearize.Turbine, doc: dict[str, Any],
         out.update({"PS_Mode": 1, "PS_BldPitchMin_N": table[0].size,
                     "PS_WindSpeeds": table[0], "PS_BldPitchMin": table[1]})
     if ipc is not None:
-        cols = ipc["schedule"]["columns"]
-        r = np.asarray(ipc["schedule"]["rows"], dtype=float)
-        # ours: theta_cs = -K_I R(-phi) int M_cs; ROSCO: theta_cs = K_I R(-phi_R) int M_cs
-        # (its offset enters the inverse transform only), so phi_R = phi - pi
-        phi = float(np.median(r[:, cols.index("azimuth_offset")]))
-        amp = ipc["settings"].get("max_amplitude_rad")
-        if amp is not None:           # ROSCO clamps each integrator; ours the amplitude
-            out["IPC_IntSat"] = float(amp)
-        out.update({"IPC_ControlMode": 1,
-                    "IPC_KI": [float(np.median(r[:, cols.index("ki")])), 0.0],
-                    "IPC_aziOffset": [math.remainder(phi - math.pi, 2.0 * math.pi), 0.0]})
+        out.update(_ipc_values(ipc))
+    return out
+
+
+def _ipc_values(ipc: dict[str, Any]) -> dict[str, Any]:
+    """ROSCO's IPC parameters from a Coleman IPC gain table: ``IPC_ControlMode`` 1, the median
+    integral gain and azimuth offset over its schedule, the largest amplitude as the
+    integrators' saturation."""
+    cols = ipc["schedule"]["columns"]
+    r = np.asarray(ipc["schedule"]["rows"], dtype=float)
+    # ours: theta_cs = -K_I R(-phi) int M_cs; ROSCO: theta_cs = K_I R(-phi_R) int M_cs
+    # (its offset enters the inverse transform only), so phi_R = phi - pi
+    phi = float(np.median(r[:, cols.index("azimuth_offset")]))
+    out: dict[str, Any] = {"IPC_ControlMode": 1,
+                           "IPC_KI": [float(np.median(r[:, cols.index("ki")])), 0.0],
+                           "IPC_aziOffset": [math.remainder(phi - math.pi, 2.0 * math.pi), 0.0]}
+    amp = ipc["settings"].get("max_amplitude_rad")
+    if amp is not None:           # ROSCO clamps each integrator; ours the amplitude
+        out["IPC_IntSat"] = float(amp)
     return out
 
 
