@@ -20,7 +20,7 @@ import json
 from concurrent.futures import ProcessPoolExecutor
 
 import numpy as np
-from _study import Sized
+from _study import Sized, add_grid_args, grid
 
 #: The channels compared and their Woehler exponents (the sign-off's).
 CHANNELS = {"flap_moment_1": 10, "shaft_bending_blade1": 4, "tower_base_fa_moment": 4,
@@ -69,14 +69,9 @@ def main() -> int:
     ap.add_argument("--setting", action="append", required=True,
                     help="a kind and its options as JSON, e.g. 'ibc {\"loop_gain_1p\": 0.4}' "
                          "(repeat for more)")
-    ap.add_argument("--winds", default="5,9,13,17,21,25", help="mean winds [m/s]")
-    ap.add_argument("--seeds", default="11,12")
-    ap.add_argument("--duration", type=float, default=300.0, help="assessed length [s]")
-    ap.add_argument("--transient", type=float, default=30.0, help="discarded start [s]")
-    ap.add_argument("--workers", type=int, default=2)
+    add_grid_args(ap, "5,9,13,17,21,25")
     args = ap.parse_args()
-    winds = [float(x) for x in args.winds.split(",")]
-    seeds = [int(x) for x in args.seeds.split(",")]
+    winds, seeds = grid(args)
     settings = [("baseline", "{}")] + [_setting(s) for s in args.setting]
     jobs = [(args.turbine, k, o, w, s, args.turbulence, args.duration, args.transient)
             for k, o in dict.fromkeys(settings) for w in winds for s in seeds]

@@ -18,7 +18,7 @@ import json
 from concurrent.futures import ProcessPoolExecutor
 
 import numpy as np
-from _study import Sized
+from _study import Sized, add_grid_args, grid
 
 #: The channels compared and their Woehler exponents (the sign-off's).
 CHANNELS = {"tower_base_fa_moment": 4, "tower_base_ss_moment": 4, "lss_torque": 4,
@@ -57,16 +57,11 @@ def main() -> int:
 
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--rates", default="1,0.5,0.35", help="observer decay rates [1/s]")
-    ap.add_argument("--winds", default="5,9,11,13,17,21,25", help="mean winds [m/s]")
-    ap.add_argument("--seeds", default="11,12")
-    ap.add_argument("--duration", type=float, default=300.0, help="assessed length [s]")
-    ap.add_argument("--transient", type=float, default=30.0, help="discarded start [s]")
+    add_grid_args(ap, "5,9,11,13,17,21,25")
     ap.add_argument("--eog-wind", type=float, default=25.0, help="the EOG's mean wind [m/s]")
-    ap.add_argument("--workers", type=int, default=2)
     args = ap.parse_args()
     rates = [float(x) for x in args.rates.split(",")]
-    winds = [float(x) for x in args.winds.split(",")]
-    seeds = [int(x) for x in args.seeds.split(",")]
+    winds, seeds = grid(args)
     settings = [("baseline", "{}")] + [("ts", json.dumps({"observer_decay_rate": r}))
                                        for r in rates]
     jobs = [(k, o, w, s, args.duration, args.transient, False) for k, o in settings

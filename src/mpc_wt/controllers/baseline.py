@@ -739,7 +739,22 @@ class LawTorque:
         if law.below_rated_pitch is None:                      # one trim sweep per law
             law.below_rated_pitch = below_rated_pitch(law.turbine)
         self._offset = law.below_rated_pitch
+        self._has_min_pitch = any(o > 0.0 for o in law.min_pitch_offsets)
         self.reset()
+
+    def min_pitch(self) -> float | None:
+        """The law's minimum pitch at the last filtered speed
+        (:meth:`BaselineController.min_pitch`).
+
+        Returns
+        -------
+        float or None
+            [rad]; None where the law has no minimum-pitch schedule, or before the first
+            call.
+        """
+        if not self._has_min_pitch or self.w_filt is None:
+            return None
+        return self.law.min_pitch(self.w_filt)
 
     def reset(self) -> None:
         """Forget the filtered speed (the next call starts from its measurement)."""

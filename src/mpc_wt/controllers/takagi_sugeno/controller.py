@@ -157,11 +157,10 @@ class TSController(ControllerBase):
         p_lo = min(float(p[0]), float(p[1]), float(p[2]))
         p_hi = max(float(p[0]), float(p[1]), float(p[2]))
         lo = max(pa.min_pitch_rad, p_lo - self._reach)
-        if self._law is not None and self._law.w_filt is not None:
-            # the baseline's minimum-pitch schedule on the torque law's filtered speed
-            floor = self.torque_law.min_pitch(self._law.w_filt)
-            if floor > self.torque_law.pitch_min:
-                lo = max(lo, floor)
+        # the baseline's minimum-pitch schedule on the torque law's filtered speed
+        floor = None if self._law is None else self._law.min_pitch()
+        if floor is not None and floor > self._law.law.pitch_min:
+            lo = max(lo, floor)
         q, dp, clipped = _ts_step(
             self.xi, self._u, y, dp_raw, ts.wind_grid, ts.reduction_grid, self._terms,
             self._phi, self._gam, ts.x0, ts.u0, self._K, -1 if self._ki is None else self._ki,
