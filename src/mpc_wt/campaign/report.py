@@ -270,9 +270,10 @@ def _md_signoff(agg: dict[str, Any]) -> list[str]:
         for ch in spec.channels:
             life = [r["change_pct"] for r in agg["lifetime"] if r["controller"] == c.name
                     and r["channel"] == ch]
+            row[f"{ch}_del"] = life[0] if life else None
+        for ch in spec.ultimate:
             gov = [r for r in agg["governing"] if r["controller"] == c.name
                    and r["channel"] == ch]
-            row[f"{ch}_del"] = life[0] if life else None
             row[f"{ch}_ult"] = gov[0]["change_pct"] if gov else None
             row[f"{ch}_dlc"] = gov[0]["dlc"] if gov else None
         w = [r for r in so if r.get("rotor_speed_max_rel") is not None]
@@ -286,10 +287,15 @@ def _md_signoff(agg: dict[str, Any]) -> list[str]:
         row["rate"] = max(rates) if rates else None
         row["failed"] = sum(r["failed"] for r in so)
         rows.append(row)
-    keys = ["controller", *[f"{ch}_{k}" for ch in spec.channels for k in ("del", "ult", "dlc")],
+    # per channel its lifetime DEL, then its governing design load where it has one; then the
+    # design loads of the ultimate channels that are not fatigue channels
+    cols = [(ch, k) for ch in spec.channels for k in ("del", "ult", "dlc")
+            if k == "del" or ch in spec.ultimate]
+    cols += [(ch, k) for ch in spec.ultimate if ch not in spec.channels for k in ("ult", "dlc")]
+    names = {"del": "lifetime DEL [%]", "ult": "design load [%]", "dlc": "governing DLC"}
+    keys = ["controller", *[f"{ch}_{k}" for ch, k in cols],
             "speed_max", "speed_dlc", "margin", "stops", "rate", "failed"]
-    heads = ["controller", *[f"{ch} {k}" for ch in spec.channels
-                             for k in ("lifetime DEL [%]", "design load [%]", "governing DLC")],
+    heads = ["controller", *[f"{ch} {names[k]}" for ch, k in cols],
              "rotor speed max / rated", "in DLC", "overspeed margin [% rated]",
              "overspeed stops", "pitch rate max / limit", "failed cases"]
     return ["## Sign-off: fatigue and ultimate loads side by side", "",

@@ -122,7 +122,7 @@ def ultimate_rows(spec: CampaignSpec, rows: Sequence[CaseRow]) -> list[dict[str,
         fam = lc.family if lc is not None and not lc.legacy else "N"
         urows = [{"case_id": r.case_id, "dlc": dlc, "wind_mps": r.wind_mps, "seed": r.seed,
                   "extremes": r.metrics["extremes"]} for r, _ in items]
-        chans = [ch for ch in (*spec.channels, "rotor_speed")
+        chans = [ch for ch in (*spec.ultimate, "rotor_speed")
                  if all(ch in u["extremes"] for u in urows)]
         for ch, u in ultimate_table(urows, chans, families={dlc: fam}).items():
             d = u["by_dlc"][dlc]
@@ -132,7 +132,7 @@ def ultimate_rows(spec: CampaignSpec, rows: Sequence[CaseRow]) -> list[dict[str,
                        "characteristic_max", "wind_max", "design_max", "characteristic_min",
                        "wind_min", "design_min", "safety_factor", "seeds")},
                    "cases": len(urows)}
-            if ch not in spec.channels:        # the rotor speed: extremes, not a load
+            if ch not in spec.ultimate:        # the rotor speed: extremes, not a load
                 row.update(design_max=None, design_min=None, safety_factor=None)
             elif lc is not None and lc.extrapolate:
                 for side in ("max", "min"):

@@ -40,7 +40,7 @@ __all__ = ["SpecError", "CampaignSpec", "ControllerSpec", "Case", "LoadCase", "W
 _TOP_KEYS = {"name", "description", "turbine", "duration", "transient", "turbulence",
              "shear_exponent", "winds", "seeds", "lidar", "controllers", "channels",
              "wind_distribution", "lifetime_years", "reference", "report", "plugins",
-             "del_convention", "load_cases", "iec_class", "supervisor"}
+             "del_convention", "load_cases", "iec_class", "supervisor", "ultimate_channels"}
 #: A controller entry's own keys; any other key is an option of the controller's kind.
 _CONTROLLER_KEYS = {"name", "controller", "winds", "seeds", "turbulence", "label", "options",
                     "mpc_options", "retrofit_options", "dlcs"}
@@ -379,6 +379,9 @@ class Case:
         A wind file's bin wind [m/s].
     design_hash : str, optional
         :attr:`ControllerSpec.design_hash` of its controller.
+    extremes_of : tuple of str
+        Channels beyond ``channels`` whose extremes are recorded (the spec's
+        ``ultimate_channels``).
     """
 
     case_id: str
@@ -401,6 +404,7 @@ class Case:
     fatigue: bool = True
     bin_wind_mps: float | None = None
     design_hash: str | None = None
+    extremes_of: tuple[str, ...] = ()
 
     @property
     def wind_mps(self) -> float:
@@ -519,6 +523,10 @@ class CampaignSpec:
         ``turbulence`` when the spec gives none).
     iec_class : str
         Wind turbine class "I", "II" or "III" of the IEC conditions.
+    ultimate_channels : tuple of str or None
+        The channels the ultimate and governing design loads are read on (None: the fatigue
+        ``channels``); e.g. ``shaft_bending_resultant`` for the shaft, whose section sees the
+        resultant at some fiber whatever the azimuth.
     """
 
     name: str
@@ -545,6 +553,13 @@ class CampaignSpec:
     del_convention: str = "range-1hz"
     load_cases: tuple[LoadCase, ...] = ()
     iec_class: str = "I"
+    ultimate_channels: tuple[str, ...] | None = None
+
+    @property
+    def ultimate(self) -> tuple[str, ...]:
+        """The channels of the ultimate loads: ``ultimate_channels``, else the fatigue ones."""
+        return tuple(self.channels) if self.ultimate_channels is None \
+            else self.ultimate_channels
 
     @property
     def spec_hash(self) -> str:
@@ -620,6 +635,8 @@ class CampaignSpec:
         assess: dict[str, Any] = {"channels": self.channels, "transient": self.transient}
         if self.del_convention != "range-1hz":      # the default keeps older hashes valid
             assess["del_convention"] = self.del_convention
+        if self.ultimate_channels is not None:
+            assess["ultimate_channels"] = list(self.ultimate_channels)
         for c in self.controllers:
             for lc in self.load_cases:
                 if c.dlcs is None or lc.dlc in c.dlcs:
@@ -666,7 +683,8 @@ class CampaignSpec:
                 plugin_folder=self.plugin_folder,
                 del_convention=self.del_convention, dlc=lc.dlc,
                 supervisor=copy.deepcopy(sup), family=lc.family, fatigue=lc.fatigue,
-                design_hash=c.design_hash))
+                design_hash=c.design_hash,
+                extremes_of=tuple(ch for ch in self.ultimate if ch not in self.channels),))
         return out
 
     def _file_cases(self, c: ControllerSpec, lc: LoadCase, a: dict[str, Any],
@@ -689,7 +707,8 @@ class CampaignSpec:
                 plugins=self.plugins, plugin_folder=self.plugin_folder,
                 del_convention=self.del_convention, dlc=lc.dlc,
                 supervisor=copy.deepcopy(sup), family=lc.family, fatigue=lc.fatigue,
-                bin_wind_mps=f.wind_mps, design_hash=c.design_hash))
+                bin_wind_mps=f.wind_mps, design_hash=c.design_hash,
+                extremes_of=tuple(ch for ch in self.ultimate if ch not in self.channels),))
         return out
 
 
@@ -1089,18 +1108,42 @@ def _plugins(raw: Any, load: bool = True, base: Path | None = None) -> tuple[str
     return tuple(raw)
 
 
+def _known_channels() -> set[str]:
+    """The plant's channels a campaign assesses: outputs, states, inputs and the shaft's."""
+    import linearize
+    from mpc_wt.simulation.results import DERIVED_UNITS
+
+    return {*linearize.OUTPUT_NAMES, *linearize.STATE_NAMES, *linearize.INPUT_NAMES,
+            *DERIVED_UNITS}
+
+
+def _ultimate_channels(raw: Any) -> tuple[str, ...] | None:
+    """The ``ultimate_channels`` list, checked (None when absent)."""
+    if raw is None:
+        return None
+    if isinstance(raw, str) or not isinstance(raw, Sequence) or not raw:
+        raise _fail("ultimate_channels", f"must be a non-empty list of channel names, got "
+                                         f"{raw!r}")
+    known = _known_channels()
+    for i, k in enumerate(raw):
+        if k not in known:
+            raise _fail(f"ultimate_channels[{i}]", f"unknown channel {k!r}; channels are "
+                                                   f"{sorted(known)}")
+    if len(set(raw)) != len(raw):
+        raise _fail("ultimate_channels", f"names a channel twice: {list(raw)}")
+    return tuple(str(k) for k in raw)
+
+
 def _channels(raw: Any) -> dict[str, float]:
     """Channel -> Woehler exponent (default :data:`mpc_wt.assessment.series.DEFAULT_CHANNELS`)."""
-    import linearize
     from mpc_wt.assessment.series import DEFAULT_CHANNELS
 
     chans_raw = DEFAULT_CHANNELS if raw is None else raw
     if not isinstance(chans_raw, Mapping) or not chans_raw:
         raise _fail("channels", "must be a non-empty mapping of channel name to Woehler "
                                 "exponent m")
-    known = {*linearize.OUTPUT_NAMES, *linearize.STATE_NAMES, *linearize.INPUT_NAMES,
-             "shaft_bending_blade1"}
     chans = {}
+    known = _known_channels()
     for k, m in chans_raw.items():
         if k not in known:
             raise _fail(f"channels.{k}", f"unknown channel; channels are {sorted(known)}")
@@ -1274,7 +1317,8 @@ def spec_from_dict(raw: Mapping[str, Any], base: Path | None = None,
                                lo_open=True),
         reference=ref, report=report, raw=raw, source=source, plugins=plugins,
         plugin_folder=str(base) if base is not None and plugins else None,
-        del_convention=_convention(raw.get("del_convention", "range-1hz")))
+        del_convention=_convention(raw.get("del_convention", "range-1hz")),
+        ultimate_channels=_ultimate_channels(raw.get("ultimate_channels")))
 
 
 _PAPER_METRICS = {"del_change_pct", "lifetime_del_change_pct", "aep_change_pct",

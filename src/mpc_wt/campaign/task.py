@@ -15,7 +15,7 @@ import socket
 import time
 import traceback
 from pathlib import Path
-from typing import Any
+from typing import Any, Sequence
 
 import numpy as np
 
@@ -84,7 +84,8 @@ def load_case_turbine(ref: str) -> Any:
 
 
 def case_metrics(t: np.ndarray, cols: dict[str, np.ndarray], channels: dict[str, float],
-                 transient: float, convention: str = "range-1hz") -> dict[str, Any]:
+                 transient: float, convention: str = "range-1hz", *,
+                 extremes_of: Sequence[str] = ()) -> dict[str, Any]:
     """The per-case numbers a campaign aggregates, after discarding ``transient`` [s]: DEL per
     channel (Woehler exponent of the spec, 1 Hz equivalent cycles), mean and std of power,
     energy, CS1-CS5 (tower-base fore-aft moment vs electrical power, Do et al. eqs 21-26), pitch
@@ -103,6 +104,8 @@ def case_metrics(t: np.ndarray, cols: dict[str, np.ndarray], channels: dict[str,
         Discarded start [s].
     convention : str
         The DEL convention (:data:`mpc_wt.assessment.fatigue.DEL_CONVENTIONS`).
+    extremes_of : sequence of str
+        Further channels whose extremes are recorded (the ultimate loads' channels).
 
     Returns
     -------
@@ -131,8 +134,8 @@ def case_metrics(t: np.ndarray, cols: dict[str, np.ndarray], channels: dict[str,
             raise ValueError(f"channel {n!r} holds NaN or inf")
     out = assess_series(t[k], sub, channels, convention=convention)
     # ultimate loads: each channel's extremes and when
-    out["extremes"] = case_extremes(t[k], sub, [n for n in (*channels, "rotor_speed")
-                                                if n in sub])
+    out["extremes"] = case_extremes(t[k], sub, [
+        n for n in dict.fromkeys((*channels, *extremes_of, "rotor_speed")) if n in sub])
     if "rotor_speed" in sub:
         out["rotor_speed_mean_rad_s"] = float(sub["rotor_speed"].mean())
         out["rotor_speed_std_rad_s"] = float(sub["rotor_speed"].std())
@@ -265,7 +268,8 @@ def run_case(case: dict[str, Any], root: str) -> dict[str, Any]:
             res.save(path)
         cols = {n: res.channel(n) for n in res.channels()}
         metrics = case_metrics(res.t, cols, case["channels"], case["transient"],
-                               case.get("del_convention", "range-1hz"))
+                               case.get("del_convention", "range-1hz"),
+                               extremes_of=case.get("extremes_of", ()))
         metrics.update(_plain(actuator_limit_metrics(
             res.t, cols, load_case_turbine(case["turbine"]).pitch_actuator.max_rate_rad_s,
             case["transient"])))

@@ -19,7 +19,7 @@ from linearize.openfast_channels import blade_frame_moment
 from mpc_wt._version import __version__
 from mpc_wt.errors import ResultFileError
 
-__all__ = ["ClosedLoopResult", "load_series", "SCHEMA_VERSION"]
+__all__ = ["ClosedLoopResult", "load_series", "shaft_bending_resultant", "SCHEMA_VERSION"]
 
 SCHEMA_VERSION = 1
 _Z = {n: i for i, n in enumerate(linearize.OUTPUT_NAMES)}
@@ -39,6 +39,34 @@ def _in_process() -> Any:
 
 #: the blade-frame root moments :meth:`ClosedLoopResult.channel` derives
 _BLADE_FRAME = tuple(f"{k}_moment_{b}" for k in ("flapwise", "edgewise") for b in (1, 2, 3))
+#: the shaft's derived channels and their units
+DERIVED_UNITS = {"shaft_bending_blade1": "N m", "shaft_bending_resultant": "N m"}
+
+
+def shaft_bending_resultant(m1: Any, m2: Any, m3: Any) -> np.ndarray:
+    """The magnitude of the low-speed shaft's bending moment from the three blades' flap
+    moments [N m]: abs(sum_k M_k exp(i psi_k)) with the blades 120 deg apart,
+    sqrt(M1^2 + M2^2 + M3^2 - M1 M2 - M2 M3 - M3 M1).
+
+    The bending toward blade 1, M1 - (M2 + M3) / 2, is this vector's projection on blade 1's
+    azimuth, so it never exceeds the resultant and reaches it only when the vector points at
+    blade 1. A shaft's section sees the resultant at some fiber at every instant: its extreme
+    design load is the resultant's, independent of where blade 1 happens to be when a gust
+    peaks (the fatigue of one fiber is read on the rotating channel).
+
+    Parameters
+    ----------
+    m1, m2, m3 : array_like
+        Flap (out-of-plane) root moments of blades 1-3 [N m].
+
+    Returns
+    -------
+    ndarray
+        [N m], >= 0.
+    """
+    a, b, c = (np.asarray(m, dtype=float) for m in (m1, m2, m3))
+    # the sum of squares of differences is the form that cannot go negative by rounding
+    return np.sqrt(0.5 * ((a - b) ** 2 + (b - c) ** 2 + (c - a) ** 2))
 
 
 @dataclass(frozen=True)
@@ -72,7 +100,10 @@ class ClosedLoopResult:
         """A time series by name: output, state, input, controller signal, or a derived one:
         ``shaft_bending_blade1``, the rotating low-speed-shaft bending moment in the direction
         of blade 1 from the blades' flap moments, M_1 - (M_2 + M_3) / 2 [N m] (rotor weight
-        and hub inertia left out); ``flapwise_moment_i`` and ``edgewise_moment_i``, blade i's
+        and hub inertia left out); ``shaft_bending_resultant``, the magnitude of that bending
+        moment's vector, the largest over the shaft section's circumference [N m]
+        (:func:`shaft_bending_resultant`: what a shaft's extreme design load is read on,
+        whatever the azimuth); ``flapwise_moment_i`` and ``edgewise_moment_i``, blade i's
         root moments in the frame that pitches with it (OpenFAST's ``RootMyb``, ``RootMxb``;
         :func:`blade_frame_moment`).
 
@@ -91,8 +122,10 @@ class ClosedLoopResult:
         KeyError
             Naming the channel and listing the channels.
         """
-        if name == "shaft_bending_blade1":
+        if name in ("shaft_bending_blade1", "shaft_bending_resultant"):
             f = self.z[:, _Z["flap_moment_1"]:_Z["flap_moment_3"] + 1]
+            if name == "shaft_bending_resultant":
+                return shaft_bending_resultant(f[:, 0], f[:, 1], f[:, 2])
             return f[:, 0] - 0.5 * (f[:, 1] + f[:, 2])
         if name in _BLADE_FRAME:
             return blade_frame_moment(name, self.z[:, _Z[f"pitch_{name[-1]}"]],
@@ -118,7 +151,7 @@ class ClosedLoopResult:
         """
         return (list(linearize.OUTPUT_NAMES) + [n for n in linearize.STATE_NAMES
                                                 if n not in _Z]
-                + list(linearize.INPUT_NAMES) + ["shaft_bending_blade1"] + list(_BLADE_FRAME)
+                + list(linearize.INPUT_NAMES) + list(DERIVED_UNITS) + list(_BLADE_FRAME)
                 + list(self.controller))
 
     def save(self, path: str | Path) -> Path:
@@ -142,6 +175,8 @@ class ClosedLoopResult:
         units = dict(zip(linearize.OUTPUT_NAMES, linearize.OUTPUT_UNITS))
         units.update(zip(linearize.STATE_NAMES, linearize.STATE_UNITS))
         units.update(zip(linearize.INPUT_NAMES, linearize.INPUT_UNITS))
+        units.update(DERIVED_UNITS)
+        units.update({n: "N m" for n in _BLADE_FRAME})
         for n in self.channels():
             key = n if n not in data else f"{n}_state"
             data[key] = xr.Variable("time", self.channel(n),

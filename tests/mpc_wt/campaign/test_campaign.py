@@ -60,6 +60,9 @@ def _spec(**over):
     ({"channels": {"flap_moment_9": 10}}, "channels.flap_moment_9"),
     ({"channels": {"flap_moment_1": -1}}, "channels.flap_moment_1"),
     ({"reference": "mpc"}, "reference"),
+    ({"ultimate_channels": ["flap_moment_9"]}, "ultimate_channels[0]"),
+    ({"ultimate_channels": "lss_torque"}, "ultimate_channels"),
+    ({"ultimate_channels": ["lss_torque", "lss_torque"]}, "ultimate_channels"),
     ({"wind_distribution": {"kind": "weibull"}}, "wind_distribution.scale"),
     ({"wind_distribution": {"kind": "gamma"}}, "wind_distribution.kind"),
     ({"turbine": "no/such/turbine.yaml"}, "turbine"),
@@ -118,6 +121,10 @@ def test_case_hash_changes_only_for_touched_cases(winds, seeds, ctl, shear):
     c = spec_from_dict({**raw, "channels": {"lss_torque": 4}}).cases()
     for x, y in zip(a, c):
         assert x.case_hash == y.case_hash and x.assess_hash != y.assess_hash
+    d = spec_from_dict({**raw, "ultimate_channels": ["shaft_bending_resultant"]}).cases()
+    for x, y in zip(a, d):
+        assert x.case_hash == y.case_hash and x.assess_hash != y.assess_hash
+        assert y.extremes_of == ("shaft_bending_resultant",) and x.extremes_of == ()
 
 
 # -- store and runner (in this process) -------------------------------------------------------
@@ -319,6 +326,41 @@ def test_report_tables_and_plots(tmp_path):
     means = [np.mean([m for w, m in peaks.values() if w == v]) for v in (10.0, 14.0)]
     assert u["characteristic_max"] == pytest.approx(max(means), rel=1e-12)
     assert u["design_max"] == pytest.approx(1.35 * max(means), rel=1e-12)
+
+
+def test_ultimate_loads_on_their_own_channels(tmp_path):
+    """``ultimate_channels``: the design loads are read on those channels (the shaft's
+    resultant, whose largest value is found here from the result files' flap moments), the
+    fatigue tables keep ``channels``, and the report shows both."""
+    from mpc_wt.campaign.aggregate import aggregate
+    from mpc_wt.campaign.report import make_report
+
+    raw = {k: v for k, v in BASE.items() if k not in ("winds", "seeds")}
+    spec = spec_from_dict({
+        **raw, "duration": 30,
+        "load_cases": [{"dlc": "1.2", "condition": "ntm", "winds": [14], "seeds": 2}],
+        "channels": {"shaft_bending_blade1": 4, "lss_torque": 4},
+        "ultimate_channels": ["shaft_bending_resultant", "lss_torque"]})
+    run_campaign(spec, tmp_path, engine="serial", progress=False)
+    agg = aggregate(tmp_path)
+    assert {r["channel"] for r in agg["ultimate"]} == {"shaft_bending_resultant",
+                                                      "lss_torque", "rotor_speed"}
+    assert {r["channel"] for r in agg["lifetime"]} == {"shaft_bending_blade1", "lss_torque"}
+    peaks = []
+    for row in agg["rows"]:
+        res = ClosedLoopResult.load(tmp_path / row.file)
+        k = res.t >= res.t[0] + spec.transient
+        f = [res.channel(f"flap_moment_{b}")[k] for b in (1, 2, 3)]
+        vec = sum(fb * np.exp(2j * np.pi * b / 3) for b, fb in enumerate(f))
+        peaks.append(float(np.abs(vec).max()))
+        assert np.abs(res.channel("shaft_bending_blade1")[k]).max() <= peaks[-1] * (1 + 1e-9)
+    u = next(r for r in agg["ultimate"] if r["channel"] == "shaft_bending_resultant")
+    assert u["max"] == pytest.approx(max(peaks), rel=1e-9)
+    assert u["design_max"] == pytest.approx(1.35 * np.mean(peaks), rel=1e-9)
+    text = Path(make_report(tmp_path)).read_text()
+    assert "shaft_bending_resultant design load [%]" in text
+    assert "shaft_bending_blade1 lifetime DEL [%]" in text
+    assert "shaft_bending_blade1 design load" not in text
 
 
 def _probs_rayleigh(winds, mean):
