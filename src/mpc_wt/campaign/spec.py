@@ -462,6 +462,7 @@ class Case:
         """
         d = dict(d)
         d["plugins"] = tuple(d.get("plugins", ()))
+        d["extremes_of"] = tuple(d.get("extremes_of", ()))
         if "scenario" in d:
             scenario = Scenario(**d.pop("scenario"))
         else:
@@ -1310,8 +1311,7 @@ def spec_from_dict(raw: Mapping[str, Any], base: Path | None = None,
         shear_exponent=_number("shear_exponent", raw.get("shear_exponent", 0.2), -1.0, 1.0),
         winds=load_cases[0].winds if "winds" not in raw else _winds("winds", raw["winds"]),
         seeds=_seeds("seeds", raw.get("seeds", 1)), load_cases=load_cases,
-        iec_class=iec_class,
-        lidar=lidar, controllers=ctls, channels=chans,
+        iec_class=iec_class, lidar=lidar, controllers=ctls, channels=chans,
         wind_distribution=_distribution(raw.get("wind_distribution", {})),
         lifetime_years=_number("lifetime_years", raw.get("lifetime_years", 20.0), 0.0,
                                lo_open=True),
