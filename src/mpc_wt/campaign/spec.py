@@ -563,6 +563,12 @@ class CampaignSpec:
             else self.ultimate_channels
 
     @property
+    def extra_extremes(self) -> tuple[str, ...]:
+        """The ultimate channels that are not fatigue channels (a case records their
+        extremes beside its channels')."""
+        return tuple(ch for ch in self.ultimate if ch not in self.channels)
+
+    @property
     def spec_hash(self) -> str:
         """SHA-256 of the canonical spec (with the turbine files' hash)."""
         return _digest({"spec": self.raw, "turbine": self.turbine_hash})
@@ -685,7 +691,7 @@ class CampaignSpec:
                 del_convention=self.del_convention, dlc=lc.dlc,
                 supervisor=copy.deepcopy(sup), family=lc.family, fatigue=lc.fatigue,
                 design_hash=c.design_hash,
-                extremes_of=tuple(ch for ch in self.ultimate if ch not in self.channels),))
+                extremes_of=self.extra_extremes))
         return out
 
     def _file_cases(self, c: ControllerSpec, lc: LoadCase, a: dict[str, Any],
@@ -709,7 +715,7 @@ class CampaignSpec:
                 del_convention=self.del_convention, dlc=lc.dlc,
                 supervisor=copy.deepcopy(sup), family=lc.family, fatigue=lc.fatigue,
                 bin_wind_mps=f.wind_mps, design_hash=c.design_hash,
-                extremes_of=tuple(ch for ch in self.ultimate if ch not in self.channels),))
+                extremes_of=self.extra_extremes))
         return out
 
 
