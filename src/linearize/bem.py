@@ -420,6 +420,43 @@ def _loads_at(phi, vx, vy, one_m_a, one_p_ap, chord, theta, k_af, table, alpha0,
     return q * (cl * c + cd * s), q * (cl * s - cd * c)
 
 
+#: The induction factors' limits, a in [-1, 1.5] and a' in [-1, 1] (as AeroDyn's BEMT).
+A_MIN, A_MAX, AP_MIN, AP_MAX = -1.0, 1.5, -1.0, 1.0
+
+
+@nb.njit(**_JIT)
+def _limited(phi, vx, vy, r, chord, theta, k_af, table, alpha0, dalpha, nb_, rtip, rhub, flags,
+             one_m_a, one_p_ap, cn, ct):  # pragma: no cover - compiled
+    """A root outside the windmill state checked and its induction limited (real).
+
+    Momentum theory holds no solution where its loading factor k = sigma' c_n / (4 F sin^2 phi)
+    has the wrong sign for the branch: k <= 1 in the propeller-brake region (phi < 0), k < -1
+    in the momentum region. Such a root, which Ning's brackets return when the local speed
+    ratio V_y / V_x is small (a feathered blade on a stopping rotor: phi = -3 deg for
+    V_y = 0.05 m/s against V_x = 25 m/s, with 1 + a' in the thousands and a 25 m edgewise load
+    of 440 MN m), is replaced by the geometric inflow without induction; otherwise a and a' are
+    kept within [:data:`A_MIN`, :data:`A_MAX`] and [:data:`AP_MIN`, :data:`AP_MAX`]. Both
+    follow AeroDyn's BEMT (Ning, Hayman, Damiani and Jonkman 2015, NREL/TP-5000-63217). A
+    changed root's phi, coefficients and inductions are returned with a flag; the normal
+    windmill state (0 < phi, 0 <= a <= 1, 0 <= a' <= 1) never comes here.
+    """
+    s = math.sin(phi)
+    ss = max(s * s, 1e-24)
+    F = _prandtl(r, rtip, rhub, nb_, abs(s), flags[0] != 0, flags[1] != 0)
+    k = nb_ * chord / (2.0 * _PI * r) * cn / (4.0 * F * ss)
+    if (phi < 0.0 and k <= 1.0) or (phi > 0.0 and k < -1.0):
+        oma, opa = 1.0, 1.0
+    else:
+        oma = min(max(one_m_a, 1.0 - A_MAX), 1.0 - A_MIN)
+        opa = min(max(one_p_ap, 1.0 + AP_MIN), 1.0 + AP_MAX)
+        if oma == one_m_a and opa == one_p_ap:
+            return phi, one_m_a, one_p_ap, cn, ct, False
+    ph = _atan2(vx * oma, vy * opa)
+    cl, cd = _polar_lookup(table, k_af, ph - theta, alpha0, dalpha)
+    sp, cp = math.sin(ph), math.cos(ph)
+    return ph, oma, opa, cl * cp + cd * sp, cl * sp - cd * cp, True
+
+
 @nb.njit(**_JIT)
 def _element_frozen(vx, vy, chord, theta, k_af, table, alpha0, dalpha, rho, u_ind,
                     v_ind):  # pragma: no cover - compiled
@@ -487,6 +524,14 @@ def element_kernel(vx, vy, r, chord, theta, k_af, table, alpha0, dalpha, nb_, rt
         phi, slope, one_m_a, one_p_ap, cn, ct = _solve_phi(
             vx.real, vy.real, r, chord, theta.real, k_af, table, alpha0, dalpha, nb_, rtip,
             rhub, flags, hint, hint_slope, tol)
+        if (phi < 0.0 or one_m_a < 0.0 or one_m_a > 1.0 or one_p_ap < 0.0
+                or one_p_ap > 2.0):
+            # outside the normal windmill state: the induction is checked and limited
+            phi, one_m_a, one_p_ap, cn, ct, lim = _limited(
+                phi, vx.real, vy.real, r, chord, theta.real, k_af, table, alpha0, dalpha, nb_,
+                rtip, rhub, flags, one_m_a, one_p_ap, cn, ct)
+            if lim:
+                slope = math.nan
         ua = vx * one_m_a
         ut = vy * one_p_ap
         q = 0.5 * rho * (ua * ua + ut * ut) * chord

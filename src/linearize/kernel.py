@@ -10,6 +10,8 @@ import numba as nb
 import numpy as np
 
 from linearize.bem import (
+    MODE_CS,
+    MODE_FROZEN,
     MODE_NOLIMITS,
     element_kernel,
     locate_cell,
@@ -37,6 +39,37 @@ _JIT = dict(cache=True, error_model="numpy")
 @nb.njit(**_JIT)
 def _clip(v, lo, hi):  # pragma: no cover - compiled
     return lo + 0.0 * v if v.real < lo else (hi + 0.0 * v if v.real > hi else v)
+
+
+#: The rotor tip-speed ratios between which the BEM induction fades out (AeroDyn's BEMT:
+#: none below the first, all above the second, a cosine blend between).
+BEM_TSR_BOUNDS = (1.0, 2.0)
+
+
+@nb.njit(**_JIT)
+def _bem_weight(wr, wind, rtip, mode):  # pragma: no cover - compiled
+    """The share of the BEM induction kept at the rotor's tip-speed ratio Omega R / U (U the
+    mean free wind over the elements): 1 from :data:`BEM_TSR_BOUNDS`[1] up, 0 below [0], a
+    cosine blend between (as AeroDyn's BEMT, Jonkman et al. 2015, NREL/TP-5000-63217 sec.
+    "low TSR"). Momentum theory has no meaning on a rotor that barely turns: a parked or
+    stopping rotor's inflow is the geometric one. A frozen-wake or complex-step evaluation
+    (linearization, at operating points) keeps all of it."""
+    if mode & (MODE_FROZEN | MODE_CS):
+        return 1.0
+    u_mean = 0.0
+    for i in range(wind.shape[0]):
+        for j in range(wind.shape[1]):
+            u_mean += wind[i, j].real
+    u_mean /= wind.shape[0] * wind.shape[1]
+    if u_mean <= 0.0:
+        return 1.0
+    tsr = abs(wr.real) * rtip / u_mean
+    lo, hi = BEM_TSR_BOUNDS
+    if tsr >= hi:
+        return 1.0
+    if tsr <= lo:
+        return 0.0
+    return 0.5 - 0.5 * math.cos(math.pi * (tsr - lo) / (hi - lo))
 
 
 @nb.njit(**_JIT)
@@ -117,6 +150,7 @@ def evaluate_plant_vw(x, u, wind, ext, p, hint, mode):  # pragma: no cover - com
     medge_aero = np.zeros(3, dtype=x.dtype)
     gq = np.zeros(3, dtype=x.dtype)
     ge = np.zeros(3, dtype=x.dtype)
+    w_bem = _bem_weight(wr, wind, p.rtip, mode)
     for i in range(3):
         psi_i = psi + i * TWO_PI_3
         sp = np.sin(psi_i)
@@ -152,10 +186,18 @@ def evaluate_plant_vw(x, u, wind, ext, p, hint, mode):  # pragma: no cover - com
                   + vw[1, i, j] * (sc * ct * cp - st * cc) - vv * sc * sp)
             vy = ((wr + roll) * rj * cc + vrel * st * sp - vhub_y * cp + ve * cs + vq * ss
                   + vv * cp + vw[1, i, j] * ct * sp)
-            npr, tpr, ph, sl, u_ind, v_ind = element_kernel(
-                vx, vy, rj, p.chord[j], p.twist[j] + pitch[i], p.af[j], p.table, p.alpha0,
-                p.dalpha, p.nb, p.rtip, p.rhub, p.flags, p.rho, hint[0, i, j].real,
-                hint[1, i, j].real, hint[2, i, j].real, hint[3, i, j].real, mode)
+            if w_bem > 0.0:
+                npr, tpr, ph, sl, u_ind, v_ind = element_kernel(
+                    vx, vy, rj, p.chord[j], p.twist[j] + pitch[i], p.af[j], p.table, p.alpha0,
+                    p.dalpha, p.nb, p.rtip, p.rhub, p.flags, p.rho, hint[0, i, j].real,
+                    hint[1, i, j].real, hint[2, i, j].real, hint[3, i, j].real, mode)
+            if w_bem < 1.0:     # low tip-speed ratio: the induction faded out
+                u_ind = w_bem * u_ind if w_bem > 0.0 else 0.0 * vx
+                v_ind = w_bem * v_ind if w_bem > 0.0 else 0.0 * vx
+                npr, tpr, ph, sl, u_ind, v_ind = element_kernel(
+                    vx, vy, rj, p.chord[j], p.twist[j] + pitch[i], p.af[j], p.table, p.alpha0,
+                    p.dalpha, p.nb, p.rtip, p.rhub, p.flags, p.rho, math.nan, math.nan,
+                    u_ind.real, v_ind.real, MODE_FROZEN)
             bem[0, i, j] = ph
             bem[1, i, j] = sl
             bem[2, i, j] = u_ind

@@ -7,8 +7,8 @@ from __future__ import annotations
 
 import math
 from collections import namedtuple
-from dataclasses import dataclass, field
-from typing import Any
+from dataclasses import dataclass, field, replace
+from typing import Any, Mapping
 
 import numpy as np
 
@@ -138,6 +138,40 @@ class PlantConfig:
         if self.integration not in ("midpoint", "trapezoid"):
             raise ValueError(f"integration must be 'midpoint' or 'trapezoid', "
                              f"got {self.integration!r}")
+
+    #: The effects a user switches on or off by name (:meth:`with_switches`).
+    SWITCHES = ("blade_body_forces", "inplane_wind", "tower_shadow", "unsteady_aero",
+                "twisted_modes", "tower_drag")
+
+    def with_switches(self, switches: Mapping[str, bool] | None) -> "PlantConfig":
+        """This configuration with the named effects (:attr:`SWITCHES`) set.
+
+        Parameters
+        ----------
+        switches : mapping of str to bool, optional
+            E.g. ``{"twisted_modes": True}``; None or empty: unchanged.
+
+        Returns
+        -------
+        PlantConfig
+
+        Raises
+        ------
+        ValueError
+            A name that is not a switch, or a value that is not true or false.
+        """
+        if not switches:
+            return self
+        if not isinstance(switches, Mapping):
+            raise ValueError(f"plant switches must be a mapping of switch to true/false, got "
+                             f"{switches!r}")
+        for k, v in switches.items():
+            if k not in self.SWITCHES:
+                raise ValueError(f"plant switch {k!r} is unknown; switches are "
+                                 f"{list(self.SWITCHES)}")
+            if not isinstance(v, (bool, np.bool_)):
+                raise ValueError(f"plant switch {k!r} must be true or false, got {v!r}")
+        return replace(self, **{k: bool(v) for k, v in switches.items()})
 
     @classmethod
     def madsen(cls, aero: AeroOptions | None = None) -> "PlantConfig":

@@ -190,7 +190,8 @@ def run_controller(turbine: linearize.Turbine, controller: str, scenario: Scenar
                    fields: FieldMemo | None = None,
                    turbulence: str | float | None = None, seed: int | None = None,
                    duration: float | None = None, shear_exponent: float | None = None,
-                   condition: Mapping[str, Any] | None = None) -> ClosedLoopResult:
+                   condition: Mapping[str, Any] | None = None,
+                   plant: Mapping[str, bool] | None = None) -> ClosedLoopResult:
     """Trim, build the controller, generate the scenario's wind and simulate.
 
     Parameters
@@ -228,6 +229,9 @@ def run_controller(turbine: linearize.Turbine, controller: str, scenario: Scenar
         With a mean wind only: an IEC 61400-1 wind condition, ``condition`` ("etm", "eog",
         "edc", "ecd", "ews-v", "ews-h", "nwp"), ``iec_class`` ("I"), ``sign`` (1),
         ``event_at`` (when the transient starts [s]).
+    plant : mapping of str to bool, optional
+        The plant's effects switched from their defaults (``meta["plant"]``), e.g.
+        ``{"twisted_modes": True}`` (:meth:`linearize.PlantConfig.with_switches`).
 
     Returns
     -------
@@ -247,21 +251,29 @@ def run_controller(turbine: linearize.Turbine, controller: str, scenario: Scenar
     scenario = _scenario_of(scenario, {"turbulence": turbulence, "seed": seed,
                                        "duration": duration, "shear_exponent": shear_exponent,
                                        "condition": condition})
-    params = linearize.plant_params(turbine)
+    params = linearize.plant_params(turbine, linearize.PlantConfig().with_switches(plant))
     built, op, wind = build_controller(turbine, controller, scenario, options, cache=cache,
                                        naming=naming, params=params, samplers=samplers,
                                        fields=fields)
     meta = {"controller": controller, **scenario.meta(), "turbine": turbine.name,
-            **built.meta, **({} if scenario.wind_file is None else {"start_wind_mps": op.wind_mps})}
-    ctl = built.controller
-    if supervisor is not None:
-        from mpc_wt.controllers.supervisor import Supervisor
-
-        ctl = Supervisor(ctl, turbine, **dict(supervisor))
-        meta["supervisor"] = {k: v for k, v in dict(supervisor).items() if v is not None}
+            **built.meta, **({} if scenario.wind_file is None else {"start_wind_mps": op.wind_mps}),
+            **({"plant": {k: bool(v) for k, v in plant.items()}} if plant else {})}
     return _warned(simulate_closed_loop(
-        params, ctl, wind, scenario.duration, x0=op.x, u0=op.u, controller_dt=built.controller_dt,
+        params, _supervised(built.controller, turbine, supervisor, meta), wind,
+        scenario.duration, x0=op.x, u0=op.u, controller_dt=built.controller_dt,
         preview=built.preview, progress=progress, meta=meta), controller)
+
+
+def _supervised(ctl: Any, turbine: linearize.Turbine, supervisor: Mapping[str, Any] | None,
+                meta: dict[str, Any]) -> Any:
+    """``ctl`` under a :class:`~mpc_wt.controllers.supervisor.Supervisor` with the settings
+    ``supervisor`` (recorded in ``meta``), or ``ctl`` itself without them."""
+    if supervisor is None:
+        return ctl
+    from mpc_wt.controllers.supervisor import Supervisor
+
+    meta["supervisor"] = {k: v for k, v in dict(supervisor).items() if v is not None}
+    return Supervisor(ctl, turbine, **dict(supervisor))
 
 
 def _warned(res: ClosedLoopResult, controller: str) -> ClosedLoopResult:

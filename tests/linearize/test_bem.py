@@ -179,3 +179,65 @@ def test_warm_start_never_keeps_a_propeller_brake_hint(turbine: linearize.Turbin
     assert cold[2] > 0.05                                   # the global root: phi > 0
     assert warm[2] == pytest.approx(cold[2], abs=1e-8)
     assert warm[0] == pytest.approx(cold[0], rel=1e-6)      # the element's normal load
+
+
+def _largest_coefficient(turbine: linearize.Turbine) -> float:
+    """max over every polar and angle of sqrt(c_l^2 + c_d^2) (the turbine's own tables)."""
+    return max(float(np.max(np.hypot(p.cl, p.cd))) for p in turbine.polars)
+
+
+@settings(max_examples=200, deadline=None)
+@given(vx=st.floats(1.0, 40.0), vy=st.floats(0.0, 100.0), pitch_deg=st.floats(-5.0, 95.0))
+def test_element_loads_within_the_limited_induction(turbine: linearize.Turbine, vx: float,
+                                                    vy: float, pitch_deg: float) -> None:
+    """No element carries more than 0.5 rho W^2 c max sqrt(cl^2 + cd^2) with the inflow the
+    induction limits of AeroDyn's BEMT allow (a <= 1.5 and a >= -1, a' <= 1: W^2 <=
+    (2 V_x)^2 + (2 V_y)^2). Before the limits, a feathered element at V_y = 0.05 m/s and
+    V_x = 25 m/s took a propeller-brake root (phi = -3 deg, 1 + a' in the thousands) and the
+    blade's edgewise root moment read 440 MN m."""
+    b = turbine.blade
+    rho = turbine.environment.air_density
+    n, t, _ = element_loads(turbine, np.full(b.r.size, vx), np.full(b.r.size, vy),
+                            math.radians(pitch_deg))
+    bound = 0.5 * rho * (4 * vx**2 + 4 * vy**2) * b.chord * _largest_coefficient(turbine)
+    assert np.all(np.abs(n) <= 1.05 * bound)  # 5 %: the kernel interpolates the polars
+    assert np.all(np.abs(t) <= 1.05 * bound)
+
+
+def test_feathered_blade_at_rest_carries_little_load(turbine: linearize.Turbine) -> None:
+    """A feathered NREL 5-MW blade (90 deg) in a 25 m/s wind on a rotor nearly at rest (V_y
+    0-1 m/s): its root moments stay below 2.6 MN m. Hand-worked bound: the chord lies along
+    the wind, alpha = -twist (0-13.3 deg), so the lift on the blade, turned in-plane by
+    phi = 90 deg, is at most 0.5 rho U^2 c |c_l(alpha)| (r - r_hub) summed over the span: with
+    |c_l| <= 1.2 and the chord-weighted span moment int c (r - r_hub) dr = 5.63e3 m^3 of the
+    blade table, 0.5 * 1.225 * 625 * 1.2 * 5.63e3 = 2.59 MN m; the old propeller-brake
+    roots gave 13.6 to 440 MN m."""
+    b, g = turbine.blade, turbine.geometry
+    rr = b.r - g.hub_radius
+    assert float(np.trapezoid(b.chord * rr, b.r)) == pytest.approx(5.63e3, rel=0.01)
+    for vy in (0.0, 1e-6, 0.05, 0.2, 0.5, 1.0):
+        n, t, _ = element_loads(turbine, np.full(b.r.size, 25.0), np.full(b.r.size, vy),
+                                math.radians(90.0))
+        assert abs(float(np.trapezoid(t * rr, b.r))) < 2.6e6, vy
+        assert abs(float(np.trapezoid(n * rr, b.r))) < 2.6e6, vy
+
+
+@pytest.mark.parametrize("tsr", [0.0, 0.5, 0.99])
+def test_parked_rotor_sees_the_geometric_inflow(turbine: linearize.Turbine, tsr: float) -> None:
+    """Below a rotor tip-speed ratio of 1 the induction is off (AeroDyn's BEMT): the rotor's
+    loads then cannot depend on the momentum model's options (tip and hub loss, tangential
+    induction), which act only through the induction. Above 2 they do."""
+    def loads(opts: AeroOptions, lam: float) -> np.ndarray:
+        p = linearize.plant_params(turbine, linearize.PlantConfig(aero=opts))
+        x = np.zeros(len(linearize.STATE_NAMES))
+        pitch = math.radians(30.0)
+        x[2], x[5:8] = lam * 12.0 / 63.0, pitch
+        u = np.array([pitch, pitch, pitch, 0.0])
+        z = linearize.plant_outputs(0.0, x, u, np.full(3, 12.0), p)
+        names = list(linearize.OUTPUT_NAMES)
+        return np.array([z[names.index(k)] for k in ("thrust", "aero_torque",
+                                                     "flap_moment_1")])
+
+    plain = AeroOptions(tip_loss=False, hub_loss=False, tangential_induction=False)
+    assert_allclose(loads(AeroOptions(), tsr), loads(plain, tsr), rtol=1e-12)
+    assert not np.allclose(loads(AeroOptions(), 3.0), loads(plain, 3.0), rtol=1e-3)

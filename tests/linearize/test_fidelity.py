@@ -213,3 +213,66 @@ def test_twisted_modes_without_pitch_or_twist_are_the_rotor_plane_modes(
         flat, PlantConfig(twisted_modes=True)))
     b = linearize.plant_rhs(0.0, x, u, d, linearize.plant_params(flat, PlantConfig()))
     assert_allclose(a, b, rtol=1e-12, atol=1e-12)
+
+
+def _flap_damping(params: linearize.PlantParams, pitch: float, wind: float) -> float:
+    """Damping ratio of blade 1's flap mode on a parked rotor (the 2x2 block of flap_1,
+    flap_rate_1 of the plant's Jacobian, central differences)."""
+    names = list(linearize.STATE_NAMES)
+    sel = [names.index("flap_1"), names.index("flap_rate_1")]
+    x0 = np.zeros(len(names))
+    x0[5:8] = pitch
+    u, d = np.array([pitch, pitch, pitch, 0.0]), np.full(3, wind)
+    jac = np.zeros((2, 2))
+    for k, s in enumerate(sel):
+        xp, xm = x0.copy(), x0.copy()
+        xp[s] += 1e-4
+        xm[s] -= 1e-4
+        jac[:, k] = (linearize.plant_rhs(0.0, xp, u, d, params)[sel]
+                     - linearize.plant_rhs(0.0, xm, u, d, params)[sel]) / 2e-4
+    lam = np.linalg.eigvals(jac)
+    lam = lam[np.argmax(lam.imag)]
+    return float(-lam.real / abs(lam))
+
+
+def test_feathered_blade_flap_mode_has_the_plunge_damping(turbine: linearize.Turbine) -> None:
+    """A feathered blade (90 deg) on a parked rotor in 25 m/s: the twisted flap mode moves the
+    sections perpendicular to their chords, across the wind, and a section plunging at h' in
+    attached flow meets dL = 0.5 rho U c (c_l,alpha + c_d) h' (quasi-steady thin-airfoil
+    plunge, Hansen 2015 sec. 10; the drag term from turning the wind by h'/U). Modal:
+    zeta = zeta_struct + int 0.5 rho U c (c_l,alpha + c_d) phi^2 ds / (2 omega int mu phi^2 ds),
+    with the turbine's polars at alpha = -twist, its mass and mode shape: 28 % of critical.
+    The plant's twisted modes give it within 15 %; the rotor-plane modes (the default) move the
+    feathered blade along its chord and keep little more than the structural 0.48 %."""
+    from linearize.turbine import mode_shape
+
+    t, g, b = turbine, turbine.geometry, turbine.blade
+    rho, u_w = t.environment.air_density, 25.0
+    lb = g.tip_radius - g.hub_radius
+    xs = (b.r - g.hub_radius) / lb
+    phi = mode_shape(t.mode_shapes.blade_flap1, xs)
+    slope = np.empty(b.r.size)
+    cd = np.empty(b.r.size)
+    for j in range(b.r.size):
+        pol = t.polars[int(b.airfoil[j])]
+        a = -float(b.twist_rad[j])
+        h = math.radians(1.0)
+        slope[j] = (np.interp(a + h, pol.alpha_rad, pol.cl)
+                    - np.interp(a - h, pol.alpha_rad, pol.cl)) / (2 * h)
+        cd[j] = np.interp(a, pol.alpha_rad, pol.cd)
+    c_aero = float(np.trapezoid(0.5 * rho * u_w * b.chord * (slope + cd) * phi**2, b.r))
+    fine = np.linspace(0.0, 1.0, 2001)
+    bs = t.blade_structure
+    mu = np.interp(fine, bs.span_fraction, bs.mass_per_length)
+    ei = np.interp(fine, bs.span_fraction, bs.flap_stiffness)
+    m_b = float(np.trapezoid(mu * mode_shape(t.mode_shapes.blade_flap1, fine)**2, fine * lb))
+    k_b = float(np.trapezoid(ei * (mode_shape(t.mode_shapes.blade_flap1, fine, 2) / lb**2)**2,
+                             fine * lb))
+    omega = math.sqrt(k_b / m_b)
+    expected = t.damping.blade + c_aero / (2 * omega * m_b)
+    assert expected == pytest.approx(0.28, abs=0.03)
+    twisted = _flap_damping(linearize.plant_params(t, PlantConfig(twisted_modes=True)),
+                            math.pi / 2, u_w)
+    assert twisted == pytest.approx(expected, rel=0.15)
+    plane = _flap_damping(linearize.plant_params(t, PlantConfig()), math.pi / 2, u_w)
+    assert plane < 0.02

@@ -336,3 +336,14 @@ def test_plant_config_rejects_unknown_dof() -> None:
         PlantConfig(frozenset({"tower_torsion"}))
     with pytest.raises(ValueError, match=r"integration must be"):
         PlantConfig(integration="simpson")
+
+
+def test_plant_switches_by_name() -> None:
+    """``PlantConfig.with_switches`` sets the named effects and names a bad switch or value."""
+    cfg = linearize.PlantConfig().with_switches({"twisted_modes": True, "inplane_wind": False})
+    assert cfg.twisted_modes and not cfg.inplane_wind and not cfg.tower_shadow
+    assert linearize.PlantConfig().with_switches(None) == linearize.PlantConfig()
+    with pytest.raises(ValueError, match=r"plant switch 'twisted' is unknown; switches are"):
+        linearize.PlantConfig().with_switches({"twisted": True})
+    with pytest.raises(ValueError, match=r"'tower_drag' must be true or false, got 1"):
+        linearize.PlantConfig().with_switches({"tower_drag": 1})

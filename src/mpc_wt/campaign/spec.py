@@ -23,6 +23,7 @@ from typing import Any, Mapping, Sequence
 import numpy as np
 import yaml
 
+import linearize
 from mpc_wt.campaign.checksum import file_sha256
 from mpc_wt.errors import SpecError
 from mpc_wt.simulation.scenario import (
@@ -40,7 +41,8 @@ __all__ = ["SpecError", "CampaignSpec", "ControllerSpec", "Case", "LoadCase", "W
 _TOP_KEYS = {"name", "description", "turbine", "duration", "transient", "turbulence",
              "shear_exponent", "winds", "seeds", "lidar", "controllers", "channels",
              "wind_distribution", "lifetime_years", "reference", "report", "plugins",
-             "del_convention", "load_cases", "iec_class", "supervisor", "ultimate_channels"}
+             "del_convention", "load_cases", "iec_class", "supervisor", "ultimate_channels",
+             "plant"}
 #: A controller entry's own keys; any other key is an option of the controller's kind.
 _CONTROLLER_KEYS = {"name", "controller", "winds", "seeds", "turbulence", "label", "options",
                     "mpc_options", "retrofit_options", "dlcs"}
@@ -382,6 +384,8 @@ class Case:
     extremes_of : tuple of str
         Channels beyond ``channels`` whose extremes are recorded (the spec's
         ``ultimate_channels``).
+    plant : dict or None
+        The simulated plant's effects switched from their defaults (the spec's ``plant``).
     """
 
     case_id: str
@@ -405,6 +409,7 @@ class Case:
     bin_wind_mps: float | None = None
     design_hash: str | None = None
     extremes_of: tuple[str, ...] = ()
+    plant: dict[str, bool] | None = None
 
     @property
     def wind_mps(self) -> float:
@@ -528,6 +533,9 @@ class CampaignSpec:
         The channels the ultimate and governing design loads are read on (None: the fatigue
         ``channels``); e.g. ``shaft_bending_resultant`` for the shaft, whose section sees the
         resultant at some fiber whatever the azimuth.
+    plant : dict of str to bool
+        The simulated plant's effects switched from their defaults
+        (:meth:`linearize.PlantConfig.with_switches`; empty: the default plant).
     """
 
     name: str
@@ -555,6 +563,7 @@ class CampaignSpec:
     load_cases: tuple[LoadCase, ...] = ()
     iec_class: str = "I"
     ultimate_channels: tuple[str, ...] | None = None
+    plant: dict[str, bool] = field(default_factory=dict)
 
     @property
     def ultimate(self) -> tuple[str, ...]:
@@ -679,6 +688,8 @@ class CampaignSpec:
                 sim["condition"] = cond
             if sup:
                 sim["supervisor"] = sup
+            if self.plant:                  # the default plant keeps older hashes valid
+                sim["plant"] = self.plant
             out.append(Case(
                 case_id=_case_id(c.name, lc, turb, v, seed, sign), controller=c.name,
                 run_name=c.controller, options=copy.deepcopy(c.options),
@@ -691,7 +702,7 @@ class CampaignSpec:
                 del_convention=self.del_convention, dlc=lc.dlc,
                 supervisor=copy.deepcopy(sup), family=lc.family, fatigue=lc.fatigue,
                 design_hash=c.design_hash,
-                extremes_of=self.extra_extremes))
+                extremes_of=self.extra_extremes, plant=dict(self.plant) or None))
         return out
 
     def _file_cases(self, c: ControllerSpec, lc: LoadCase, a: dict[str, Any],
@@ -704,6 +715,8 @@ class CampaignSpec:
                    "options": c.options, "wind_file": f.sha256, "duration": f.duration}
             if sup:
                 sim["supervisor"] = sup
+            if self.plant:
+                sim["plant"] = self.plant
             out.append(Case(
                 case_id=f"{c.name}__dlc{lc.dlc}__file-{f.stem}__v{f.wind_mps:g}",
                 controller=c.name, run_name=c.controller, options=copy.deepcopy(c.options),
@@ -715,7 +728,7 @@ class CampaignSpec:
                 del_convention=self.del_convention, dlc=lc.dlc,
                 supervisor=copy.deepcopy(sup), family=lc.family, fatigue=lc.fatigue,
                 bin_wind_mps=f.wind_mps, design_hash=c.design_hash,
-                extremes_of=self.extra_extremes))
+                extremes_of=self.extra_extremes, plant=dict(self.plant) or None))
         return out
 
 
@@ -1141,6 +1154,23 @@ def _ultimate_channels(raw: Any) -> tuple[str, ...] | None:
     return tuple(str(k) for k in raw)
 
 
+def _description(desc: Any) -> str:
+    if not isinstance(desc, str):
+        raise _fail("description", f"must be a string, got {desc!r}")
+    return desc
+
+
+def _plant(raw: Any) -> dict[str, bool]:
+    """The ``plant`` mapping of effect switches, checked (empty when absent)."""
+    if raw is None:
+        return {}
+    try:
+        linearize.PlantConfig().with_switches(raw)
+    except ValueError as err:
+        raise _fail("plant", str(err)) from None
+    return {str(k): bool(v) for k, v in dict(raw).items()}
+
+
 def _channels(raw: Any) -> dict[str, float]:
     """Channel -> Woehler exponent (default :data:`mpc_wt.assessment.series.DEFAULT_CHANNELS`)."""
     from mpc_wt.assessment.series import DEFAULT_CHANNELS
@@ -1307,9 +1337,7 @@ def spec_from_dict(raw: Mapping[str, Any], base: Path | None = None,
     if ref not in names:
         raise _fail("reference", f"{ref!r} is not a controller name; names are {names}")
     report = _report(raw.get("report", {}), names, chans)
-    desc = raw.get("description", "")
-    if not isinstance(desc, str):
-        raise _fail("description", f"must be a string, got {desc!r}")
+    desc = _description(raw.get("description", ""))
     return CampaignSpec(
         name=name, description=desc, turbine=turbine, turbine_hash=thash,
         duration=duration, transient=transient,
@@ -1324,7 +1352,8 @@ def spec_from_dict(raw: Mapping[str, Any], base: Path | None = None,
         reference=ref, report=report, raw=raw, source=source, plugins=plugins,
         plugin_folder=str(base) if base is not None and plugins else None,
         del_convention=_convention(raw.get("del_convention", "range-1hz")),
-        ultimate_channels=_ultimate_channels(raw.get("ultimate_channels")))
+        ultimate_channels=_ultimate_channels(raw.get("ultimate_channels")),
+        plant=_plant(raw.get("plant")))
 
 
 _PAPER_METRICS = {"del_change_pct", "lifetime_del_change_pct", "aep_change_pct",

@@ -252,7 +252,8 @@ def run_case(case: dict[str, Any], root: str) -> dict[str, Any]:
                 res = run_controller(load_case_turbine(case["turbine"]), case["run_name"],
                                      Scenario(**case["scenario"]), case["options"],
                                      supervisor=case.get("supervisor"),
-                                     samplers=WORKER_SAMPLERS, fields=WORKER_FIELDS)
+                                     samplers=WORKER_SAMPLERS, fields=WORKER_FIELDS,
+                                     plant=case.get("plant"))
             except SimulationDivergedError as err:
                 if getattr(err, "partial", None) is not None:
                     err.partial.meta["campaign_case"] = {"case_id": case["case_id"],

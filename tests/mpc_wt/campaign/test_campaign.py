@@ -25,6 +25,7 @@ from mpc_wt.campaign import (
     run_campaign,
     spec_from_dict,
 )
+from mpc_wt.campaign.spec import Case
 from mpc_wt.simulation.results import ClosedLoopResult
 from mpc_wt.simulation.scenario import Scenario
 
@@ -63,6 +64,9 @@ def _spec(**over):
     ({"ultimate_channels": ["flap_moment_9"]}, "ultimate_channels[0]"),
     ({"ultimate_channels": "lss_torque"}, "ultimate_channels"),
     ({"ultimate_channels": ["lss_torque", "lss_torque"]}, "ultimate_channels"),
+    ({"plant": {"twisted": True}}, "plant"),
+    ({"plant": {"twisted_modes": "yes"}}, "plant"),
+    ({"plant": ["twisted_modes"]}, "plant"),
     ({"wind_distribution": {"kind": "weibull"}}, "wind_distribution.scale"),
     ({"wind_distribution": {"kind": "gamma"}}, "wind_distribution.kind"),
     ({"turbine": "no/such/turbine.yaml"}, "turbine"),
@@ -125,6 +129,10 @@ def test_case_hash_changes_only_for_touched_cases(winds, seeds, ctl, shear):
     for x, y in zip(a, d):
         assert x.case_hash == y.case_hash and x.assess_hash != y.assess_hash
         assert y.extremes_of == ("shaft_bending_resultant",) and x.extremes_of == ()
+    e = spec_from_dict({**raw, "plant": {"twisted_modes": True}}).cases()
+    for x, y in zip(a, e):
+        assert x.case_hash != y.case_hash and x.assess_hash == y.assess_hash
+        assert y.plant == {"twisted_modes": True} and x.plant is None
 
 
 # -- store and runner (in this process) -------------------------------------------------------
@@ -361,6 +369,23 @@ def test_ultimate_loads_on_their_own_channels(tmp_path):
     assert "shaft_bending_resultant design load [%]" in text
     assert "shaft_bending_blade1 lifetime DEL [%]" in text
     assert "shaft_bending_blade1 design load" not in text
+
+
+def test_a_campaign_runs_the_plant_its_spec_names(tmp_path):
+    """``plant``: the cases run on the plant with those effects (recorded in each result's
+    meta); the same case on the default plant differs in its loads, and a stored case read
+    back keeps the switches."""
+    raw = {**BASE, "duration": 10, "transient": 2, "winds": [14]}
+    twisted = spec_from_dict({**raw, "plant": {"twisted_modes": True}})
+    run_campaign(twisted, tmp_path / "tw", engine="serial", progress=False)
+    run_campaign(spec_from_dict(raw), tmp_path / "plain", engine="serial", progress=False)
+    (ft,) = (tmp_path / "tw" / "cases").glob("*.nc")
+    (fp,) = (tmp_path / "plain" / "cases").glob("*.nc")
+    rt, rp = ClosedLoopResult.load(ft), ClosedLoopResult.load(fp)
+    assert rt.meta["plant"] == {"twisted_modes": True} and "plant" not in rp.meta
+    assert not np.allclose(rt.channel("edge_moment_1"), rp.channel("edge_moment_1"), rtol=1e-3)
+    case = twisted.cases()[0]
+    assert Case.from_dict(json.loads(json.dumps(case.to_dict()))).plant == case.plant
 
 
 def _probs_rayleigh(winds, mean):
