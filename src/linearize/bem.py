@@ -436,7 +436,8 @@ def _limited(phi, vx, vy, r, chord, theta, k_af, table, alpha0, dalpha, nb_, rti
     V_y = 0.05 m/s against V_x = 25 m/s, with 1 + a' in the thousands and a 25 m edgewise load
     of 440 MN m), is replaced by the geometric inflow without induction; otherwise a and a' are
     kept within [:data:`A_MIN`, :data:`A_MAX`] and [:data:`AP_MIN`, :data:`AP_MAX`]. Both
-    follow AeroDyn's BEMT (Ning, Hayman, Damiani and Jonkman 2015, NREL/TP-5000-63217). A
+    follow AeroDyn 15's BEMT in OpenFAST (its invalid-solution test and
+    ``BEMT_MinInduction``, ``BEMT_MaxInduction``). A
     changed root's phi, coefficients and inductions are returned with a flag; the normal
     windmill state (0 < phi, 0 <= a <= 1, 0 <= a' <= 1) never comes here.
     """

@@ -50,10 +50,10 @@ BEM_TSR_BOUNDS = (1.0, 2.0)
 def _bem_weight(wr, wind, rtip, mode):  # pragma: no cover - compiled
     """The share of the BEM induction kept at the rotor's tip-speed ratio Omega R / U (U the
     mean free wind over the elements): 1 from :data:`BEM_TSR_BOUNDS`[1] up, 0 below [0], a
-    cosine blend between (as AeroDyn's BEMT, Jonkman et al. 2015, NREL/TP-5000-63217 sec.
-    "low TSR"). Momentum theory has no meaning on a rotor that barely turns: a parked or
-    stopping rotor's inflow is the geometric one. A frozen-wake or complex-step evaluation
-    (linearization, at operating points) keeps all of it."""
+    cosine blend between (as AeroDyn 15's BEMT in OpenFAST: ``BEMT_lowerBoundTSR`` = 1,
+    ``BEMT_upperBoundTSR`` = 2). Momentum theory has no meaning on a rotor that barely turns:
+    a parked or stopping rotor's inflow is the geometric one. A frozen-wake or complex-step
+    evaluation (linearization, at operating points) keeps all of it."""
     if mode & (MODE_FROZEN | MODE_CS):
         return 1.0
     u_mean = 0.0
