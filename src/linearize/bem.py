@@ -60,6 +60,11 @@ class AeroOptions:
         Apply shaft tilt and precone in the element kinematics and loads.
     gravity : bool
         Add the blade's gravity moment to the edgewise root moment.
+    induction_limits : bool
+        AeroDyn 15's checks where momentum theory has no meaning (:func:`_limited`): a root
+        whose loading factor has the wrong sign for its branch takes the geometric inflow, a
+        and a' stay within [-1, 1.5] and [-1, 1]. CCBlade has none (off to compare with it);
+        the windmill state never reaches them.
     """
 
     tip_loss: bool = True
@@ -68,6 +73,7 @@ class AeroOptions:
     tilt: bool = True
     cone: bool = True
     gravity: bool = True
+    induction_limits: bool = True
 
     @property
     def azimuth_independent(self) -> "AeroOptions":
@@ -525,8 +531,8 @@ def element_kernel(vx, vy, r, chord, theta, k_af, table, alpha0, dalpha, nb_, rt
         phi, slope, one_m_a, one_p_ap, cn, ct = _solve_phi(
             vx.real, vy.real, r, chord, theta.real, k_af, table, alpha0, dalpha, nb_, rtip,
             rhub, flags, hint, hint_slope, tol)
-        if (phi < 0.0 or one_m_a < 0.0 or one_m_a > 1.0 or one_p_ap < 0.0
-                or one_p_ap > 2.0):
+        if flags[3] != 0 and (phi < 0.0 or one_m_a < 0.0 or one_m_a > 1.0 or one_p_ap < 0.0
+                              or one_p_ap > 2.0):
             # outside the normal windmill state: the induction is checked and limited
             phi, one_m_a, one_p_ap, cn, ct, lim = _limited(
                 phi, vx.real, vy.real, r, chord, theta.real, k_af, table, alpha0, dalpha, nb_,
@@ -547,9 +553,9 @@ def element_kernel(vx, vy, r, chord, theta, k_af, table, alpha0, dalpha, nb_, rt
 # Public entry points
 # --------------------------------------------------------------------------------------------
 def aero_flags(options: AeroOptions) -> np.ndarray:
-    """Kernel flag vector (tip_loss, hub_loss, tangential_induction)."""
-    return np.array([options.tip_loss, options.hub_loss, options.tangential_induction],
-                    dtype=np.int64)
+    """Kernel flag vector (tip_loss, hub_loss, tangential_induction, induction_limits)."""
+    return np.array([options.tip_loss, options.hub_loss, options.tangential_induction,
+                     options.induction_limits], dtype=np.int64)
 
 
 _TABLE_CACHE: dict[int, tuple[Turbine, PolarTable]] = {}

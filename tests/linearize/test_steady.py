@@ -69,6 +69,11 @@ def test_negative_pitch_against_rosco_table(turbine, rosco_nrel5mw) -> None:
     np.testing.assert_allclose(cp, cp_ref[i, cols], rtol=0, atol=0.01)
 
 
+#: CCBlade's BEM has no limits on the induction (AeroDyn 15's, on in our plant, act only in
+#: the braking region here: TSR 12 at 25 deg, C_P = -5).
+_CCBLADE_AERO = linearize.AeroOptions(induction_limits=False)
+
+
 def _ccblade_setup(turbine: linearize.Turbine) -> linearize.Turbine:
     """The NREL 5-MW as ROSCO's tuning tool hands it to CCBlade (rosco/toolbox/turbine.py):
     the 19 AeroDyn-15 nodes at r = BlSpn + HubRad, the last at 62.9999 m (the deck's BlSpn
@@ -120,7 +125,7 @@ def test_cp_ct_surface_reproduces_rosco_table(turbine, rosco_nrel5mw) -> None:
     lam, beta = np.meshgrid(tsr[rows], pitch[cols], indexing="ij")
     cp_r, ct_r = cp_ref[np.ix_(rows, cols)], ct_ref[np.ix_(rows, cols)]
     on = cp_r > 0.0
-    cp, ct = linearize.steady_coefficients(_ccblade_setup(turbine), lam, beta,
+    cp, ct = linearize.steady_coefficients(_ccblade_setup(turbine), lam, beta, _CCBLADE_AERO,
                                            shear_exponent=0.2, integration="trapezoid")
     assert np.max(np.abs(cp - cp_r)[on]) <= 0.003
     assert np.max(np.abs(ct - ct_r)[on]) <= 0.003
@@ -147,7 +152,7 @@ def test_cp_ct_whole_grid_rms_and_max(turbine, rosco_nrel5mw) -> None:
     lam, beta = np.meshgrid(tsr[rows], pitch[cols], indexing="ij")
     cp_r, ct_r = cp_ref[np.ix_(rows, cols)], ct_ref[np.ix_(rows, cols)]
     assert lam.size == 588
-    cp, ct = linearize.steady_coefficients(_ccblade_setup(turbine), lam, beta,
+    cp, ct = linearize.steady_coefficients(_ccblade_setup(turbine), lam, beta, _CCBLADE_AERO,
                                            shear_exponent=0.2, integration="trapezoid")
     assert np.sqrt(np.mean((cp - cp_r) ** 2)) <= 0.005
     assert np.sqrt(np.mean((ct - ct_r) ** 2)) <= 0.003
