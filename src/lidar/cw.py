@@ -22,12 +22,15 @@ field (wind evolution is applied to the field, see :func:`lidar.evolve_field`).
 from __future__ import annotations
 
 import functools
+import hashlib
 import math
 from dataclasses import dataclass
+from pathlib import Path
 
 import numba as nb
 import numpy as np
 
+from lidar import field as _field
 from lidar._typing import FloatArray
 from lidar.field import WindField, trilinear_point
 
@@ -436,3 +439,18 @@ class LidarSensor:
         LidarMeasurement
         """
         return self.instrument.measure(self.field, t, blade_azimuth_rad, rotor_speed_rad_s)
+
+
+def _key_cache_on_field() -> None:
+    """:func:`_los_kernel` compiles the field's interpolation into itself, and numba keys its
+    disk cache on this file only: the field module's source enters the key too, so that an
+    edit or upgrade of it recompiles the kernel (through numba 0.68's cache object; on another
+    layout numba's own key stays)."""
+    cache_file = getattr(getattr(_los_kernel, "_cache", None), "_cache_file", None)
+    if cache_file is not None and hasattr(cache_file, "_source_stamp"):
+        h = hashlib.sha256(repr(cache_file._source_stamp).encode())
+        h.update(Path(_field.__file__).read_bytes())
+        cache_file._source_stamp = h.hexdigest()
+
+
+_key_cache_on_field()

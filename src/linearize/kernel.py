@@ -16,6 +16,7 @@ from linearize.bem import (
     element_kernel,
     locate_cell,
 )
+from linearize.jitcache import key_caches_on_callees
 from linearize.params import n_x
 from linearize.unsteady import HINT_ROWS_UA, UA_ROW, ua_coefficients, ua_update
 
@@ -648,3 +649,6 @@ def simulate_kernel(x0, u_seq, t0, h, n_steps, p, kind, wpar, grid, lim, rate_tq
             return xs[:k + 1], zs[:k + 1], us[:k + 1], k + 1, bad, xn[bad]
         x = xn
     return xs, zs, us, n_steps + 1, -1, 0.0
+
+
+key_caches_on_callees(__name__)

@@ -54,6 +54,7 @@ import numpy as np
 from linearize._typing import FloatArray
 from linearize.bem import MODE_CS, MODE_FROZEN, MODE_NOLIMITS, MODE_TIGHT
 from linearize.errors import LinearizationError
+from linearize.jitcache import key_caches_on_callees
 from linearize.kernel import evaluate_plant, sample_wind
 from linearize.models import LinearModel, LinearModelFamily, check_wind_grid
 from linearize.params import (
@@ -523,3 +524,6 @@ def linearize_family(turbine: Turbine, wind_mps: Sequence[float] | FloatArray | 
     models = tuple(linearize(turbine, float(w), params=p, **kwargs)
                    for w in bar(v, "linearize", "op", enabled=progress))
     return LinearModelFamily(v, models)
+
+
+key_caches_on_callees(__name__)

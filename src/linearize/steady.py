@@ -14,6 +14,7 @@ from scipy.optimize import minimize_scalar
 
 from linearize._typing import FloatArray
 from linearize.bem import MODE_NOLIMITS, AeroOptions
+from linearize.jitcache import key_caches_on_callees
 from linearize.kernel import evaluate_plant, sample_wind
 from linearize.params import PlantConfig, PlantParams, n_x, plant_params
 from linearize.turbine import Turbine
@@ -190,3 +191,5 @@ def optimal_tsr(turbine: Turbine, pitch_deg: float = 0.0, options: AeroOptions |
     res = minimize_scalar(neg, bounds=(lo, hi), method="bounded", options={"xatol": 1e-6})
     return float(res.x), -float(res.fun)
 
+
+key_caches_on_callees(__name__)

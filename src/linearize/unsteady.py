@@ -43,6 +43,7 @@ import numba as nb
 import numpy as np
 
 from linearize.bem import polar_lookup
+from linearize.jitcache import key_caches_on_callees
 
 __all__ = ["UA_ROW", "N_UA", "HINT_ROWS_UA", "UA_PAR", "ua_coefficients", "ua_update",
            "ua_steady"]
@@ -235,3 +236,6 @@ def ua_steady(alpha, w, par, table, k, a0, dalpha):  # pragma: no cover - compil
     st = _initial(alpha, w, par, table, k, a0, dalpha)
     cl, cd, _ = _chain(alpha, w, 1.0, 0.01, par, st, table, k, a0, dalpha)
     return _blend(alpha, cl, cd, par, table, k, a0, dalpha)
+
+
+key_caches_on_callees(__name__)

@@ -37,6 +37,7 @@ import numba as nb
 import numpy as np
 
 import linearize
+from linearize.jitcache import key_caches_on_callees
 from linearize.validate import check_number
 from mpc_wt.controllers.base import ControllerBase
 from mpc_wt.controllers.baseline import LawTorque
@@ -1618,3 +1619,6 @@ class ScheduledMPC(ControllerBase):
                             schedule_outside=float(self.schedule.outside),
                             estimator_outside=float(self.schedule.estimator_outside))
         return u
+
+
+key_caches_on_callees(__name__)

@@ -16,26 +16,17 @@ and no LIDAR.
 """
 from __future__ import annotations
 
-import hashlib
-import logging
 import math
-from pathlib import Path
 from typing import Any
 
 import numba as nb
 import numpy as np
 
-import linearize
-import linearize.bem
-import linearize.kernel
+from linearize.jitcache import key_caches_on_callees
 from linearize.kernel import step_kernel
-from mpc_wt.controllers import baseline_law
 from mpc_wt.controllers.baseline_law import law
 
 __all__ = ["run_steps"]
-
-log = logging.getLogger(__name__)
-
 
 _JIT = dict(cache=True, error_model="numpy")
 
@@ -74,27 +65,6 @@ def _loop(k0, k1, ratio, h, pk, kind, wpar, grid, hint, dphi, lim, xs, us, zs, u
     return k1, -1
 
 
-def _tie_cache_to_sources(dispatcher: Any, paths: tuple[str, ...]) -> None:
-    """numba keys a kernel's disk cache on its own file's source only; :func:`_loop` compiles
-    the plant's kernels and the baseline's law into itself, so their sources enter the key
-    too: an edit of linearize's plant kernels or BEM, or of the law, recompiles the loop
-    instead of loading a stale one. Through
-    numba's cache object (its attributes as of numba 0.68); without them, numba's own key
-    and a debug log."""
-    try:
-        cache_file = dispatcher._cache._cache_file
-        h = hashlib.sha256(repr(cache_file._source_stamp).encode())
-        for path in paths:
-            h.update(Path(path).read_bytes())
-        cache_file._source_stamp = h.hexdigest()
-    except (AttributeError, OSError) as err:      # pragma: no cover - another numba
-        log.debug("compiled loop's cache keyed on its own source only: %s", err)
-
-
-_tie_cache_to_sources(_loop, (linearize.kernel.__file__, linearize.bem.__file__,
-                              baseline_law.__file__))
-
-
 def run_steps(k0: int, k1: int, ratio: int, stepper: Any, arrays: tuple[np.ndarray, ...]
               ) -> tuple[int, int]:
     """Run plant steps ``k0`` to ``k1 - 1`` of a compiled closed loop.
@@ -122,3 +92,6 @@ def run_steps(k0: int, k1: int, ratio: int, stepper: Any, arrays: tuple[np.ndarr
     h, pk, kind, wpar, grid, hint, dphi, lim = stepper.kernel_args()
     done, flag = _loop(k0, k1, ratio, h, pk, kind, wpar, grid, hint, dphi, lim, *arrays)
     return int(done), int(flag)
+
+
+key_caches_on_callees(__name__)

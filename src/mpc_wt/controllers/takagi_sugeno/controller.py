@@ -12,6 +12,7 @@ import numpy as np
 import scipy.linalg
 
 import linearize
+from linearize.jitcache import key_caches_on_callees
 from linearize.validate import check_number
 from mpc_wt.controllers.base import ControllerBase
 from mpc_wt.controllers.baseline import LawTorque
@@ -252,3 +253,6 @@ def _ts_step(xi: np.ndarray, u: np.ndarray, y: np.ndarray, dp_raw: float, wg: np
         q = q_prev        # anti-windup: no integration while an applied input saturates
     u[0], u[1] = pitch, torque
     return q, dp, c1 or c2
+
+
+key_caches_on_callees(__name__)
