@@ -61,9 +61,18 @@ def key_caches_on_callees(module_name: str) -> int:
     """Key the disk cache of each cached kernel defined in ``module_name`` on the sources of
     all kernels it compiles in; call it at the end of the module.
 
-    Returns the number of kernels whose key now covers another module's source. Works through
-    numba's cache object (its attributes as of numba 0.68); on another layout it leaves numba's
-    own key and says so in a debug log.
+    Works through numba's cache object (its attributes as of numba 0.68); on another layout it
+    leaves numba's own key.
+
+    Parameters
+    ----------
+    module_name : str
+        The module (imported), usually ``__name__``.
+
+    Returns
+    -------
+    int
+        The number of kernels whose key now covers another module's source.
     """
     module = sys.modules[module_name]
     tied = 0
