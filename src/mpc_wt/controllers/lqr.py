@@ -4,8 +4,9 @@ LQR (Do et al. eqs 9-10): on the actuator-augmented linear model (eq 6; our mode
 pitch servo as states, so ``linearize.PlantConfig.do()`` gives it directly), minimise
 integral x'Qx + u'Ru (continuous) or sum x'Qx + u'Ru (discrete); u = -K x with K from
 python-control's ``lqr`` / ``dlqr`` (the Riccati solution P of eq 10 is returned too). Q is built
-from weights per named state and per named output (an output weight w on z = C x adds
-w C_i' C_i, so a blade-root moment can be weighted directly), R from weights per input; weights
+from weights per named state and per named output, R from weights per input; an output
+z_i = C_i x + D_i u weighted by w adds w (C_i x + D_i u)^2 (Q, R and the cross term N of
+x'Qx + 2 x'Nu + u'Ru), so a blade-root moment or a pitch rate can be weighted directly; weights
 are divided by the squares of optional typical magnitudes (``scales``) so that they are
 dimensionless.
 
@@ -165,8 +166,9 @@ def design_lqr(model: linearize.LinearModel, *,
     Parameters
     ----------
     state_weights, output_weights : dict of name to weight >= 0
-        Diagonal weights on named states and on named outputs (w C_i' C_i). Default: rotor
-        speed 1 (speed regulation, Do's region III).
+        Weights on named states and on named outputs (an output z_i = C_i x + D_i u adds
+        w (C_i x + D_i u)^2 to the cost: Q, R and the cross term N). Default: rotor speed 1
+        (speed regulation, Do's region III).
     input_weights : dict of input name to weight > 0
         Default 1 for every input used (Do: R = I).
     inputs : names of the inputs the gain acts on (default the three pitch references; the
@@ -194,10 +196,11 @@ def design_lqr(model: linearize.LinearModel, *,
     ow = dict(output_weights or {})
     if not sw and not ow:
         sw = {"rotor_speed": 1.0}
-    q = _state_weight_matrix(model, sw, ow, scales)
     inputs = tuple(inputs)
     r, iw = _input_weight_matrix(model, inputs, input_weights, scales)
     iu = [model.inputs.index(n) for n in inputs]
+    q, r_out, n_cross = _weight_matrices(model, sw, ow, scales, iu)
+    r = r + r_out
     a, b = model.A, model.B_u[:, iu]
     discrete = model.dt is not None
     modes = uncontrollable_modes(a, b, discrete)
@@ -208,7 +211,7 @@ def design_lqr(model: linearize.LinearModel, *,
             f"{'outside the unit circle' if discrete else 'not in the open left half-plane'} and "
             f"cannot be moved; add an input that acts on them or a model DOF that damps them")
     try:
-        k, p, eig = (control.dlqr if discrete else control.lqr)(a, b, q, r)
+        k, p, eig = (control.dlqr if discrete else control.lqr)(a, b, q, r, n_cross)
     except Exception as err:  # python-control raises ControlArgument / LinAlgError
         raise SynthesisError(f"the Riccati equation has no stabilizing solution: {err}; "
                              f"check that every unstable mode is seen by Q (detectability)") \
@@ -225,11 +228,17 @@ def _check_scales(scales: Mapping[str, float] | None) -> dict[str, float]:
     return {k: check_number(f"scale {k!r}", v, lo=0.0, lo_open=True) for k, v in out.items()}
 
 
-def _state_weight_matrix(model: linearize.LinearModel, sw: Mapping[str, float],
-                         ow: Mapping[str, float], scales: Mapping[str, float]) -> np.ndarray:
-    """Q from weights on named states and outputs (w C_i' C_i), each divided by its scale^2."""
+def _weight_matrices(model: linearize.LinearModel, sw: Mapping[str, float],
+                     ow: Mapping[str, float], scales: Mapping[str, float], iu: Sequence[int]
+                     ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Q, the inputs' share R_z and the cross term N of the cost from weights on named states
+    and outputs, each divided by its scale^2: an output z_i = C_i x + D_i u weighted by w adds
+    w (C_i x + D_i u)^2, i.e. w C_i' C_i to Q, w D_i' D_i to R and w C_i' D_i to N (a pitch
+    rate, (u - x_pitch) / tau, is weighted as the rate it is)."""
     nx = len(model.states)
     q = np.zeros((nx, nx))
+    r = np.zeros((len(iu), len(iu)))
+    n_cross = np.zeros((nx, len(iu)))
     for group, kind in ((sw, "state"), (ow, "output")):
         pool = model.states if kind == "state" else model.outputs
         for n, w in group.items():
@@ -237,14 +246,19 @@ def _state_weight_matrix(model: linearize.LinearModel, sw: Mapping[str, float],
                 raise ValueError(f"{kind}_weights: unknown {kind} {n!r}; the model's {kind}s are "
                                  f"{list(pool)}")
             w = _check_weight(n, w) / scales.get(n, 1.0) ** 2
-            row = (model.C_z[model.outputs.index(n)] if kind == "output"
-                   else np.eye(nx)[model.states.index(n)])
+            if kind == "output":
+                row = model.C_z[model.outputs.index(n)]
+                d = model.D_u[model.outputs.index(n), iu]
+                r += w * np.outer(d, d)
+                n_cross += w * np.outer(row, d)
+            else:
+                row = np.eye(nx)[model.states.index(n)]
             q += w * np.outer(row, row)
     q = 0.5 * (q + q.T)
     lam = np.linalg.eigvalsh(q)
     if lam[0] < -1e-10 * max(1.0, lam[-1]):
         raise ValueError(f"Q is not positive semidefinite (smallest eigenvalue {lam[0]:g})")
-    return q
+    return q, 0.5 * (r + r.T), n_cross
 
 
 def _input_weight_matrix(model: linearize.LinearModel, inputs: tuple[str, ...],

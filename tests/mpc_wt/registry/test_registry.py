@@ -260,6 +260,7 @@ def test_design_weights_reach_the_designs() -> None:
         lq = b.meta["lqr"]["weights"]["III"]
         assert lq["state"] == {"rotor_speed": 2.0, "tower_fa_velocity": 1.0}
         assert lq["input"] == {f"pitch_ref_{i}": wp for i in (1, 2, 3)}
+        assert lq["output"] == {f"pitch_rate_{i}": 0.4 for i in (1, 2, 3)}
         gains[wp] = np.linalg.norm(b.controller.controllers[-1].lqr.K)
     assert gains[10.0] < gains[1.0]
     with pytest.raises(OptionsError, match="weights.flap_moment must be >= 0"):
