@@ -792,10 +792,11 @@ class LQRPIOOptions(Options):
     w_pitch: float = option(1.0, help="LQR input weight on each blade's pitch (scale 1 deg "
                             "x the square root of the pitch drives' rate over 8 deg/s)",
                             unit="-", lo=0.0, lo_open=True)
-    w_pitch_rate: float = option(LQR_PITCH_RATE_WEIGHT,
-                                 help="LQR weight on each blade's pitch rate, the output "
-                                 "(pitch_ref - pitch) / tau of the servo model (scale: the "
-                                 "pitch drives' largest rate)", unit="-", lo=0.0)
+    w_pitch_rate: Optional[float] = option(None, help="LQR weight on each blade's pitch "
+                                           "rate, the output (pitch_ref - pitch) / tau of the "
+                                           "servo model (scale: the pitch drives' largest "
+                                           "rate; default 0.4, 0 with design_wind_mps)",
+                                           unit="-", lo=0.0)
     design_wind_mps: Optional[float] = option(None, help="one design at this mean wind (Do et "
                                               "al.'s single point); default: designs from "
                                               "cut-in to cut-out scheduled on the measured "
@@ -831,8 +832,8 @@ class LQRPIOOptions(Options):
         Returns
         -------
         state_weights, input_weights : dict of str to float
-            For :func:`mpc_wt.controllers.lqr.design_lqr` (zero weights left out; the pitch
-            rates' are :meth:`output_weights`).
+            For :func:`mpc_wt.controllers.lqr.design_lqr` (zero weights left out; the
+            weights on the pitch rates come from :meth:`output_weights`).
         """
         from mpc_wt.controllers.lqr import REGION2_WEIGHTS, REGION3_WEIGHTS
         from mpc_wt.controllers.mpc import pitch_drive_scale_ratio
@@ -854,11 +855,19 @@ class LQRPIOOptions(Options):
                 {f"pitch_ref_{i}": self.w_pitch for i in (1, 2, 3)})
 
     def output_weights(self) -> dict[str, float]:
-        """The weights on the model's outputs: each blade's pitch rate (``w_pitch_rate``; on
-        the scale of the drives' largest rate), none when it is 0."""
-        if self.w_pitch_rate <= 0:
-            return {}
-        return {f"pitch_rate_{i}": self.w_pitch_rate for i in (1, 2, 3)}
+        """The weights on the model's outputs: each blade's pitch rate, on the scale of the
+        drives' largest rate (``w_pitch_rate``; unset, :data:`LQR_PITCH_RATE_WEIGHT` for the
+        scheduled designs and none for Do et al.'s single point); none when it is 0.
+
+        Returns
+        -------
+        dict of str to float
+            For :func:`mpc_wt.controllers.lqr.design_lqr`'s ``output_weights``.
+        """
+        w = self.w_pitch_rate
+        if w is None:
+            w = LQR_PITCH_RATE_WEIGHT if self.design_wind_mps is None else 0.0
+        return {f"pitch_rate_{i}": w for i in (1, 2, 3)} if w > 0 else {}
 
 
 def _design_lqr_pio(turbine: linearize.Turbine) -> tuple[dict, str]:

@@ -377,7 +377,8 @@ def test_the_scheduled_lqr_weights_follow_the_pitch_drives() -> None:
     square root of the pitch drives' rate over 8 deg/s and its tower fore-aft weight with that
     ratio itself: on the NREL 5-MW (8 deg/s) exactly Do et al.'s defaults as before (10 and
     1), on the IEA-15-240-RWT (2 deg/s) 20 and 0.25. Weights set as options, and the
-    single-point design, are left as given."""
+    single-point design, are left as given; the single point has no pitch-rate weight unless
+    one is set."""
     from mpc_wt.registry.builtin import LQRPIOOptions
 
     five, fifteen = linearize.load_turbine("nrel5mw"), linearize.load_turbine("iea15mw")
@@ -393,3 +394,8 @@ def test_the_scheduled_lqr_weights_follow_the_pitch_drives() -> None:
     assert given.lqr_weights("III", fifteen)[0] == {"rotor_speed": 3.0, "tower_fa_velocity": 0.7}
     single = LQRPIOOptions(design_wind_mps=18.0)
     assert single.lqr_weights("III", fifteen) == single.lqr_weights("III")
+    # the pitch rate: weighted by default in the scheduled designs, not in the single point
+    assert opts.output_weights() == {f"pitch_rate_{i}": 0.4 for i in (1, 2, 3)}
+    assert single.output_weights() == {}
+    assert LQRPIOOptions(design_wind_mps=18.0, w_pitch_rate=1.0).output_weights()[
+        "pitch_rate_2"] == 1.0
