@@ -1,6 +1,6 @@
 """numba's disk cache keyed on every source a kernel compiles in.
 
-numba keys a cached kernel on its own file's modification time and size. A kernel that calls
+numba keys a cached kernel on its own file's source only. A kernel that calls
 kernels of another module compiles their code into its own, so an edit of the callee's module
 (or an upgrade that leaves the caller's file as it was) would load the caller's stale machine
 code: the plant would run yesterday's BEM. :func:`key_caches_on_callees` replaces that stamp,

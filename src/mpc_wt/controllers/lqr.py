@@ -258,7 +258,7 @@ def _weight_matrices(model: linearize.LinearModel, sw: Mapping[str, float],
     lam = np.linalg.eigvalsh(q)
     if lam[0] < -1e-10 * max(1.0, lam[-1]):
         raise ValueError(f"Q is not positive semidefinite (smallest eigenvalue {lam[0]:g})")
-    return q, 0.5 * (r + r.T), n_cross
+    return q, r, n_cross
 
 
 def _input_weight_matrix(model: linearize.LinearModel, inputs: tuple[str, ...],
