@@ -84,20 +84,26 @@ def _design_lqr(turbine: linearize.Turbine, *, winds: Any = None,
 
 
 def _ts_designs(turbine: linearize.Turbine, ts: Any, rate: float | None,
-                observer_rate: float | None, law: Any) -> tuple[Any, Any]:
+                observer_rate: float | None, law: Any,
+                side_side_feedback: bool = False) -> tuple[Any, Any]:
     """The TS controller and observer at the given decay rates [1/s]; a rate left None is the
     fastest whose loop, scheduled on the estimated wind, decays on the whole plant
-    (:func:`~mpc_wt.controllers.takagi_sugeno.robustness.design_for_loop`)."""
+    (:func:`~mpc_wt.controllers.takagi_sugeno.robustness.design_for_loop`). Without
+    ``side_side_feedback`` the law leaves the tower's side-side states alone
+    (:data:`~mpc_wt.controllers.takagi_sugeno.SIDE_SIDE_STATES`)."""
     from mpc_wt.controllers.takagi_sugeno import design_ts_controller, design_ts_observer
     from mpc_wt.controllers.takagi_sugeno.robustness import (
         design_for_loop,
         design_observer_for_loop,
     )
 
+    from mpc_wt.controllers.takagi_sugeno import SIDE_SIDE_STATES
+
+    unc = () if side_side_feedback else SIDE_SIDE_STATES
     if rate is None:
         kw = {} if observer_rate is None else {"observer_candidates": (observer_rate,)}
-        return design_for_loop(ts, turbine, torque_law=law, **kw)[:2]
-    ctl = design_ts_controller(ts, decay_rate=rate)
+        return design_for_loop(ts, turbine, torque_law=law, uncontrolled=unc, **kw)[:2]
+    ctl = design_ts_controller(ts, decay_rate=rate, uncontrolled=unc)
     if observer_rate is not None:
         return ctl, design_ts_observer(ts, decay_rate=observer_rate)
     return ctl, design_observer_for_loop(ts, ctl, turbine, torque_law=law)[0]
@@ -994,8 +1000,9 @@ class TSOptions(Options):
         "scheduled on the estimated wind, decays on the whole plant's linear models)",
         unit="1/s", lo=0.0, lo_open=True, flag="")
     observer_decay_rate: Optional[float] = option(
-        None, help="observer decay rate (default: the fastest of 1, 0.7, 0.5, 0.35, 0.25 whose "
-        "loop decays with the controller's)",
+        None, help="observer decay rate (default: the fastest of 1, 0.7, 0.5, 0.35, 0.25, at "
+        "most half the tower's first fore-aft frequency, whose loop decays with the "
+        "controller's)",
         unit="1/s", lo=0.0, lo_open=True, flag="")
     observer_signals: str = option("turbine", help="the wind observer's measurements: "
                                    "turbine (tower-top fore-aft and side-side accelerations, "
@@ -1008,6 +1015,10 @@ class TSOptions(Options):
                                    "constant power above), the TS law setting the pitch; ts: "
                                    "the TS law's own torque everywhere (Clemens et al.'s "
                                    "full-load design)", choices=("baseline", "ts"))
+    side_side_feedback: bool = option(False, help="the law acts on the tower's side-side "
+                                      "states too and requires their decay at the "
+                                      "controller's rate (Clemens et al.'s full-state PDC); "
+                                      "default: it leaves that mode to its own damping")
 
 
 @register("ts", TSOptions, field_components="u", design=_design_ts,
@@ -1032,10 +1043,11 @@ def _build_ts(ctx: BuildContext, opts: TSOptions) -> Built:
     def make() -> tuple[Any, Any, Any]:
         ts0 = build_ts_model(ctx.turbine, measured=measured)
         return (ts0,) + _ts_designs(ctx.turbine, ts0, opts.decay_rate, opts.observer_decay_rate,
-                                    law)
+                                    law, opts.side_side_feedback)
 
     ts, c, o = ctx.cache.get(ctx.turbine, ("ts", opts.decay_rate, opts.observer_decay_rate,
-                                           measured, opts.generator_torque), make)
+                                           measured, opts.generator_torque,
+                                           opts.side_side_feedback), make)
     dp = None if opts.apc_frequency is None else apc_reference(
         opts.apc_frequency, amplitude=opts.apc_amplitude, offset=opts.apc_offset)
     ctl = TSController(ts, c, o, ctx.turbine, power_reduction=dp,  # starts from its measurements

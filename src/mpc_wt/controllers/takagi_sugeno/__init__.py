@@ -18,9 +18,12 @@ active together)::
     H_ii < 0,   H_ij + H_ji <= 0,                                  (decay rate alpha)
     [[-r X, G_ij + G_ji], [*, -r X]] < 0 ... (for a disk abs(lambda) < r, D-stability)
     [[1, s_k'], [s_k, X]] >= 0   (the ellipsoid x' P x <= 1 holds the typical deviations s_k)
-    [[X, Y_i' e_j], [e_j' Y_i, mu_j^2]] >= 0   (abs(u_j - u_0,j) <= mu_j on that ellipsoid)
+    [[X, Y_i' e_j], [e_j' Y_i, mu_ij^2]] >= 0  (abs(u_j - u_0,j) <= mu_ij on that ellipsoid
+                                                at vertex i)
 
-minimising sum_j mu_j^2 (least effort for the required decay), or with mu_j fixed.
+minimising sum_ij mu_ij^2 (each vertex's least effort for the required decay), or with
+mu_ij <= mu_j fixed. States the law leaves alone (``uncontrolled``: by default in the registry
+the tower's side-side pair, which the inputs barely reach) are left out of these LMIs.
 
 Observer (eqs 8-10): the state augmented by the rotor-effective wind with the inflow model
 dv/dt = -(v - v_0,i) / tau_v (eq 9, tau_v = 4 s), xi = [x; v], gains L_i from
@@ -37,6 +40,7 @@ magnitudes) so that the SDP is well conditioned; the gains are returned in SI un
 from mpc_wt.controllers.takagi_sugeno.controller import TSController
 from mpc_wt.controllers.takagi_sugeno.model import (
     CLEMENS_MEASURED,
+    SIDE_SIDE_STATES,
     TURBINE_MEASURED,
     TSModel,
     build_ts_model,
@@ -53,4 +57,4 @@ from mpc_wt.controllers.takagi_sugeno.synthesis import (
 
 __all__ = ["TSModel", "build_ts_model", "TSControllerDesign", "TSObserverDesign", "Certificate",
            "design_ts_controller", "design_ts_observer", "verify_controller", "verify_observer",
-           "TSController", "CLEMENS_MEASURED", "TURBINE_MEASURED"]
+           "TSController", "CLEMENS_MEASURED", "TURBINE_MEASURED", "SIDE_SIDE_STATES"]

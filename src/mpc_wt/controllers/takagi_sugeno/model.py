@@ -3,6 +3,7 @@ over rotor-effective wind and power reduction, blended by triangular membership 
 """
 from __future__ import annotations
 
+import functools
 import itertools
 import math
 from dataclasses import dataclass, field
@@ -14,11 +15,15 @@ import numpy as np
 import linearize
 from mpc_wt.errors import PremiseError
 
-__all__ = ["turbine_scales", "CLEMENS_MEASURED", "TURBINE_MEASURED", "DEFAULT_SCALES", "DEFAULT_WIND_GRID",
+__all__ = ["turbine_scales", "SIDE_SIDE_STATES", "CLEMENS_MEASURED", "TURBINE_MEASURED", "DEFAULT_SCALES", "DEFAULT_WIND_GRID",
            "DEFAULT_REDUCTION_GRID", "TSModel", "build_ts_model"]
 
 #: Clemens et al. eq 6: tower side-side and fore-aft displacement, rotor and generator speed.
 CLEMENS_MEASURED = ("tower_ss_displacement", "tower_fa_displacement", "rotor_speed", "gen_speed")
+#: The tower's side-side states of the TS model: a mode the collective pitch and the torque
+#: barely reach, which the default design leaves to its own damping
+#: (:func:`~mpc_wt.controllers.takagi_sugeno.synthesis.design_ts_controller`'s ``uncontrolled``).
+SIDE_SIDE_STATES = ("tower_ss_displacement", "tower_ss_velocity")
 #: What a turbine's controller is given in their place (the Bladed interface's records 53, 54,
 #: 21 and 20): the tower-top fore-aft and side-side accelerations, rotor and generator speed.
 TURBINE_MEASURED = ("tower_fa_acceleration", "tower_ss_acceleration", "rotor_speed",
@@ -43,6 +48,12 @@ def turbine_scales(turbine: linearize.Turbine) -> dict[str, float]:
     (:func:`mpc_wt.controllers.mpc.turbine_scale_ratios`; the generator speed is the rotor's
     times the gearbox ratio); displacements, accelerations, angles and the wind keep theirs.
 
+    The tower's displacements, velocities and accelerations go with the tower top's
+    fore-aft deflection at rated wind (thrust over stiffness), times its first fore-aft
+    frequency to the power 0, 1 and 2 (:func:`_tower_ratios`: 2.35, 1.72 and 1.26 on the
+    IEA-15-240-RWT). With the NREL 5-MW's, the IEA-15's tower moved twice as far as the
+    design took as typical, and its PDC gains pitched on that motion.
+
     With the NREL 5-MW's scales the IEA-15's direct-drive generator speed (0.79 rad/s at
     rated) was scaled by 9.7 rad/s and its torque (19 MN m) by 4 kN m: the observer all but
     ignored the generator speed, and its drivetrain estimate swung by +-2 rad/s in steady wind.
@@ -60,12 +71,46 @@ def turbine_scales(turbine: linearize.Turbine) -> dict[str, float]:
 
     r = turbine_scale_ratios(turbine)
     out = dict(DEFAULT_SCALES)
+    tower = _tower_ratios(turbine)
+    for side in ("fa", "ss"):
+        out[f"tower_{side}_displacement"] *= tower["displacement"]
+        out[f"tower_{side}_velocity"] *= tower["velocity"]
+        out[f"tower_{side}_acceleration"] *= tower["acceleration"]
     out["rotor_speed"] *= r["rotor_speed"]
     out["gen_speed"] = DEFAULT_SCALES["gen_speed"] * r["rotor_speed"] * (
         turbine.drivetrain.gearbox_ratio / 97.0)
     out["gen_torque_ref"] *= r["gen_torque_ref"]
     out["shaft_torsion"] *= r["shaft_torsion"]
     return out
+
+
+def _tower_magnitudes(turbine: linearize.Turbine) -> tuple[float, float]:
+    """The tower top's fore-aft deflection at rated wind [m] and the plant's first fore-aft
+    frequency there [rad/s] (the eigenvalue of the linear model at rated wind, 2 m/s above,
+    whose eigenvector lies most on the tower's fore-aft states)."""
+    v = linearize.rated_wind_speed(turbine)
+    op = linearize.trim(turbine, v)
+    model = linearize.linearize(turbine, v + 2.0)
+    idx = [model.states.index(n) for n in ("tower_fa_displacement", "tower_fa_velocity")]
+    ev, vec = np.linalg.eig(model.A)
+    share = np.linalg.norm(vec[idx], axis=0) / np.linalg.norm(vec, axis=0)
+    share[ev.imag <= 0] = 0.0
+    return abs(float(op.as_dict()["tower_fa_deflection_m"])), abs(complex(ev[np.argmax(share)]))
+
+
+@functools.lru_cache(maxsize=8)
+def _nrel5mw_tower() -> tuple[float, float]:
+    return _tower_magnitudes(linearize.load_turbine("nrel5mw"))
+
+
+def _tower_ratios(turbine: linearize.Turbine) -> dict[str, float]:
+    """``turbine``'s tower-top deflection at rated wind, and its velocity and acceleration at
+    the first fore-aft frequency, over the NREL 5-MW's: 1 on the NREL 5-MW (the same
+    computation)."""
+    d0, w0 = _nrel5mw_tower()
+    d, w = _tower_magnitudes(turbine)
+    return {"displacement": d / d0, "velocity": d * w / (d0 * w0),
+            "acceleration": d * w * w / (d0 * w0 * w0)}
 
 
 @nb.njit(cache=True, nogil=True)
