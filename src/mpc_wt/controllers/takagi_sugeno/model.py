@@ -15,7 +15,7 @@ import numpy as np
 import linearize
 from mpc_wt.errors import PremiseError
 
-__all__ = ["turbine_scales", "SIDE_SIDE_STATES", "CLEMENS_MEASURED", "TURBINE_MEASURED", "DEFAULT_SCALES", "DEFAULT_WIND_GRID",
+__all__ = ["turbine_scales", "fore_aft_frequency", "SIDE_SIDE_STATES", "CLEMENS_MEASURED", "TURBINE_MEASURED", "DEFAULT_SCALES", "DEFAULT_WIND_GRID",
            "DEFAULT_REDUCTION_GRID", "TSModel", "build_ts_model"]
 
 #: Clemens et al. eq 6: tower side-side and fore-aft displacement, rotor and generator speed.
@@ -91,11 +91,40 @@ def _tower_magnitudes(turbine: linearize.Turbine) -> tuple[float, float]:
     v = linearize.rated_wind_speed(turbine)
     op = linearize.trim(turbine, v)
     model = linearize.linearize(turbine, v + 2.0)
-    idx = [model.states.index(n) for n in ("tower_fa_displacement", "tower_fa_velocity")]
-    ev, vec = np.linalg.eig(model.A)
+    return (abs(float(op.as_dict()["tower_fa_deflection_m"])),
+            fore_aft_frequency(model.A, model.states))
+
+
+def fore_aft_frequency(a: np.ndarray, states: Sequence[str]) -> float:
+    """The tower's first fore-aft frequency of a linear model [rad/s]: the modulus of the
+    eigenvalue of ``a`` whose eigenvector lies most on ``tower_fa_displacement`` and
+    ``tower_fa_velocity`` (of those with a positive imaginary part).
+
+    Parameters
+    ----------
+    a : (n, n) ndarray
+        The state matrix.
+    states : sequence of str
+        Its states' names.
+
+    Returns
+    -------
+    float
+        [rad/s].
+
+    Raises
+    ------
+    ValueError
+        Without the tower's fore-aft states.
+    """
+    idx = [list(states).index(n) for n in ("tower_fa_displacement", "tower_fa_velocity")
+           if n in states]
+    if not idx:
+        raise ValueError(f"the model has no tower fore-aft states ({list(states)})")
+    ev, vec = np.linalg.eig(a)
     share = np.linalg.norm(vec[idx], axis=0) / np.linalg.norm(vec, axis=0)
     share[ev.imag <= 0] = 0.0
-    return abs(float(op.as_dict()["tower_fa_deflection_m"])), abs(complex(ev[np.argmax(share)]))
+    return abs(complex(ev[int(np.argmax(share))]))
 
 
 @functools.lru_cache(maxsize=8)

@@ -20,7 +20,7 @@ import numpy as np
 import scipy.linalg
 
 import linearize
-from mpc_wt.controllers.takagi_sugeno.model import TSModel
+from mpc_wt.controllers.takagi_sugeno.model import TSModel, fore_aft_frequency
 from mpc_wt.controllers.takagi_sugeno.synthesis import (
     TSControllerDesign,
     TSObserverDesign,
@@ -269,17 +269,7 @@ def tower_frequency(ts: TSModel) -> float:
     ValueError
         A model without the tower's fore-aft states.
     """
-    idx = [ts.states.index(n) for n in ("tower_fa_displacement", "tower_fa_velocity")
-           if n in ts.states]
-    if not idx:
-        raise ValueError(f"the TS model has no tower fore-aft states ({list(ts.states)})")
-    out = np.inf
-    for a in ts.A:
-        ev, vec = np.linalg.eig(a)
-        share = np.linalg.norm(vec[idx], axis=0) / np.linalg.norm(vec, axis=0)
-        share[ev.imag <= 0] = 0.0
-        out = min(out, abs(complex(ev[int(np.argmax(share))])))
-    return float(out)
+    return min(fore_aft_frequency(a, ts.states) for a in ts.A)
 
 
 def observer_rate_limit(ts: TSModel) -> float:
