@@ -28,8 +28,7 @@ from mpc_wt.controllers.takagi_sugeno.synthesis import (
 
 __all__ = ["LoopMargin", "plant_models", "scheduled_loop_margin", "design_observer_for_loop",
            "design_for_loop", "OBSERVER_DECAY_CANDIDATES", "CONTROLLER_DECAY_CANDIDATES",
-           "OBSERVER_TOWER_FRACTION", "tower_frequency", "observer_rate_limit",
-           "default_observer_candidates"]
+           "OBSERVER_TOWER_FRACTION", "tower_frequency", "default_observer_candidates"]
 
 
 @dataclass(frozen=True)
@@ -198,7 +197,7 @@ def scheduled_loop_margin(ts: TSModel, ctl: TSControllerDesign, obs: TSObserverD
         j = i if na == 1 else ((a + 1) * nb if a + 1 < na else (a - 1) * nb)
         z = _loop_matrix(ts, ctl, obs, plants[a], i, j, dt, torque_law)
         lam = np.log(np.linalg.eigvals(z).astype(complex)) / dt
-        lam = _without_own_modes(lam, plants[a], getattr(ctl, "uncontrolled", ()))
+        lam = _without_own_modes(lam, plants[a], ctl.uncontrolled)
         m = int(np.argmax(lam.real))
         decay.append(float(lam[m].real))
         freq.append(abs(float(lam[m].imag)))
@@ -272,21 +271,6 @@ def tower_frequency(ts: TSModel) -> float:
     return min(fore_aft_frequency(a, ts.states) for a in ts.A)
 
 
-def observer_rate_limit(ts: TSModel) -> float:
-    """The default observer's largest decay rate.
-
-    Parameters
-    ----------
-    ts : TSModel
-
-    Returns
-    -------
-    float
-        :data:`OBSERVER_TOWER_FRACTION` x :func:`tower_frequency` [1/s].
-    """
-    return OBSERVER_TOWER_FRACTION * tower_frequency(ts)
-
-
 def default_observer_candidates(ts: TSModel) -> tuple[float, ...]:
     """The observer decay rates a design tries by default.
 
@@ -297,10 +281,10 @@ def default_observer_candidates(ts: TSModel) -> tuple[float, ...]:
     Returns
     -------
     tuple of float
-        :data:`OBSERVER_DECAY_CANDIDATES` at or below :func:`observer_rate_limit`, fastest
-        first (at least the slowest of them) [1/s].
+        :data:`OBSERVER_DECAY_CANDIDATES` at or below :data:`OBSERVER_TOWER_FRACTION` x
+        :func:`tower_frequency`, fastest first (at least the slowest of them) [1/s].
     """
-    lim = observer_rate_limit(ts)
+    lim = OBSERVER_TOWER_FRACTION * tower_frequency(ts)
     out = tuple(r for r in OBSERVER_DECAY_CANDIDATES if r <= lim)
     return out or OBSERVER_DECAY_CANDIDATES[-1:]
 
@@ -329,7 +313,7 @@ def design_observer_for_loop(ts: TSModel, ctl: TSControllerDesign, turbine: line
         Controller period [s].
     candidates : tuple of float, optional
         Observer decay rates to try, in order [1/s]. Default: those of
-        :data:`OBSERVER_DECAY_CANDIDATES` at or below :func:`observer_rate_limit`.
+        :func:`default_observer_candidates`.
     required : float
         The largest decay accepted [1/s] (negative: every mode decays).
     warn : bool
