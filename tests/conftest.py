@@ -1,12 +1,45 @@
-"""Shared fixtures: the reference turbine (session scope), its plant parameters, a seeded rng."""
+"""Shared fixtures: the reference turbine (session scope), its plant parameters, a seeded rng;
+and the compiled kernels shared out between the test workers at the start."""
 from __future__ import annotations
 
+import os
+import sys
+import traceback
 from pathlib import Path
 
 import numpy as np
 import pytest
 
 import linearize
+
+
+def _compile_closed_loop() -> None:
+    from mpc_wt.run import run_controller
+
+    run_controller(linearize.load_turbine("nrel5mw"), "baseline", 12.0, turbulence="A",
+                   duration=0.5)
+
+
+def _compile_linearization() -> None:
+    from linearize.linear import jacobian_check
+
+    jacobian_check(linearize.load_turbine("nrel5mw"), 12.0, wake="quasi-steady",
+                   shear_exponent=0.2)
+
+
+def pytest_sessionstart(session: pytest.Session) -> None:
+    """On a fresh install every test worker would compile the same numba kernels at once
+    (about a minute each on 2 cores). The first two workers share the work out instead: each
+    first compiles one half (the closed loop; the real and complex-step linearization), then
+    asks for the other, which by then the other worker has put in numba's disk cache. With the
+    kernels cached this takes a second or two."""
+    order = {"gw0": (_compile_closed_loop, _compile_linearization),
+             "gw1": (_compile_linearization, _compile_closed_loop)}
+    for step in order.get(os.environ.get("PYTEST_XDIST_WORKER", ""), ()):
+        try:
+            step()
+        except Exception:              # the tests that need these kernels report it
+            print(f"warming the kernels failed:\n{traceback.format_exc()}", file=sys.stderr)
 
 
 @pytest.fixture(scope="session")

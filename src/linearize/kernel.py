@@ -198,7 +198,7 @@ def evaluate_plant_vw(x, u, wind, ext, p, hint, mode):  # pragma: no cover - com
                 npr, tpr, ph, sl, u_ind, v_ind = element_kernel(
                     vx, vy, rj, p.chord[j], p.twist[j] + pitch[i], p.af[j], p.table, p.alpha0,
                     p.dalpha, p.nb, p.rtip, p.rhub, p.flags, p.rho, math.nan, math.nan,
-                    u_ind.real, v_ind.real, MODE_FROZEN)
+                    u_ind.real, v_ind.real, np.int64(MODE_FROZEN))
             bem[0, i, j] = ph
             bem[1, i, j] = sl
             bem[2, i, j] = u_ind
@@ -544,7 +544,7 @@ def _stage(t, x, u, p, kind, wpar, grid, hint):  # pragma: no cover - compiled
     w = sample_wind(t, x[16], p, kind, wpar, grid[0])
     vw = sample_inplane(t, x[16], p, kind, wpar, grid[1])
     tw = sample_tower(t, p, kind, wpar, grid)
-    return evaluate_plant_vw(x, u, w, (vw, tw), p, hint, 0)
+    return evaluate_plant_vw(x, u, w, (vw, tw), p, hint, np.int64(0))
 
 
 @nb.njit(**_JIT)

@@ -97,7 +97,7 @@ def _check_xud(x: Any, u: Any, d: Any, n_r: int) -> tuple[FloatArray, FloatArray
     d = check_array("d (wind)", d, (N_BLADE, n_r), shape_names="(n_blade, n_r) or (n_blade,)")
     if np.any(d < 0):
         raise ValueError(f"d (wind) must be >= 0 m/s, got min {d.min()!r}")
-    return x, u, d
+    return x.copy(), u.copy(), d.copy()   # writable: one compiled kernel for every caller
 
 
 def plant_rhs(t: float, x: FloatArray, u: FloatArray, d: FloatArray,

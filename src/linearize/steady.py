@@ -36,7 +36,7 @@ def _avg_eval(x, u, speed, shear, p, n_az, mode=0):  # pragma: no cover - compil
     xx = x.copy()
     for k in range(n_az):
         xx[16] = k * _TWO_PI_3 / n_az
-        w = sample_wind(0.0, xx[16], p, 0, wpar, dummy)
+        w = sample_wind(0.0, xx[16], p, np.int64(0), wpar, dummy)
         dx, z, phis = evaluate_plant(xx, u, w, p, hint, mode)
         hint = phis
         dx_avg += dx
@@ -60,7 +60,7 @@ def _coeff_grid(tsr, pitch, speed, shear, p, n_az, ngear):  # pragma: no cover -
         for i in range(3):
             x[5 + i] = pitch[k]
             u[i] = pitch[k]
-        _, z = _avg_eval(x, u, speed, shear, p, n_az, MODE_NOLIMITS)
+        _, z = _avg_eval(x, u, speed, shear, p, n_az, np.int64(MODE_NOLIMITS))
         cp[k] = z[22] * om / (qdyn * speed)
         ct[k] = z[23] / qdyn
     return cp, ct
@@ -93,8 +93,8 @@ def rotor_average(params: PlantParams, x: FloatArray, u: FloatArray, wind_mps: f
     dxdt : (n_x,) ndarray
     z : (n_z,) ndarray
     """
-    return _avg_eval(np.asarray(x, dtype=float), np.asarray(u, dtype=float), float(wind_mps),
-                     float(shear_exponent), params.pack, _n_az(params, shear_exponent))
+    return _avg_eval(np.array(x, dtype=float), np.array(u, dtype=float), float(wind_mps),
+                     float(shear_exponent), params.pack, _n_az(params, shear_exponent), 0)
 
 
 def steady_coefficients(turbine: Turbine, tsr: FloatArray | float, pitch_deg: FloatArray | float,

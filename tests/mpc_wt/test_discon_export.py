@@ -356,6 +356,38 @@ def test_makefile_builds_the_library(baseline_export, tmp_path):
     assert (tmp_path / baseline_export.library.name).is_file()
 
 
+def test_the_same_sources_are_compiled_once_a_changed_one_again(baseline_export, tmp_path,
+                                                                 caplog):
+    """Exports of the same sources with the same compiler and flags share one compilation: the
+    second library is a file of its own with the first one's bytes. A changed source is
+    compiled again, and so are the same sources once the library compiled first is gone; each
+    library loads and answers."""
+    def build(name: str, edit: bool) -> tuple[Path, bool]:
+        d = tmp_path / name
+        (d / "daqp").mkdir(parents=True)
+        for p in baseline_export.sources:
+            shutil.copy(p, d / p.relative_to(baseline_export.directory))
+        if edit:
+            c_file = sorted(d.glob("*.c"))[0]
+            c_file.write_text(c_file.read_text() + "\n/* another source */\n")
+        caplog.clear()
+        with caplog.at_level("DEBUG", logger="mpc_wt.io.discon_export"):
+            lib = build_library(d, "baseline")
+        assert ctypes.CDLL(str(lib)).DISCON is not None
+        return lib, "copied" in caplog.text
+
+    same, copied = build("same", False)
+    assert copied and same.read_bytes() == baseline_export.library.read_bytes()
+    assert not same.samefile(baseline_export.library)
+    first, copied = build("changed", True)
+    assert not copied
+    second, copied = build("changed_too", True)
+    assert copied and second.read_bytes() == first.read_bytes()
+    first.unlink()
+    _, copied = build("changed_again", True)
+    assert not copied
+
+
 def test_iea15_baseline_library_holds_the_minimum_pitch_schedule(tmp_path):
     """The IEA-15's baseline at 5 m/s (class A, 120 s): the minimum-pitch schedule holds the
     pitch 2.5-3.9 deg above fine, and the library's pitch demands are within 0.01 deg and its

@@ -760,12 +760,55 @@ def build_library(directory: str | Path, kind: str, *, compiler: str | None = No
            *[str(directory / n) for n in _c_files()], "-lm"]
     if sys.platform != "win32":
         cmd.append("-lpthread")
+    key = _build_key(directory, cc, flags)
+    if _reuse_build(key, lib):
+        return lib
     proc = subprocess.run(cmd, capture_output=True, text=True, cwd=directory)
     if proc.returncode != 0 or not lib.is_file():
         raise ControllerLibraryError(
             f"building {lib.name} failed (exit {proc.returncode}): {' '.join(cmd)}\n"
             f"{proc.stderr.strip() or proc.stdout.strip()}")
+    _BUILDS[key] = (lib, _digest(lib.read_bytes()))
     return lib
+
+
+#: This process's builds: (compiler, flags, the sources' digest) -> (library, its digest)
+_BUILDS: dict[tuple[str, ...], tuple[Path, str]] = {}
+
+
+def _digest(data: bytes) -> str:
+    import hashlib
+
+    return hashlib.sha256(data).hexdigest()
+
+
+def _build_key(directory: Path, cc: str, flags: list[str]) -> tuple[str, ...]:
+    """What a build depends on: the compiler, its flags and every source file's bytes."""
+    src = b"".join(n.encode() + b"\0" + (directory / n).read_bytes() + b"\0"
+                   for n in _source_names() if n.endswith((".c", ".h")))
+    return (cc, *flags, sys.platform, _digest(src))
+
+
+def _reuse_build(key: tuple[str, ...], lib: Path) -> bool:
+    """Copy an earlier build of the same sources with the same compiler and flags to ``lib``
+    (compiling the same sources again gives the same library); False if there is none, or it
+    was removed or changed since."""
+    hit = _BUILDS.get(key)
+    if hit is None or hit[0] == lib:
+        return False
+    try:
+        data = hit[0].read_bytes()
+    except OSError:
+        data = b""
+    if _digest(data) != hit[1]:
+        del _BUILDS[key]
+        return False
+    tmp = lib.with_name(lib.name + ".part")     # a new file: a loaded library is not touched
+    tmp.write_bytes(data)
+    os.chmod(tmp, 0o755)
+    os.replace(tmp, lib)
+    log.debug("%s: the same sources were built as %s in this process; copied", lib, hit[0])
+    return True
 
 
 #: ServoDyn inputs of the packaged OpenFAST decks, by turbine name prefix.

@@ -294,6 +294,7 @@ def test_the_tower_notch_sits_at_the_plants_side_side_mode(turbine) -> None:
     assert plain.controller.tower_notch_hz is None
 
 
+@pytest.mark.slow
 def test_the_notch_takes_the_drivetrain_out_of_the_shaft_torque(turbine) -> None:
     """`mpc-lidar` at 13 m/s (class A, seed 12, 300 s after 30 s) against the baseline: with
     the designs chosen by the wind alone and the soft speed limit at 1.028 x rated (where it
