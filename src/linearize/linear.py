@@ -435,11 +435,11 @@ def _z0(p: PlantParams, op: OperatingPoint, shear: float, n_azimuth: int = 24) -
     pk = p.pack
     wpar = np.array([op.wind_mps, shear])
     z = np.zeros(len(OUTPUT_NAMES))
-    x = op.x.copy()
+    x, u = op.x.copy(), op.u.copy()      # writable: the kernel compiled for every caller
     for psi in 2 * math.pi * np.arange(n_azimuth) / n_azimuth:
         x[16] = psi
         w = sample_wind(0.0, float(psi), pk, 0, wpar, np.zeros((1, 1, 1), dtype=np.float32))
-        z += evaluate_plant(x, op.u.copy(), w, pk, np.full((4, 3, pk.r.size), np.nan), 0)[1]
+        z += evaluate_plant(x, u, w, pk, np.full((4, 3, pk.r.size), np.nan), 0)[1]
     return z / n_azimuth
 
 

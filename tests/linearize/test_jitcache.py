@@ -83,4 +83,3 @@ def test_every_kernel_that_compiles_another_modules_kernel_is_keyed_on_it() -> N
                 if stamp == obj._cache._impl.locator.get_source_stamp():
                     plain.append(f"{module.__name__}.{name}")
     assert seen >= 8 and not plain, f"keyed on their own file only: {plain}"
-

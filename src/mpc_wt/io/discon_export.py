@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import dataclasses
 import datetime as _dt
+import hashlib
 import importlib.resources
 import logging
 import math
@@ -777,8 +778,6 @@ _BUILDS: dict[tuple[str, ...], tuple[Path, str]] = {}
 
 
 def _digest(data: bytes) -> str:
-    import hashlib
-
     return hashlib.sha256(data).hexdigest()
 
 
