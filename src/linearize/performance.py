@@ -10,6 +10,8 @@ same floats.
 from __future__ import annotations
 
 import math
+import threading
+from collections import OrderedDict
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -18,6 +20,7 @@ import numpy as np
 from linearize._typing import FloatArray
 from linearize.bem import AeroOptions
 from linearize.errors import TurbineFileError
+from linearize.turbine import content_digest
 from linearize.validate import frozen_array
 
 __all__ = ["RotorPerformance", "read_rotor_performance", "write_rotor_performance",
@@ -89,6 +92,13 @@ class RotorPerformance:
         return float(self.cp[i, j]), float(self.tsr[i]), float(self.pitch_rad[j])
 
 
+#: tables computed in this process, by (turbine content, grid, wind, shear, options)
+_TABLES: OrderedDict[tuple[object, ...], RotorPerformance] = OrderedDict()
+_TABLES_LOCK = threading.Lock()
+#: how many tables :func:`rotor_performance` keeps
+TABLES_KEPT = 8
+
+
 def rotor_performance(turbine: object, tsr: FloatArray, pitch_deg: FloatArray, *,
                       wind_mps: float = 10.0, shear_exponent: float = 0.0,
                       options: AeroOptions | None = None) -> RotorPerformance:
@@ -98,6 +108,12 @@ def rotor_performance(turbine: object, tsr: FloatArray, pitch_deg: FloatArray, *
     :func:`steady_coefficients`); C_Q follows ROSCO's tables, C_Q = C_P / (TSR cos(precone)),
     i.e. the torque over the projected area and the blade's tip radius (checked on ROSCO's NREL
     5-MW table: the ratio is 1/cos 2.5 deg to 1e-5).
+
+    A table takes seconds (a wind estimator's 69 x 91 points with shear: about 3 s for the
+    NREL 5-MW, 9 s for the IEA-15). The process keeps the last :data:`TABLES_KEPT` tables, keyed
+    on the turbine's content (:func:`linearize.turbine.content_digest`), the grid, the wind, the
+    shear and the options: asking again for the same table returns the kept one (immutable),
+    so that the designs of one turbine share it.
 
     Parameters
     ----------
@@ -126,12 +142,25 @@ def rotor_performance(turbine: object, tsr: FloatArray, pitch_deg: FloatArray, *
         raise ValueError(f"tsr and pitch_deg must be 1-D; got shapes {lam.shape}, {beta.shape}")
     if np.any(lam <= 0):
         raise ValueError(f"tsr must be > 0, got min {lam.min():g}")
+    opts = options or AeroOptions()
+    key = (content_digest(turbine), lam.tobytes(), beta.tobytes(), float(wind_mps),
+           float(shear_exponent), repr(opts))
+    with _TABLES_LOCK:
+        kept = _TABLES.get(key)
+        if kept is not None:
+            _TABLES.move_to_end(key)
+            return kept
     L, B = np.meshgrid(lam, beta, indexing="ij")
     cp, ct = steady_coefficients(turbine, L, B, options,  # type: ignore[arg-type]
                                  shear_exponent=shear_exponent)
-    cone = turbine.geometry.precone_rad if (options or AeroOptions()).cone else 0.0  # type: ignore[attr-defined]
-    return RotorPerformance(pitch_deg=beta, tsr=lam, cp=cp, ct=ct, cq=cp / (L * math.cos(cone)),
-                            wind_mps=float(wind_mps), name=getattr(turbine, "name", ""))
+    cone = turbine.geometry.precone_rad if opts.cone else 0.0  # type: ignore[attr-defined]
+    table = RotorPerformance(pitch_deg=beta, tsr=lam, cp=cp, ct=ct, cq=cp / (L * math.cos(cone)),
+                             wind_mps=float(wind_mps), name=getattr(turbine, "name", ""))
+    with _TABLES_LOCK:
+        _TABLES[key] = table
+        while len(_TABLES) > TABLES_KEPT:
+            _TABLES.popitem(last=False)
+    return table
 
 
 def _fmt(v: float) -> str:

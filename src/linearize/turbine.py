@@ -8,8 +8,9 @@ range on any error. Everything held by :class:`Turbine` is SI (angles in rad).
 from __future__ import annotations
 
 import csv
+import hashlib
 import math
-from dataclasses import dataclass, field, fields
+from dataclasses import dataclass, field, fields, is_dataclass
 from importlib import resources
 from pathlib import Path
 from typing import Any, Callable
@@ -25,7 +26,7 @@ __all__ = [
     "TurbineFileError", "Geometry", "Operation", "Environment", "RotorMass", "Nacelle",
     "Drivetrain", "Generator", "PitchActuator", "Damping", "BladeAero", "Polar", "UAParams",
     "BladeStructure", "TowerStructure", "ModeShapes", "Turbine",
-    "available_turbines", "LoadReport", "ReportEntry",
+    "available_turbines", "LoadReport", "ReportEntry", "content_digest",
 ]
 
 SCHEMA_VERSION = 1
@@ -737,6 +738,58 @@ class Turbine:
         """Generator torque at rated power and rated speed [N m]."""
         return self.operation.rated_power / (
             self.drivetrain.generator_efficiency * self.rated_generator_speed_rad_s)
+
+
+def content_digest(obj: Any) -> str:
+    """A digest of a turbine's content (every field and array; not where it was read from),
+    for keeping what is computed from a turbine (designs, tables) and naming it.
+
+    Walks dataclasses (fields with ``compare=False``, such as a turbine's source path and load
+    report, are left out), arrays (shape and float64 bytes), mappings, sequences and scalars.
+
+    Parameters
+    ----------
+    obj : Turbine or any dataclass, array, mapping, sequence or scalar
+        What to digest.
+
+    Returns
+    -------
+    str
+        SHA-256 hex digest; equal content gives equal digests whatever the objects' identity.
+
+    Examples
+    --------
+    >>> from linearize import load_turbine
+    >>> content_digest(load_turbine("nrel5mw")) == content_digest(load_turbine("nrel5mw"))
+    True
+    """
+    h = hashlib.sha256()
+    _feed(h, obj)
+    return h.hexdigest()
+
+
+def _feed(h: Any, obj: Any) -> None:
+    if is_dataclass(obj) and not isinstance(obj, type):
+        h.update(type(obj).__name__.encode())
+        for f in fields(obj):
+            if not f.compare:           # provenance (a turbine's source path, its load report)
+                continue
+            h.update(f.name.encode())
+            _feed(h, getattr(obj, f.name))
+    elif isinstance(obj, np.ndarray):
+        h.update(str(obj.shape).encode())
+        h.update(np.ascontiguousarray(obj, dtype=float).tobytes())
+    elif isinstance(obj, dict):
+        for k in sorted(obj, key=str):
+            h.update(str(k).encode())
+            _feed(h, obj[k])
+    elif isinstance(obj, (list, tuple)):
+        for v in obj:
+            _feed(h, v)
+    elif isinstance(obj, float) and math.isnan(obj):
+        h.update(b"nan")
+    else:
+        h.update(repr(obj).encode())
 
 
 # --------------------------------------------------------------------------------------------

@@ -97,6 +97,36 @@ def test_our_table_reproduces_roscos_and_cq_is_cp_over_tsr(turbine) -> None:
     assert np.abs(mine.cp - ref.cp[np.ix_(rows, cols)])[on].max() <= 0.016
 
 
+def test_a_table_asked_for_again_is_the_kept_one_other_content_its_own(turbine) -> None:
+    """The same turbine content (a second load of its file) and grid: the kept table itself;
+    a turbine with wider chords, another grid or another shear: a table of its own, equal to
+    the steady coefficients computed for it."""
+    import dataclasses
+
+    from linearize.performance import TABLES_KEPT
+
+    tsr, pitch = np.array([5.0, 7.5, 10.0]), np.array([0.0, 4.0])
+    first = linearize.rotor_performance(turbine, tsr, pitch, shear_exponent=0.2)
+    again = linearize.rotor_performance(linearize.load_turbine("nrel5mw"), tsr.copy(),
+                                        pitch.copy(), shear_exponent=0.2)
+    assert again is first
+    wide = dataclasses.replace(turbine, blade=dataclasses.replace(
+        turbine.blade, chord=1.1 * turbine.blade.chord))
+    for other, t, p, shear in ((wide, tsr, pitch, 0.2), (turbine, tsr[:2], pitch, 0.2),
+                               (turbine, tsr, pitch, 0.0)):
+        table = linearize.rotor_performance(other, t, p, shear_exponent=shear)
+        assert table is not first
+        L, B = np.meshgrid(t, p, indexing="ij")
+        cp, ct = linearize.steady_coefficients(other, L, B, shear_exponent=shear)
+        np.testing.assert_array_equal(table.cp, cp)
+        np.testing.assert_array_equal(table.ct, ct)
+    assert not np.array_equal(linearize.rotor_performance(wide, tsr, pitch,
+                                                          shear_exponent=0.2).cp, first.cp)
+    for k in range(TABLES_KEPT):           # older tables make way for newer ones
+        linearize.rotor_performance(turbine, tsr, pitch + k + 1.0, shear_exponent=0.2)
+    assert linearize.rotor_performance(turbine, tsr, pitch, shear_exponent=0.2) is not first
+
+
 @pytest.mark.parametrize("edit, match", [
     (lambda s: s.replace("# Pitch angle", "# Pitch"), r"no '# \.\.\. Pitch angle \.\.\.' line"),
     (lambda s: s.replace("0.006673   0.009813", "0.006673   x", 1), r"line 13: expected a row"),

@@ -13,6 +13,7 @@ import numpy as np
 
 import lidar
 import linearize
+from linearize.turbine import content_digest
 from mpc_wt.errors import CaseDataError
 
 __all__ = ["turbine_key", "design_digest", "DesignCache", "DEFAULT_CACHE", "BuildContext",
@@ -21,7 +22,7 @@ __all__ = ["turbine_key", "design_digest", "DesignCache", "DEFAULT_CACHE", "Buil
 
 def turbine_key(turbine: linearize.Turbine) -> str:
     """A digest of a turbine's content (every field and array; not where it was read from),
-    for caching designs and naming a campaign's turbine.
+    for caching designs and naming a campaign's turbine (:func:`linearize.turbine.content_digest`).
 
     Parameters
     ----------
@@ -33,33 +34,7 @@ def turbine_key(turbine: linearize.Turbine) -> str:
     str
         SHA-256 hex digest; equal turbines give equal keys whatever their identity.
     """
-    h = hashlib.sha256()
-    _feed(h, turbine)
-    return h.hexdigest()
-
-
-def _feed(h: Any, obj: Any) -> None:
-    if dataclasses.is_dataclass(obj) and not isinstance(obj, type):
-        h.update(type(obj).__name__.encode())
-        for f in dataclasses.fields(obj):
-            if not f.compare:           # provenance (a turbine's source path, its load report)
-                continue
-            h.update(f.name.encode())
-            _feed(h, getattr(obj, f.name))
-    elif isinstance(obj, np.ndarray):
-        h.update(str(obj.shape).encode())
-        h.update(np.ascontiguousarray(obj, dtype=float).tobytes())
-    elif isinstance(obj, dict):
-        for k in sorted(obj, key=str):
-            h.update(str(k).encode())
-            _feed(h, obj[k])
-    elif isinstance(obj, (list, tuple)):
-        for v in obj:
-            _feed(h, v)
-    elif isinstance(obj, float) and math.isnan(obj):
-        h.update(b"nan")
-    else:
-        h.update(repr(obj).encode())
+    return content_digest(turbine)
 
 
 #: Types a design digest does not walk into: solver handles and compiled functions hold
