@@ -24,6 +24,7 @@ CONFIGS = (("default plant", {}),
            ("+ tower drag", {"tower_drag": True}),
            ("+ twisted modes", {"twisted_modes": True}),
            ("+ unsteady aerodynamics", {"unsteady_aero": True}),
+           ("+ skewed wake", {"skewed_wake": True}),
            ("all (PlantConfig.openfast())", None))
 
 

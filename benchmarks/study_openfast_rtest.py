@@ -33,6 +33,7 @@ STEPS = (("plant before (none)", {}),
          ("+ tower shadow", {"tower_shadow": True}),
          ("+ tower drag", {"tower_drag": True}),
          ("+ twisted modes", {"twisted_modes": True}),
+         ("+ skewed wake", {"skewed_wake": True}),
          ("+ unsteady aerodynamics (all on)", {"unsteady_aero": True}))
 #: target per statistic: (channel, statistic, bound, unit)
 TARGETS = (("flapwise_moment_1", "del_diff_pct", 10.0), ("edgewise_moment_1", "del_diff_pct", 10.0),
@@ -45,7 +46,7 @@ TARGETS = (("flapwise_moment_1", "del_diff_pct", 10.0), ("edgewise_moment_1", "d
 
 def _config(on: dict[str, bool], dofs: frozenset[str]) -> linearize.PlantConfig:
     base = dict(blade_body_forces=False, inplane_wind=False, tower_shadow=False,
-                tower_drag=False, twisted_modes=False, unsteady_aero=False)
+                tower_drag=False, twisted_modes=False, unsteady_aero=False, skewed_wake=False)
     return linearize.PlantConfig(dofs, **{**base, **on})
 
 

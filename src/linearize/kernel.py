@@ -152,6 +152,14 @@ def evaluate_plant_vw(x, u, wind, ext, p, hint, mode):  # pragma: no cover - com
     gq = np.zeros(3, dtype=x.dtype)
     ge = np.zeros(3, dtype=x.dtype)
     w_bem = _bem_weight(wr, wind, p.rtip, mode)
+    # the skewed wake (Pitt and Peters): the disk-averaged wind relative to the hub, its angle
+    # to the shaft (chi_0) and the direction of its part in the rotor plane
+    skew = p.opt[7] != 0 and mode == 0
+    chi0 = 0.0
+    dir_y = 0.0
+    dir_up = 0.0
+    if skew:
+        chi0, dir_y, dir_up = _disk_skew(wind, vw, vhub_x.real, vhub_y.real, ct, st)
     for i in range(3):
         psi_i = psi + i * TWO_PI_3
         sp = np.sin(psi_i)
@@ -203,6 +211,19 @@ def evaluate_plant_vw(x, u, wind, ext, p, hint, mode):  # pragma: no cover - com
             bem[1, i, j] = sl
             bem[2, i, j] = u_ind
             bem[3, i, j] = v_ind
+            if skew and chi0 > 0.0 and vx.real > 0.0:
+                # the solved induction scaled as AeroDyn's BEM_Mod = 1 does, the loads from it
+                # (the next solve starts from the uncorrected root kept above)
+                a_ind = u_ind.real / vx.real
+                chi = (0.6 * a_ind + 1.0) * chi0
+                tn = math.tan(0.5 * chi) if abs(chi) <= 0.5 * math.pi else math.copysign(1.0, chi)
+                corr = (SKEW_FACTOR * tn * rj * cc / p.rtip
+                        * (cp.real * dir_up - sp.real * dir_y))
+                u_ind = u_ind * (1.0 + corr)
+                npr, tpr, ph, _, _, _ = element_kernel(
+                    vx, vy, rj, p.chord[j], p.twist[j] + pitch[i], p.af[j], p.table, p.alpha0,
+                    p.dalpha, p.nb, p.rtip, p.rhub, p.flags, p.rho, math.nan, math.nan,
+                    u_ind.real, v_ind.real, np.int64(MODE_FROZEN))
             if ua_on and p.ua[p.af[j], 0] != 0.0:
                 npr, tpr = _ua_loads(npr, tpr, ph, vx - u_ind, vy + v_ind, p.twist[j] + pitch[i],
                                      i, j, p, hint, bem)
@@ -361,6 +382,37 @@ def evaluate_plant_vw(x, u, wind, ext, p, hint, mode):  # pragma: no cover - com
     z[29] = x[0]
     z[30] = x[8]
     return dx, z, bem
+
+
+#: Pitt and Peters' skewed-wake factor, 15 pi / 32 (AeroDyn's default ``SkewRedistrFactor``)
+SKEW_FACTOR = 15.0 * math.pi / 32.0
+
+
+@nb.njit(**_JIT)
+def _disk_skew(wind, vw, vhub_x, vhub_y, ct, st):  # pragma: no cover - compiled
+    """The wake's skew from the wind the elements meet: the mean over all elements of the free
+    wind (u, v, w) less the hub's translation (AeroDyn's disk average ``V_diskAvg``), resolved
+    along the tilted shaft (x_s = (cos t, 0, -sin t)) and in the rotor plane (lateral y and
+    the plane's up, (sin t, 0, cos t)). Returns chi_0 = acos(V.x_s / |V|) [rad] and the unit
+    direction of V's in-plane part (lateral, up); (0, 0, 0) when V has none."""
+    su = 0.0
+    sv = 0.0
+    sw = 0.0
+    for i in range(wind.shape[0]):
+        for j in range(wind.shape[1]):
+            su += wind[i, j].real
+            sv += vw[0, i, j].real
+            sw += vw[1, i, j].real
+    n = wind.shape[0] * wind.shape[1]
+    wx = su / n - vhub_x
+    wy = sv / n - vhub_y
+    wz = sw / n
+    w_ax = wx * ct - wz * st
+    w_up = wx * st + wz * ct
+    w_ip = math.sqrt(wy * wy + w_up * w_up)
+    if w_ip <= 0.0:
+        return 0.0, 0.0, 0.0
+    return math.atan2(w_ip, w_ax), wy / w_ip, w_up / w_ip
 
 
 @nb.njit(**_JIT)

@@ -117,6 +117,23 @@ class PlantConfig:
         (``TowerStructure.outer_diameter``). Off by default: a narrow azimuthal feature that
         the trim's and the linearization's few azimuth samples misrepresent; on in
         :meth:`openfast`.
+    unsteady_aero, twisted_modes, tower_drag : bool
+        Beddoes-Leishman-type unsteady airfoil aerodynamics (:mod:`linearize.unsteady`), the
+        blade modes along their pitched, twisted principal axes, and the tower's drag (see
+        the validation page on the plant against OpenFAST). Off by default; on in
+        :meth:`openfast`.
+    skewed_wake : bool
+        The skewed-wake correction of the axial induction (Pitt and Peters 1981, as AeroDyn's
+        ``Skew_Mod = 1`` with ``SkewRedistr_Mod = 1`` and ``BEM_Mod = 1``; Moriarty and Hansen
+        2005, NREL/EL-500-36881, the skewed-wake correction): each element's solved
+        induction a is scaled by 1 + (15 pi/32) tan(chi/2) (r/R) cos(gamma), where chi =
+        (0.6 a + 1) chi_0, chi_0 the angle between the shaft and the disk-averaged wind
+        relative to the hub (tilt and the wind's own direction) and gamma the angle in the
+        rotor plane between the blade and that wind's in-plane part (the induction grows on the
+        side toward which the wake is skewed). The loads follow the corrected induction; for
+        three blades the correction cancels in the rotor's thrust and torque to first order
+        and moves load between the blades (1P loads, tilt and yaw moments, the rotor's side
+        force). Off by default; on in :meth:`openfast`.
     """
 
     dofs: frozenset[str] = frozenset(DOF_NAMES)
@@ -128,6 +145,7 @@ class PlantConfig:
     unsteady_aero: bool = False
     twisted_modes: bool = False
     tower_drag: bool = False
+    skewed_wake: bool = False
 
     def __post_init__(self) -> None:
         dofs = frozenset(self.dofs)
@@ -141,7 +159,7 @@ class PlantConfig:
 
     #: The effects a user switches on or off by name (:meth:`with_switches`).
     SWITCHES = ("blade_body_forces", "inplane_wind", "tower_shadow", "unsteady_aero",
-                "twisted_modes", "tower_drag")
+                "twisted_modes", "tower_drag", "skewed_wake")
 
     def with_switches(self, switches: Mapping[str, bool] | None) -> "PlantConfig":
         """This configuration with the named effects (:attr:`SWITCHES`) set.
@@ -194,7 +212,7 @@ class PlantConfig:
     @classmethod
     def openfast(cls, *, unsteady_aero: bool = True, tower_drag: bool = True,
                  tower_shadow: bool = True, twisted_modes: bool = True,
-                 blade_body_forces: bool = True,
+                 blade_body_forces: bool = True, skewed_wake: bool = True,
                  dofs: frozenset[str] | None = None) -> "PlantConfig":
         """Every effect OpenFAST's ElastoDyn and AeroDyn 15 models and the plant has, as the
         regression case ``5MW_Land_DLL_WTurb`` runs them (AeroDyn's ``UA_Mod = 3``,
@@ -203,10 +221,10 @@ class PlantConfig:
 
         Parameters
         ----------
-        unsteady_aero, tower_drag, tower_shadow, twisted_modes, blade_body_forces : bool
-            The effects off by default (the AeroDyn file's ``UA_Mod > 0``, ``TwrAero`` and
-            ``TwrPotent > 0``; ElastoDyn's modes along the principal axes and its blade
-            kinematics).
+        unsteady_aero, tower_drag, tower_shadow, twisted_modes, blade_body_forces, skewed_wake : bool
+            The effects off by default (the AeroDyn file's ``UA_Mod > 0``, ``TwrAero``,
+            ``TwrPotent > 0`` and ``Skew_Mod = 1``; ElastoDyn's modes along the principal axes
+            and its blade kinematics).
         dofs : frozenset of str, optional
             Degrees of freedom (default: all).
 
@@ -217,7 +235,7 @@ class PlantConfig:
         return cls(frozenset(DOF_NAMES) if dofs is None else frozenset(dofs),
                    unsteady_aero=unsteady_aero, tower_drag=tower_drag,
                    tower_shadow=tower_shadow, twisted_modes=twisted_modes,
-                   blade_body_forces=blade_body_forces)
+                   blade_body_forces=blade_body_forces, skewed_wake=skewed_wake)
 
     def active_states(self) -> tuple[str, ...]:
         """Names of the states that evolve under this configuration (azimuth excluded).
@@ -414,7 +432,9 @@ def plant_params(turbine: Turbine, config: PlantConfig | None = None) -> PlantPa
         slope = float(dph[-1])
         mass = float(np.trapezoid(mt * ph**2, h)) + rot_inertia * slope**2
         inertia_moment = float(np.trapezoid(mt * ph * h, h)) + rot_inertia * slope
-        k = float(np.trapezoid(eit * ddph**2, h)) - float(np.trapezoid(weight_above * dph**2, h))
+        k_elastic = float(np.trapezoid(eit * ddph**2, h))
+        m_tower = float(np.trapezoid(mt * ph**2, h))
+        k = k_elastic - float(np.trapezoid(weight_above * dph**2, h))
         for mb, xb, zb in bodies:
             mass += mb * ((1.0 + zb * slope) ** 2 + (xb * slope) ** 2)
             inertia_moment += mb * (ht + zb) * (1.0 + zb * slope)
@@ -422,7 +442,10 @@ def plant_params(turbine: Turbine, config: PlantConfig | None = None) -> PlantPa
         if k <= 0:
             raise ValueError(f"tower modal stiffness {k:g} N/m is not positive: the tower "
                              f"buckles under the top mass")
-        c = 2.0 * zeta * math.sqrt(k * mass)
+        # the damping ratio is of the isolated tower's mode, as ElastoDyn's TwrFADmp/TwrSSDmp
+        # and the NREL 5-MW's 1 %: stiffness-proportional, c = zeta K_el / (pi f_iso) with
+        # f_iso from the tower's own elastic stiffness and mass (no top mass, no gravity)
+        c = 2.0 * zeta * math.sqrt(k_elastic * m_tower)
         pdelta = grav * (m_top + float(np.trapezoid(mt * ph, h)))
         return mass, k, c, 1.0 + g.twr2shft * slope, slope, pdelta, inertia_moment
 
@@ -449,7 +472,8 @@ def plant_params(turbine: Turbine, config: PlantConfig | None = None) -> PlantPa
     pa = t.pitch_actuator
     dofs = np.array([d in cfg.dofs for d in DOF_NAMES], dtype=np.int64)
     opt = np.array([cfg.aero.gravity, cfg.blade_body_forces, cfg.inplane_wind,
-                    cfg.tower_shadow, cfg.unsteady_aero, twisted["on"], 0], dtype=np.int64)
+                    cfg.tower_shadow, cfg.unsteady_aero, twisted["on"], 0, cfg.skewed_wake],
+                   dtype=np.int64)
     drag = _tower_drag_points(t, ht)
     opt[6] = int(cfg.tower_drag and drag["tq_h"].size > 0)
     ua = np.array([pol.ua.row() if pol.ua is not None else (0.0,) * len(UA_PAR)

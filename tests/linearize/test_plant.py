@@ -44,6 +44,35 @@ def test_first_mode_frequencies_match_fast(params: linearize.PlantParams, mode: 
     assert_allclose(f[mode], PUBLISHED_HZ[mode], rtol=rtol, atol=0)
 
 
+def test_tower_free_decay_keeps_its_damping_as_elastodyn(turbine: linearize.Turbine) -> None:
+    """The tower's damping ratio is that of the isolated tower's mode (ElastoDyn's
+    ``TwrFADmp``). Published: a FAST free decay of the land-based NREL 5-MW's first fore-aft
+    mode alone, ``TwrFADmp = 2 %``, no wind, rotor at rest, 0.5 m at the top: 0.327 Hz and
+    0.75 % of critical by logarithmic decrement, "lower than the uncoupled tower ... due to
+    inertia of the nacelle and rotor" (NREL forum, "Instruction for the seismic FAST version").
+    The plant the same way, blades feathered (the least aerodynamic damping): within 10 %
+    and 1 % (measured 0.72 %, 0.328 Hz; with the damping ratio taken for the whole mode, as
+    before, 2 %)."""
+    import dataclasses
+
+    from scipy.signal import find_peaks
+
+    tb = dataclasses.replace(turbine, damping=dataclasses.replace(turbine.damping,
+                                                                  tower_fa=0.02))
+    p = linearize.plant_params(tb, PlantConfig(frozenset({"tower_fa"})))
+    x0 = np.zeros(len(STATE_NAMES))
+    x0[0] = 0.5
+    x0[5:8] = math.radians(90.0)
+    res = rk4_simulate(p, x0, np.array([math.radians(90.0)] * 3 + [0.0]), SteadyWind(0.0),
+                       60.0)
+    y = res.x[:, 0]
+    peaks, _ = find_peaks(y)
+    delta = math.log(y[peaks[0]] / y[peaks[-1]]) / (len(peaks) - 1)
+    zeta = delta / math.sqrt(4.0 * math.pi**2 + delta**2)
+    assert zeta == pytest.approx(0.0075, rel=0.10)
+    assert 1.0 / np.mean(np.diff(res.t[peaks])) == pytest.approx(0.327, rel=0.01)
+
+
 # published: Jonkman et al. (2009) Table 9-1 (report values, not re-read): 1st blade asymmetric
 # edgewise (pitch / yaw) 1.0793 / 1.0898 Hz, 1st drivetrain torsion 0.6205 Hz. Conditions: a
 # parked rotor with the generator locked (RotSpeed = 0, GenDOF = False), J. Jonkman on the NREL
@@ -128,9 +157,11 @@ def test_with_azimuth_effects_settles_to_1p_periodic_motion(turbine: linearize.T
     # before to 1e-3 of its oscillation amplitude, and the mean is the trimmed (azimuth-averaged)
     # equilibrium to 1 % (the nonlinear mean of a periodic response differs from the
     # equilibrium of the averaged loads at second order in the 1P amplitude).
+    # (900 s: the tower's side-side mode keeps 0.36 % of critical, a 140 s time constant, and
+    # its start transient reaches the other states through the rotor's loads)
     op = trim(turbine, 18.0, shear_exponent=0.2)
-    res = rk4_simulate(params, op.x, op.u, SteadyWind(18.0, 0.2), 600.0)
-    late = res.t > 450.0
+    res = rk4_simulate(params, op.x, op.u, SteadyWind(18.0, 0.2), 900.0)
+    late = res.t > 750.0
     w = res.state("rotor_speed")[late].mean()
     period = 2 * math.pi / w
     last = res.t > res.t[-1] - period

@@ -153,7 +153,7 @@ def read_openfast_case(fst: str | Path, *, wind: str | Path | None = None,
         cfg = linearize.PlantConfig.openfast(
             unsteady_aero=bool(ua), tower_drag=_flag(ad, "TwrAero", False),
             tower_shadow=(ad.number("TwrPotent") > 0) if ad.has("TwrPotent") else False,
-            dofs=_dofs(ed))
+            skewed_wake=_skewed_wake(ad), dofs=_dofs(ed))
         notes.append("pitch as the controller commands it (no actuator lag), as ServoDyn "
                      "applies a DLL's pitch")
         for key in ("FlapDOF2", "TwFADOF2", "TwSSDOF2", "YawDOF"):
@@ -165,6 +165,19 @@ def read_openfast_case(fst: str | Path, *, wind: str | Path | None = None,
                             notes=tuple(notes), steady_wind=steady)
     except linearize.TurbineFileError as err:
         raise ResultFileError(str(err)) from None
+
+
+def _skewed_wake(ad: OpenFASTFile) -> bool:
+    """AeroDyn's Pitt and Peters skewed-wake correction: ``Skew_Mod = 1`` with
+    ``SkewRedistr_Mod`` 1 or "default" (AeroDyn 4.0 on), or ``SkewMod = 2`` (earlier)."""
+    if ad.has("Skew_Mod"):
+        if ad.number("Skew_Mod") != 1:
+            return False
+        return (not ad.has("SkewRedistr_Mod") or ad.is_default("SkewRedistr_Mod")
+                or ad.number("SkewRedistr_Mod") == 1)
+    if ad.has("SkewMod"):
+        return ad.number("SkewMod") == 2
+    return False
 
 
 def _inflow(main: OpenFASTFile) -> tuple[Path | None, tuple[float, float] | None]:

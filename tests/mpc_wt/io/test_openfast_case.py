@@ -53,6 +53,7 @@ def test_the_case_is_read_as_openfast_runs_it() -> None:
     assert case.x0[5] == 0.0 and case.x0[0] == 0.0
     c = case.config
     assert c.unsteady_aero and c.tower_shadow and c.tower_drag and c.twisted_modes
+    assert c.skewed_wake                                    # Skew_Mod 1, SkewRedistr_Mod default
     assert {"blade_flap", "blade_edge", "tower_fa", "tower_ss", "drivetrain"} <= c.dofs
     assert "pitch_actuator" not in c.dofs
     assert case.discon_in is None and case.duration == 60.0
@@ -64,27 +65,28 @@ def test_the_case_is_read_as_openfast_runs_it() -> None:
 
 @_NO_WIND
 def test_means_and_the_load_channels_within_the_targets(comparison) -> None:
-    """The targets the plant meets (measured on 2026-11-27: flapwise mean -1.2 %, tower
-    fore-aft mean -0.4 %, edgewise DEL +4.9 %, shaft torque DEL -0.1 %, power mean -0.1 %)."""
+    """The targets the plant meets (measured on 2026-11-29: flapwise mean -1.1 %, tower
+    fore-aft mean -0.5 %, edgewise DEL +4.4 %, shaft torque DEL -0.1 %, tower side-side DEL
+    -6.6 %, power mean -0.1 %)."""
     c = comparison
     assert abs(c["flapwise_moment_1"]["mean_diff_pct"]) <= 5.0
     assert abs(c["tower_base_fa_moment"]["mean_diff_pct"]) <= 5.0
     assert abs(c["edgewise_moment_1"]["del_diff_pct"]) <= 10.0
     assert abs(c["lss_torque"]["del_diff_pct"]) <= 10.0
+    assert abs(c["tower_base_ss_moment"]["del_diff_pct"]) <= 10.0
     assert abs(c["gen_power"]["mean_diff_pct"]) <= 0.5
 
 
 @_NO_WIND
 @pytest.mark.xfail(strict=True, reason=(
-    "not reached (2026-11-27): flapwise DEL +14.9 %, tower fore-aft DEL +15.9 %, side-side "
-    "DEL -30.7 %, pitch mean +0.55 deg, rotor-speed std +16.7 %; without the unsteady "
-    "aerodynamics the flapwise and fore-aft DELs are +7.7 and +11.9 % and the speed std +9.1 % "
-    "but the pitch +1.11 deg. Missing: the second flap and tower modes, the yaw DOF, "
-    "AeroDyn's full UA model (vortex lift, time-constant switching); see the docs' page on "
-    "the plant against OpenFAST"))
+    "not reached (2026-11-29): flapwise DEL +11.8 %, tower fore-aft DEL +19.9 %, pitch mean "
+    "+0.53 deg, rotor-speed std +16.5 %; without the unsteady aerodynamics the flapwise and "
+    "fore-aft DELs are +4.6 and +14.9 % and the speed std +8.7 % but the pitch +1.09 deg. "
+    "Missing: the second flap and tower modes, the yaw DOF, AeroDyn's full UA model (vortex "
+    "lift, time-constant switching); see the docs' page on the plant against OpenFAST"))
 def test_the_remaining_targets(comparison) -> None:
     c = comparison
-    for ch in ("flapwise_moment_1", "tower_base_fa_moment", "tower_base_ss_moment"):
+    for ch in ("flapwise_moment_1", "tower_base_fa_moment"):
         assert abs(c[ch]["del_diff_pct"]) <= 10.0, ch
     assert abs(math.degrees(c["pitch_1"]["mean"] - c["pitch_1"]["mean_ref"])) <= 0.4
     assert abs(c["rotor_speed"]["std_diff_pct"]) <= 10.0

@@ -318,9 +318,11 @@ def design_ts_controller(ts: TSModel, *, decay_rate: float = 0.2,
                              grid_points=grid_points, integral_of=integral_of,
                              uncontrolled=uncontrolled)
     if not cert.ok:
+        hint = ("the LMIs may be infeasible: relax input_bounds, disk_radius or decay_rate, or "
+                "tighten the solver tolerance" if status == "optimal_inaccurate" else
+                "tighten the solver tolerance or scale the model")
         raise SynthesisError(f"the solver ({used}, status {status}) returned gains whose "
-                             f"certificate fails: {'; '.join(cert.failures[:3])}; tighten the "
-                             f"solver tolerance or scale the model")
+                             f"certificate fails: {'; '.join(cert.failures[:3])}; {hint}")
     bounds = np.sqrt(np.maximum(tv.value.max(axis=0), 0)) * su if tv.value is not None \
         else np.full(len(ts.inputs), np.nan)
     return TSControllerDesign(K=k, P=p, scale_x=sx, scale_u=su, decay_rate=alpha,
