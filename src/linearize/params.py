@@ -133,7 +133,8 @@ class PlantConfig:
         side toward which the wake is skewed). The loads follow the corrected induction; for
         three blades the correction cancels in the rotor's thrust and torque to first order
         and moves load between the blades (1P loads, tilt and yaw moments, the rotor's side
-        force). Off by default; on in :meth:`openfast`.
+        force). It acts in simulation and in the trim; the linear models leave it out, as they
+        leave out the unsteady aerodynamics. Off by default; on in :meth:`openfast`.
     """
 
     dofs: frozenset[str] = frozenset(DOF_NAMES)

@@ -318,17 +318,23 @@ def design_ts_controller(ts: TSModel, *, decay_rate: float = 0.2,
                              grid_points=grid_points, integral_of=integral_of,
                              uncontrolled=uncontrolled)
     if not cert.ok:
-        hint = ("the LMIs may be infeasible: relax input_bounds, disk_radius or decay_rate, or "
-                "tighten the solver tolerance" if status == "optimal_inaccurate" else
-                "tighten the solver tolerance or scale the model")
-        raise SynthesisError(f"the solver ({used}, status {status}) returned gains whose "
-                             f"certificate fails: {'; '.join(cert.failures[:3])}; {hint}")
+        raise SynthesisError(_certificate_failed(used, status, cert.failures))
     bounds = np.sqrt(np.maximum(tv.value.max(axis=0), 0)) * su if tv.value is not None \
         else np.full(len(ts.inputs), np.nan)
     return TSControllerDesign(K=k, P=p, scale_x=sx, scale_u=su, decay_rate=alpha,
                               disk_radius=radius, input_bounds=bounds, integral_of=integral_of,
                               solver=used, solve_time_s=dt, certificate=cert, margin=margin,
                               uncontrolled=uncontrolled)
+
+
+def _certificate_failed(used: str, status: str, failures: list[str]) -> str:
+    """What to do when the solver's gains fail the certificate: an inaccurate solve of LMIs that
+    may be infeasible says what to relax."""
+    hint = ("the LMIs may be infeasible: relax input_bounds, disk_radius or decay_rate, or "
+            "tighten the solver tolerance" if status == "optimal_inaccurate" else
+            "tighten the solver tolerance or scale the model")
+    return (f"the solver ({used}, status {status}) returned gains whose certificate fails: "
+            f"{'; '.join(failures[:3])}; {hint}")
 
 
 def _gains(x: np.ndarray, y: list[np.ndarray], keep: np.ndarray, sx: np.ndarray,
