@@ -222,10 +222,12 @@ class PlantConfig:
 
         Parameters
         ----------
-        unsteady_aero, tower_drag, tower_shadow, twisted_modes, blade_body_forces, skewed_wake : bool
-            The effects off by default (the AeroDyn file's ``UA_Mod > 0``, ``TwrAero``,
-            ``TwrPotent > 0`` and ``Skew_Mod = 1``; ElastoDyn's modes along the principal axes
-            and its blade kinematics).
+        unsteady_aero, tower_drag, tower_shadow, skewed_wake : bool
+            AeroDyn's effects, off by default (the AeroDyn file's ``UA_Mod > 0``, ``TwrAero``,
+            ``TwrPotent > 0`` and ``Skew_Mod = 1``).
+        twisted_modes, blade_body_forces : bool
+            ElastoDyn's modes along the principal axes and its blade kinematics, off by
+            default.
         dofs : frozenset of str, optional
             Degrees of freedom (default: all).
 

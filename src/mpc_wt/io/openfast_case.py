@@ -7,9 +7,9 @@ aerodynamic options, and the controller it runs; so that mpc-wt's plant can run 
 Read from the ``.fst`` (``TMax``, ``EDFile``, ``AeroFile``, ``ServoFile``, ``InflowFile``), from
 ElastoDyn (the DOF flags and the initial conditions ``RotSpeed``, ``BlPitch``, ``Azimuth``,
 ``OoPDefl``, ``IPDefl``, ``TTDspFA``, ``TTDspSS``), from AeroDyn 15 (``UA_Mod``,
-``TwrPotent``, ``TwrAero``), from InflowWind (``WindType = 3``, a TurbSim ``.bts``) and from
-ServoDyn (``DLL_InFile``: a ROSCO ``DISCON.IN``, or none for Jonkman's baseline DLL, whose gains
-are compiled in).
+``TwrPotent``, ``TwrAero``, ``Skew_Mod``), from InflowWind (``WindType = 3``, a TurbSim
+``.bts``) and from ServoDyn (``DLL_InFile``: a ROSCO ``DISCON.IN``, or none for Jonkman's
+baseline DLL, whose gains are compiled in).
 """
 from __future__ import annotations
 
