@@ -433,10 +433,10 @@ def plant_params(turbine: Turbine, config: PlantConfig | None = None) -> PlantPa
         ddph = mode_shape(coeffs, xh, 2) / ht**2
         eit = np.interp(xh, ts.height_fraction, ei_tab)
         slope = float(dph[-1])
-        mass = float(np.trapezoid(mt * ph**2, h)) + rot_inertia * slope**2
+        m_tower = float(np.trapezoid(mt * ph**2, h))
+        mass = m_tower + rot_inertia * slope**2
         inertia_moment = float(np.trapezoid(mt * ph * h, h)) + rot_inertia * slope
         k_elastic = float(np.trapezoid(eit * ddph**2, h))
-        m_tower = float(np.trapezoid(mt * ph**2, h))
         k = k_elastic - float(np.trapezoid(weight_above * dph**2, h))
         for mb, xb, zb in bodies:
             mass += mb * ((1.0 + zb * slope) ** 2 + (xb * slope) ** 2)

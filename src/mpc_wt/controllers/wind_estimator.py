@@ -65,8 +65,8 @@ class WindEstimatorSettings:
 
 
 def estimator_performance(turbine: linearize.Turbine, shear_exponent: float = 0.2) -> Any:
-    """The C_P table of :class:`WindSpeedEstimator` (tip-speed ratio 1-18, pitch -5 to 40 deg),
-    to make once and share between estimators of one turbine (it takes seconds).
+    """The C_P table of :class:`WindSpeedEstimator` (tip-speed ratio 1-18, pitch -5 to 40 deg;
+    it takes seconds, and :func:`linearize.rotor_performance` keeps it for the process).
 
     Parameters
     ----------

@@ -569,12 +569,11 @@ def _envelope_family(ctx: BuildContext, config: str, step: float,
 
 
 def _wind_estimator(ctx: BuildContext, dt: float) -> Any:
-    """A wind estimator at ``dt`` on the turbine's C_P table (the table kept in the cache)."""
-    from mpc_wt.controllers.wind_estimator import WindSpeedEstimator, estimator_performance
+    """A wind estimator at ``dt`` on the turbine's C_P table (which
+    :func:`linearize.rotor_performance` keeps for the process)."""
+    from mpc_wt.controllers.wind_estimator import WindSpeedEstimator
 
-    table = ctx.cache.get(ctx.turbine, ("estimator-cp", 0.2),
-                          lambda: estimator_performance(ctx.turbine, 0.2))
-    return WindSpeedEstimator(ctx.turbine, dt, performance=table)
+    return WindSpeedEstimator(ctx.turbine, dt)
 
 
 def _check_design_wind(turbine: linearize.Turbine, v: float) -> float:
