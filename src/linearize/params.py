@@ -6,7 +6,8 @@ geometric parameters derived from the turbine data (:class:`PlantParams`,
 from __future__ import annotations
 
 import math
-from collections import namedtuple
+import threading
+from collections import OrderedDict, namedtuple
 from dataclasses import dataclass, field, replace
 from typing import Any, Mapping
 
@@ -363,12 +364,25 @@ def _cumtrapz_from_end(y: FloatArray, x: FloatArray) -> FloatArray:
     return out
 
 
+#: the last parameters derived in this process: (id(turbine), config) -> PlantParams (which
+#: holds its turbine, so that the id stays that turbine's while the entry is kept)
+_DERIVED: OrderedDict[tuple[int, PlantConfig], PlantParams] = OrderedDict()
+_DERIVED_LOCK = threading.Lock()
+#: how many derivations :func:`plant_params` keeps
+PARAMS_KEPT = 16
+
+
 def plant_params(turbine: Turbine, config: PlantConfig | None = None) -> PlantParams:
     """Derive modal, inertial and geometric plant parameters from the turbine data.
 
     Modal mass and stiffness of each assumed mode phi (Hansen 2015, ch. 11):
     ``m = int mu phi^2 + sum_bodies``, ``k = int EI phi''^2 - g int N(h) phi'^2`` (gravity
     softening with N the weight above h), damping ``c = 2 zeta sqrt(k m)``.
+
+    The process keeps the last :data:`PARAMS_KEPT` derivations, by the turbine object (a
+    :class:`Turbine` is immutable) and the config: a steady solve, a trim or a C_P table asks
+    for the same parameters thousands of times in a design, and the derivation takes
+    milliseconds. The kept :class:`PlantParams` is shared; it is not to be changed.
 
     Parameters
     ----------
@@ -383,6 +397,22 @@ def plant_params(turbine: Turbine, config: PlantConfig | None = None) -> PlantPa
         The plant's parameters.
     """
     cfg = config or PlantConfig()
+    key = (id(turbine), cfg)
+    with _DERIVED_LOCK:
+        kept = _DERIVED.get(key)
+        if kept is not None and kept.turbine is turbine:
+            _DERIVED.move_to_end(key)
+            return kept
+    derived = _derive_plant_params(turbine, cfg)
+    with _DERIVED_LOCK:
+        _DERIVED[key] = derived
+        while len(_DERIVED) > PARAMS_KEPT:
+            _DERIVED.popitem(last=False)
+    return derived
+
+
+def _derive_plant_params(turbine: Turbine, cfg: PlantConfig) -> PlantParams:
+    """:func:`plant_params` computed afresh."""
     t = turbine
     g = t.geometry
     grav = t.environment.gravity

@@ -185,8 +185,9 @@ def optimal_tsr(turbine: Turbine, pitch_deg: float = 0.0, options: AeroOptions |
                                           integration=integration)[0])
 
     grid = np.linspace(2.0, 16.0, 57)
-    vals = [neg(v) for v in grid]
-    i = int(np.argmin(vals))
+    vals = steady_coefficients(turbine, grid, pitch_deg, options, shear_exponent=shear_exponent,
+                               integration=integration)[0]
+    i = int(np.argmax(vals))
     lo, hi = grid[max(i - 1, 0)], grid[min(i + 1, grid.size - 1)]
     res = minimize_scalar(neg, bounds=(lo, hi), method="bounded", options={"xatol": 1e-6})
     return float(res.x), -float(res.fun)

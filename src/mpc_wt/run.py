@@ -16,7 +16,8 @@ from mpc_wt.registry.registry import API_NAMING, Naming, Selection, resolve
 from mpc_wt.simulation.memory import check_run_memory, estimate_run_memory
 from mpc_wt.simulation.loop import simulate_closed_loop
 from mpc_wt.simulation.results import ClosedLoopResult
-from mpc_wt.simulation.scenario import FieldMemo, Scenario, lidar_field, make_wind, start_wind
+from mpc_wt.simulation.scenario import (DEFAULT_FIELDS, FieldMemo, Scenario, lidar_field,
+                                       make_wind, start_wind)
 
 __all__ = ["run_controller", "build_controller", "design_controller", "export_discon",
            "run_openfast_case", "run_warnings", "CASE_CONTROLLERS", "VALIDITY_SIGNALS"]
@@ -130,7 +131,9 @@ def build_controller(turbine: linearize.Turbine, controller: str, scenario: Scen
     samplers : lidar.SamplerCache, optional
         Keeps the turbulence generator's sampler for the next field of the same wind and grid.
     fields : FieldMemo, optional
-        Keeps the scenario's fields for the next run of the same scenario.
+        Keeps the scenario's fields for the next run of the same scenario (default: the
+        process's :data:`~mpc_wt.simulation.scenario.DEFAULT_FIELDS`; ``FieldMemo(0)`` keeps
+        none).
 
     Returns
     -------
@@ -156,6 +159,7 @@ def build_controller(turbine: linearize.Turbine, controller: str, scenario: Scen
     check_run_memory(estimate_run_memory(turbine, scenario, components=len(comps),
                                          lidar_fields=lidars),
                      what=f"a {scenario.duration:g} s run of {controller}")
+    fields = DEFAULT_FIELDS if fields is None else fields
     wind, field = make_wind(turbine, scenario, comps,
                             samplers=samplers, fields=fields)
     for sensor in built.sensors:
@@ -221,8 +225,8 @@ def run_controller(turbine: linearize.Turbine, controller: str, scenario: Scenar
     naming : Naming
         How error messages name options.
     samplers, fields : lidar.SamplerCache, FieldMemo, optional
-        Keep the turbulence generator's sampler and the scenario's fields for the next runs (a
-        campaign's seeds and controllers); the fields are the same with or without them.
+        Keep the generator's sampler and the fields for the next runs (the same fields with or
+        without them); fields default to :data:`~mpc_wt.simulation.scenario.DEFAULT_FIELDS`.
     turbulence, seed, duration, shear_exponent : optional
         With a mean wind only: the :class:`Scenario`'s fields (defaults "A", 1, 600 s, 0.2).
     condition : mapping, optional

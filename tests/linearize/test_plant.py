@@ -119,6 +119,34 @@ def test_turbine_without_edge_mode_has_no_edge_frequencies(turbine: linearize.Tu
     assert "edge_asymmetric" not in f and "drivetrain" in f
 
 
+def test_parameters_asked_for_again_are_the_kept_ones_another_turbine_its_own(
+        turbine: linearize.Turbine) -> None:
+    """The same turbine and an equal config: the kept parameters themselves. A turbine with
+    twice the blade's mass per length (another object): its own parameters, with twice the
+    blade mass and the first moment (both integrals linear in the mass) and the rest of the
+    blade's geometry unchanged; the first turbine's are still its own."""
+    import dataclasses
+
+    from linearize.params import PARAMS_KEPT
+
+    cfg = PlantConfig(frozenset({"generator"}))
+    first = linearize.plant_params(turbine, cfg)
+    assert linearize.plant_params(turbine, PlantConfig(frozenset({"generator"}))) is first
+    assert linearize.plant_params(turbine) is not first
+    heavy = dataclasses.replace(turbine, blade_structure=dataclasses.replace(
+        turbine.blade_structure, mass_per_length=2.0 * turbine.blade_structure.mass_per_length))
+    p = linearize.plant_params(heavy, cfg)
+    assert p is not first and p.turbine is heavy
+    assert_allclose(p.blade_mass, 2.0 * first.blade_mass, rtol=1e-12)
+    assert_allclose(p.pack.s1, 2.0 * first.pack.s1, rtol=1e-12)
+    np.testing.assert_array_equal(p.pack.chord, first.pack.chord)
+    assert linearize.plant_params(turbine, cfg) is first
+    for k in range(PARAMS_KEPT):            # older derivations make way for newer ones
+        linearize.plant_params(dataclasses.replace(turbine, name=f"copy {k}"), cfg)
+    again = linearize.plant_params(turbine, cfg)
+    assert again is not first and again.blade_mass == first.blade_mass
+
+
 def test_flap_mode_stiffens_with_rotor_speed(params: linearize.PlantParams) -> None:
     f0 = structural_frequencies(params, 0.0)["flap_asymmetric"]
     f1 = structural_frequencies(params, 1.2671)["flap_asymmetric"]

@@ -68,3 +68,20 @@ def test_the_memo_keeps_within_its_limit_oldest_out(turbine: linearize.Turbine) 
 def test_a_bad_limit_is_named(bad: float) -> None:
     with pytest.raises(ValueError, match="max_bytes"):
         FieldMemo(max_bytes=bad)
+
+
+def test_runs_without_a_memo_share_the_process_fields(turbine: linearize.Turbine) -> None:
+    """Two controllers run on one case without a memo: the second meets the field the first
+    made (the process's ``DEFAULT_FIELDS``), and its run equals, bit for bit, one on a field
+    made afresh (``FieldMemo(0)`` keeps none)."""
+    from mpc_wt.run import run_controller
+    from mpc_wt.simulation.scenario import DEFAULT_FIELDS
+
+    sc = Scenario(13.0, "B", 7, duration=20.0)
+    run_controller(turbine, "baseline", sc)
+    hits, misses = DEFAULT_FIELDS.hits, DEFAULT_FIELDS.misses
+    shared = run_controller(turbine, "derate90", sc)
+    assert (DEFAULT_FIELDS.hits, DEFAULT_FIELDS.misses) == (hits + 1, misses)
+    fresh = run_controller(turbine, "derate90", sc, fields=FieldMemo(0))
+    assert (DEFAULT_FIELDS.hits, DEFAULT_FIELDS.misses) == (hits + 1, misses)
+    assert _same(shared.z, fresh.z) and _same(shared.u, fresh.u)
