@@ -10,10 +10,11 @@ import numpy as np
 
 import lidar
 import linearize
+from mpc_wt.errors import RunTooLargeError
 from mpc_wt.registry.context import DEFAULT_CACHE, BuildContext, Built, DesignCache, design_digest
 from mpc_wt.registry.options import Options
 from mpc_wt.registry.registry import API_NAMING, Naming, Selection, resolve
-from mpc_wt.simulation.memory import check_run_memory, estimate_run_memory
+from mpc_wt.simulation.memory import RunMemory, check_run_memory, estimate_run_memory
 from mpc_wt.simulation.loop import simulate_closed_loop
 from mpc_wt.simulation.results import ClosedLoopResult
 from mpc_wt.simulation.scenario import (DEFAULT_FIELDS, FieldMemo, Scenario, lidar_field,
@@ -156,10 +157,10 @@ def build_controller(turbine: linearize.Turbine, controller: str, scenario: Scen
     built, new = _design(turbine, sel, opts, cache, params)
     comps = sel.field_components
     lidars = len(built.sensors) + (built.preview is not None)
-    check_run_memory(estimate_run_memory(turbine, scenario, components=len(comps),
-                                         lidar_fields=lidars),
-                     what=f"a {scenario.duration:g} s run of {controller}")
     fields = DEFAULT_FIELDS if fields is None else fields
+    _check_memory(estimate_run_memory(turbine, scenario, components=len(comps),
+                                      lidar_fields=lidars),
+                  f"a {scenario.duration:g} s run of {controller}", fields)
     wind, field = make_wind(turbine, scenario, comps,
                             samplers=samplers, fields=fields)
     for sensor in built.sensors:
@@ -169,6 +170,20 @@ def build_controller(turbine: linearize.Turbine, controller: str, scenario: Scen
         built.preview.reset()
     meta = {**built.meta, "design": {**built.meta["design"], "new": new}}
     return dataclasses.replace(built, meta=meta), op, wind
+
+
+def _check_memory(need: RunMemory, what: str, fields: FieldMemo) -> None:
+    """:func:`check_run_memory`; where the run does not fit while earlier fields are kept,
+    they are released (logged) and the run is checked again."""
+    try:
+        check_run_memory(need, what=what)
+    except RunTooLargeError:
+        if not len(fields):
+            raise
+        log.info("releasing %.0f MB of kept wind fields to make room for %s",
+                 fields.nbytes / 1e6, what)
+        fields.clear()
+        check_run_memory(need, what=what)
 
 
 def _scenario_of(scenario: Scenario | float, fields: dict[str, Any]) -> Scenario:

@@ -312,7 +312,8 @@ class FieldMemo:
 #: The fields :func:`mpc_wt.run.run_controller` and :func:`mpc_wt.run.build_controller` keep
 #: when given none: the last runs' fields, up to 600 MB (on the NREL 5-MW's grid a 600 s field
 #: takes 51 MB with u alone, 153 MB with u, v and w), for the next run of the same scenario
-#: (controllers compared on one case). ``DEFAULT_FIELDS.clear()`` releases them;
+#: (controllers compared on one case). A run that would not fit in the memory available
+#: otherwise releases them first (logged); ``DEFAULT_FIELDS.clear()`` releases them;
 #: ``fields=FieldMemo(0)`` keeps none.
 DEFAULT_FIELDS = FieldMemo(max_bytes=6.0e8)
 

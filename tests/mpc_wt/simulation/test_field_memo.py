@@ -85,3 +85,28 @@ def test_runs_without_a_memo_share_the_process_fields(turbine: linearize.Turbine
     fresh = run_controller(turbine, "derate90", sc, fields=FieldMemo(0))
     assert (DEFAULT_FIELDS.hits, DEFAULT_FIELDS.misses) == (hits + 1, misses)
     assert _same(shared.z, fresh.z) and _same(shared.u, fresh.u)
+
+
+def test_a_run_that_does_not_fit_first_releases_the_kept_fields(
+        turbine: linearize.Turbine, monkeypatch, caplog) -> None:
+    """With more memory than the run needs, the kept fields stay; with less, they are released
+    (logged, with their size) before the run is refused, naming the memory it needs."""
+    import logging
+
+    from mpc_wt.errors import RunTooLargeError
+    from mpc_wt.run import build_controller
+    from mpc_wt.simulation import memory
+
+    memo = FieldMemo()
+    make_wind(turbine, Scenario(11.0, "A", 2, duration=20.0), "u", fields=memo)
+    monkeypatch.setattr(memory, "available_memory", lambda: 1e12)
+    build_controller(turbine, "baseline", Scenario(11.0, "A", 3, duration=20.0), fields=memo)
+    assert len(memo) == 2
+    held = memo.nbytes
+    monkeypatch.setattr(memory, "available_memory", lambda: 1e6)
+    with caplog.at_level(logging.INFO, logger="mpc_wt.run"), \
+            pytest.raises(RunTooLargeError, match="needs about"):
+        build_controller(turbine, "baseline", Scenario(11.0, "A", 4, duration=20.0),
+                         fields=memo)
+    assert len(memo) == 0
+    assert f"releasing {held / 1e6:.0f} MB of kept wind fields" in caplog.text
