@@ -6,13 +6,13 @@ geometric parameters derived from the turbine data (:class:`PlantParams`,
 from __future__ import annotations
 
 import math
-import threading
-from collections import OrderedDict, namedtuple
+from collections import namedtuple
 from dataclasses import dataclass, field, replace
 from typing import Any, Mapping
 
 import numpy as np
 
+from linearize._kept import Kept
 from linearize._typing import FloatArray
 from linearize.bem import (
     AeroOptions,
@@ -364,12 +364,11 @@ def _cumtrapz_from_end(y: FloatArray, x: FloatArray) -> FloatArray:
     return out
 
 
-#: the last parameters derived in this process: (id(turbine), config) -> PlantParams (which
-#: holds its turbine, so that the id stays that turbine's while the entry is kept)
-_DERIVED: OrderedDict[tuple[int, PlantConfig], PlantParams] = OrderedDict()
-_DERIVED_LOCK = threading.Lock()
 #: how many derivations :func:`plant_params` keeps
 PARAMS_KEPT = 16
+#: the last parameters derived in this process, by (id(turbine), config); a kept PlantParams
+#: holds its turbine, so the id names that turbine for as long as the entry is kept
+_DERIVED = Kept(PARAMS_KEPT)
 
 
 def plant_params(turbine: Turbine, config: PlantConfig | None = None) -> PlantParams:
@@ -397,18 +396,7 @@ def plant_params(turbine: Turbine, config: PlantConfig | None = None) -> PlantPa
         The plant's parameters.
     """
     cfg = config or PlantConfig()
-    key = (id(turbine), cfg)
-    with _DERIVED_LOCK:
-        kept = _DERIVED.get(key)
-        if kept is not None and kept.turbine is turbine:
-            _DERIVED.move_to_end(key)
-            return kept
-    derived = _derive_plant_params(turbine, cfg)
-    with _DERIVED_LOCK:
-        _DERIVED[key] = derived
-        while len(_DERIVED) > PARAMS_KEPT:
-            _DERIVED.popitem(last=False)
-    return derived
+    return _DERIVED.get((id(turbine), cfg), lambda: _derive_plant_params(turbine, cfg))
 
 
 def _derive_plant_params(turbine: Turbine, cfg: PlantConfig) -> PlantParams:

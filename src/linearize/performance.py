@@ -10,13 +10,12 @@ same floats.
 from __future__ import annotations
 
 import math
-import threading
-from collections import OrderedDict
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
+from linearize._kept import Kept
 from linearize._typing import FloatArray
 from linearize.bem import AeroOptions
 from linearize.errors import TurbineFileError
@@ -92,11 +91,10 @@ class RotorPerformance:
         return float(self.cp[i, j]), float(self.tsr[i]), float(self.pitch_rad[j])
 
 
-#: tables computed in this process, by (turbine content, grid, wind, shear, options)
-_TABLES: OrderedDict[tuple[object, ...], RotorPerformance] = OrderedDict()
-_TABLES_LOCK = threading.Lock()
 #: how many tables :func:`rotor_performance` keeps
 TABLES_KEPT = 8
+#: tables computed in this process, by (turbine content, grid, wind, shear, options)
+_TABLES = Kept(TABLES_KEPT)
 
 
 def rotor_performance(turbine: object, tsr: FloatArray, pitch_deg: FloatArray, *,
@@ -145,22 +143,16 @@ def rotor_performance(turbine: object, tsr: FloatArray, pitch_deg: FloatArray, *
     opts = options or AeroOptions()
     key = (content_digest(turbine), lam.tobytes(), beta.tobytes(), float(wind_mps),
            float(shear_exponent), repr(opts))
-    with _TABLES_LOCK:
-        kept = _TABLES.get(key)
-        if kept is not None:
-            _TABLES.move_to_end(key)
-            return kept
-    L, B = np.meshgrid(lam, beta, indexing="ij")
-    cp, ct = steady_coefficients(turbine, L, B, options,  # type: ignore[arg-type]
-                                 shear_exponent=shear_exponent)
-    cone = turbine.geometry.precone_rad if opts.cone else 0.0  # type: ignore[attr-defined]
-    table = RotorPerformance(pitch_deg=beta, tsr=lam, cp=cp, ct=ct, cq=cp / (L * math.cos(cone)),
-                             wind_mps=float(wind_mps), name=getattr(turbine, "name", ""))
-    with _TABLES_LOCK:
-        _TABLES[key] = table
-        while len(_TABLES) > TABLES_KEPT:
-            _TABLES.popitem(last=False)
-    return table
+
+    def make() -> RotorPerformance:
+        L, B = np.meshgrid(lam, beta, indexing="ij")
+        cp, ct = steady_coefficients(turbine, L, B, options,  # type: ignore[arg-type]
+                                     shear_exponent=shear_exponent)
+        cone = turbine.geometry.precone_rad if opts.cone else 0.0  # type: ignore[attr-defined]
+        return RotorPerformance(pitch_deg=beta, tsr=lam, cp=cp, ct=ct,
+                                cq=cp / (L * math.cos(cone)), wind_mps=float(wind_mps),
+                                name=getattr(turbine, "name", ""))
+    return _TABLES.get(key, make)
 
 
 def _fmt(v: float) -> str:
