@@ -30,6 +30,11 @@ __all__ = ["evaluate_plant", "evaluate_plant_vw", "sample_wind", "sample_inplane
 
 DENSE_STRIDES = (8,)                   # the strides of a 1-D C-contiguous float64 array
 
+#: The u grid a wind without one passes to :func:`sample_wind`. Read-only, as every grid wind's
+#: is: numba compiles a kernel for a writable array apart from one for a read-only array.
+NO_GRID = np.zeros((1, 1, 1), dtype=np.float32)
+NO_GRID.flags.writeable = False
+
 
 # --------------------------------------------------------------------------------------------
 # Kernels

@@ -55,7 +55,7 @@ from linearize._typing import FloatArray
 from linearize.bem import MODE_CS, MODE_FROZEN, MODE_NOLIMITS, MODE_TIGHT
 from linearize.errors import LinearizationError
 from linearize.jitcache import key_caches_on_callees
-from linearize.kernel import evaluate_plant, sample_wind
+from linearize.kernel import NO_GRID, evaluate_plant, sample_wind
 from linearize.models import LinearModel, LinearModelFamily, check_wind_grid
 from linearize.params import (
     INPUT_NAMES,
@@ -177,7 +177,7 @@ def _raw_jacobians(params: PlantParams, op: OperatingPoint, wake: str, shear: fl
     x0 = op.x.copy()
     x0[16] = psi
     u0 = op.u.copy()
-    w0 = sample_wind(0.0, psi, pk, 0, np.array([op.wind_mps, shear]), np.zeros((1, 1, 1), dtype=np.float32))
+    w0 = sample_wind(0.0, psi, pk, 0, np.array([op.wind_mps, shear]), NO_GRID)
     bem0 = evaluate_plant(x0, u0, w0, pk, np.full((4, 3, pk.r.size), np.nan), MODE_NOLIMITS)[2]
     mode = MODE_NOLIMITS | (MODE_FROZEN if wake == "frozen" else 0)
     if method == "cs":
@@ -438,7 +438,7 @@ def _z0(p: PlantParams, op: OperatingPoint, shear: float, n_azimuth: int = 24) -
     x, u = op.x.copy(), op.u.copy()      # writable: the kernel compiled for every caller
     for psi in 2 * math.pi * np.arange(n_azimuth) / n_azimuth:
         x[16] = psi
-        w = sample_wind(0.0, float(psi), pk, 0, wpar, np.zeros((1, 1, 1), dtype=np.float32))
+        w = sample_wind(0.0, float(psi), pk, 0, wpar, NO_GRID)
         z += evaluate_plant(x, u, w, pk, np.full((4, 3, pk.r.size), np.nan), 0)[1]
     return z / n_azimuth
 

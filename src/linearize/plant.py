@@ -287,7 +287,9 @@ def rk4_simulate(params: PlantParams, x0: FloatArray, u: FloatArray,
     wind.check_covers(params, t0 + n_steps * dt)
     kind, wpar, grid = wind._kernel_args()
     lim = _state_limits(params)
-    xs, zs, us, n, bad, val = simulate_kernel(x0, np.ascontiguousarray(u), float(t0), float(dt),
+    # writable copies: numba compiles a read-only array's kernel apart
+    xs, zs, us, n, bad, val = simulate_kernel(np.array(x0, dtype=float), np.array(u, order="C"),
+                                        float(t0), float(dt),
                                         n_steps, params.pack, kind, wpar, grid, lim,
                                         params.turbine.generator.max_torque_rate)
     t = t0 + dt * np.arange(n)

@@ -15,7 +15,7 @@ from scipy.optimize import minimize_scalar
 from linearize._typing import FloatArray
 from linearize.bem import MODE_NOLIMITS, AeroOptions
 from linearize.jitcache import key_caches_on_callees
-from linearize.kernel import evaluate_plant, sample_wind
+from linearize.kernel import NO_GRID, evaluate_plant, sample_wind
 from linearize.params import PlantConfig, PlantParams, n_x, plant_params
 from linearize.turbine import Turbine
 
@@ -32,7 +32,7 @@ def _avg_eval(x, u, speed, shear, p, n_az, mode=0):  # pragma: no cover - compil
     z_avg = np.zeros(31)
     hint = np.full((4, 3, p.r.size), np.nan)
     wpar = np.array([speed, shear])
-    dummy = np.zeros((1, 1, 1), dtype=np.float32)
+    dummy = NO_GRID
     xx = x.copy()
     for k in range(n_az):
         xx[16] = k * _TWO_PI_3 / n_az

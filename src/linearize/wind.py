@@ -10,7 +10,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from linearize._typing import FloatArray
-from linearize.kernel import sample_wind
+from linearize.kernel import NO_GRID, sample_wind
 from linearize.params import PlantParams
 from linearize.validate import check_array
 
@@ -66,8 +66,7 @@ class SteadyWind:
             raise ValueError(f"shear_exponent must be in [-1, 1], got {self.shear_exponent!r}")
 
     def _kernel_args(self) -> tuple[int, FloatArray, tuple[FloatArray, FloatArray]]:
-        return (0, np.array([float(self.speed), float(self.shear_exponent)]),
-                (np.zeros((1, 1, 1), dtype=np.float32), _NO_VW))
+        return (0, np.array([float(self.speed), float(self.shear_exponent)]), (NO_GRID, _NO_VW))
 
     def check_covers(self, params: PlantParams, t_end: float) -> None:
         """Steady wind covers any rotor and any duration.
@@ -81,7 +80,8 @@ class SteadyWind:
         """
 
 
-#: the kernel's v-w grid of a wind without lateral and vertical components
+#: the kernel's v-w grid of a wind without lateral and vertical components (read-only, as
+#: :data:`linearize.kernel.NO_GRID`)
 _NO_VW = np.zeros((2, 1, 1, 1), dtype=np.float32)
 _NO_VW.flags.writeable = False
 

@@ -83,3 +83,30 @@ def test_every_kernel_that_compiles_another_modules_kernel_is_keyed_on_it() -> N
                 if stamp == obj._cache._impl.locator.get_source_stamp():
                     plain.append(f"{module.__name__}.{name}")
     assert seen >= 8 and not plain, f"keyed on their own file only: {plain}"
+
+
+def test_steady_and_grid_winds_share_one_compiled_plant_kernel() -> None:
+    """numba compiles a kernel again for every new combination of argument types, read-only
+    arrays apart from writable ones, and the plant's simulation kernel takes tens of seconds.
+    A steady wind and a gridded one, a read-only trim state and input history and writable
+    ones, all run on one compiled version of it and of the step inside it."""
+    import numpy as np
+
+    import linearize
+    from linearize import kernel
+
+    tb = linearize.load_turbine("nrel5mw")
+    params = linearize.plant_params(tb)
+    op = linearize.trim(tb, 12.0)
+    assert not op.x.flags.writeable                   # the trim hands out read-only states
+    t, y, z = np.array([0.0, 1.0]), np.array([-80.0, 80.0]), np.array([0.0, 200.0])
+    grid = linearize.GridWind(t, y, z, np.full((2, 2, 2), 12.0, np.float32))
+    u_ro = np.tile(op.u, (3, 1))
+    u_ro.flags.writeable = False
+    for wind in (linearize.SteadyWind(12.0), grid):
+        for x0, u in ((op.x, u_ro), (np.array(op.x), np.array(u_ro))):
+            linearize.rk4_simulate(params, x0, u, wind, duration=3 / 80)
+    real = [s for s in kernel.simulate_kernel.signatures if "complex" not in str(s)]
+    assert len(real) == 1, real
+    steps = [s for s in kernel._rk4.signatures if "complex" not in str(s)]
+    assert len(steps) == 1, steps

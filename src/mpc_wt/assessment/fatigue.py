@@ -141,7 +141,7 @@ def rainflow(x: Any) -> tuple[FloatArray, FloatArray, FloatArray]:
         Cycle ranges (peak to valley), means [unit of x] and counts (1 or 0.5) [-].
     """
     arr = check_series("x", x)
-    r, mu, c, _ = _count(_reversals(arr), True)
+    r, mu, c, _ = _count(_reversals(np.ascontiguousarray(arr)), True)
     return r, mu, c
 
 
