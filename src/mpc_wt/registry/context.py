@@ -45,8 +45,9 @@ _OPAQUE = ("ctypes", "numba", "osqp", "daqp", "scipy.interpolate", "logging", "t
 
 def design_digest(obj: Any) -> str:
     """A digest of a built controller's design: every array, number, string and option it holds
-    (walked through dataclasses, containers and object attributes; solver handles, compiled
-    functions, modules, the wind a LIDAR is bound to, the design's own solve times
+    (walked through dataclasses, containers and object attributes; a turbine by its content,
+    not the file it was read from; solver handles, compiled functions, modules, the wind a LIDAR
+    is bound to, the design's own solve times
     (``*_time_s``), classes marked ``__design__ = False`` and the attributes a class names in
     ``__not_design__`` are not design data and are skipped).
 
@@ -70,6 +71,9 @@ def design_digest(obj: Any) -> str:
         if depth > 40:
             return
         if isinstance(o, lidar.WindField):      # the wind a LIDAR measures: the case's
+            return
+        if isinstance(o, linearize.Turbine):    # its content, not where it was read from
+            h.update(content_digest(o).encode())
             return
         if isinstance(o, lidar.LidarSensor):    # the instrument, not the wind bound to it
             h.update(b"LidarSensor")

@@ -11,6 +11,7 @@ fresh one (``reset()`` forgets everything of the case before).
 from __future__ import annotations
 
 import dataclasses
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -58,6 +59,24 @@ def test_the_digest_sees_a_design_change(turbine: linearize.Turbine) -> None:
     c, _ = _design(turbine, "coleman-ipc", {"crossover_rad_s": 0.3})
     d, _ = _design(turbine, "coleman-ipc", {})
     assert a != b and c != d and b == _design(turbine, "ibc", {})[0]
+
+
+def test_the_digest_does_not_depend_on_where_the_turbine_was_read_from(
+        turbine: linearize.Turbine, tmp_path) -> None:
+    """The same turbine data read from another folder (an install elsewhere, a worktree) give
+    the same design digest, so a campaign resumed from there does not compute its cases again;
+    a turbine whose data differ (the generator's torque limit 1 % lower) gives another."""
+    import shutil
+
+    src = Path(turbine.source).parent
+    shutil.copytree(src, tmp_path / "copy")
+    moved = linearize.load_turbine(tmp_path / "copy" / Path(turbine.source).name)
+    assert moved.source != turbine.source
+    gen = dataclasses.replace(turbine.generator,
+                              max_torque=0.99 * turbine.generator.max_torque)
+    changed = dataclasses.replace(turbine, generator=gen)
+    digests = [_design(t, "ibc", {})[0] for t in (turbine, moved, changed)]
+    assert digests[0] == digests[1] != digests[2]
 
 
 def _design(turbine: linearize.Turbine, kind: str, options: dict) -> tuple[str, Built]:
