@@ -47,9 +47,8 @@ def design_digest(obj: Any) -> str:
     """A digest of a built controller's design: every array, number, string and option it holds
     (walked through dataclasses, containers and object attributes; a turbine by its content,
     not the file it was read from; solver handles, compiled functions, modules, the wind a LIDAR
-    is bound to, the design's own solve times
-    (``*_time_s``), classes marked ``__design__ = False`` and the attributes a class names in
-    ``__not_design__`` are not design data and are skipped).
+    is bound to, the design's own solve times (``*_time_s``), classes marked ``__design__ =
+    False`` and the attributes a class names in ``__not_design__`` are skipped).
 
     Two builds give equal digests when they hold the same gains, models and QP data; a design
     that read the case (its mean wind, its field) differs from case to case.
