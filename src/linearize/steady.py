@@ -32,11 +32,10 @@ def _avg_eval(x, u, speed, shear, p, n_az, mode=0):  # pragma: no cover - compil
     z_avg = np.zeros(31)
     hint = np.full((4, 3, p.r.size), np.nan)
     wpar = np.array([speed, shear])
-    dummy = NO_GRID
     xx = x.copy()
     for k in range(n_az):
         xx[16] = k * _TWO_PI_3 / n_az
-        w = sample_wind(0.0, xx[16], p, np.int64(0), wpar, dummy)
+        w = sample_wind(0.0, xx[16], p, np.int64(0), wpar, NO_GRID)
         dx, z, phis = evaluate_plant(xx, u, w, p, hint, mode)
         hint = phis
         dx_avg += dx

@@ -31,7 +31,8 @@ def check_series(name: str, x: Any) -> FloatArray:
     Returns
     -------
     (n_t,) ndarray
-        The series as floats.
+        The series as contiguous floats (one compiled version of the counting kernels for
+        every caller: numba compiles a strided array's apart).
 
     Raises
     ------
@@ -44,7 +45,7 @@ def check_series(name: str, x: Any) -> FloatArray:
     if not np.all(np.isfinite(arr)):
         i = int(np.argmax(~np.isfinite(arr)))
         raise ValueError(f"{name} must be finite; sample {i} is {float(arr[i])!r}")
-    return arr
+    return np.ascontiguousarray(arr)
 
 
 @nb.njit(cache=True)
@@ -141,7 +142,7 @@ def rainflow(x: Any) -> tuple[FloatArray, FloatArray, FloatArray]:
         Cycle ranges (peak to valley), means [unit of x] and counts (1 or 0.5) [-].
     """
     arr = check_series("x", x)
-    r, mu, c, _ = _count(_reversals(np.ascontiguousarray(arr)), True)
+    r, mu, c, _ = _count(_reversals(arr), True)
     return r, mu, c
 
 
