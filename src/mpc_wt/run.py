@@ -7,6 +7,7 @@ from pathlib import Path
 from typing import Any, Mapping, Sequence
 
 import numpy as np
+from threadpoolctl import threadpool_limits
 
 import lidar
 import linearize
@@ -91,9 +92,12 @@ def _design(turbine: linearize.Turbine, sel: Selection, opts: Sequence[Options],
         made.append(True)
         ctx = BuildContext(turbine=turbine, params=params or linearize.plant_params(turbine),
                            cache=cache)
-        built = sel.base.build(ctx, opts[0])
-        for kind, o in zip(sel.addons, opts[1:]):
-            built = kind.build(ctx, o, built)
+        # one BLAS thread, as in a campaign's workers: a multi-threaded BLAS sums in another
+        # order, and the design's last bits (and its digest) would depend on the process
+        with threadpool_limits(limits=1):
+            built = sel.base.build(ctx, opts[0])
+            for kind, o in zip(sel.addons, opts[1:]):
+                built = kind.build(ctx, o, built)
         built.sensors = list(ctx.sensors)
         built.meta["design"] = {"digest": design_digest(built.controller)}
         return built

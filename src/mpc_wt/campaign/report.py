@@ -85,8 +85,8 @@ def _fmt(v: Any) -> str:
 
 def _write_csv(path: Path, rows: list[dict[str, Any]]) -> None:
     cols: list[str] = []
-    for r in rows:
-        cols += [k for k in r if k not in cols]
+    for r in rows:        # keys with a leading underscore are the aggregate's, not the table's
+        cols += [k for k in r if k not in cols and not k.startswith("_")]
     tmp = path.with_suffix(".csv.tmp")
     with tmp.open("w", newline="") as fh:
         w = csv.DictWriter(fh, fieldnames=cols)
@@ -337,11 +337,13 @@ def _md_ultimate(agg: dict[str, Any]) -> list[str]:
           "largest over the winds; design: times the partial safety factor of the DLC's family "
           "(IEC 61400-1 ed. 3 table 3: normal 1.35, abnormal 1.1); extrapolated: the 50-year "
           "load of a DLC's maxima (Gumbel per wind, weighted by the wind distribution; factor "
-          "1.25). Governing: the largest design load in magnitude over the DLCs.", "",
+          "1.25). Governing: the largest design load in magnitude over the DLCs; its change "
+          "against the reference's with the standard error the seeds' scatter leaves on it "
+          "(paired by case where both come from the same DLC and wind).", "",
           _md(agg["governing"], ["controller", "channel", "unit", "design", "side", "dlc",
-                                 "case", "change_pct"],
+                                 "case", "change_pct", "change_se_pct"],
               ["controller", "channel", "unit", "governing design load", "max/min", "DLC",
-               "case of the extreme", "change [%]"]), "",
+               "case of the extreme", "change [%]", "standard error [%]"]), "",
           "Per DLC (all columns in `ultimate.csv`):", "",
           _md(agg["ultimate"], ["controller", "dlc", "family", "channel", "unit", "max",
                                 "max_case",

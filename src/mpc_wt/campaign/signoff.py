@@ -110,8 +110,12 @@ def ultimate_rows(spec: CampaignSpec, rows: Sequence[CaseRow]) -> list[dict[str,
         ``controller``, ``dlc``, ``family``, ``channel``, ``max``/``max_case``,
         ``min``/``min_case`` (the DLC's extremes), ``characteristic_max``, ``wind_max``,
         ``design_max``, ``characteristic_min``, ``design_min``, ``safety_factor``, ``seeds``,
-        ``cases`` and, for an ``extrapolate`` DLC, ``extrapolated_max``/``_min`` and
-        ``design_extrapolated_max``/``_min`` (factor 1.25).
+        ``cases``, ``characteristic_max_se``/``_min_se`` (the standard error of the seed mean,
+        s / sqrt(n), at the characteristic's wind; None for a deterministic load case or a
+        single seed) and, for an ``extrapolate`` DLC, ``extrapolated_max``/``_min`` and
+        ``design_extrapolated_max``/``_min`` (factor 1.25). The per-case extremes at the
+        characteristic's wind are kept under ``_cases_max``/``_cases_min`` (case id without
+        the controller -> extreme) for :func:`governing_rows`' pairing.
     """
     out = []
     for (ctl, dlc), items in _by_controller_dlc(spec, rows).items():
@@ -132,6 +136,12 @@ def ultimate_rows(spec: CampaignSpec, rows: Sequence[CaseRow]) -> list[dict[str,
                        "characteristic_max", "wind_max", "design_max", "characteristic_min",
                        "wind_min", "design_min", "safety_factor", "seeds")},
                    "cases": len(urows)}
+            turbulent = lc is None or not lc.deterministic
+            for side in ("max", "min"):
+                at = {_paired(r): r.metrics["extremes"][ch][side] for r, _ in items
+                      if r.wind_mps == d[f"wind_{side}"]}
+                row[f"characteristic_{side}_se"] = _std_error(at.values()) if turbulent else None
+                row[f"_cases_{side}"] = at
             if ch not in spec.ultimate:        # the rotor speed: extremes, not a load
                 row.update(design_max=None, design_min=None, safety_factor=None)
             elif lc is not None and lc.extrapolate:
@@ -161,7 +171,13 @@ def governing_rows(spec: CampaignSpec, ult: Sequence[Mapping[str, Any]]
     -------
     list of dict
         ``controller``, ``channel``, ``design`` (signed: the governing design max or min),
-        ``side``, ``dlc``, ``case`` (the case of that DLC's extreme), ``change_pct``.
+        ``side``, ``dlc``, ``wind`` (where the characteristic load is), ``case`` (the case of
+        that DLC's extreme), ``change_pct`` and ``change_se_pct``: the standard error of the
+        change from the seeds' scatter, in % of the reference's governing design load. Where
+        both governing loads come from the same DLC, side and wind, it is paired by case (the
+        same fields and events: the standard error of the seeds' differences); otherwise the
+        two seed means' standard errors combine as independent. None where neither load has
+        seeds to scatter (deterministic load cases).
     """
     best: dict[tuple[str, str], dict[str, Any]] = {}
     for u in ult:
@@ -173,15 +189,48 @@ def governing_rows(spec: CampaignSpec, ult: Sequence[Mapping[str, Any]]
             if key not in best or abs(val) > abs(best[key]["design"]):
                 best[key] = {"controller": u["controller"], "channel": u["channel"],
                              "design": val, "side": side, "dlc": u["dlc"],
-                             "case": u[f"{side}_case"]}
+                             "wind": u.get(f"wind_{side}"), "case": u[f"{side}_case"],
+                             "_se": u.get(f"characteristic_{side}_se"),
+                             "_cases": u.get(f"_cases_{side}", {}),
+                             "_factor": u["safety_factor"]}
     out = list(best.values())
     for b in out:
         ref = best.get((spec.reference, b["channel"]))
-        b["change_pct"] = None
+        b["change_pct"] = b["change_se_pct"] = None
         if ref is not None and ref["design"] != 0:
             v = pct_change(abs(ref["design"]), abs(b["design"]))
             b["change_pct"] = v if math.isfinite(v) else None
-    return out
+            b["change_se_pct"] = _change_se(b, ref)
+    return [{k: v for k, v in b.items() if not k.startswith("_")} for b in out]
+
+
+def _paired(row: CaseRow) -> str:
+    """The case a row ran, without its controller: the key that pairs two controllers' runs of
+    the same field and events."""
+    return row.case_id.split("__", 1)[-1]
+
+
+def _std_error(values: Any) -> float | None:
+    """The standard error of a mean, s / sqrt(n) with the sample standard deviation; None for
+    fewer than two values."""
+    v = np.asarray(list(values), float)
+    return float(np.std(v, ddof=1) / math.sqrt(v.size)) if v.size >= 2 else None
+
+
+def _change_se(b: Mapping[str, Any], ref: Mapping[str, Any]) -> float | None:
+    """Standard error of a governing load's change against the reference's, in % of the
+    reference's design load (:func:`governing_rows`)."""
+    common = sorted(set(b["_cases"]) & set(ref["_cases"]))
+    paired = ((b["dlc"], b["side"], b["wind"]) == (ref["dlc"], ref["side"], ref["wind"])
+              and len(common) >= 2 and b["_se"] is not None and ref["_se"] is not None)
+    if paired:
+        se = b["_factor"] * _std_error(abs(b["_cases"][k]) - abs(ref["_cases"][k])
+                                       for k in common)
+    elif b["_se"] is None and ref["_se"] is None:
+        return None
+    else:
+        se = math.hypot(b["_factor"] * (b["_se"] or 0.0), ref["_factor"] * (ref["_se"] or 0.0))
+    return 100.0 * se / abs(ref["design"])
 
 
 def signoff_rows(spec: CampaignSpec, rows: Sequence[CaseRow],

@@ -305,3 +305,66 @@ def test_incomplete_fatigue_bins_counted_against_the_load_cases_seeds() -> None:
     assert one.missing_seeds() == [13.0]
     two = _Group(spec, "baseline", "A", {13.0: ["s1", "s2"]}, {})
     assert two.missing_seeds() == []
+
+
+def _rows_with_extremes(spec, extremes):
+    """Finished-case rows of ``spec`` whose extremes are ``extremes[case_id][channel]`` =
+    (max, min) (the other fields as a campaign's index holds them)."""
+    from mpc_wt.campaign.store import CaseRow
+
+    out = []
+    for c in spec.cases():
+        ex = {ch: {"max": hi, "min": lo} for ch, (hi, lo) in extremes[c.case_id].items()}
+        out.append(CaseRow(c.case_id, c.controller, c.controller, c.wind_mps, c.seed, "A",
+                           c.case_hash, "", "done", f"{c.case_id}.nc", {"extremes": ex},
+                           None, None, None, None, 1, 1.0, None))
+    return out
+
+
+def test_governing_change_carries_the_seeds_standard_error() -> None:
+    """A hand-worked pair of controllers: the pitch runaway (3 seeds at 25 m/s, family N) and
+    a deterministic ECD. Side-side governed by the runaway for both: the reference's minima
+    -50, -40, -60 MN m (design 1.35 x -50 = -67.5), the other's -55, -38, -66 (design
+    -71.55): +6.0 %, and paired by seed the differences of magnitude 5, -2, 6 give
+    s = sqrt(19), a standard error 1.35 sqrt(19/3) = 3.397 MN m = 5.03 % of 67.5 (unpaired
+    it would be 19.97 %). Fore-aft: the reference governed by the ECD (no scatter), the
+    other by the runaway: its own seed mean's error alone. Shaft torque: the ECD for both:
+    no standard error."""
+    from mpc_wt.campaign.signoff import governing_rows, ultimate_rows
+
+    spec = spec_from_dict({
+        "name": "se", "duration": 20.0, "transient": 5.0,
+        "load_cases": [{"dlc": "2.1", "winds": [25.0], "seeds": 3},
+                       {"dlc": "1.4", "condition": "ecd", "winds": [11.4], "signs": [1, -1]}],
+        "controllers": ["baseline", {"name": "other", "controller": "baseline"}],
+        "channels": {"tower_base_fa_moment": 4},
+        "ultimate_channels": ["tower_base_ss_moment", "tower_base_fa_moment", "lss_torque"]})
+    ss = {"baseline": (-50e6, -40e6, -60e6), "other": (-55e6, -38e6, -66e6)}
+    fa = {"baseline": (10e6, 11e6, 12e6), "other": (50e6, 60e6, 70e6)}
+    ext = {}
+    for c in spec.cases():
+        if c.dlc == "2.1":
+            i = c.seed - 1
+            ext[c.case_id] = {"tower_base_ss_moment": (1e6, ss[c.controller][i]),
+                              "tower_base_fa_moment": (fa[c.controller][i], -1e6),
+                              "lss_torque": (1e6, -1e5)}
+        else:
+            ext[c.case_id] = {"tower_base_ss_moment": (1e6, -1e6),
+                              "tower_base_fa_moment": (40e6, -1e6),
+                              "lss_torque": (5e6, -1e5)}
+    gov = {(g["controller"], g["channel"]): g
+           for g in governing_rows(spec, ultimate_rows(spec, _rows_with_extremes(spec, ext)))}
+    g = gov[("other", "tower_base_ss_moment")]
+    assert (g["dlc"], g["side"], g["wind"]) == ("2.1", "min", 25.0)
+    assert g["design"] == pytest.approx(-71.55e6)
+    assert g["change_pct"] == pytest.approx(6.0)
+    assert g["change_se_pct"] == pytest.approx(100 * 1.35 * math.sqrt(19 / 3) / 67.5)
+    assert gov[("baseline", "tower_base_ss_moment")]["change_se_pct"] == 0.0
+    # fore-aft: 1.35 x 60 = 81 against the ECD's 1.35 x 40 = 54; the seed mean's error
+    # s / sqrt(3) = 10 / sqrt(3) MN m, times 1.35, in % of 54
+    g = gov[("other", "tower_base_fa_moment")]
+    assert (g["dlc"], gov[("baseline", "tower_base_fa_moment")]["dlc"]) == ("2.1", "1.4")
+    assert g["change_pct"] == pytest.approx(50.0)
+    assert g["change_se_pct"] == pytest.approx(100 * 1.35 * 10.0 / math.sqrt(3) / 54.0)
+    assert gov[("other", "lss_torque")]["change_se_pct"] is None
+    assert not any(k.startswith("_") for g in gov.values() for k in g)

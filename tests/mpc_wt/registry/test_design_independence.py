@@ -20,7 +20,7 @@ import linearize
 from mpc_wt.errors import CaseDataError
 from mpc_wt.registry.context import Built, DesignCache, design_digest
 from mpc_wt.registry.registry import _KINDS, register
-from mpc_wt.run import build_controller, run_controller
+from mpc_wt.run import build_controller, design_controller, run_controller
 from mpc_wt.simulation.scenario import Scenario
 
 ADVANCED = ["mpc", "mpc-lidar", "mpc-collective", "lqr-pio", "ts", "baseline+lidar-ff", "ibc",
@@ -125,3 +125,21 @@ def test_a_reused_design_runs_as_a_fresh_one(turbine: linearize.Turbine, kind: s
     assert cache.made["built"] == 2
     for ch in ("pitch_1", "gen_torque", "rotor_speed"):
         np.testing.assert_array_equal(reused.channel(ch), fresh.channel(ch))
+
+
+def test_the_design_does_not_depend_on_the_processs_blas_threads(
+        turbine: linearize.Turbine) -> None:
+    """A campaign's workers run numpy's and scipy's BLAS on one thread, the process that
+    checks the finished cases' designs on as many as it has: a multi-threaded BLAS sums in
+    another order, and before designs were made on one thread the IBC design's digest (like
+    the MPC's and LQR-PIO's) differed between the two, so a resumed campaign computed every
+    case of those kinds again. Made with the BLAS on one and on two threads, the designs are
+    the same."""
+    from threadpoolctl import threadpool_limits
+
+    digests = set()
+    for n in (1, 2):
+        with threadpool_limits(limits=n):
+            built, _ = design_controller(turbine, "ibc", cache=DesignCache())
+        digests.add(built.meta["design"]["digest"])
+    assert len(digests) == 1
