@@ -368,3 +368,26 @@ def test_governing_change_carries_the_seeds_standard_error() -> None:
     assert g["change_se_pct"] == pytest.approx(100 * 1.35 * 10.0 / math.sqrt(3) / 54.0)
     assert gov[("other", "lss_torque")]["change_se_pct"] is None
     assert not any(k.startswith("_") for g in gov.values() for k in g)
+
+
+@settings(max_examples=25, deadline=None)
+@given(st.lists(st.floats(20.0, 80.0), min_size=3, max_size=3), st.floats(-10.0, 10.0))
+def test_a_constant_paired_difference_has_no_standard_error(ref, shift) -> None:
+    """Paired by seed, a controller whose runaway extreme exceeds the reference's by the same
+    amount in every seed changes the governing load by exactly that amount (in % of the
+    reference's) with a standard error of zero, however much the seeds scatter."""
+    from mpc_wt.campaign.signoff import governing_rows, ultimate_rows
+
+    spec = spec_from_dict({
+        "name": "se", "duration": 20.0, "transient": 5.0,
+        "load_cases": [{"dlc": "2.1", "winds": [25.0], "seeds": 3}],
+        "controllers": ["baseline", {"name": "other", "controller": "baseline"}],
+        "channels": {"tower_base_ss_moment": 4}})
+    mins = {"baseline": [-1e6 * v for v in ref], "other": [-1e6 * (v + shift) for v in ref]}
+    ext = {c.case_id: {"tower_base_ss_moment": (1e5, mins[c.controller][c.seed - 1])}
+           for c in spec.cases()}
+    gov = {g["controller"]: g for g in governing_rows(
+        spec, ultimate_rows(spec, _rows_with_extremes(spec, ext)))}
+    g = gov["other"]
+    assert g["change_pct"] == pytest.approx(100.0 * shift / np.mean(ref), abs=1e-9)
+    assert g["change_se_pct"] == pytest.approx(0.0, abs=1e-9)
