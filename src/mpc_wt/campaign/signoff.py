@@ -23,6 +23,7 @@ from collections import defaultdict
 from typing import Any, Mapping, Sequence
 
 import numpy as np
+from scipy import stats
 
 from mpc_wt.assessment.performance import pct_change
 from mpc_wt.assessment.ultimate import (
@@ -124,6 +125,7 @@ def ultimate_rows(spec: CampaignSpec, rows: Sequence[CaseRow]) -> list[dict[str,
             continue
         lc = _load_case(spec, dlc)
         fam = lc.family if lc is not None and not lc.legacy else "N"
+        turbulent = lc is None or not lc.deterministic
         urows = [{"case_id": r.case_id, "dlc": dlc, "wind_mps": r.wind_mps, "seed": r.seed,
                   "extremes": r.metrics["extremes"]} for r, _ in items]
         chans = [ch for ch in (*spec.ultimate, "rotor_speed")
@@ -136,7 +138,6 @@ def ultimate_rows(spec: CampaignSpec, rows: Sequence[CaseRow]) -> list[dict[str,
                        "characteristic_max", "wind_max", "design_max", "characteristic_min",
                        "wind_min", "design_min", "safety_factor", "seeds")},
                    "cases": len(urows)}
-            turbulent = lc is None or not lc.deterministic
             for side in ("max", "min"):
                 at = {_paired(r): r.metrics["extremes"][ch][side] for r, _ in items
                       if r.wind_mps == d[f"wind_{side}"]}
@@ -211,10 +212,10 @@ def _paired(row: CaseRow) -> str:
 
 
 def _std_error(values: Any) -> float | None:
-    """The standard error of a mean, s / sqrt(n) with the sample standard deviation; None for
-    fewer than two values."""
+    """The standard error of a mean (scipy's ``sem``: s / sqrt(n)); None for fewer than two
+    values."""
     v = np.asarray(list(values), float)
-    return float(np.std(v, ddof=1) / math.sqrt(v.size)) if v.size >= 2 else None
+    return float(stats.sem(v)) if v.size >= 2 else None
 
 
 def _change_se(b: Mapping[str, Any], ref: Mapping[str, Any]) -> float | None:
