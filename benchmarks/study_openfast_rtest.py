@@ -34,7 +34,9 @@ STEPS = (("plant before (none)", {}),
          ("+ tower drag", {"tower_drag": True}),
          ("+ twisted modes", {"twisted_modes": True}),
          ("+ skewed wake", {"skewed_wake": True}),
-         ("+ unsteady aerodynamics (all on)", {"unsteady_aero": True}))
+         ("+ unsteady aerodynamics", {"unsteady_aero": True}),
+         ("+ AeroDyn 15's node integration", {"integration": "trapezoid"}),
+         ("+ deflected blades (all on)", {"deflected_blades": True}))
 #: target per statistic: (channel, statistic, bound, unit)
 TARGETS = (("flapwise_moment_1", "del_diff_pct", 10.0), ("edgewise_moment_1", "del_diff_pct", 10.0),
            ("lss_torque", "del_diff_pct", 10.0), ("tower_base_fa_moment", "del_diff_pct", 10.0),
@@ -44,9 +46,10 @@ TARGETS = (("flapwise_moment_1", "del_diff_pct", 10.0), ("edgewise_moment_1", "d
            ("rotor_speed", "std_diff_pct", 10.0))
 
 
-def _config(on: dict[str, bool], dofs: frozenset[str]) -> linearize.PlantConfig:
+def _config(on: dict[str, object], dofs: frozenset[str]) -> linearize.PlantConfig:
     base = dict(blade_body_forces=False, inplane_wind=False, tower_shadow=False,
-                tower_drag=False, twisted_modes=False, unsteady_aero=False, skewed_wake=False)
+                tower_drag=False, twisted_modes=False, unsteady_aero=False, skewed_wake=False,
+                deflected_blades=False, integration="midpoint")
     return linearize.PlantConfig(dofs, **{**base, **on})
 
 

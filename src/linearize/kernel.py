@@ -151,6 +151,7 @@ def evaluate_plant_vw(x, u, wind, ext, p, hint, mode):  # pragma: no cover - com
     mtilt = 0.0 * wr
     myaw = 0.0 * wr
     shadow = p.opt[3] != 0 and p.twr_h.size > 1
+    defl = p.opt[8] != 0
     mflap_aero = np.zeros(3, dtype=x.dtype)
     mbody = np.zeros(3, dtype=x.dtype)
     medge_aero = np.zeros(3, dtype=x.dtype)
@@ -171,6 +172,8 @@ def evaluate_plant_vw(x, u, wind, ext, p, hint, mode):  # pragma: no cover - com
         cp = np.cos(psi_i)
         qd = x[13 + i] if dof_flap else 0.0 * x[13 + i]
         ed = x[20 + i] if dof_edge else 0.0 * x[20 + i]
+        qx = x[10 + i] if dof_flap else 0.0 * x[10 + i]
+        ex = x[17 + i] if dof_edge else 0.0 * x[17 + i]
         tor_i = 0.0 * wr
         thr_i = 0.0 * wr
         mf = 0.0 * wr
@@ -196,9 +199,26 @@ def evaluate_plant_vw(x, u, wind, ext, p, hint, mode):  # pragma: no cover - com
                 ss = 0.0 * pitch[i]
             vq = qd * p.phi_flap[j]
             ve = ed * p.phi_edge[j]
-            vx = (vrel * (ct * cc + st * sc * cp) - vq * cs + ve * ss
-                  + vw[1, i, j] * (sc * ct * cp - st * cc) - vv * sc * sp)
-            vy = ((wr + roll) * rj * cc + vrel * st * sp - vhub_y * cp + ve * cs + vq * ss
+            if defl:
+                # the element's local cone, the precone less the out-of-plane bending slope,
+                # and its distance from the shaft: the out-of-plane deflection along the coned
+                # normal, less the blade's axial shortening (an inextensible blade)
+                slope = qx * p.dphi_flap[j] * cs - ex * p.dphi_edge[j] * ss
+                ccj = np.cos(p.cone - slope)
+                scj = np.sin(p.cone - slope)
+                rad = (rj * cc + (qx * p.phi_flap[j] * cs - ex * p.phi_edge[j] * ss) * sc
+                       - (qx * qx * p.ax_flap[j] + ex * ex * p.ax_edge[j]) * cc)
+                # the in-plane deflection turns with the rotor: its velocity, radially inward,
+                # has a part along the coned normal
+                v_ip = wr * (qx * p.phi_flap[j] * ss + ex * p.phi_edge[j] * cs) * scj
+            else:
+                ccj = cc + 0.0 * wr
+                scj = sc + 0.0 * wr
+                rad = rj * cc + 0.0 * wr
+                v_ip = 0.0 * wr
+            vx = (vrel * (ct * ccj + st * scj * cp) - vq * cs + ve * ss
+                  + vw[1, i, j] * (scj * ct * cp - st * ccj) - vv * scj * sp + v_ip)
+            vy = ((wr + roll) * rad + vrel * st * sp - vhub_y * cp + ve * cs + vq * ss
                   + vv * cp + vw[1, i, j] * ct * sp)
             if w_bem > 0.0:
                 npr, tpr, ph, sl, u_ind, v_ind = element_kernel(
@@ -233,8 +253,8 @@ def evaluate_plant_vw(x, u, wind, ext, p, hint, mode):  # pragma: no cover - com
                 npr, tpr = _ua_loads(npr, tpr, ph, vx - u_ind, vy + v_ind, p.twist[j] + pitch[i],
                                      i, j, p, hint, bem)
             wj = p.w[j]
-            tor_i += tpr * rj * cc * wj
-            thr_i += npr * cc * wj
+            tor_i += tpr * rad * wj
+            thr_i += npr * ccj * wj
             mf += npr * (rj - p.rhub) * wj
             me += tpr * (rj - p.rhub) * wj
             gqi += (npr * cs + tpr * ss) * p.phi_flap[j] * wj
@@ -364,16 +384,21 @@ def evaluate_plant_vw(x, u, wind, ext, p, hint, mode):  # pragma: no cover - com
             me += p.grav * p.s1 * np.sin(psi_i) * ct
         z[10 + i] = mf
         z[13 + i] = me
-    z[16] = (thrust * ct * p.zhub + mtilt + p.fa_static + p.fa_pdelta * x[0]
-             - p.fa_inertia * xdd + drag_my)
-    z[17] = m_react - fy * p.zhub - p.ss_pdelta * x[8] + p.ss_inertia * ydd - drag_mx
-    z[18] = qs
     tl = 0.0 * wr
     yw = 0.0 * wr
+    f_flap = 0.0 * wr
     for i in range(3):
         psi_i = psi + i * TWO_PI_3
         tl += np.cos(psi_i) * z[10 + i]
         yw += np.sin(psi_i) * z[10 + i]
+        f_flap += qdd[i]
+    # the tower base takes what the blade roots pass on: the thrust less the flap modes'
+    # inertia relative to the hub, int m phi q'' (the same coupling as the tower's equation),
+    # and the root moments' tilt (aerodynamic, inertial and body forces)
+    z[16] = ((thrust - p.g_b * f_flap) * ct * p.zhub + tl + p.fa_static + p.fa_pdelta * x[0]
+             - p.fa_inertia * xdd + drag_my)
+    z[17] = m_react - fy * p.zhub - p.ss_pdelta * x[8] + p.ss_inertia * ydd - drag_mx
+    z[18] = qs
     z[19] = 2.0 / 3.0 * tl
     z[20] = 2.0 / 3.0 * yw
     z[21] = psi - 2.0 * math.pi * math.floor(psi.real / (2.0 * math.pi))

@@ -3,11 +3,15 @@ controller) and compared with OpenFAST's output; the channel frames; the command
 
 Reference: OpenFAST r-test (dev, cc0bb3b, 2024-09-04) ``glue-codes/openfast/5MW_Land_DLL_WTurb``,
 its ``.outb``, and the wind regenerated with TurbSim (shared/validation/nrel5mw/openfast_rtest,
-README there). Targets over 10-60 s: DELs within 10 %, blade out-of-plane and tower fore-aft
-means within 5 %, pitch mean within 0.4 deg, rotor-speed std within 10 %.
+README there); OpenFAST v5.0.0 runs of the same case with fewer degrees of freedom
+(tests/data/openfast_v5_nrel5mw_checks.json). Targets over 10-60 s: DELs within 10 %, blade
+out-of-plane and tower fore-aft means within 5 %, pitch mean within 0.4 deg, rotor-speed std
+within 10 %.
 """
 from __future__ import annotations
 
+import dataclasses
+import json
 import math
 from pathlib import Path
 
@@ -64,32 +68,50 @@ def test_the_case_is_read_as_openfast_runs_it() -> None:
 
 
 @_NO_WIND
-def test_means_and_the_load_channels_within_the_targets(comparison) -> None:
-    """The targets the plant meets (measured on 2026-11-29: flapwise mean -1.1 %, tower
-    fore-aft mean -0.5 %, edgewise DEL +4.4 %, shaft torque DEL -0.1 %, tower side-side DEL
-    -6.6 %, power mean -0.1 %)."""
+def test_every_target_is_met_over_10_to_60_s(comparison) -> None:
+    """Every target of the comparison (measured on 2026-11-30: blade flapwise DEL +4.5 %,
+    edgewise +4.0 %, shaft torque -3.1 %, tower fore-aft +5.2 %, side-side +0.9 %; flapwise mean
+    -0.1 %, tower fore-aft mean +0.1 %; pitch mean +0.17 deg; rotor-speed std +5.1 %; power mean
+    within 0.5 %)."""
     c = comparison
+    for ch in ("flapwise_moment_1", "edgewise_moment_1", "lss_torque", "tower_base_fa_moment",
+               "tower_base_ss_moment"):
+        assert abs(c[ch]["del_diff_pct"]) <= 10.0, ch
     assert abs(c["flapwise_moment_1"]["mean_diff_pct"]) <= 5.0
     assert abs(c["tower_base_fa_moment"]["mean_diff_pct"]) <= 5.0
-    assert abs(c["edgewise_moment_1"]["del_diff_pct"]) <= 10.0
-    assert abs(c["lss_torque"]["del_diff_pct"]) <= 10.0
-    assert abs(c["tower_base_ss_moment"]["del_diff_pct"]) <= 10.0
+    assert abs(math.degrees(c["pitch_1"]["mean"] - c["pitch_1"]["mean_ref"])) <= 0.4
+    assert abs(c["rotor_speed"]["std_diff_pct"]) <= 10.0
     assert abs(c["gen_power"]["mean_diff_pct"]) <= 0.5
 
 
 @_NO_WIND
-@pytest.mark.xfail(strict=True, reason=(
-    "not reached (2026-11-29): flapwise DEL +11.8 %, tower fore-aft DEL +19.9 %, pitch mean "
-    "+0.53 deg, rotor-speed std +16.5 %; without the unsteady aerodynamics the flapwise and "
-    "fore-aft DELs are +4.6 and +14.9 % and the speed std +8.7 % but the pitch +1.09 deg. "
-    "Missing: the second flap and tower modes, the yaw DOF, AeroDyn's full UA model (vortex "
-    "lift, time-constant switching); see the docs' page on the plant against OpenFAST"))
-def test_the_remaining_targets(comparison) -> None:
-    c = comparison
-    for ch in ("flapwise_moment_1", "tower_base_fa_moment"):
-        assert abs(c[ch]["del_diff_pct"]) <= 10.0, ch
-    assert abs(math.degrees(c["pitch_1"]["mean"] - c["pitch_1"]["mean_ref"])) <= 0.4
-    assert abs(c["rotor_speed"]["std_diff_pct"]) <= 10.0
+def test_with_rigid_blades_the_plant_is_openfasts_with_rigid_blades() -> None:
+    """OpenFAST v5.0.0 run here on the same case with the plant's degrees of freedom and the
+    blades rigid (tests/data/openfast_v5_nrel5mw_checks.json, ``v_rblade``), against the plant
+    with the same: the tower, drivetrain, controller and aerodynamics alone. Measured: pitch mean
+    -0.07 deg, rotor-speed std -1.1 %, tower fore-aft DEL -1.8 %, side-side +0.4 %, shaft torque
+    +2.2 %, edgewise -0.4 %, flapwise -4.4 %; asserted: pitch within 0.15 deg, each within 5 %.
+    With flexible blades the same comparison (``v_all4``) gives tower fore-aft DEL +11.7 %,
+    flapwise +9.6 %, shaft -10.3 %, pitch +0.18 deg: what the blades' flexibility does is where
+    the plant and ElastoDyn differ (see the docs' page on the plant against OpenFAST)."""
+    runs = json.loads((Path(__file__).resolve().parents[2] / "data"
+                       / "openfast_v5_nrel5mw_checks.json").read_text())["openfast_runs"]
+    ref = runs["v_rblade"]["stats"]
+    case = read_openfast_case(FST, wind=BTS, turbine=linearize.load_turbine("nrel5mw"))
+    cfg = dataclasses.replace(case.config, dofs=case.config.dofs - {"blade_flap", "blade_edge"})
+    res = run_openfast_case(case, config=cfg)
+    names = ("pitch_1", "rotor_speed", "tower_base_fa_moment", "tower_base_ss_moment",
+             "lss_torque", "edgewise_moment_1", "flapwise_moment_1")
+    ours = {r["channel"]: r for r in compare_series(
+        res.t, {n: res.channel(n) for n in names}, res.t, {n: res.channel(n) for n in names},
+        (10.0, 60.0), channels=names)}
+    pitch = math.degrees(ours["pitch_1"]["mean"] - ref["pitch_1"]["mean"])
+    assert abs(pitch) <= 0.15, pitch
+    speed_std = ours["rotor_speed"]["std"] / ref["rotor_speed"]["std"] - 1
+    assert abs(speed_std) <= 0.05, speed_std
+    for ch in names[2:]:
+        assert abs(ours[ch]["del"] / ref[ch]["del"] - 1) <= 0.05, (ch, ours[ch]["del"],
+                                                                 ref[ch]["del"])
 
 
 def test_blade_frame_moments_by_hand() -> None:
