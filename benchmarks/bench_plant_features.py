@@ -25,6 +25,7 @@ CONFIGS = (("default plant", {}),
            ("+ twisted modes", {"twisted_modes": True}),
            ("+ unsteady aerodynamics", {"unsteady_aero": True}),
            ("+ skewed wake", {"skewed_wake": True}),
+           ("+ deflected blades", {"deflected_blades": True}),
            ("all (PlantConfig.openfast())", None))
 
 
