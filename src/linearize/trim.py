@@ -173,11 +173,32 @@ def _state(params: PlantParams, omega: float, pitch: float) -> FloatArray:
 
 def _aero(params: PlantParams, v: float, omega: float, pitch: float,
           shear: float) -> tuple[float, float]:
-    """Azimuth-averaged aerodynamic torque [N m] and thrust [N]."""
+    """Azimuth-averaged aerodynamic torque [N m] and thrust [N]; with ``deflected_blades`` at the
+    structure's static deflection under those loads (found by :func:`_displacement_step` with
+    the generator balancing the rotor: the loads then depend on the deflection, a fixed point
+    that converges in a few steps, the blades' aeroelastic stiffness being small)."""
     x = _state(params, omega, pitch)
     u = np.array([pitch, pitch, pitch, 0.0])
     _, z = rotor_average(params, x, u, v, shear)
+    if _deflection_matters(params):
+        ngear = params.turbine.drivetrain.gearbox_ratio
+        for _ in range(_DEFLECTION_STEPS):
+            u[3] = z[22] / ngear
+            if params.dof("drivetrain"):
+                x[4] = z[22] / params.pack.k_shaft
+            x, _, z = _displacement_step(params, x, u, v, omega, shear)
     return float(z[22]), float(z[23])
+
+
+#: fixed-point steps of the aerodynamic loads at the blades' own deflection
+_DEFLECTION_STEPS = 8
+
+
+def _deflection_matters(params: PlantParams) -> bool:
+    """Whether the loads depend on the blades' deflection (``deflected_blades`` with a blade
+    DOF)."""
+    return bool(params.config.deflected_blades
+                and (params.dof("blade_flap") or params.dof("blade_edge")))
 
 
 def _best_pitch(p: PlantParams, v: float, omega: float, fine: float, shear: float) -> float:
@@ -417,7 +438,8 @@ def _equilibrium(p: PlantParams, v: float, omega: float, pitch: float, tg: float
 
     The loads do not depend on displacements, so the accelerations are affine in them and
     one solve of K delta = M a is exact; a second one from the displacements found checks it
-    (and removes round-off).
+    (and removes round-off). With ``deflected_blades`` they do, and the steps are a fixed-point
+    iteration (a few more).
     """
     pk = p.pack
     x = _state(p, omega, pitch)
@@ -426,7 +448,7 @@ def _equilibrium(p: PlantParams, v: float, omega: float, pitch: float, tg: float
     if p.dof("drivetrain"):
         q, _ = _aero(p, v, omega, pitch, shear)
         x[4] = q / pk.k_shaft
-    for _ in range(8):
+    for _ in range(8 + 12 * _deflection_matters(p)):
         x, dx, z = _displacement_step(p, x, u, v, omega, shear)
         resid = _residual(dx)
         if np.all(np.isfinite(dx)) and resid.max() <= 1e-6:

@@ -1,6 +1,7 @@
 """Trim: the published NREL 5-MW operating schedule, equilibrium, power references, errors."""
 from __future__ import annotations
 
+import dataclasses
 import math
 
 import numpy as np
@@ -48,6 +49,24 @@ def test_trim_is_an_equilibrium(turbine: linearize.Turbine,
         dx = linearize.plant_rhs(0.0, op.x, op.u, np.full(3, v), params_axisym)
         # tolerance from the solvers: brentq on pitch to 1e-14 rad, BEM to 1e-13 rad
         assert np.max(np.abs(np.delete(dx, 16))) < 1e-8, (v, dx)
+
+
+def test_trim_with_deflected_blades_is_an_equilibrium(turbine: linearize.Turbine,
+                                                     params_axisym: linearize.PlantParams) -> None:
+    """With ``deflected_blades`` the loads depend on the deflection they make: the trim is a
+    fixed point, and the plant's right-hand side vanishes at it as without the switch (bound
+    1e-6, the fixed point's own tolerance; around rated the blades bend most, 4-5 m)."""
+    cfg = dataclasses.replace(params_axisym.config, deflected_blades=True)
+    params = linearize.plant_params(turbine, cfg)
+    for v in (5.0, 11.0, 11.4, 13.0, 22.0):
+        op = trim(turbine, v, config=cfg)
+        dx = linearize.plant_rhs(0.0, op.x, op.u, np.full(3, v), params)
+        assert np.max(np.abs(np.delete(dx, 16))) < 1e-6, (v, dx)
+        straight = trim(turbine, v, config=params_axisym.config)
+        # the deflection undoes the upwind precone toward the tip: less torque at a pitch, so
+        # above rated less pitch
+        if straight.region == "3":
+            assert op.pitch_rad < straight.pitch_rad
 
 
 @pytest.mark.parametrize("wind", [8.0, 18.0])
