@@ -102,7 +102,9 @@ def evaluate_plant_vw(x, u, wind, ext, p, hint, mode):  # pragma: no cover - com
     normal  u (cos t cos c + sin t sin c cos psi) + w (sin c cos t cos psi - sin t cos c)
     - v sin c sin psi, tangential (against the blade's motion) v cos psi + w cos t sin psi
     (and u sin t sin psi), with shaft tilt t, precone c and azimuth psi (Jonkman 2007,
-    NREL/TP-500-41958, the hub and blade coordinate systems; AeroDyn's relative velocity).
+    NREL/TP-500-41958, the hub and blade coordinate systems; AeroDyn's relative velocity);
+    with ``deflected_blades`` (``opt[8]``) c is each element's local cone, the precone less
+    its out-of-plane bending slope, and its distance from the shaft follows the deflection.
     """
     vw = ext[0]
     tw = ext[1]

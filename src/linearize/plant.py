@@ -39,6 +39,9 @@ Equations
 * Drivetrain (Madsen eq 11), generator power (eq 13), pitch servo (eqs 14-15), generator torque
   limits (eq 12; the rate limit acts on the held command in the stepper).
 * Coleman tilt and yaw moments (Madsen eqs 8-9) are outputs.
+* Tower base moments: what the blade roots pass on (the thrust less the flap modes' inertia
+  relative to the hub, int m phi q'', and the root moments' tilt), the tower's and the top
+  mass's inertia, P-delta, gravity and drag, about the base.
 
 References
 ----------
