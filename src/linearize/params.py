@@ -513,16 +513,7 @@ def _derive_plant_params(turbine: Turbine, cfg: PlantConfig) -> PlantParams:
         rr = np.concatenate(([g.hub_radius], b.r, [g.tip_radius]))
         weights = 0.5 * (rr[2:] - rr[:-2])
     phi_el = mode_shape(t.mode_shapes.blade_flap1, (b.r - g.hub_radius) / lb)
-    # the mode shapes' slopes at the elements [1/m] (held at the tip beyond it)
-    x_el = np.minimum((b.r - g.hub_radius) / lb, 1.0)
-    dphi_el = mode_shape(t.mode_shapes.blade_flap1, x_el, 1) / lb
-    dphi_e_el = (mode_shape(t.mode_shapes.blade_edge1, x_el, 1) / lb
-                 if t.mode_shapes.blade_edge1 is not None else np.zeros_like(b.r))
-    # the axial shortening per unit modal deflection squared, 0.5 int_0^s phi'^2 [1/m]
-    ax_fl = 0.5 * np.interp(x_el * lb, s, _cumtrapz(dphi**2, s))
-    ax_ed = (0.5 * np.interp(x_el * lb, s, _cumtrapz((mode_shape(t.mode_shapes.blade_edge1, xs, 1)
-                                                       / lb) ** 2, s))
-             if t.mode_shapes.blade_edge1 is not None else np.zeros_like(b.r))
+    dphi_el, ax_fl = _element_slopes(t, t.mode_shapes.blade_flap1, s, dphi)
     edge, edge_pack = _edge_mode(t, s, mu, tension)
     twisted = _twisted_modes(t, cfg, s, mu, phi, b.r)
     if "blade_edge" in cfg.dofs and not edge:
@@ -563,8 +554,7 @@ def _derive_plant_params(turbine: Turbine, cfg: PlantConfig) -> PlantParams:
         fa_inertia=in_fa, ss_pdelta=pd_ss, ss_inertia=in_ss, g_b=m_c,
         twr_h=twr_h, twr_r=twr_r, x_apex=-g.overhang * math.cos(g.shaft_tilt_rad), ua=ua,
         twist_s=twisted["twist_s"], sfc=twisted["sfc"], sfs=twisted["sfs"], sec=twisted["sec"],
-        ses=twisted["ses"], dphi_flap=dphi_el, dphi_edge=dphi_e_el, ax_flap=ax_fl, ax_edge=ax_ed,
-        **drag, **edge_pack)
+        ses=twisted["ses"], dphi_flap=dphi_el, ax_flap=ax_fl, **drag, **edge_pack)
     return PlantParams(
         turbine=t, config=cfg, rotor_inertia=rotor_inertia, rotor_mass=rotor_mass,
         blade_mass=blade_mass, tower_fa_modal_mass=m_fa, tower_fa_modal_stiffness=k_fa,
@@ -572,6 +562,18 @@ def _derive_plant_params(turbine: Turbine, cfg: PlantConfig) -> PlantParams:
         tower_ss_modal_damping=c_ss, blade_modal_mass=m_b, blade_modal_stiffness=k_b,
         blade_centrifugal_stiffness=k_cf, blade_modal_damping=c_b, blade_tower_coupling=m_c,
         **edge, pack=pack)
+
+
+def _element_slopes(t: Turbine, shape: FloatArray, s: FloatArray,
+                    dphi: FloatArray) -> tuple[FloatArray, FloatArray]:
+    """A blade mode's slope at the aero elements [1/m] (held at the tip beyond it) and the
+    blade's axial shortening there per unit modal deflection squared, 0.5 int_0^s phi'^2 [1/m],
+    from the slope ``dphi`` on the span grid ``s`` (``deflected_blades``)."""
+    g = t.geometry
+    lb = g.tip_radius - g.hub_radius
+    x_el = np.minimum((t.blade.r - g.hub_radius) / lb, 1.0)
+    return (mode_shape(shape, x_el, 1) / lb,
+            0.5 * np.interp(x_el * lb, s, _cumtrapz(dphi**2, s)))
 
 
 def _edge_mode(t: Turbine, s: FloatArray, mu: FloatArray,
@@ -585,7 +587,8 @@ def _edge_mode(t: Turbine, s: FloatArray, mu: FloatArray,
     b = t.blade
     if shape is None:
         zero = dict.fromkeys(("m_e", "k_e", "k_cf_e", "c_e", "s_e", "g_e"), 0.0)
-        return {}, {"phi_edge": np.zeros_like(b.r), **zero}
+        return {}, {"phi_edge": np.zeros_like(b.r), "dphi_edge": np.zeros_like(b.r),
+                    "ax_edge": np.zeros_like(b.r), **zero}
     g = t.geometry
     lb = g.tip_radius - g.hub_radius
     xs = s / lb
@@ -599,7 +602,9 @@ def _edge_mode(t: Turbine, s: FloatArray, mu: FloatArray,
     s_e = float(np.trapezoid(mu * phi * (g.hub_radius + s), s))
     public = {"edge_modal_mass": m_e, "edge_modal_stiffness": k_e,
               "edge_centrifugal_stiffness": k_cf_e, "edge_rotor_coupling": s_e}
-    kernel = {"phi_edge": mode_shape(shape, (b.r - g.hub_radius) / lb), "m_e": m_e, "k_e": k_e,
+    dphi_el, ax_el = _element_slopes(t, shape, s, dphi)
+    kernel = {"phi_edge": mode_shape(shape, (b.r - g.hub_radius) / lb), "dphi_edge": dphi_el,
+              "ax_edge": ax_el, "m_e": m_e, "k_e": k_e,
               "k_cf_e": k_cf_e, "c_e": 2.0 * t.damping.blade * math.sqrt(k_e * m_e),
               "s_e": s_e, "g_e": float(np.trapezoid(mu * phi, s))}
     return public, kernel
