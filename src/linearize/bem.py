@@ -351,10 +351,13 @@ def _solve_phi(vx, vy, r, chord, theta, k_af, table, alpha0, dalpha, nb_, rtip, 
     to ``_XTOL`` (1e-13 rad); this always converges and is what trim uses. With a hint (an
     earlier solution nearby, as in time stepping) a secant iteration starts from it with the
     slope cached at that solve, confined to (0, pi), and stops at the evaluated point whose
-    Newton correction is below ``tol`` (with ``tol <= _XTOL``, as linearization asks, that last
-    correction is applied too, which puts phi at rounding level: finite differences of a 1e7 N m
-    rotor sum then resolve 1e-7 N m); if it does not get there in 8 steps it falls back to the
-    global brackets.
+    Newton correction is below ``tol``. With ``tol <= _XTOL``, as linearization asks, that last
+    correction is applied too, which puts phi at rounding level (finite differences of a 1e7 N m
+    rotor sum then resolve 1e-7 N m). Time stepping asks ``_XTOL_WARM`` (1e-9 rad): at the
+    first point the hint is returned as it is; after a secant step the last correction is
+    taken and the factors there follow linearly from the last two points (errors of order the
+    correction times the secant's step, without a further evaluation). If it does not get
+    there in 8 steps it falls back to the global brackets.
 
     A hint in the propeller-brake region (phi < 0) is not used: Ning's procedure takes that
     region only when (0, pi/2) holds no root, and the residual jumps at phi = 0, where a secant
@@ -372,6 +375,8 @@ def _solve_phi(vx, vy, r, chord, theta, k_af, table, alpha0, dalpha, nb_, rtip, 
             if not (slope == slope) or slope == 0.0:
                 x1 = x0 + 1e-6 if x0 + 1e-6 < hi_b else x0 - 1e-6
                 slope = (_res(x1, *args) - f0) / (x1 - x0)
+            dx_prev = math.inf
+            oma_p, opa_p, cn_p, ct_p = oma, opa, cn, ct
             for _ in range(8):
                 if slope == 0.0 or not (slope == slope):
                     break
@@ -381,12 +386,22 @@ def _solve_phi(vx, vy, r, chord, theta, k_af, table, alpha0, dalpha, nb_, rtip, 
                         # tight: take the last correction too (superlinear: to rounding)
                         x0 = x0 - step
                         _, oma, opa, cn, ct = _induction(x0, *args)
+                    elif dx_prev != math.inf and lo_b < x0 - step < hi_b:
+                        # warm, after a secant step: take the last correction too, and the
+                        # factors there by linear extrapolation from the last two points
+                        # (both errors of order |step dx_prev|, no further evaluation)
+                        g = -step / dx_prev
+                        return (x0 - step, slope, oma + g * (oma - oma_p),
+                                opa + g * (opa - opa_p), cn + g * (cn - cn_p),
+                                ct + g * (ct - ct_p))
                     return x0, slope, oma, opa, cn, ct
                 x1 = x0 - step
                 if x1 <= lo_b or x1 >= hi_b:
                     break
+                oma_p, opa_p, cn_p, ct_p = oma, opa, cn, ct
                 f1, oma, opa, cn, ct = _induction(x1, *args)
                 slope = (f1 - f0) / (x1 - x0)
+                dx_prev = x1 - x0
                 x0 = x1
                 f0 = f1
     # Ning's brackets
@@ -474,9 +489,16 @@ def _element_frozen(vx, vy, chord, theta, k_af, table, alpha0, dalpha, rho, u_in
     ut = vy + v_ind
     phi = _atan2(ua, ut)
     cl, cd = _polar_lookup(table, k_af, phi - theta, alpha0, dalpha)
-    s = np.sin(phi)
-    c = np.cos(phi)
-    q = 0.5 * rho * (ua * ua + ut * ut) * chord
+    w2 = ua * ua + ut * ut
+    q = 0.5 * rho * w2 * chord
+    # sin and cos of phi = atan2(W_x, W_y) from the velocities (q = 0 where they vanish)
+    if w2.real > 0.0:
+        w = np.sqrt(w2)
+        s = ua / w
+        c = ut / w
+    else:
+        s = 0.0 * phi
+        c = 1.0 + 0.0 * phi
     return q * (cl * c + cd * s), q * (cl * s - cd * c), phi, math.nan, u_ind + 0.0 * phi, \
         v_ind + 0.0 * phi
 

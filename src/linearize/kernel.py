@@ -14,11 +14,12 @@ from linearize.bem import (
     MODE_FROZEN,
     MODE_NOLIMITS,
     element_kernel,
+    polar_lookup,
     locate_cell,
 )
 from linearize.jitcache import key_caches_on_callees
 from linearize.params import n_x
-from linearize.unsteady import HINT_ROWS_UA, UA_ROW, ua_coefficients, ua_update
+from linearize.unsteady import HINT_ROWS_UA, UA_ROW, ua_increment, ua_update
 
 _ALPHA_ROW, _W_ROW = HINT_ROWS_UA - 2, HINT_ROWS_UA - 1
 
@@ -262,6 +263,17 @@ def evaluate_plant_vw(x, u, wind, ext, p, hint, mode):  # pragma: no cover - com
             gqi += (npr * cs + tpr * ss) * p.phi_flap[j] * wj
             ge[i] += (tpr * cs - npr * ss) * p.phi_edge[j] * wj
             fy += -tpr * cp * wj
+        if p.w[nr] > 0.0:
+            npr, tpr, rad_t, cs_t, ss_t = _tip_node(i, wr, roll, vhub_x, vhub_y, nod, qd, ed,
+                                                    pitch[i], sp, cp, cc, ct, st, wind, vw, p)
+            wt = p.w[nr]
+            tor_i += tpr * rad_t * wt
+            thr_i += npr * cc * wt
+            mf += npr * (p.rtip - p.rhub) * wt
+            me += tpr * (p.rtip - p.rhub) * wt
+            gqi += (npr * cs_t + tpr * ss_t) * p.w[nr + 1] * wt
+            ge[i] += (tpr * cs_t - npr * ss_t) * p.w[nr + 2] * wt
+            fy += -tpr * cp * wt
         if p.opt[1]:
             # the blade's own forces normal to it (precone centrifugal, gravity along the
             # tilted shaft and across the coned blade), on the flap mode and the root moment
@@ -416,6 +428,33 @@ def evaluate_plant_vw(x, u, wind, ext, p, hint, mode):  # pragma: no cover - com
     return dx, z, bem
 
 
+@nb.njit(**_JIT)
+def _tip_node(i, wr, roll, vhub_x, vhub_y, nod, qd, ed, pitch, sp, cp, cc, ct, st, wind, vw,
+              p):  # pragma: no cover - compiled
+    """Line loads (N', T') [N/m] at blade i's tip node as AeroDyn 15 has them with the tip
+    loss on (its BEMT's ``FixedInductions``: where the Prandtl factor's constant vanishes the
+    inductions are a = 1, a' = 0): the inflow lies in the rotor plane, phi = 0, alpha =
+    -(pitch + twist), W = V_y, so N' = q C_l, T' = -q C_d with q = rho W^2 c / 2. The tip
+    node has the last element's chord, twist, airfoil and free wind, its weight and the flap
+    and edge modes' values there follow the elements' weights in ``p.w``; also returned: its
+    distance from the shaft and the cosine and sine of its structural twist with the
+    pitch."""
+    jt = p.r.size - 1
+    if p.opt[5]:
+        cs = np.cos(pitch + p.twist_s[jt])
+        ss = np.sin(pitch + p.twist_s[jt])
+    else:
+        cs = 1.0 + 0.0 * pitch
+        ss = 0.0 * pitch
+    rad = p.rtip * cc + 0.0 * wr
+    vrel = wind[i, jt] - vhub_x - nod * p.rtip * cc * cp
+    vy = ((wr + roll) * rad + vrel * st * sp - vhub_y * cp + ed * p.w[jt + 3] * cs
+          + qd * p.w[jt + 2] * ss + vw[0, i, jt] * cp + vw[1, i, jt] * ct * sp)
+    cl, cd = polar_lookup(p.table, p.af[jt], -(p.twist[jt] + pitch), p.alpha0, p.dalpha)
+    q = 0.5 * p.rho * vy * vy * p.chord[jt]
+    return q * cl, -q * cd, rad, cs, ss
+
+
 #: Pitt and Peters' skewed-wake factor, 15 pi / 32 (AeroDyn's default ``SkewRedistrFactor``)
 SKEW_FACTOR = 15.0 * math.pi / 32.0
 
@@ -496,23 +535,23 @@ def sample_tower(t, p, kind, wpar, grid):  # pragma: no cover - compiled
 
 @nb.njit(**_JIT)
 def _ua_loads(npr, tpr, phi, ua, ut, theta, i, j, p, hint, bem):  # pragma: no cover - compiled
-    """Element (i, j)'s loads with the unsteady airfoil coefficients
-    (:func:`linearize.unsteady.ua_coefficients`) in place of the static ones: the BEM's
-    inflow angle and induction stay (AeroDyn's coupling), the lift and drag follow the states.
+    """Element (i, j)'s loads with the unsteady airfoil coefficients in place of the static
+    ones: the BEM's inflow angle and induction stay (AeroDyn's coupling), the lift and drag
+    follow the states. The static loads ``npr``, ``tpr`` are q (C_l cos phi + C_d sin phi),
+    q (C_l sin phi - C_d cos phi) at this phi and W, so the model's increment
+    (:func:`linearize.unsteady.ua_increment`) is added to them without a second polar lookup.
     Leaves the element's alpha and W in ``bem`` for the step's state update."""
-    w = math.sqrt(ua.real * ua.real + ut.real * ut.real)
-    alpha = phi.real - theta.real
-    bem[_ALPHA_ROW, i, j] = alpha
-    bem[_W_ROW, i, j] = w
-    k = p.af[j]
-    cl, cd, valid = ua_coefficients(alpha, w, p.chord[j], hint, i, j, p.ua[k], p.table, k,
-                                    p.alpha0, p.dalpha)
-    if not valid:
+    w2 = ua.real * ua.real + ut.real * ut.real
+    bem[_ALPHA_ROW, i, j] = phi.real - theta.real
+    bem[_W_ROW, i, j] = math.sqrt(w2)
+    dcl, dcd, valid = ua_increment(hint, i, j)
+    if not valid or w2 <= 0.0:
         return npr, tpr
-    q = 0.5 * p.rho * w * w * p.chord[j]
-    s = np.sin(phi)
-    c = np.cos(phi)
-    return q * (cl * c + cd * s) + 0.0 * npr, q * (cl * s - cd * c) + 0.0 * tpr
+    w = math.sqrt(w2)
+    q = 0.5 * p.rho * w2 * p.chord[j]
+    s = ua.real / w         # sin and cos of the inflow angle
+    c = ut.real / w
+    return npr + q * (dcl * c + dcd * s), tpr + q * (dcl * s - dcd * c)
 
 
 @nb.njit(**_JIT)

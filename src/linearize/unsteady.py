@@ -45,7 +45,7 @@ import numpy as np
 from linearize.bem import polar_lookup
 from linearize.jitcache import key_caches_on_callees
 
-__all__ = ["UA_ROW", "N_UA", "HINT_ROWS_UA", "UA_PAR", "ua_coefficients", "ua_update",
+__all__ = ["UA_ROW", "N_UA", "HINT_ROWS_UA", "UA_PAR", "ua_increment", "ua_update",
            "ua_steady"]
 
 #: first ``hint`` row of the UA states
@@ -68,19 +68,15 @@ _JIT = dict(cache=True, error_model="numpy")
 
 
 @nb.njit(**_JIT)
-def _static_cn_cc(table, k, alpha, a0, dalpha, cd0):  # pragma: no cover - compiled
-    cl, cd = polar_lookup(table, k, alpha, a0, dalpha)
-    s, c = math.sin(alpha), math.cos(alpha)
-    return cl * c + (cd - cd0) * s, cl * s - (cd - cd0) * c
-
-
-@nb.njit(**_JIT)
 def _separation(table, k, alpha, par, cna, a0, dalpha):  # pragma: no cover - compiled
     """From one lookup of the static polar at alpha: the separation point f' of the normal
     force (inverse Kirchhoff, eq 1.32a) with the attached-flow slope ``cna``, the fully
     separated normal force C_n,fs there, and the separation point f'_c of the chordwise force
     (eq 1.32b, Gonzalez offset)."""
-    cn, cc = _static_cn_cc(table, k, alpha, a0, dalpha, par[3])
+    cl, cd = polar_lookup(table, k, alpha, a0, dalpha)
+    s, c = math.sin(alpha), math.cos(alpha)
+    cn = cl * c + (cd - par[3]) * s
+    cc = cl * s - (cd - par[3]) * c
     lin = cna * (alpha - par[1])
     x = 0.0
     if lin != 0.0 and cn != 0.0:
@@ -94,18 +90,19 @@ def _separation(table, k, alpha, par, cna, a0, dalpha):  # pragma: no cover - co
     else:
         cn_fs = (cn - lin * f) / (1.0 - f)
     limit = (1.0 + _GONZALEZ) ** 2
-    den = lin * math.tan(alpha)
     fc = limit
-    if den != 0.0:
-        fc = min((cc / den + _GONZALEZ) ** 2, limit)
+    if lin * s != 0.0:
+        # cc / (lin tan(alpha))
+        fc = min((cc * c / (lin * s) + _GONZALEZ) ** 2, limit)
     return f, cn_fs, fc
 
 
 @nb.njit(**_JIT)
-def _chain(alpha, w, chord, dt, par, st, table, k, a0, dalpha):  # pragma: no cover - compiled
+def _chain(alpha, w, chord, dt, par, st, new, table, k, a0, dalpha):  # pragma: no cover
     """One step of the model from the states ``st`` (N_UA,) of the previous step: the
-    coefficients (C_l, C_d) at the current alpha [rad] and relative speed w [m/s], and the new
-    states (written into a fresh array)."""
+    coefficients (C_l, C_d) at the current alpha [rad] and relative speed w [m/s]; the new
+    states are written into ``new`` (N_UA,), which may be ``st`` itself (no allocation in the
+    plant's step)."""
     w = max(w, 1e-3)
     mach = min(w / par[12], 0.7)
     beta2 = 1.0 - mach * mach
@@ -124,23 +121,24 @@ def _chain(alpha, w, chord, dt, par, st, table, k, a0, dalpha):  # pragma: no co
     k_alpha = 1.0 / ((1.0 - mach) + 0.5 * par[2] * mach * mach * beta
                      * (par[4] * par[6] + par[5] * par[7]))
     t_alpha = 0.75 * k_alpha * chord / par[12]
-    et = math.exp(-dt / t_alpha)
-    kp_alpha = st[11] * et + (ka_f - st[9]) * math.sqrt(et)
+    het = math.exp(-0.5 * dt / t_alpha)     # sqrt of the decay, squared below
+    et = het * het
+    kp_alpha = st[11] * et + (ka_f - st[9]) * het
     cn_nc = 4.0 * t_alpha * (ka_f - kp_alpha) / mach
     # circulatory, Wagner (eqs 1.13-1.15)
-    e1, e2 = math.exp(-par[6] * ds * beta2), math.exp(-par[7] * ds * beta2)
-    x1 = st[1] * e1 + par[4] * da * math.sqrt(e1)
-    x2 = st[2] * e2 + par[5] * da * math.sqrt(e2)
+    he1, he2 = math.exp(-0.5 * par[6] * ds * beta2), math.exp(-0.5 * par[7] * ds * beta2)
+    x1 = st[1] * he1 * he1 + par[4] * da * he1
+    x2 = st[2] * he2 * he2 + par[5] * da * he2
     a_e = a_filt - par[1] - x1 - x2
     cn_circ = cna * a_e
     cn_pot = cn_circ + cn_nc
-    ep = math.exp(-ds / par[8])
-    dp = st[4] * ep + (cn_pot - st[3]) * math.sqrt(ep)
+    hep = math.exp(-0.5 * ds / par[8])
+    dp = st[4] * hep * hep + (cn_pot - st[3]) * hep
     a_f = (cn_pot - dp) / cna + par[1]
     fp, _, fpc = _separation(table, k, a_f, par, cna, a0, dalpha)
-    ef = math.exp(-ds / par[9])
-    df = st[6] * ef + (fp - st[5]) * math.sqrt(ef)
-    dfc = st[8] * ef + (fpc - st[7]) * math.sqrt(ef)
+    hef = math.exp(-0.5 * ds / par[9])
+    df = st[6] * hef * hef + (fp - st[5]) * hef
+    dfc = st[8] * hef * hef + (fpc - st[7]) * hef
     f2 = min(max(fp - df, 0.0), 1.0)
     f2c = min(max(fpc - dfc, 0.0), (1.0 + _GONZALEZ) ** 2)
     _, cn_fs, _ = _separation(table, k, a_e + par[1], par, cna, a0, dalpha)
@@ -149,7 +147,6 @@ def _chain(alpha, w, chord, dt, par, st, table, k, a0, dalpha):  # pragma: no co
     s, c = math.sin(alpha), math.cos(alpha)
     cl = cn * c + cc * s
     cd = cn * s - cc * c + par[3]
-    new = np.empty(N_UA)
     new[0] = a_filt
     new[1] = x1
     new[2] = x2
@@ -162,7 +159,7 @@ def _chain(alpha, w, chord, dt, par, st, table, k, a0, dalpha):  # pragma: no co
     new[9] = ka_f
     new[10] = q_f
     new[11] = kp_alpha
-    return cl, cd, new
+    return cl, cd
 
 
 @nb.njit(**_JIT)
@@ -191,15 +188,15 @@ def _initial(alpha, w, par, table, k, a0, dalpha):  # pragma: no cover - compile
 
 
 @nb.njit(**_JIT)
-def ua_coefficients(alpha, w, chord, hint, i, j, par, table, k, a0, dalpha):  # pragma: no cover
-    """(C_l, C_d, valid) of element (i, j) at alpha [rad]: the static polar's plus the model's
-    difference from it at the last update (held over the step, as the model's states are: the
-    model runs once per element and step, in :func:`ua_update`); ``valid`` False (and the
-    static coefficients) before the first update."""
-    cl, cd = polar_lookup(table, k, alpha, a0, dalpha)
+def ua_increment(hint, i, j):  # pragma: no cover - compiled
+    """(dC_l, dC_d, valid) of element (i, j): the model's lift and drag less the static
+    polar's at the last update, held over the step as the model's states are (the model runs
+    once per element and step, in :func:`ua_update`); the element's unsteady coefficients
+    are the static polar's at its current alpha plus these. ``valid`` False (and zeros)
+    before the first update."""
     if hint[UA_ROW, i, j] != hint[UA_ROW, i, j]:
-        return cl, cd, False
-    return cl + hint[_DCL, i, j], cd + hint[_DCD, i, j], True
+        return 0.0, 0.0, False
+    return hint[_DCL, i, j], hint[_DCD, i, j], True
 
 
 @nb.njit(**_JIT)
@@ -215,18 +212,17 @@ def ua_update(hint, p):  # pragma: no cover - compiled
             alpha = hint[_ALPHA, i, j]
             if par[0] == 0.0 or alpha != alpha:
                 continue
+            new = hint[UA_ROW:UA_ROW + N_UA, i, j]
             if hint[UA_ROW, i, j] != hint[UA_ROW, i, j]:
                 st = _initial(alpha, hint[_W, i, j], par, p.table, k, p.alpha0, p.dalpha)
             else:
-                st = hint[UA_ROW:UA_ROW + N_UA, i, j]
-            cl, cd, st = _chain(alpha, hint[_W, i, j], p.chord[j], hint[_DT, i, j], par, st,
-                                p.table, k, p.alpha0, p.dalpha)
+                st = new
+            cl, cd = _chain(alpha, hint[_W, i, j], p.chord[j], hint[_DT, i, j], par, st, new,
+                            p.table, k, p.alpha0, p.dalpha)
             cl, cd = _blend(alpha, cl, cd, par, p.table, k, p.alpha0, p.dalpha)
             cls, cds = polar_lookup(p.table, k, alpha, p.alpha0, p.dalpha)
             hint[_DCL, i, j] = cl - cls
             hint[_DCD, i, j] = cd - cds
-            for s in range(N_UA):
-                hint[UA_ROW + s, i, j] = st[s]
 
 
 @nb.njit(**_JIT)
@@ -234,7 +230,7 @@ def ua_steady(alpha, w, par, table, k, a0, dalpha):  # pragma: no cover - compil
     """The model's steady-flow coefficients (C_l, C_d) at alpha [rad] and relative speed w
     [m/s]: its fixed point."""
     st = _initial(alpha, w, par, table, k, a0, dalpha)
-    cl, cd, _ = _chain(alpha, w, 1.0, 0.01, par, st, table, k, a0, dalpha)
+    cl, cd = _chain(alpha, w, 1.0, 0.01, par, st, st, table, k, a0, dalpha)
     return _blend(alpha, cl, cd, par, table, k, a0, dalpha)
 
 

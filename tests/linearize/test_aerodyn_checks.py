@@ -53,9 +53,12 @@ def test_rigid_rotor_torque_and_thrust_are_aerodyn_15s(turbine, row) -> None:
     """A rigid rotor held at speed and pitch in steady wind, AeroDyn 15's options as the case runs
     them (BEM with tip and hub losses, tangential induction, tower potential flow, skew
     correction; UA_Mod 3 and without it) and AeroDyn 15's integration of its nodes' line loads
-    (``PlantConfig.openfast``): torque within 0.6 %, thrust within 2.5 % (measured: torque
-    -0.4 to -0.1 %, thrust -1.1 to +2.3 %, largest at 14 deg pitch); the unsteady model's steady
-    loss of torque (AeroDyn: 3.8-5.9 %) within 0.3 points."""
+    (``PlantConfig.openfast``, AeroDyn's tip node included: its inductions fixed at a = 1,
+    a' = 0, as AeroDyn's node outputs show): torque within 1.0 %, thrust within 1.2 %
+    (measured on 2026-11-30: torque -0.92 to -0.37 %, thrust -1.01 to -0.38 %, largest at
+    18 m/s, 14 deg; without the tip node's load the torque was -0.51 to -0.28 %, its drag
+    missing, and the thrust -1.2 to +2.3 %); the unsteady model's steady loss of torque
+    (AeroDyn: 3.8-5.9 %) within 0.3 points."""
     base = PlantConfig.openfast(dofs=frozenset())
     out = {}
     for ua in (False, True):
@@ -64,8 +67,8 @@ def test_rigid_rotor_torque_and_thrust_are_aerodyn_15s(turbine, row) -> None:
                             row["pitch_deg"])
         tag = "ua3" if ua else "ua0"
         q_ref, f_ref = row[f"torque_kNm_{tag}"], row[f"thrust_kN_{tag}"]
-        assert abs(q / q_ref - 1) <= 0.006, (tag, q, q_ref)
-        assert abs(f / f_ref - 1) <= 0.025, (tag, f, f_ref)
+        assert abs(q / q_ref - 1) <= 0.010, (tag, q, q_ref)
+        assert abs(f / f_ref - 1) <= 0.012, (tag, f, f_ref)
         out[tag] = q
     loss, loss_ref = (1 - out["ua3"] / out["ua0"],
                       1 - row["torque_kNm_ua3"] / row["torque_kNm_ua0"])

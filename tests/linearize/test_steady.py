@@ -116,9 +116,10 @@ def test_cp_ct_surface_reproduces_rosco_table(turbine, rosco_nrel5mw) -> None:
     0.003 for both (measured 0.0015 and 0.0011).
 
     With the plant's own 17 AeroDyn-v13 elements and the raw polars the same grid differs by
-    up to 0.0135 in C_P (pitch 3-6 deg at TSR 8-12: the smoothed C_l near zero lift) and 0.048
-    in C_T (TSR > 8: CCBlade's node at 62.9999 m carries load the element layout does not), which
-    the last assertion pins so that a change of either is seen."""
+    up to 0.0152 in C_P (pitch 3-6 deg at TSR 8-12: the smoothed C_l near zero lift) and 0.026
+    in C_T (TSR 12, pitch -1 deg: CCBlade's node at 62.9999 m carries a tip load unlike the
+    one AeroDyn 15's fixed-induction tip node carries; 0.048 without that tip node), which the
+    last assertion pins so that a change of either is seen."""
     pitch, tsr, cp_ref, ct_ref = rosco_nrel5mw
     rows = (tsr >= 3.0) & (tsr <= 12.0)
     cols = (pitch >= -2.0) & (pitch <= 20.0)
@@ -132,7 +133,7 @@ def test_cp_ct_surface_reproduces_rosco_table(turbine, rosco_nrel5mw) -> None:
     cp0, ct0 = linearize.steady_coefficients(turbine, lam, beta, shear_exponent=0.2,
                                              integration="trapezoid")
     assert 0.010 < np.max(np.abs(cp0 - cp_r)[on]) < 0.016
-    assert 0.040 < np.max(np.abs(ct0 - ct_r)[on]) < 0.055
+    assert 0.020 < np.max(np.abs(ct0 - ct_r)[on]) < 0.032
 
 
 def test_cp_ct_whole_grid_rms_and_max(turbine, rosco_nrel5mw) -> None:

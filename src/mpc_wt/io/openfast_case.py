@@ -260,10 +260,13 @@ def aeromap_comparison(outb: str | Path, turbine: linearize.Turbine,
                        config: linearize.PlantConfig | None = None) -> list[dict[str, float]]:
     """An OpenFAST AeroMap's blade-root moments beside the plant's steady ones at its points.
 
-    OpenFAST's AeroMap solves the steady state of the elastic rotor at given rotor speed, wind
-    (or tip-speed ratio) and pitch, without gravity. The plant is put at each point's operating
-    point (:func:`linearize.operating_point`, structure in equilibrium), blade 1 up; points the
-    plant cannot hold (the generator torque out of range) are left out.
+    OpenFAST's AeroMap solves the static equilibrium of the elastic rotor held at azimuth 0
+    (blade 1 up) at given rotor speed, wind (or tip-speed ratio) and pitch, without gravity:
+    each blade deflects under its own loads at its azimuth. The plant is put at each point's
+    operating point (:func:`linearize.operating_point`), turned to azimuth 0, and its tower,
+    flap and edge modes are brought to the same static equilibrium there (Newton's method on
+    their accelerations); points the plant cannot hold (the generator torque out of range)
+    are left out.
 
     Parameters
     ----------
@@ -272,20 +275,27 @@ def aeromap_comparison(outb: str | Path, turbine: linearize.Turbine,
         ``RootMyb1``, ``RootMxb1`` in deg, -, m/s, rpm, kN m).
     turbine : linearize.Turbine
     config : linearize.PlantConfig, optional
-        Default: the blade body forces and twisted modes on, gravity off (the AeroMap's).
+        Default: AeroDyn 15's load integration, the blade body forces and twisted modes on,
+        gravity off (the AeroMap's).
 
     Returns
     -------
     list of dict
         Per point: ``pitch_deg``, ``tsr``, ``flapwise_of_kNm``, ``flapwise_kNm``,
         ``edgewise_of_kNm``, ``edgewise_kNm``.
+
+    Raises
+    ------
+    linearize.TrimError
+        If the modes' equilibrium at a point is not found.
     """
     from mpc_wt.io.openfast_output import read_openfast_output
 
     of = read_openfast_output(outb)
     d = {n: of.data[:, i] for i, n in enumerate(of.names)}
     cfg = config or linearize.PlantConfig(aero=linearize.AeroOptions(gravity=False),
-                                          blade_body_forces=True, twisted_modes=True)
+                                          blade_body_forces=True, twisted_modes=True,
+                                          integration="trapezoid")
     params = linearize.plant_params(turbine, cfg)
     iz = {n: i for i, n in enumerate(linearize.OUTPUT_NAMES)}
     rows = []
@@ -296,10 +306,8 @@ def aeromap_comparison(outb: str | Path, turbine: linearize.Turbine,
                                            math.radians(pitch), config=cfg)
         except linearize.TrimError:
             continue
-        x = op.x.copy()
-        x[16] = 0.0
-        z = linearize.PlantStepper(params, linearize.SteadyWind(wind), 0.0125,
-                                   1.0).outputs(0.0, x, op.u)
+        x = _static_modes_at_azimuth(params, op.x, op.u, wind, 0.0)
+        z = linearize.plant_outputs(0.0, x, op.u, np.full(3, wind), params)
         args = (z[iz["pitch_1"]], z[iz["flap_moment_1"]], z[iz["edge_moment_1"]])
         rows.append({"pitch_deg": float(pitch), "tsr": float(d["TSR"][k]),
                      "flapwise_of_kNm": float(d["RootMyb1"][k]),
@@ -307,3 +315,45 @@ def aeromap_comparison(outb: str | Path, turbine: linearize.Turbine,
                      "edgewise_of_kNm": float(d["RootMxb1"][k]),
                      "edgewise_kNm": float(blade_frame_moment("edgewise_moment_1", *args)) / 1e3})
     return rows
+
+
+#: the structural modes of a static equilibrium: (displacement, velocity) state indices of the
+#: tower fore-aft and side-side modes and each blade's flap and edge modes
+_MODE_STATES = ((0, 1), (8, 9), (10, 13), (11, 14), (12, 15), (17, 20), (18, 21), (19, 22))
+
+
+def _static_modes_at_azimuth(params: linearize.PlantParams, x0: np.ndarray, u: np.ndarray,
+                             wind: float, azimuth: float) -> np.ndarray:
+    """The state ``x0`` turned to ``azimuth`` [rad] with the enabled tower, flap and edge modes
+    in static equilibrium there (their accelerations zero, rates zero) in a steady uniform
+    ``wind`` [m/s]: Newton's method with a finite-difference Jacobian."""
+    on = set(params.config.active_states())
+    names = linearize.STATE_NAMES
+    pairs = [(i, j) for i, j in _MODE_STATES if names[i] in on]
+    x = np.asarray(x0, dtype=float).copy()
+    x[16] = azimuth
+    if not pairs:
+        return x
+    pos = [i for i, _ in pairs]
+    acc = [j for _, j in pairs]
+    x[acc] = 0.0
+    d = np.full(3, wind)
+
+    def accel(xx: np.ndarray) -> np.ndarray:
+        return linearize.plant_rhs(0.0, xx, u, d, params)[acc]
+
+    for _ in range(20):
+        f = accel(x)
+        jac = np.empty((len(pos), len(pos)))
+        for c, i in enumerate(pos):
+            h = 1e-6 * max(1.0, abs(x[i]))
+            xp = x.copy()
+            xp[i] += h
+            jac[:, c] = (accel(xp) - f) / h
+        step = np.linalg.solve(jac, f)
+        x[pos] -= step
+        if np.max(np.abs(step)) < 1e-10:
+            return x
+    raise linearize.TrimError(f"the modes' static equilibrium at azimuth {azimuth:g} rad in "
+                              f"{wind:g} m/s did not converge (last step "
+                              f"{np.max(np.abs(step)):.2e})")

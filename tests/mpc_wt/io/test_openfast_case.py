@@ -70,9 +70,9 @@ def test_the_case_is_read_as_openfast_runs_it() -> None:
 
 @_NO_WIND
 def test_every_target_is_met_over_10_to_60_s(comparison) -> None:
-    """Every target of the comparison (measured on 2026-11-30: blade flapwise DEL +4.5 %,
-    edgewise +4.0 %, shaft torque -3.1 %, tower fore-aft +5.2 %, side-side +0.9 %; flapwise mean
-    -0.1 %, tower fore-aft mean +0.1 %; pitch mean +0.17 deg; rotor-speed std +5.1 %; power mean
+    """Every target of the comparison (measured on 2026-11-30: blade flapwise DEL +7.3 %,
+    edgewise +4.0 %, shaft torque -2.1 %, tower fore-aft +7.7 %, side-side -0.2 %; flapwise mean
+    -0.2 %, tower fore-aft mean +0.1 %; pitch mean +0.16 deg; rotor-speed std +6.7 %; power mean
     within 0.5 %)."""
     c = comparison
     for ch in ("flapwise_moment_1", "edgewise_moment_1", "lss_torque", "tower_base_fa_moment",
@@ -145,23 +145,22 @@ def test_compare_openfast_command_names_what_is_missing(capsys, tmp_path) -> Non
 
 
 @pytest.mark.skipif(not AEROMAP.is_file(), reason="the regression case's AeroMap is absent")
-def test_aeromap_root_moments_within_five_percent() -> None:
+def test_aeromap_root_moments_within_three_percent() -> None:
     """OpenFAST's AeroMap of the case (r-test ``5MW_Land_AeroMap``: 8 rpm, TSR 3-15.5, pitch
-    0-25 deg, elastic blades, no gravity in its steady solution) against the plant's steady state
-    at the same points with the blade body forces, twisted modes and gravity off: the flapwise
-    root moment within 5 % where it is above 1 MN m, the edgewise within 5 % where it is above
-    100 kN m but at pitch 10 deg, TSR 5.5 (109 against 122 kN m, 11 %)."""
-    rows = aeromap_comparison(AEROMAP,
-                              linearize.load_turbine("nrel5mw"))
+    0-25 deg, elastic blades held at azimuth 0, no gravity) against the plant with AeroDyn 15's
+    integration (its tip node included), the blade body forces and twisted modes, its modes in
+    static equilibrium at azimuth 0: the flapwise and edgewise root moments (blade frame)
+    within 3 % at every point where OpenFAST's is above 50 kN m (the issue's bound 5 %;
+    measured on 2026-11-30: flapwise -2.0 to +0.5 %, edgewise -2.5 to +0.3 %)."""
+    rows = aeromap_comparison(AEROMAP, linearize.load_turbine("nrel5mw"))
     checked = 0
     for r in rows:
-        if abs(r["flapwise_of_kNm"]) > 1000:
-            assert abs(r["flapwise_kNm"] / r["flapwise_of_kNm"] - 1) <= 0.05, r
-            checked += 1
-        if abs(r["edgewise_of_kNm"]) > 100:
-            bound = 0.11 if (round(r["pitch_deg"]), round(r["tsr"], 1)) == (10, 5.5) else 0.05
-            assert abs(r["edgewise_kNm"] / r["edgewise_of_kNm"] - 1) <= bound, r
-    assert checked >= 10
+        for kind in ("flapwise", "edgewise"):
+            ref = r[f"{kind}_of_kNm"]
+            if abs(ref) > 50.0:
+                assert abs(r[f"{kind}_kNm"] / ref - 1) <= 0.03, (kind, r)
+                checked += 1
+    assert checked >= 20
 
 
 def test_a_rosco_deck_in_steady_wind_runs_with_rosco_and_lands_on_openfasts_curve() -> None:
