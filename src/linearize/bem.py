@@ -42,7 +42,7 @@ __all__ = ["AeroOptions", "PolarTable", "build_polar_table", "element_induction"
 _PI = math.pi
 _EPS_PHI = 1e-6          # Ning's epsilon: bracket ends stay clear of the phi = 0 singularity
 _XTOL = 1e-13            # absolute tolerance on phi, cold solves [rad]
-_XTOL_WARM = 1e-9        # Newton correction at which a warm-started solve stops [rad]
+_XTOL_WARM = 1e-7        # Newton correction at which a warm-started solve stops [rad]
 _N_ALPHA = 1441          # polar grid: 0.25 deg from -180 to 180 deg
 
 
@@ -353,11 +353,11 @@ def _solve_phi(vx, vy, r, chord, theta, k_af, table, alpha0, dalpha, nb_, rtip, 
     slope cached at that solve, confined to (0, pi), and stops at the evaluated point whose
     Newton correction is below ``tol``. With ``tol <= _XTOL``, as linearization asks, that last
     correction is applied too, which puts phi at rounding level (finite differences of a 1e7 N m
-    rotor sum then resolve 1e-7 N m). Time stepping asks ``_XTOL_WARM`` (1e-9 rad): at the
-    first point the hint is returned as it is; after a secant step the last correction is
-    taken and the factors there follow linearly from the last two points (errors of order the
-    correction times the secant's step, without a further evaluation). If it does not get
-    there in 8 steps it falls back to the global brackets.
+    rotor sum then resolve 1e-7 N m). Time stepping asks ``_XTOL_WARM`` (1e-7 rad, a relative
+    load error of about 1e-6): at the first point the hint is returned as it is; after a
+    secant step the last correction is taken and the factors there follow linearly from the
+    last two points (errors of order the correction times the secant's step, without a further
+    evaluation). If it does not get there in 8 steps it falls back to the global brackets.
 
     A hint in the propeller-brake region (phi < 0) is not used: Ning's procedure takes that
     region only when (0, pi/2) holds no root, and the residual jumps at phi = 0, where a secant
@@ -365,16 +365,15 @@ def _solve_phi(vx, vy, r, chord, theta, k_af, table, alpha0, dalpha, nb_, rtip, 
     a hint once kept a tip element at phi = -3e-5 while the root had come back to 0.106 rad, and
     the next step's loads threw the edgewise rates to 200 m/s (a campaign case that diverged).
     """
-    args = (vx, vy, r, chord, theta, k_af, table, alpha0, dalpha, nb_, rtip, rhub, flags)
     if hint == hint and hint > 0.0:  # not NaN, not in the propeller-brake region
         lo_b, hi_b = _EPS_PHI, _PI - _EPS_PHI
         if lo_b < hint < hi_b:
             x0 = hint
-            f0, oma, opa, cn, ct = _induction(x0, *args)
+            f0, oma, opa, cn, ct = _induction(x0, vx, vy, r, chord, theta, k_af, table, alpha0, dalpha, nb_, rtip, rhub, flags)
             slope = hint_slope
             if not (slope == slope) or slope == 0.0:
                 x1 = x0 + 1e-6 if x0 + 1e-6 < hi_b else x0 - 1e-6
-                slope = (_res(x1, *args) - f0) / (x1 - x0)
+                slope = (_res(x1, vx, vy, r, chord, theta, k_af, table, alpha0, dalpha, nb_, rtip, rhub, flags) - f0) / (x1 - x0)
             dx_prev = math.inf
             oma_p, opa_p, cn_p, ct_p = oma, opa, cn, ct
             for _ in range(8):
@@ -385,7 +384,7 @@ def _solve_phi(vx, vy, r, chord, theta, k_af, table, alpha0, dalpha, nb_, rtip, 
                     if tol <= _XTOL and step != 0.0 and lo_b < x0 - step < hi_b:
                         # tight: take the last correction too (superlinear: to rounding)
                         x0 = x0 - step
-                        _, oma, opa, cn, ct = _induction(x0, *args)
+                        _, oma, opa, cn, ct = _induction(x0, vx, vy, r, chord, theta, k_af, table, alpha0, dalpha, nb_, rtip, rhub, flags)
                     elif dx_prev != math.inf and lo_b < x0 - step < hi_b:
                         # warm, after a secant step: take the last correction too, and the
                         # factors there by linear extrapolation from the last two points
@@ -399,7 +398,7 @@ def _solve_phi(vx, vy, r, chord, theta, k_af, table, alpha0, dalpha, nb_, rtip, 
                 if x1 <= lo_b or x1 >= hi_b:
                     break
                 oma_p, opa_p, cn_p, ct_p = oma, opa, cn, ct
-                f1, oma, opa, cn, ct = _induction(x1, *args)
+                f1, oma, opa, cn, ct = _induction(x1, vx, vy, r, chord, theta, k_af, table, alpha0, dalpha, nb_, rtip, rhub, flags)
                 slope = (f1 - f0) / (x1 - x0)
                 dx_prev = x1 - x0
                 x0 = x1
@@ -407,24 +406,24 @@ def _solve_phi(vx, vy, r, chord, theta, k_af, table, alpha0, dalpha, nb_, rtip, 
     # Ning's brackets
     lo = _EPS_PHI
     hi = 0.5 * _PI
-    flo = _res(lo, *args)
-    fhi = _res(hi, *args)
+    flo = _res(lo, vx, vy, r, chord, theta, k_af, table, alpha0, dalpha, nb_, rtip, rhub, flags)
+    fhi = _res(hi, vx, vy, r, chord, theta, k_af, table, alpha0, dalpha, nb_, rtip, rhub, flags)
     root = math.nan
     if flo * fhi > 0.0:
-        fa = _res(-0.25 * _PI, *args)
-        fb = _res(-_EPS_PHI, *args)
+        fa = _res(-0.25 * _PI, vx, vy, r, chord, theta, k_af, table, alpha0, dalpha, nb_, rtip, rhub, flags)
+        fb = _res(-_EPS_PHI, vx, vy, r, chord, theta, k_af, table, alpha0, dalpha, nb_, rtip, rhub, flags)
         if fa < 0.0 and fb > 0.0:
             lo, hi, flo, fhi = -0.25 * _PI, -_EPS_PHI, fa, fb
         else:
             lo = 0.5 * _PI
             hi = _PI - _EPS_PHI
             flo = fhi
-            fhi = _res(hi, *args)
+            fhi = _res(hi, vx, vy, r, chord, theta, k_af, table, alpha0, dalpha, nb_, rtip, rhub, flags)
             if flo * fhi > 0.0:  # cannot happen for V_x, V_y > 0 (Ning 2014); stay finite
                 root = math.atan2(vx, vy)
     if root != root:
-        root = _brent(lo, hi, flo, fhi, *args)
-    _, oma, opa, cn, ct = _induction(root, *args)
+        root = _brent(lo, hi, flo, fhi, vx, vy, r, chord, theta, k_af, table, alpha0, dalpha, nb_, rtip, rhub, flags)
+    _, oma, opa, cn, ct = _induction(root, vx, vy, r, chord, theta, k_af, table, alpha0, dalpha, nb_, rtip, rhub, flags)
     return root, math.nan, oma, opa, cn, ct
 
 

@@ -169,6 +169,12 @@ def evaluate_plant_vw(x, u, wind, ext, p, hint, mode):  # pragma: no cover - com
     dir_up = 0.0
     if skew:
         chi0, dir_y, dir_up = _disk_skew(wind, vw, vhub_x.real, vhub_y.real, ct, st)
+    # the element data as locals: an array field read from the parameter tuple in the loop
+    # costs a reference count each time
+    r_e, chord_e, twist_e, af_e, w_e = p.r, p.chord, p.twist, p.af, p.w
+    phi_fl, phi_ed, dphi_fl, dphi_ed = p.phi_flap, p.phi_edge, p.dphi_flap, p.dphi_edge
+    ax_fl, ax_ed, twist_se = p.ax_flap, p.ax_edge, p.twist_s
+    table, alpha0, dalpha, flags, ua_par = p.table, p.alpha0, p.dalpha, p.flags, p.ua
     for i in range(3):
         psi_i = psi + i * TWO_PI_3
         sp = np.sin(psi_i)
@@ -183,7 +189,7 @@ def evaluate_plant_vw(x, u, wind, ext, p, hint, mode):  # pragma: no cover - com
         me = 0.0 * wr
         gqi = 0.0 * wr
         for j in range(nr):
-            rj = p.r[j]
+            rj = r_e[j]
             uf = wind[i, j]
             v_tw = 0.0 * uf
             if shadow:
@@ -195,25 +201,25 @@ def evaluate_plant_vw(x, u, wind, ext, p, hint, mode):  # pragma: no cover - com
             # the modes' directions: flapwise cos(th) x + sin(th) e, edgewise cos(th) e -
             # sin(th) x (x downwind, e the direction of rotation), th = pitch + twist
             if p.opt[5]:
-                cs = np.cos(pitch[i] + p.twist_s[j])
-                ss = np.sin(pitch[i] + p.twist_s[j])
+                cs = np.cos(pitch[i] + twist_se[j])
+                ss = np.sin(pitch[i] + twist_se[j])
             else:
                 cs = 1.0 + 0.0 * pitch[i]
                 ss = 0.0 * pitch[i]
-            vq = qd * p.phi_flap[j]
-            ve = ed * p.phi_edge[j]
+            vq = qd * phi_fl[j]
+            ve = ed * phi_ed[j]
             if defl:
                 # the element's local cone, the precone less the out-of-plane bending slope,
                 # and its distance from the shaft: the out-of-plane deflection along the coned
                 # normal, less the blade's axial shortening (an inextensible blade)
-                slope = qx * p.dphi_flap[j] * cs - ex * p.dphi_edge[j] * ss
+                slope = qx * dphi_fl[j] * cs - ex * dphi_ed[j] * ss
                 ccj = np.cos(p.cone - slope)
                 scj = np.sin(p.cone - slope)
-                rad = (rj * cc + (qx * p.phi_flap[j] * cs - ex * p.phi_edge[j] * ss) * sc
-                       - (qx * qx * p.ax_flap[j] + ex * ex * p.ax_edge[j]) * cc)
+                rad = (rj * cc + (qx * phi_fl[j] * cs - ex * phi_ed[j] * ss) * sc
+                       - (qx * qx * ax_fl[j] + ex * ex * ax_ed[j]) * cc)
                 # the in-plane deflection turns with the rotor: its velocity, radially inward,
                 # has a part along the coned normal
-                v_ip = wr * (qx * p.phi_flap[j] * ss + ex * p.phi_edge[j] * cs) * scj
+                v_ip = wr * (qx * phi_fl[j] * ss + ex * phi_ed[j] * cs) * scj
             else:
                 ccj = cc + 0.0 * wr
                 scj = sc + 0.0 * wr
@@ -225,15 +231,15 @@ def evaluate_plant_vw(x, u, wind, ext, p, hint, mode):  # pragma: no cover - com
                   + vv * cp + vw[1, i, j] * ct * sp)
             if w_bem > 0.0:
                 npr, tpr, ph, sl, u_ind, v_ind = element_kernel(
-                    vx, vy, rj, p.chord[j], p.twist[j] + pitch[i], p.af[j], p.table, p.alpha0,
-                    p.dalpha, p.nb, p.rtip, p.rhub, p.flags, p.rho, hint[0, i, j].real,
+                    vx, vy, rj, chord_e[j], twist_e[j] + pitch[i], af_e[j], table, alpha0,
+                    dalpha, p.nb, p.rtip, p.rhub, flags, p.rho, hint[0, i, j].real,
                     hint[1, i, j].real, hint[2, i, j].real, hint[3, i, j].real, mode)
             if w_bem < 1.0:     # low tip-speed ratio: the induction faded out
                 u_ind = w_bem * u_ind if w_bem > 0.0 else 0.0 * vx
                 v_ind = w_bem * v_ind if w_bem > 0.0 else 0.0 * vx
                 npr, tpr, ph, sl, u_ind, v_ind = element_kernel(
-                    vx, vy, rj, p.chord[j], p.twist[j] + pitch[i], p.af[j], p.table, p.alpha0,
-                    p.dalpha, p.nb, p.rtip, p.rhub, p.flags, p.rho, math.nan, math.nan,
+                    vx, vy, rj, chord_e[j], twist_e[j] + pitch[i], af_e[j], table, alpha0,
+                    dalpha, p.nb, p.rtip, p.rhub, flags, p.rho, math.nan, math.nan,
                     u_ind.real, v_ind.real, np.int64(MODE_FROZEN))
             bem[0, i, j] = ph
             bem[1, i, j] = sl
@@ -248,20 +254,18 @@ def evaluate_plant_vw(x, u, wind, ext, p, hint, mode):  # pragma: no cover - com
                 corr = (SKEW_FACTOR * tn * rj * cc / p.rtip
                         * (cp.real * dir_up - sp.real * dir_y))
                 u_ind = u_ind * (1.0 + corr)
-                npr, tpr, ph, _, _, _ = element_kernel(
-                    vx, vy, rj, p.chord[j], p.twist[j] + pitch[i], p.af[j], p.table, p.alpha0,
-                    p.dalpha, p.nb, p.rtip, p.rhub, p.flags, p.rho, math.nan, math.nan,
-                    u_ind.real, v_ind.real, np.int64(MODE_FROZEN))
-            if ua_on and p.ua[p.af[j], 0] != 0.0:
-                npr, tpr = _ua_loads(npr, tpr, ph, vx - u_ind, vy + v_ind, p.twist[j] + pitch[i],
+                npr, tpr, ph = _frozen_loads(vx.real - u_ind.real, vy.real + v_ind.real,
+                                             chord_e[j], twist_e[j] + pitch[i].real, af_e[j], p)
+            if ua_on and ua_par[af_e[j], 0] != 0.0:
+                npr, tpr = _ua_loads(npr, tpr, ph, vx - u_ind, vy + v_ind, twist_e[j] + pitch[i],
                                      i, j, p, hint, bem)
-            wj = p.w[j]
+            wj = w_e[j]
             tor_i += tpr * rad * wj
             thr_i += npr * ccj * wj
             mf += npr * (rj - p.rhub) * wj
             me += tpr * (rj - p.rhub) * wj
-            gqi += (npr * cs + tpr * ss) * p.phi_flap[j] * wj
-            ge[i] += (tpr * cs - npr * ss) * p.phi_edge[j] * wj
+            gqi += (npr * cs + tpr * ss) * phi_fl[j] * wj
+            ge[i] += (tpr * cs - npr * ss) * phi_ed[j] * wj
             fy += -tpr * cp * wj
         if p.w[nr] > 0.0:
             npr, tpr, rad_t, cs_t, ss_t = _tip_node(i, wr, roll, vhub_x, vhub_y, nod, qd, ed,
@@ -426,6 +430,21 @@ def evaluate_plant_vw(x, u, wind, ext, p, hint, mode):  # pragma: no cover - com
     z[29] = x[0]
     z[30] = x[8]
     return dx, z, bem
+
+
+@nb.njit(**_JIT)
+def _frozen_loads(wx, wy, chord, theta, k_af, p):  # pragma: no cover - compiled
+    """Line loads (N', T') [N/m] and inflow angle [rad] of an element at given relative
+    velocities W_x = V_x - u_ind, W_y = V_y + v_ind (real; the frozen-wake evaluation of
+    :func:`linearize.bem.element_kernel`, written for the time step's real arithmetic)."""
+    phi = math.atan2(wx, wy)
+    cl, cd = polar_lookup(p.table, k_af, phi - theta, p.alpha0, p.dalpha)
+    w2 = wx * wx + wy * wy
+    if w2 <= 0.0:
+        return 0.0, 0.0, phi
+    w = math.sqrt(w2)
+    q = 0.5 * p.rho * w * chord      # q W, with sin(phi) = W_x / W, cos(phi) = W_y / W
+    return q * (cl * wy + cd * wx), q * (cl * wx - cd * wy), phi
 
 
 @nb.njit(**_JIT)
@@ -639,9 +658,11 @@ def _sample_grid(t, ys, zs, wpar, grid, out):  # pragma: no cover - compiled
                 wt = (1.0 - at) if kt == 0 else at
                 if nt == 1:
                     wt = 1.0
-                g = grid[it + kt]
-                acc += wt * ((1 - ay) * (1 - az) * g[iy, iz] + ay * (1 - az) * g[iy + 1, iz]
-                             + (1 - ay) * az * g[iy, iz + 1] + ay * az * g[iy + 1, iz + 1])
+                m = it + kt         # indexed in place: a view per point costs its refcounts
+                acc += wt * ((1 - ay) * (1 - az) * grid[m, iy, iz]
+                             + ay * (1 - az) * grid[m, iy + 1, iz]
+                             + (1 - ay) * az * grid[m, iy, iz + 1]
+                             + ay * az * grid[m, iy + 1, iz + 1])
             out[i, j] = acc
 
 
@@ -661,11 +682,53 @@ def sample_inplane(t, psi, p, kind, wpar, vw_grid):  # pragma: no cover - compil
 
 
 @nb.njit(**_JIT)
+def _sample_uvw(t, psi, p, kind, wpar, grid_u, grid_vw):  # pragma: no cover - compiled
+    """:func:`sample_wind` and :func:`sample_inplane` together: with a grid wind that has v and
+    w, the elements' positions and cells are found once for the three components."""
+    nr = p.r.size
+    if kind != 1 or grid_vw.shape[1] == 1 or p.opt[2] == 0:
+        return (sample_wind(t, psi, p, kind, wpar, grid_u),
+                sample_inplane(t, psi, p, kind, wpar, grid_vw))
+    ys, zs = _element_positions(psi, p)
+    out = np.empty((3, nr))
+    vw = np.empty((2, 3, nr))
+    t0, dt, y0, dy, z0, dz = wpar[0], wpar[1], wpar[2], wpar[3], wpar[4], wpar[5]
+    nt, ny, nz = grid_u.shape
+    it, at = (0, 0.0) if nt == 1 else locate_cell((t - t0) / dt, nt)
+    nt2 = 1 if nt == 1 else 2
+    for i in range(3):
+        for j in range(nr):
+            iy, ay = locate_cell((ys[i, j] - y0) / dy, ny)
+            iz, az = locate_cell((zs[i, j] - z0) / dz, nz)
+            w00 = (1 - ay) * (1 - az)
+            w10 = ay * (1 - az)
+            w01 = (1 - ay) * az
+            w11 = ay * az
+            su = 0.0
+            sv = 0.0
+            sw = 0.0
+            for kt in range(nt2):
+                wt = 1.0 if nt == 1 else ((1.0 - at) if kt == 0 else at)
+                m = it + kt
+                su += wt * (w00 * grid_u[m, iy, iz] + w10 * grid_u[m, iy + 1, iz]
+                            + w01 * grid_u[m, iy, iz + 1] + w11 * grid_u[m, iy + 1, iz + 1])
+                sv += wt * (w00 * grid_vw[0, m, iy, iz] + w10 * grid_vw[0, m, iy + 1, iz]
+                            + w01 * grid_vw[0, m, iy, iz + 1]
+                            + w11 * grid_vw[0, m, iy + 1, iz + 1])
+                sw += wt * (w00 * grid_vw[1, m, iy, iz] + w10 * grid_vw[1, m, iy + 1, iz]
+                            + w01 * grid_vw[1, m, iy, iz + 1]
+                            + w11 * grid_vw[1, m, iy + 1, iz + 1])
+            out[i, j] = su
+            vw[0, i, j] = sv
+            vw[1, i, j] = sw
+    return out, vw
+
+
+@nb.njit(**_JIT)
 def _stage(t, x, u, p, kind, wpar, grid, hint):  # pragma: no cover - compiled
     """The plant at one RK4 stage: the wind at the elements (``grid``: the u grid and the
     (2, ...) v, w grid) and :func:`evaluate_plant_vw`."""
-    w = sample_wind(t, x[16], p, kind, wpar, grid[0])
-    vw = sample_inplane(t, x[16], p, kind, wpar, grid[1])
+    w, vw = _sample_uvw(t, x[16], p, kind, wpar, grid[0], grid[1])
     tw = sample_tower(t, p, kind, wpar, grid)
     return evaluate_plant_vw(x, u, w, (vw, tw), p, hint, np.int64(0))
 
@@ -678,20 +741,26 @@ def _rk4(t, x, u, h, p, kind, wpar, grid, hint, dphi):  # pragma: no cover - com
 
     Returns the new state, the outputs at t, the stage-4 BEM state and the new ``dphi``.
     """
+    nx = x.size
     k1, z, ph1 = _stage(t, x, u, p, kind, wpar, grid, hint)
-    x2 = x + 0.5 * h * k1
-    hint2 = ph1.copy()
-    hint2[0] += 0.5 * dphi
-    k2, _, ph2 = _stage(t + 0.5 * h, x2, u, p, kind, wpar, grid, hint2)
-    x3 = x + 0.5 * h * k2
-    k3, _, ph3 = _stage(t + 0.5 * h, x3, u, p, kind, wpar, grid, ph2)
-    x4 = x + h * k3
-    hint4 = ph3.copy()
-    hint4[0] += 0.5 * dphi
-    k4, _, ph4 = _stage(t + h, x4, u, p, kind, wpar, grid, hint4)
-    xn = x + h / 6.0 * (k1 + 2.0 * k2 + 2.0 * k3 + k4)
+    phi1 = ph1[0].copy()
+    xs = np.empty(nx)
+    for m in range(nx):
+        xs[m] = x[m] + 0.5 * h * k1[m]
+    ph1[0] += 0.5 * dphi             # the stage-1 solution, extrapolated: stage 2's warm start
+    k2, _, ph2 = _stage(t + 0.5 * h, xs, u, p, kind, wpar, grid, ph1)
+    for m in range(nx):
+        xs[m] = x[m] + 0.5 * h * k2[m]
+    k3, _, ph3 = _stage(t + 0.5 * h, xs, u, p, kind, wpar, grid, ph2)
+    for m in range(nx):
+        xs[m] = x[m] + h * k3[m]
+    ph3[0] += 0.5 * dphi
+    k4, _, ph4 = _stage(t + h, xs, u, p, kind, wpar, grid, ph3)
+    xn = np.empty(nx)
+    for m in range(nx):
+        xn[m] = x[m] + h / 6.0 * (k1[m] + 2.0 * k2[m] + 2.0 * k3[m] + k4[m])
     ua_update(ph4, p)
-    new_dphi = ph4[0] - ph1[0]
+    new_dphi = ph4[0] - phi1
     for i in range(new_dphi.shape[0]):
         for j in range(new_dphi.shape[1]):
             if new_dphi[i, j] != new_dphi[i, j]:

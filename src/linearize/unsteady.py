@@ -68,16 +68,17 @@ _JIT = dict(cache=True, error_model="numpy")
 
 
 @nb.njit(**_JIT)
-def _separation(table, k, alpha, par, cna, a0, dalpha):  # pragma: no cover - compiled
+def _separation(table, k, alpha, ua, kp, cna, a0, dalpha):  # pragma: no cover - compiled
     """From one lookup of the static polar at alpha: the separation point f' of the normal
     force (inverse Kirchhoff, eq 1.32a) with the attached-flow slope ``cna``, the fully
     separated normal force C_n,fs there, and the separation point f'_c of the chordwise force
-    (eq 1.32b, Gonzalez offset)."""
+    (eq 1.32b, Gonzalez offset). ``ua[kp]``: the airfoil's parameters (:data:`UA_PAR`)."""
     cl, cd = polar_lookup(table, k, alpha, a0, dalpha)
     s, c = math.sin(alpha), math.cos(alpha)
-    cn = cl * c + (cd - par[3]) * s
-    cc = cl * s - (cd - par[3]) * c
-    lin = cna * (alpha - par[1])
+    cd0 = ua[kp, 3]
+    cn = cl * c + (cd - cd0) * s
+    cc = cl * s - (cd - cd0) * c
+    lin = cna * (alpha - ua[kp, 1])
     x = 0.0
     if lin != 0.0 and cn != 0.0:
         x = cn / lin
@@ -98,92 +99,94 @@ def _separation(table, k, alpha, par, cna, a0, dalpha):  # pragma: no cover - co
 
 
 @nb.njit(**_JIT)
-def _chain(alpha, w, chord, dt, par, st, new, table, k, a0, dalpha):  # pragma: no cover
-    """One step of the model from the states ``st`` (N_UA,) of the previous step: the
-    coefficients (C_l, C_d) at the current alpha [rad] and relative speed w [m/s]; the new
-    states are written into ``new`` (N_UA,), which may be ``st`` itself (no allocation in the
-    plant's step)."""
+def _chain(alpha, w, chord, dt, ua, kp, st, r0, i, j, table, k, a0,
+           dalpha):  # pragma: no cover - compiled
+    """One step of the model: the coefficients (C_l, C_d) at the current alpha [rad] and
+    relative speed w [m/s], from the previous step's states ``st[r0:r0 + N_UA, i, j]``, which
+    it replaces with the new ones (in place: no views, no allocation in the plant's step).
+    ``ua[kp]``: the airfoil's parameters (:data:`UA_PAR`); ``k``: its polar in ``table``."""
     w = max(w, 1e-3)
-    mach = min(w / par[12], 0.7)
+    mach = min(w / ua[kp, 12], 0.7)
     beta2 = 1.0 - mach * mach
     beta = math.sqrt(beta2)
-    cna = par[2] / beta
+    cna = ua[kp, 2] / beta
     ds = 2.0 * w * dt / chord
-    cut = max(1.0, w) * par[10] / (math.pi * chord)
+    cut = max(1.0, w) * ua[kp, 10] / (math.pi * chord)
     lp = math.exp(-2.0 * math.pi * dt * cut)
-    a_prev = st[0]
+    a_prev = st[r0 + 0, i, j]
     a_filt = lp * a_prev + (1.0 - lp) * alpha
     da = a_filt - a_prev
     # non-circulatory normal force of the filtered rate (eqs 1.7-1.11, 1.18)
     q_cur = da / dt * chord / w
-    q_f = lp * st[10] + (1.0 - lp) * q_cur
+    q_f = lp * st[r0 + 10, i, j] + (1.0 - lp) * q_cur
     ka_f = q_f * w / chord
-    k_alpha = 1.0 / ((1.0 - mach) + 0.5 * par[2] * mach * mach * beta
-                     * (par[4] * par[6] + par[5] * par[7]))
-    t_alpha = 0.75 * k_alpha * chord / par[12]
+    k_alpha = 1.0 / ((1.0 - mach) + 0.5 * ua[kp, 2] * mach * mach * beta
+                     * (ua[kp, 4] * ua[kp, 6] + ua[kp, 5] * ua[kp, 7]))
+    t_alpha = 0.75 * k_alpha * chord / ua[kp, 12]
     het = math.exp(-0.5 * dt / t_alpha)     # sqrt of the decay, squared below
     et = het * het
-    kp_alpha = st[11] * et + (ka_f - st[9]) * het
+    kp_alpha = st[r0 + 11, i, j] * et + (ka_f - st[r0 + 9, i, j]) * het
     cn_nc = 4.0 * t_alpha * (ka_f - kp_alpha) / mach
     # circulatory, Wagner (eqs 1.13-1.15)
-    he1, he2 = math.exp(-0.5 * par[6] * ds * beta2), math.exp(-0.5 * par[7] * ds * beta2)
-    x1 = st[1] * he1 * he1 + par[4] * da * he1
-    x2 = st[2] * he2 * he2 + par[5] * da * he2
-    a_e = a_filt - par[1] - x1 - x2
+    he1, he2 = math.exp(-0.5 * ua[kp, 6] * ds * beta2), math.exp(-0.5 * ua[kp, 7] * ds * beta2)
+    x1 = st[r0 + 1, i, j] * he1 * he1 + ua[kp, 4] * da * he1
+    x2 = st[r0 + 2, i, j] * he2 * he2 + ua[kp, 5] * da * he2
+    a_e = a_filt - ua[kp, 1] - x1 - x2
     cn_circ = cna * a_e
     cn_pot = cn_circ + cn_nc
-    hep = math.exp(-0.5 * ds / par[8])
-    dp = st[4] * hep * hep + (cn_pot - st[3]) * hep
-    a_f = (cn_pot - dp) / cna + par[1]
-    fp, _, fpc = _separation(table, k, a_f, par, cna, a0, dalpha)
-    hef = math.exp(-0.5 * ds / par[9])
-    df = st[6] * hef * hef + (fp - st[5]) * hef
-    dfc = st[8] * hef * hef + (fpc - st[7]) * hef
+    hep = math.exp(-0.5 * ds / ua[kp, 8])
+    dp = st[r0 + 4, i, j] * hep * hep + (cn_pot - st[r0 + 3, i, j]) * hep
+    a_f = (cn_pot - dp) / cna + ua[kp, 1]
+    fp, _, fpc = _separation(table, k, a_f, ua, kp, cna, a0, dalpha)
+    hef = math.exp(-0.5 * ds / ua[kp, 9])
+    df = st[r0 + 6, i, j] * hef * hef + (fp - st[r0 + 5, i, j]) * hef
+    dfc = st[r0 + 8, i, j] * hef * hef + (fpc - st[r0 + 7, i, j]) * hef
     f2 = min(max(fp - df, 0.0), 1.0)
     f2c = min(max(fpc - dfc, 0.0), (1.0 + _GONZALEZ) ** 2)
-    _, cn_fs, _ = _separation(table, k, a_e + par[1], par, cna, a0, dalpha)
+    _, cn_fs, _ = _separation(table, k, a_e + ua[kp, 1], ua, kp, cna, a0, dalpha)
     cn = cn_nc + cn_circ * f2 + cn_fs * (1.0 - f2)
-    cc = cn_circ * math.tan(a_e + par[1]) * (math.sqrt(f2c) - _GONZALEZ)
+    cc = cn_circ * math.tan(a_e + ua[kp, 1]) * (math.sqrt(f2c) - _GONZALEZ)
     s, c = math.sin(alpha), math.cos(alpha)
     cl = cn * c + cc * s
-    cd = cn * s - cc * c + par[3]
-    new[0] = a_filt
-    new[1] = x1
-    new[2] = x2
-    new[3] = cn_pot
-    new[4] = dp
-    new[5] = fp
-    new[6] = df
-    new[7] = fpc
-    new[8] = dfc
-    new[9] = ka_f
-    new[10] = q_f
-    new[11] = kp_alpha
+    cd = cn * s - cc * c + ua[kp, 3]
+    st[r0 + 0, i, j] = a_filt
+    st[r0 + 1, i, j] = x1
+    st[r0 + 2, i, j] = x2
+    st[r0 + 3, i, j] = cn_pot
+    st[r0 + 4, i, j] = dp
+    st[r0 + 5, i, j] = fp
+    st[r0 + 6, i, j] = df
+    st[r0 + 7, i, j] = fpc
+    st[r0 + 8, i, j] = dfc
+    st[r0 + 9, i, j] = ka_f
+    st[r0 + 10, i, j] = q_f
+    st[r0 + 11, i, j] = kp_alpha
     return cl, cd
 
 
 @nb.njit(**_JIT)
-def _blend(alpha, cl, cd, par, table, k, a0, dalpha):  # pragma: no cover - compiled
+def _blend(alpha, cl, cd, ua, kp, table, k, a0, dalpha):  # pragma: no cover - compiled
     """The model's coefficients blended to the static polar near and above the cut-out."""
     a = abs(alpha)
-    if a <= par[11] - math.radians(5.0):
+    if a <= ua[kp, 11] - math.radians(5.0):
         return cl, cd
     cls, cds = polar_lookup(table, k, alpha, a0, dalpha)
-    if a >= par[11]:
+    if a >= ua[kp, 11]:
         return cls, cds
-    w = 0.5 + 0.5 * math.cos(math.pi * (a - par[11] + math.radians(5.0)) / math.radians(5.0))
+    w = 0.5 + 0.5 * math.cos(math.pi * (a - ua[kp, 11] + math.radians(5.0)) / math.radians(5.0))
     return w * cl + (1.0 - w) * cls, w * cd + (1.0 - w) * cds
 
 
 @nb.njit(**_JIT)
-def _initial(alpha, w, par, table, k, a0, dalpha):  # pragma: no cover - compiled
-    """States of a steady flow at alpha and relative speed w [m/s] (the first step of a run)."""
-    mach = min(max(w, 1e-3) / par[12], 0.7)
-    cna = par[2] / math.sqrt(1.0 - mach * mach)
+def _initial(alpha, w, ua, kp, table, k, a0, dalpha):  # pragma: no cover - compiled
+    """States of a steady flow at alpha and relative speed w [m/s] (the first step of a run),
+    (N_UA,)."""
+    mach = min(max(w, 1e-3) / ua[kp, 12], 0.7)
+    cna = ua[kp, 2] / math.sqrt(1.0 - mach * mach)
     st = np.zeros(N_UA)
     st[0] = alpha
-    st[3] = cna * (alpha - par[1])
-    st[5], _, st[7] = _separation(table, k, alpha, par, cna, a0, dalpha)
+    st[3] = cna * (alpha - ua[kp, 1])
+    st[5], _, st[7] = _separation(table, k, alpha, ua, kp, cna, a0, dalpha)
     return st
 
 
@@ -205,21 +208,20 @@ def ua_update(hint, p):  # pragma: no cover - compiled
     ``hint`` (in place); elements of airfoils without UA data keep NaN states."""
     if hint.shape[0] < HINT_ROWS_UA:
         return
+    ua = p.ua
     for i in range(hint.shape[1]):
         for j in range(hint.shape[2]):
             k = p.af[j]
-            par = p.ua[k]
             alpha = hint[_ALPHA, i, j]
-            if par[0] == 0.0 or alpha != alpha:
+            if ua[k, 0] == 0.0 or alpha != alpha:
                 continue
-            new = hint[UA_ROW:UA_ROW + N_UA, i, j]
             if hint[UA_ROW, i, j] != hint[UA_ROW, i, j]:
-                st = _initial(alpha, hint[_W, i, j], par, p.table, k, p.alpha0, p.dalpha)
-            else:
-                st = new
-            cl, cd = _chain(alpha, hint[_W, i, j], p.chord[j], hint[_DT, i, j], par, st, new,
-                            p.table, k, p.alpha0, p.dalpha)
-            cl, cd = _blend(alpha, cl, cd, par, p.table, k, p.alpha0, p.dalpha)
+                st = _initial(alpha, hint[_W, i, j], ua, k, p.table, k, p.alpha0, p.dalpha)
+                for m in range(N_UA):
+                    hint[UA_ROW + m, i, j] = st[m]
+            cl, cd = _chain(alpha, hint[_W, i, j], p.chord[j], hint[_DT, i, j], ua, k, hint,
+                            UA_ROW, i, j, p.table, k, p.alpha0, p.dalpha)
+            cl, cd = _blend(alpha, cl, cd, ua, k, p.table, k, p.alpha0, p.dalpha)
             cls, cds = polar_lookup(p.table, k, alpha, p.alpha0, p.dalpha)
             hint[_DCL, i, j] = cl - cls
             hint[_DCD, i, j] = cd - cds
@@ -228,10 +230,12 @@ def ua_update(hint, p):  # pragma: no cover - compiled
 @nb.njit(**_JIT)
 def ua_steady(alpha, w, par, table, k, a0, dalpha):  # pragma: no cover - compiled
     """The model's steady-flow coefficients (C_l, C_d) at alpha [rad] and relative speed w
-    [m/s]: its fixed point."""
-    st = _initial(alpha, w, par, table, k, a0, dalpha)
-    cl, cd = _chain(alpha, w, 1.0, 0.01, par, st, st, table, k, a0, dalpha)
-    return _blend(alpha, cl, cd, par, table, k, a0, dalpha)
+    [m/s]: its fixed point. ``par``: the airfoil's parameters (:data:`UA_PAR`), contiguous;
+    ``k``: its polar in ``table``."""
+    ua = par.reshape((1, par.size))
+    st = _initial(alpha, w, ua, 0, table, k, a0, dalpha).reshape((N_UA, 1, 1))
+    cl, cd = _chain(alpha, w, 1.0, 0.01, ua, 0, st, 0, 0, 0, table, k, a0, dalpha)
+    return _blend(alpha, cl, cd, ua, 0, table, k, a0, dalpha)
 
 
 key_caches_on_callees(__name__)

@@ -183,13 +183,15 @@ def test_unsteady_model_step_follows_wagners_indicial_function(
     par[8] = par[9] = 1e-6   # no separation lags
     chord, w, dt = 3.0, 60.0, 0.0025
     a0, a1 = math.radians(1.0), math.radians(2.0)
-    st = _initial(a0, w, par, tab.table, k, tab.alpha0, tab.dalpha)
+    ua = par.reshape(1, -1)
+    st = _initial(a0, w, ua, 0, tab.table, k, tab.alpha0, tab.dalpha).reshape(-1, 1, 1)
     cnalpha, alpha0 = par[2], par[1]
-    cl, cd = _chain(a1, w, chord, dt, par, st, st, tab.table, k, tab.alpha0, tab.dalpha)
+    cl, cd = _chain(a1, w, chord, dt, ua, 0, st, 0, 0, 0, tab.table, k, tab.alpha0, tab.dalpha)
     impulse = cl * math.cos(a1) + (cd - par[3]) * math.sin(a1) - cnalpha * (a0 - alpha0)
     assert 0.5 * 3 * chord / w * (a1 - a0) / dt < impulse <= 3 * chord / w * (a1 - a0) / dt
     for n in range(2, 161):
-        cl, cd = _chain(a1, w, chord, dt, par, st, st, tab.table, k, tab.alpha0, tab.dalpha)
+        cl, cd = _chain(a1, w, chord, dt, ua, 0, st, 0, 0, 0, tab.table, k, tab.alpha0,
+                        tab.dalpha)
         s = 2 * w * dt * n / chord
         expected = cnalpha * (a1 - alpha0 - (a1 - a0) * (0.3 * math.exp(-0.14 * s)
                                                           + 0.7 * math.exp(-0.53 * s)))
