@@ -149,18 +149,9 @@ def _chain(alpha, w, chord, dt, ua, kp, st, r0, i, j, table, k, a0,
     s, c = math.sin(alpha), math.cos(alpha)
     cl = cn * c + cc * s
     cd = cn * s - cc * c + ua[kp, 3]
-    st[r0 + 0, i, j] = a_filt
-    st[r0 + 1, i, j] = x1
-    st[r0 + 2, i, j] = x2
-    st[r0 + 3, i, j] = cn_pot
-    st[r0 + 4, i, j] = dp
-    st[r0 + 5, i, j] = fp
-    st[r0 + 6, i, j] = df
-    st[r0 + 7, i, j] = fpc
-    st[r0 + 8, i, j] = dfc
-    st[r0 + 9, i, j] = ka_f
-    st[r0 + 10, i, j] = q_f
-    st[r0 + 11, i, j] = kp_alpha
+    new = (a_filt, x1, x2, cn_pot, dp, fp, df, fpc, dfc, ka_f, q_f, kp_alpha)   # N_UA states
+    for m in range(N_UA):
+        st[r0 + m, i, j] = new[m]
     return cl, cd
 
 

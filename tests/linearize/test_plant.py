@@ -415,16 +415,16 @@ def test_the_stage_samples_a_linear_field_exactly(params: linearize.PlantParams,
                                                   b: float, c: float, psi: float,
                                                   t: float) -> None:
     """Closed form: trilinear interpolation reproduces a field linear in t, y and z. With
-    u = 10 + a t + b y + c z, v = 2 u and w = -u on a grid, the wind the plant's stage takes at
-    each element (u, v and w found together) is that function at the element's place,
-    y = -r cos(c) sin(psi_i), z = z_hub + r cos(c) cos(psi_i) cos(t), to the grid's float32
-    storage (1e-6 relative)."""
+    u = 30 + a t + b y + c z (positive), v = 2 u and w = -u on a grid, the wind the plant's
+    stage takes at each element (u, v and w found together) is that function at the element's
+    place, y = -r cos(c) sin(psi_i), z = z_hub + r cos(c) cos(psi_i) cos(t), to the grid's
+    float32 storage (1e-6 relative)."""
     from linearize.kernel import _sample_uvw
 
     tt = np.linspace(0.0, 10.0, 11)
     y = np.linspace(-70.0, 70.0, 15)
     z = np.linspace(20.0, 160.0, 15)
-    f = (10.0 + a * tt[:, None, None] + b * y[None, :, None] + c * z[None, None, :])
+    f = (30.0 + a * tt[:, None, None] + b * y[None, :, None] + c * z[None, None, :])
     wind = GridWind(t=tt, y=y, z=z, u=f, v=2.0 * f, w=-f)
     kind, wpar, grid = wind._kernel_args()
     pk = params.pack
@@ -432,7 +432,7 @@ def test_the_stage_samples_a_linear_field_exactly(params: linearize.PlantParams,
     r = pk.r * math.cos(pk.cone)
     for i in range(3):
         p_i = psi + 2 * math.pi * i / 3
-        expected = (10.0 + a * t + b * (-r * math.sin(p_i))
+        expected = (30.0 + a * t + b * (-r * math.sin(p_i))
                     + c * (pk.zhub + r * math.cos(p_i) * math.cos(pk.tilt)))
         assert_allclose(u[i], expected, rtol=1e-6, atol=1e-6)
         assert_allclose(vw[0, i], 2.0 * expected, rtol=1e-6, atol=1e-6)
