@@ -365,15 +365,16 @@ def _solve_phi(vx, vy, r, chord, theta, k_af, table, alpha0, dalpha, nb_, rtip, 
     a hint once kept a tip element at phi = -3e-5 while the root had come back to 0.106 rad, and
     the next step's loads threw the edgewise rates to 200 m/s (a campaign case that diverged).
     """
+    args = (vx, vy, r, chord, theta, k_af, table, alpha0, dalpha, nb_, rtip, rhub, flags)
     if hint == hint and hint > 0.0:  # not NaN, not in the propeller-brake region
         lo_b, hi_b = _EPS_PHI, _PI - _EPS_PHI
         if lo_b < hint < hi_b:
             x0 = hint
-            f0, oma, opa, cn, ct = _induction(x0, vx, vy, r, chord, theta, k_af, table, alpha0, dalpha, nb_, rtip, rhub, flags)
+            f0, oma, opa, cn, ct = _induction(x0, *args)
             slope = hint_slope
             if not (slope == slope) or slope == 0.0:
                 x1 = x0 + 1e-6 if x0 + 1e-6 < hi_b else x0 - 1e-6
-                slope = (_res(x1, vx, vy, r, chord, theta, k_af, table, alpha0, dalpha, nb_, rtip, rhub, flags) - f0) / (x1 - x0)
+                slope = (_res(x1, *args) - f0) / (x1 - x0)
             dx_prev = math.inf
             oma_p, opa_p, cn_p, ct_p = oma, opa, cn, ct
             for _ in range(8):
@@ -384,7 +385,7 @@ def _solve_phi(vx, vy, r, chord, theta, k_af, table, alpha0, dalpha, nb_, rtip, 
                     if tol <= _XTOL and step != 0.0 and lo_b < x0 - step < hi_b:
                         # tight: take the last correction too (superlinear: to rounding)
                         x0 = x0 - step
-                        _, oma, opa, cn, ct = _induction(x0, vx, vy, r, chord, theta, k_af, table, alpha0, dalpha, nb_, rtip, rhub, flags)
+                        _, oma, opa, cn, ct = _induction(x0, *args)
                     elif dx_prev != math.inf and lo_b < x0 - step < hi_b:
                         # warm, after a secant step: take the last correction too, and the
                         # factors there by linear extrapolation from the last two points
@@ -398,7 +399,7 @@ def _solve_phi(vx, vy, r, chord, theta, k_af, table, alpha0, dalpha, nb_, rtip, 
                 if x1 <= lo_b or x1 >= hi_b:
                     break
                 oma_p, opa_p, cn_p, ct_p = oma, opa, cn, ct
-                f1, oma, opa, cn, ct = _induction(x1, vx, vy, r, chord, theta, k_af, table, alpha0, dalpha, nb_, rtip, rhub, flags)
+                f1, oma, opa, cn, ct = _induction(x1, *args)
                 slope = (f1 - f0) / (x1 - x0)
                 dx_prev = x1 - x0
                 x0 = x1
@@ -406,24 +407,24 @@ def _solve_phi(vx, vy, r, chord, theta, k_af, table, alpha0, dalpha, nb_, rtip, 
     # Ning's brackets
     lo = _EPS_PHI
     hi = 0.5 * _PI
-    flo = _res(lo, vx, vy, r, chord, theta, k_af, table, alpha0, dalpha, nb_, rtip, rhub, flags)
-    fhi = _res(hi, vx, vy, r, chord, theta, k_af, table, alpha0, dalpha, nb_, rtip, rhub, flags)
+    flo = _res(lo, *args)
+    fhi = _res(hi, *args)
     root = math.nan
     if flo * fhi > 0.0:
-        fa = _res(-0.25 * _PI, vx, vy, r, chord, theta, k_af, table, alpha0, dalpha, nb_, rtip, rhub, flags)
-        fb = _res(-_EPS_PHI, vx, vy, r, chord, theta, k_af, table, alpha0, dalpha, nb_, rtip, rhub, flags)
+        fa = _res(-0.25 * _PI, *args)
+        fb = _res(-_EPS_PHI, *args)
         if fa < 0.0 and fb > 0.0:
             lo, hi, flo, fhi = -0.25 * _PI, -_EPS_PHI, fa, fb
         else:
             lo = 0.5 * _PI
             hi = _PI - _EPS_PHI
             flo = fhi
-            fhi = _res(hi, vx, vy, r, chord, theta, k_af, table, alpha0, dalpha, nb_, rtip, rhub, flags)
+            fhi = _res(hi, *args)
             if flo * fhi > 0.0:  # cannot happen for V_x, V_y > 0 (Ning 2014); stay finite
                 root = math.atan2(vx, vy)
     if root != root:
-        root = _brent(lo, hi, flo, fhi, vx, vy, r, chord, theta, k_af, table, alpha0, dalpha, nb_, rtip, rhub, flags)
-    _, oma, opa, cn, ct = _induction(root, vx, vy, r, chord, theta, k_af, table, alpha0, dalpha, nb_, rtip, rhub, flags)
+        root = _brent(lo, hi, flo, fhi, *args)
+    _, oma, opa, cn, ct = _induction(root, *args)
     return root, math.nan, oma, opa, cn, ct
 
 

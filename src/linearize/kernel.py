@@ -254,8 +254,10 @@ def evaluate_plant_vw(x, u, wind, ext, p, hint, mode):  # pragma: no cover - com
                 corr = (SKEW_FACTOR * tn * rj * cc / p.rtip
                         * (cp.real * dir_up - sp.real * dir_y))
                 u_ind = u_ind * (1.0 + corr)
-                npr, tpr, ph = _frozen_loads(vx.real - u_ind.real, vy.real + v_ind.real,
-                                             chord_e[j], twist_e[j] + pitch[i].real, af_e[j], p)
+                npr, tpr, ph, _, _, _ = element_kernel(
+                    vx, vy, rj, chord_e[j], twist_e[j] + pitch[i], af_e[j], table, alpha0,
+                    dalpha, p.nb, p.rtip, p.rhub, flags, p.rho, math.nan, math.nan,
+                    u_ind.real, v_ind.real, np.int64(MODE_FROZEN))
             if ua_on and ua_par[af_e[j], 0] != 0.0:
                 npr, tpr = _ua_loads(npr, tpr, ph, vx - u_ind, vy + v_ind, twist_e[j] + pitch[i],
                                      i, j, p, hint, bem)
@@ -433,21 +435,6 @@ def evaluate_plant_vw(x, u, wind, ext, p, hint, mode):  # pragma: no cover - com
 
 
 @nb.njit(**_JIT)
-def _frozen_loads(wx, wy, chord, theta, k_af, p):  # pragma: no cover - compiled
-    """Line loads (N', T') [N/m] and inflow angle [rad] of an element at given relative
-    velocities W_x = V_x - u_ind, W_y = V_y + v_ind (real; the frozen-wake evaluation of
-    :func:`linearize.bem.element_kernel`, written for the time step's real arithmetic)."""
-    phi = math.atan2(wx, wy)
-    cl, cd = polar_lookup(p.table, k_af, phi - theta, p.alpha0, p.dalpha)
-    w2 = wx * wx + wy * wy
-    if w2 <= 0.0:
-        return 0.0, 0.0, phi
-    w = math.sqrt(w2)
-    q = 0.5 * p.rho * w * chord      # q W, with sin(phi) = W_x / W, cos(phi) = W_y / W
-    return q * (cl * wy + cd * wx), q * (cl * wx - cd * wy), phi
-
-
-@nb.njit(**_JIT)
 def _tip_node(i, wr, roll, vhub_x, vhub_y, nod, qd, ed, pitch, sp, cp, cc, ct, st, wind, vw,
               p):  # pragma: no cover - compiled
     """Line loads (N', T') [N/m] at blade i's tip node as AeroDyn 15 has them with the tip
@@ -561,12 +548,12 @@ def _ua_loads(npr, tpr, phi, ua, ut, theta, i, j, p, hint, bem):  # pragma: no c
     (:func:`linearize.unsteady.ua_increment`) is added to them without a second polar lookup.
     Leaves the element's alpha and W in ``bem`` for the step's state update."""
     w2 = ua.real * ua.real + ut.real * ut.real
+    w = math.sqrt(w2)
     bem[_ALPHA_ROW, i, j] = phi.real - theta.real
-    bem[_W_ROW, i, j] = math.sqrt(w2)
+    bem[_W_ROW, i, j] = w
     dcl, dcd, valid = ua_increment(hint, i, j)
     if not valid or w2 <= 0.0:
         return npr, tpr
-    w = math.sqrt(w2)
     q = 0.5 * p.rho * w2 * p.chord[j]
     s = ua.real / w         # sin and cos of the inflow angle
     c = ut.real / w
