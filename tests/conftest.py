@@ -3,7 +3,9 @@ and the compiled kernels shared out between the test workers at the start."""
 from __future__ import annotations
 
 import os
+import shutil
 import sys
+import tempfile
 import traceback
 from pathlib import Path
 
@@ -25,6 +27,26 @@ def _compile_linearization() -> None:
 
     jacobian_check(linearize.load_turbine("nrel5mw"), 12.0, wake="quasi-steady",
                    shear_exponent=0.2)
+
+
+_CACHE = pytest.StashKey[str]()
+
+
+def pytest_configure(config: pytest.Config) -> None:
+    """The suite keeps mpc-wt's per-user cache (the MPC exports' solver sources) in a folder of
+    its own, made by the main process and shared with its workers, so that no test writes to
+    the user's cache."""
+    if "PYTEST_XDIST_WORKER" not in os.environ and "MPCWT_CACHE_DIR" not in os.environ:
+        path = tempfile.mkdtemp(prefix="mpcwt-test-cache-")
+        os.environ["MPCWT_CACHE_DIR"] = path
+        config.stash[_CACHE] = path
+
+
+def pytest_unconfigure(config: pytest.Config) -> None:
+    path = config.stash.get(_CACHE, None)
+    if path is not None:
+        shutil.rmtree(path, ignore_errors=True)
+        os.environ.pop("MPCWT_CACHE_DIR", None)
 
 
 def pytest_sessionstart(session: pytest.Session) -> None:

@@ -141,3 +141,65 @@ def test_runs_module_is_gone_and_one_simulation_diverged_error() -> None:
             if isinstance(n, ast.ClassDef) and n.name.endswith("Error"):
                 raise AssertionError(f"{f.relative_to(SRC)} defines {n.name}; errors belong "
                                      f"in the package's errors module")
+
+
+#: What marks a file as someone else's: a licence file, a licence or copyright header, the
+#: definition of a known QP solver's entry point (DAQP, OSQP, qpOASES, HPIPM, Eigen's own).
+_LICENCE_FILES = ("LICENSE", "LICENCE", "COPYING", "NOTICE")
+_FOREIGN_HEADERS = ("SPDX-License-Identifier", "Permission is hereby granted",
+                    "Licensed under the", "Copyright (c)", "Copyright (C)", "GNU General Public",
+                    "Redistribution and use in source")
+_SOLVER_DEFINITIONS = ("setup_daqp(", "daqp_solve(", "osqp_setup(", "osqp_solve(",
+                       "qpOASES_", "d_ocp_qp_ipm_solve(", "EIGEN_WORLD_VERSION")
+
+
+def _foreign_files(root: Path) -> list[str]:
+    """The files under ``root`` that are not ours: licence files, files whose first 60 lines
+    carry a licence or copyright header, C and C++ sources that define a known QP solver."""
+    bad = []
+    for p in sorted(root.rglob("*")):
+        if not p.is_file() or "__pycache__" in p.parts:
+            continue
+        rel = str(p.relative_to(root))
+        if p.name.split(".")[0].upper() in _LICENCE_FILES:
+            bad.append(f"{rel}: a licence file")
+            continue
+        if p.suffix not in (".py", ".c", ".h", ".cpp", ".hpp", ".f90", ".f", ".pyx"):
+            continue
+        text = p.read_text(errors="replace")
+        head = "\n".join(text.splitlines()[:60])
+        hits = [h for h in _FOREIGN_HEADERS if h in head]
+        if p.suffix in (".c", ".h", ".cpp", ".hpp"):
+            hits += [d for d in _SOLVER_DEFINITIONS if d in text and _defines(text, d)]
+        if hits:
+            bad.append(f"{rel}: {', '.join(hits)}")
+    return bad
+
+
+def _defines(text: str, name: str) -> bool:
+    """Whether C source ``text`` defines (not only calls) ``name``: the name at the start of a
+    line or after a return type at the start of a line, followed by a body."""
+    for line in text.splitlines():
+        s = line.strip()
+        if name in s and not s.startswith(("//", "/*", "*")) and not line.startswith((" ", "\t")) \
+                and not s.endswith(";"):
+            return True
+    return False
+
+
+def test_no_third_party_code_in_src() -> None:
+    """mpc-wt's sources are its own: no vendored library (the exported MPC's QP solver comes
+    from DAQP's published distribution at export time)."""
+    assert _foreign_files(SRC) == []
+
+
+def test_the_foreign_code_check_catches_a_vendored_solver(tmp_path: Path) -> None:
+    (tmp_path / "solver").mkdir()
+    (tmp_path / "solver" / "LICENSE").write_text("MIT License\n")
+    (tmp_path / "solver" / "api.c").write_text(
+        "#include \"api.h\"\nint setup_daqp(DAQPProblem *p, DAQPWorkspace *w, c_float *t)\n{\n"
+        "    return 0;\n}\n")
+    (tmp_path / "lib.py").write_text("# SPDX-License-Identifier: BSD-3-Clause\nx = 1\n")
+    (tmp_path / "ours.c").write_text("static int f(void)\n{\n    return setup_daqp(0, 0, 0);\n}\n")
+    bad = _foreign_files(tmp_path)
+    assert [b.split(":")[0] for b in bad] == ["lib.py", "solver/LICENSE", "solver/api.c"]

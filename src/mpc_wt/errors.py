@@ -7,7 +7,7 @@ from linearize import SimulationDivergedError
 
 __all__ = ["RunTooLargeError", "UsageError", "OptionsError", "SpecError", "CampaignLockedError", "CampaignIndexError",
            "GainTableError", "ResultFileError", "PremiseError", "SynthesisError",
-           "SimulationDivergedError", "QPSetupError", "ControllerLibraryError", "TrialFailed",
+           "SimulationDivergedError", "QPSetupError", "ControllerLibraryError", "SolverSourceError", "TrialFailed",
            "CaseDataError"]
 
 
@@ -85,6 +85,12 @@ class ControllerLibraryError(RuntimeError):
     def __init__(self, message: str, partial: object = None) -> None:
         super().__init__(message)
         self.partial = partial
+
+
+class SolverSourceError(ControllerLibraryError):
+    """The C sources of a QP solver that an export needs cannot be had: not in the cache and
+    not downloadable, or an archive whose digest is not the recorded one. The message gives the
+    command that fixes it."""
 
 
 class TrialFailed(RuntimeError):

@@ -391,10 +391,14 @@ def export_discon(turbine: linearize.Turbine, controller: str, out: str | Path,
         A kind that does not export (listing those that do), or bad options.
     ControllerLibraryError
         The compiler failed.
+    SolverSourceError
+        An MPC kind whose QP solver's sources are neither cached nor downloadable (checked
+        before the design is made).
     """
-    from mpc_wt.io.discon_export import check_exportable, export_controller
+    from mpc_wt.io.discon_export import check_exportable, export_controller, prepare_sources
 
     check_exportable(controller)
+    prepare_sources(controller)
     built, _ = design_controller(turbine, controller, options)
     opts = ", ".join(f"{k}={v}" for k, v in sorted((options or {}).items()))
     return export_controller(built.controller, controller, turbine, out, build=build,

@@ -218,7 +218,7 @@ LAYOUT = {
     "simulation": {"scenario", "loop", "compiled", "results", "preview", "solver_timing", "memory"},
     "assessment": {"fatigue", "performance", "series", "ultimate", "lidar", "compare"},
     "io": {"gain_tables", "rosco", "openfast_output", "discon_export", "openfast_case",
-           "json_text"},
+           "json_text", "solver_sources"},
 }
 
 

@@ -19,6 +19,7 @@ tune         design parameters optimized over load cases: ``tune SPEC.yaml --out
 bench        ``bench mpc``: QP solver comparison
 compare-openfast  an OpenFAST case run on mpc-wt's plant, compared with its output:
              ``compare-openfast CASE.fst --outb CASE.outb [--wind FILE.bts]``
+solver       the exported MPC's QP solver sources: ``solver fetch [--from FILE]``, ``status``
 
 ``--plugin MODULE`` (before the subcommand, repeatable) imports a module that registers
 controller kinds, which ``simulate`` and campaign specs can then use.
@@ -34,12 +35,12 @@ import sys
 from typing import Sequence
 
 import linearize
-from mpc_wt.cli import campaign, compare, design, runs, steady, wind
+from mpc_wt.cli import campaign, compare, design, runs, solver, steady, wind
 from mpc_wt.errors import CampaignLockedError, ControllerLibraryError, UsageError
 
 __all__ = ["main", "build_parser"]
 
-_GROUPS = (runs, steady, wind, design, campaign, compare)
+_GROUPS = (runs, steady, wind, design, campaign, compare, solver)
 
 
 def build_parser() -> argparse.ArgumentParser:

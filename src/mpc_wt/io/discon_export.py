@@ -36,7 +36,7 @@ import linearize
 from mpc_wt.errors import ControllerLibraryError
 
 __all__ = ["DisconExport", "EXPORTABLE", "REBUILT", "export_controller", "export_design", "controller_input",
-           "check_exportable",
+           "check_exportable", "prepare_sources",
            "build_library",
            "find_compiler", "library_name", "servodyn_input", "SWAP_READ", "SWAP_WRITTEN"]
 
@@ -104,8 +104,9 @@ SWAP_WRITTEN: dict[int, str] = {
     47: "generator torque demand [N m]", 48: "yaw rate demand (0)",
     55: "pitch override (0: off)", 56: "torque override (0: off)", 65: "logging channels (0)"}
 
-_SOURCES = ("mpcwt_discon.h", "input.c", "baseline.c", "ibc.c", "windest.c", "mpc.c", "lqr.c",
-            "ts.c", "discon.c")
+_SOURCES = ("mpcwt_discon.h", "input.c", "baseline.c", "ibc.c", "windest.c", "lqr.c", "ts.c",
+            "discon.c")
+_MPC_SOURCE = "mpc.c"
 _DAQP = "daqp"
 _CFLAGS = "-O2 -std=c99 -Wall -fPIC -fvisibility=hidden"
 _SANITIZE = "-O1 -g -fno-omit-frame-pointer -fsanitize=address,undefined " \
@@ -682,33 +683,79 @@ def controller_input(controller: Any, kind: str, turbine: linearize.Turbine,
     return "\n".join(head + body) + "\n"
 
 
-def _source_names() -> list[str]:
-    """The export's source files, relative to its folder: ours, then DAQP's (``daqp/``)."""
-    src = importlib.resources.files("mpc_wt.io") / "discon_c"
-    daqp = sorted(f"{_DAQP}/{p.name}" for p in (src / _DAQP).iterdir()
-                  if p.name.endswith((".c", ".h")) or p.name in ("LICENSE", "README.md"))
-    return list(_SOURCES) + daqp
+def _needs_qp(kind: str) -> bool:
+    """Whether a kind's library carries the MPC and its QP solver."""
+    return _LIBRARY_KIND[kind] == "mpc"
 
 
-def _copy_sources(directory: Path) -> tuple[Path, ...]:
+def _source_names(directory: Path) -> list[str]:
+    """An export's source files, relative to its folder: ours (with ``mpc.c`` where the folder
+    has it), then the QP solver's (``daqp/``)."""
+    names = list(_SOURCES)
+    if (directory / _MPC_SOURCE).is_file():
+        names.append(_MPC_SOURCE)
+        qp = directory / _DAQP
+        if qp.is_dir():
+            names += sorted(f"{_DAQP}/{p.name}" for p in qp.iterdir()
+                            if p.name.endswith((".c", ".h")))
+    return names
+
+
+def prepare_sources(kind: str) -> None:
+    """Make sure the sources a kind's library is built from can be had: for an MPC kind,
+    DAQP's C sources in the per-user cache (downloaded where they are not yet).
+
+    Parameters
+    ----------
+    kind : str
+        A controller kind (one of :data:`EXPORTABLE`).
+
+    Raises
+    ------
+    SolverSourceError
+        Neither cached nor downloadable; the message gives the command that fixes it.
+    """
+    if _needs_qp(kind):
+        from mpc_wt.io.solver_sources import daqp_sources
+
+        daqp_sources()
+
+
+def _copy_sources(directory: Path, kind: str) -> tuple[Path, ...]:
+    """Write the kind's C sources into its export folder; an MPC kind's come with DAQP's
+    sources from its published distribution (:func:`mpc_wt.io.solver_sources.daqp_sources`)."""
     src = importlib.resources.files("mpc_wt.io") / "discon_c"
-    (directory / _DAQP).mkdir(exist_ok=True)
+    names = list(_SOURCES) + ([_MPC_SOURCE] if _needs_qp(kind) else [])
     out = []
-    for name in _source_names():
+    for name in names:
         target = directory / name
         target.write_text((src / name).read_text())
         out.append(target)
+    stale = directory / _MPC_SOURCE
+    if not _needs_qp(kind) and stale.is_file():
+        stale.unlink()                  # an earlier MPC export into the same folder
+    if _needs_qp(kind):
+        from mpc_wt.io.solver_sources import daqp_sources
+
+        out += daqp_sources().write(directory / _DAQP)
     return tuple(out)
 
 
-def _c_files() -> list[str]:
-    return [n for n in _source_names() if n.endswith(".c")]
+def _c_files(directory: Path) -> list[str]:
+    return [n for n in _source_names(directory) if n.endswith(".c")]
+
+
+def _defines(directory: Path) -> list[str]:
+    """The preprocessor's flags beyond ``-I.``: the MPC and its solver's headers, where the
+    folder has them."""
+    return ["-DMPCWT_WITH_MPC", f"-I{_DAQP}"] if (directory / _MPC_SOURCE).is_file() else []
 
 
 def _makefile(directory: Path, lib: str) -> Path:
-    srcs = " ".join(_c_files())
+    srcs = " ".join(_c_files(directory))
+    cppflags = " ".join(["-I.", *_defines(directory)])
     text = (f"# Builds {lib} with the system's C compiler (make CC=... to choose another).\n"
-            f"CC ?= cc\nCFLAGS ?= {_CFLAGS}\nCPPFLAGS += -I. -I{_DAQP}\n"
+            f"CC ?= cc\nCFLAGS ?= {_CFLAGS}\nCPPFLAGS += {cppflags}\n"
             f"LDLIBS = -lm -lpthread\n\n"
             f"{lib}: {srcs} mpcwt_discon.h\n"
             f"\t$(CC) $(CPPFLAGS) $(CFLAGS) -shared -o $@ {srcs} $(LDLIBS)\n\n"
@@ -757,8 +804,9 @@ def build_library(directory: str | Path, kind: str, *, compiler: str | None = No
     flags = (_SANITIZE if sanitize else _CFLAGS).split()
     if sanitize:
         flags += ["-fPIC"]
-    cmd = [cc, f"-I{directory}", f"-I{directory / _DAQP}", *flags, "-shared", "-o", str(lib),
-           *[str(directory / n) for n in _c_files()], "-lm"]
+    flags += _defines(directory)            # relative to the folder, the compiler's cwd
+    cmd = [cc, f"-I{directory}", *flags, "-shared", "-o", str(lib),
+           *[str(directory / n) for n in _c_files(directory)], "-lm"]
     if sys.platform != "win32":
         cmd.append("-lpthread")
     key = _build_key(directory, cc, flags)
@@ -784,7 +832,7 @@ def _digest(data: bytes) -> str:
 def _build_key(directory: Path, cc: str, flags: list[str]) -> tuple[str, ...]:
     """What a build depends on: the compiler, its flags and every source file's bytes."""
     src = b"".join(n.encode() + b"\0" + (directory / n).read_bytes() + b"\0"
-                   for n in _source_names() if n.endswith((".c", ".h")))
+                   for n in _source_names(directory) if n.endswith((".c", ".h")))
     return (cc, *flags, sys.platform, _digest(src))
 
 
@@ -933,7 +981,7 @@ def export_controller(controller: Any, kind: str, turbine: linearize.Turbine,
     stem = _stem(kind)
     input_file = directory / f"{stem}.in"
     input_file.write_text(text)
-    sources = _copy_sources(directory)
+    sources = _copy_sources(directory, kind)
     lib_name = library_name(kind)
     makefile = _makefile(directory, lib_name)
     notes = []

@@ -114,7 +114,7 @@ def run_solver_benchmark(steps: int = 3000, progress: bool = True) -> dict[str, 
                            "solvers": []}
     backends = ["osqp"] + ["daqp"] * backend_installed("daqp")
     if "daqp" not in backends:
-        res["daqp"] = "not installed (pip install 'mpc-wt[daqp]')"
+        res["daqp"] = "not installed (pip install 'daqp>=0.11')"
     res["closed_loop_backend"] = default_backend()
     rec = _record_closed_loop(t, model, steps, res, progress)
     ctl = rec["controller"]

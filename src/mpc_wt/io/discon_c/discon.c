@@ -95,7 +95,12 @@ static mw_ctrl *create(const char *path, const float *swap, char *msg)
     if (strcmp(kind, "baseline") == 0)
         c = mw_baseline_new(&in, msg);
     else if (strcmp(kind, "mpc") == 0)
+#ifdef MPCWT_WITH_MPC
         c = mw_mpc_new(&in, msg);
+#else
+        mw_msg(msg, "mpc-wt controller: input file '%s': kind 'mpc' needs a library built with "
+               "the MPC and its QP solver; export an MPC kind to build one", path);
+#endif
     else if (strcmp(kind, "lqr") == 0)
         c = mw_lqr_new(&in, msg);
     else if (strcmp(kind, "ts") == 0)
