@@ -50,11 +50,17 @@ def _condition(raw: Mapping[str, Any] | None) -> dict[str, Any]:
 def design_controller(turbine: linearize.Turbine, controller: str,
                       options: Mapping[str, Any] | None = None, *,
                       cache: DesignCache = DEFAULT_CACHE, naming: Naming = API_NAMING,
-                      params: linearize.PlantParams | None = None) -> tuple[Built, bool]:
+                      params: linearize.PlantParams | None = None,
+                      shipped: bool = False) -> tuple[Built, bool]:
     """The design of a controller for a turbine: made once and kept in ``cache`` (keyed on the
     turbine's content, the name and the options), so that every case after the first runs the
     same design (``reset()`` between runs). The build sees the turbine, its options and the
     harness's step only (:class:`~mpc_wt.registry.context.BuildContext`).
+
+    With ``shipped``, a kind that exports (:data:`mpc_wt.io.discon_export.EXPORTABLE`) runs as
+    it is shipped: its design's numbers in the input file of its compiled C law, which the host
+    calls as OpenFAST's ServoDyn does (:class:`~mpc_wt.controllers.discon.DisconController`, in
+    this process).
 
     Parameters
     ----------
@@ -70,22 +76,27 @@ def design_controller(turbine: linearize.Turbine, controller: str,
         How error messages name options.
     params : PlantParams, optional
         The turbine's plant parameters, if already derived.
+    shipped : bool
+        The design run as it is shipped, where the kind has a shipped law; False (default):
+        the design's Python objects (what an export writes out).
 
     Returns
     -------
     built : Built
         The design; ``meta["design"]`` holds its digest
-        (:func:`~mpc_wt.registry.context.design_digest`).
+        (:func:`~mpc_wt.registry.context.design_digest`, of the design's numbers either way).
     new : bool
         True when it was made now, False when it came from the cache.
     """
     sel = resolve(controller)
-    return _design(turbine, sel, sel.options(options, naming), cache, params)
+    return _design(turbine, sel, sel.options(options, naming), cache, params, shipped)
 
 
 def _design(turbine: linearize.Turbine, sel: Selection, opts: Sequence[Options],
-            cache: DesignCache, params: linearize.PlantParams | None) -> tuple[Built, bool]:
-    """The design of a resolved selection with checked options (see design_controller)."""
+            cache: DesignCache, params: linearize.PlantParams | None,
+            shipped: bool = False) -> tuple[Built, bool]:
+    """The design of a resolved selection with checked options (see design_controller); with
+    ``shipped``, that design run as it is shipped where its last part has a shipped law."""
     made: list[bool] = []
 
     def make() -> Built:
@@ -103,7 +114,14 @@ def _design(turbine: linearize.Turbine, sel: Selection, opts: Sequence[Options],
         return built
 
     key = ("built", sel.name, tuple(repr(o) for o in opts))
-    return cache.get(turbine, key, make), bool(made)
+    built = cache.get(turbine, key, make)
+    hook = sel.parts[-1].shipped
+    if not shipped or hook is None:
+        return built, bool(made)
+    ctx = BuildContext(turbine=turbine, params=params or linearize.plant_params(turbine),
+                       cache=cache)
+    return cache.get(turbine, ("shipped", *key[1:]),
+                     lambda: hook(ctx, sel, opts[-1], built)), bool(made)
 
 
 def build_controller(turbine: linearize.Turbine, controller: str, scenario: Scenario,
@@ -111,7 +129,7 @@ def build_controller(turbine: linearize.Turbine, controller: str, scenario: Scen
                      cache: DesignCache = DEFAULT_CACHE, naming: Naming = API_NAMING,
                      params: linearize.PlantParams | None = None,
                      samplers: lidar.SamplerCache | None = None,
-                     fields: FieldMemo | None = None
+                     fields: FieldMemo | None = None, shipped: bool = False
                      ) -> tuple[Built, linearize.OperatingPoint, Any]:
     """The controller's design (:func:`design_controller`, from the cache when it is there),
     the scenario's trim point and wind, and the design's LIDARs bound to the wind they see.
@@ -139,6 +157,9 @@ def build_controller(turbine: linearize.Turbine, controller: str, scenario: Scen
         Keeps the scenario's fields for the next run of the same scenario (default: the
         process's :data:`~mpc_wt.simulation.scenario.DEFAULT_FIELDS`; ``FieldMemo(0)`` keeps
         none).
+    shipped : bool
+        Run a kind that exports as it is shipped, its compiled C law; False (default): the
+        design's Python step (:func:`design_controller`).
 
     Returns
     -------
@@ -158,7 +179,7 @@ def build_controller(turbine: linearize.Turbine, controller: str, scenario: Scen
     sel = resolve(controller)
     opts = sel.options(options, naming)
     op = _operating_point(turbine, sel, opts, scenario)
-    built, new = _design(turbine, sel, opts, cache, params)
+    built, new = _design(turbine, sel, opts, cache, params, shipped)
     comps = sel.field_components
     lidars = len(built.sensors) + (built.preview is not None)
     fields = DEFAULT_FIELDS if fields is None else fields
@@ -214,7 +235,8 @@ def run_controller(turbine: linearize.Turbine, controller: str, scenario: Scenar
                    turbulence: str | float | None = None, seed: int | None = None,
                    duration: float | None = None, shear_exponent: float | None = None,
                    condition: Mapping[str, Any] | None = None,
-                   plant: Mapping[str, bool] | None = None) -> ClosedLoopResult:
+                   plant: Mapping[str, bool] | None = None,
+                   shipped: bool = False) -> ClosedLoopResult:
     """Trim, build the controller, generate the scenario's wind and simulate.
 
     Parameters
@@ -242,7 +264,7 @@ def run_controller(turbine: linearize.Turbine, controller: str, scenario: Scenar
     cache : DesignCache
         For designs that cost seconds (the TS LMIs), keyed on the turbine's content.
     naming : Naming
-        How error messages name options.
+        How messages name options.
     samplers, fields : lidar.SamplerCache, FieldMemo, optional
         Keep the generator's sampler and the fields for the next runs (the same fields with or
         without them); fields default to :data:`~mpc_wt.simulation.scenario.DEFAULT_FIELDS`.
@@ -255,6 +277,8 @@ def run_controller(turbine: linearize.Turbine, controller: str, scenario: Scenar
     plant : mapping of str to bool, optional
         The plant's effects switched from their defaults (``meta["plant"]``), e.g.
         ``{"twisted_modes": True}`` (:meth:`linearize.PlantConfig.with_switches`).
+    shipped : bool
+        An exportable kind runs its compiled C law (``meta["law"]``); False: its Python step.
 
     Returns
     -------
@@ -269,22 +293,27 @@ def run_controller(turbine: linearize.Turbine, controller: str, scenario: Scenar
     TypeError
         Scenario fields given beside a whole :class:`Scenario`.
     SimulationDivergedError
-        If the run leaves the physical envelope (``.partial`` keeps what was simulated).
+        The run left the physical envelope (``.partial`` keeps what was simulated).
     """
-    scenario = _scenario_of(scenario, {"turbulence": turbulence, "seed": seed,
-                                       "duration": duration, "shear_exponent": shear_exponent,
-                                       "condition": condition})
+    scenario = _scenario_of(scenario, dict(turbulence=turbulence, seed=seed, duration=duration,
+                                           shear_exponent=shear_exponent, condition=condition))
     params = linearize.plant_params(turbine, linearize.PlantConfig().with_switches(plant))
     built, op, wind = build_controller(turbine, controller, scenario, options, cache=cache,
                                        naming=naming, params=params, samplers=samplers,
-                                       fields=fields)
-    meta = {"controller": controller, **scenario.meta(), "turbine": turbine.name,
-            **built.meta, **({} if scenario.wind_file is None else {"start_wind_mps": op.wind_mps}),
-            **({"plant": {k: bool(v) for k, v in plant.items()}} if plant else {})}
+                                       fields=fields, shipped=shipped)
+    meta = _run_meta(controller, scenario, turbine, built, op, plant)
     return _warned(simulate_closed_loop(
         params, _supervised(built.controller, turbine, supervisor, meta), wind,
         scenario.duration, x0=op.x, u0=op.u, controller_dt=built.controller_dt,
         preview=built.preview, progress=progress, meta=meta), controller)
+
+
+def _run_meta(controller: str, scenario: Scenario, turbine: linearize.Turbine, built: Built,
+              op: linearize.OperatingPoint, plant: Mapping[str, bool] | None) -> dict[str, Any]:
+    """A run's metadata: the controller, the case, the turbine, the design and the plant."""
+    return {"controller": controller, **scenario.meta(), "turbine": turbine.name, **built.meta,
+            **({} if scenario.wind_file is None else {"start_wind_mps": op.wind_mps}),
+            **({"plant": {k: bool(v) for k, v in plant.items()}} if plant else {})}
 
 
 def _supervised(ctl: Any, turbine: linearize.Turbine, supervisor: Mapping[str, Any] | None,

@@ -36,7 +36,7 @@ import linearize
 from mpc_wt.errors import ControllerLibraryError
 
 __all__ = ["DisconExport", "EXPORTABLE", "REBUILT", "export_controller", "export_design", "controller_input",
-           "check_exportable", "prepare_sources",
+           "check_exportable", "prepare_sources", "shipped_library", "shipped_input",
            "build_library",
            "find_compiler", "library_name", "servodyn_input", "SWAP_READ", "SWAP_WRITTEN"]
 
@@ -859,6 +859,107 @@ def _reuse_build(key: tuple[str, ...], lib: Path) -> bool:
 
 
 #: ServoDyn inputs of the packaged OpenFAST decks, by turbine name prefix.
+#: This process's libraries of the shipped laws: (core or mpc, compiler) -> the library
+_SHIPPED: dict[tuple[bool, str], Path] = {}
+_INPUTS: dict[str, Path] = {}
+_INPUT_DIR: list[Path] = []
+
+
+def shipped_library(kind: str, *, compiler: str | None = None) -> Path:
+    """The library a kind exports as, compiled once per machine and kept in the per-user cache
+    (:func:`mpc_wt.io.solver_sources.cache_dir`, ``libraries/``): the law mpc-wt's own runs
+    call, the same bytes a user's export builds.
+
+    Parameters
+    ----------
+    kind : str
+        An exportable kind (the MPC kinds share one library, every other kind another).
+    compiler : str, optional
+        The C compiler (default :func:`find_compiler`).
+
+    Returns
+    -------
+    Path
+        The library; a new build where the sources, compiler or flags changed.
+
+    Raises
+    ------
+    ControllerLibraryError
+        No C compiler, or the build failed.
+    SolverSourceError
+        An MPC kind whose QP solver's sources cannot be had.
+    """
+    import tempfile
+
+    from mpc_wt.io.solver_sources import cache_dir
+
+    check_exportable(kind)
+    cc = compiler or find_compiler()
+    if cc is None:
+        raise ControllerLibraryError(
+            f"controller kind {kind!r} runs its exported C law, and no C compiler was found "
+            f"(looked for $CC, cc, gcc, clang): install one (e.g. build-essential, Xcode's "
+            f"command line tools, MSYS2)")
+    memo = (_needs_qp(kind), cc)
+    if memo in _SHIPPED and _SHIPPED[memo].is_file():
+        return _SHIPPED[memo]
+    name = library_name("mpc" if _needs_qp(kind) else "core")
+    with tempfile.TemporaryDirectory(prefix="mpcwt_shipped_") as tmp:
+        folder = Path(tmp)
+        _copy_sources(folder, kind)
+        flags = _CFLAGS.split() + _defines(folder)
+        key = _digest("\0".join(_build_key(folder, cc, flags)).encode())[:24]
+        target = cache_dir() / "libraries" / key / name
+        if not target.is_file():
+            lib = build_library(folder, kind, compiler=cc, name=name)
+            target.parent.mkdir(parents=True, exist_ok=True)
+            part = target.with_name(f"{name}.{os.getpid()}.part")
+            shutil.copy2(lib, part)
+            os.replace(part, target)      # whole or not at all, also for a parallel worker
+            log.info("the %s law's library built and cached at %s", kind, target)
+    _SHIPPED[memo] = target
+    return target
+
+
+def shipped_input(controller: Any, kind: str, turbine: linearize.Turbine,
+                  preview: Any = None) -> Path:
+    """A designed controller's input file for its library (:func:`controller_input`), written
+    once per content into a folder kept for this process.
+
+    Parameters
+    ----------
+    controller : object
+        The design (of the type its kind builds).
+    kind : str
+        Its kind (one of :data:`EXPORTABLE`).
+    turbine : Turbine
+        Its turbine.
+    preview : LidarPreview, optional
+        The design's LIDAR preview (the LIDAR kinds).
+
+    Returns
+    -------
+    Path
+        The input file.
+    """
+    import atexit
+    import tempfile
+
+    text = controller_input(controller, kind, turbine, "the design mpc-wt runs", preview)
+    key = _digest(text.encode())
+    hit = _INPUTS.get(key)
+    if hit is not None and hit.is_file():
+        return hit
+    if not _INPUT_DIR or not _INPUT_DIR[0].is_dir():
+        d = Path(tempfile.mkdtemp(prefix="mpcwt_inputs_"))
+        atexit.register(shutil.rmtree, d, ignore_errors=True)
+        _INPUT_DIR[:] = [d]
+    path = _INPUT_DIR[0] / f"{_stem(kind)}_{key[:16]}.in"
+    path.write_text(text)
+    _INPUTS[key] = path
+    return path
+
+
 def _deck_servodyn(turbine: linearize.Turbine) -> Path | None:
     name = turbine.name
     if name.startswith("IEA-15-240-RWT"):

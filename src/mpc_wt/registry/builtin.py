@@ -30,6 +30,36 @@ __all__ = ["BaselineOptions", "DerateOptions", "APCOptions", "IBCOptions", "Cole
            "DisconOptions", "RoscoOptions"]
 
 
+# -- the shipped laws: a kind that exports runs its compiled C law --------------------------
+def _shipped(kind: str, base: str | None = None) -> Any:
+    """The ``shipped`` hook of an exportable kind: the design's numbers written to its input
+    file, its compiled library (:func:`mpc_wt.io.discon_export.shipped_library`) called through
+    the host in this process, every run of the kind then calls the law users run in OpenFAST.
+    ``base``: for an add-on, the base its export is made on (another base keeps the Python
+    step). A design with options the library does not take (an MPC on OSQP, the sparse
+    formulation) keeps its Python step too; the run's metadata says which law ran."""
+    def hook(ctx: BuildContext, sel: Any, opts: Any, built: Built) -> Built:
+        from mpc_wt.controllers.discon import DisconController
+        from mpc_wt.io.discon_export import shipped_input, shipped_library
+
+        if base is not None and sel.base.name != base:
+            return built
+        try:
+            infile = shipped_input(built.controller, kind, ctx.turbine, built.preview)
+        except ValueError as err:
+            log.info("%s: the design does not export (%s); its Python step runs", kind, err)
+            return dataclasses.replace(built, meta={**built.meta, "law": "python"})
+        dt = float(built.controller.dt)
+        ctl = DisconController(shipped_library(kind), infile, ctx.turbine, dt=dt,
+                               lidar=built.sensors[-1] if built.sensors else None,
+                               isolate=False)
+        ctl.design = built.controller
+        return dataclasses.replace(built, controller=ctl, controller_dt=dt, preview=None,
+                                   meta={**built.meta, "law": "shipped",
+                                         "library": ctl.library.name})
+    return hook
+
+
 # -- designs behind `mpcwt design` ------------------------------------------------------------
 def _design_ibc(turbine: linearize.Turbine, *, power_fraction: float = 1.0,
                 loop_gain: float | None = None) -> tuple[dict, str]:
@@ -199,10 +229,10 @@ def _design_baseline(turbine: linearize.Turbine, *, omega_n_rad_s: float | None 
 
 
 register("baseline", BaselineOptions, field_components="u", design=_design_baseline,
-         summary="tuned PI pitch and torque law, constant power in region III (80 Hz)"
+         shipped=_shipped("baseline"), summary="tuned PI pitch and torque law, constant power in region III (80 Hz)"
          )(_baseline("constant_power"))
 register("baseline-ct", BaselineOptions, field_components="u",
-         summary="the baseline with constant torque in region III (Do et al.'s PI)"
+         shipped=_shipped("baseline-ct"), summary="the baseline with constant torque in region III (Do et al.'s PI)"
          )(_baseline("constant_torque"))
 register("derate", DerateOptions, field_components="u", pattern=r"derate(\d+(?:\.\d+)?)",
          pattern_options=_derate_preset, pattern_help="derateNN (NN % of rated power)",
@@ -244,7 +274,7 @@ class IBCOptions(Options):
 
 
 @register("ibc", IBCOptions, field_components="u", addon_to=("baseline", "derate"),
-          default_base="baseline", design=_design_ibc,
+          default_base="baseline", design=_design_ibc, shipped=_shipped("ibc", "baseline"),
           group="the ibc controllers",
           summary="individual blade control on a baseline (ibc, derateNN+ibc)")
 def _build_ibc(ctx: BuildContext, opts: IBCOptions, base: Built) -> Built:
@@ -721,15 +751,16 @@ def _design_mpc(collective: bool, with_lidar: bool = False) -> Any:
 
 _MPC_GROUP = "the MPC controllers"
 register("mpc", MPCOptions, field_components="u", group=_MPC_GROUP, design=_design_mpc(False),
+         shipped=_shipped("mpc"),
          summary="Madsen's Coleman-weighted individual-pitch MPC, scheduled from cut-in to "
                  "cut-out on the estimated wind, Kalman estimator (without a preview no cyclic "
                  "pitch unless weights.flap_moment is set)"
          )(_mpc(False, False))
 register("mpc-collective", MPCOptions, field_components="u", group=_MPC_GROUP,
-         design=_design_mpc(True),
+         design=_design_mpc(True), shipped=_shipped("mpc-collective"),
          summary="the scheduled MPC with one collective pitch input")(_mpc(True, False))
 register("mpc-lidar", MPCLidarOptions, field_components="u", group=_MPC_GROUP,
-         design=_design_mpc(False, True), summary="the individual-pitch MPC with a CW LIDAR's per-blade preview "
+         design=_design_mpc(False, True), shipped=_shipped("mpc-lidar"), summary="the individual-pitch MPC with a CW LIDAR's per-blade preview "
                  "(range weighting, LOS error and wind evolution on)")(_mpc(False, True))
 
 
@@ -892,6 +923,7 @@ def _design_lqr_pio(turbine: linearize.Turbine) -> tuple[dict, str]:
 
 
 @register("lqr-pio", LQRPIOOptions, field_components="u", design=_design_lqr,
+          shipped=_shipped("lqr-pio"),
           design_name="lqr", more_designs=(("lqr-pio", _design_lqr_pio),),
           summary="Do et al.'s LQR with a PI observer, scheduled from cut-in to cut-out on the "
                   "estimated wind (region II below rated, III above)")
@@ -1020,7 +1052,7 @@ class TSOptions(Options):
                                       "default: it leaves that mode to its own damping")
 
 
-@register("ts", TSOptions, field_components="u", design=_design_ts,
+@register("ts", TSOptions, field_components="u", design=_design_ts, shipped=_shipped("ts"),
           summary="Clemens et al.'s Takagi-Sugeno controller and wind observer (LMI gains)")
 def _build_ts(ctx: BuildContext, opts: TSOptions) -> Built:
     from mpc_wt.controllers.apc import apc_reference
@@ -1348,6 +1380,7 @@ def _design_lidar_ff(turbine: linearize.Turbine) -> tuple[dict, str]:
 
 @register("lidar-ff", LidarFFOptions, addon_to=("baseline", "derate"), default_base="baseline",
           field_components="u", group="the lidar feedforward", design=_design_lidar_ff,
+          shipped=_shipped("baseline+lidar-ff", "baseline"),
           design_name="baseline+lidar-ff",
           summary="collective pitch feedforward from the CW LIDAR on a baseline "
                   "(baseline+lidar-ff, derate80+lidar-ff)")

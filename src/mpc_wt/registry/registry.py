@@ -72,6 +72,11 @@ class ControllerKind:
         meets only u either way). A LIDAR that takes its field from
         ``ctx.lidar_field`` (all the built-in ones) needs only "u": that field is made whole
         from the case's seed.
+    shipped : callable, optional
+        ``shipped(ctx, selection, options, built) -> Built``: the design as it is shipped (its
+        compiled library in the loop through the host), which every run then calls; it returns
+        ``built`` unchanged for a composition that has no shipped law. Applied once the whole
+        composition is built, by its last part. None: the kind's Python step is its law.
     """
 
     name: str
@@ -89,6 +94,7 @@ class ControllerKind:
     more_designs: tuple[tuple[str, Callable[..., Any]], ...] = ()
     group: str = ""
     field_components: str = "uvw"
+    shipped: Callable[..., Any] | None = None
 
     @property
     def is_addon(self) -> bool:

@@ -1,0 +1,57 @@
+"""Each exportable kind's shipped law (its compiled C library through the host, as
+``run_controller(..., shipped=True)`` runs it) against the design's Python step on the same case:
+the largest pitch and torque differences over the run, and each run's wall time.
+
+Run:  python benchmarks/study_shipped_law.py [--wind 14] [--duration 120] [--seed 11]
+                                             [--kinds baseline mpc ...]
+
+The two runs share the case's field (``FieldMemo``); the design is made once (before the first
+run's clock starts) and shared by both.
+"""
+from __future__ import annotations
+
+import argparse
+import platform
+import time
+
+import numpy as np
+
+import linearize
+from mpc_wt.io.discon_export import EXPORTABLE
+from mpc_wt.run import design_controller, run_controller
+from mpc_wt.simulation.scenario import FieldMemo
+
+
+def main() -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--wind", type=float, default=14.0, help="[m/s]")
+    ap.add_argument("--duration", type=float, default=120.0, help="[s]")
+    ap.add_argument("--seed", type=int, default=11)
+    ap.add_argument("--kinds", nargs="+", default=sorted(EXPORTABLE))
+    args = ap.parse_args()
+    t = linearize.load_turbine("nrel5mw")
+    fields = FieldMemo()
+    print(f"# {time.strftime('%Y-%m-%d %H:%M')} {platform.machine()} Python "
+          f"{platform.python_version()}; NREL 5-MW, {args.wind:g} m/s, class A, seed "
+          f"{args.seed}, {args.duration:g} s")
+    print("| kind | law | largest pitch difference [deg] | largest torque difference [rated] "
+          "| shipped [s] | Python [s] |\n|---|---|---|---|---|---|")
+    kw = dict(duration=args.duration, turbulence="A", seed=args.seed, fields=fields)
+    for kind in args.kinds:
+        design_controller(t, kind)
+        design_controller(t, kind, shipped=True)
+        runs = []
+        for shipped in (True, False):
+            t0 = time.perf_counter()
+            r = run_controller(t, kind, args.wind, shipped=shipped, **kw)
+            runs.append((r, time.perf_counter() - t0))
+        (a, ta), (b, tb) = runs
+        dp = float(np.degrees(np.max(np.abs(a.u[:, :3] - b.u[:, :3]))))
+        dq = float(np.max(np.abs(a.u[:, 3] - b.u[:, 3]))) / t.rated_generator_torque
+        print(f"| {kind} | {a.meta.get('law', 'python')} | {dp:.2e} | {dq:.2e} | {ta:.2f} | "
+              f"{tb:.2f} |")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
