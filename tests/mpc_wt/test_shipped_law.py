@@ -7,6 +7,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+import linearize
+
 from mpc_wt.io.discon_export import EXPORTABLE, find_compiler, shipped_library
 from mpc_wt.io.solver_sources import cache_dir
 from mpc_wt.run import export_discon, run_controller
@@ -68,3 +70,75 @@ def test_the_guides_python_examples_run(tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)
     for code in blocks:
         exec(compile(code, str(guide), "exec"), {"__name__": "__guide__"})
+
+
+def _both_paths(turbine, kind, wind, options=None, duration=30.0):
+    """The same case with the library called from the loop compiled with the plant and from
+    the Python loop through the host's ``step``."""
+    from mpc_wt.run import build_controller
+    from mpc_wt.simulation.loop import simulate_closed_loop
+    from mpc_wt.simulation.scenario import Scenario
+
+    sc = Scenario(wind_mps=wind, turbulence="A", seed=29, duration=duration)
+    out = []
+    for compiled in (True, False):
+        built, op, field = build_controller(turbine, kind, sc, options, shipped=True,
+                                            fields=_FIELDS)
+        out.append(simulate_closed_loop(linearize.plant_params(turbine), built.controller, field,
+                                        sc.duration, x0=op.x, u0=op.u,
+                                        controller_dt=built.controller_dt, compiled=compiled))
+    return out
+
+
+@pytest.mark.parametrize("kind, wind", [("baseline", 9.0), ("mpc", 16.0), ("lqr-pio", 13.0)])
+def test_the_compiled_loop_calls_the_library_as_the_host_does(turbine, kind, wind):
+    """The library called from the loop compiled with the plant gives the Python host's run to
+    the last bit: states, inputs and the host's signals."""
+    fast, slow = _both_paths(turbine, kind, wind)
+    np.testing.assert_array_equal(fast.x, slow.x)
+    np.testing.assert_array_equal(fast.u, slow.u)
+    assert sorted(fast.controller) == sorted(slow.controller)
+    for name in slow.controller:
+        np.testing.assert_array_equal(fast.controller[name], slow.controller[name])
+
+
+def test_the_compiled_loop_reports_warnings_and_stops_as_the_host(turbine, tmp_path, caplog):
+    """A QP time budget no solve meets: the library warns at every call (aviFAIL = 1), which
+    the compiled loop reports as the host does (the same log lines and warning signal); a
+    library that stops the run (a broken input file at the first call) stops it with its
+    message and nothing computed is lost."""
+    from mpc_wt.controllers.discon import DisconController
+    from mpc_wt.errors import ControllerLibraryError
+    from mpc_wt.simulation.loop import simulate_closed_loop
+
+    ex = export_discon(turbine, "mpc", tmp_path / "mpc")
+    inp = tmp_path / "budget.in"
+    inp.write_text(ex.input_file.read_text().replace("\nqp_time_budget_ms ",
+                                                     "\nqp_time_budget_ms 1e-9 # "))
+    op = linearize.trim(turbine, 14.0)
+    params = linearize.plant_params(turbine)
+    wind = linearize.SteadyWind(14.0)
+    logs = []
+    for compiled in (True, False):
+        ctl = DisconController(ex.library, inp, turbine, dt=0.1, isolate=False)
+        caplog.clear()
+        with caplog.at_level("WARNING", logger="mpc_wt.controllers.discon"):
+            r = simulate_closed_loop(params, ctl, wind, 3.0, x0=op.x, u0=op.u,
+                                     controller_dt=0.1, compiled=compiled)
+        logs.append(([m.getMessage() for m in caplog.records], r))
+    (fast_log, fast), (slow_log, slow) = logs
+
+    def untimed(msgs):                           # the QP's own solve time differs per run
+        import re
+        return [re.sub(r"took [0-9.e+-]+ ms", "took _ ms", m) for m in msgs]
+    assert len(fast_log) == 30 and untimed(fast_log) == untimed(slow_log)
+    np.testing.assert_array_equal(fast.controller["library_warning"],
+                                  slow.controller["library_warning"])
+    np.testing.assert_array_equal(fast.u, slow.u)
+    bad = tmp_path / "bad.in"
+    bad.write_text(ex.input_file.read_text().replace("\nkind mpc", "\nkind nothing"))
+    ctl = DisconController(ex.library, bad, turbine, dt=0.1, isolate=False)
+    with pytest.raises(ControllerLibraryError, match=r"stopped the run at t = 0 s .*'nothing'") \
+            as err:
+        simulate_closed_loop(params, ctl, wind, 3.0, x0=op.x, u0=op.u, controller_dt=0.1)
+    assert err.value.partial is not None

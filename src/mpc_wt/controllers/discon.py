@@ -308,6 +308,22 @@ class _ChildLibrary:
             self._mem.close()
 
 
+def _output_records() -> tuple[np.ndarray, np.ndarray]:
+    """The swap records (0-based) :meth:`DisconController._fill` takes from the plant's
+    outputs, and those outputs' indices (:data:`linearize.OUTPUT_NAMES`): the rest of its
+    records (status, time, last pitch demand, hub wind) the compiled loop writes itself."""
+    import linearize
+
+    z = {n: i for i, n in enumerate(linearize.OUTPUT_NAMES)}
+    pairs = [(3, 1), (32, 2), (33, 3), (13, z["aero_power"]), (14, z["gen_power"]),
+             (19, z["gen_speed"]), (20, z["rotor_speed"]), (22, z["gen_torque"]),
+             (29, 10), (30, 11), (31, 12), (68, 13), (69, 14), (70, 15),
+             (52, z["tower_fa_acceleration"]), (53, z["tower_ss_acceleration"]),
+             (59, z["azimuth"]), (74, z["tilt_moment"]), (75, z["yaw_moment"]),
+             (108, z["lss_torque"]), (109, z["thrust"])]
+    return (np.array([r for r, _ in pairs], np.int64), np.array([i for _, i in pairs], np.int64))
+
+
 def _signal_name(num: int) -> str:
     import signal
 
@@ -581,6 +597,75 @@ class DisconController(ControllerBase):
         if text:
             self.messages.append(f"t = {t:g} s: {text}")
             log.warning("%s at t = %g s: %s", self.library.name, t, text)
+
+    # -- the closed loop compiled with the plant ----------------------------------------------
+    def compiled_library(self) -> tuple[Any, ...] | None:
+        """What the closed loop compiled with the plant needs to call the library itself
+        (:func:`mpc_wt.simulation.compiled.run_library_steps`), after :meth:`reset`: ``DISCON``,
+        the swap array, ``aviFAIL``, the string buffers (input file, OUTNAME, message, OUTNAME's
+        text), the records filled from the plant's outputs and those outputs' indices, and the
+        host's state (status, last pitch demand, individual pitch, pitch limits, largest
+        torque). None where the loop cannot: a library in a child process, or a LIDAR's records
+        to fill.
+
+        Returns
+        -------
+        tuple or None
+        """
+        if self.isolate or self.lidar is not None or self._lib is None:
+            return None
+        bufs = np.zeros((4, _OUT_LEN), np.uint8)
+        bufs[0, :len(self._infile)] = np.frombuffer(self._infile, np.uint8)
+        bufs[3, :len(self._outname)] = np.frombuffer(self._outname, np.uint8)
+        lib = np.array([float(self._status), float(self._last_pitch[0]),
+                        1.0 if self.pitch_control == "individual" else 0.0, self._p_lo,
+                        self._p_hi, self._tq_hi])
+        rec, zi = _output_records()
+        fn = self._lib["DISCON"]                  # its own function object, pointer arguments
+        fn.restype, fn.argtypes = None, [ctypes.c_void_p] * 5
+        return (fn, self._view, np.zeros(1, np.int32), bufs, rec, zi, lib)
+
+    def compiled_report(self, t: float, call: tuple[Any, ...]) -> None:
+        """The compiled loop's word from the library at time ``t``: its ``aviFAIL`` and message
+        (as :meth:`step` reports them: a warning logged and kept, a stop raised).
+
+        Parameters
+        ----------
+        t : float
+            The call's time [s].
+        call : tuple
+            :meth:`compiled_library`'s arrays, as the loop left them.
+
+        Raises
+        ------
+        ControllerLibraryError
+            If the library stopped the run (``aviFAIL < 0``).
+        """
+        msg = bytes(call[3][2]).split(b"\0", 1)[0].decode(errors="replace").strip()
+        self._report(t, int(call[2][0]), msg)
+
+    def adopt_compiled_state(self, call: tuple[Any, ...], signals: np.ndarray) -> None:
+        """Take the state a compiled run left, so the host reads as if :meth:`step` had run
+        (the last call, :meth:`finalize`, then follows as usual).
+
+        Parameters
+        ----------
+        call : tuple
+            :meth:`compiled_library`'s arrays, as the loop left them.
+        signals : (4,) ndarray
+            The last call's signals (pitch command, torque command, contactor, warning).
+        """
+        lib = call[6]
+        self._status = int(lib[0])
+        if self._status == 0:
+            return
+        v = self._view
+        p = v[41:44].tolist() if lib[2] else [float(v[44])] * 3
+        self._last_pitch = np.array([lib[1], *p[1:]])
+        self._last_torque = float(signals[1])
+        self.signals = {"pitch_command": float(signals[0]), "torque_command": float(signals[1]),
+                        "generator_contactor": float(signals[2]),
+                        "library_warning": float(signals[3])}
 
     def step(self, t: float, meas: dict[str, Any]) -> tuple[np.ndarray, float]:
         """Fill the swap array, call the library, read its demands.

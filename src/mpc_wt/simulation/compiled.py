@@ -1,4 +1,5 @@
-"""The baseline's closed loop compiled with the plant.
+"""Closed loops compiled with the plant: the baseline's law, and any Bladed-style library
+loaded in this process.
 
 A closed loop in Python pays some 30 µs a plant step around an ~80 µs plant step: the
 measurement dict, the controller's call, the command checks, the signals. For the baseline PI
@@ -13,6 +14,12 @@ the last bit (the test compares them over turbulent runs in regions 2 and 3). It
 where the law is exactly that: no power reference, gain schedule or add-on feedforward
 (:meth:`~mpc_wt.controllers.baseline.BaselineController.compiled_law` says None otherwise),
 and no LIDAR.
+
+A controller library (:class:`~mpc_wt.controllers.discon.DisconController` with
+``isolate=False`` and no LIDAR) runs in the same compiled loop: the swap records filled from
+the plant's outputs, ``DISCON`` called through its function pointer, the demands read back, as
+:meth:`~mpc_wt.controllers.discon.DisconController.step` does them, record for record, so the
+two paths agree to the last bit (tested).
 """
 from __future__ import annotations
 
@@ -26,7 +33,7 @@ from linearize.jitcache import key_caches_on_callees
 from linearize.kernel import step_kernel
 from mpc_wt.controllers.baseline_law import law
 
-__all__ = ["run_steps"]
+__all__ = ["run_steps", "run_library_steps"]
 
 _JIT = dict(cache=True, error_model="numpy")
 
@@ -91,6 +98,118 @@ def run_steps(k0: int, k1: int, ratio: int, stepper: Any, arrays: tuple[np.ndarr
     """
     h, pk, kind, wpar, grid, hint, dphi, lim = stepper.kernel_args()
     done, flag = _loop(k0, k1, ratio, h, pk, kind, wpar, grid, hint, dphi, lim, *arrays)
+    return int(done), int(flag)
+
+
+@nb.njit(**_JIT)
+def _library_call(k, t, z, fn, swap, fail, bufs, rec, zi, hub, lib, cmd):  # pragma: no cover
+    """One call of the library at plant step ``k`` (time ``t``): the records of this call,
+    ``DISCON``, the demands into ``cmd`` (pitch 1-3, torque, contactor). ``lib`` holds the
+    status, the last pitch demand of blade 1, the individual-pitch flag, the pitch limits and
+    the largest torque. Returns aviFAIL, or 2 for a non-finite demand."""
+    swap[0] = lib[0]
+    swap[1] = t
+    swap[10] = lib[1]
+    swap[26] = hub[k]
+    for j in range(rec.size):
+        swap[rec[j]] = z[zi[j]]
+    fail[0] = 0
+    bufs[2, 0] = 0
+    bufs[1, :] = bufs[3, :]
+    fn(swap.ctypes, fail.ctypes, bufs[0].ctypes, bufs[1].ctypes, bufs[2].ctypes)
+    if fail[0] < 0:
+        return fail[0]
+    lib[0] = 1.0
+    if lib[2] != 0.0:
+        p0, p1, p2 = float(swap[41]), float(swap[42]), float(swap[43])
+    else:
+        p0 = p1 = p2 = float(swap[44])
+    contactor = float(swap[34])
+    torque = float(swap[46]) if contactor != 0.0 else 0.0
+    hi = lib[5]
+    if hi < torque <= hi * (1 + 1e-6):
+        torque = hi
+    cmd[0], cmd[1], cmd[2] = p0, p1, p2
+    for i in range(3):
+        if lib[3] - 1e-6 <= cmd[i] < lib[3]:
+            cmd[i] = lib[3]
+        elif lib[4] < cmd[i] <= lib[4] + 1e-6:
+            cmd[i] = lib[4]
+    cmd[3], cmd[4] = torque, contactor
+    if not (math.isfinite(cmd[0] + cmd[1] + cmd[2]) and math.isfinite(torque)):
+        return 2
+    lib[1] = cmd[0]
+    return fail[0]
+
+
+@nb.njit(**_JIT)
+def _library_loop(k0, k1, ratio, h, pk, kind, wpar, grid, hint, dphi, lim, xs, us, zs, u,
+                  held, fn, swap, fail, bufs, rec, zi, hub, lib, sigs, act, counts
+                  ):  # pragma: no cover - compiled
+    """:func:`_loop` with a controller library's call in place of the law. Returns (steps
+    done, -1 | the state leaving the envelope | -4 for aviFAIL < 0 | -5 after a step with a
+    warning (aviFAIL > 0), to be reported | -6 for a non-finite demand)."""
+    cmd = np.empty(5)
+    for k in range(k0, k1):
+        t = k * h
+        us[k] = u
+        bad = step_kernel(t, xs[k], u, h, pk, kind, wpar, grid, hint, dphi, lim, xs[k + 1],
+                          zs[k])
+        warned = 0
+        if k % ratio == 0:
+            flag = _library_call(k, t, zs[k], fn, swap, fail, bufs, rec, zi, hub, lib, cmd)
+            if flag < 0:
+                return k, -4
+            if flag == 2:
+                return k, -6
+            warned = flag
+            lo, hi = min(min(cmd[0], cmd[1]), cmd[2]), max(max(cmd[0], cmd[1]), cmd[2])
+            if not (act[1] <= lo and hi <= act[2] and act[3] <= cmd[3] <= act[4]):
+                if counts[0] == 0:
+                    counts[1] = k
+                counts[0] += 1
+            u[0], u[1], u[2] = cmd[0], cmd[1], cmd[2]
+            held[0] = cmd[3]
+            sigs[k, 0] = (cmd[0] + cmd[1] + cmd[2]) / 3.0
+            sigs[k, 1], sigs[k, 2], sigs[k, 3] = cmd[3], cmd[4], 1.0 if warned > 0 else 0.0
+        else:
+            sigs[k] = sigs[k - 1]
+        u[3] += min(max(held[0] - u[3], -act[0]), act[0])
+        if bad >= 0:
+            return k + 1, bad
+        if warned > 0:
+            return k + 1, -5
+    return k1, -1
+
+
+def run_library_steps(k0: int, k1: int, ratio: int, stepper: Any,
+                      arrays: tuple[Any, ...]) -> tuple[int, int]:
+    """Run plant steps ``k0`` to ``k1 - 1`` of a closed loop around a controller library.
+
+    Parameters
+    ----------
+    k0, k1 : int
+        The block of steps.
+    ratio : int
+        Plant steps per library call.
+    stepper : linearize.PlantStepper
+        The plant and its BEM warm start (advanced in place).
+    arrays : tuple
+        (xs, us, zs, u, held, DISCON, swap, aviFAIL, string buffers, records, output
+        indices, hub wind, library state, signals, actuator, counts), see
+        :func:`_library_loop`; written in place.
+
+    Returns
+    -------
+    done : int
+        Steps done.
+    flag : int
+        -1; the index of a state that left its envelope; -4: the library stopped the run at
+        step ``done``; -5: it warned at step ``done - 1``; -6: a non-finite demand at ``done``.
+    """
+    h, pk, kind, wpar, grid, hint, dphi, lim = stepper.kernel_args()
+    done, flag = _library_loop(k0, k1, ratio, h, pk, kind, wpar, grid, hint, dphi, lim,
+                               *arrays)
     return int(done), int(flag)
 
 

@@ -21,8 +21,11 @@ without the torque-rate limit.
 """
 from __future__ import annotations
 
+import contextlib
 import logging
 import math
+import os
+import sys
 from typing import Any
 
 import numpy as np
@@ -249,13 +252,94 @@ def _run_compiled(loop: _Loop, stepper: linearize.PlantStepper, ratio: int, bar:
                         counts[1] * dt)
 
 
+def _compiled_library(loop: _Loop, compiled: bool) -> Any:
+    """The controller library's arrays for the compiled loop (a library loaded in this
+    process, no LIDAR preview), else None."""
+    offer = getattr(loop.controller, "compiled_library", None)
+    if not compiled or loop.preview is not None or not callable(offer):
+        return None
+    return offer()
+
+
+def _run_library(loop: _Loop, stepper: linearize.PlantStepper, ratio: int, bar: Any,
+                 call: tuple[Any, ...]) -> None:
+    """:func:`_run` for a controller library loaded in this process
+    (:func:`mpc_wt.simulation.compiled.run_library_steps`): the same steps in compiled blocks
+    of 800; the library's warnings reported where they happen, its stop raised."""
+    from mpc_wt.simulation.compiled import run_library_steps
+
+    n, dt, ctl = loop.n, loop.dt, loop.controller
+    loop.xs[0] = loop.x
+    hub = (np.array([loop.hub_wind(k * dt) for k in range(n + 1)]) if loop.hub_wind is not None
+           else np.zeros(n + 1))
+    sigs = np.zeros((n + 1, 4))
+    held, counts = np.array([loop.u_tq]), np.zeros(2, dtype=np.int64)
+    act = np.array([loop.rate, loop._p_lo, loop._p_hi, loop._q_lo, loop._q_hi])
+    fn, swap, fail, bufs, rec, zi, lib = call
+    arrays = (loop.xs, loop.us, loop.zs, loop.u, held, fn, swap, fail, bufs, rec, zi, hub, lib,
+              sigs, act, counts)
+    loop.sig = {name: sigs[:, i] for i, name in
+                enumerate(("pitch_command", "torque_command", "generator_contactor",
+                           "library_warning"))}
+    try:
+        with _quiet(getattr(ctl, "quiet", False)):
+            k = 0
+            while k < n:
+                block = min(k + 800 - k % 800, n)
+                done, flag = run_library_steps(k, block, ratio, stepper, arrays)
+                loop.k_done = done
+                bar.update(done - k)
+                k = done
+                if flag == -5:                       # a warning at the step before
+                    ctl.compiled_report((done - 1) * dt, call)
+                elif flag == -4:
+                    ctl.compiled_report(done * dt, call)
+                elif flag == -6:
+                    raise ControllerLibraryError(
+                        f"controller library {ctl.library.name} returned pitch "
+                        f"{swap[41:44].tolist()} rad, torque {float(swap[46])} N m at "
+                        f"t = {done * dt:g} s")
+                elif flag >= 0:
+                    raise _Diverged(done, flag, float(loop.xs[done, flag]))
+        loop.us[n] = loop.u
+        loop.zs[n] = stepper.outputs(n * dt, loop.xs[n], loop.u)
+        sigs[n] = sigs[n - 1]
+    finally:
+        loop.clipped, loop.u_tq = int(counts[0]), float(held[0])
+        ctl.adopt_compiled_state(call, sigs[max(loop.k_done - 1, 0)])
+        if counts[0]:
+            log.warning("controller command out of the actuator range at t = %g s: the plant "
+                        "clips it; the count is in result.meta['commands_clipped']",
+                        counts[1] * dt)
+
+
+@contextlib.contextmanager
+def _quiet(on: bool) -> Any:
+    """Standard output to the null device while ``on`` (what a library prints)."""
+    if not on:
+        yield
+        return
+    sys.stdout.flush()
+    null, saved = os.open(os.devnull, os.O_WRONLY), os.dup(1)
+    os.dup2(null, 1)
+    try:
+        yield
+    finally:
+        os.dup2(saved, 1)
+        os.close(null)
+        os.close(saved)
+
+
 def _advance(loop: _Loop, stepper: linearize.PlantStepper, ratio: int, bar: Any,
              compiled: bool) -> None:
-    """The whole run: compiled where the controller offers a law (:func:`_run_compiled`), else
-    in Python (:func:`_run`)."""
+    """The whole run: compiled where the controller offers a law (:func:`_run_compiled`) or is
+    a library loaded in this process (:func:`_run_library`), else in Python (:func:`_run`)."""
     law = _compiled_law(loop, compiled)
+    call = None if law is not None else _compiled_library(loop, compiled)
     if law is not None:
         _run_compiled(loop, stepper, ratio, bar, law)
+    elif call is not None:
+        _run_library(loop, stepper, ratio, bar, call)
     else:
         _run(loop, stepper, ratio, bar)
 
@@ -326,8 +410,10 @@ def simulate_closed_loop(params: linearize.PlantParams, controller: Any,
     meta : dict, optional
         Configuration stored with the result.
     compiled : bool
-        Run a controller with a compiled law (the plain baseline, :mod:`mpc_wt.simulation.compiled`)
-        compiled with the plant (default: the same loop, 1.35x faster); False: in Python.
+        Run a controller with a compiled law (the plain baseline) or a controller library
+        loaded in this process (no LIDAR) in a loop compiled with the plant
+        (:mod:`mpc_wt.simulation.compiled`; default: the same loop to the last bit, faster);
+        False: in Python.
 
     Returns
     -------
