@@ -39,6 +39,19 @@ _JIT = dict(cache=True, error_model="numpy")
 
 
 @nb.njit(**_JIT)
+def _hold(k, cmd, u, held, act, counts):  # pragma: no cover - compiled
+    """Hold the commands of plant step ``k`` (pitch into ``u``, torque into ``held``),
+    counting those out of the actuator ranges ``act`` and the first step with one."""
+    lo, hi = min(min(cmd[0], cmd[1]), cmd[2]), max(max(cmd[0], cmd[1]), cmd[2])
+    if not (act[1] <= lo and hi <= act[2] and act[3] <= cmd[3] <= act[4]):
+        if counts[0] == 0:
+            counts[1] = k
+        counts[0] += 1
+    u[0], u[1], u[2] = cmd[0], cmd[1], cmd[2]
+    held[0] = cmd[3]
+
+
+@nb.njit(**_JIT)
 def _loop(k0, k1, ratio, h, pk, kind, wpar, grid, hint, dphi, lim, xs, us, zs, u, held, st,
           par, sigs, act, counts):  # pragma: no cover - compiled
     """Plant steps k0..k1-1 of the closed loop (simulate._run's order). ``u`` holds the
@@ -57,13 +70,7 @@ def _loop(k0, k1, ratio, h, pk, kind, wpar, grid, hint, dphi, lim, xs, us, zs, u
                 return k, -2
             if not (math.isfinite(cmd[0]) and math.isfinite(cmd[3])):
                 return k, -3
-            lo, hi = min(min(cmd[0], cmd[1]), cmd[2]), max(max(cmd[0], cmd[1]), cmd[2])
-            if not (act[1] <= lo and hi <= act[2] and act[3] <= cmd[3] <= act[4]):
-                if counts[0] == 0:
-                    counts[1] = k
-                counts[0] += 1
-            u[0], u[1], u[2] = cmd[0], cmd[1], cmd[2]
-            held[0] = cmd[3]
+            _hold(k, cmd, u, held, act, counts)
         else:
             sigs[k] = sigs[k - 1]
         u[3] += min(max(held[0] - u[3], -act[0]), act[0])
@@ -163,13 +170,7 @@ def _library_loop(k0, k1, ratio, h, pk, kind, wpar, grid, hint, dphi, lim, xs, u
             if flag == 2:
                 return k, -6
             warned = flag
-            lo, hi = min(min(cmd[0], cmd[1]), cmd[2]), max(max(cmd[0], cmd[1]), cmd[2])
-            if not (act[1] <= lo and hi <= act[2] and act[3] <= cmd[3] <= act[4]):
-                if counts[0] == 0:
-                    counts[1] = k
-                counts[0] += 1
-            u[0], u[1], u[2] = cmd[0], cmd[1], cmd[2]
-            held[0] = cmd[3]
+            _hold(k, cmd, u, held, act, counts)
             sigs[k, 0] = (cmd[0] + cmd[1] + cmd[2]) / 3.0
             sigs[k, 1], sigs[k, 2], sigs[k, 3] = cmd[3], cmd[4], 1.0 if warned > 0 else 0.0
         else:
