@@ -93,13 +93,35 @@ def _both_paths(turbine, kind, wind, options=None, duration=30.0):
 @pytest.mark.parametrize("kind, wind", [("baseline", 9.0), ("mpc", 16.0), ("lqr-pio", 13.0)])
 def test_the_compiled_loop_calls_the_library_as_the_host_does(turbine, kind, wind):
     """The library called from the loop compiled with the plant gives the Python host's run to
-    the last bit: states, inputs and the host's signals."""
+    the last bit: states, inputs, the host's signals and the library's logging channels (but
+    the QP's solve time, a clock's reading)."""
     fast, slow = _both_paths(turbine, kind, wind)
     np.testing.assert_array_equal(fast.x, slow.x)
     np.testing.assert_array_equal(fast.u, slow.u)
     assert sorted(fast.controller) == sorted(slow.controller)
     for name in slow.controller:
-        np.testing.assert_array_equal(fast.controller[name], slow.controller[name])
+        if name != "qp_solve_ms":
+            np.testing.assert_array_equal(fast.controller[name], slow.controller[name])
+
+
+@pytest.mark.parametrize("kind, wind", [("mpc", 14.0), ("mpc-lidar", 14.0), ("ts", 10.0)])
+def test_the_librarys_logging_channels_are_the_python_steps_signals(turbine, kind, wind):
+    """The shipped MPC's fallback level and schedule wind and the TS controller's wind
+    estimate and premise clips, returned as logging channels, are the Python step's signals
+    (the schedule and estimate to the float32 of the swap array: 1e-5 m/s); the QP's solve
+    time is a positive reading of the library's own clock."""
+    kw = dict(duration=30.0, turbulence="A", seed=31, fields=_FIELDS)
+    lib = run_controller(turbine, kind, wind, shipped=True, **kw)
+    py = run_controller(turbine, kind, wind, **kw)
+    for name in ("qp_fallback", "premise_clipped"):
+        if name in py.controller:
+            np.testing.assert_array_equal(lib.controller[name], py.controller[name])
+    for name in ("schedule_wind", "wind_est"):
+        if name in py.controller:
+            np.testing.assert_allclose(lib.controller[name], py.controller[name], rtol=0,
+                                       atol=1e-5)
+    if "qp_solve_ms" in py.controller:
+        assert np.all(lib.controller["qp_solve_ms"] > 0)
 
 
 def test_the_compiled_loop_reports_warnings_and_stops_as_the_host(turbine, tmp_path, caplog):

@@ -35,8 +35,8 @@ import numpy as np
 from mpc_wt.controllers.base import ControllerBase
 from mpc_wt.errors import ControllerLibraryError
 
-__all__ = ["DisconController", "SWAP_RECORDS", "SWAP_SIZE", "LIDAR_RECORDS", "rosco_library",
-           "rosco_discon"]
+__all__ = ["DisconController", "SWAP_RECORDS", "SWAP_SIZE", "LIDAR_RECORDS", "LOG_ROOM",
+           "LOG_START", "rosco_library", "rosco_discon"]
 
 log = logging.getLogger(__name__)
 
@@ -76,6 +76,8 @@ SWAP_RECORDS = {
     109: "low-speed-shaft torque [N m]", 110: "rotor thrust [N]", 129: "swap array length",
 }
 _LOG_START = 165
+#: The logging channels the host offers a library (record 62) and where they start (63).
+LOG_ROOM, LOG_START = 8, _LOG_START
 #: OpenFAST's lidar block of the extended swap array (ServoDyn's BladedInterface_EX: records
 #: 2001-2500), as :class:`DisconController` fills it from a CW LIDAR with three beams.
 LIDAR_RECORDS = {
@@ -369,6 +371,10 @@ class DisconController(ControllerBase):
         its process fails the run with its exit status and last output instead of ending the
         simulation's process. False loads it in this process (a private copy per controller;
         faster per call, uncontained).
+    log_names : tuple of str
+        The names of the logging channels the library returns (record 65 counts them, their
+        values from record :data:`LOG_START` on), recorded as signals; a channel without a
+        name is ``log_<i>``. The host offers :data:`LOG_ROOM` of them (record 62).
 
     Raises
     ------
@@ -380,7 +386,8 @@ class DisconController(ControllerBase):
     def __init__(self, library: str | Path, discon_in: str | Path, turbine: Any, *,
                  dt: float = 1.0 / 80.0, pitch_control: str = "individual",
                  workdir: str | Path | None = None, root_name: str = "mpcwt_discon",
-                 quiet: bool = True, lidar: Any = None, isolate: bool = True) -> None:
+                 quiet: bool = True, lidar: Any = None, isolate: bool = True,
+                 log_names: tuple[str, ...] = ()) -> None:
         self.library = Path(library).resolve()
         self.discon_in = Path(discon_in).resolve()
         _check_library(self.library)
@@ -402,6 +409,7 @@ class DisconController(ControllerBase):
         self.quiet = quiet
         self.lidar = lidar
         self.isolate = bool(isolate)
+        self.log_names = tuple(log_names)
         self._fds: tuple[int, int] | None = None
         self._lib: Any = None
         self._copy_dir: str | None = None
@@ -523,8 +531,8 @@ class DisconController(ControllerBase):
                  19: op.rated_rotor_speed_rad_s * n, 22: tb.rated_generator_torque, 24: 0.0,
                  28: 1.0 if self.pitch_control == "individual" else 0.0, 29: 0.0, 37: 0.0,
                  49: float(_MSG_LEN), 50: float(len(self._infile) + 1),
-                 51: float(len(self._outname) + 1), 61: 3.0, 62: 0.0, 63: float(_LOG_START),
-                 64: float(_OUT_LEN), 66: 1001.0, 95: tb.environment.air_density,
+                 51: float(len(self._outname) + 1), 61: 3.0, 62: float(LOG_ROOM),
+                 63: float(_LOG_START), 64: float(_OUT_LEN), 66: 1001.0, 95: tb.environment.air_density,
                  129: float(SWAP_SIZE)}
         self._view[np.array(list(fixed)) - 1] = np.array(list(fixed.values()), np.float32)
         self._msg = ctypes.create_string_buffer(_MSG_LEN)
@@ -619,7 +627,7 @@ class DisconController(ControllerBase):
         bufs[3, :len(self._outname)] = np.frombuffer(self._outname, np.uint8)
         lib = np.array([float(self._status), float(self._last_pitch[0]),
                         1.0 if self.pitch_control == "individual" else 0.0, self._p_lo,
-                        self._p_hi, self._tq_hi])
+                        self._p_hi, self._tq_hi, 0.0])
         rec, zi = _output_records()
         fn = self._lib["DISCON"]                  # its own function object, pointer arguments
         fn.restype, fn.argtypes = None, [ctypes.c_void_p] * 5
@@ -652,8 +660,9 @@ class DisconController(ControllerBase):
         ----------
         call : tuple
             :meth:`compiled_library`'s arrays, as the loop left them.
-        signals : (4,) ndarray
-            The last call's signals (pitch command, torque command, contactor, warning).
+        signals : (4 + n,) ndarray
+            The last call's signals (pitch command, torque command, contactor, warning, the
+            ``n`` logging channels).
         """
         lib = call[6]
         self._status = int(lib[0])
@@ -666,6 +675,23 @@ class DisconController(ControllerBase):
         self.signals = {"pitch_command": float(signals[0]), "torque_command": float(signals[1]),
                         "generator_contactor": float(signals[2]),
                         "library_warning": float(signals[3])}
+        self.signals.update(zip(self.compiled_signals(call)[4:], map(float, signals[4:])))
+
+    def compiled_signals(self, call: tuple[Any, ...]) -> list[str]:
+        """The names of the compiled loop's signal columns: the host's four, then the logging
+        channels the library returned.
+
+        Parameters
+        ----------
+        call : tuple
+            :meth:`compiled_library`'s arrays, as the loop left them.
+
+        Returns
+        -------
+        list of str
+        """
+        return ["pitch_command", "torque_command", "generator_contactor", "library_warning",
+                *self._log_keys(int(call[6][6]))]
 
     def step(self, t: float, meas: dict[str, Any]) -> tuple[np.ndarray, float]:
         """Fill the swap array, call the library, read its demands.
@@ -724,4 +750,13 @@ class DisconController(ControllerBase):
         self.signals = {"pitch_command": (p[0] + p[1] + p[2]) / 3.0,
                         "torque_command": torque, "generator_contactor": contactor,
                         "library_warning": float(self._warned)}
+        n = min(int(v[64]), LOG_ROOM)
+        if n > 0:
+            self.signals.update(zip(self._log_keys(n), v[_LOG_START - 1:_LOG_START - 1 + n]
+                                    .tolist()))
         return pitch, torque
+
+    def _log_keys(self, n: int) -> list[str]:
+        """The signal names of ``n`` logging channels."""
+        return [self.log_names[i] if i < len(self.log_names) else f"log_{i + 1}"
+                for i in range(n)]

@@ -37,6 +37,7 @@ from mpc_wt.errors import ControllerLibraryError
 
 __all__ = ["DisconExport", "EXPORTABLE", "REBUILT", "export_controller", "export_design", "controller_input",
            "check_exportable", "prepare_sources", "shipped_library", "shipped_input",
+           "LOG_CHANNELS", "log_channels",
            "build_library",
            "find_compiler", "library_name", "servodyn_input", "SWAP_READ", "SWAP_WRITTEN"]
 
@@ -72,6 +73,31 @@ REBUILT = frozenset(EXPORTABLE) - {"baseline", "baseline-ct"}
 _LIBRARY_KIND = {"baseline": "baseline", "baseline-ct": "baseline", "mpc": "mpc",
                  "mpc-collective": "mpc", "mpc-lidar": "mpc", "baseline+lidar-ff": "baseline",
                  "lqr-pio": "lqr", "ts": "ts", "ibc": "baseline"}
+
+#: The logging channels each library kind returns (records 65 and 63 on), in order: the
+#: signals a shipped run records beside the host's (the C laws fill them, ``mw_cmd.log``).
+LOG_CHANNELS: dict[str, tuple[str, ...]] = {
+    "mpc": ("qp_fallback", "qp_solve_ms", "schedule_wind"),
+    "ts": ("wind_est", "premise_clipped"),
+}
+
+
+def log_channels(kind: str) -> tuple[str, ...]:
+    """The logging channels of a kind's library (:data:`LOG_CHANNELS`).
+
+    Parameters
+    ----------
+    kind : str
+        An exportable kind.
+
+    Returns
+    -------
+    tuple of str
+        Empty for a library that returns none.
+    """
+    check_exportable(kind)
+    return LOG_CHANNELS.get(_LIBRARY_KIND[kind], ())
+
 
 #: The measured signals of the Kalman filter (MPC) and the observer (LQR-PIO) and their codes
 #: in the library.

@@ -40,7 +40,7 @@ def _shipped(kind: str, base: str | None = None) -> Any:
     formulation) keeps its Python step too; the run's metadata says which law ran."""
     def hook(ctx: BuildContext, sel: Any, opts: Any, built: Built) -> Built:
         from mpc_wt.controllers.discon import DisconController
-        from mpc_wt.io.discon_export import shipped_input, shipped_library
+        from mpc_wt.io.discon_export import log_channels, shipped_input, shipped_library
 
         if base is not None and sel.base.name != base:
             return built
@@ -52,7 +52,7 @@ def _shipped(kind: str, base: str | None = None) -> Any:
         dt = float(built.controller.dt)
         ctl = DisconController(shipped_library(kind), infile, ctx.turbine, dt=dt,
                                lidar=built.sensors[-1] if built.sensors else None,
-                               isolate=False)
+                               isolate=False, log_names=log_channels(kind))
         ctl.design = built.controller
         return dataclasses.replace(built, controller=ctl, controller_dt=dt, preview=None,
                                    meta={**built.meta, "law": "shipped",

@@ -146,7 +146,17 @@ def _library_call(k, t, z, fn, swap, fail, bufs, rec, zi, hub, lib, cmd):  # pra
     if not (math.isfinite(cmd[0] + cmd[1] + cmd[2]) and math.isfinite(torque)):
         return 2
     lib[1] = cmd[0]
+    n = min(int(swap[64]), cmd.size - 5)
+    for i in range(max(n, 0)):
+        cmd[5 + i] = swap[_log_start(swap) + i]
+    lib[6] = max(lib[6], float(n))
     return fail[0]
+
+
+@nb.njit(**_JIT)
+def _log_start(swap):  # pragma: no cover - compiled
+    """The 0-based index of the first logging channel (record 63's record number)."""
+    return int(swap[62]) - 1
 
 
 @nb.njit(**_JIT)
@@ -156,7 +166,7 @@ def _library_loop(k0, k1, ratio, h, pk, kind, wpar, grid, hint, dphi, lim, xs, u
     """:func:`_loop` with a controller library's call in place of the law. Returns (steps
     done, -1 | the state leaving the envelope | -4 for aviFAIL < 0 | -5 after a step with a
     warning (aviFAIL > 0), to be reported | -6 for a non-finite demand)."""
-    cmd = np.empty(5)
+    cmd = np.zeros(sigs.shape[1] + 1)
     for k in range(k0, k1):
         t = k * h
         us[k] = u
@@ -173,6 +183,8 @@ def _library_loop(k0, k1, ratio, h, pk, kind, wpar, grid, hint, dphi, lim, xs, u
             _hold(k, cmd, u, held, act, counts)
             sigs[k, 0] = (cmd[0] + cmd[1] + cmd[2]) / 3.0
             sigs[k, 1], sigs[k, 2], sigs[k, 3] = cmd[3], cmd[4], 1.0 if warned > 0 else 0.0
+            for i in range(4, sigs.shape[1]):
+                sigs[k, i] = cmd[i + 1]
         else:
             sigs[k] = sigs[k - 1]
         u[3] += min(max(held[0] - u[3], -act[0]), act[0])

@@ -272,15 +272,12 @@ def _run_library(loop: _Loop, stepper: linearize.PlantStepper, ratio: int, bar: 
     loop.xs[0] = loop.x
     hub = (np.array([loop.hub_wind(k * dt) for k in range(n + 1)]) if loop.hub_wind is not None
            else np.zeros(n + 1))
-    sigs = np.zeros((n + 1, 4))
+    fn, swap, fail, bufs, rec, zi, lib = call
+    sigs = np.zeros((n + 1, 4 + int(swap[61])))     # the host's signals, the logging channels
     held, counts = np.array([loop.u_tq]), np.zeros(2, dtype=np.int64)
     act = np.array([loop.rate, loop._p_lo, loop._p_hi, loop._q_lo, loop._q_hi])
-    fn, swap, fail, bufs, rec, zi, lib = call
     arrays = (loop.xs, loop.us, loop.zs, loop.u, held, fn, swap, fail, bufs, rec, zi, hub, lib,
               sigs, act, counts)
-    loop.sig = {name: sigs[:, i] for i, name in
-                enumerate(("pitch_command", "torque_command", "generator_contactor",
-                           "library_warning"))}
     try:
         with _quiet(getattr(ctl, "quiet", False)):
             k = 0
@@ -306,7 +303,8 @@ def _run_library(loop: _Loop, stepper: linearize.PlantStepper, ratio: int, bar: 
         sigs[n] = sigs[n - 1]
     finally:
         loop.clipped, loop.u_tq = int(counts[0]), float(held[0])
-        ctl.adopt_compiled_state(call, sigs[max(loop.k_done - 1, 0)])
+        loop.sig = {name: sigs[:, i] for i, name in enumerate(ctl.compiled_signals(call))}
+        ctl.adopt_compiled_state(call, sigs[max(loop.k_done - 1, 0), :len(loop.sig)])
         if counts[0]:
             log.warning("controller command out of the actuator range at t = %g s: the plant "
                         "clips it; the count is in result.meta['commands_clipped']",

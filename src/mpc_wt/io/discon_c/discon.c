@@ -149,6 +149,17 @@ static void read_meas(const float *s, mw_meas *m)
     }
 }
 
+/* the kind's logging channels at records L1 = record 63 on, their number in record 65, as
+ * far as the host has room for them (record 62, and the swap array's length in record 129) */
+static void write_log(float *s, const mw_cmd *c)
+{
+    int room = (int)s[61], first = (int)s[62], len = (int)s[128], n = c->nlog, i;
+    if (n > room) n = room;
+    if (n < 0 || first < 130 || first - 1 + n > len) n = 0;  /* no room the host offers */
+    for (i = 0; i < n; i++) s[first - 1 + i] = (float)c->log[i];
+    s[64] = (float)n;
+}
+
 static void write_cmd(float *s, const mw_cmd *c)
 {
     s[34] = 1.0f;                     /* 35: generator contactor on */
@@ -162,7 +173,7 @@ static void write_cmd(float *s, const mw_cmd *c)
     s[47] = 0.0f;                     /* 48: yaw rate demand */
     s[54] = 0.0f;                     /* 55: pitch override off */
     s[55] = 0.0f;                     /* 56: torque override off */
-    s[64] = 0.0f;                     /* 65: no logging channels */
+    write_log(s, c);                  /* 65 and L1 on: the logging channels */
 }
 
 MW_EXPORT void DISCON(float *avrSWAP, int *aviFAIL, const char *accINFILE, char *avcOUTNAME,
@@ -240,6 +251,7 @@ MW_EXPORT void DISCON(float *avrSWAP, int *aviFAIL, const char *accINFILE, char 
      * the interval is the design's (checked at the first call) */
     m.t = inst->t0 + (double)inst->calls * inst->ctrl->dt;
     inst->calls++;
+    cmd.nlog = 0;
     rc = inst->ctrl->step(inst->ctrl, &m, &cmd, msg);
     if (rc < 0) {
         *aviFAIL = -1;

@@ -81,6 +81,8 @@ typedef struct {
     int has_notch;                /* the notch on the torque command, its largest rate */
     mw_sos notch;
     double torque_rate;
+    int level;                    /* the last step's fallback (0: the QP's plan) */
+    double qp_ms;                 /* the last step's QP solve time [ms] */
 } mw_mpc;
 
 static double dmin(double a, double b) { return a < b ? a : b; }
@@ -442,6 +444,7 @@ static int point_step(mw_mpc *c, mw_point *p, const mw_meas *m, double *u, char 
         if (flag == 1 && !step_result(p)) flag = 0;
     }
     ms = now_ms() - t0;
+    c->qp_ms = ms;
     if (flag == 1 && c->qp_budget_ms > 0 && ms > c->qp_budget_ms) flag = -100;
     if (flag == 1) {
         int iv = p->nz + p->ny + p->nb;
@@ -474,6 +477,7 @@ static int point_step(mw_mpc *c, mw_point *p, const mw_meas *m, double *u, char 
     }
     for (i = 0; i < 3; i++) u[i] = dmin(dmax(u[i], p->limits[0]), p->limits[1]);
     u[3] = dmin(dmax(u[3], p->limits[2]), p->limits[3]);
+    c->level = level;
     return level ? 1 : 0;
 }
 
@@ -586,6 +590,10 @@ static int mpc_step(mw_ctrl *self, const mw_meas *m, mw_cmd *out, char *msg)
     }
     for (i = 0; i < 3; i++) out->pitch[i] = u[i];
     out->torque = u[3];
+    out->nlog = 3;                  /* qp_fallback, qp_solve_ms, schedule_wind */
+    out->log[0] = c->level;
+    out->log[1] = c->qp_ms;
+    out->log[2] = c->sched.wind;
     return rc;
 }
 

@@ -54,9 +54,15 @@ typedef struct {
     double los[3];         /* records 2005-2007 [m/s] */
 } mw_meas;
 
+/* logging channels a kind returns beside its demands (Bladed's records 65 and L1 = record 63
+ * on): each kind's are listed, in order, in mpc-wt's discon_export.LOG_CHANNELS */
+#define MW_LOG_MAX 8
+
 typedef struct {
     double pitch[3];       /* demands [rad] */
     double torque;         /* demand [N m] */
+    int nlog;              /* logging channels this step (0 to MW_LOG_MAX) */
+    double log[MW_LOG_MAX];
 } mw_cmd;
 
 /* measured signals an estimator reads, by code (the input file's lists of codes) */

@@ -52,6 +52,12 @@ static int hat(const double *g, int n, double s, double *w0, double *w1)
     return k;
 }
 
+/* whether the premise s lies outside the grid (and is clipped to it) */
+static int outside(const double *g, int n, double s)
+{
+    return s < g[0] || s > g[n - 1];
+}
+
 /* the tensor-product hats of eq 3 at (v, dp), vertex (a, b) at a n_r + b */
 static void memberships(const mw_ts *c, double v, double dp, double *h)
 {
@@ -149,7 +155,7 @@ static int ts_step(mw_ctrl *self, const mw_meas *m, mw_cmd *out, char *msg)
 {
     mw_ts *c = (mw_ts *)self;
     double raw[2], pitch, torque, q, lo, hi;
-    int b;
+    int b, clipped;
     if (mw_signals_get(m, c->signals, c->n_signals, c->y, "ts", msg)) return -1;
     if (!mw_finite(m->pitch[0] + m->pitch[1] + m->pitch[2]) || !mw_finite(m->gen_speed)) {
         mw_msg(msg, "mpc-wt ts: measured pitch (records 4, 33, 34) or generator speed (20) is "
@@ -157,7 +163,9 @@ static int ts_step(mw_ctrl *self, const mw_meas *m, mw_cmd *out, char *msg)
         return -1;
     }
     if (!c->started) start(c, (m->pitch[0] + m->pitch[1] + m->pitch[2]) / 3.0);
+    clipped = outside(c->wg, c->nw, c->xi[c->n - 1]) || outside(c->rg, c->nr, 0.0);
     observe(c);
+    clipped = clipped || outside(c->wg, c->nw, c->xi[c->n - 1]);
     q = law_pdc(c, raw);
     lo = c->limits[0];
     hi = c->limits[1];
@@ -185,6 +193,9 @@ static int ts_step(mw_ctrl *self, const mw_meas *m, mw_cmd *out, char *msg)
     }
     for (b = 0; b < 3; b++) out->pitch[b] = pitch;
     out->torque = torque;
+    out->nlog = 2;                  /* wind_est, premise_clipped */
+    out->log[0] = c->xi[c->n - 1];
+    out->log[1] = clipped;
     return 0;
 }
 
