@@ -3,7 +3,10 @@
 the largest pitch and torque differences over the run, and each run's wall time.
 
 Run:  python benchmarks/study_shipped_law.py [--wind 14] [--duration 120] [--seed 11]
-                                             [--kinds baseline mpc ...]
+                                             [--kinds baseline mpc ...] [--supervised]
+
+``--supervised`` runs every case under the supervisor with the sign-off's overspeed
+protection (1.25 x rated), as the sign-off does (its loop then runs in Python).
 
 The two runs share the case's field (``FieldMemo``); the design is made once (before the first
 run's clock starts) and shared by both.
@@ -28,15 +31,17 @@ def main() -> int:
     ap.add_argument("--duration", type=float, default=120.0, help="[s]")
     ap.add_argument("--seed", type=int, default=11)
     ap.add_argument("--kinds", nargs="+", default=sorted(EXPORTABLE))
+    ap.add_argument("--supervised", action="store_true")
     args = ap.parse_args()
     t = linearize.load_turbine("nrel5mw")
     fields = FieldMemo()
     print(f"# {time.strftime('%Y-%m-%d %H:%M')} {platform.machine()} Python "
           f"{platform.python_version()}; NREL 5-MW, {args.wind:g} m/s, class A, seed "
-          f"{args.seed}, {args.duration:g} s")
+          f"{args.seed}, {args.duration:g} s{', supervised' if args.supervised else ''}")
     print("| kind | law | largest pitch difference [deg] | largest torque difference [rated] "
           "| shipped [s] | Python [s] |\n|---|---|---|---|---|---|")
-    kw = dict(duration=args.duration, turbulence="A", seed=args.seed, fields=fields)
+    kw = dict(duration=args.duration, turbulence="A", seed=args.seed, fields=fields,
+              supervisor={"overspeed": 1.25} if args.supervised else None)
     for kind in args.kinds:
         design_controller(t, kind)
         design_controller(t, kind, shipped=True)

@@ -71,7 +71,7 @@ def _compare(turbine, kind, ex, wind, seed=11):
     """The same 120 s class-A case with the Python controller and with its library: the
     largest pitch [deg] and torque [fraction of rated] differences, and the two runs."""
     kw = dict(duration=120.0, turbulence="A", seed=seed, fields=_FIELDS)
-    py = run_controller(turbine, kind, wind, **kw)
+    py = run_controller(turbine, kind, wind, shipped=False, **kw)
     lib = run_controller(turbine, "discon", wind, _discon(ex), **kw)
     assert py.u.shape == lib.u.shape
     dp = float(np.degrees(np.max(np.abs(py.u[:, :3] - lib.u[:, :3]))))
@@ -262,7 +262,7 @@ def test_ibc_library_holds_the_amplitude_as_the_python_controller(nrel5mw, tmp_p
     opts = {"max_amplitude_deg": 0.3}
     ex = export_discon(nrel5mw, "ibc", tmp_path / "ibc03", opts)
     kw = dict(duration=120.0, turbulence="A", seed=11, fields=_FIELDS)
-    py = run_controller(nrel5mw, "ibc", 18.0, opts, **kw)
+    py = run_controller(nrel5mw, "ibc", 18.0, opts, shipped=False, **kw)
     lib = run_controller(nrel5mw, "discon", 18.0, _discon(ex), **kw)
     dp = float(np.degrees(np.max(np.abs(py.u[:, :3] - lib.u[:, :3]))))
     assert dp <= 0.01, dp

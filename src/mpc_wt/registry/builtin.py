@@ -53,8 +53,8 @@ def _shipped(kind: str, base: str | None = None) -> Any:
         ctl = DisconController(shipped_library(kind), infile, ctx.turbine, dt=dt,
                                lidar=built.sensors[-1] if built.sensors else None,
                                isolate=False, log_names=log_channels(kind))
-        ctl.design = built.controller
         return dataclasses.replace(built, controller=ctl, controller_dt=dt, preview=None,
+                                   design=built.controller,
                                    meta={**built.meta, "law": "shipped",
                                          "library": ctl.library.name})
     return hook

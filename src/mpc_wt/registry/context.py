@@ -293,6 +293,9 @@ class Built:
         The fraction of rated power the design targets (add-ons tune for it) [-].
     sensors : list of lidar.LidarSensor
         The LIDARs the design declared (:meth:`BuildContext.lidar`); the harness binds them.
+    design : object, optional
+        The design's own objects where ``controller`` runs it otherwise (its shipped law: the
+        compiled library through the host); None: ``controller`` is the design.
     """
 
     controller: Any
@@ -301,3 +304,4 @@ class Built:
     meta: dict[str, Any] = field(default_factory=dict)
     power_fraction: float = 1.0
     sensors: list[Any] = field(default_factory=list)
+    design: Any = None

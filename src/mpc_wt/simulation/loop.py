@@ -408,10 +408,8 @@ def simulate_closed_loop(params: linearize.PlantParams, controller: Any,
     meta : dict, optional
         Configuration stored with the result.
     compiled : bool
-        Run a controller with a compiled law (the plain baseline) or a controller library
-        loaded in this process (no LIDAR) in a loop compiled with the plant
-        (:mod:`mpc_wt.simulation.compiled`; default: the same loop to the last bit, faster);
-        False: in Python.
+        A compiled law (the plain baseline) or a library in this process (no LIDAR) runs in a
+        loop compiled with the plant (the same loop to the last bit; default); False: Python.
 
     Returns
     -------
