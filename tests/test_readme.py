@@ -44,3 +44,20 @@ def test_no_issue_numbers_in_code_or_docs(folder: str) -> None:
             if re.search(r"issue [0-9]", line, flags=re.I):
                 hits.append(f"{path.relative_to(ROOT)}:{n}: {line.strip()}")
     assert not hits, "\n".join(hits)
+
+
+@pytest.mark.parametrize("name", ["CHANGELOG.md", "benchmarks/RESULTS.md"])
+def test_no_issue_numbers_in_the_changelog_and_the_results(name: str) -> None:
+    text = (ROOT / name).read_text()
+    hits = [f"{name}:{n}: {line.strip()}" for n, line in enumerate(text.splitlines(), 1)
+            if re.search(r"issue [0-9]", line, flags=re.I)]
+    assert not hits, "\n".join(hits)
+
+
+def test_the_changelog_is_release_notes() -> None:
+    """One section per version, newest first, one 'Unreleased' at most; no dated history."""
+    text = (ROOT / "CHANGELOG.md").read_text()
+    heads = re.findall(r"^## (.+)$", text, flags=re.M)
+    assert heads[0] == "Unreleased" and heads.count("Unreleased") == 1
+    assert all(re.fullmatch(r"[0-9]+\.[0-9]+\.[0-9]+", h) for h in heads[1:]), heads
+    assert not re.search(r"\b20[0-9]{2}-[01][0-9]-[0-3][0-9]\b", text), "dated history"

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import ast
 import importlib
+import re
 from pathlib import Path
 
 import pytest
@@ -14,22 +15,21 @@ PACKAGES = ("linearize", "lidar", "mpc_wt")
 
 #: what each part of mpc_wt may not import (parts: subpackages and top-level modules)
 FORBIDDEN = {
-    "controllers": {"simulation", "registry", "run", "campaign", "tuning", "cli", "plotting",
-                    "io"},
-    "simulation": {"registry", "run", "campaign", "tuning", "cli"},
-    "assessment": {"controllers", "simulation", "registry", "run", "campaign", "tuning", "cli",
-                   "plotting", "io"},
-    "io": {"simulation", "registry", "run", "campaign", "tuning", "cli", "plotting"},
-    "registry": {"run", "campaign", "tuning", "cli"},
-    "plotting": {"controllers", "simulation", "registry", "run", "campaign", "tuning", "cli"},
+    "controllers": {"simulation", "registry", "kinds", "run", "campaign", "tuning", "cli",
+                    "plotting", "io"},
+    "simulation": {"registry", "kinds", "run", "campaign", "tuning", "cli"},
+    "assessment": {"controllers", "simulation", "registry", "kinds", "run", "campaign", "tuning",
+                   "cli", "plotting", "io"},
+    "io": {"simulation", "registry", "kinds", "run", "campaign", "tuning", "cli", "plotting"},
+    # the mechanism only: it knows no controller, no format and no kind
+    "registry": {"controllers", "io", "kinds", "plotting", "run", "campaign", "tuning", "cli"},
+    "kinds": {"run", "campaign", "tuning", "cli"},
+    "plotting": {"controllers", "simulation", "registry", "kinds", "run", "campaign", "tuning",
+                 "cli"},
     "run": {"campaign", "tuning", "cli"},
     "campaign": {"tuning", "cli"},
     "tuning": {"cli"},
 }
-#: the one deferred import that points up a layer: ``mpc_wt.controllers.__getattr__`` serves
-#: the registry's plugin API where plugin authors have always imported it from; it runs at
-#: attribute access, never at import time
-LAZY_COMPAT = {("mpc_wt.controllers", "mpc_wt.registry")}
 
 
 def _modules() -> dict[str, Path]:
@@ -119,13 +119,13 @@ def _part(module: str) -> str | None:
 
 
 def _package_graph(graph: dict[str, set[str]]) -> dict[str, set[str]]:
-    """Edges between the parts of each package, the lazy compatibility edge left out."""
+    """Edges between the parts of each package."""
     out: dict[str, set[str]] = {}
     for a, deps in graph.items():
         pa = ".".join(a.split(".")[:2])
         for b in deps:
             pb = ".".join(b.split(".")[:2])
-            if pa != pb and (a, b) not in LAZY_COMPAT:
+            if pa != pb:
                 out.setdefault(pa, set()).add(pb)
     return out
 
@@ -133,8 +133,7 @@ def _package_graph(graph: dict[str, set[str]]) -> dict[str, set[str]]:
 def test_no_module_imports_a_layer_above_its_own() -> None:
     graph = import_graph()
     bad = sorted(f"{a} -> {b}" for a, deps in graph.items() for b in deps
-                 if _part(a) in FORBIDDEN and _part(b) in FORBIDDEN[_part(a)]
-                 and (a, b) not in LAZY_COMPAT)
+                 if _part(a) in FORBIDDEN and _part(b) in FORBIDDEN[_part(a)])
     assert not bad, "upward imports:\n" + "\n".join(bad)
 
 
@@ -214,7 +213,8 @@ LAYOUT = {
                     "ipc", "apc", "derating", "lidar_feedforward", "supervisor", "discon",
                     "filters", "wind_estimator", "scheduling"},
     "controllers/takagi_sugeno": {"model", "synthesis", "controller", "robustness"},
-    "registry": {"registry", "options", "builtin", "context"},
+    "registry": {"registry", "options", "context"},
+    "kinds": {"common", "baseline", "ipc", "mpc", "lqr", "ts", "apc", "libraries", "lidar_ff"},
     "simulation": {"scenario", "loop", "compiled", "results", "preview", "solver_timing", "memory"},
     "assessment": {"fatigue", "performance", "series", "ultimate", "lidar", "compare"},
     "io": {"gain_tables", "rosco", "openfast_output", "discon_export", "openfast_case",
@@ -241,15 +241,45 @@ def test_the_public_api_is_where_users_find_it() -> None:
         assert name in mpc_wt.__all__, name
 
 
-def test_the_plugin_api_is_served_from_controllers_and_registry_alike() -> None:
+def test_the_plugin_api_has_one_home() -> None:
+    """The registry's mechanism is :mod:`mpc_wt.registry`; the controllers package serves none
+    of it (no shim), and the kinds' options are :mod:`mpc_wt.kinds`'."""
     import mpc_wt.controllers as controllers
+    import mpc_wt.kinds as kinds
     import mpc_wt.registry as registry
 
-    for name in controllers.REGISTRY_NAMES:
-        assert getattr(controllers, name) is getattr(registry, name), name
-    from mpc_wt.controllers import Built, Options, option, register  # noqa: F401
-    with pytest.raises(AttributeError, match="no attribute 'nothing_here'"):
-        controllers.nothing_here  # noqa: B018
+    for name in ("register", "Options", "option", "Built", "BuildContext", "kinds", "resolve"):
+        assert hasattr(registry, name) and not hasattr(controllers, name), name
+    assert "MPCOptions" in kinds.__all__ and not hasattr(registry, "MPCOptions")
+
+
+def _kind_names_in_code(path: Path, names: set[str]) -> list[str]:
+    """String constants of a module's code (not its docstrings) that name a kind."""
+    tree = ast.parse(path.read_text(), filename=str(path))
+    docs = {id(n.body[0].value) for n in ast.walk(tree)
+            if isinstance(n, (ast.Module, ast.ClassDef, ast.FunctionDef, ast.AsyncFunctionDef))
+            and n.body and isinstance(n.body[0], ast.Expr)
+            and isinstance(n.body[0].value, ast.Constant)}
+    return [f"{path.name}:{n.lineno}: {n.value!r}" for n in ast.walk(tree)
+            if isinstance(n, ast.Constant) and isinstance(n.value, str) and id(n) not in docs
+            and any(re.search(rf"(?<![\w-]){re.escape(k)}(?![\w-])", n.value) for k in names)]
+
+
+def test_the_registry_knows_no_kind() -> None:
+    """No module of ``registry/`` names a kind mpc-wt ships in its code: the kinds register
+    themselves from :mod:`mpc_wt.kinds`."""
+    from mpc_wt.registry import kinds
+
+    names = set(kinds()) | {"derate80"}
+    bad = [hit for p in sorted((SRC / "mpc_wt" / "registry").glob("*.py"))
+           for hit in _kind_names_in_code(p, names)]
+    assert bad == []
+
+
+def test_the_kind_name_check_catches_one(tmp_path: Path) -> None:
+    f = tmp_path / "m.py"
+    f.write_text('"""Doc naming mpc-lidar."""\nX = {"mpc-lidar": 1}\nY = "baseline-like"\n')
+    assert _kind_names_in_code(f, {"mpc-lidar", "baseline"}) == ["m.py:2: 'mpc-lidar'"]
 
 
 @pytest.mark.parametrize("module", sorted(m for m in MODULES if m.startswith("mpc_wt")

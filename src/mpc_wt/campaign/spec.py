@@ -201,7 +201,7 @@ class ControllerSpec:
         Label in the index, the file names and the report (letters, digits, ``-_.+``).
     controller : str
         A registered controller name (``baseline``, ``mpc-lidar``, ``ts``, ``derate80+ibc``
-        ...; :func:`mpc_wt.controllers.kinds`).
+        ...; :func:`mpc_wt.registry.kinds`).
     options : dict
         The kind's options as given (checked by the registry when the spec loads), e.g.
         ``apc_frequency`` [Hz], ``horizon``, ``lidar``.
@@ -852,9 +852,9 @@ def _controller(i: int, raw: Any, lidar: dict[str, Any],
 
 def _lidar(key: str, raw: Any) -> dict[str, Any]:
     """The campaign's LIDAR settings (defaults of the kinds that take ``lidar``), checked by
-    :class:`mpc_wt.controllers.LidarOptions`."""
+    :class:`mpc_wt.kinds.LidarOptions`."""
     from mpc_wt.errors import OptionsError
-    from mpc_wt.registry.builtin import LidarOptions
+    from mpc_wt.kinds import LidarOptions
 
     if not isinstance(raw, Mapping):
         raise _fail(key, f"must be a mapping, got {raw!r}")

@@ -11,10 +11,9 @@ feedforward (:mod:`.lidar_feedforward`), the rotor-effective wind from measureme
 DISCON libraries in the loop (:mod:`.discon`). Every controller offers ``reset()`` and
 ``step(t, measurements)`` (:class:`~mpc_wt.controllers.base.Controller`).
 
-The plugin API (``register``, ``Options``, ``option``, ``Built``, ``BuildContext``, ``kinds``,
-``describe`` ...) lives in :mod:`mpc_wt.registry`; it is re-exported here, where plugin authors
-import it from (``from mpc_wt.controllers import register``), without importing the registry
-when this package is imported.
+The controller kinds, their options and their builds are registered in :mod:`mpc_wt.kinds`;
+the plugin API (``register``, ``Options``, ``option``, ``Built``, ``BuildContext``, ``kinds``,
+``describe`` ...) is :mod:`mpc_wt.registry`.
 """
 from mpc_wt.controllers.apc import apc_reference
 from mpc_wt.controllers.base import Controller, ControllerBase
@@ -47,24 +46,6 @@ from mpc_wt.controllers.takagi_sugeno import (
 )
 from mpc_wt.controllers.wind_estimator import WindEstimatorSettings, WindSpeedEstimator
 
-#: names of :mod:`mpc_wt.registry` served from this package (the plugin API's former home)
-REGISTRY_NAMES = ("register", "register_kind", "kinds", "describe", "get_kind", "resolve",
-                  "load_plugins", "designs", "cli_naming", "API_NAMING", "ControllerKind",
-                  "Naming", "Selection", "Options", "option", "REQUIRED", "Built",
-                  "BuildContext", "DesignCache", "turbine_key", "APCOptions", "BaselineOptions",
-                  "ColemanIPCOptions", "DerateOptions", "IBCOptions", "LidarOptions",
-                  "LQRPIOOptions", "MPCLidarOptions", "MPCOptions", "TSOptions")
-
-
-def __getattr__(name: str):  # type: ignore[no-untyped-def]
-    """Serve the registry's plugin API (:data:`REGISTRY_NAMES`) from :mod:`mpc_wt.registry`."""
-    if name in REGISTRY_NAMES:
-        import mpc_wt.registry
-
-        return getattr(mpc_wt.registry, name)
-    raise AttributeError(f"module 'mpc_wt.controllers' has no attribute {name!r}")
-
-
 __all__ = ["apc_reference", "Controller", "ControllerBase", "BaselineController",
            "BaselineGains", "tune_baseline", "tune_baseline_schedule", "DisconController",
            "KalmanEstimator", "ColemanIPCController", "IBCController", "tune_coleman_ipc",
@@ -74,4 +55,4 @@ __all__ = ["apc_reference", "Controller", "ControllerBase", "BaselineController"
            "envelope_winds", "region3_wind", "BACKENDS", "default_backend", "Supervisor",
            "TorqueLawGuard",
            "TSController", "build_ts_model", "design_ts_controller", "design_ts_observer",
-           "WindEstimatorSettings", "WindSpeedEstimator", "REGISTRY_NAMES", *REGISTRY_NAMES]
+           "WindEstimatorSettings", "WindSpeedEstimator"]

@@ -41,7 +41,7 @@ class ControllerKind:
     name : str
         The name users write (``baseline``, ``mpc-lidar``).
     options : type
-        Its :class:`~mpc_wt.controllers.Options` subclass.
+        Its :class:`~mpc_wt.registry.Options` subclass.
     build : callable
         ``build(ctx, options) -> Built`` for a base kind; ``build(ctx, options, base) -> Built``
         for an add-on (``base`` is the wrapped controller's :class:`Built`).
@@ -104,6 +104,23 @@ class ControllerKind:
 
 _KINDS: dict[str, ControllerKind] = {}
 _PLUGINS_LOADED: set[str] = set()
+#: The module that registers the kinds mpc-wt ships, imported before any other registration
+#: (by its path: the registry itself knows no kind).
+BUILTIN_KINDS = "mpc_wt.kinds"
+_BUILTIN: list[bool] = []          # [] before, [False] while, [True] after it is imported
+
+
+def _ensure_builtin() -> None:
+    """Import :data:`BUILTIN_KINDS` once, so that the shipped kinds are registered first."""
+    if _BUILTIN:
+        return
+    _BUILTIN.append(False)
+    try:
+        importlib.import_module(BUILTIN_KINDS)
+    except BaseException:
+        _BUILTIN.clear()
+        raise
+    _BUILTIN[0] = True
 
 
 def register_kind(kind: ControllerKind, *, replace: bool = False) -> ControllerKind:
@@ -129,6 +146,7 @@ def register_kind(kind: ControllerKind, *, replace: bool = False) -> ControllerK
     if not re.fullmatch(r"[A-Za-z][A-Za-z0-9_.-]*", kind.name):
         raise ValueError(f"controller kind name must be letters, digits and -_. starting with "
                          f"a letter, got {kind.name!r}")
+    _ensure_builtin()
     if kind.name in _KINDS and not replace:
         raise ValueError(f"controller kind {kind.name!r} is registered already")
     _KINDS[kind.name] = kind
@@ -173,6 +191,7 @@ def kinds() -> dict[str, ControllerKind]:
     dict of str to ControllerKind
         A copy of the registry.
     """
+    _ensure_builtin()
     _load_entry_points()
     return dict(_KINDS)
 

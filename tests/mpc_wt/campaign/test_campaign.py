@@ -762,7 +762,7 @@ def test_fault_injection_campaign(tmp_path):
 
 KIND_WITH_A_CODE_DEFAULT = '''
 import dataclasses
-from mpc_wt.controllers import Built, Options, register
+from mpc_wt.registry import Built, Options, register
 from mpc_wt.controllers.baseline import BaselineController, tune_baseline
 
 #: a default that lives in code, not in an option: no case hash covers it

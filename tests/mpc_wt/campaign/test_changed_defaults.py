@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 from mpc_wt.campaign import CampaignStore, run_campaign, spec_from_dict
-from mpc_wt.controllers import Built, Options, option, register
+from mpc_wt.registry import Built, Options, option, register
 from mpc_wt.registry.registry import _KINDS
 from mpc_wt.simulation.results import ClosedLoopResult
 

@@ -16,7 +16,7 @@ import linearize
 from mpc_wt import run_controller
 from mpc_wt.assessment.performance import tracking_response
 from mpc_wt.assessment.series import assess_series, lifetime_comparison
-from mpc_wt.controllers import resolve
+from mpc_wt.registry import resolve
 from mpc_wt.controllers.apc import apc_reference
 from mpc_wt.controllers.baseline import BaselineController, tune_baseline
 from mpc_wt.controllers.derating import aep_change, steady_power_curve

@@ -379,7 +379,7 @@ def test_the_scheduled_lqr_weights_follow_the_pitch_drives() -> None:
     1), on the IEA-15-240-RWT (2 deg/s) 20 and 0.25. Weights set as options, and the
     single-point design, are left as given; the single point has no pitch-rate weight unless
     one is set."""
-    from mpc_wt.registry.builtin import LQRPIOOptions
+    from mpc_wt.kinds import LQRPIOOptions
 
     five, fifteen = linearize.load_turbine("nrel5mw"), linearize.load_turbine("iea15mw")
     opts = LQRPIOOptions()

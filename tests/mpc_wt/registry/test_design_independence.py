@@ -88,7 +88,7 @@ def _design(turbine: linearize.Turbine, kind: str, options: dict) -> tuple[str, 
 
 @pytest.mark.parametrize("reads", ["scenario", "field", "op"])
 def test_a_build_that_reads_the_case_fails(turbine: linearize.Turbine, reads: str) -> None:
-    from mpc_wt.controllers import Options
+    from mpc_wt.registry import Options
 
     @dataclasses.dataclass(frozen=True)
     class NoOptions(Options):

@@ -14,17 +14,10 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import linearize
-from mpc_wt import controllers
+from mpc_wt import registry as controllers
 from mpc_wt.cli import main
-from mpc_wt.controllers import (
-    DesignCache,
-    IBCOptions,
-    MPCOptions,
-    Options,
-    option,
-    resolve,
-    turbine_key,
-)
+from mpc_wt.kinds import IBCOptions, MPCOptions
+from mpc_wt.registry import DesignCache, Options, option, resolve, turbine_key
 from mpc_wt.errors import OptionsError
 from mpc_wt.registry.registry import _KINDS
 from mpc_wt.run import build_controller
@@ -37,7 +30,7 @@ BUILTIN = ["baseline", "baseline-ct", "derate", "ibc", "coleman-ipc", "mpc", "mp
 PLUGIN = textwrap.dedent('''
     from dataclasses import dataclass
     import numpy as np
-    from mpc_wt.controllers import Built, Options, option, register
+    from mpc_wt.registry import Built, Options, option, register
 
     @dataclass(frozen=True)
     class HoldOptions(Options):

@@ -1,0 +1,92 @@
+"""The baseline family: the tuned PI pitch and torque law (Jonkman et al. 2009, sec. 7.2), with
+constant power or constant torque in region III, and derated (Pettas and Cheng)."""
+from __future__ import annotations
+
+import logging
+from dataclasses import dataclass
+from typing import Any, Optional
+
+
+import linearize
+from mpc_wt.registry.context import BuildContext, Built
+from mpc_wt.registry.options import REQUIRED, Options, option
+from mpc_wt.registry.registry import register
+from mpc_wt.simulation.scenario import Scenario, start_wind
+from mpc_wt.kinds.common import shipped_law
+
+log = logging.getLogger(__name__)
+
+# -- baseline family ---------------------------------------------------------------------------
+@dataclass(frozen=True)
+class BaselineOptions(Options):
+    """The baseline PI's design (Jonkman et al. 2009, sec. 7.2)."""
+
+    omega_n_rad_s: Optional[float] = option(None, help="PI closed-loop natural frequency "
+                                            "(default 0.6 rad/s x rated rotor speed / 12.1 rpm: "
+                                            "the NREL 5-MW report's 0.6 on that turbine)",
+                                            unit="rad/s", lo=0.0, lo_open=True, flag="")
+    zeta: float = option(0.7, help="PI closed-loop damping ratio", unit="-", lo=0.0,
+                         lo_open=True, flag="")
+
+
+@dataclass(frozen=True)
+class DerateOptions(BaselineOptions):
+    """The baseline derated to a fraction of rated power (Pettas and Cheng sec. 3.2)."""
+
+    power_fraction: float = option(REQUIRED, help="fraction of rated power, in (0, 1]",
+                                   unit="-", lo=0.0, lo_open=True, hi=1.0, flag="")
+
+
+def baseline_build(region3: str) -> Any:
+    def build(ctx: BuildContext, opts: BaselineOptions) -> Built:
+        from mpc_wt.controllers.baseline import BaselineController, tune_baseline
+
+        frac = getattr(opts, "power_fraction", 1.0)
+        gains = tune_baseline(ctx.turbine, omega_n_rad_s=opts.omega_n_rad_s, zeta=opts.zeta,
+                              power_fraction=frac)
+        ctl = BaselineController(ctx.turbine, gains, region3=region3)
+        meta = {"gains": {"kp": gains.kp, "ki": gains.ki, "theta_k_rad": gains.theta_k_rad,
+                          "k_opt": gains.k_opt, "power_fraction": frac, "region3": region3}}
+        return Built(ctl, meta=meta, power_fraction=frac)
+    return build
+
+
+def derated_trim(turbine: linearize.Turbine, sc: Scenario, opts: DerateOptions
+                  ) -> linearize.OperatingPoint:
+    """Trim at the derated power; below it (low wind) at the turbine's own optimum."""
+    try:
+        return linearize.trim(turbine, start_wind(turbine, sc), opts.power_fraction
+                              * turbine.operation.rated_power)
+    except linearize.TrimError:
+        return linearize.trim(turbine, start_wind(turbine, sc))
+
+
+def _derate_preset(mt: Any) -> dict[str, Any]:
+    pct = float(mt.group(1))
+    if not 0.0 < pct <= 100.0:
+        raise ValueError(f"derating in {mt.group(0)!r} is {pct:g} % of rated power; allowed: "
+                         f"(0, 100] %")
+    return {"power_fraction": pct / 100.0}
+
+
+def _design_baseline(turbine: linearize.Turbine, *, omega_n_rad_s: float | None = None,
+                     zeta: float = 0.7, power_fraction: float = 1.0) -> tuple[dict, str]:
+    from mpc_wt.controllers.baseline import tune_baseline
+    from mpc_wt.io.gain_tables import baseline_table
+
+    doc = baseline_table(turbine, tune_baseline(turbine, omega_n_rad_s=omega_n_rad_s, zeta=zeta,
+                                                power_fraction=power_fraction))
+    return doc, f"kp {doc['settings']['kp']:.4g} s, ki {doc['settings']['ki']:.4g}"
+
+
+register("baseline", BaselineOptions, field_components="u", design=_design_baseline,
+         shipped=shipped_law("baseline"), summary="tuned PI pitch and torque law, constant power in region III (80 Hz)"
+         )(baseline_build("constant_power"))
+register("baseline-ct", BaselineOptions, field_components="u",
+         shipped=shipped_law("baseline-ct"), summary="the baseline with constant torque in region III (Do et al.'s PI)"
+         )(baseline_build("constant_torque"))
+register("derate", DerateOptions, field_components="u", pattern=r"derate(\d+(?:\.\d+)?)",
+         pattern_options=_derate_preset, pattern_help="derateNN (NN % of rated power)",
+         operating_point=derated_trim,
+         summary="the baseline derated to NN % of rated power, PI re-tuned")(
+    baseline_build("constant_power"))

@@ -1,0 +1,122 @@
+"""Add-ons on a baseline: Pettas and Cheng's individual blade control and Coleman IPC."""
+from __future__ import annotations
+
+import logging
+from dataclasses import dataclass
+from typing import Optional
+
+
+import linearize
+from mpc_wt.controllers.ipc import IBC_LOOP_GAIN
+from mpc_wt.registry.context import BuildContext, Built
+from mpc_wt.registry.options import Options, option
+from mpc_wt.registry.registry import register
+from mpc_wt.kinds.common import shipped_law
+
+log = logging.getLogger(__name__)
+
+def _design_ibc(turbine: linearize.Turbine, *, power_fraction: float = 1.0,
+                loop_gain: float | None = None) -> tuple[dict, str]:
+    from mpc_wt.controllers.ipc import tune_ibc
+    from mpc_wt.io.gain_tables import ibc_table
+
+    g = tune_ibc(turbine, power_fraction=power_fraction, loop_gain_1p=loop_gain)
+    doc = ibc_table(turbine, g)
+    doc["settings"]["options"] = {"loop_gain_1p": float(g.info["target_loop_gain_1p"])}
+    return doc, (f"{g.gain.size} points, gain margin >= "
+                                   f"{g.gain_margin.min():.3g}, high-pass {g.highpass_hz:.3g} Hz")
+
+
+
+
+def _design_coleman(turbine: linearize.Turbine, *, power_fraction: float = 1.0
+                    ) -> tuple[dict, str]:
+    from mpc_wt.controllers.ipc import tune_coleman_ipc
+    from mpc_wt.io.gain_tables import coleman_ipc_table
+
+    g = tune_coleman_ipc(turbine, power_fraction=power_fraction)
+    return coleman_ipc_table(turbine, g), (f"{g.ki.size} points, gain margin >= "
+                                           f"{g.gain_margin.min():.3g}")
+
+
+
+
+# -- add-ons: IBC and Coleman IPC -----------------------------------------------------------
+@dataclass(frozen=True)
+class IBCOptions(Options):
+    """Individual blade control (Pettas and Cheng sec. 3.1; :func:`mpc_wt.controllers.ipc.tune_ibc`)."""
+
+    loop_gain_1p: Optional[float] = option(None, help="loop gain at 1P of each blade loop "
+                                           f"(default {IBC_LOOP_GAIN:g}, less on pitch drives "
+                                           "too slow for a 2 deg cyclic at half their rate)",
+                                           unit="-", lo=0.0, lo_open=True, flag="--loop-gain")
+    remove_collective: bool = option(True, help="subtract the blades' mean IBC pitch (cyclic "
+                                     "action only)",
+                                     flag="--keep-collective", flag_value=False)
+    min_gain_margin: float = option(2.0, help="smallest gain margin allowed", unit="-",
+                                    lo=1.0, lo_open=True, flag="")
+    highpass_hz: Optional[float] = option(None, help="input high-pass corner (default half "
+                                          "the rated 1P)", unit="Hz", lo=0.0, lo_open=True,
+                                          flag="")
+    notch_harmonics: tuple[int, ...] = option((3,), help="output band-stops at these "
+                                              "multiples of rated 1P", lo=1, flag="")
+    notch_q: float = option(1.0, help="band-stop quality factor", unit="-", lo=0.0,
+                            lo_open=True, flag="")
+    weight_range: tuple[float, ...] = option((0.8, 0.95), help="power fractions of the fade-in",
+                                             unit="-", lo=0.0, flag="")
+    lowpass_hz: Optional[float] = option(None, help="output low-pass corner", unit="Hz",
+                                         lo=0.0, lo_open=True, flag="")
+    max_amplitude_deg: Optional[float] = option(None, help="largest IBC pitch of each blade "
+                                                "(default 2 deg, or less where a cyclic of it "
+                                                "at rated 1P would take more than half the "
+                                                "actuator's rate)", unit="deg", lo=0.0,
+                                                lo_open=True, hi=20.0, flag="")
+
+
+@register("ibc", IBCOptions, field_components="u", addon_to=("baseline", "derate"),
+          default_base="baseline", design=_design_ibc, shipped=shipped_law("ibc", "baseline"),
+          group="the ibc controllers",
+          summary="individual blade control on a baseline (ibc, derateNN+ibc)")
+def _build_ibc(ctx: BuildContext, opts: IBCOptions, base: Built) -> Built:
+    from mpc_wt.controllers.ipc import IBCController, tune_ibc
+
+    tune = {k: v for k, v in opts.to_dict().items() if k != "remove_collective"}
+    tune["notch_harmonics"] = tuple(opts.notch_harmonics)
+    tune["weight_range"] = tuple(opts.weight_range)
+    g = tune_ibc(ctx.turbine, power_fraction=base.power_fraction, dt=base.controller.dt, **tune)
+    ctl = IBCController(base.controller, g, remove_collective=opts.remove_collective)
+    meta = {"gain": g.gain.tolist(), "pitch_rad": g.pitch_rad.tolist(),
+            "highpass_hz": g.highpass_hz, "notch_harmonics": list(g.notch_harmonics),
+            **opts.to_dict()}
+    return Built(ctl, base.controller_dt, base.preview, {**base.meta, "ibc": meta},
+                 base.power_fraction)
+
+
+@dataclass(frozen=True)
+class ColemanIPCOptions(Options):
+    """Tilt/yaw integral IPC in the Coleman frame (:func:`mpc_wt.controllers.ipc.tune_coleman_ipc`)."""
+
+    crossover_rad_s: float = option(0.2, help="crossover of the integral loops", unit="rad/s",
+                                    lo=0.0, lo_open=True, flag="")
+    max_amplitude_deg: Optional[float] = option(None, help="largest cyclic pitch amplitude "
+                                                "(default 2 deg, or less where the cyclic "
+                                                "at rated 1P would take more than half the "
+                                                "actuator's rate)", unit="deg",
+                                                lo=0.0, lo_open=True, flag="")
+    weight_range: tuple[float, ...] = option((0.8, 0.95), help="power fractions of the fade-in",
+                                             unit="-", lo=0.0, flag="")
+
+
+@register("coleman-ipc", ColemanIPCOptions, field_components="u", addon_to=("baseline", "derate"),
+          default_base="baseline", design=_design_coleman,
+          summary="tilt/yaw integral IPC on a baseline (coleman-ipc, derateNN+coleman-ipc)")
+def _build_coleman(ctx: BuildContext, opts: ColemanIPCOptions, base: Built) -> Built:
+    from mpc_wt.controllers.ipc import ColemanIPCController, tune_coleman_ipc
+
+    d = opts.to_dict()
+    d["weight_range"] = tuple(opts.weight_range)
+    g = tune_coleman_ipc(ctx.turbine, power_fraction=base.power_fraction, **d)
+    meta = {"ki": g.ki.tolist(), "pitch_rad": g.pitch_rad.tolist(),
+            "azimuth_offset_rad": g.azimuth_offset_rad.tolist(), **opts.to_dict()}
+    return Built(ColemanIPCController(base.controller, g), base.controller_dt, base.preview,
+                 {**base.meta, "coleman_ipc": meta}, base.power_fraction)

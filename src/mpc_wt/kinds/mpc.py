@@ -1,0 +1,394 @@
+"""Madsen et al.'s MPC: individual-pitch, collective and with the CW LIDAR's per-blade
+preview, scheduled over the model family on the estimated wind; the torque-law guard."""
+from __future__ import annotations
+
+import dataclasses
+import logging
+import math
+from dataclasses import dataclass
+from typing import Any, Optional
+
+
+import linearize
+from mpc_wt.registry.context import BuildContext, Built
+from mpc_wt.registry.options import Options, option
+from mpc_wt.registry.registry import register
+from mpc_wt.kinds.common import (LidarOptions, check_design_wind, envelope_family, shipped_law,
+                                  wind_estimator)
+
+log = logging.getLogger(__name__)
+
+# -- MPC -----------------------------------------------------------------------------------
+_MW = "weight of the MPC cost on the scaled signal (unset: mpc_wt.MPCWeights' default)"
+
+
+@dataclass(frozen=True)
+class MPCWeightOptions(Options):
+    """Weights of Madsen's MPC cost (:class:`mpc_wt.MPCWeights`); unset ones keep the default.
+    Outputs are divided by their scales (0.5 MW, 1 deg/s, 0.1 m/s, 0.05 rad/s, 1 mrad, 1 MN m)
+    and inputs by theirs (1 deg, 4 kN m) before weighting."""
+
+    gen_power: Optional[float] = option(None, help=_MW, unit="-", lo=0.0)
+    pitch_rate: Optional[float] = option(None, help=_MW, unit="-", lo=0.0)
+    tower_fa_velocity: Optional[float] = option(None, help=_MW, unit="-", lo=0.0)
+    rotor_speed: Optional[float] = option(None, help=_MW, unit="-", lo=0.0)
+    shaft_torsion: Optional[float] = option(None, help=_MW, unit="-", lo=0.0)
+    flap_moment: Optional[float] = option(None, help=_MW + "; Coleman-weighted", unit="-",
+                                          lo=0.0)
+    pitch_ref: Optional[float] = option(None, help="input " + _MW, unit="-", lo=0.0)
+    gen_torque_ref: Optional[float] = option(None, help="input " + _MW, unit="-", lo=0.0)
+    pitch_ref_rate: Optional[float] = option(None, help="the pitch input's change per step "
+                                             + _MW, unit="-", lo=0.0)
+    gen_torque_ref_rate: Optional[float] = option(None, help="the torque input's change per "
+                                                  "step " + _MW, unit="-", lo=0.0)
+
+    def weights(self, defaults: dict[str, float] | None = None) -> Any:
+        """The cost weights.
+
+        Parameters
+        ----------
+        defaults : dict, optional
+            Output weights in place of :class:`mpc_wt.MPCWeights`' defaults where no option
+            is set (the scheduled designs' tuned ones, :data:`ENVELOPE_WEIGHTS`).
+
+        Returns
+        -------
+        MPCWeights
+            :class:`mpc_wt.MPCWeights` with the set options in place of its defaults.
+        """
+        from mpc_wt.controllers.mpc import MPCWeights
+
+        return self.over(_placed(MPCWeights(), defaults or {}))
+
+    def over(self, weights: Any) -> Any:
+        """``weights`` with the set options in place of theirs.
+
+        Parameters
+        ----------
+        weights : MPCWeights
+
+        Returns
+        -------
+        MPCWeights
+        """
+        return _placed(weights, {k: v for k, v in self.to_dict().items() if v is not None})
+
+
+def _placed(weights: Any, given: dict[str, float]) -> Any:
+    """``weights`` (MPCWeights) with ``given`` in place: option names of inputs and input
+    rates (``*_rate``) to theirs, the others to the outputs'."""
+    given = dict(given)
+    ins = {k: given.pop(k) for k in ("pitch_ref", "gen_torque_ref") if k in given}
+    rate = {k[:-5]: given.pop(k) for k in ("pitch_ref_rate", "gen_torque_ref_rate")
+            if k in given}
+    return dataclasses.replace(weights, outputs={**weights.outputs, **given},
+                               inputs={**weights.inputs, **ins}, rate={**weights.rate, **rate})
+
+
+@dataclass(frozen=True)
+class MPCOptions(Options):
+    """Madsen et al.'s MPC at 10 Hz (:class:`mpc_wt.MPCSettings` holds the full set)."""
+
+    backend: Optional[str] = option(None, help="QP solver (default DAQP when installed, else "
+                                    "OSQP)", choices=(None, "osqp", "daqp"))
+    formulation: str = option("condensed", help="QP formulation (sparse: OSQP only)",
+                              choices=("condensed", "sparse"))
+    horizon: int = option(15, help="H_p = H_u", lo=1, hi=200)
+    estimator: str = option("kalman", help="kalman: states and blade winds estimated from "
+                            "measured signals (rotor and generator speed, pitch, flap moments, "
+                            "tower-top acceleration); full-state: the plant's true states, an "
+                            "idealization no turbine has (labelled so in results)",
+                            choices=("kalman", "full-state"))
+    design_wind_mps: Optional[float] = option(None, help="one design at this mean wind "
+                                              "(Madsen's single-point design); default: "
+                                              "designs from cut-in to cut-out scheduled on the "
+                                              "measured wind", unit="m/s", lo=0.0,
+                                              lo_open=True)
+    schedule_step: float = option(1.0, help="spacing of the scheduled designs' grid",
+                                  unit="m/s", lo=0.1, hi=5.0, flag="")
+    kalman_wind_std: float = option(0.118, help="the Kalman estimator's random walk of each "
+                                    "blade wind per step (larger follows gusts faster and "
+                                    "passes more noise into the pitch)", unit="m/s", lo=0.0,
+                                    lo_open=True, flag="")
+    kalman_flap_std: float = option(4.2e5, help="the Kalman estimator's flap-moment "
+                                    "measurement noise (default tuned with the scheduled "
+                                    "design)", unit="N m", lo=0.0, lo_open=True,
+                                    flag="")
+    schedule_time_constant: float = option(3.0, help="low-pass of the scheduling wind "
+                                           "(the designs switch at 0.25 m/s past the midpoint "
+                                           "between grid winds)", unit="s", lo=0.0, hi=600.0,
+                                           flag="")
+    speed_limit: Optional[float] = option(None, help="soft upper limit of the predicted rotor "
+                                          "speed, a fraction of rated (default 1.065 for the "
+                                          "scheduled designs, none for design_wind_mps)",
+                                          unit="-", lo=0.5, hi=2.0)
+    torque_limit: Optional[float] = option(
+        None, help="the QP's upper bound on the generator torque, a fraction of rated torque "
+        "(default: the generator's maximum)", unit="-", lo=0.5, hi=2.0, flag="")
+    below_rated_speed_limit: Optional[float] = option(
+        None, help="the scheduled designs' soft rotor-speed limit below rated wind, a fraction "
+        "of rated (default speed_limit when that is given, else 1.065)", unit="-", lo=0.5,
+        hi=2.0, flag="")
+    weights: MPCWeightOptions = option(MPCWeightOptions(), help="cost weights (gen_power, "
+                                       "flap_moment, rotor_speed, ...)", flag="")
+    below_rated_weights: MPCWeightOptions = option(
+        MPCWeightOptions(), help="the scheduled designs' weights below rated wind where they "
+        "differ from weights (default: weights without the flap moment's, and those of "
+        "BELOW_RATED_WEIGHTS)", flag="")
+    time_budget_ms: Optional[float] = option(None, help="wall time a QP may take; a slower "
+                                             "solve takes the logged fallback (default none: "
+                                             "reproducible runs, the solver's iteration limit "
+                                             "is the budget)", unit="ms", lo=0.0, lo_open=True)
+    torque_notch_hz: Optional[float] = option(
+        None, help="centre of the scheduled designs' notch on the generator-torque command "
+        "(default: the drivetrain torsion mode of the turbine's full linearization at rated "
+        "wind, when below 0.8 x the controller's Nyquist frequency; 0: no notch)", unit="Hz",
+        lo=0.0, flag="")
+    torque_notch_q: float = option(2.0, help="the torque notch's quality factor (bandwidth = "
+                                   "centre / Q)", unit="-", lo=0.0, lo_open=True, flag="")
+    tower_notch: bool = option(False, help="a second notch on the scheduled designs' "
+                               "generator-torque command at the tower's first side-side mode "
+                               "(the designs' models have no side-side freedom; the torque's "
+                               "reaction drives it), when below 0.8 x the controller's Nyquist "
+                               "frequency", flag="")
+    region_floor: bool = option(True, help="the scheduled designs are chosen also by the "
+                                "operating region the measurements tell: at least the design "
+                                "whose trim has the measured collective pitch, and one inside "
+                                "region 3 while the rotor runs above rated speed (false: by "
+                                "the measured wind alone)", flag="")
+    region3_pitch_deg: float = option(2.0, help="the first scheduled design above rated wind "
+                                      "is made where the trim's pitch is this far above fine "
+                                      "pitch (0: at rated wind, where the torque is flat in "
+                                      "pitch)", unit="deg", lo=0.0, hi=10.0, flag="")
+
+
+
+
+@dataclass(frozen=True)
+class MPCLidarOptions(MPCOptions):
+    """The MPC with a CW LIDAR's per-blade preview."""
+
+    lidar: LidarOptions = option(LidarOptions(), help="CW LIDAR settings (focus_distance, "
+                                 "noise_std, ...)", flag="")
+
+
+#: The scheduled MPC designs' weights where the options set none: tuned with
+#: ``benchmarks/studies/tune_mpc_envelope.yaml`` (mpc-lidar at 9, 13 and 18 m/s, class A,
+#: seed 1; held-out seeds 3-4: power -0.2 %, pitch travel 2.6x and the largest rotor speed
+#: +1.0 % against the baseline). Madsen's single-point design keeps the paper's.
+ENVELOPE_WEIGHTS = {"pitch_rate": 0.0235, "flap_moment": 0.1024}
+#: The scheduled designs' weights without a preview, on the Kalman estimator: no flap moment's
+#: (no cyclic pitch). The blade winds the estimator infers from the root moments come late
+#: for the 1P load: with the flap weight of ENVELOPE_WEIGHTS the MPC without preview moved
+#: the pitch twice as far for a higher flap DEL and 16 % more shaft bending at 18-21 m/s than
+#: without it (class A, seeds 12-13; ``weights.flap_moment`` turns it back on).
+NO_PREVIEW_WEIGHTS = {"flap_moment": 0.0}
+#: The scheduled designs' weights below rated wind in place of theirs above: no flap
+#: moment's (the pitch rests at fine pitch there), and a weight on the torque's change per
+#: step (the designs track the optimal tip-speed ratio with the torque, which moved it 10x as
+#: much as the baseline's torque law at 0.2-1 Hz, where the tower's modes are: on `mpc-lidar`
+#: at 5-13 m/s, class A, seeds 11-12, the tower fore-aft DEL against the baseline's +3.1 ->
+#: -1.7 %, side-side +25.6 -> +20.5 %, power +0.7 -> +0.8 %).
+BELOW_RATED_WEIGHTS = {"flap_moment": 0.0, "gen_torque_ref_rate": 10.0}
+#: The soft rotor-speed limit of the scheduled designs below rated wind (a fraction of rated).
+BELOW_RATED_SPEED_LIMIT = 1.065
+#: The scheduled designs' soft rotor-speed limit (a fraction of rated). With the exact
+#: penalty the limit acts as a hard one: the MPC brakes at it with the torque at its maximum
+#: and a fast pitch pulse, which loads the tower; 1.028 (tuned before the region floor) had it
+#: binding in most gusts near rated (tower fore-aft DEL +36 % against the baseline at 11 m/s).
+ENVELOPE_SPEED_LIMIT = 1.065
+
+
+def _mpc_settings(opts: MPCOptions, collective: bool, preview: bool) -> Any:
+    from mpc_wt.controllers.mpc import MPCSettings
+
+    defaults = None
+    if opts.design_wind_mps is None:
+        defaults = dict(ENVELOPE_WEIGHTS)
+        if not preview and not collective and opts.estimator == "kalman":
+            defaults.update(NO_PREVIEW_WEIGHTS)
+    return MPCSettings(horizon=opts.horizon, backend=opts.backend,
+                       formulation=opts.formulation,
+                       estimator=None if opts.estimator == "full-state" else opts.estimator,
+                       estimator_settings={
+                           "wind_std_per_step": opts.kalman_wind_std,
+                           "measurement_std": {f"flap_moment_{b}": opts.kalman_flap_std
+                                               for b in (1, 2, 3)}},
+                       collective=collective, weights=opts.weights.weights(defaults),
+                       time_budget_ms=opts.time_budget_ms)
+
+
+#: The result label of a design that reads the plant's true states.
+FULL_STATE = "full-state information (idealization)"
+
+
+#: The default torque notch is left out when the drivetrain mode lies above this fraction of
+#: the controller's Nyquist frequency (a stiff or direct drive: the designs' commands do not
+#: reach it).
+NOTCH_NYQUIST_SHARE = 0.8
+
+
+def _torque_notch(ctx: BuildContext, opts: MPCOptions, dt: float) -> Optional[float]:
+    """The scheduled MPC's torque-notch centre [Hz] from the options (None: no notch)."""
+    from mpc_wt.controllers.mpc import drivetrain_frequency
+
+    nyquist = 0.5 / dt
+    f = opts.torque_notch_hz
+    if f is not None:
+        if f == 0.0:
+            return None
+        if f >= nyquist:
+            raise ValueError(f"torque_notch_hz = {f:g} Hz must be below the controller's "
+                             f"Nyquist frequency {nyquist:g} Hz (0: no notch)")
+        return float(f)
+    try:
+        f = ctx.cache.get(ctx.turbine, ("drivetrain-mode",),
+                          lambda: drivetrain_frequency(ctx.turbine))
+    except ValueError as err:
+        log.info("MPC: no torque notch (%s)", err)
+        return None
+    if f >= NOTCH_NYQUIST_SHARE * nyquist:
+        log.info("MPC: no torque notch: the drivetrain mode at %.3g Hz is above %g x the "
+                 "controller's Nyquist frequency %g Hz", f, NOTCH_NYQUIST_SHARE, nyquist)
+        return None
+    return float(f)
+
+
+def _tower_notch(ctx: BuildContext, opts: MPCOptions, dt: float) -> Optional[float]:
+    """The scheduled MPC's second torque notch [Hz]: the plant's first tower side-side mode
+    (None: switched off, or above :data:`NOTCH_NYQUIST_SHARE` x the Nyquist frequency)."""
+    if not opts.tower_notch:
+        return None
+    f = ctx.cache.get(ctx.turbine, ("tower-ss-mode",), lambda: float(
+        linearize.structural_frequencies(linearize.plant_params(ctx.turbine))["tower_ss"]))
+    if not f < NOTCH_NYQUIST_SHARE * 0.5 / dt:
+        log.info("MPC: no tower notch: the side-side mode at %.3g Hz is above %g x the "
+                 "controller's Nyquist frequency %g Hz", f, NOTCH_NYQUIST_SHARE, 0.5 / dt)
+        return None
+    return f
+
+
+def _below_rated(ctx: BuildContext, opts: MPCOptions, settings: Any) -> Any:
+    """The scheduled designs' settings below rated wind: their weights
+    (:data:`BELOW_RATED_WEIGHTS` and the options' ``below_rated_weights`` over the others) and
+    soft speed limit (``below_rated_speed_limit``, default :data:`BELOW_RATED_SPEED_LIMIT`)."""
+    weights = opts.below_rated_weights.over(MPCWeightOptions(**BELOW_RATED_WEIGHTS).over(
+        settings.weights))
+    limit = opts.below_rated_speed_limit
+    if limit is None:
+        limit = BELOW_RATED_SPEED_LIMIT if opts.speed_limit is None else opts.speed_limit
+    return settings.replace(weights=weights, max_rotor_speed=limit
+                            * ctx.turbine.operation.rated_rotor_speed_rad_s)
+
+
+def _mpc(collective: bool, with_lidar: bool) -> Any:
+    def build(ctx: BuildContext, opts: MPCOptions) -> Built:
+        from mpc_wt.controllers.mpc import MPC, ScheduledMPC
+
+        settings = _mpc_settings(opts, collective, with_lidar)
+        settings = settings.replace(weights=settings.weights.for_turbine(ctx.turbine))
+        limit = opts.speed_limit
+        if limit is None and opts.design_wind_mps is None:
+            limit = ENVELOPE_SPEED_LIMIT
+        if limit is not None:
+            settings = settings.replace(
+                max_rotor_speed=limit * ctx.turbine.operation.rated_rotor_speed_rad_s)
+        if opts.torque_limit is not None:
+            settings = settings.replace(max_torque=opts.torque_limit
+                                        * ctx.turbine.rated_generator_torque)
+        if opts.design_wind_mps is None:
+            fam = envelope_family(ctx, "madsen", opts.schedule_step, opts.region3_pitch_deg)
+            from mpc_wt.controllers.baseline import BaselineController, tune_baseline
+
+            law = BaselineController(ctx.turbine, ctx.cache.get(
+                ctx.turbine, ("baseline-gains",), lambda: tune_baseline(ctx.turbine)))
+            ctl = ScheduledMPC(fam, ctx.turbine, settings,
+                               wind_source="preview" if with_lidar else "estimator",
+                               wind_estimator=wind_estimator(ctx, settings.dt),
+                               time_constant=opts.schedule_time_constant,
+                               torque_law=law, below_rated=_below_rated(ctx, opts, settings),
+                               torque_notch_hz=_torque_notch(ctx, opts, settings.dt),
+                               torque_notch_q=opts.torque_notch_q,
+                               tower_notch_hz=_tower_notch(ctx, opts, settings.dt),
+                               region_floor=opts.region_floor)
+            grid = [float(fam.wind_mps[0]), float(fam.wind_mps[-1])]
+        else:
+            v = check_design_wind(ctx.turbine, opts.design_wind_mps)
+            model = linearize.linearize(ctx.turbine, v, config=linearize.PlantConfig.madsen())
+            ctl = MPC(model, ctx.turbine, settings)
+            grid = [v, v]
+        cdt = ctl.dt
+        meta: dict[str, Any] = {"mpc": {
+            "horizon": settings.horizon, "backend": settings.resolved_backend, "dt": cdt,
+            "formulation": settings.formulation, "estimator": opts.estimator,
+            "design_winds_mps": grid, "schedule_step_mps": opts.schedule_step,
+            "torque_notch_hz": getattr(ctl, "torque_notch_hz", None),
+            **({"idealization": FULL_STATE} if opts.estimator == "full-state" else {})}}
+        preview = None
+        if with_lidar:
+            from mpc_wt.simulation.preview import LidarPreview
+
+            lidar_opts = opts.lidar  # type: ignore[attr-defined]
+            sensor = ctx.lidar(lidar_opts.instrument(ctx.turbine), lidar_opts.evolution)
+            preview = LidarPreview(sensor, settings.horizon, cdt)
+            meta["lidar"] = {**lidar_opts.given(), "evolution": lidar_opts.evolution}
+        return Built(ctl, cdt, preview, meta)
+    return build
+
+
+def _design_mpc(collective: bool, with_lidar: bool = False) -> Any:
+    """The design function of a scheduled MPC kind: its design with the default options, as a
+    table of its grid points (``mpcwt design mpc``; ``mpcwt export --format discon`` builds it
+    again from the table's options)."""
+    kind = "mpc-lidar" if with_lidar else "mpc-collective" if collective else "mpc"
+
+    def design(turbine: linearize.Turbine) -> tuple[dict, str]:
+        from mpc_wt.io.gain_tables import mpc_table
+        from mpc_wt.registry.context import DEFAULT_CACHE
+
+        ctx = BuildContext(turbine=turbine, params=linearize.plant_params(turbine),
+                           cache=DEFAULT_CACHE)
+        opts = MPCLidarOptions() if with_lidar else MPCOptions()
+        ctl = _mpc(collective, with_lidar)(ctx, opts).controller
+        doc = mpc_table(turbine, ctl, kind, options={})
+        n = len(doc["schedule"]["rows"])
+        return doc, f"{n} grid winds {doc['schedule']['rows'][0][0]:g}-" \
+                    f"{doc['schedule']['rows'][-1][0]:g} m/s, horizon {ctl.settings.horizon}"
+    return design
+
+
+_MPC_GROUP = "the MPC controllers"
+register("mpc", MPCOptions, field_components="u", group=_MPC_GROUP, design=_design_mpc(False),
+         shipped=shipped_law("mpc"),
+         summary="Madsen's Coleman-weighted individual-pitch MPC, scheduled from cut-in to "
+                 "cut-out on the estimated wind, Kalman estimator (without a preview no cyclic "
+                 "pitch unless weights.flap_moment is set)"
+         )(_mpc(False, False))
+register("mpc-collective", MPCOptions, field_components="u", group=_MPC_GROUP,
+         design=_design_mpc(True), shipped=shipped_law("mpc-collective"),
+         summary="the scheduled MPC with one collective pitch input")(_mpc(True, False))
+register("mpc-lidar", MPCLidarOptions, field_components="u", group=_MPC_GROUP,
+         design=_design_mpc(False, True), shipped=shipped_law("mpc-lidar"), summary="the individual-pitch MPC with a CW LIDAR's per-blade preview "
+                 "(range weighting, LOS error and wind evolution on)")(_mpc(False, True))
+
+
+@dataclass(frozen=True)
+class TorqueLawOptions(Options):
+    """The torque-law guard in lulls (:class:`mpc_wt.controllers.supervisor.TorqueLawGuard`)."""
+
+    fine_band_deg: float = option(1.0, help="pitch above fine within which the guard acts",
+                                  unit="deg", lo=0.0, flag="")
+
+
+@register("torque-law", TorqueLawOptions, field_components="u",
+          addon_to=("mpc", "mpc-lidar", "mpc-collective"), default_base="mpc",
+          group=_MPC_GROUP, summary="caps the MPC's torque at the baseline's torque-speed law "
+                                    "at fine pitch below rated speed (mpc+torque-law, "
+                                    "mpc-lidar+torque-law)")
+def _build_torque_law(ctx: BuildContext, opts: TorqueLawOptions, base: Built) -> Built:
+    from mpc_wt.controllers.supervisor import TorqueLawGuard
+
+    ctl = TorqueLawGuard(base.controller, ctx.turbine,
+                         fine_band=math.radians(opts.fine_band_deg))
+    return Built(ctl, base.controller_dt, base.preview,
+                 {**base.meta, "torque_law": opts.to_dict()}, base.power_fraction)
