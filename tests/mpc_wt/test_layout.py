@@ -209,6 +209,7 @@ def test_the_private_name_checker_catches_both_forms(tmp_path: Path) -> None:
 #: the roles and the modules a newcomer finds in them
 LAYOUT = {
     "controllers": {"base", "baseline", "baseline_law", "mpc", "qp", "estimator", "lqr",
+                    "discon_kernel",
                     "discon_child",
                     "ipc", "apc", "derating", "lidar_feedforward", "supervisor", "discon",
                     "filters", "wind_estimator", "scheduling"},

@@ -164,3 +164,48 @@ def test_the_compiled_loop_reports_warnings_and_stops_as_the_host(turbine, tmp_p
             as err:
         simulate_closed_loop(params, ctl, wind, 3.0, x0=op.x, u0=op.u, controller_dt=0.1)
     assert err.value.partial is not None
+
+
+class _RecordsFromTheDict:
+    """A wrapper that hands the host its measurements without the plant's output row, so it
+    fills the swap records from the measurement dict (``DisconController._fill``)."""
+
+    def __init__(self, ctl):
+        self.ctl = ctl
+
+    def reset(self):
+        self.ctl.reset()
+
+    def finalize(self):
+        self.ctl.finalize()
+
+    @property
+    def signals(self):
+        return self.ctl.signals
+
+    def step(self, t, meas):
+        return self.ctl.step(t, {k: v for k, v in meas.items() if k != "outputs"})
+
+
+@pytest.mark.parametrize("kind, wind", [("baseline", 12.0), ("mpc", 16.0)])
+def test_the_hosts_compiled_call_fills_the_records_as_its_dict_path(turbine, kind, wind):
+    """The host's step from the plant's output row (the compiled call) and from the
+    measurement dict give the same run to the last bit."""
+    from mpc_wt.run import build_controller
+    from mpc_wt.simulation.loop import simulate_closed_loop
+    from mpc_wt.simulation.scenario import Scenario
+
+    sc = Scenario(wind_mps=wind, turbulence="A", seed=37, duration=20.0)
+    runs = []
+    for wrap in (False, True):
+        built, op, field = build_controller(turbine, kind, sc, shipped=True, fields=_FIELDS)
+        ctl = _RecordsFromTheDict(built.controller) if wrap else built.controller
+        runs.append(simulate_closed_loop(linearize.plant_params(turbine), ctl, field,
+                                         sc.duration, x0=op.x, u0=op.u,
+                                         controller_dt=built.controller_dt, compiled=False))
+    fast, slow = runs
+    np.testing.assert_array_equal(fast.u, slow.u)
+    np.testing.assert_array_equal(fast.x, slow.x)
+    for name in slow.controller:
+        if name != "qp_solve_ms":
+            np.testing.assert_array_equal(fast.controller[name], slow.controller[name])

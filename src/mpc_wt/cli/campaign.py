@@ -7,6 +7,7 @@ import logging
 from pathlib import Path
 from typing import Any
 
+from mpc_wt.campaign.runner import ENGINES
 from mpc_wt.cli.common import check_out_folder, to_json
 from mpc_wt.errors import UsageError
 
@@ -41,7 +42,7 @@ def add_parsers(sub: Any) -> None:
     q.add_argument("--scheduler", default=None,
                    help="address of a running Dask scheduler, tcp://HOST:PORT")
     q.add_argument("--out", default=None, help="campaign directory (default campaigns/NAME)")
-    q.add_argument("--engine", choices=("dask", "processes", "serial"), default="dask",
+    q.add_argument("--engine", choices=ENGINES, default="dask",
                    help="dask (default), a plain process pool, or this process")
     q.add_argument("--report", action="store_true", help="write the report when all cases "
                                                          "finished")
@@ -70,7 +71,7 @@ def add_parsers(sub: Any) -> None:
                    help="local worker processes (default: one per core)")
     q.add_argument("--scheduler", default=None,
                    help="address of a running Dask scheduler, tcp://HOST:PORT")
-    q.add_argument("--engine", choices=("dask", "processes", "serial"), default="dask")
+    q.add_argument("--engine", choices=ENGINES, default="dask")
     q.add_argument("--trust", action="store_true",
                    help="run a spec, plugins or libraries that another user wrote (they are "
                         "code; see the docs' Security page)")

@@ -11,6 +11,7 @@ import linearize
 from mpc_wt.cli.common import add_turbine, check_out_folder, floats, number_pairs, parse_range
 from mpc_wt.controllers.ipc import IBC_LOOP_GAIN
 from mpc_wt.errors import GainTableError, UsageError
+from mpc_wt.io.gain_tables import FORMATS
 
 __all__ = ["add_parsers"]
 
@@ -65,7 +66,7 @@ def add_parsers(sub: Any) -> None:
                                       "ROSCO DISCON.IN (rosco) or a Bladed-style controller "
                                       "library with its C sources (discon)")
     p.add_argument("design", help="design directory (from `mpcwt design`) or gain-table JSON")
-    p.add_argument("--format", required=True, choices=("csv", "json", "mat", "rosco", "discon"))
+    p.add_argument("--format", required=True, choices=FORMATS)
     p.add_argument("--to", "--out", dest="to",
                    help="output directory (default: the design directory)")
     p.add_argument("--turbine", default=None,

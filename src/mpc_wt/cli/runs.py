@@ -16,7 +16,9 @@ from typing import Any
 import numpy as np
 
 import lidar
+from lidar.iec import IEC_REFERENCE_SPEED
 import linearize
+from mpc_wt.assessment.fatigue import DEL_CONVENTIONS
 from mpc_wt.cli.common import (
     to_json,
     add_turbine,
@@ -95,7 +97,7 @@ def _add_simulate(sub: Any) -> None:
     e.add_argument("--condition", choices=sorted(lidar.CONDITIONS), default="ntm",
                    help="wind condition (default ntm: --turbulence as given; the others take "
                         "--turbulence as the category A, B or C)")
-    e.add_argument("--iec-class", choices=("I", "II", "III"), default="I")
+    e.add_argument("--iec-class", choices=tuple(IEC_REFERENCE_SPEED), default="I")
     e.add_argument("--sign", type=int, choices=(1, -1), default=1,
                    help="direction of a direction change or shear")
     e.add_argument("--event-at", type=float, default=30.0,
@@ -297,7 +299,7 @@ def _add_assess(sub: Any) -> None:
     p.add_argument("--t-start", type=float, default=0.0,
                    help="discard samples before this time, e.g. the start-up transient [s]")
     p.add_argument("--del-convention", default="range-1hz",
-                   choices=("range-1hz", "clemens", "pcrunch"),
+                   choices=tuple(DEL_CONVENTIONS),
                    help="DEL as ranges over 1 Hz equivalent cycles (default; IEC, MLife), as "
                         "amplitudes over the counted cycles (Clemens et al. eq 17), or as "
                         "pCrunch counts")

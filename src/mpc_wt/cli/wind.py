@@ -5,6 +5,7 @@ import argparse
 from typing import Any
 
 import linearize
+from lidar.iec import CONDITIONS, IEC_TURBULENCE
 from mpc_wt.cli.common import add_turbine, to_json
 from mpc_wt.errors import UsageError
 
@@ -23,7 +24,8 @@ def add_parsers(sub: Any) -> None:
     wind = p.add_subparsers(dest="wind_command", required=True)
     q = wind.add_parser("generate", help="IEC 61400-1 Kaimal field (TurbSim IECKAI model)")
     q.add_argument("--mean", type=float, required=True, help="hub-height mean speed [m/s]")
-    q.add_argument("--class", dest="turbulence_class", choices=("A", "B", "C"), default="A")
+    q.add_argument("--class", dest="turbulence_class", choices=sorted(IEC_TURBULENCE),
+                   default="A")
     q.add_argument("--ti", type=float, default=None, help="turbulence intensity instead of a class")
     q.add_argument("--seed", type=int, default=1)
     q.add_argument("--duration", type=float, default=600.0, help="[s]")
@@ -33,7 +35,7 @@ def add_parsers(sub: Any) -> None:
     q.add_argument("--hub-height", type=float, default=90.0, help="[m]")
     q.add_argument("--shear", type=float, default=0.2, help="power-law exponent")
     q.add_argument("--condition", default=None,
-                   choices=("ntm", "etm", "nwp", "eog", "edc", "ecd", "ews-v", "ews-h"),
+                   choices=sorted(CONDITIONS),
                    help="an IEC 61400-1 ed. 3 wind condition (default: the NTM field, or --ti)")
     q.add_argument("--iec-class", default="I", help="wind turbine class I, II or III (for "
                    "--condition; V_ref 50, 42.5, 37.5 m/s)")

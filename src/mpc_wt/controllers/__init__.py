@@ -1,14 +1,14 @@
 """Controllers: the laws that run in the closed loop, and their synthesis.
 
-Each module holds one kind of controller with its design functions: the tuned baseline PI and
-torque law (:mod:`.baseline`, its law compiled in :mod:`.baseline_law`), Madsen's MPC
-(:mod:`.mpc` on the QP backends of :mod:`.qp`, the Kalman estimator of :mod:`.estimator`), Do
-et al.'s LQR with a PI observer (:mod:`.lqr`), Clemens et al.'s Takagi-Sugeno controller and
-wind observer (:mod:`.takagi_sugeno`), individual blade control and Coleman IPC (:mod:`.ipc`),
-active power control (:mod:`.apc`), down-regulation (:mod:`.derating`), LIDAR collective pitch
-feedforward (:mod:`.lidar_feedforward`), the rotor-effective wind from measurements
-(:mod:`.wind_estimator`), the supervisor (:mod:`.supervisor`) and Bladed-style
-DISCON libraries in the loop (:mod:`.discon`). Every controller offers ``reset()`` and
+Each module holds one kind of controller with its design functions (all in
+``mpc_wt.controllers``): the tuned baseline PI and torque law (``baseline``, its law compiled in
+``baseline_law``), Madsen's MPC (``mpc`` on the QP backends of ``qp``, the Kalman estimator of
+``estimator``), Do et al.'s LQR with a PI observer (``lqr``), Clemens et al.'s Takagi-Sugeno
+controller and wind observer (``takagi_sugeno``), individual blade control and Coleman IPC
+(``ipc``), active power control (``apc``), down-regulation (``derating``), LIDAR collective
+pitch feedforward (``lidar_feedforward``), the rotor-effective wind from measurements
+(``wind_estimator``), the supervisor (``supervisor``) and Bladed-style DISCON libraries in the
+loop (``discon``, its compiled call ``discon_kernel``). Every controller offers ``reset()`` and
 ``step(t, measurements)`` (:class:`~mpc_wt.controllers.base.Controller`).
 
 The controller kinds, their options and their builds are registered in :mod:`mpc_wt.kinds`;

@@ -33,6 +33,7 @@ from typing import Any
 import numpy as np
 
 from mpc_wt.controllers.base import ControllerBase
+from mpc_wt.controllers.discon_kernel import library_call
 from mpc_wt.errors import ControllerLibraryError
 
 __all__ = ["DisconController", "SWAP_RECORDS", "SWAP_SIZE", "LIDAR_RECORDS", "LOG_ROOM",
@@ -487,6 +488,9 @@ class DisconController(ControllerBase):
                                       self._outname.decode())
         self.messages = []
         self.signals = {}
+        # the step's compiled call (the closed loop's own): a library in this process, no LIDAR
+        self._fast = self.compiled_library()
+        self._cmd, self._hub = np.zeros(5 + LOG_ROOM), np.zeros(1)
 
     def finalize(self) -> None:
         """The library's last call (status -1), then unload it; its files stay in
@@ -627,7 +631,7 @@ class DisconController(ControllerBase):
         bufs[3, :len(self._outname)] = np.frombuffer(self._outname, np.uint8)
         lib = np.array([float(self._status), float(self._last_pitch[0]),
                         1.0 if self.pitch_control == "individual" else 0.0, self._p_lo,
-                        self._p_hi, self._tq_hi, 0.0])
+                        self._p_hi, self._tq_hi, 0.0, 0.0])
         rec, zi = _output_records()
         fn = self._lib["DISCON"]                  # its own function object, pointer arguments
         fn.restype, fn.argtypes = None, [ctypes.c_void_p] * 5
@@ -720,6 +724,8 @@ class DisconController(ControllerBase):
         if self._lib is None:
             raise ControllerLibraryError(f"controller library {self.library.name}: step() "
                                          f"before reset() or after finalize()")
+        if self._fast is not None and "outputs" in meas:
+            return self._step_compiled(t, meas)
         self._fill(t, meas)
         self._call(t)
         self._status = 1
@@ -755,6 +761,51 @@ class DisconController(ControllerBase):
             self.signals.update(zip(self._log_keys(n), v[_LOG_START - 1:_LOG_START - 1 + n]
                                     .tolist()))
         return pitch, torque
+
+    def _step_compiled(self, t: float, meas: dict[str, Any]) -> tuple[np.ndarray, float]:
+        """:meth:`step` through the compiled call (:func:`~mpc_wt.controllers.discon_kernel.library_call`)
+        on the plant's output row ``meas["outputs"]``: the same records, demands and signals."""
+        call, cmd = self._fast, self._cmd
+        lib = call[6]
+        lib[0], lib[1] = float(self._status), float(self._last_pitch[0])
+        self._hub[0] = meas.get("hub_wind_speed", 0.0)
+        with self._quiet_call():
+            flag = library_call(0, t, meas["outputs"], *call[:6], self._hub, lib, cmd)
+        if flag == 2:
+            raise ControllerLibraryError(
+                f"controller library {self.library.name} returned pitch "
+                f"{self._view[41:44].tolist()} rad, torque {float(self._view[46])} N m at "
+                f"t = {t:g} s")
+        if call[2][0] != 0:
+            self.compiled_report(t, call)        # raises for aviFAIL < 0
+        else:
+            self._warned = False
+        self._status = 1
+        p = cmd[:3].tolist()
+        torque = float(cmd[3])
+        self._last_pitch, self._last_torque = np.array(p), torque
+        self.signals = {"pitch_command": (p[0] + p[1] + p[2]) / 3.0,
+                        "torque_command": torque, "generator_contactor": float(cmd[4]),
+                        "library_warning": float(self._warned)}
+        n = int(lib[7])
+        if n > 0:
+            self.signals.update(zip(self._log_keys(n), cmd[5:5 + n].tolist()))
+        return np.array(p), torque
+
+    @contextlib.contextmanager
+    def _quiet_call(self) -> Any:
+        """The library's standard output to the null device during a call (``quiet``)."""
+        if not self.quiet:
+            yield
+            return
+        if self._fds is None:
+            sys.stdout.flush()
+            self._fds = (os.open(os.devnull, os.O_WRONLY), os.dup(1))
+        os.dup2(self._fds[0], 1)
+        try:
+            yield
+        finally:
+            os.dup2(self._fds[1], 1)
 
     def _log_keys(self, n: int) -> list[str]:
         """The signal names of ``n`` logging channels."""

@@ -1,5 +1,5 @@
 """Retrofit load control: individual blade control and Coleman-frame IPC, added to a baseline
-(down-regulation and active power control are in :mod:`.derating` and :mod:`.apc`).
+(down-regulation and active power control are in :mod:`mpc_wt.controllers.derating` and :mod:`mpc_wt.controllers.apc`).
 
 Individual blade control (Pettas and Cheng 2018, sec. 3.1, fig. 3): three decoupled
 proportional loops, one per blade, on the blade-root flap moment M_i. A high-pass filter on the

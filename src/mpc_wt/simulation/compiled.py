@@ -32,6 +32,7 @@ import numpy as np
 from linearize.jitcache import key_caches_on_callees
 from linearize.kernel import step_kernel
 from mpc_wt.controllers.baseline_law import law
+from mpc_wt.controllers.discon_kernel import library_call
 
 __all__ = ["run_steps", "run_library_steps"]
 
@@ -109,57 +110,6 @@ def run_steps(k0: int, k1: int, ratio: int, stepper: Any, arrays: tuple[np.ndarr
 
 
 @nb.njit(**_JIT)
-def _library_call(k, t, z, fn, swap, fail, bufs, rec, zi, hub, lib, cmd):  # pragma: no cover
-    """One call of the library at plant step ``k`` (time ``t``): the records of this call,
-    ``DISCON``, the demands into ``cmd`` (pitch 1-3, torque, contactor). ``lib`` holds the
-    status, the last pitch demand of blade 1, the individual-pitch flag, the pitch limits and
-    the largest torque. Returns aviFAIL, or 2 for a non-finite demand."""
-    swap[0] = lib[0]
-    swap[1] = t
-    swap[10] = lib[1]
-    swap[26] = hub[k]
-    for j in range(rec.size):
-        swap[rec[j]] = z[zi[j]]
-    fail[0] = 0
-    bufs[2, 0] = 0
-    bufs[1, :] = bufs[3, :]
-    fn(swap.ctypes, fail.ctypes, bufs[0].ctypes, bufs[1].ctypes, bufs[2].ctypes)
-    if fail[0] < 0:
-        return fail[0]
-    lib[0] = 1.0
-    if lib[2] != 0.0:
-        p0, p1, p2 = float(swap[41]), float(swap[42]), float(swap[43])
-    else:
-        p0 = p1 = p2 = float(swap[44])
-    contactor = float(swap[34])
-    torque = float(swap[46]) if contactor != 0.0 else 0.0
-    hi = lib[5]
-    if hi < torque <= hi * (1 + 1e-6):
-        torque = hi
-    cmd[0], cmd[1], cmd[2] = p0, p1, p2
-    for i in range(3):
-        if lib[3] - 1e-6 <= cmd[i] < lib[3]:
-            cmd[i] = lib[3]
-        elif lib[4] < cmd[i] <= lib[4] + 1e-6:
-            cmd[i] = lib[4]
-    cmd[3], cmd[4] = torque, contactor
-    if not (math.isfinite(cmd[0] + cmd[1] + cmd[2]) and math.isfinite(torque)):
-        return 2
-    lib[1] = cmd[0]
-    n = min(int(swap[64]), cmd.size - 5)
-    for i in range(max(n, 0)):
-        cmd[5 + i] = swap[_log_start(swap) + i]
-    lib[6] = max(lib[6], float(n))
-    return fail[0]
-
-
-@nb.njit(**_JIT)
-def _log_start(swap):  # pragma: no cover - compiled
-    """The 0-based index of the first logging channel (record 63's record number)."""
-    return int(swap[62]) - 1
-
-
-@nb.njit(**_JIT)
 def _library_loop(k0, k1, ratio, h, pk, kind, wpar, grid, hint, dphi, lim, xs, us, zs, u,
                   held, fn, swap, fail, bufs, rec, zi, hub, lib, sigs, act, counts
                   ):  # pragma: no cover - compiled
@@ -174,7 +124,7 @@ def _library_loop(k0, k1, ratio, h, pk, kind, wpar, grid, hint, dphi, lim, xs, u
                           zs[k])
         warned = 0
         if k % ratio == 0:
-            flag = _library_call(k, t, zs[k], fn, swap, fail, bufs, rec, zi, hub, lib, cmd)
+            flag = library_call(k, t, zs[k], fn, swap, fail, bufs, rec, zi, hub, lib, cmd)
             if flag < 0:
                 return k, -4
             if flag == 2:

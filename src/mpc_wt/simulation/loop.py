@@ -12,7 +12,9 @@ Measurements given to the controller: ``t``, ``gen_speed``, ``rotor_speed``, ``p
 ``aero_power``, ``lss_torque``, ``thrust``, ``tilt_moment``, ``yaw_moment``,
 ``hub_wind_speed`` (the free wind at the hub, as a nacelle anemometer would see it without the
 rotor: OpenFAST's ``HorWindV``); ``state``, the full plant state
-(:data:`linearize.STATE_NAMES`), for full-state-information designs (Madsen's MPC); and
+(:data:`linearize.STATE_NAMES`), for full-state-information designs (Madsen's MPC);
+``outputs``, the plant's output row (:data:`linearize.OUTPUT_NAMES`; a wrapper that changes a
+measurement must drop it, the library host reads its records from it); and
 ``preview`` when a LIDAR preview is attached. A controller with a ``finalize()`` method gets
 it called once after the run (also after a failed one): a Bladed-style library's last call.
 A controller whose ``grid_connected`` attribute turns False (a grid loss,
@@ -66,7 +68,8 @@ def _measurements(t: float, x: np.ndarray, z: np.ndarray) -> dict[str, Any]:
             "flap_moment": z[10:13].copy(), "edge_moment": z[13:16].copy(),
             "tower_fa_acceleration": v[fa], "tower_ss_acceleration": v[ss], "azimuth": v[az],
             "gen_power": v[gp], "gen_torque": v[gt], "aero_power": v[ap], "lss_torque": v[lss],
-            "thrust": v[th], "tilt_moment": v[tm], "yaw_moment": v[ym], "state": x.copy()}
+            "thrust": v[th], "tilt_moment": v[tm], "yaw_moment": v[ym], "state": x.copy(),
+            "outputs": z}
 
 
 def _hub_wind(wind: Any, hub_height: float) -> Any:
