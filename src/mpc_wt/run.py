@@ -68,8 +68,9 @@ def design_controller(turbine: linearize.Turbine, controller: str,
         The turbine.
     controller : str
         A registered name, with a pattern or add-ons (``derate80+ibc``).
-    options : mapping, optional
-        Flat option name -> value, split over the base and its add-ons.
+    options : mapping or tuple of Options, optional
+        Flat option name -> value, split over the base and its add-ons; or the options
+        ``Selection.options`` checked (taken as they are).
     cache : DesignCache
         Where designs are kept.
     naming : Naming
@@ -143,8 +144,9 @@ def build_controller(turbine: linearize.Turbine, controller: str, scenario: Scen
         (``derate80+ibc``).
     scenario : Scenario
         The load case: the simulator's, never the design's.
-    options : mapping, optional
-        Flat option name -> value, split over the base and its add-ons.
+    options : mapping or tuple of Options, optional
+        Flat option name -> value, split over the base and its add-ons; or the options
+        ``Selection.options`` checked (taken as they are).
     cache : DesignCache
         For designs (kept between runs).
     naming : Naming

@@ -160,9 +160,8 @@ def _simulate(args: argparse.Namespace) -> int:
     if args.controller is None:
         args.controller = "baseline"
         print("controller: baseline (the default; --controller KIND chooses another)")
-    opts = controller_options(args)
     try:
-        resolve(args.controller).options(opts, naming)
+        opts = resolve(args.controller).options(controller_options(args), naming)
     except ValueError as err:
         prefix = "" if hasattr(err, "key") else "--controller: "
         raise UsageError(f"{prefix}{err}") from None

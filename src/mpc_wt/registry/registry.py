@@ -303,14 +303,15 @@ class Selection:
         """
         return {f.name for k in self.parts for f in option_fields(k.options)}
 
-    def options(self, raw: Mapping[str, Any] | None = None,
+    def options(self, raw: Mapping[str, Any] | tuple[Options, ...] | None = None,
                 naming: Naming = API_NAMING) -> tuple[Options, ...]:
         """Split a flat mapping of options over the parts and validate each part's share.
 
         Parameters
         ----------
-        raw : mapping, optional
-            Option name -> value.
+        raw : mapping or tuple of Options, optional
+            Option name -> value; or options this method returned for the same name, which are
+            taken as they are (already checked).
         naming : Naming
             How messages name options and controllers.
 
@@ -325,6 +326,13 @@ class Selection:
             For an option no part takes (naming the kinds that take it), one the name already
             sets, a missing required option, or a bad value; ``.key`` is the option's name.
         """
+        if isinstance(raw, tuple):
+            if len(raw) == len(self.parts) and all(
+                    type(o) is k.options for o, k in zip(raw, self.parts)):
+                return raw
+            raise OptionsError(f"checked options for {naming.one(self.name)} are one of "
+                               f"{[k.options.__name__ for k in self.parts]} each, got "
+                               f"{[type(o).__name__ for o in raw]}")
         raw = dict(raw or {})
         for k in raw:
             if k in self.preset:

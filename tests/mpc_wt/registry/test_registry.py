@@ -313,3 +313,19 @@ def test_lidar_field_is_made_from_the_seed_not_beside_the_case_field() -> None:
     with pytest.raises(ValueError, match="scenario 'eog' with turbulence 'A' has no "
                                          "turbulent field"):
         field_spec(tb, Scenario(18.0, "A", 1, 20.0, 0.2, condition="eog"))
+
+
+def test_checked_options_pass_through_unchanged(turbine):
+    """The options a selection checked once are taken as they are (the command line checks
+    them before it runs); another selection's are refused with both named."""
+    sel = resolve("derate80+ibc")
+    checked = sel.options({"loop_gain_1p": 0.5})
+    assert sel.options(checked) is checked
+    with pytest.raises(OptionsError, match=r"DerateOptions', 'IBCOptions'\] each, got "
+                                           r"\['MPCOptions'\]"):
+        sel.options((MPCOptions(),))
+    a = build_controller(turbine, "derate80+ibc", Scenario(14.0, "A", 3, 2.0), checked)[0]
+    b = build_controller(turbine, "derate80+ibc", Scenario(14.0, "A", 3, 2.0),
+                         {"loop_gain_1p": 0.5})[0]
+    assert a.controller is b.controller         # the same design from the cache
+    assert not b.meta["design"]["new"]
