@@ -104,23 +104,28 @@ def test_the_compiled_loop_calls_the_library_as_the_host_does(turbine, kind, win
             np.testing.assert_array_equal(fast.controller[name], slow.controller[name])
 
 
-@pytest.mark.parametrize("kind, wind", [("mpc", 14.0), ("mpc-lidar", 14.0), ("ts", 10.0)])
+@pytest.mark.parametrize("kind, wind", [("mpc", 14.0), ("mpc-lidar", 14.0), ("ts", 10.0),
+                                        ("lqr-pio", 8.0), ("lqr-pio", 16.0)])
 def test_the_librarys_logging_channels_are_the_python_steps_signals(turbine, kind, wind):
-    """The shipped MPC's fallback level and schedule wind and the TS controller's wind
-    estimate and premise clips, returned as logging channels, are the Python step's signals
-    (the schedule and estimate to the float32 of the swap array: 1e-5 m/s); the QP's solve
-    time is a positive reading of the library's own clock."""
+    """The shipped MPC's fallback level and schedule winds, LQR-PIO's region and schedule
+    winds and the TS controller's wind estimate and premise clips, returned as logging
+    channels, are the Python step's signals (the winds to the float32 of the swap array:
+    1e-5 m/s); the QP's solve time is a positive reading of the library's own clock."""
     kw = dict(duration=30.0, turbulence="A", seed=31, fields=_FIELDS)
     lib = run_controller(turbine, kind, wind, shipped=True, **kw)
     py = run_controller(turbine, kind, wind, **kw)
-    for name in ("qp_fallback", "premise_clipped"):
-        if name in py.controller:
+    from mpc_wt.io.discon_export import log_channels
+
+    names = log_channels(kind)
+    assert set(names) <= set(lib.controller) and set(names) <= set(py.controller)
+    for name in ("qp_fallback", "premise_clipped", "region"):
+        if name in names:
             np.testing.assert_array_equal(lib.controller[name], py.controller[name])
-    for name in ("schedule_wind", "wind_est"):
-        if name in py.controller:
+    for name in ("schedule_wind", "schedule_grid_wind", "wind_est"):
+        if name in names:
             np.testing.assert_allclose(lib.controller[name], py.controller[name], rtol=0,
                                        atol=1e-5)
-    if "qp_solve_ms" in py.controller:
+    if "qp_solve_ms" in names:
         assert np.all(lib.controller["qp_solve_ms"] > 0)
 
 

@@ -77,7 +77,8 @@ _LIBRARY_KIND = {"baseline": "baseline", "baseline-ct": "baseline", "mpc": "mpc"
 #: The logging channels each library kind returns (records 65 and 63 on), in order: the
 #: signals a shipped run records beside the host's (the C laws fill them, ``mw_cmd.log``).
 LOG_CHANNELS: dict[str, tuple[str, ...]] = {
-    "mpc": ("qp_fallback", "qp_solve_ms", "schedule_wind"),
+    "mpc": ("qp_fallback", "qp_solve_ms", "schedule_wind", "schedule_grid_wind"),
+    "lqr": ("region", "schedule_wind", "schedule_grid_wind"),
     "ts": ("wind_est", "premise_clipped"),
 }
 

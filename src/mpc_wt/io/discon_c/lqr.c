@@ -115,6 +115,10 @@ static int lqr_step(mw_ctrl *self, const mw_meas *m, mw_cmd *out, char *msg)
     p->udev[3] = torque - p->u0[3];
     for (b = 0; b < 3; b++) out->pitch[b] = pitch[b];
     out->torque = torque;
+    out->nlog = 3;                  /* region, schedule_wind, schedule_grid_wind */
+    out->log[0] = p->region;
+    out->log[1] = c->sched.wind;
+    out->log[2] = c->sched.grid[k];
     return 0;
 }
 

@@ -590,10 +590,11 @@ static int mpc_step(mw_ctrl *self, const mw_meas *m, mw_cmd *out, char *msg)
     }
     for (i = 0; i < 3; i++) out->pitch[i] = u[i];
     out->torque = u[3];
-    out->nlog = 3;                  /* qp_fallback, qp_solve_ms, schedule_wind */
+    out->nlog = 4;                  /* qp_fallback, qp_solve_ms, schedule_wind, its grid wind */
     out->log[0] = c->level;
     out->log[1] = c->qp_ms;
     out->log[2] = c->sched.wind;
+    out->log[3] = c->sched.grid[k];
     return rc;
 }
 
