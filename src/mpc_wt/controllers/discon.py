@@ -76,9 +76,8 @@ SWAP_RECORDS = {
     76: "fixed-frame hub yaw moment [N m]", 95: "air density [kg/m^3]",
     109: "low-speed-shaft torque [N m]", 110: "rotor thrust [N]", 129: "swap array length",
 }
-_LOG_START = 165
 #: The logging channels the host offers a library (record 62) and where they start (63).
-LOG_ROOM, LOG_START = 8, _LOG_START
+LOG_ROOM, LOG_START = 8, 165
 #: OpenFAST's lidar block of the extended swap array (ServoDyn's BladedInterface_EX: records
 #: 2001-2500), as :class:`DisconController` fills it from a CW LIDAR with three beams.
 LIDAR_RECORDS = {
@@ -536,8 +535,8 @@ class DisconController(ControllerBase):
                  28: 1.0 if self.pitch_control == "individual" else 0.0, 29: 0.0, 37: 0.0,
                  49: float(_MSG_LEN), 50: float(len(self._infile) + 1),
                  51: float(len(self._outname) + 1), 61: 3.0, 62: float(LOG_ROOM),
-                 63: float(_LOG_START), 64: float(_OUT_LEN), 66: 1001.0, 95: tb.environment.air_density,
-                 129: float(SWAP_SIZE)}
+                 63: float(LOG_START), 64: float(_OUT_LEN), 66: 1001.0,
+                 95: tb.environment.air_density, 129: float(SWAP_SIZE)}
         self._view[np.array(list(fixed)) - 1] = np.array(list(fixed.values()), np.float32)
         self._msg = ctypes.create_string_buffer(_MSG_LEN)
         self._out = ctypes.create_string_buffer(_OUT_LEN)
@@ -584,16 +583,7 @@ class DisconController(ControllerBase):
         fail = ctypes.c_int(0)
         self._msg[0] = b"\0"
         ctypes.memmove(self._out, self._outname + b"\0", len(self._outname) + 1)
-        if self.quiet:
-            if self._fds is None:
-                sys.stdout.flush()
-                self._fds = (os.open(os.devnull, os.O_WRONLY), os.dup(1))
-            os.dup2(self._fds[0], 1)
-            try:
-                self._fn(self._swap, ctypes.byref(fail), self._infile, self._out, self._msg)
-            finally:
-                os.dup2(self._fds[1], 1)
-        else:
+        with self.quiet_calls():
             self._fn(self._swap, ctypes.byref(fail), self._infile, self._out, self._msg)
         self._report(t, fail.value, self._msg.value.decode(errors="replace").strip())
 
@@ -637,22 +627,33 @@ class DisconController(ControllerBase):
         fn.restype, fn.argtypes = None, [ctypes.c_void_p] * 5
         return (fn, self._view, np.zeros(1, np.int32), bufs, rec, zi, lib)
 
-    def compiled_report(self, t: float, call: tuple[Any, ...]) -> None:
-        """The compiled loop's word from the library at time ``t``: its ``aviFAIL`` and message
-        (as :meth:`step` reports them: a warning logged and kept, a stop raised).
+    def compiled_report(self, t: float, call: tuple[Any, ...], finite: bool = True) -> None:
+        """The compiled call's word from the library at time ``t``: its ``aviFAIL`` and message
+        (as :meth:`step` reports them: a warning logged and kept, a stop raised), or demands
+        that are not finite.
 
         Parameters
         ----------
         t : float
             The call's time [s].
         call : tuple
-            :meth:`compiled_library`'s arrays, as the loop left them.
+            :meth:`compiled_library`'s arrays, as the call left them.
+        finite : bool
+            False: the call's demands were not finite (the call's flag 2).
 
         Raises
         ------
         ControllerLibraryError
-            If the library stopped the run (``aviFAIL < 0``).
+            If the library stopped the run (``aviFAIL < 0``) or its demands are not finite.
         """
+        if not finite:
+            v = call[1]
+            raise ControllerLibraryError(
+                f"controller library {self.library.name} returned pitch {v[41:44].tolist()} "
+                f"rad, torque {float(v[46])} N m at t = {t:g} s")
+        if call[2][0] == 0:
+            self._warned = False
+            return
         msg = bytes(call[3][2]).split(b"\0", 1)[0].decode(errors="replace").strip()
         self._report(t, int(call[2][0]), msg)
 
@@ -753,13 +754,8 @@ class DisconController(ControllerBase):
                 f"{torque} N m at t = {t:g} s")
         pitch = np.array(p)
         self._last_pitch, self._last_torque = pitch, torque
-        self.signals = {"pitch_command": (p[0] + p[1] + p[2]) / 3.0,
-                        "torque_command": torque, "generator_contactor": contactor,
-                        "library_warning": float(self._warned)}
-        n = min(int(v[64]), LOG_ROOM)
-        if n > 0:
-            self.signals.update(zip(self._log_keys(n), v[_LOG_START - 1:_LOG_START - 1 + n]
-                                    .tolist()))
+        n = max(min(int(v[64]), LOG_ROOM), 0)
+        self._set_signals(p, torque, contactor, v[LOG_START - 1:LOG_START - 1 + n].tolist())
         return pitch, torque
 
     def _step_compiled(self, t: float, meas: dict[str, Any]) -> tuple[np.ndarray, float]:
@@ -769,32 +765,36 @@ class DisconController(ControllerBase):
         lib = call[6]
         lib[0], lib[1] = float(self._status), float(self._last_pitch[0])
         self._hub[0] = meas.get("hub_wind_speed", 0.0)
-        with self._quiet_call():
+        with self.quiet_calls():
             flag = library_call(0, t, meas["outputs"], *call[:6], self._hub, lib, cmd)
-        if flag == 2:
-            raise ControllerLibraryError(
-                f"controller library {self.library.name} returned pitch "
-                f"{self._view[41:44].tolist()} rad, torque {float(self._view[46])} N m at "
-                f"t = {t:g} s")
-        if call[2][0] != 0:
-            self.compiled_report(t, call)        # raises for aviFAIL < 0
-        else:
-            self._warned = False
+        self.compiled_report(t, call, flag != 2)     # raises for aviFAIL < 0
         self._status = 1
         p = cmd[:3].tolist()
         torque = float(cmd[3])
         self._last_pitch, self._last_torque = np.array(p), torque
-        self.signals = {"pitch_command": (p[0] + p[1] + p[2]) / 3.0,
-                        "torque_command": torque, "generator_contactor": float(cmd[4]),
-                        "library_warning": float(self._warned)}
-        n = int(lib[7])
-        if n > 0:
-            self.signals.update(zip(self._log_keys(n), cmd[5:5 + n].tolist()))
+        self._set_signals(p, torque, float(cmd[4]), cmd[5:5 + int(lib[7])].tolist())
         return np.array(p), torque
 
+    def _set_signals(self, p: list[float], torque: float, contactor: float,
+                     logs: list[float]) -> None:
+        """The host's signals of a call: the demands, the contactor, a warning, the library's
+        logging channels."""
+        self.signals = {"pitch_command": (p[0] + p[1] + p[2]) / 3.0,
+                        "torque_command": torque, "generator_contactor": contactor,
+                        "library_warning": float(self._warned)}
+        if logs:
+            self.signals.update(zip(self._log_keys(len(logs)), logs))
+
     @contextlib.contextmanager
-    def _quiet_call(self) -> Any:
-        """The library's standard output to the null device during a call (``quiet``)."""
+    def quiet_calls(self) -> Any:
+        """The library's standard output to the null device while in this block, when the
+        host is ``quiet`` (its calls, or a compiled loop's block of them).
+
+        Returns
+        -------
+        context manager
+            Restores standard output on leaving.
+        """
         if not self.quiet:
             yield
             return

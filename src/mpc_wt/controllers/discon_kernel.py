@@ -12,7 +12,7 @@ import numba as nb
 
 from linearize.jitcache import key_caches_on_callees
 
-__all__ = ["library_call", "log_start"]
+__all__ = ["library_call"]
 
 _JIT = dict(cache=True, error_model="numpy")
 
@@ -57,17 +57,12 @@ def library_call(k, t, z, fn, swap, fail, bufs, rec, zi, hub, lib, cmd):  # prag
         return 2
     lib[1] = cmd[0]
     n = min(int(swap[64]), cmd.size - 5)
+    first = int(swap[62]) - 1               # record 63: the first channel's record
     for i in range(max(n, 0)):
-        cmd[5 + i] = swap[log_start(swap) + i]
+        cmd[5 + i] = swap[first + i]
     lib[6] = max(lib[6], float(n))
     lib[7] = float(max(n, 0))
     return fail[0]
-
-
-@nb.njit(**_JIT)
-def log_start(swap):  # pragma: no cover - compiled
-    """The 0-based index of the first logging channel (record 63's record number)."""
-    return int(swap[62]) - 1
 
 
 key_caches_on_callees(__name__)

@@ -23,11 +23,8 @@ without the torque-rate limit.
 """
 from __future__ import annotations
 
-import contextlib
 import logging
 import math
-import os
-import sys
 from typing import Any
 
 import numpy as np
@@ -282,7 +279,7 @@ def _run_library(loop: _Loop, stepper: linearize.PlantStepper, ratio: int, bar: 
     arrays = (loop.xs, loop.us, loop.zs, loop.u, held, fn, swap, fail, bufs, rec, zi, hub, lib,
               sigs, act, counts)
     try:
-        with _quiet(getattr(ctl, "quiet", False)):
+        with ctl.quiet_calls():
             k = 0
             while k < n:
                 block = min(k + 800 - k % 800, n)
@@ -292,13 +289,8 @@ def _run_library(loop: _Loop, stepper: linearize.PlantStepper, ratio: int, bar: 
                 k = done
                 if flag == -5:                       # a warning at the step before
                     ctl.compiled_report((done - 1) * dt, call)
-                elif flag == -4:
-                    ctl.compiled_report(done * dt, call)
-                elif flag == -6:
-                    raise ControllerLibraryError(
-                        f"controller library {ctl.library.name} returned pitch "
-                        f"{swap[41:44].tolist()} rad, torque {float(swap[46])} N m at "
-                        f"t = {done * dt:g} s")
+                elif flag in (-4, -6):               # a stop, demands not finite
+                    ctl.compiled_report(done * dt, call, flag == -4)
                 elif flag >= 0:
                     raise _Diverged(done, flag, float(loop.xs[done, flag]))
         loop.us[n] = loop.u
@@ -312,23 +304,6 @@ def _run_library(loop: _Loop, stepper: linearize.PlantStepper, ratio: int, bar: 
             log.warning("controller command out of the actuator range at t = %g s: the plant "
                         "clips it; the count is in result.meta['commands_clipped']",
                         counts[1] * dt)
-
-
-@contextlib.contextmanager
-def _quiet(on: bool) -> Any:
-    """Standard output to the null device while ``on`` (what a library prints)."""
-    if not on:
-        yield
-        return
-    sys.stdout.flush()
-    null, saved = os.open(os.devnull, os.O_WRONLY), os.dup(1)
-    os.dup2(null, 1)
-    try:
-        yield
-    finally:
-        os.dup2(saved, 1)
-        os.close(null)
-        os.close(saved)
 
 
 def _advance(loop: _Loop, stepper: linearize.PlantStepper, ratio: int, bar: Any,
