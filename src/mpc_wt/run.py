@@ -121,7 +121,7 @@ def _design(turbine: linearize.Turbine, sel: Selection, opts: Sequence[Options],
         return built, bool(made)
     ctx = BuildContext(turbine=turbine, params=params or linearize.plant_params(turbine),
                        cache=cache)
-    return cache.get(turbine, ("shipped", *key[1:]),
+    return cache.get(turbine, ("shipped", *key[1:], built.meta["design"]["digest"]),
                      lambda: hook(ctx, sel, opts[-1], built)), bool(made)
 
 
@@ -130,7 +130,7 @@ def build_controller(turbine: linearize.Turbine, controller: str, scenario: Scen
                      cache: DesignCache = DEFAULT_CACHE, naming: Naming = API_NAMING,
                      params: linearize.PlantParams | None = None,
                      samplers: lidar.SamplerCache | None = None,
-                     fields: FieldMemo | None = None, shipped: bool = False
+                     fields: FieldMemo | None = None, shipped: bool = True
                      ) -> tuple[Built, linearize.OperatingPoint, Any]:
     """The controller's design (:func:`design_controller`, from the cache when it is there),
     the scenario's trim point and wind, and the design's LIDARs bound to the wind they see.
@@ -160,8 +160,8 @@ def build_controller(turbine: linearize.Turbine, controller: str, scenario: Scen
         process's :data:`~mpc_wt.simulation.scenario.DEFAULT_FIELDS`; ``FieldMemo(0)`` keeps
         none).
     shipped : bool
-        Run a kind that exports as it is shipped, its compiled C law; False (default): the
-        design's Python step (:func:`design_controller`).
+        Run a kind that exports as it is shipped, its compiled C law (default); False: the
+        design's Python step (:func:`design_controller`), for studies of the design itself.
 
     Returns
     -------
@@ -238,7 +238,7 @@ def run_controller(turbine: linearize.Turbine, controller: str, scenario: Scenar
                    duration: float | None = None, shear_exponent: float | None = None,
                    condition: Mapping[str, Any] | None = None,
                    plant: Mapping[str, bool] | None = None,
-                   shipped: bool = False) -> ClosedLoopResult:
+                   shipped: bool = True) -> ClosedLoopResult:
     """Trim, build the controller, generate the scenario's wind and simulate.
 
     Parameters
@@ -280,7 +280,7 @@ def run_controller(turbine: linearize.Turbine, controller: str, scenario: Scenar
         The plant's effects switched from their defaults (``meta["plant"]``), e.g.
         ``{"twisted_modes": True}`` (:meth:`linearize.PlantConfig.with_switches`).
     shipped : bool
-        An exportable kind runs its compiled C law (``meta["law"]``); False: its Python step.
+        An exportable kind runs its C law (default; ``meta["law"]``); False: its Python step.
 
     Returns
     -------

@@ -142,7 +142,8 @@ def _replay(turbine, kind, ex, wind):
     from mpc_wt.simulation.scenario import Scenario
 
     built, op, field = build_controller(turbine, kind, Scenario(wind_mps=wind, turbulence="A",
-                                                                seed=11, duration=120.0))
+                                                                seed=11, duration=120.0),
+                                        shipped=False)
     ctl = built.controller
     host = DisconController(ex.library, ex.input_file, turbine, dt=ex.dt,
                             lidar=None if built.preview is None else built.preview.sensor)
@@ -223,7 +224,7 @@ def test_ts_library_holds_a_minimum_pitch_schedule_as_the_python_controller(nrel
     from mpc_wt.simulation.loop import simulate_closed_loop
     from mpc_wt.simulation.scenario import Scenario
 
-    built, _, _ = build_controller(nrel5mw, "ts", Scenario(7.0, duration=30.0))
+    built, _, _ = build_controller(nrel5mw, "ts", Scenario(7.0, duration=30.0), shipped=False)
     ctl = built.controller
     law = ctl.torque_law
     g = dataclasses.replace(law.gains, min_pitch_speeds=(law.w_cutin, law.w_rated),

@@ -1,4 +1,4 @@
-"""A kind that exports runs, on request, as it is shipped: its design's numbers in the input file
+"""A kind that exports runs as it is shipped: its design's numbers in the input file
 of its compiled C law, called through the host. The peer is the user's own path: the same
 design exported with ``export_discon`` (a folder of sources built by itself) and run as any
 Bladed-style library (the ``discon`` kind); the shipped run must be that run, step for step."""
@@ -47,7 +47,10 @@ def test_the_python_step_stays_where_the_library_takes_no_such_design(turbine):
                        turbulence="A", seed=23)
     assert "law" not in r.meta                 # no shipped law for this composition
     r = run_controller(turbine, "baseline", 14.0, duration=2.0, turbulence="A", seed=23)
-    assert "law" not in r.meta                 # the Python step unless asked
+    assert r.meta["law"] == "shipped"          # the library unless the Python step is asked
+    r = run_controller(turbine, "baseline", 14.0, duration=2.0, turbulence="A", seed=23,
+                       shipped=False)
+    assert "law" not in r.meta
 
 
 def test_the_library_is_built_once_into_the_users_cache():
@@ -72,9 +75,11 @@ def test_the_guides_python_examples_run(tmp_path, monkeypatch):
         exec(compile(code, str(guide), "exec"), {"__name__": "__guide__"})
 
 
-def _both_paths(turbine, kind, wind, options=None, duration=30.0):
+def _both_paths(turbine, kind, wind, options=None, duration=30.0, supervisor=None):
     """The same case with the library called from the loop compiled with the plant and from
-    the Python loop through the host's ``step``."""
+    the Python loop through the host's ``step`` (with ``supervisor``: under a
+    :class:`~mpc_wt.controllers.supervisor.Supervisor` of those settings)."""
+    from mpc_wt.controllers.supervisor import Supervisor
     from mpc_wt.run import build_controller
     from mpc_wt.simulation.loop import simulate_closed_loop
     from mpc_wt.simulation.scenario import Scenario
@@ -84,10 +89,23 @@ def _both_paths(turbine, kind, wind, options=None, duration=30.0):
     for compiled in (True, False):
         built, op, field = build_controller(turbine, kind, sc, options, shipped=True,
                                             fields=_FIELDS)
-        out.append(simulate_closed_loop(linearize.plant_params(turbine), built.controller, field,
+        ctl = built.controller
+        if supervisor is not None:
+            ctl = Supervisor(ctl, turbine, **supervisor)
+        out.append(simulate_closed_loop(linearize.plant_params(turbine), ctl, field,
                                         sc.duration, x0=op.x, u0=op.u,
                                         controller_dt=built.controller_dt, compiled=compiled))
     return out
+
+
+def _same_runs(fast, slow):
+    np.testing.assert_array_equal(fast.x, slow.x)
+    np.testing.assert_array_equal(fast.u, slow.u)
+    assert sorted(fast.controller) == sorted(slow.controller)
+    for name in slow.controller:
+        if name != "qp_solve_ms":
+            np.testing.assert_array_equal(fast.controller[name], slow.controller[name],
+                                          err_msg=name)
 
 
 @pytest.mark.parametrize("kind, wind", [("baseline", 9.0), ("mpc", 16.0), ("lqr-pio", 13.0)])
@@ -96,24 +114,46 @@ def test_the_compiled_loop_calls_the_library_as_the_host_does(turbine, kind, win
     the last bit: states, inputs, the host's signals and the library's logging channels (but
     the QP's solve time, a clock's reading)."""
     fast, slow = _both_paths(turbine, kind, wind)
-    np.testing.assert_array_equal(fast.x, slow.x)
-    np.testing.assert_array_equal(fast.u, slow.u)
-    assert sorted(fast.controller) == sorted(slow.controller)
-    for name in slow.controller:
-        if name != "qp_solve_ms":
-            np.testing.assert_array_equal(fast.controller[name], slow.controller[name])
+    _same_runs(fast, slow)
+    assert (fast.meta["loop"], slow.meta["loop"]) == ("compiled", "python")
+
+
+@pytest.mark.parametrize("kind, wind, supervisor", [
+    ("baseline", 12.0, {"overspeed": 1.25, "shutdown_at": 17.3}),
+    ("lqr-pio", 18.0, {"overspeed": 1.01}),
+    ("ibc", 14.0, {"grid_loss_at": 11.0}),
+    ("ts", 16.0, {"pitch_fault_at": 8.0, "pitch_fault": "runaway",
+                  "pitch_fault_azimuth_deg": 120.0}),
+    ("baseline+lidar-ff", 16.0, {"overspeed": 1.25, "shutdown_at": 20.0}),
+    ("mpc-lidar", 15.0, None)])
+def test_the_compiled_loop_hands_the_supervisor_and_the_lidar_their_steps(
+        turbine, kind, wind, supervisor):
+    """Under a supervisor the compiled loop runs the library until a trip can come (an event's
+    time, the rotor above the overspeed limit) and the Python loop goes on from there; a LIDAR
+    takes its samples where they are due: the run is the Python host's to the last bit, the
+    supervisor's state and trip time too."""
+    fast, slow = _both_paths(turbine, kind, wind, supervisor=supervisor)
+    _same_runs(fast, slow)
+    assert slow.meta["loop"] == "python"
+    if supervisor is None:
+        assert fast.meta["loop"] == "compiled"
+    else:
+        assert fast.meta["loop"] == "compiled+python"
+        assert np.any(slow.controller["supervisor_state"] > 0), "the case must trip"
 
 
 @pytest.mark.parametrize("kind, wind", [("mpc", 14.0), ("mpc-lidar", 14.0), ("ts", 10.0),
-                                        ("lqr-pio", 8.0), ("lqr-pio", 16.0)])
+                                        ("lqr-pio", 8.0), ("lqr-pio", 16.0), ("ibc", 18.0),
+                                        ("baseline+lidar-ff", 16.0)])
 def test_the_librarys_logging_channels_are_the_python_steps_signals(turbine, kind, wind):
     """The shipped MPC's fallback level and schedule winds, LQR-PIO's region and schedule
-    winds and the TS controller's wind estimate and premise clips, returned as logging
-    channels, are the Python step's signals (the winds to the float32 of the swap array:
+    winds, the TS controller's wind estimate and premise clips, the IBC's weight, gain and
+    blade pitch and the LIDAR feedforward's wind, pitch, mean wind and corner, returned as
+    logging channels, are the Python step's signals (the winds to the float32 of the swap array:
     1e-5 m/s); the QP's solve time is a positive reading of the library's own clock."""
     kw = dict(duration=30.0, turbulence="A", seed=31, fields=_FIELDS)
-    lib = run_controller(turbine, kind, wind, shipped=True, **kw)
-    py = run_controller(turbine, kind, wind, **kw)
+    lib = run_controller(turbine, kind, wind, **kw)
+    py = run_controller(turbine, kind, wind, shipped=False, **kw)
     from mpc_wt.io.discon_export import log_channels
 
     names = log_channels(kind)
@@ -125,6 +165,17 @@ def test_the_librarys_logging_channels_are_the_python_steps_signals(turbine, kin
         if name in names:
             np.testing.assert_allclose(lib.controller[name], py.controller[name], rtol=0,
                                        atol=1e-5)
+    # the IBC's and the feedforward's: the pitch within 1e-7 rad (the demands agree within
+    # 2e-5 deg), the winds within 1e-5 m/s, the gain to 1e-7 of itself (float32)
+    for name, atol in (("ibc_weight", 1e-9), ("ibc_pitch_1", 1e-7), ("ibc_pitch_2", 1e-7),
+                       ("ibc_pitch_3", 1e-7), ("ff_pitch", 1e-7), ("ff_wind", 1e-5),
+                       ("ff_mean_wind", 1e-5), ("ff_corner", 1e-6)):
+        if name in names:
+            np.testing.assert_allclose(lib.controller[name], py.controller[name], rtol=0,
+                                       atol=atol, err_msg=name)
+    if "ibc_gain" in names:                  # the float32 of the swap array
+        np.testing.assert_allclose(lib.controller["ibc_gain"], py.controller["ibc_gain"],
+                                   rtol=1e-7)
     if "qp_solve_ms" in names:
         assert np.all(lib.controller["qp_solve_ms"] > 0)
 

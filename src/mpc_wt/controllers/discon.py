@@ -77,7 +77,7 @@ SWAP_RECORDS = {
     109: "low-speed-shaft torque [N m]", 110: "rotor thrust [N]", 129: "swap array length",
 }
 #: The logging channels the host offers a library (record 62) and where they start (63).
-LOG_ROOM, LOG_START = 8, 165
+LOG_ROOM, LOG_START = 12, 165
 #: OpenFAST's lidar block of the extended swap array (ServoDyn's BladedInterface_EX: records
 #: 2001-2500), as :class:`DisconController` fills it from a CW LIDAR with three beams.
 LIDAR_RECORDS = {
@@ -487,7 +487,7 @@ class DisconController(ControllerBase):
                                       self._outname.decode())
         self.messages = []
         self.signals = {}
-        # the step's compiled call (the closed loop's own): a library in this process, no LIDAR
+        # the step's compiled call (the closed loop's own): a library in this process
         self._fast = self.compiled_library()
         self._cmd, self._hub = np.zeros(5 + LOG_ROOM), np.zeros(1)
 
@@ -550,9 +550,28 @@ class DisconController(ControllerBase):
         a sample is due (held in between)."""
         if t < self._lidar_next - 1e-9:
             return
+        self.sample_lidar(t, float(meas["azimuth"]), float(meas["rotor_speed"]))
+
+    def sample_lidar(self, t: float, azimuth: float, rotor_speed: float) -> float:
+        """Write the LIDAR's sample at time ``t`` to the lidar records (the compiled loop asks
+        for it when one is due).
+
+        Parameters
+        ----------
+        t : float
+            The sample's time [s].
+        azimuth : float
+            The rotor's azimuth [rad, 0-2 pi].
+        rotor_speed : float
+            The rotor's speed [rad/s].
+
+        Returns
+        -------
+        float
+            When the next sample is due [s].
+        """
         self._lidar_next = t + 1.0 / self.lidar.instrument.sample_rate
-        m = self.lidar.measure(np.array([t]), np.array([float(meas["azimuth"])]),
-                               float(meas["rotor_speed"]))
+        m = self.lidar.measure(np.array([t]), np.array([azimuth]), rotor_speed)
         ang = m.beam_azimuth_rad[0]
         r = m.radius
         v = self._view
@@ -561,6 +580,7 @@ class DisconController(ControllerBase):
         v[2007:2010] = self.lidar.focus_distance
         v[2010:2013] = -r * np.sin(ang)
         v[2013:2016] = r * np.cos(ang)
+        return self._lidar_next
 
     def _fill(self, t: float, meas: dict[str, Any]) -> None:
         if self.lidar is not None:
@@ -607,14 +627,14 @@ class DisconController(ControllerBase):
         the swap array, ``aviFAIL``, the string buffers (input file, OUTNAME, message, OUTNAME's
         text), the records filled from the plant's outputs and those outputs' indices, and the
         host's state (status, last pitch demand, individual pitch, pitch limits, largest
-        torque). None where the loop cannot: a library in a child process, or a LIDAR's records
-        to fill.
+        torque). None where the loop cannot: a library in a child process. A LIDAR's records
+        the loop leaves to :meth:`sample_lidar`.
 
         Returns
         -------
         tuple or None
         """
-        if self.isolate or self.lidar is not None or self._lib is None:
+        if self.isolate or self._lib is None:
             return None
         bufs = np.zeros((4, _OUT_LEN), np.uint8)
         bufs[0, :len(self._infile)] = np.frombuffer(self._infile, np.uint8)
@@ -765,6 +785,8 @@ class DisconController(ControllerBase):
         lib = call[6]
         lib[0], lib[1] = float(self._status), float(self._last_pitch[0])
         self._hub[0] = meas.get("hub_wind_speed", 0.0)
+        if self.lidar is not None:
+            self._fill_lidar(t, meas)
         with self.quiet_calls():
             flag = library_call(0, t, meas["outputs"], *call[:6], self._hub, lib, cmd)
         self.compiled_report(t, call, flag != 2)     # raises for aviFAIL < 0

@@ -243,6 +243,47 @@ class Supervisor(ControllerBase):
                         "supervisor_trip_time": self.trip_time}
         return pitch, tq
 
+    def compiled_gate(self, dt: float, ratio: int, n: int) -> tuple[float, int] | None:
+        """Where a closed loop compiled around the wrapped controller must hand its call steps
+        to :meth:`step`: the rotor speed above which it trips (the overspeed limit) and the
+        first call step at which a timed event can come (a shutdown, a grid loss, a pitch
+        fault's time). None once it has left the running state.
+
+        Parameters
+        ----------
+        dt : float
+            The plant's step [s]; call step ``k`` is at ``k * dt``.
+        ratio : int
+            Plant steps per call.
+        n : int
+            The run's plant steps.
+
+        Returns
+        -------
+        (float, int) or None
+            Rotor speed limit [rad/s] (inf: none), the first plant step that is the
+            supervisor's (``n + 1``: none).
+        """
+        if self.state != "running" or self.fault_time is not None and \
+                self.fault_time != self.pitch_fault_at:
+            return None
+        due = [v for v in (self.grid_loss_at, self.shutdown_at, self.pitch_fault_at)
+               if v is not None]
+        if not due:
+            return self.limit, n + 1
+        first = min(due)
+        k = max(0, (int(first / dt) // ratio - 1) * ratio)
+        while k * dt < first:             # the step's own test: t >= the event's time
+            k += ratio
+        return self.limit, min(k, n + 1)
+
+    def adopt_running(self) -> None:
+        """The signals after call steps a compiled loop made in the running state: the wrapped
+        controller's, the state 0."""
+        self._inner = dict(getattr(self.controller, "signals", {}))
+        self.signals = {**self._inner, "supervisor_state": 0.0,
+                        "supervisor_trip_time": math.nan}
+
     def _await_azimuth(self, t: float, meas: dict[str, Any]) -> None:
         """Count the faulty blade's way to ``pitch_fault_azimuth_deg``; set
         :attr:`fault_time` when it gets there (or when the wait runs out)."""

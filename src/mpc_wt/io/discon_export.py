@@ -74,12 +74,16 @@ _LIBRARY_KIND = {"baseline": "baseline", "baseline-ct": "baseline", "mpc": "mpc"
                  "mpc-collective": "mpc", "mpc-lidar": "mpc", "baseline+lidar-ff": "baseline",
                  "lqr-pio": "lqr", "ts": "ts", "ibc": "baseline"}
 
-#: The logging channels each library kind returns (records 65 and 63 on), in order: the
-#: signals a shipped run records beside the host's (the C laws fill them, ``mw_cmd.log``).
+#: The logging channels each exported kind's library returns (records 65 and 63 on), in
+#: order: the signals a shipped run records beside the host's (the C laws fill them,
+#: ``mw_cmd.log``).
+_MPC_LOG = ("qp_fallback", "qp_solve_ms", "schedule_wind", "schedule_grid_wind")
 LOG_CHANNELS: dict[str, tuple[str, ...]] = {
-    "mpc": ("qp_fallback", "qp_solve_ms", "schedule_wind", "schedule_grid_wind"),
-    "lqr": ("region", "schedule_wind", "schedule_grid_wind"),
+    "mpc": _MPC_LOG, "mpc-collective": _MPC_LOG, "mpc-lidar": _MPC_LOG,
+    "lqr-pio": ("region", "schedule_wind", "schedule_grid_wind"),
     "ts": ("wind_est", "premise_clipped"),
+    "baseline+lidar-ff": ("ff_wind", "ff_pitch", "ff_mean_wind", "ff_corner"),
+    "ibc": ("ibc_weight", "ibc_gain", "ibc_pitch_1", "ibc_pitch_2", "ibc_pitch_3"),
 }
 
 
@@ -97,7 +101,7 @@ def log_channels(kind: str) -> tuple[str, ...]:
         Empty for a library that returns none.
     """
     check_exportable(kind)
-    return LOG_CHANNELS.get(_LIBRARY_KIND[kind], ())
+    return LOG_CHANNELS.get(kind, ())
 
 
 #: The measured signals of the Kalman filter (MPC) and the observer (LQR-PIO) and their codes
@@ -443,6 +447,10 @@ def _mpc_entries(ctl: Any, preview: Any = None) -> list[tuple[str, Any, str]]:
                          "export_discon)")
     n = len(ctl._grid)
     pts = [ctl.controller(k) for k in range(n)]
+    if pts[0].estimator is None:
+        raise ValueError("an MPC on the plant's true states (estimator 'full-state') does not "
+                         "export: a controller library has its measurements only (the "
+                         "default estimator, 'kalman', does)")
     signals = pts[0].estimator.signals
     sched = ctl.schedule
     budget = ctl.settings.time_budget_ms

@@ -305,3 +305,14 @@ class Built:
     power_fraction: float = 1.0
     sensors: list[Any] = field(default_factory=list)
     design: Any = None
+
+    @property
+    def designed(self) -> Any:
+        """The design's own objects: :attr:`design` where the controller runs it as shipped,
+        else the controller (gains, models, settings to read; what an export writes out).
+
+        Returns
+        -------
+        object
+        """
+        return self.controller if self.design is None else self.design

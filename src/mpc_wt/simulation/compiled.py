@@ -30,6 +30,7 @@ import numba as nb
 import numpy as np
 
 from linearize.jitcache import key_caches_on_callees
+from linearize import STATE_NAMES
 from linearize.kernel import step_kernel
 from mpc_wt.controllers.baseline_law import law
 from mpc_wt.controllers.discon_kernel import library_call
@@ -37,6 +38,9 @@ from mpc_wt.controllers.discon_kernel import library_call
 __all__ = ["run_steps", "run_library_steps"]
 
 _JIT = dict(cache=True, error_model="numpy")
+
+#: the rotor speed's index in the plant's state (the supervisor's overspeed check)
+_ROTOR = STATE_NAMES.index("rotor_speed")
 
 
 @nb.njit(**_JIT)
@@ -111,14 +115,23 @@ def run_steps(k0: int, k1: int, ratio: int, stepper: Any, arrays: tuple[np.ndarr
 
 @nb.njit(**_JIT)
 def _library_loop(k0, k1, ratio, h, pk, kind, wpar, grid, hint, dphi, lim, xs, us, zs, u,
-                  held, fn, swap, fail, bufs, rec, zi, hub, lib, sigs, act, counts
+                  held, fn, swap, fail, bufs, rec, zi, hub, lib, gate, sigs, act, counts
                   ):  # pragma: no cover - compiled
-    """:func:`_loop` with a controller library's call in place of the law. Returns (steps
-    done, -1 | the state leaving the envelope | -4 for aviFAIL < 0 | -5 after a step with a
-    warning (aviFAIL > 0), to be reported | -6 for a non-finite demand)."""
+    """:func:`_loop` with a controller library's call in place of the law. ``gate`` holds
+    where the host takes a call step back before the plant steps: a rotor speed above
+    ``gate[0]`` or the step ``gate[1]`` (a supervisor's trip), and, with ``gate[3]`` set, the
+    time ``gate[2]`` of the next LIDAR sample. Returns (steps done, -1 | the state leaving the
+    envelope | -4 for aviFAIL < 0 | -5 after a step with a warning (aviFAIL > 0), to be
+    reported | -6 for a non-finite demand | -7 for the supervisor's step | -8 for a LIDAR
+    sample due)."""
     cmd = np.zeros(sigs.shape[1] + 1)
     for k in range(k0, k1):
         t = k * h
+        if k % ratio == 0:
+            if xs[k, _ROTOR] > gate[0] or k >= gate[1]:
+                return k, -7
+            if gate[3] != 0.0 and t >= gate[2] - 1e-9:
+                return k, -8
         us[k] = u
         bad = step_kernel(t, xs[k], u, h, pk, kind, wpar, grid, hint, dphi, lim, xs[k + 1],
                           zs[k])
@@ -159,7 +172,7 @@ def run_library_steps(k0: int, k1: int, ratio: int, stepper: Any,
         The plant and its BEM warm start (advanced in place).
     arrays : tuple
         (xs, us, zs, u, held, DISCON, swap, aviFAIL, string buffers, records, output
-        indices, hub wind, library state, signals, actuator, counts), see
+        indices, hub wind, library state, gate, signals, actuator, counts), see
         :func:`_library_loop`; written in place.
 
     Returns
@@ -168,7 +181,9 @@ def run_library_steps(k0: int, k1: int, ratio: int, stepper: Any,
         Steps done.
     flag : int
         -1; the index of a state that left its envelope; -4: the library stopped the run at
-        step ``done``; -5: it warned at step ``done - 1``; -6: a non-finite demand at ``done``.
+        step ``done``; -5: it warned at step ``done - 1``; -6: a non-finite demand at ``done``;
+        -7: the supervisor's step ``done`` (not stepped); -8: a LIDAR sample due at step
+        ``done`` (not stepped).
     """
     h, pk, kind, wpar, grid, hint, dphi, lim = stepper.kernel_args()
     done, flag = _library_loop(k0, k1, ratio, h, pk, kind, wpar, grid, hint, dphi, lim,

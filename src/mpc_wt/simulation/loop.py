@@ -252,23 +252,35 @@ def _run_compiled(loop: _Loop, stepper: linearize.PlantStepper, ratio: int, bar:
                         counts[1] * dt)
 
 
-def _compiled_library(loop: _Loop, compiled: bool) -> Any:
-    """The controller library's arrays for the compiled loop (a library loaded in this
-    process, no LIDAR preview), else None."""
-    offer = getattr(loop.controller, "compiled_library", None)
+def _compiled_library(loop: _Loop, compiled: bool, ratio: int) -> Any:
+    """The controller library's host, its arrays for the compiled loop and the supervisor
+    around it (a library loaded in this process, alone or under a supervisor that is
+    running; no preview of the harness's), else None."""
+    ctl, sup = loop.controller, None
+    if callable(getattr(ctl, "compiled_gate", None)):
+        sup, ctl = ctl, getattr(ctl, "controller", None)
+    offer = getattr(ctl, "compiled_library", None)
     if not compiled or loop.preview is not None or not callable(offer):
         return None
-    return offer()
+    gate = (math.inf, loop.n + 1) if sup is None else \
+        sup.compiled_gate(loop.dt, ratio, loop.n)
+    call = offer()
+    if call is None or gate is None:
+        return None
+    lidar = getattr(ctl, "lidar", None) is not None
+    return ctl, call, sup, np.array([gate[0], gate[1], -math.inf, 1.0 if lidar else 0.0])
 
 
 def _run_library(loop: _Loop, stepper: linearize.PlantStepper, ratio: int, bar: Any,
-                 call: tuple[Any, ...]) -> None:
+                 host: tuple[Any, ...]) -> str:
     """:func:`_run` for a controller library loaded in this process
     (:func:`mpc_wt.simulation.compiled.run_library_steps`): the same steps in compiled blocks
-    of 800; the library's warnings reported where they happen, its stop raised."""
+    of 800; the library's warnings reported where they happen, its stop raised; the LIDAR's
+    samples taken where they are due; the steps from a supervisor's trip on in Python."""
     from mpc_wt.simulation.compiled import run_library_steps
 
-    n, dt, ctl = loop.n, loop.dt, loop.controller
+    ctl, call, sup, gate = host
+    n, dt = loop.n, loop.dt
     loop.xs[0] = loop.x
     hub = (np.array([loop.hub_wind(k * dt) for k in range(n + 1)]) if loop.hub_wind is not None
            else np.zeros(n + 1))
@@ -277,10 +289,10 @@ def _run_library(loop: _Loop, stepper: linearize.PlantStepper, ratio: int, bar: 
     held, counts = np.array([loop.u_tq]), np.zeros(2, dtype=np.int64)
     act = np.array([loop.rate, loop._p_lo, loop._p_hi, loop._q_lo, loop._q_hi])
     arrays = (loop.xs, loop.us, loop.zs, loop.u, held, fn, swap, fail, bufs, rec, zi, hub, lib,
-              sigs, act, counts)
+              gate, sigs, act, counts)
+    k = 0
     try:
         with ctl.quiet_calls():
-            k = 0
             while k < n:
                 block = min(k + 800 - k % 800, n)
                 done, flag = run_library_steps(k, block, ratio, stepper, arrays)
@@ -291,45 +303,78 @@ def _run_library(loop: _Loop, stepper: linearize.PlantStepper, ratio: int, bar: 
                     ctl.compiled_report((done - 1) * dt, call)
                 elif flag in (-4, -6):               # a stop, demands not finite
                     ctl.compiled_report(done * dt, call, flag == -4)
+                elif flag == -8:
+                    psi = float(loop.xs[done, _IX_AZ])     # the plant's azimuth output
+                    gate[2] = ctl.sample_lidar(done * dt,
+                                               psi - 2.0 * math.pi *
+                                               math.floor(psi / (2.0 * math.pi)),
+                                               float(loop.xs[done, _IX_ROTOR]))
+                elif flag == -7:
+                    break
                 elif flag >= 0:
                     raise _Diverged(done, flag, float(loop.xs[done, flag]))
-        loop.us[n] = loop.u
-        loop.zs[n] = stepper.outputs(n * dt, loop.xs[n], loop.u)
-        sigs[n] = sigs[n - 1]
+        if k >= n:
+            loop.us[n] = loop.u
+            loop.zs[n] = stepper.outputs(n * dt, loop.xs[n], loop.u)
+            sigs[n] = sigs[n - 1]
     finally:
-        loop.clipped, loop.u_tq = int(counts[0]), float(held[0])
-        loop.sig = {name: sigs[:, i] for i, name in enumerate(ctl.compiled_signals(call))}
-        ctl.adopt_compiled_state(call, sigs[max(loop.k_done - 1, 0), :len(loop.sig)])
-        if counts[0]:
-            log.warning("controller command out of the actuator range at t = %g s: the plant "
-                        "clips it; the count is in result.meta['commands_clipped']",
-                        counts[1] * dt)
+        _adopt_library(loop, ctl, call, sup, sigs, counts, held, k if k < n else n + 1)
+    if k >= n:
+        return "compiled"
+    _run(loop, stepper, ratio, bar, k)
+    return "compiled+python"
+
+
+def _adopt_library(loop: _Loop, ctl: Any, call: tuple[Any, ...], sup: Any, sigs: np.ndarray,
+                   counts: np.ndarray, held: np.ndarray, kept: int) -> None:
+    """The state a compiled library run left, taken by the loop, the host and the supervisor:
+    the first ``kept`` signal rows (as lists when the Python loop goes on from there)."""
+    loop.clipped, loop.u_tq = int(counts[0]), float(held[0])
+    names = ctl.compiled_signals(call)
+    if kept <= loop.n:
+        loop.sig = {name: sigs[:kept, i].tolist() for i, name in enumerate(names)}
+    else:
+        loop.sig = {name: sigs[:, i] for i, name in enumerate(names)}
+    ctl.adopt_compiled_state(call, sigs[max(min(loop.k_done, kept) - 1, 0), :len(names)])
+    if sup is not None:
+        sup.adopt_running()
+        m = min(kept, loop.n + 1)
+        loop.sig["supervisor_state"] = [0.0] * m
+        loop.sig["supervisor_trip_time"] = [math.nan] * m
+    if counts[0]:
+        log.warning("controller command out of the actuator range at t = %g s: the plant "
+                    "clips it; the count is in result.meta['commands_clipped']",
+                    counts[1] * loop.dt)
 
 
 def _advance(loop: _Loop, stepper: linearize.PlantStepper, ratio: int, bar: Any,
-             compiled: bool) -> None:
+             compiled: bool) -> str:
     """The whole run: compiled where the controller offers a law (:func:`_run_compiled`) or is
-    a library loaded in this process (:func:`_run_library`), else in Python (:func:`_run`)."""
+    a library loaded in this process (:func:`_run_library`), else in Python (:func:`_run`);
+    says which (``meta["loop"]``)."""
     law = _compiled_law(loop, compiled)
-    call = None if law is not None else _compiled_library(loop, compiled)
+    call = None if law is not None else _compiled_library(loop, compiled, ratio)
     if law is not None:
         _run_compiled(loop, stepper, ratio, bar, law)
-    elif call is not None:
-        _run_library(loop, stepper, ratio, bar, call)
-    else:
-        _run(loop, stepper, ratio, bar)
+        return "compiled"
+    if call is not None:
+        return _run_library(loop, stepper, ratio, bar, call)
+    _run(loop, stepper, ratio, bar)
+    return "python"
 
 
-def _run(loop: _Loop, stepper: linearize.PlantStepper, ratio: int, bar: Any) -> None:
-    """Advance the loop over all its steps; raises :class:`_Diverged` at the first state
+def _run(loop: _Loop, stepper: linearize.PlantStepper, ratio: int, bar: Any,
+         k0: int = 0) -> None:
+    """Advance the loop over its steps from ``k0`` (where a compiled run handed over); raises :class:`_Diverged` at the first state
     outside the envelope (``loop.k_done`` then counts the samples kept).
 
     The plant writes each new state and the outputs straight into the record rows
     (:meth:`~linearize.PlantStepper.step_into`), so a step moves no arrays through Python."""
     n, dt = loop.n, loop.dt
     xs, us, zs = loop.xs, loop.us, loop.zs
-    xs[0] = loop.x
-    for k in range(n + 1):
+    if k0 == 0:
+        xs[0] = loop.x
+    for k in range(k0, n + 1):
         t = k * dt
         x, z = xs[k], zs[k]
         loop.x = x
@@ -370,10 +415,8 @@ def simulate_closed_loop(params: linearize.PlantParams, controller: Any,
         The free wind; it must cover the rotor and the run.
     duration : float
         [s]
-    x0 : (n_x,) ndarray
-        Initial state (e.g. a trim point's).
-    u0 : (n_u,) ndarray
-        Initial inputs.
+    x0, u0 : ndarray
+        Initial state and inputs (e.g. a trim point's).
     dt : float
         Plant step [s] (default 1/80).
     controller_dt : float, optional
@@ -386,15 +429,17 @@ def simulate_closed_loop(params: linearize.PlantParams, controller: Any,
     meta : dict, optional
         Configuration stored with the result.
     compiled : bool
-        A compiled law (the plain baseline) or a library in this process (no LIDAR) runs in a
-        loop compiled with the plant (the same loop to the last bit; default); False: Python.
+        A compiled law (the plain baseline) or a library in this process (alone or under a
+        supervisor, with or without a LIDAR) runs in a loop compiled with the plant (the same
+        loop to the last bit; default); False: Python.
 
     Returns
     -------
     ClosedLoopResult
         ``round(duration / dt) + 1`` samples; ``meta`` gains ``dt``, ``controller_dt``,
         ``commands_clipped``, ``torque_pinned_steps`` (plant steps with the generator torque at
-        its maximum) and ``software_version``.
+        its maximum), ``software_version`` and ``loop`` (``compiled``, ``python``, or
+        ``compiled+python``: in Python from a supervisor's trip on).
 
     Raises
     ------
@@ -414,7 +459,7 @@ def simulate_closed_loop(params: linearize.PlantParams, controller: Any,
     bar = _progress_bar(n, f"simulate {(meta or {}).get('controller', 'closed loop')}",
                         progress)
     try:
-        _advance(loop, stepper, ratio, bar, compiled)
+        how = _advance(loop, stepper, ratio, bar, compiled)
     except _Diverged as d:
         raise SimulationDivergedError(
             f"simulation diverged at t = {d.k * dt:.4f} s: state "
@@ -430,7 +475,7 @@ def simulate_closed_loop(params: linearize.PlantParams, controller: Any,
     return loop.result(n + 1, {**(meta or {}), "dt": dt,
                                "controller_dt": cdt, "commands_clipped": loop.clipped,
                                "torque_pinned_steps": loop.pinned(),
-                               "software_version": __version__})
+                               "software_version": __version__, "loop": how})
 
 
 def _finalize(controller: Any) -> None:

@@ -126,7 +126,7 @@ def test_a_failed_qp_takes_the_logged_fallback_and_the_run_goes_on(turbine, monk
     monkeypatch.setattr(MPC, "_solve_z", failing)
     monkeypatch.setattr(MPC, "step", timed)
     with caplog.at_level(logging.WARNING, logger="mpc_wt.controllers.mpc"):
-        res = run_controller(turbine, "mpc", Scenario(15.0, "B", 4, 30.0))
+        res = run_controller(turbine, "mpc", Scenario(15.0, "B", 4, 30.0), shipped=False)
     assert res.t[-1] == pytest.approx(30.0)
     fb = res.controller["qp_fallback"][::8]
     n_fail = int(np.sum(fb > 0))
@@ -145,7 +145,7 @@ def test_a_solve_over_its_time_budget_takes_the_fallback(turbine, caplog) -> Non
 
     with caplog.at_level(logging.WARNING, logger="mpc_wt.controllers.mpc"):
         built, op, wind = build_controller(turbine, "mpc", Scenario(15.0, "B", 4, 5.0),
-                                           {"design_wind_mps": 15.0})
+                                           {"design_wind_mps": 15.0}, shipped=False)
         ctl = built.controller
         ctl.settings = ctl.settings.replace(time_budget_ms=1e-6)
         res = simulate_closed_loop(linearize.plant_params(turbine), ctl, wind, 5.0, x0=op.x,
@@ -224,7 +224,7 @@ def test_below_rated_designs_take_their_own_weights_and_limit(turbine) -> None:
             "below_rated_weights": {"rotor_speed": 0.1, "gen_torque_ref": 2.0},
             "speed_limit": 1.08, "below_rated_speed_limit": 1.01}
     built, _, _ = build_controller(turbine, "mpc", Scenario(12.0, "steady", 1, 1.0), opts)
-    ctl = built.controller
+    ctl = built.designed
     rated_speed = turbine.operation.rated_rotor_speed_rad_s
     for k, v in enumerate(ctl.family.wind_mps):
         mpc = ctl.controller(k)
@@ -267,7 +267,7 @@ def test_the_torque_notch_sits_at_the_plants_drivetrain_mode(turbine) -> None:
     assert f == pytest.approx(f_hand, rel=0.02)
     assert f < 2.0
     built, _, _ = build_controller(turbine, "mpc", Scenario(13.0))
-    ctl = built.controller
+    ctl = built.designed
     assert ctl.torque_notch_hz == pytest.approx(f)
     h = ctl._notch.response([0.32, f], 1.0 / ctl.dt)
     assert 20 * np.log10(abs(h[1])) <= -20.0
@@ -284,14 +284,14 @@ def test_the_tower_notch_sits_at_the_plants_side_side_mode(turbine) -> None:
     from mpc_wt.controllers import drivetrain_frequency
 
     built, _, _ = build_controller(turbine, "mpc", Scenario(13.0), {"tower_notch": True})
-    ctl = built.controller
+    ctl = built.designed
     f_ss, f_dt = ctl.tower_notch_hz, drivetrain_frequency(turbine)
     assert f_ss == pytest.approx(0.3120, rel=0.04)
     h = ctl._notch.response([0.02, f_ss, f_dt], 1.0 / ctl.dt)
     assert 20 * np.log10(abs(h[1])) <= -20.0 and 20 * np.log10(abs(h[2])) <= -20.0
     assert abs(20 * np.log10(abs(h[0]))) <= 0.1 and abs(np.degrees(np.angle(h[0]))) <= 3.0
     plain, _, _ = build_controller(turbine, "mpc", Scenario(13.0))
-    assert plain.controller.tower_notch_hz is None
+    assert plain.designed.tower_notch_hz is None
 
 
 @pytest.mark.slow
@@ -329,7 +329,7 @@ def test_torque_notch_options_are_checked(turbine) -> None:
     with pytest.raises(ValueError, match="torque_notch_hz = 6 Hz must be below"):
         build_controller(turbine, "mpc", Scenario(13.0), {"torque_notch_hz": 6.0})
     built, _, _ = build_controller(turbine, "mpc", Scenario(13.0), {"torque_notch_hz": 0.0})
-    assert built.controller.torque_notch_hz is None
+    assert built.designed.torque_notch_hz is None
     assert built.meta["mpc"]["torque_notch_hz"] is None
     assert drivetrain_frequency(linearize.load_turbine("iea15mw")) > 4.0
 
@@ -346,7 +346,7 @@ def test_cyclic_pitch_only_with_a_preview_or_when_asked(turbine, kind, opts, abo
     the tuned 0.1024 with the LIDAR's preview and with the plant's true states; none below
     rated in any case."""
     built, _, _ = build_controller(turbine, kind, Scenario(12.0, "steady", 1, 1.0), opts)
-    ctl = built.controller
+    ctl = built.designed
     for k, v in enumerate(ctl.family.wind_mps):
         below = v < linearize.rated_wind_speed(turbine)
         w = ctl.controller(k).w.outputs["flap_moment"]

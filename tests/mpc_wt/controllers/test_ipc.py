@@ -185,7 +185,8 @@ def test_ibc_holds_each_blade_within_its_amplitude(turbine) -> None:
                                                           "max_amplitude_deg": amp})
         peak[amp] = max(np.abs(np.degrees(res.channel(f"ibc_pitch_{b}"))).max()
                         for b in (1, 2, 3))
-    assert peak[0.5] <= 0.5 + 1e-9 and peak[0.5] > 0.5 - 1e-6
+    # the shipped law's channel is the float32 of the swap array: 0.5 deg to 1e-7 deg
+    assert peak[0.5] <= 0.5 + 1e-7 and peak[0.5] > 0.5 - 1e-6
     assert peak[20.0] > 0.6
 
 

@@ -135,7 +135,8 @@ def test_corner_is_raised_to_fit_the_preview(turbine, caplog) -> None:
     model = np.interp(res.controller["ff_mean_wind"][-1], res.meta["lidar_ff"]["corner_winds_mps"],
                       res.meta["lidar_ff"]["corner_rad_s"])
     tp = 30.0 / res.controller["ff_mean_wind"][-1]
-    assert corner > model and corner == pytest.approx(1.4 / (tp - 0.1 - 0.1), rel=1e-9)
+    # the shipped law's channels are the float32 of the swap array (6e-8 of each value)
+    assert corner > model and corner == pytest.approx(1.4 / (tp - 0.1 - 0.1), rel=1e-6)
 
 
 @settings(max_examples=200, deadline=None)

@@ -45,7 +45,7 @@ def test_the_design_is_the_same_for_every_case(turbine: linearize.Turbine, kind:
         cache.clear("built")
         built, _, _ = build_controller(turbine, kind, sc, cache=cache)
         assert built.meta["design"]["new"] is True
-        digests.add(design_digest(built.controller))
+        digests.add(design_digest(built.designed))
         made.add(built.meta["design"]["digest"])
     assert cache.made["built"] == len(CASES)
     assert len(digests) == 1, f"{kind}: {len(digests)} different designs for {len(CASES)} cases"

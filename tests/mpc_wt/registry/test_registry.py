@@ -244,7 +244,7 @@ def test_design_weights_reach_the_designs() -> None:
     sc = Scenario(18.0, "A", 1, 30.0)
     built, _, _ = build_controller(t, "mpc", sc, {"weights": {"flap_moment": 2.0,
                                                               "pitch_ref": 0.05}})
-    w = built.controller.settings.weights
+    w = built.designed.settings.weights
     assert w.outputs["flap_moment"] == 2.0 and w.inputs["pitch_ref"] == 0.05
     assert w.outputs["rotor_speed"] == MPCWeights().outputs["rotor_speed"]
     gains = {}
@@ -254,7 +254,7 @@ def test_design_weights_reach_the_designs() -> None:
         assert lq["state"] == {"rotor_speed": 2.0, "tower_fa_velocity": 1.0}
         assert lq["input"] == {f"pitch_ref_{i}": wp for i in (1, 2, 3)}
         assert lq["output"] == {f"pitch_rate_{i}": 0.4 for i in (1, 2, 3)}
-        gains[wp] = np.linalg.norm(b.controller.controllers[-1].lqr.K)
+        gains[wp] = np.linalg.norm(b.designed.controllers[-1].lqr.K)
     assert gains[10.0] < gains[1.0]
     with pytest.raises(OptionsError, match="weights.flap_moment must be >= 0"):
         resolve("mpc").options({"weights": {"flap_moment": -1}})

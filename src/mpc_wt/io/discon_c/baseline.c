@@ -24,7 +24,7 @@ typedef struct {
     double *cw, *cc, *cv, *cp;
     double mean, vf, x[2], next, w_disc, corner, lead, tp, phi[4], gam[2];
     double *arr, *val;
-    double ff_last;
+    double ff_last, wind;           /* this step's feedforward pitch and filtered wind */
     int has_ff_last;
 } mw_ff;
 
@@ -269,6 +269,7 @@ static int ff_step(mw_ff *f, const mw_meas *m, double *pitch, char *msg)
             v = f->val[k - 1] + (f->val[k] - f->val[k - 1]) * (x - f->arr[k - 1])
                 / (f->arr[k] - f->arr[k - 1]);
     }
+    f->wind = v;
     *pitch = mw_interp(v, f->cv, f->cp, f->ncurve);
     return 0;
 }
@@ -325,9 +326,22 @@ static int baseline_step(mw_ctrl *self, const mw_meas *m, mw_cmd *out, char *msg
     b->started = 1;
     out->pitch[0] = out->pitch[1] = out->pitch[2] = p;
     out->torque = tq;
-    if (b->ibc.on) {
+    out->nlog = 0;
+    if (b->ff.on) {                 /* ff_wind, ff_pitch, ff_mean_wind, ff_corner */
+        out->log[0] = b->ff.wind;
+        out->log[1] = b->ff.ff_last;
+        out->log[2] = b->ff.mean;
+        out->log[3] = b->ff.corner;
+        out->nlog = 4;
+    }
+    if (b->ibc.on) {                /* ibc_weight, ibc_gain, ibc_pitch_1..3 */
         double pc[3] = {p, p, p};
-        return mw_ibc_step(&b->ibc, m, c->dt, pc, out->pitch, msg);
+        int i, n = out->nlog;
+        if (mw_ibc_step(&b->ibc, m, c->dt, pc, out->pitch, msg)) return -1;
+        out->log[n] = b->ibc.weight;
+        out->log[n + 1] = b->ibc.gain;
+        for (i = 0; i < 3; i++) out->log[n + 2 + i] = b->ibc.u[i];
+        out->nlog = n + 5;
     }
     return 0;
 }

@@ -91,7 +91,9 @@ int mw_ibc_step(mw_ibc *b, const mw_meas *m, double dt, const double *pc, double
         mean = (u[0] + u[1] + u[2]) / 3.0;
         for (i = 0; i < 3; i++) u[i] -= mean;
     }
-    for (i = 0; i < 3; i++) u[i] = dmin(dmax(u[i], -b->amp), b->amp);
+    for (i = 0; i < 3; i++) u[i] = b->u[i] = dmin(dmax(u[i], -b->amp), b->amp);
+    b->weight = w;
+    b->gain = k;
     for (i = 0; i < 3; i++) {
         double prev = b->has_last ? b->last[i] : m->pitch[i], d = b->rate * dt;
         double v = dmin(dmax(pc[i] + u[i], b->pmin), b->pmax);

@@ -56,7 +56,7 @@ typedef struct {
 
 /* logging channels a kind returns beside its demands (Bladed's records 65 and L1 = record 63
  * on): each kind's are listed, in order, in mpc-wt's discon_export.LOG_CHANNELS */
-#define MW_LOG_MAX 8
+#define MW_LOG_MAX 12
 
 typedef struct {
     double pitch[3];       /* demands [rad] */
@@ -151,6 +151,7 @@ typedef struct {
     double *gp, *gg;
     mw_sos hp, bs;
     double w_lo, w_hi, rated, p_alpha, pmin, pmax, rate, amp, p_filt, last[3];
+    double weight, gain, u[3];    /* this step's fade-in weight, gain and blade additions */
 } mw_ibc;
 int mw_ibc_read(const mw_input *in, mw_ibc *b, char *msg);
 void mw_ibc_free(mw_ibc *b);
