@@ -22,7 +22,7 @@ import time
 import numpy as np
 
 import linearize
-from mpc_wt.io.discon_export import EXPORTABLE
+from mpc_wt.registry import exportable
 from mpc_wt.run import design_controller, run_controller
 from mpc_wt.simulation.scenario import FieldMemo
 
@@ -32,7 +32,7 @@ def main() -> int:
     ap.add_argument("--wind", type=float, default=14.0, help="[m/s]")
     ap.add_argument("--duration", type=float, default=120.0, help="[s]")
     ap.add_argument("--seed", type=int, default=11)
-    ap.add_argument("--kinds", nargs="+", default=sorted(EXPORTABLE))
+    ap.add_argument("--kinds", nargs="+", default=sorted(exportable()))
     ap.add_argument("--supervised", action="store_true")
     ap.add_argument("--main-job", action="store_true")
     args = ap.parse_args()

@@ -14,7 +14,7 @@ import linearize
 from mpc_wt.errors import RunTooLargeError
 from mpc_wt.registry.context import DEFAULT_CACHE, BuildContext, Built, DesignCache, design_digest
 from mpc_wt.registry.options import Options
-from mpc_wt.registry.registry import API_NAMING, Naming, Selection, resolve
+from mpc_wt.registry.registry import API_NAMING, Naming, Selection, law_export, resolve
 from mpc_wt.simulation.memory import RunMemory, check_run_memory, estimate_run_memory
 from mpc_wt.simulation.loop import simulate_closed_loop
 from mpc_wt.simulation.results import ClosedLoopResult
@@ -57,8 +57,8 @@ def design_controller(turbine: linearize.Turbine, controller: str,
     same design (``reset()`` between runs). The build sees the turbine, its options and the
     harness's step only (:class:`~mpc_wt.registry.context.BuildContext`).
 
-    With ``shipped``, a kind that exports (:data:`mpc_wt.io.discon_export.EXPORTABLE`) runs as
-    it is shipped: its design's numbers in the input file of its compiled C law, which the host
+    With ``shipped``, a kind that exports (:func:`mpc_wt.registry.exportable`) runs as it is
+    shipped: its design's numbers in the input file of its compiled C law, which the host
     calls as OpenFAST's ServoDyn does (:class:`~mpc_wt.controllers.discon.DisconController`, in
     this process).
 
@@ -116,13 +116,15 @@ def _design(turbine: linearize.Turbine, sel: Selection, opts: Sequence[Options],
 
     key = ("built", sel.name, tuple(repr(o) for o in opts))
     built = cache.get(turbine, key, make)
-    hook = sel.parts[-1].shipped
-    if not shipped or hook is None:
+    export = sel.export
+    if not shipped or export is None:
         return built, bool(made)
+    from mpc_wt.kinds.common import run_as_shipped
+
     ctx = BuildContext(turbine=turbine, params=params or linearize.plant_params(turbine),
                        cache=cache)
     return cache.get(turbine, ("shipped", *key[1:], built.meta["design"]["digest"]),
-                     lambda: hook(ctx, sel, opts[-1], built)), bool(made)
+                     lambda: run_as_shipped(ctx, export, built)), bool(made)
 
 
 def build_controller(turbine: linearize.Turbine, controller: str, scenario: Scenario,
@@ -401,7 +403,7 @@ def export_discon(turbine: linearize.Turbine, controller: str, out: str | Path,
     turbine : Turbine
         The turbine.
     controller : str
-        The kind (one of :data:`mpc_wt.io.discon_export.EXPORTABLE`).
+        The kind (one of :func:`mpc_wt.registry.exportable`).
     out : path
         The export folder (created; files of an earlier export are replaced).
     options : mapping, optional
@@ -426,16 +428,101 @@ def export_discon(turbine: linearize.Turbine, controller: str, out: str | Path,
         An MPC kind whose QP solver's sources are neither cached nor downloadable (checked
         before the design is made).
     """
-    from mpc_wt.io.discon_export import check_exportable, export_controller, prepare_sources
+    from mpc_wt.io import discon_export as dx
 
-    check_exportable(controller)
-    prepare_sources(controller)
+    export = law_export(controller)
+    dx.prepare_sources(export)
     built, _ = design_controller(turbine, controller, options)
     opts = ", ".join(f"{k}={v}" for k, v in sorted((options or {}).items()))
-    return export_controller(built.controller, controller, turbine, out, build=build,
-                             compiler=compiler,
-                             source=f"options: {opts}" if opts else "default options",
-                             preview=built.preview)
+    return dx.export_controller(built.designed, export, turbine, out, build=build,
+                                compiler=compiler,
+                                source=f"options: {opts}" if opts else "default options",
+                                preview=built.preview)
+
+
+def export_controller(controller: Any, kind: str, turbine: linearize.Turbine, out: str | Path,
+                      *, build: bool = True, compiler: str | None = None, source: str = "",
+                      preview: Any = None) -> Any:
+    """Export a controller object a kind builds (a design changed by hand, a derated
+    baseline) as a Bladed-style library
+    (:func:`mpc_wt.io.discon_export.export_controller` with the kind's export).
+
+    Parameters
+    ----------
+    controller : object
+        The design (of the type the kind builds; ``Built.designed``).
+    kind : str
+        Its kind (one of :func:`mpc_wt.registry.exportable`).
+    turbine : Turbine
+        Its turbine.
+    out : path
+        The export folder.
+    build : bool
+        Compile the library now.
+    compiler : str, optional
+        The C compiler.
+    source : str
+        How it was designed (a comment in the input file).
+    preview : LidarPreview, optional
+        The design's LIDAR preview (the LIDAR kinds).
+
+    Returns
+    -------
+    mpc_wt.io.discon_export.DisconExport
+
+    Raises
+    ------
+    ValueError
+        A kind that does not export, or a controller its law does not take.
+    """
+    from mpc_wt.io import discon_export as dx
+
+    export = law_export(kind)
+    dx.prepare_sources(export)
+    return dx.export_controller(controller, export, turbine, out, build=build,
+                                compiler=compiler, source=source, preview=preview)
+
+
+def export_saved_design(doc: Mapping[str, Any], turbine: linearize.Turbine, out: str | Path,
+                        *, build: bool = True, compiler: str | None = None) -> Any:
+    """Export a saved design (a gain-table document of ``mpcwt design``) as a library: a
+    baseline's from its gain table, a kind whose export builds it again from the options the
+    document keeps (:attr:`mpc_wt.io.discon_export.LawExport.rebuilt`) through
+    :func:`export_discon`.
+
+    Parameters
+    ----------
+    doc : mapping
+        The design document (:func:`mpc_wt.io.gain_tables.load_design`).
+    turbine : Turbine
+        Its turbine.
+    out : path
+        The export folder.
+    build : bool
+        Compile the library now.
+    compiler : str, optional
+        The C compiler.
+
+    Returns
+    -------
+    mpc_wt.io.discon_export.DisconExport
+
+    Raises
+    ------
+    ValueError
+        A design of a kind that does not export, or one its kind cannot build again from
+        the document (:attr:`~mpc_wt.io.discon_export.LawExport.check_saved`).
+    """
+    from mpc_wt.io import discon_export as dx
+
+    export = law_export(str(doc.get("kind")))
+    if not export.rebuilt:
+        return dx.export_design(doc, export, turbine, out, build=build, compiler=compiler)
+    if export.check_saved is not None:
+        export.check_saved(doc)
+    return export_discon(turbine, export.name, out,
+                         (doc.get("settings") or {}).get("options") or None, build=build,
+                         compiler=compiler)
 
 
 #: the controllers :func:`run_openfast_case` runs a case with

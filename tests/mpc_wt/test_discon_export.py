@@ -21,8 +21,8 @@ import linearize
 from mpc_wt.assessment.fatigue import damage_equivalent_load
 from mpc_wt.controllers.discon import DisconController
 from mpc_wt.errors import ControllerLibraryError
-from mpc_wt.io.discon_export import (EXPORTABLE, build_library, find_compiler, library_name,
-                                     servodyn_input)
+from mpc_wt.io.discon_export import build_library, find_compiler, library_name, servodyn_input
+from mpc_wt.registry import exportable, law_export
 from mpc_wt.run import export_discon, run_controller
 from mpc_wt.simulation.scenario import FieldMemo
 
@@ -219,8 +219,7 @@ def test_ts_library_holds_a_minimum_pitch_schedule_as_the_python_controller(nrel
     import dataclasses
 
     from mpc_wt.controllers.baseline import BaselineController, LawTorque
-    from mpc_wt.io.discon_export import export_controller
-    from mpc_wt.run import build_controller
+    from mpc_wt.run import build_controller, export_controller
     from mpc_wt.simulation.loop import simulate_closed_loop
     from mpc_wt.simulation.scenario import Scenario
 
@@ -590,14 +589,16 @@ def test_sanitized_libraries_run_60_s_clean(baseline_export, mpc_export, mpc_lid
     IBC built with -fsanitize=address,undefined (any report aborts), 60 s of turbulent closed loop
     each in a process that loads the sanitizer runtime first: exit 0, no report, no warning
     from the library."""
-    # an MPC kind's library runs every kind (its input file says which): built once with the
-    # sanitizers
-    d = tmp_path / "asan"
-    (d / "daqp").mkdir(parents=True)
-    for p in mpc_export.sources:
-        shutil.copy(p, d / p.relative_to(mpc_export.directory))
-    lib = build_library(d, "mpc", sanitize=True, name="libasan_mpcwt.so")
-    runs = [dict(_discon(ex), discon_library=str(lib))
+    # each law's library (the kinds of one law share it) built with the sanitizers
+    libs = {}
+    for ex in (baseline_export, mpc_export, lqr_export, ts_export):
+        d = tmp_path / f"asan_{ex.kind}"
+        (d / "daqp").mkdir(parents=True)
+        for p in ex.sources:
+            shutil.copy(p, d / p.relative_to(ex.directory))
+        libs[ex.kind] = build_library(d, ex.kind, sanitize=True, name="libasan_mpcwt.so")
+    law = {"mpc-lidar": "mpc", "ibc": "baseline"}
+    runs = [dict(_discon(ex), discon_library=str(libs[law.get(ex.kind, ex.kind)]))
             for ex in (baseline_export, mpc_export, mpc_lidar_export, lqr_export, ts_export,
                        ibc_export)]
     script = textwrap.dedent(f"""
@@ -624,9 +625,11 @@ def test_kinds_that_do_not_export_are_named(nrel5mw, tmp_path):
     with pytest.raises(ValueError, match="LIDAR"):
         from mpc_wt.io.discon_export import controller_input
         from mpc_wt.run import design_controller
-        controller_input(design_controller(nrel5mw, "mpc-lidar")[0].controller, "mpc",
-                         nrel5mw)
-    assert "baseline" in EXPORTABLE
+        controller_input(design_controller(nrel5mw, "mpc-lidar")[0].controller,
+                         law_export("mpc"), nrel5mw)
+    assert "baseline" in exportable()
+    with pytest.raises(ValueError, match="the kinds that do: .*'ibc'"):
+        law_export("derate80+ibc")        # IBC exports on the full-power baseline
 
 
 def test_servodyn_template_without_the_keys(tmp_path, baseline_export):
@@ -656,7 +659,7 @@ def test_cli_design_then_export_discon(tmp_path, capsys):
     assert main(["design", "coleman-ipc", "--out", str(i)]) == 0
     assert main(["export", str(i), "--format", "discon"]) != 0
     err = capsys.readouterr().err
-    assert "'coleman-ipc' design does not export" in err and "baseline" in err
+    assert "controller kind 'coleman-ipc' does not export" in err and "baseline" in err
 
 
 def test_cli_design_mpc_then_export_discon(tmp_path, capsys):

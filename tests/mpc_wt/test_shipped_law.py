@@ -9,7 +9,8 @@ import pytest
 
 import linearize
 
-from mpc_wt.io.discon_export import EXPORTABLE, find_compiler, shipped_library
+from mpc_wt.io.discon_export import find_compiler, shipped_library
+from mpc_wt.registry import exportable, law_export
 from mpc_wt.io.solver_sources import cache_dir
 from mpc_wt.run import export_discon, run_controller
 from mpc_wt.simulation.scenario import FieldMemo
@@ -21,7 +22,7 @@ _FIELDS = FieldMemo()
 _KW = dict(duration=30.0, turbulence="A", seed=23, fields=_FIELDS)
 
 
-@pytest.mark.parametrize("kind", sorted(EXPORTABLE))
+@pytest.mark.parametrize("kind", sorted(exportable()))
 def test_the_shipped_run_is_the_users_export_run(turbine, kind, tmp_path):
     """Every exportable kind, 30 s of class-A turbulence at 14 m/s: the shipped run and the run
     of the user's export of the same design give the same demands to the last bit, and both
@@ -54,11 +55,14 @@ def test_the_python_step_stays_where_the_library_takes_no_such_design(turbine):
 
 
 def test_the_library_is_built_once_into_the_users_cache():
-    """Both libraries sit in the per-user cache under a key of their sources, compiler and
-    flags; asking again gives the same file."""
-    core, mpc = shipped_library("baseline"), shipped_library("mpc")
-    assert core != mpc and core.parent.parent == mpc.parent.parent == cache_dir() / "libraries"
-    assert shipped_library("ts") == core and shipped_library("mpc-lidar") == mpc
+    """A law's library sits in the per-user cache under a key of its sources, compiler and
+    flags; the kinds of one law share it, asking again gives the same file."""
+    lib = {k: shipped_library(law_export(k)) for k in ("baseline", "ibc", "mpc", "mpc-lidar",
+                                                        "ts")}
+    assert len(set(lib.values())) == 3
+    assert all(p.parent.parent == cache_dir() / "libraries" for p in lib.values())
+    assert lib["baseline"] == lib["ibc"] and lib["mpc"] == lib["mpc-lidar"]
+    assert shipped_library(law_export("ts")) == lib["ts"] != lib["baseline"]
 
 
 def test_the_guides_python_examples_run(tmp_path, monkeypatch):
@@ -154,9 +158,7 @@ def test_the_librarys_logging_channels_are_the_python_steps_signals(turbine, kin
     kw = dict(duration=30.0, turbulence="A", seed=31, fields=_FIELDS)
     lib = run_controller(turbine, kind, wind, **kw)
     py = run_controller(turbine, kind, wind, shipped=False, **kw)
-    from mpc_wt.io.discon_export import log_channels
-
-    names = log_channels(kind)
+    names = law_export(kind).log
     assert set(names) <= set(lib.controller) and set(names) <= set(py.controller)
     for name in ("qp_fallback", "premise_clipped", "region"):
         if name in names:

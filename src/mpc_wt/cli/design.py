@@ -124,47 +124,21 @@ def _design(args: argparse.Namespace) -> int:
     return 0
 
 
-def _export_registered(args: argparse.Namespace, turbine: Any) -> list[Path] | None:
-    """``--format discon`` of a design that is built again from its options (the MPC kinds and
-    the LIDAR feedforward); None for the others."""
-    from mpc_wt.io.discon_export import REBUILT
+def _export_discon(args: argparse.Namespace, turbine: Any) -> list[Path] | None:
+    """``--format discon``: the saved design exported as a controller library (its kind's
+    export, :func:`mpc_wt.run.export_saved_design`); None for the other formats."""
     from mpc_wt.io.gain_tables import design_turbine, load_design
-    from mpc_wt.run import export_discon
+    from mpc_wt.run import export_saved_design
 
     if args.format != "discon":
         return None
     try:
         doc = load_design(args.design)
-    except GainTableError as err:
-        raise UsageError(str(err)) from None
-    if doc["kind"] not in REBUILT:
-        return None
-    if doc["kind"] == "ts":
-        from mpc_wt.controllers.takagi_sugeno.model import (
-            DEFAULT_REDUCTION_GRID,
-            DEFAULT_WIND_GRID,
-        )
-
-        s = doc["settings"]
-        if (list(s.get("wind_grid", [])) != list(DEFAULT_WIND_GRID)
-                or list(s.get("reduction_grid", [])) != list(DEFAULT_REDUCTION_GRID)):
-            raise UsageError(
-                f"{args.design}: this TS design's vertex grid (winds {s.get('wind_grid')}, "
-                f"reductions {s.get('reduction_grid')}) is not the one the controller kind "
-                f"'ts' is built on (winds {list(DEFAULT_WIND_GRID)}, reductions "
-                f"{list(DEFAULT_REDUCTION_GRID)}); design it with the default --wind, or "
-                f"export a TSController built on your grid with "
-                f"mpc_wt.io.discon_export.export_controller")
-    if doc["kind"] == "ibc" and doc["settings"].get("power_fraction", 1.0) != 1.0:
-        raise UsageError(
-            f"{args.design}: this IBC design is on a derated baseline (power fraction "
-            f"{doc['settings']['power_fraction']:g}); the library exports IBC on the full-power "
-            f"baseline: design it without --power-fraction, or export an IBCController on "
-            f"your derated baseline with mpc_wt.io.discon_export.export_controller")
-    p = Path(args.design)
-    out = Path(args.to) if args.to else (p if p.is_dir() else p.parent)
-    ex = export_discon(design_turbine(doc, turbine), doc["kind"], out,
-                       doc["settings"].get("options") or None)
+        p = Path(args.design)
+        out = Path(args.to) if args.to else (p if p.is_dir() else p.parent)
+        ex = export_saved_design(doc, design_turbine(doc, turbine), out)
+    except (GainTableError, ValueError) as err:
+        raise UsageError(f"{args.design}: {err}") from None
     if ex.note:
         print(f"note: {ex.note}")
     return ex.files()
@@ -176,7 +150,7 @@ def _export(args: argparse.Namespace) -> int:
     check_out_folder("--to", args.to)
     turbine = linearize.load_turbine(args.turbine) if args.turbine else None
     try:
-        files = _export_registered(args, turbine) or export(args.design, args.format, args.to,
+        files = _export_discon(args, turbine) or export(args.design, args.format, args.to,
                                                              turbine)
     except GainTableError as err:
         raise UsageError(str(err)) from None

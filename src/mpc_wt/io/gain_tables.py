@@ -616,16 +616,9 @@ def _write_rosco(doc: dict[str, Any], out: Path,
 
 def _write_discon(doc: dict[str, Any], out: Path,
                   turbine: linearize.Turbine | None = None) -> list[Path]:
-    from mpc_wt.io.discon_export import REBUILT, export_design
-
-    if doc["kind"] in REBUILT:
-        raise GainTableError(f"a {doc['kind']!r} design is built again from its options to "
-                             f"export: use mpc_wt.run.export_discon (mpcwt export does)")
-    t = design_turbine(doc, turbine)
-    try:
-        return export_design(doc, t, out).files()
-    except ValueError as err:
-        raise GainTableError(str(err)) from None
+    raise GainTableError(f"a {doc['kind']!r} design exports as a controller library through its "
+                         f"kind's export: mpc_wt.run.export_saved_design (mpcwt export "
+                         f"--format discon)")
 
 
 def read_rosco(path: str | Path) -> dict[str, Any]:
@@ -671,8 +664,8 @@ def export(doc_or_dir: dict[str, Any] | str | Path, fmt: str,
     doc_or_dir : dict or str or Path
         A gain-table document or a design directory.
     fmt : {"csv", "json", "mat", "rosco", "discon"}
-        The format (``discon``: a Bladed-style controller library, its C sources, input file
-        and ServoDyn file, :mod:`mpc_wt.io.discon_export`).
+        The format (``discon``, a Bladed-style controller library, is written by the design's
+        kind: :func:`mpc_wt.run.export_saved_design`; here it raises GainTableError).
     out_dir : str or Path, optional
         Where to write (default the design directory).
     turbine : Turbine, optional

@@ -12,7 +12,8 @@ from mpc_wt.registry.context import BuildContext, Built
 from mpc_wt.registry.options import REQUIRED, Options, option
 from mpc_wt.registry.registry import register
 from mpc_wt.simulation.scenario import Scenario, start_wind
-from mpc_wt.kinds.common import shipped_law
+from mpc_wt.io.discon_export import LawExport
+from mpc_wt.kinds.common import baseline_entries
 
 log = logging.getLogger(__name__)
 
@@ -79,11 +80,21 @@ def _design_baseline(turbine: linearize.Turbine, *, omega_n_rad_s: float | None 
     return doc, f"kp {doc['settings']['kp']:.4g} s, ki {doc['settings']['ki']:.4g}"
 
 
+def _baseline_input(ctl: Any, preview: Any) -> list[tuple[str, Any, str]]:
+    """The baseline's input file: its law, no feedforward, no IBC."""
+    return baseline_entries(ctl) + [("feedforward", 0.0, "no LIDAR feedforward"),
+                                    ("ibc", 0.0, "no individual blade control")]
+
+
 register("baseline", BaselineOptions, field_components="u", design=_design_baseline,
-         shipped=shipped_law("baseline"), summary="tuned PI pitch and torque law, constant power in region III (80 Hz)"
+         export=LawExport("baseline", "the tuned PI pitch loop and torque law, constant power "
+                          "in region III", "baseline", _baseline_input, rebuilt=False),
+         summary="tuned PI pitch and torque law, constant power in region III (80 Hz)"
          )(baseline_build("constant_power"))
 register("baseline-ct", BaselineOptions, field_components="u",
-         shipped=shipped_law("baseline-ct"), summary="the baseline with constant torque in region III (Do et al.'s PI)"
+         export=LawExport("baseline-ct", "the baseline with constant torque in region III",
+                          "baseline", _baseline_input, rebuilt=False),
+         summary="the baseline with constant torque in region III (Do et al.'s PI)"
          )(baseline_build("constant_torque"))
 register("derate", DerateOptions, field_components="u", pattern=r"derate(\d+(?:\.\d+)?)",
          pattern_options=_derate_preset, pattern_help="derateNN (NN % of rated power)",

@@ -9,6 +9,8 @@ from dataclasses import dataclass
 from typing import Any, Optional
 
 
+import numpy as np
+
 import linearize
 from mpc_wt.registry.context import BuildContext, Built
 from mpc_wt.registry.options import Options, option
@@ -16,33 +18,44 @@ from mpc_wt.registry.options import Options, option
 log = logging.getLogger(__name__)
 
 # -- the shipped laws: a kind that exports runs its compiled C law --------------------------
-def shipped_law(kind: str, base: str | None = None) -> Any:
-    """The ``shipped`` hook of an exportable kind: the design's numbers written to its input
-    file, its compiled library (:func:`mpc_wt.io.discon_export.shipped_library`) called through
-    the host in this process, every run of the kind then calls the law users run in OpenFAST.
-    ``base``: for an add-on, the base its export is made on (another base keeps the Python
-    step). A design with options the library does not take (an MPC on OSQP, the sparse
-    formulation) keeps its Python step too; the run's metadata says which law ran."""
-    def hook(ctx: BuildContext, sel: Any, opts: Any, built: Built) -> Built:
-        from mpc_wt.controllers.discon import DisconController
-        from mpc_wt.io.discon_export import log_channels, shipped_input, shipped_library
+def run_as_shipped(ctx: BuildContext, export: Any, built: Built) -> Built:
+    """A design as it is shipped: its numbers written to its law's input file, its compiled
+    library (:func:`mpc_wt.io.discon_export.shipped_library`) called through the host in this
+    process, so that every run of the kind calls the law users run in OpenFAST. A design with
+    options the law does not take (an MPC on OSQP, the sparse formulation, the true states)
+    keeps its Python step; the run's metadata says which law ran (``meta["law"]``).
 
-        if base is not None and sel.base.name != base:
-            return built
-        try:
-            infile = shipped_input(built.controller, kind, ctx.turbine, built.preview)
-        except ValueError as err:
-            log.info("%s: the design does not export (%s); its Python step runs", kind, err)
-            return dataclasses.replace(built, meta={**built.meta, "law": "python"})
-        dt = float(built.controller.dt)
-        ctl = DisconController(shipped_library(kind), infile, ctx.turbine, dt=dt,
-                               lidar=built.sensors[-1] if built.sensors else None,
-                               isolate=False, log_names=log_channels(kind))
-        return dataclasses.replace(built, controller=ctl, controller_dt=dt, preview=None,
-                                   design=built.controller,
-                                   meta={**built.meta, "law": "shipped",
-                                         "library": ctl.library.name})
-    return hook
+    Parameters
+    ----------
+    ctx : BuildContext
+        The design's context (its turbine).
+    export : LawExport
+        The kind's export (:attr:`mpc_wt.registry.Selection.export`).
+    built : Built
+        The design with its Python objects.
+
+    Returns
+    -------
+    Built
+        The library's host as the controller, the design in ``design``; or ``built`` with
+        ``meta["law"] = "python"``.
+    """
+    from mpc_wt.controllers.discon import DisconController
+    from mpc_wt.io.discon_export import shipped_input, shipped_library
+
+    try:
+        infile = shipped_input(built.controller, export, ctx.turbine, built.preview)
+    except ValueError as err:
+        log.info("%s: the design does not export (%s); its Python step runs", export.name, err)
+        return dataclasses.replace(built, meta={**built.meta, "law": "python"})
+    dt = float(built.controller.dt)
+    ctl = DisconController(shipped_library(export), infile, ctx.turbine, dt=dt,
+                           lidar=built.sensors[-1] if built.sensors else None,
+                           isolate=False, log_names=export.log)
+    return dataclasses.replace(built, controller=ctl, controller_dt=dt, preview=None,
+                               design=built.controller,
+                               meta={**built.meta, "law": "shipped",
+                                     "library": ctl.library.name})
 
 
 _CW = "lidar.CWLidar setting (unset: its default)"
@@ -133,3 +146,155 @@ def check_design_wind(turbine: linearize.Turbine, v: float) -> float:
         raise ValueError(f"design_wind_mps = {v:g} m/s is outside the turbine's operating range "
                          f"{op.cut_in_wind:g}..{op.cut_out_wind:g} m/s")
     return float(v)
+
+
+# -- what the exports share: the baseline law's numbers (every law's torque schedule), the
+# wind estimator's and a schedule's region floor ------------------------------------------
+
+
+def baseline_entries(ctl: Any, prefix: str = "") -> list[tuple[str, Any, str]]:
+    """The numbers of a :class:`~mpc_wt.controllers.baseline.BaselineController` as input-file
+    entries: the baseline law's, which every law's torque schedule is.
+
+    Parameters
+    ----------
+    ctl : BaselineController
+        The design.
+    prefix : str
+        Before every key (``law.`` for the torque schedule in another law).
+
+    Returns
+    -------
+    list of (str, object, str)
+        Key, value (a number or an array) and its meaning, in the input file's order.
+
+    Raises
+    ------
+    ValueError
+        Another controller, or a baseline with a power reference or gain schedule.
+    """
+    from mpc_wt.controllers.baseline import BaselineController
+
+    if type(ctl) is not BaselineController:
+        raise ValueError(f"the baseline export takes a BaselineController, got "
+                         f"{type(ctl).__name__}")
+    if ctl.power_reference is not None or ctl._sched_f is not None:
+        raise ValueError("a baseline with a power reference or a gain schedule (active power "
+                         "control) does not export yet: export the plain design")
+    g, tb = ctl.gains, ctl.turbine
+    rows = [
+        ("dt", ctl.dt, "communication interval [s] (ServoDyn DLL_DT)"),
+        ("speed_filter_corner_hz", ctl.wc / (2 * math.pi),
+         "generator-speed low-pass corner [Hz]"),
+        ("gen_speed_setpoint", g.rated_gen_speed_rad_s, "PI speed set-point [rad/s]"),
+        ("kp", g.kp, "proportional gain at fine pitch [s]"),
+        ("ki", g.ki, "integral gain at fine pitch [-]"),
+        ("theta_k", g.theta_k_rad, "pitch at which the gain has halved [rad]"),
+        ("pitch_min", ctl.pitch_min, "minimum pitch command [rad]"),
+        ("pitch_max", ctl.pitch_max, "maximum pitch command [rad]"),
+        ("pitch_rate_max", ctl.rate, "pitch-rate limit [rad/s]"),
+        ("torque_rate_max", ctl.tq_rate, "generator-torque rate limit [N m/s]"),
+        ("torque_max", ctl.tq_max, "maximum generator torque [N m]"),
+        ("gen_speed_cutin", ctl.w_cutin, "region 1.5 starts [rad/s]"),
+        ("gen_speed_region2", ctl.w_rgn2, "region 2 starts [rad/s]"),
+        ("gen_speed_transition", ctl.w_trans, "region 2.5 starts [rad/s]"),
+        ("gen_speed_rated", ctl.w_rated, "region 3 speed [rad/s]"),
+        ("gen_speed_sync", ctl.w_sync, "region 2.5 line's zero-torque speed [rad/s]"),
+        ("slope_region15", ctl.slope15, "region 1.5 torque slope [N m s/rad]"),
+        ("slope_region25", ctl.slope25, "region 2.5 torque slope [N m s/rad]"),
+        ("k_opt", g.k_opt, "region 2 torque gain [N m s^2/rad^2]"),
+        ("torque_cap", ctl.tq_cap, "largest torque below rated [N m]"),
+        ("rated_power", g.rated_power, "rated electrical power [W]"),
+        ("gen_efficiency", tb.drivetrain.generator_efficiency, "generator efficiency [-]"),
+        ("rated_torque", g.rated_torque, "region 3 torque (constant torque) [N m]"),
+        ("region3_constant_power", float(ctl.region3 == "constant_power"),
+         "1: constant power above rated, 0: constant torque"),
+    ]
+    rows += [
+        ("min_pitch_speeds", np.array(ctl.min_pitch_speeds, float),
+         "minimum-pitch schedule: filtered generator speeds [rad/s]"),
+        ("min_pitch_offsets", np.array(ctl.min_pitch_offsets, float),
+         "minimum-pitch schedule: pitch above pitch_min [rad]"),
+    ]
+    return [(prefix + k, v, doc) for k, v, doc in rows]
+
+
+def law_entries(law: Any) -> list[tuple[str, Any, str]]:
+    """A :class:`~mpc_wt.controllers.baseline.LawTorque` (the baseline's torque schedule in
+    another controller) as input-file entries.
+
+    Parameters
+    ----------
+    law : LawTorque
+        The torque schedule.
+
+    Returns
+    -------
+    list of (str, object, str)
+        Key, value (a number or an array) and its meaning, in the input file's order.
+    """
+    return baseline_entries(law.law, "law.") + [
+        ("law_torque", np.array([law._a, law._offset, law._lo, law._hi], float),
+         "speed filter pole, below-rated pitch offset [rad], torque min, max [N m]")]
+
+
+def windest_entries(est: Any, prefix: str) -> list[tuple[str, Any, str]]:
+    """A :class:`~mpc_wt.controllers.wind_estimator.WindSpeedEstimator` (a schedule's wind)
+    as input-file entries: its C_P spline and constants.
+
+    Parameters
+    ----------
+    est : WindSpeedEstimator
+        The estimator.
+    prefix : str
+        Before every key.
+
+    Returns
+    -------
+    list of (str, object, str)
+        Key, value (a number or an array) and its meaning, in the input file's order.
+    """
+    tx, ty, c, kx, ky = est._spline
+    k = np.concatenate([est._k, [est.settings.speed_std ** 2, 1.0]])
+    return [
+        (prefix + "spline_degrees", np.array([kx, ky], float), "C_P spline degrees"),
+        (prefix + "spline_tx", np.asarray(tx, float), "C_P spline knots in tip-speed ratio"),
+        (prefix + "spline_ty", np.asarray(ty, float), "C_P spline knots in pitch [rad]"),
+        (prefix + "spline_c", np.asarray(c, float), "C_P spline coefficients"),
+        (prefix + "constants", k,
+         "radius [m], air density [kg/m^3], gearbox ratio, inertia [kg m^2], dt [s], process "
+         "noise of speed and wind, speed noise, wind range [m/s], tip-speed ratio range, "
+         "initial variances of speed and wind"),
+    ]
+
+
+def floor_entries(floor: Any, pre: str) -> list[tuple[str, Any, str]]:
+    """A schedule's region floor (:class:`~mpc_wt.controllers.scheduling.RegionFloor`) as
+    input-file entries.
+
+    Parameters
+    ----------
+    floor : RegionFloor or None
+        The floor (None: none).
+    pre : str
+        Before every key.
+
+    Returns
+    -------
+    list of (str, object, str)
+        Key, value (a number or an array) and its meaning, in the input file's order.
+    """
+    if floor is None:
+        return [(pre + "region_floor", 0.0, "0: the designs chosen by the measured wind alone")]
+    return [(pre + "region_floor", 1.0, "1: at least the design the measured pitch and rotor "
+                                        "speed tell"),
+            (pre + "floor_winds", np.asarray(floor.winds, float),
+             "the trim's pitch curve above rated: winds [m/s]"),
+            (pre + "floor_pitches", np.asarray(floor.pitches, float),
+             "... and their collective pitch [rad]"),
+            (pre + "floor_limits", np.array([floor.pitch_threshold,
+                                             floor.pitch_min_speed * floor.rated_speed,
+                                             floor.speed_margin * floor.rated_speed,
+                                             floor.region3_wind], float),
+             "a pitch above [rad] with the rotor above [rad/s]; a rotor speed above [rad/s] "
+             "and the design wind then [m/s]")]

@@ -2,8 +2,11 @@
 from __future__ import annotations
 
 import logging
+import math
 from dataclasses import dataclass
-from typing import Optional
+from typing import Any, Optional
+
+import numpy as np
 
 
 import linearize
@@ -11,7 +14,8 @@ from mpc_wt.controllers.ipc import IBC_LOOP_GAIN
 from mpc_wt.registry.context import BuildContext, Built
 from mpc_wt.registry.options import Options, option
 from mpc_wt.registry.registry import register
-from mpc_wt.kinds.common import shipped_law
+from mpc_wt.io.discon_export import LawExport
+from mpc_wt.kinds.common import baseline_entries
 
 log = logging.getLogger(__name__)
 
@@ -73,8 +77,60 @@ class IBCOptions(Options):
                                                 lo_open=True, hi=20.0, flag="")
 
 
+def _ibc_entries(ctl: Any, preview: Any = None) -> list[tuple[str, Any, str]]:
+    """An :class:`~mpc_wt.controllers.ipc.IBCController` on the baseline: the baseline's law
+    and the IBC's gain schedule, filters (second-order sections and their unit-step states),
+    power fade-in and limits."""
+    from mpc_wt.controllers.ipc import IBCController
+
+    if type(ctl) is not IBCController:
+        raise ValueError(f"the IBC export takes an IBCController, got {type(ctl).__name__}")
+    g = ctl.gains
+    return baseline_entries(ctl.collective) + [
+        ("feedforward", 0.0, "no LIDAR feedforward"),
+        ("ibc", 1.0, "1: individual blade control on the collective command"),
+        ("ibc_settings", np.array([g.weight_range[0], g.weight_range[1], g.rated_power,
+                                   math.exp(-ctl.dt / ctl.power_tau), ctl.pitch_min,
+                                   ctl.pitch_max, ctl.step_max / ctl.dt,
+                                   float(ctl.remove_collective),
+                                   min(g.max_amplitude_rad, 1e300)], float),
+         "the fade-in's power fractions [-], the power it refers to [W], the power filter's "
+         "pole, pitch min, max [rad], pitch rate [rad/s], 1: the blades' mean removed, each "
+         "blade's largest IBC pitch [rad] (1e300: none)"),
+        ("ibc_gain_pitch", np.asarray(g.pitch_rad, float), "mean pitch of the gain schedule "
+                                                           "[rad]"),
+        ("ibc_gain", np.asarray(g.gain, float), "gain [rad/(N m)]"),
+        ("ibc_input_sos", ctl._hp.sos.ravel(), "input (high-pass) sections b0 b1 b2 a0 a1 a2"),
+        ("ibc_input_zi", np.asarray(ctl._hp._zi1, float).ravel(),
+         "their state at a unit input's steady state"),
+        ("ibc_output_sos", ctl._bs.sos.ravel(), "output (band-stop, low-pass) sections"),
+        ("ibc_output_zi", np.asarray(ctl._bs._zi1, float).ravel(),
+         "their state at a unit input's steady state"),
+    ]
+
+
+def _check_saved_ibc(doc: Any) -> None:
+    """A saved IBC design exports when it is on the full-power baseline."""
+    frac = doc["settings"].get("power_fraction", 1.0)
+    if frac != 1.0:
+        raise ValueError(
+            f"this IBC design is on a derated baseline (power fraction {frac:g}); the library "
+            f"exports IBC on the full-power baseline: design it without --power-fraction, or "
+            f"export an IBCController on your derated baseline with "
+            f"mpc_wt.run.export_controller")
+
+
+#: IBC's export: the baseline's law with the IBC on its collective command
+IBC_EXPORT = LawExport(
+    "ibc", "Pettas and Cheng's individual blade control on the baseline: each blade's root "
+    "moment filtered, scaled by the gain scheduled on the mean pitch, faded in with the power",
+    "baseline", _ibc_entries, base="baseline",
+    log=("ibc_weight", "ibc_gain", "ibc_pitch_1", "ibc_pitch_2", "ibc_pitch_3"),
+    check_saved=_check_saved_ibc)
+
+
 @register("ibc", IBCOptions, field_components="u", addon_to=("baseline", "derate"),
-          default_base="baseline", design=_design_ibc, shipped=shipped_law("ibc", "baseline"),
+          default_base="baseline", design=_design_ibc, export=IBC_EXPORT,
           group="the ibc controllers",
           summary="individual blade control on a baseline (ibc, derateNN+ibc)")
 def _build_ibc(ctx: BuildContext, opts: IBCOptions, base: Built) -> Built:

@@ -6,13 +6,15 @@ import math
 from dataclasses import dataclass
 from typing import Any, Optional
 
+import numpy as np
 
 import linearize
 from mpc_wt.registry.context import BuildContext, Built
 from mpc_wt.registry.options import Options, option
 from mpc_wt.registry.registry import register
 from mpc_wt.kinds.baseline import BaselineOptions, baseline_build
-from mpc_wt.kinds.common import LidarOptions, shipped_law
+from mpc_wt.io.discon_export import LawExport
+from mpc_wt.kinds.common import LidarOptions, baseline_entries
 
 log = logging.getLogger(__name__)
 
@@ -56,9 +58,42 @@ def _design_lidar_ff(turbine: linearize.Turbine) -> tuple[dict, str]:
                  f"rad/s over {rows[0][0]:g}-{rows[-1][0]:g} m/s")
 
 
+def _ff_entries(ctl: Any, preview: Any = None) -> list[tuple[str, Any, str]]:
+    """A :class:`~mpc_wt.controllers.lidar_feedforward.LidarFeedforward` on the baseline: the
+    baseline's law and the feedforward's LIDAR processing, filter, lead and pitch curve."""
+    from mpc_wt.controllers.lidar_feedforward import LidarFeedforward
+
+    if type(ctl) is not LidarFeedforward:
+        raise ValueError(f"the feedforward export takes a LidarFeedforward, got "
+                         f"{type(ctl).__name__}")
+    inst = ctl.sensor.instrument
+    return baseline_entries(ctl.base) + [
+        ("feedforward", 1.0, "1: the LIDAR's collective pitch feedforward"),
+        ("ff", np.array([math.cos(inst.cone_angle_rad), inst.focus_distance, ctl.sample_dt,
+                         ctl.mean_time_constant, ctl.tau_act,
+                         -1.0 if ctl.lead_given is None else ctl.lead_given, ctl.order], float),
+         "cos(cone), focus distance [m], LIDAR sample period [s], the mean wind's averaging "
+         "time [s], pitch actuator time constant [s], a fixed lead [s] (-1: from the filter), "
+         "filter order"),
+        ("ff_corner_winds", np.asarray(ctl.corner_winds, float), "mean winds of the filter "
+                                                                 "corners [m/s]"),
+        ("ff_corners", np.asarray(ctl.corners, float), "filter corners [rad/s]"),
+        ("ff_curve_winds", np.asarray(ctl.curve_v, float), "winds of the static pitch curve "
+                                                           "[m/s]"),
+        ("ff_curve_pitch", np.asarray(ctl.curve_pitch, float), "static pitch [rad]"),
+    ]
+
+
+#: The LIDAR feedforward's export: the baseline's law with the feedforward in its integral
+LIDAR_FF_EXPORT = LawExport(
+    "baseline+lidar-ff", "the baseline with the collective pitch feedforward of a hub-mounted "
+    "CW LIDAR, read from OpenFAST's lidar records", "baseline", _ff_entries, base="baseline",
+    log=("ff_wind", "ff_pitch", "ff_mean_wind", "ff_corner"))
+
+
 @register("lidar-ff", LidarFFOptions, addon_to=("baseline", "derate"), default_base="baseline",
           field_components="u", group="the lidar feedforward", design=_design_lidar_ff,
-          shipped=shipped_law("baseline+lidar-ff", "baseline"),
+          export=LIDAR_FF_EXPORT,
           design_name="baseline+lidar-ff",
           summary="collective pitch feedforward from the CW LIDAR on a baseline "
                   "(baseline+lidar-ff, derate80+lidar-ff)")

@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import logging
+import math
 from dataclasses import dataclass
 from typing import Any, Optional
 
@@ -11,7 +12,9 @@ import linearize
 from mpc_wt.registry.context import BuildContext, Built
 from mpc_wt.registry.options import Options, option
 from mpc_wt.registry.registry import register
-from mpc_wt.kinds.common import check_design_wind, envelope_family, shipped_law, wind_estimator
+from mpc_wt.io.discon_export import LawExport, signal_codes
+from mpc_wt.kinds.common import (baseline_entries, check_design_wind, envelope_family, law_entries,
+                                 wind_estimator, windest_entries)
 
 log = logging.getLogger(__name__)
 
@@ -183,8 +186,84 @@ def _design_lqr_pio(turbine: linearize.Turbine) -> tuple[dict, str]:
                  f"{', '.join(ctl.controllers[0].obs.measured)}")
 
 
+def _lqr_point(c: Any, k: int) -> list[tuple[str, Any, str]]:
+    """One design of a scheduled LQR-PIO: its discretized observer, gains and operating
+    point."""
+    law = c._law
+    nx, nf = c._nx, c._nf
+    p = f"point.{k}."
+    return [
+        (p + "sizes", np.array([nx, nf, len(c.obs.measured), c._nu_all, len(c._iu),
+                                2 if c.region == "II" else 3, float(law is not None)], float),
+         "n_x n_f n_y n_u n_gain region has_torque_law"),
+        (p + "ad", c._ad.ravel(), "observer A_d (n_x + n_f square, row-major)"),
+        (p + "bd", c._bd.ravel(), "observer B_d: [u_dev; y - y0] columns (row-major)"),
+        (p + "gain", c._gain.ravel(), "[K K_f] on the estimate (n_gain x (n_x + n_f))"),
+        (p + "gain_inputs", np.asarray(c._iu, float), "the inputs the gain rows command"),
+        (p + "y0", np.asarray(c.obs.y0, float), "operating point measurements"),
+        (p + "u0", np.asarray(c.model.u0, float), "operating point inputs [rad, rad, rad, N m]"),
+        (p + "x0d0", np.concatenate([c.model.x0, np.asarray(c.model.d0)[:nf]]).astype(float),
+         "operating point states and unknown inputs"),
+        (p + "k_opt", 0.0 if c.k_opt is None else float(c.k_opt),
+         "region II torque gain without a torque law [N m s^2/rad^2]"),
+    ]
+
+
+def _lqr_entries(ctl: Any, preview: Any = None) -> list[tuple[str, Any, str]]:
+    """The numbers of a :class:`~mpc_wt.controllers.lqr.ScheduledLQRPIO` as input-file
+    entries: the wind schedule, the torque law and every design's observer and gains."""
+    from mpc_wt.controllers.lqr import ScheduledLQRPIO
+
+    if type(ctl) is not ScheduledLQRPIO:
+        raise ValueError(f"the LQR-PIO export takes the scheduled design (ScheduledLQRPIO), got "
+                         f"{type(ctl).__name__}: leave design_wind_mps unset")
+    pts = ctl.controllers
+    signals = pts[0].obs.measured
+    if any(c.obs.measured != signals for c in pts):
+        raise ValueError("the LQR-PIO exports with the same measured signals at every design")
+    codes = signal_codes(signals, "PI observer")
+    sched, c0 = ctl.schedule, pts[0]
+    pa, g = c0.turbine.pitch_actuator, c0.turbine.generator
+    reach = c0._reach if math.isfinite(c0._reach) else -1.0
+    rows: list[tuple[str, Any, str]] = [
+        ("dt", ctl.dt, "controller period [s] (ServoDyn DLL_DT)"),
+        ("n_points", float(len(pts)), "designs over the wind"),
+        ("signals", codes, "measured: " + ", ".join(signals)),
+        ("limits", np.array([pa.min_pitch_rad, pa.max_pitch_rad, g.min_torque, g.max_torque,
+                             reach], float),
+         "pitch min, max [rad], torque min, max [N m], how far a pitch command may lead the "
+         "measured pitch [rad] (-1: no bound)"),
+        ("schedule.grid", np.asarray(ctl.winds, float), "the designs' winds [m/s]"),
+        ("schedule.time_constant_hysteresis", np.array([sched.tau, sched.hyst], float),
+         "low-pass of the scheduling wind [s], hysteresis [m/s]"),
+        *windest_entries(sched.estimator, "schedule.windest."),
+    ]
+    laws = [c._law for c in pts if c._law is not None]
+    if laws:
+        lt = laws[0]
+        first = baseline_entries(lt.law, "law.")
+        ref = np.concatenate([np.atleast_1d(v) for _, v, _ in first] + [[lt._a, lt._offset]])
+        for x in laws[1:]:
+            other = np.concatenate([np.atleast_1d(v) for _, v, _ in
+                                    baseline_entries(x.law, "law.")] + [[x._a, x._offset]])
+            if ref.shape != other.shape or not np.array_equal(ref, other, equal_nan=True):
+                raise ValueError("the LQR-PIO exports with one torque law for every design")
+        rows += law_entries(lt)
+    for k, c in enumerate(pts):
+        rows += _lqr_point(c, k)
+    return rows
+
+
+#: LQR-PIO's export: its C law, the schedule's designs with their observers and gains
+LQR_PIO_EXPORT = LawExport(
+    "lqr-pio", "Do et al.'s LQR on PI-observer estimates, scheduled from cut-in to cut-out on "
+    "the estimated wind, observing generator speed, tower-top acceleration and the blade root "
+    "moments", "lqr", _lqr_entries, sources=("lqr.c",),
+    log=("region", "schedule_wind", "schedule_grid_wind"))
+
+
 @register("lqr-pio", LQRPIOOptions, field_components="u", design=_design_lqr,
-          shipped=shipped_law("lqr-pio"),
+          export=LQR_PIO_EXPORT,
           design_name="lqr", more_designs=(("lqr-pio", _design_lqr_pio),),
           summary="Do et al.'s LQR with a PI observer, scheduled from cut-in to cut-out on the "
                   "estimated wind (region II below rated, III above)")

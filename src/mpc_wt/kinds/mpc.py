@@ -8,13 +8,17 @@ import math
 from dataclasses import dataclass
 from typing import Any, Optional
 
+import numpy as np
+
 
 import linearize
 from mpc_wt.registry.context import BuildContext, Built
 from mpc_wt.registry.options import Options, option
 from mpc_wt.registry.registry import register
-from mpc_wt.kinds.common import (LidarOptions, check_design_wind, envelope_family, shipped_law,
-                                  wind_estimator)
+from mpc_wt.io.discon_export import LawExport, signal_codes
+from mpc_wt.kinds.common import (LidarOptions, baseline_entries, check_design_wind,
+                                 envelope_family, floor_entries, wind_estimator,
+                                 windest_entries)
 
 log = logging.getLogger(__name__)
 
@@ -357,18 +361,168 @@ def _design_mpc(collective: bool, with_lidar: bool = False) -> Any:
     return design
 
 
+def _mpc_point(m: Any, k: int, signals: tuple[str, ...]) -> list[tuple[str, Any, str]]:
+    """One grid point of a scheduled MPC: its QP's packed step data, matrices and Kalman
+    filter."""
+    from mpc_wt.controllers.estimator import KalmanEstimator
+
+    if m.formulation != "condensed" or m.backend != "daqp":
+        raise ValueError(f"the MPC exports with the condensed formulation solved by DAQP; grid "
+                         f"point {k} has {m.formulation!r} with {m.backend!r}")
+    est = m.estimator
+    if not isinstance(est, KalmanEstimator) or est.signals != signals:
+        raise ValueError("the MPC exports with its Kalman estimator (estimator='kalman') on "
+                         "the same measured signals at every grid point")
+    nx, nd, nu = m._nx, m._nd, m._nu
+    ny, nb, nz = m._wt.shape[1], len(m._bconst), len(m._z)
+    head = [int(v) for v in m._im[:9]]
+    sizes = [nx, nd, nu, ny, nb, m._map_nv, nz, m._nzd, m._nvu, m.hp, m.hu, m._slack0,
+             len(m.model.outputs), int(m.collective)]
+    if head != [m._nzd, m._slack0, nx, nd, ny, nb, m._map_nv, nu, nz]:
+        raise ValueError(f"grid point {k}: the MPC's packed step data is not laid out as the "
+                         f"library reads it ({head})")
+    z_init = np.zeros(nz)
+    z_init[0] = 1.0
+    p = f"point.{k}."
+    a_gen = np.asarray(m._a_gen_s, float)
+    return [
+        (p + "sizes", np.array(sizes, float),
+         "n_x n_d n_u n_y n_bounds n_v n_z n_z_data n_v_inputs H_p H_u first_slack n_outputs "
+         "collective"),
+        (p + "im", np.asarray(m._im, float), "packed integers: sizes, state index, bound rows, "
+                                             "command columns"),
+        (p + "fc", np.asarray(m._fc, float), "packed constants: x0, d0, bound constants and "
+                                             "signs, input scales, u0"),
+        (p + "wt", np.asarray(m._wt, float).ravel(), "the step's affine map Y, transposed "
+                                                     "(n_z x n_y, row-major)"),
+        (p + "z_init", z_init, "the step data at a reset"),
+        (p + "su", np.asarray(m._su, float), "variable scales"),
+        (p + "u0", np.asarray(m.model.u0, float), "operating point inputs [rad, rad, rad, N m]"),
+        (p + "z0", np.asarray(m.model.z0, float), "operating point outputs"),
+        (p + "x0d0", np.concatenate([m.model.x0, m.model.d0]).astype(float),
+         "operating point states and winds"),
+        (p + "up0", np.asarray(m._up0, float), "previous command deviation at the start"),
+        (p + "h", np.asarray(m._h_s, float).ravel(), "QP Hessian (scaled, row-major)"),
+        (p + "n_box", float(m._n_box), "simple bounds (the first QP rows)"),
+        (p + "a", a_gen.ravel(), "QP general constraint rows (scaled, row-major)"),
+        (p + "limits", np.asarray(m._limits, float), "pitch min, max [rad], torque min, max "
+                                                     "[N m]"),
+        (p + "kalman.n_ny", np.array([est.a.shape[0], len(est.signals)], float),
+         "Kalman filter states and measurements"),
+        (p + "kalman.a", est.a.ravel(), "Kalman A"), (p + "kalman.b", est.b.ravel(), "B"),
+        (p + "kalman.c", est.c.ravel(), "C"), (p + "kalman.d", est.d.ravel(), "D"),
+        (p + "kalman.gain", est.gain.ravel(), "steady-state gain"),
+        (p + "kalman.y0", np.asarray(est.y0, float), "operating point measurements"),
+    ]
+
+
+def _preview_entries(preview: Any, horizon: int) -> list[tuple[str, Any, str]]:
+    """A :class:`~mpc_wt.simulation.preview.LidarPreview`'s processing as input-file
+    entries (the instrument's cone and focus, the mean wind's averaging, the preview time)."""
+    inst = preview.sensor.instrument
+    if getattr(inst, "noise_std", 0.0) > 0:
+        log.warning("the LIDAR's measurement noise is the simulator's; the library reads "
+                    "whatever the host's LIDAR measures")
+    return [("lidar_preview", 1.0, "1: the LIDAR's per-blade preview (records 2001-2016)"),
+            ("lidar_horizon", float(preview.horizon), "preview steps"),
+            ("lidar", np.array([math.cos(inst.cone_angle_rad), inst.focus_distance,
+                                preview.min_wind, preview.mean_time_constant,
+                                -1.0 if preview.fixed is None else preview.fixed], float),
+             "cos(cone), focus distance [m], lowest mean wind for the preview time [m/s], the "
+             "mean wind's averaging time [s], a fixed preview time [s] (-1: D / measured mean)")]
+
+
+def _mpc_entries(ctl: Any, preview: Any = None) -> list[tuple[str, Any, str]]:
+    """The numbers of a :class:`~mpc_wt.controllers.mpc.ScheduledMPC` (and its LIDAR preview)
+    as input-file entries."""
+    from mpc_wt.controllers.mpc import ScheduledMPC
+
+    if type(ctl) is not ScheduledMPC:
+        raise ValueError(f"the MPC export takes a ScheduledMPC, got {type(ctl).__name__}")
+    if ctl.wind_source != "estimator" and preview is None:
+        raise ValueError("an MPC scheduled on its LIDAR's measurement exports with its LIDAR "
+                         "preview (export the kind 'mpc-lidar' through mpc_wt.run."
+                         "export_discon)")
+    n = len(ctl._grid)
+    pts = [ctl.controller(k) for k in range(n)]
+    if pts[0].estimator is None:
+        raise ValueError("an MPC on the plant's true states (estimator 'full-state') does not "
+                         "export: a controller library has its measurements only (the "
+                         "default estimator, 'kalman', does)")
+    signals = pts[0].estimator.signals
+    sched = ctl.schedule
+    budget = ctl.settings.time_budget_ms
+    rows: list[tuple[str, Any, str]] = [
+        ("dt", ctl.dt, "controller period [s] (ServoDyn DLL_DT)"),
+        ("n_points", float(n), "designs over the wind"),
+        ("n_outputs", float(len(ctl._z_trim[0])), "performance outputs of each design"),
+        ("power_output", float(ctl._ip), "the generator power's index among them"),
+        ("power_efficiency", ctl._eff, "power / (torque x generator speed) at the trim"),
+        ("target_time_constant", -1.0 if ctl.target_tau is None else float(ctl.target_tau),
+         "low-pass of the wind whose trim the cost tracks [s] (-1: each design's own)"),
+        ("qp_time_budget_ms", 0.0 if budget is None else float(budget),
+         "a QP over this time takes the fallback [ms] (0: no budget)"),
+        ("torque_law", float(ctl._law is not None), "1: the target torque from the baseline's "
+                                                    "schedule"),
+        ("kalman_signals", signal_codes(signals, "Kalman filter"),
+         "measured: " + ", ".join(signals)),
+        ("schedule.grid", np.asarray(ctl._grid, float), "the designs' winds [m/s]"),
+        ("schedule.time_constant_hysteresis", np.array([sched.tau, sched.hyst], float),
+         "low-pass of the scheduling wind [s], hysteresis [m/s]"),
+        *windest_entries(sched.estimator, "schedule.windest."),
+        *floor_entries(sched.floor, "schedule."),
+        ("trim_z", np.asarray(ctl._z_trim, float).ravel(), "the trim's outputs over the grid"),
+        ("trim_u", np.asarray(ctl._u_trim, float).ravel(), "the trim's inputs over the grid"),
+    ]
+    if ctl._law is not None:
+        lt = ctl._law
+        rows += baseline_entries(ctl.torque_law, "law.")
+        rows.append(("law_torque", np.array([lt._a, lt._offset, lt._lo, lt._hi], float),
+                     "speed filter pole, below-rated pitch offset [rad], torque min, max "
+                     "[N m]"))
+    notch = ctl._notch
+    rows.append(("torque_notch", float(notch is not None),
+                 "1: a notch on the torque command (the estimator is given the filtered torque)"))
+    if notch is not None:
+        rows += [("torque_notch_sos", notch.sos.ravel(),
+                  f"its sections b0 b1 b2 a0 a1 a2 (centres "
+                  f"{', '.join(f'{f:.6g}' for f in (ctl.torque_notch_hz, ctl.tower_notch_hz) if f is not None)}"
+                  f" Hz, Q {ctl.torque_notch_q:g})"),
+                 ("torque_notch_zi", np.asarray(notch._zi1, float).ravel(),
+                  "their state at a unit input's steady state"),
+                 ("torque_notch_rate", float(ctl.turbine.generator.max_torque_rate),
+                  "the filtered torque's largest rate [N m/s]")]
+    rows += _preview_entries(preview, ctl.settings.horizon) if preview is not None else \
+        [("lidar_preview", 0.0, "no LIDAR")]
+    for k, m in enumerate(pts):
+        rows += _mpc_point(m, k, signals)
+    return rows
+
+
+def _mpc_export(name: str, summary: str) -> LawExport:
+    """An MPC kind's export: the MPC law with DAQP, from its published distribution."""
+    return LawExport(name, summary, "mpc", _mpc_entries, sources=("mpc.c",), qp=True,
+                     log=("qp_fallback", "qp_solve_ms", "schedule_wind", "schedule_grid_wind"))
+
+
 _MPC_GROUP = "the MPC controllers"
 register("mpc", MPCOptions, field_components="u", group=_MPC_GROUP, design=_design_mpc(False),
-         shipped=shipped_law("mpc"),
+         export=_mpc_export("mpc", "Madsen's individual-pitch MPC scheduled from cut-in to "
+                            "cut-out on the estimated wind, with its Kalman estimator and the "
+                            "QP solved by DAQP"),
          summary="Madsen's Coleman-weighted individual-pitch MPC, scheduled from cut-in to "
                  "cut-out on the estimated wind, Kalman estimator (without a preview no cyclic "
                  "pitch unless weights.flap_moment is set)"
          )(_mpc(False, False))
 register("mpc-collective", MPCOptions, field_components="u", group=_MPC_GROUP,
-         design=_design_mpc(True), shipped=shipped_law("mpc-collective"),
+         design=_design_mpc(True),
+         export=_mpc_export("mpc-collective", "the scheduled MPC with collective pitch"),
          summary="the scheduled MPC with one collective pitch input")(_mpc(True, False))
 register("mpc-lidar", MPCLidarOptions, field_components="u", group=_MPC_GROUP,
-         design=_design_mpc(False, True), shipped=shipped_law("mpc-lidar"), summary="the individual-pitch MPC with a CW LIDAR's per-blade preview "
+         design=_design_mpc(False, True),
+         export=_mpc_export("mpc-lidar", "the scheduled MPC with the per-blade preview of a "
+                            "hub-mounted CW LIDAR, read from OpenFAST's lidar records"),
+         summary="the individual-pitch MPC with a CW LIDAR's per-blade preview "
                  "(range weighting, LOS error and wind evolution on)")(_mpc(False, True))
 
 

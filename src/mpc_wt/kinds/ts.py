@@ -2,15 +2,19 @@
 from __future__ import annotations
 
 import logging
+import math
 from dataclasses import dataclass
 from typing import Any, Optional
+
+import numpy as np
 
 
 import linearize
 from mpc_wt.registry.context import BuildContext, Built
 from mpc_wt.registry.options import Options, option
 from mpc_wt.registry.registry import register
-from mpc_wt.kinds.common import shipped_law
+from mpc_wt.io.discon_export import LawExport, signal_codes
+from mpc_wt.kinds.common import law_entries
 
 log = logging.getLogger(__name__)
 
@@ -106,7 +110,83 @@ class TSOptions(Options):
                                       "default: it leaves that mode to its own damping")
 
 
-@register("ts", TSOptions, field_components="u", design=_design_ts, shipped=shipped_law("ts"),
+def _ts_entries(ctl: Any, preview: Any = None) -> list[tuple[str, Any, str]]:
+    """The numbers of a :class:`~mpc_wt.controllers.takagi_sugeno.TSController`: its grids,
+    the observer's blended zero-order-hold maps, the vertex equilibria and gains."""
+    from mpc_wt.controllers.takagi_sugeno import TSController
+
+    if type(ctl) is not TSController:
+        raise ValueError(f"the TS export takes a TSController, got {type(ctl).__name__}")
+    if ctl.power_reduction is not None or ctl._v_given is not None:
+        raise ValueError("a TS design with a power reduction over time (apc_frequency) or a "
+                         "given initial wind does not export: the library takes its power "
+                         "from the torque schedule and starts from the measured pitch")
+    ts, gen, pa = ctl.ts, ctl.turbine.generator, ctl.turbine.pitch_actuator
+    codes = signal_codes(ts.measured, "TS observer")
+    n, nx = ctl._phi.shape[1], len(ts.states)
+    dp0 = float(ts.reduction_grid[0])
+    eq = np.array([ts.blend(ts.membership(float(v), dp0))["u0"][0] for v in ts.wind_grid])
+    order = np.argsort(eq)
+    kk = np.asarray(ctl._K, float)
+    rows: list[tuple[str, Any, str]] = [
+        ("dt", ctl.dt, "controller period [s] (ServoDyn DLL_DT)"),
+        ("sizes", np.array([ts.wind_grid.size, ts.reduction_grid.size, n, len(ts.inputs),
+                            len(ts.measured), kk.shape[2], -1 if ctl._ki is None else ctl._ki,
+                            float(ctl.torque_law is None)], float),
+         "winds, reductions, observer states (x and v), inputs, measurements, gain columns, "
+         "integral state (-1: none), 1: the TS law's torque applied"),
+        ("signals", codes, "measured: " + ", ".join(ts.measured)),
+        ("limits", np.array([pa.min_pitch_rad, pa.max_pitch_rad, gen.min_torque,
+                             gen.max_torque,
+                             ctl._reach if math.isfinite(ctl._reach) else -1.0], float),
+         "pitch min, max [rad], torque min, max [N m], how far a pitch command may lead the "
+         "measured pitch [rad] (-1: no bound)"),
+        ("rated_power", float(ts.rated_power), "electrical power the torque schedule holds [W]"),
+        ("integral_source", float(-1 if ctl._int_src is None else ctl._int_src),
+         "the measurement whose deviation is integrated (-1: the estimate)"),
+        ("torque_law", float(ctl._law is not None), "1: the generator torque from the "
+                                                    "baseline's schedule"),
+        ("wind_grid", np.asarray(ts.wind_grid, float), "vertex winds [m/s]"),
+        ("reduction_grid", np.asarray(ts.reduction_grid, float), "vertex power reductions [-]"),
+        ("start_pitch", eq[order], "the vertex pitch without reduction, increasing [rad]"),
+        ("start_wind", np.asarray(ts.wind_grid, float)[order], "its wind [m/s]"),
+        ("terms", np.asarray(ctl._terms, float).ravel(),
+         "the observer's terms: vertex i and j (weight h_i h_j; j = -1: h_i)"),
+        ("phi", ctl._phi.ravel(), "each term's state map over a period (row-major)"),
+        ("gamma", ctl._gam.ravel(), "each term's map of [u; y; 1] over a period (row-major)"),
+        ("x0", np.asarray(ts.x0, float).ravel(), f"vertex equilibria ({nx} states each)"),
+        ("u0", np.asarray(ts.u0, float).ravel(), "vertex inputs [rad, N m]"),
+        ("gain", kk.ravel(), "vertex gains K_i (inputs x gain columns, row-major)"),
+    ]
+    if ctl._law is not None:
+        rows += law_entries(ctl._law)
+    return rows
+
+
+def _check_saved_ts(doc: Any) -> None:
+    """A saved TS design exports when it is on the kind's vertex grid (the export builds the
+    kind again from the design's options)."""
+    from mpc_wt.controllers.takagi_sugeno.model import DEFAULT_REDUCTION_GRID, DEFAULT_WIND_GRID
+
+    s = doc["settings"]
+    if (list(s.get("wind_grid", [])) != list(DEFAULT_WIND_GRID)
+            or list(s.get("reduction_grid", [])) != list(DEFAULT_REDUCTION_GRID)):
+        raise ValueError(
+            f"this TS design's vertex grid (winds {s.get('wind_grid')}, reductions "
+            f"{s.get('reduction_grid')}) is not the one the controller kind 'ts' is built on "
+            f"(winds {list(DEFAULT_WIND_GRID)}, reductions {list(DEFAULT_REDUCTION_GRID)}); "
+            f"design it with the default --wind, or export a TSController built on your grid "
+            f"with mpc_wt.run.export_controller")
+
+
+#: The TS controller's export: its C law, the observer's maps and the vertex gains
+TS_EXPORT = LawExport(
+    "ts", "Clemens et al.'s Takagi-Sugeno controller and wind observer, observing the tower-top "
+    "accelerations and the rotor and generator speeds", "ts", _ts_entries, sources=("ts.c",),
+    log=("wind_est", "premise_clipped"), check_saved=_check_saved_ts)
+
+
+@register("ts", TSOptions, field_components="u", design=_design_ts, export=TS_EXPORT,
           summary="Clemens et al.'s Takagi-Sugeno controller and wind observer (LMI gains)")
 def _build_ts(ctx: BuildContext, opts: TSOptions) -> Built:
     from mpc_wt.controllers.apc import apc_reference

@@ -17,8 +17,10 @@ from mpc_wt.registry.registry import (
                                      cli_naming,
                                      describe,
                                      designs,
+                                     exportable,
                                      get_kind,
                                      kinds,
+                                     law_export,
                                      load_plugins,
                                      register,
                                      register_kind,
@@ -27,5 +29,5 @@ from mpc_wt.registry.registry import (
 
 __all__ = ["DEFAULT_CACHE", "BuildContext", "Built", "DesignCache", "turbine_key", "REQUIRED",
            "Options", "option", "API_NAMING", "ControllerKind", "Naming", "Selection",
-           "cli_naming", "describe", "designs", "get_kind", "kinds", "load_plugins", "register",
-           "register_kind", "resolve"]
+           "cli_naming", "describe", "designs", "exportable", "get_kind", "kinds", "law_export",
+           "load_plugins", "register", "register_kind", "resolve"]

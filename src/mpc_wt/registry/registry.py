@@ -13,7 +13,6 @@ User kinds register with :func:`register`; modules named by ``--plugin`` (comman
 """
 from __future__ import annotations
 
-import dataclasses
 
 import importlib
 import logging
@@ -27,7 +26,8 @@ from mpc_wt.errors import OptionsError
 from mpc_wt.registry.options import REQUIRED, Options, flag_of, option_fields
 
 __all__ = ["ControllerKind", "Selection", "Naming", "register", "register_kind", "get_kind",
-           "resolve", "kinds", "designs", "describe", "load_plugins", "API_NAMING", "cli_naming"]
+           "resolve", "kinds", "designs", "describe", "exportable", "law_export", "load_plugins",
+           "API_NAMING", "cli_naming"]
 
 log = logging.getLogger(__name__)
 
@@ -72,11 +72,13 @@ class ControllerKind:
         meets only u either way). A LIDAR that takes its field from
         ``ctx.lidar_field`` (all the built-in ones) needs only "u": that field is made whole
         from the case's seed.
-    shipped : callable, optional
-        ``shipped(ctx, selection, options, built) -> Built``: the design as it is shipped (its
-        compiled library in the loop through the host), which every run then calls; it returns
-        ``built`` unchanged for a composition that has no shipped law. Applied once the whole
-        composition is built, by its last part. None: the kind's Python step is its law.
+    export : object, optional
+        How the kind exports as a Bladed-style controller library
+        (:class:`mpc_wt.io.discon_export.LawExport`: its name, what it becomes, its C law and
+        the design's numbers for it; ``export.base`` the base an add-on's export is made on).
+        A kind with one is exported by ``mpcwt export`` and
+        :func:`~mpc_wt.run.export_discon`, and every run calls its compiled law (the design
+        as it is shipped). None: the kind's Python step is its law.
     """
 
     name: str
@@ -94,7 +96,7 @@ class ControllerKind:
     more_designs: tuple[tuple[str, Callable[..., Any]], ...] = ()
     group: str = ""
     field_components: str = "uvw"
-    shipped: Callable[..., Any] | None = None
+    export: Any = None
 
     @property
     def is_addon(self) -> bool:
@@ -289,6 +291,18 @@ class Selection:
         return (self.base, *self.addons)
 
     @property
+    def export(self) -> Any:
+        """The export of this composition (:attr:`ControllerKind.export` of its last part,
+        where the composition is that export's: an add-on on its export's base), else None."""
+        ex = self.parts[-1].export
+        if ex is None:
+            return None
+        base = getattr(ex, "base", None)
+        if base is None:
+            return ex if not self.addons else None
+        return ex if len(self.addons) == 1 and self.base.name == base else None
+
+    @property
     def field_components(self) -> str:
         """The wind components any part reads from the case's field, in ``"uvw"`` order."""
         return "".join(c for c in "uvw" if any(c in k.field_components for k in self.parts))
@@ -440,6 +454,47 @@ def _unknown(name: str, ks: Mapping[str, ControllerKind]) -> str:
     return (f"controller must be one of {plain}" + (f" or {', '.join(pats)}" if pats else "")
             + (f", optionally +ADDON ({'|'.join(addons)}) on a base" if addons else "")
             + f", got {name!r}")
+
+
+def exportable() -> dict[str, Any]:
+    """The controller names that export as a controller library, and their exports.
+
+    Returns
+    -------
+    dict of str to object
+        The export's name (``baseline+lidar-ff``) -> the kind's export
+        (:class:`mpc_wt.io.discon_export.LawExport`), in registration order.
+    """
+    return {k.export.name: k.export for k in kinds().values() if k.export is not None}
+
+
+def law_export(name: str) -> Any:
+    """The export of a controller name: a kind that exports, or an add-on on its export's base
+    (``ibc`` is ``baseline+ibc``).
+
+    Parameters
+    ----------
+    name : str
+        A controller name.
+
+    Returns
+    -------
+    object
+        Its export (:class:`mpc_wt.io.discon_export.LawExport`).
+
+    Raises
+    ------
+    ValueError
+        A name that does not export (or no kind), listing those that do.
+    """
+    try:
+        ex = resolve(name).export
+    except ValueError:
+        ex = None
+    if ex is None:
+        raise ValueError(f"controller kind {name!r} does not export as a DISCON library; "
+                         f"the kinds that do: {sorted(exportable())}")
+    return ex
 
 
 def designs() -> dict[str, ControllerKind]:

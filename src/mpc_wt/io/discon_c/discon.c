@@ -79,12 +79,21 @@ static mw_instance *lookup(const char *key)
     return NULL;
 }
 
+/* the laws this library holds (mw_laws.h) and their constructors */
+#define MW_LAW_ENTRY(law) {#law, mw_##law##_new},
+static const struct {
+    const char *name;
+    mw_ctrl *(*make)(const mw_input *in, char *msg);
+} laws[] = {MW_LAWS(MW_LAW_ENTRY)};
+#undef MW_LAW_ENTRY
+static const int n_laws = (int)(sizeof(laws) / sizeof(laws[0]));
+
 static mw_ctrl *create(const char *path, const float *swap, char *msg)
 {
     mw_input in;
     mw_ctrl *c = NULL;
     char kind[64];
-    int version;
+    int version, i;
     double dt_call;
     if (mw_input_read(&in, path, msg)) return NULL;
     if (mw_get_int(&in, "format_version", 1, 1, &version, msg)
@@ -92,22 +101,21 @@ static mw_ctrl *create(const char *path, const float *swap, char *msg)
         mw_input_free(&in);
         return NULL;
     }
-    if (strcmp(kind, "baseline") == 0)
-        c = mw_baseline_new(&in, msg);
-    else if (strcmp(kind, "mpc") == 0)
-#ifdef MPCWT_WITH_MPC
-        c = mw_mpc_new(&in, msg);
-#else
-        mw_msg(msg, "mpc-wt controller: input file '%s': kind 'mpc' needs a library built with "
-               "the MPC and its QP solver; export an MPC kind to build one", path);
-#endif
-    else if (strcmp(kind, "lqr") == 0)
-        c = mw_lqr_new(&in, msg);
-    else if (strcmp(kind, "ts") == 0)
-        c = mw_ts_new(&in, msg);
-    else
-        mw_msg(msg, "mpc-wt controller: input file '%s': kind '%s' is not one this library "
-               "knows (baseline, mpc, lqr, ts)", path, kind);
+    for (i = 0; i < n_laws; i++)
+        if (strcmp(kind, laws[i].name) == 0) {
+            c = laws[i].make(&in, msg);
+            break;
+        }
+    if (i == n_laws) {
+        char held[256] = "";
+        for (i = 0; i < n_laws; i++) {
+            if (i) strncat(held, ", ", sizeof(held) - strlen(held) - 1);
+            strncat(held, laws[i].name, sizeof(held) - strlen(held) - 1);
+        }
+        mw_msg(msg, "mpc-wt controller: input file '%s': kind '%s' is not a law this library "
+               "holds (%s); export a controller of that kind to build its library", path, kind,
+               held);
+    }
     mw_input_free(&in);
     if (!c) return NULL;
     dt_call = swap[2];

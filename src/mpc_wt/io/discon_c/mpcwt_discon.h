@@ -55,7 +55,7 @@ typedef struct {
 } mw_meas;
 
 /* logging channels a kind returns beside its demands (Bladed's records 65 and L1 = record 63
- * on): each kind's are listed, in order, in mpc-wt's discon_export.LOG_CHANNELS */
+ * on): each kind lists its own, in order, in its export (LawExport.log) */
 #define MW_LOG_MAX 12
 
 typedef struct {
@@ -85,11 +85,14 @@ struct mw_ctrl {
     void (*destroy)(mw_ctrl *self);
 };
 
-/* the kinds */
-mw_ctrl *mw_baseline_new(const mw_input *in, char *msg);
-mw_ctrl *mw_mpc_new(const mw_input *in, char *msg);
-mw_ctrl *mw_lqr_new(const mw_input *in, char *msg);
-mw_ctrl *mw_ts_new(const mw_input *in, char *msg);
+/* the laws: each law's C file defines mw_<law>_new, which reads the input file and makes its
+ * controller (NULL with msg on failure); the library holds the laws mw_laws.h lists (written
+ * by the export: MW_LAWS(X) expands X(law) for each), discon.c makes the one the input file's
+ * `kind` names */
+#include "mw_laws.h"
+#define MW_LAW_NEW(law) mw_ctrl *mw_##law##_new(const mw_input *in, char *msg);
+MW_LAWS(MW_LAW_NEW)
+#undef MW_LAW_NEW
 
 /* ---- shared parts --------------------------------------------------------------------- */
 /* input keys are "<prefix><name>"; these read one with the prefix */
