@@ -267,3 +267,94 @@ def test_the_hosts_compiled_call_fills_the_records_as_its_dict_path(turbine, kin
     for name in slow.controller:
         if name != "qp_solve_ms":
             np.testing.assert_array_equal(fast.controller[name], slow.controller[name])
+
+
+_PLUGIN_LAW = r"""
+/* a region-2 law for the test: fine pitch, torque k * generator speed^2 (capped) */
+#include "mpcwt_discon.h"
+
+#include <stdlib.h>
+
+typedef struct {
+    mw_ctrl base;
+    double k, fine, cap;
+} komega2;
+
+static int komega2_step(mw_ctrl *self, const mw_meas *m, mw_cmd *out, char *msg)
+{
+    komega2 *c = (komega2 *)self;
+    double tq = c->k * m->gen_speed * m->gen_speed;
+    (void)msg;
+    out->pitch[0] = out->pitch[1] = out->pitch[2] = c->fine;
+    out->torque = tq < c->cap ? tq : c->cap;
+    out->nlog = 1;
+    out->log[0] = tq;
+    return 0;
+}
+
+static void komega2_destroy(mw_ctrl *self) { free(self); }
+
+static int komega2_read(const mw_input *in, mw_ctrl *self, char *msg)
+{
+    komega2 *c = (komega2 *)self;
+    return mw_get(in, "dt", &self->dt, msg) || mw_get(in, "k", &c->k, msg)
+           || mw_get(in, "fine_pitch", &c->fine, msg) || mw_get(in, "torque_cap", &c->cap, msg);
+}
+
+mw_ctrl *mw_komega2_new(const mw_input *in, char *msg)
+{
+    return mw_ctrl_new(sizeof(komega2), "komega2", komega2_step, komega2_destroy, komega2_read,
+                       in, msg);
+}
+"""
+
+
+def test_a_plugin_kind_with_its_own_c_law_is_one_registration(turbine, tmp_path):
+    """A kind with a C law of its own (a file beside its module) is its registration and that
+    file: its runs call the compiled law in the loop compiled with the plant (its logging
+    channel recorded), and ``export_discon`` writes its input file and sources and builds
+    the library whose law list holds it. Its Python step (``shipped=False``) gives the same
+    demands to the float32 of the swap array (the torque to 1e-6 of itself)."""
+    from mpc_wt.io.discon_export import LawExport
+    from mpc_wt.registry import Built, register
+    from mpc_wt.registry.registry import _KINDS
+
+    law = tmp_path / "komega2.c"
+    law.write_text(_PLUGIN_LAW)
+    k, fine = 2.332, 0.0                     # the NREL 5-MW's region-2 gain [N m s^2/rad^2]
+    cap = turbine.rated_generator_torque
+
+    class KOmega2:
+        dt = 0.05
+
+        def reset(self):
+            self.signals = {}
+
+        def step(self, t, meas):
+            tq = k * meas["gen_speed"] ** 2
+            self.signals = {"plugin_torque": tq}
+            return np.full(3, fine), min(tq, cap)
+
+    def entries(ctl, preview):
+        return [("dt", ctl.dt, "[s]"), ("k", k, "[N m s^2]"), ("fine_pitch", fine, "[rad]"),
+                ("torque_cap", cap, "[N m]")]
+
+    export = LawExport("komega2-test", "a region-2 law", "komega2", entries,
+                       sources=(str(law),), log=("plugin_torque",))
+    register("komega2-test", export=export, summary="test")(
+        lambda ctx, opts: Built(KOmega2(), controller_dt=0.05))
+    try:
+        kw = dict(duration=20.0, turbulence="A", seed=3, fields=_FIELDS)
+        lib = run_controller(turbine, "komega2-test", 8.0, **kw)
+        py = run_controller(turbine, "komega2-test", 8.0, shipped=False, **kw)
+        assert (lib.meta["law"], lib.meta["loop"]) == ("shipped", "compiled")
+        np.testing.assert_allclose(lib.channel("gen_torque_ref"), py.channel("gen_torque_ref"),
+                                   rtol=1e-6)
+        np.testing.assert_allclose(lib.controller["plugin_torque"],
+                                   py.controller["plugin_torque"], rtol=1e-6)
+        ex = export_discon(turbine, "komega2-test", tmp_path / "export")
+        assert "kind komega2" in ex.input_file.read_text()
+        assert "X(baseline) X(komega2)" in (ex.directory / "mw_laws.h").read_text()
+        assert (ex.directory / "komega2.c").is_file() and ex.library.is_file()
+    finally:
+        _KINDS.pop("komega2-test", None)

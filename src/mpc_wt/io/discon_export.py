@@ -63,8 +63,8 @@ class LawExport:
         ``entries(controller, preview) -> [(key, value, meaning), ...]``: the design's numbers
         as input-file entries; ``ValueError`` for a design the law does not take.
     sources : tuple of str
-        The law's C files beside the common ones (:data:`COMMON_SOURCES`), in
-        ``mpc_wt/io/discon_c/``.
+        The law's C files beside the common ones (:data:`COMMON_SOURCES`): names in
+        ``mpc_wt/io/discon_c/``, or absolute paths (a plugin's C file beside its module).
     qp : bool
         The law solves a QP: its library carries DAQP's sources from their published
         distribution (:mod:`mpc_wt.io.solver_sources`).
@@ -322,13 +322,18 @@ def _copy_sources(directory: Path, export: LawExport) -> tuple[Path, ...]:
     list of laws the library holds); a QP law's come with DAQP's sources from its published
     distribution (:func:`mpc_wt.io.solver_sources.daqp_sources`)."""
     src = importlib.resources.files("mpc_wt.io") / "discon_c"
+    own = {Path(n).name: Path(n) for n in export.sources}
     for stale in directory.glob("*.c"):         # an earlier export of another law
-        if stale.name not in COMMON_SOURCES and stale.name not in export.sources:
+        if stale.name not in COMMON_SOURCES and stale.name not in own:
             stale.unlink()
     out = []
-    for name in (*COMMON_SOURCES, *export.sources):
+    for name in COMMON_SOURCES:
         target = directory / name
         target.write_text((src / name).read_text())
+        out.append(target)
+    for name, path in own.items():
+        target = directory / name
+        target.write_text(path.read_text() if path.is_absolute() else (src / name).read_text())
         out.append(target)
     laws = ["baseline"] + ([export.law] if export.law != "baseline" else [])
     header = directory / _LAWS_HEADER

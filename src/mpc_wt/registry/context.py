@@ -132,10 +132,12 @@ class DesignCache:
     Parameters
     ----------
     max_items : int
-        Entries kept; the oldest goes first (default 16).
+        Entries kept; the one used longest ago goes first (default 64: a campaign worker
+        keeps every kind of the sign-off, each its design, its shipped law and the parts they
+        are made of).
     """
 
-    def __init__(self, max_items: int = 16) -> None:
+    def __init__(self, max_items: int = 64) -> None:
         self.max_items = int(max_items)
         self._items: dict[tuple[Any, ...], Any] = {}
         self._lock = threading.Lock()
@@ -165,7 +167,9 @@ class DesignCache:
         with self._lock:
             if full in self._items:
                 self.hits += 1
-                return self._items[full]
+                value = self._items.pop(full)     # the most recently used goes last
+                self._items[full] = value
+                return value
         value = make()
         with self._lock:
             name = str(key[0]) if key else ""

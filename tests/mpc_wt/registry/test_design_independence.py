@@ -143,3 +143,18 @@ def test_the_design_does_not_depend_on_the_processs_blas_threads(
             built, _ = design_controller(turbine, "ibc", cache=DesignCache())
         digests.add(built.meta["design"]["digest"])
     assert len(digests) == 1
+
+
+def test_the_cache_drops_the_design_used_longest_ago(turbine: linearize.Turbine) -> None:
+    """With room for two: A, B, A again (a hit), then C drops B, not A; a campaign worker
+    that runs nine kinds in turn keeps each kind's design (the default room is 64)."""
+    cache = DesignCache(max_items=2)
+    made = []
+
+    def make(name):
+        return lambda: made.append(name) or name
+
+    for name in ("A", "B", "A", "C", "A", "B"):
+        assert cache.get(turbine, ("part", name), make(name)) == name
+    assert made == ["A", "B", "C", "B"] and cache.hits == 2
+    assert DesignCache().max_items == 64
