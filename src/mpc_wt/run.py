@@ -449,22 +449,11 @@ def export_controller(controller: Any, kind: str, turbine: linearize.Turbine, ou
 
     Parameters
     ----------
-    controller : object
-        The design (of the type the kind builds; ``Built.designed``).
     kind : str
-        Its kind (one of :func:`mpc_wt.registry.exportable`).
-    turbine : Turbine
-        Its turbine.
-    out : path
-        The export folder.
-    build : bool
-        Compile the library now.
-    compiler : str, optional
-        The C compiler.
-    source : str
-        How it was designed (a comment in the input file).
-    preview : LidarPreview, optional
-        The design's LIDAR preview (the LIDAR kinds).
+        The controller's kind (one of :func:`mpc_wt.registry.exportable`).
+    controller, turbine, out, build, compiler, source, preview
+        As :func:`mpc_wt.io.discon_export.export_controller` takes them (``controller`` is of
+        the type the kind builds: ``Built.designed``).
 
     Returns
     -------
@@ -494,14 +483,8 @@ def export_saved_design(doc: Mapping[str, Any], turbine: linearize.Turbine, out:
     ----------
     doc : mapping
         The design document (:func:`mpc_wt.io.gain_tables.load_design`).
-    turbine : Turbine
-        Its turbine.
-    out : path
-        The export folder.
-    build : bool
-        Compile the library now.
-    compiler : str, optional
-        The C compiler.
+    turbine, out, build, compiler
+        As :func:`export_discon` takes them.
 
     Returns
     -------

@@ -412,6 +412,7 @@ class DisconController(ControllerBase):
         self.log_names = tuple(log_names)
         self._fds: tuple[int, int] | None = None
         self._lib: Any = None
+        self._fast: tuple[Any, ...] | None = None
         self._copy_dir: str | None = None
         self._swap = (ctypes.c_float * SWAP_SIZE)()
         self._view = np.frombuffer(self._swap, dtype=np.float32)
@@ -449,6 +450,7 @@ class DisconController(ControllerBase):
         self._lib, self._fn = lib, fn
 
     def _unload(self) -> None:
+        self._fast = None                    # its DISCON goes with the library
         if isinstance(self._lib, _ChildLibrary):
             self._lib.close()
             self._lib = None
@@ -488,7 +490,8 @@ class DisconController(ControllerBase):
         self.messages = []
         self.signals = {}
         # the step's compiled call (the closed loop's own): a library in this process
-        self._fast = self.compiled_library()
+        self._fast = None
+        self._fast = self.compiled_library()     # built anew: this copy's DISCON
         self._cmd, self._hub = np.zeros(5 + LOG_ROOM), np.zeros(1)
 
     def finalize(self) -> None:
@@ -633,9 +636,14 @@ class DisconController(ControllerBase):
         Returns
         -------
         tuple or None
+            The same arrays as :meth:`step` calls through until the next :meth:`reset`, with
+            the host's status and last pitch demand as they stand.
         """
         if self.isolate or self._lib is None:
             return None
+        if self._fast is not None:
+            self._fast[6][0], self._fast[6][1] = float(self._status), float(self._last_pitch[0])
+            return self._fast
         bufs = np.zeros((4, _OUT_LEN), np.uint8)
         bufs[0, :len(self._infile)] = np.frombuffer(self._infile, np.uint8)
         bufs[3, :len(self._outname)] = np.frombuffer(self._outname, np.uint8)
