@@ -23,8 +23,9 @@ from mpc_wt.controllers.discon import DisconController
 from mpc_wt.errors import ControllerLibraryError
 from mpc_wt.io.discon_export import build_library, find_compiler, library_name, servodyn_input
 from mpc_wt.registry import exportable, law_export
-from mpc_wt.run import export_discon, run_controller
-from mpc_wt.simulation.scenario import FieldMemo
+from mpc_wt.run import build_controller, export_discon, run_controller
+from mpc_wt.simulation.scenario import FieldMemo, Scenario
+from servodyn_measures import run_python
 
 pytestmark = pytest.mark.skipif(find_compiler() is None,
                                 reason="no C compiler ($CC, cc, gcc, clang) to build the "
@@ -71,7 +72,7 @@ def _compare(turbine, kind, ex, wind, seed=11):
     """The same 120 s class-A case with the Python controller and with its library: the
     largest pitch [deg] and torque [fraction of rated] differences, and the two runs."""
     kw = dict(duration=120.0, turbulence="A", seed=seed, fields=_FIELDS)
-    py = run_controller(turbine, kind, wind, shipped=False, **kw)
+    py = run_python(turbine, kind, wind, **kw)
     lib = run_controller(turbine, "discon", wind, _discon(ex), **kw)
     assert py.u.shape == lib.u.shape
     dp = float(np.degrees(np.max(np.abs(py.u[:, :3] - lib.u[:, :3]))))
@@ -148,10 +149,12 @@ def _replay(turbine, kind, ex, wind):
     host = DisconController(ex.library, ex.input_file, turbine, dt=ex.dt,
                             lidar=None if built.preview is None else built.preview.sensor)
     host.reset()
-    worst = [0.0, 0.0]
+    worst = [0.0, 0.0, 0.0]
     inner = ctl.step
 
     def both(t, meas):
+        if not worst[2]:       # the first call as ServoDyn's: no torque or power yet
+            meas, worst[2] = {**meas, "gen_torque": 0.0, "gen_power": 0.0}, 1.0
         u = inner(t, meas)
         pitch, torque = host.step(t, {k: v for k, v in meas.items() if k != "preview"})
         worst[0] = max(worst[0], float(np.degrees(np.max(np.abs(u[0] - pitch)))))
@@ -262,7 +265,7 @@ def test_ibc_library_holds_the_amplitude_as_the_python_controller(nrel5mw, tmp_p
     opts = {"max_amplitude_deg": 0.3}
     ex = export_discon(nrel5mw, "ibc", tmp_path / "ibc03", opts)
     kw = dict(duration=120.0, turbulence="A", seed=11, fields=_FIELDS)
-    py = run_controller(nrel5mw, "ibc", 18.0, opts, shipped=False, **kw)
+    py = run_python(nrel5mw, "ibc", 18.0, opts, **kw)
     lib = run_controller(nrel5mw, "discon", 18.0, _discon(ex), **kw)
     dp = float(np.degrees(np.max(np.abs(py.u[:, :3] - lib.u[:, :3]))))
     assert dp <= 0.01, dp

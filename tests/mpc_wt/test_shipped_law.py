@@ -14,6 +14,7 @@ from mpc_wt.registry import exportable, law_export
 from mpc_wt.io.solver_sources import cache_dir
 from mpc_wt.run import export_discon, run_controller
 from mpc_wt.simulation.scenario import FieldMemo
+from servodyn_measures import run_python
 
 pytestmark = pytest.mark.skipif(find_compiler() is None,
                                 reason="no C compiler ($CC, cc, gcc, clang) to build the law")
@@ -157,7 +158,7 @@ def test_the_librarys_logging_channels_are_the_python_steps_signals(turbine, kin
     1e-5 m/s); the QP's solve time is a positive reading of the library's own clock."""
     kw = dict(duration=30.0, turbulence="A", seed=31, fields=_FIELDS)
     lib = run_controller(turbine, kind, wind, **kw)
-    py = run_controller(turbine, kind, wind, shipped=False, **kw)
+    py = run_python(turbine, kind, wind, **kw)
     names = law_export(kind).log
     assert set(names) <= set(lib.controller) and set(names) <= set(py.controller)
     for name in ("qp_fallback", "premise_clipped", "region"):

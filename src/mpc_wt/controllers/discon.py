@@ -597,6 +597,8 @@ class DisconController(ControllerBase):
             e[0], e[1], e[2], g("tower_fa_acceleration", 0.0), g("tower_ss_acceleration", 0.0),
             g("azimuth", 0.0), g("tilt_moment", 0.0), g("yaw_moment", 0.0),
             g("lss_torque", 0.0), g("thrust", 0.0))
+        if self._status == 0:                # ServoDyn's first call (library_call's)
+            self._view[[10, 14, 22]] = (p[0], 0.0, 0.0)
 
     def _call(self, t: float) -> None:
         if isinstance(self._lib, _ChildLibrary):

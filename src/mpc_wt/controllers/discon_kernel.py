@@ -23,13 +23,20 @@ def library_call(k, t, z, fn, swap, fail, bufs, rec, zi, hub, lib, cmd):  # prag
     ``DISCON``, the demands into ``cmd`` (pitch 1-3, torque, contactor, then the logging
     channels). ``lib`` holds the status, the last pitch demand of blade 1, the individual-pitch
     flag, the pitch limits, the largest torque, the most logging channels seen and this call's.
-    Returns aviFAIL, or 2 for a non-finite demand."""
+    The first call (status 0) is ServoDyn's: measured generator torque and electrical power
+    (records 23 and 15: the previous step's in ServoDyn) 0, the demanded pitch (record 11) the
+    initial pitch. Returns aviFAIL, or 2 for a non-finite demand."""
     swap[0] = lib[0]
     swap[1] = t
-    swap[10] = lib[1]
     swap[26] = hub[k]
     for j in range(rec.size):
         swap[rec[j]] = z[zi[j]]
+    if lib[0] == 0.0:               # ServoDyn's first call: no torque or power yet, the
+        swap[10] = swap[3]          # demanded pitch is the initial pitch
+        swap[14] = 0.0
+        swap[22] = 0.0
+    else:
+        swap[10] = lib[1]
     fail[0] = 0
     bufs[2, 0] = 0
     bufs[1, :] = bufs[3, :]

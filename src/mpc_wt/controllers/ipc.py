@@ -506,6 +506,8 @@ class _PitchAddOn(ControllerBase):
     def _weight(self, meas: dict[str, Any]) -> float:
         p = float(meas["gen_power"])
         a = math.exp(-self.dt / self.power_tau)
+        if self._p_filt is None and p <= 0.0:   # no power yet (ServoDyn's first call sends 0):
+            return power_weight(0.0, self.gains.rated_power, self.gains.weight_range)  # no seed
         self._p_filt = p if self._p_filt is None else a * self._p_filt + (1 - a) * p
         return power_weight(self._p_filt, self.gains.rated_power, self.gains.weight_range)
 

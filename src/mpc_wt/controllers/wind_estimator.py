@@ -11,7 +11,13 @@ R_p = R cos(precone) the projected radius and C_P the turbine's steady power coe
 (:func:`linearize.rotor_performance`, a smooth bicubic fit). It measures the rotor speed
 omega; the collective pitch theta and the generator torque Q_g enter as known inputs. So it uses
 measurements alone (rotor speed, pitch, generator torque) and the turbine's design data; it
-starts from the wind that balances the measured torque at the first step.
+starts from the wind that balances the measured torque at the first step. Where that torque is
+not positive (OpenFAST's ServoDyn sends 0 at its first call: it has no torque of a previous
+step yet), it takes the torque schedule's instead, the torque the generator will take once the
+controller acts: K omega^2 with K = 1/2 rho pi R_p^5 C_P* / (lambda*^3 N) from the table's best
+C_P* at lambda*, the rated torque Q_rated = P_rated / (eta omega_g,rated) from rated speed on,
+and a line between them over the last 1 % below rated speed (Jonkman et al. 2009, NREL
+TP-500-38060, section 7.1: regions 2, 2 1/2 and 3).
 
 References
 ----------
@@ -184,6 +190,18 @@ def _ekf_step(tx: np.ndarray, ty: np.ndarray, c: np.ndarray, kx: int, ky: int, k
     p[1, 0], p[1, 1] = n10 - g1 * n00, n11 - g1 * n01
 
 
+def _start_torque(gain: float, rated: float, rated_speed: float, rotor_speed: float) -> float:
+    """The torque schedule at a rotor speed: K omega^2 below 0.99 x rated speed, the rated
+    torque from rated speed on, a line in between (the module's docstring)."""
+    w1 = 0.99 * rated_speed
+    if rotor_speed >= rated_speed:
+        return rated
+    if rotor_speed <= w1:
+        return min(gain * rotor_speed**2, rated)
+    q1 = min(gain * w1**2, rated)
+    return q1 + (rated - q1) * (rotor_speed - w1) / (rated_speed - w1)
+
+
 class WindSpeedEstimator:
     """Extended Kalman filter for the rotor-effective wind speed (module docstring).
 
@@ -230,6 +248,14 @@ class WindSpeedEstimator:
                             (s.torque_model_std / self.inertia) ** 2 * self.dt,
                             s.wind_std_per_sqrt_s**2 * self.dt, s.speed_std**2,
                             *self.wind_range, tsr[0], tsr[-1]])
+        i, j = np.unravel_index(int(np.argmax(table.cp)), table.cp.shape)
+        gain = 0.5 * self.rho * math.pi * self.radius**5 * float(table.cp[i, j]) \
+            / float(tsr[i]) ** 3 / self.gear
+        eta = turbine.drivetrain.generator_efficiency * turbine.drivetrain.gearbox_efficiency
+        rated = op.rated_power / (eta * op.rated_rotor_speed_rad_s * self.gear)
+        #: the first step's torque schedule where none is measured: K [N m s^2/rad^2] on the
+        #: rotor speed, rated torque [N m], rated rotor speed [rad/s]
+        self.start_torque = (gain, rated, op.rated_rotor_speed_rad_s)
         self.reset()
 
     def reset(self) -> None:
@@ -303,7 +329,8 @@ class WindSpeedEstimator:
         pitch : float
             Collective (mean) pitch [rad].
         gen_torque : float
-            Generator torque [N m] (high-speed shaft).
+            Generator torque [N m] (high-speed shaft); at the first step, not positive: none
+            measured (:attr:`start_torque` instead).
 
         Returns
         -------
@@ -320,6 +347,8 @@ class WindSpeedEstimator:
             if not math.isfinite(val):
                 raise ValueError(f"measurement {name} must be finite, got {val!r}")
         if self.x is None:
+            if gen_torque <= 0.0:       # none measured yet: the torque schedule's
+                gen_torque = _start_torque(*self.start_torque, rotor_speed)
             self.x = np.array([rotor_speed, self._balance(rotor_speed, pitch, gen_torque)])
         else:
             # predict with the previous step's inputs (held over the step), then correct with

@@ -255,7 +255,7 @@ def windest_entries(est: Any, prefix: str) -> list[tuple[str, Any, str]]:
         Key, value (a number or an array) and its meaning, in the input file's order.
     """
     tx, ty, c, kx, ky = est._spline
-    k = np.concatenate([est._k, [est.settings.speed_std ** 2, 1.0]])
+    k = np.concatenate([est._k, [est.settings.speed_std ** 2, 1.0], est.start_torque])
     return [
         (prefix + "spline_degrees", np.array([kx, ky], float), "C_P spline degrees"),
         (prefix + "spline_tx", np.asarray(tx, float), "C_P spline knots in tip-speed ratio"),
@@ -264,7 +264,9 @@ def windest_entries(est: Any, prefix: str) -> list[tuple[str, Any, str]]:
         (prefix + "constants", k,
          "radius [m], air density [kg/m^3], gearbox ratio, inertia [kg m^2], dt [s], process "
          "noise of speed and wind, speed noise, wind range [m/s], tip-speed ratio range, "
-         "initial variances of speed and wind"),
+         "initial variances of speed and wind, the torque schedule of the first step where "
+         "no torque is measured (K [N m s^2/rad^2] on the rotor speed, rated torque [N m], "
+         "rated rotor speed [rad/s])"),
     ]
 
 

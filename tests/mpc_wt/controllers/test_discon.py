@@ -63,7 +63,7 @@ def test_swap_array_records_as_the_interface_defines(probe, tmp_path, turbine) -
     idx = np.arange(40) * 2                                     # controller samples in res.t
     np.testing.assert_allclose(r(2)[:-1], res.t[idx], atol=1e-6)
     assert np.all(r(3) == np.float32(0.025))
-    for k, ch in ((20, "gen_speed"), (21, "rotor_speed"), (15, "gen_power"),
+    for k, ch in ((20, "gen_speed"), (21, "rotor_speed"),
                   (14, "aero_power"), (60, "azimuth"), (53, "tower_fa_acceleration"),
                   (54, "tower_ss_acceleration"), (109, "lss_torque"), (110, "thrust")):
         np.testing.assert_allclose(r(k)[:-1], res.channel(ch)[idx], rtol=2e-6, atol=1e-5,
@@ -72,6 +72,13 @@ def test_swap_array_records_as_the_interface_defines(probe, tmp_path, turbine) -
                   (31, "flap_moment_2"), (32, "flap_moment_3"), (69, "edge_moment_1"),
                   (70, "edge_moment_2"), (71, "edge_moment_3")):
         np.testing.assert_allclose(r(k)[:-1], res.channel(ch)[idx], rtol=2e-6, atol=1e-5,
+                                   err_msg=f"record {k} ({ch})")
+    # ServoDyn's first call (BladedInterface.f90, Fill_avrSWAP; ServoDyn.f90's initialization):
+    # electrical power and generator torque are the previous step's, so 0; the demanded pitch
+    # is the initial pitch
+    assert r(15)[0] == 0.0 and r(23)[0] == 0.0 and r(11)[0] == r(4)[0]
+    for k, ch in ((15, "gen_power"), (23, "gen_torque")):
+        np.testing.assert_allclose(r(k)[1:-1], res.channel(ch)[idx[1:]], rtol=2e-6, atol=1e-5,
                                    err_msg=f"record {k} ({ch})")
     np.testing.assert_allclose(r(27)[:-1], 18.0, rtol=1e-7)             # hub wind, free
     tb = turbine

@@ -78,9 +78,11 @@ int mw_ibc_step(mw_ibc *b, const mw_meas *m, double dt, const double *pc, double
                "electrical power (15) are not finite at t = %g s", m->t);
         return -1;
     }
-    b->p_filt = b->has_p ? b->p_alpha * b->p_filt + (1.0 - b->p_alpha) * m->gen_power
-                         : m->gen_power;
-    b->has_p = 1;
+    if (b->has_p || m->gen_power > 0.0) {  /* no power yet (ServoDyn's first call): no seed */
+        b->p_filt = b->has_p ? b->p_alpha * b->p_filt + (1.0 - b->p_alpha) * m->gen_power
+                             : m->gen_power;
+        b->has_p = 1;
+    }
     w = dmin(dmax((b->p_filt / b->rated - b->w_lo) / (b->w_hi - b->w_lo), 0.0), 1.0);
     k = mw_interp((pc[0] + pc[1] + pc[2]) / 3.0, b->gp, b->gg, b->ng);
     mw_sos_step(&b->hp, m->flap, hp);

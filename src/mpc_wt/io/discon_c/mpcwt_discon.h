@@ -178,6 +178,7 @@ typedef struct {
     int ntx, nty, kx, ky;
     double radius, rho, gear, inertia, dt, q0, q1, r, vmin, vmax, tsr0, tsr1;
     double p0_speed, p0_wind;
+    double start_gain, start_rated, start_speed;   /* the first torque where none is measured */
     double x[2], p[4], u[2];
     int started;
 } mw_windest;

@@ -148,10 +148,10 @@ static double brent(const mw_windest *e, double w, double pitch, double tq, doub
 
 int mw_windest_read(const mw_input *in, const char *pre, mw_windest *e, char *msg)
 {
-    double deg[2], k[14];
+    double deg[2], k[17];
     memset(e, 0, sizeof(*e));
     if (mw_getp_vec(in, pre, "spline_degrees", deg, 2, msg)
-        || mw_getp_vec(in, pre, "constants", k, 14, msg))
+        || mw_getp_vec(in, pre, "constants", k, 17, msg))
         return -1;
     e->kx = (int)deg[0];
     e->ky = (int)deg[1];
@@ -187,6 +187,9 @@ int mw_windest_read(const mw_input *in, const char *pre, mw_windest *e, char *ms
     e->tsr1 = k[11];
     e->p0_speed = k[12];
     e->p0_wind = k[13];
+    e->start_gain = k[14];
+    e->start_rated = k[15];
+    e->start_speed = k[16];
     mw_windest_reset(e);
     return 0;
 }
@@ -208,12 +211,25 @@ void mw_windest_reset(mw_windest *e)
     e->u[0] = e->u[1] = 0.0;
 }
 
+/* the torque schedule at a rotor speed: K w^2 below 0.99 x rated speed, the rated torque from
+ * rated speed on, a line in between (wind_estimator.py's _start_torque) */
+static double start_torque(const mw_windest *e, double w)
+{
+    double w1 = 0.99 * e->start_speed, q1;
+    if (w >= e->start_speed) return e->start_rated;
+    if (w <= w1) return dmin(e->start_gain * w * w, e->start_rated);
+    q1 = dmin(e->start_gain * w1 * w1, e->start_rated);
+    return q1 + (e->start_rated - q1) * (w - w1) / (e->start_speed - w1);
+}
+
 double mw_windest_step(mw_windest *e, double rotor_speed, double pitch, double gen_torque)
 {
     if (!e->started) {
-        double lo = e->vmin, hi = e->vmax;
-        double a = residual(e, lo, rotor_speed, pitch, gen_torque);
-        double b = residual(e, hi, rotor_speed, pitch, gen_torque);
+        double lo = e->vmin, hi = e->vmax, a, b;
+        if (gen_torque <= 0.0)      /* none measured yet (ServoDyn's first call) */
+            gen_torque = start_torque(e, rotor_speed);
+        a = residual(e, lo, rotor_speed, pitch, gen_torque);
+        b = residual(e, hi, rotor_speed, pitch, gen_torque);
         e->x[0] = rotor_speed;
         if (a * b < 0.0)
             e->x[1] = brent(e, rotor_speed, pitch, gen_torque, lo, hi, a, b, 1e-6);
