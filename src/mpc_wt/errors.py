@@ -8,7 +8,7 @@ from linearize import SimulationDivergedError
 __all__ = ["RunTooLargeError", "UsageError", "OptionsError", "SpecError", "CampaignLockedError", "CampaignIndexError",
            "GainTableError", "ResultFileError", "PremiseError", "SynthesisError",
            "SimulationDivergedError", "QPSetupError", "ControllerLibraryError", "SolverSourceError", "TrialFailed",
-           "CaseDataError"]
+           "CaseDataError", "OpenFASTRunError"]
 
 
 class UsageError(ValueError):
@@ -91,6 +91,23 @@ class SolverSourceError(ControllerLibraryError):
     """The C sources of a QP solver that an export needs cannot be had: not in the cache and
     not downloadable, or an archive whose digest is not the recorded one. The message gives the
     command that fixes it."""
+
+
+class OpenFASTRunError(RuntimeError):
+    """OpenFAST could not be found, or did not finish: the message says which, with OpenFAST's
+    last lines where it ran.
+
+    Parameters
+    ----------
+    message : str
+        What was tried, or OpenFAST's last lines.
+    ran : bool
+        Whether OpenFAST was started (False: no executable found).
+    """
+
+    def __init__(self, message: str, ran: bool = True) -> None:
+        super().__init__(message)
+        self.ran = ran
 
 
 class TrialFailed(RuntimeError):

@@ -3,7 +3,7 @@ from __future__ import annotations
 
 import math
 from pathlib import Path
-from typing import Any, Sequence
+from typing import Any, Mapping, Sequence
 
 import numpy as np
 
@@ -11,7 +11,7 @@ from linearize import OperatingPoint
 
 __all__ = ["plot_lidar_evaluation", "plot_cp_surface", "plot_operating_schedule", "plot_lidar_coherence",
            "plot_scan_pattern", "plot_cs_ellipses", "plot_psd_comparison", "plot_design",
-           "assess_plots", "plot_pareto", "plot_wind_condition"]
+           "assess_plots", "plot_pareto", "plot_wind_condition", "plot_verify"]
 
 
 def save_figure(fig, path: str | Path) -> Path:  # type: ignore[no-untyped-def]
@@ -728,4 +728,52 @@ def plot_psd_grid(panels: Sequence[tuple[str, str, Sequence[tuple[str, np.ndarra
     if title:
         fig.suptitle(title, fontsize=10)
     fig.tight_layout()
+    return save_figure(fig, path)
+
+
+#: the channels :func:`plot_verify` draws: name, axis label, scale (SI value / scale)
+_VERIFY_PANELS = (("gen_power", "generator power [MW]", 1e6),
+                  ("rotor_speed", "rotor speed [rpm]", math.pi / 30),
+                  ("pitch_1", "blade 1 pitch [deg]", math.pi / 180),
+                  ("gen_torque", "generator torque [kN m]", 1e3),
+                  ("flap_moment_1", "blade 1 out-of-plane root moment [MN m]", 1e6),
+                  ("tower_base_fa_moment", "tower base fore-aft moment [MN m]", 1e6))
+
+
+def plot_verify(t_ref: np.ndarray, ref: Mapping[str, np.ndarray], t: np.ndarray,
+                ours: Mapping[str, np.ndarray], path: str | Path, title: str = "") -> Path:
+    """OpenFAST's run and mpc-wt's of the same case, side by side in time: power, rotor
+    speed, pitch, torque, blade root and tower base moments (those both runs have).
+
+    Parameters
+    ----------
+    t_ref, t : ndarray
+        The runs' times [s] (OpenFAST's, mpc-wt's).
+    ref, ours : mapping of str to ndarray
+        Their channels by mpc-wt's names (SI).
+    path, title
+        The PNG file to write and the figure's title, as :func:`plot_psd_grid` takes them.
+
+    Returns
+    -------
+    Path
+        ``path``, written.
+    """
+    plt = pyplot()
+    panels = [p for p in _VERIFY_PANELS if p[0] in ref and p[0] in ours]
+    rows = max(math.ceil(len(panels) / 2), 1)
+    fig, axs = plt.subplots(rows, 2, figsize=(12.0, 2.6 * rows), dpi=110, squeeze=False,
+                            sharex=True)
+    for ax, (name, label, scale) in zip(axs.flat, panels):
+        ax.plot(t_ref, np.asarray(ref[name]) / scale, lw=0.8, label="OpenFAST")
+        ax.plot(t, np.asarray(ours[name]) / scale, lw=0.8, label="mpc-wt", alpha=0.85)
+        ax.set_ylabel(label, fontsize=8)
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize=7)
+    for ax in axs[-1]:
+        ax.set_xlabel("time [s]", fontsize=8)
+    for ax in list(axs.flat)[len(panels):]:
+        ax.set_visible(False)
+    if title:
+        fig.suptitle(title, fontsize=10)
     return save_figure(fig, path)

@@ -1,10 +1,12 @@
 """One closed-loop run from a controller name: trim, build, wind, simulate (STYLE rule 12)."""
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import logging
+import re
 from pathlib import Path
-from typing import Any, Mapping, Sequence
+from typing import Any, Iterator, Mapping, Sequence
 
 import numpy as np
 from threadpoolctl import threadpool_limits
@@ -22,7 +24,8 @@ from mpc_wt.simulation.scenario import (DEFAULT_FIELDS, FieldMemo, Scenario, lid
                                        make_wind, start_wind)
 
 __all__ = ["run_controller", "build_controller", "design_controller", "export_discon",
-           "run_openfast_case", "run_warnings", "CASE_CONTROLLERS", "VALIDITY_SIGNALS"]
+           "run_openfast_case", "run_warnings", "verify_openfast", "CASE_CONTROLLERS",
+           "VALIDITY_SIGNALS", "VERIFY_BOUNDS"]
 
 log = logging.getLogger(__name__)
 
@@ -512,6 +515,20 @@ def export_saved_design(doc: Mapping[str, Any], turbine: linearize.Turbine, out:
 CASE_CONTROLLERS = ("auto", "jonkman", "rosco", "discon")
 
 
+def _case_interval(case: Any, dt: float) -> float:
+    """The interval a case's ServoDyn calls its library at, on the plant's step ``dt``: its
+    ``DLL_DT`` where that is a whole number of steps (the MPC's 0.1 s), else every step (a
+    ``DLL_DT`` of OpenFAST's own 0.00625 s step runs at the plant's)."""
+    dll = case.dll_dt
+    if dll is None or dll <= dt * (1 + 1e-9):
+        return dt
+    n = round(dll / dt)
+    if abs(n * dt - dll) > 1e-9 * dll:
+        raise ValueError(f"ServoDyn's DLL_DT = {dll:g} s is not a whole number of the plant's "
+                         f"{dt:g} s steps; pass another dt")
+    return n * dt
+
+
 def run_openfast_case(case: Any, controller: str = "auto", *, library: str | Path | None = None,
                       discon_in: str | Path | None = None, config: Any = None,
                       dt: float = 1.0 / 80.0, progress: bool = False) -> ClosedLoopResult:
@@ -568,7 +585,9 @@ def run_openfast_case(case: Any, controller: str = "auto", *, library: str | Pat
         if lib is None or dis is None:
             raise ValueError(f"controller {controller!r} needs a library and a controller input "
                              f"file (library={library!r}, discon_in={dis!r})")
-        ctl = DisconController(lib, dis, turbine, dt=dt, pitch_control="collective")
+        ctl = DisconController(lib, dis, turbine, dt=_case_interval(case, dt),
+                               pitch_control="individual" if case.individual_pitch
+                               else "collective")
     wind, shift = case_grid_wind(case)
     params = linearize.plant_params(turbine, config or case.config)
     x0 = case.x0.copy()
@@ -580,4 +599,159 @@ def run_openfast_case(case: Any, controller: str = "auto", *, library: str | Pat
     meta = {"controller": controller, "openfast_case": describe(case),
             "wind_shift_s": shift, "turbine": turbine.name}
     return simulate_closed_loop(params, ctl, wind, case.duration, x0=x0, u0=u0, dt=dt,
-                                progress=progress, meta=meta)
+                                controller_dt=getattr(ctl, "dt", dt), progress=progress,
+                                meta=meta)
+
+
+#: what :func:`verify_openfast` flags: (row key, channel, bound, what it is), a difference of
+#: mpc-wt's run from OpenFAST's beyond the bound is flagged
+VERIFY_BOUNDS = (("mean_diff_pct", "gen_power", 1.0, "mean power [%]"),
+                 ("mean_diff_pct", "rotor_speed", 1.0, "mean rotor speed [%]"),
+                 ("std_diff_pct", "rotor_speed", 10.0, "rotor speed std [%]"),
+                 ("del_diff_pct", "flapwise_moment_1", 10.0, "blade 1 flapwise DEL [%]"),
+                 ("del_diff_pct", "flap_moment_1", 10.0, "blade 1 out-of-plane DEL [%]"),
+                 ("del_diff_pct", "lss_torque", 10.0, "shaft torque DEL [%]"),
+                 ("del_diff_pct", "tower_base_fa_moment", 10.0, "tower base fore-aft DEL [%]"),
+                 ("del_diff_pct", "tower_base_ss_moment", 10.0, "tower base side-side DEL [%]"))
+
+
+def _reads_lidar(input_file: Path) -> bool:
+    """Whether an exported library's input file turns on a LIDAR (the feedforward or the MPC's
+    preview)."""
+    return re.search(r"^(feedforward|lidar_preview)\s+1\b", input_file.read_text(),
+                     re.M) is not None
+
+
+def _verify_flags(rows: list[dict[str, Any]], travel: tuple[float, float],
+                  rated: float) -> list[str]:
+    """The differences beyond :data:`VERIFY_BOUNDS`, the largest power's beyond 2 % of rated,
+    pitch travel's beyond 10 %, and OpenFAST's largest power above 1.1 x rated."""
+    by = {r["channel"]: r for r in rows}
+    flags = []
+    for key, ch, bound, what in VERIFY_BOUNDS:
+        v = by.get(ch, {}).get(key)
+        if v is not None and not abs(v) <= bound:
+            flags.append(f"{what}: {v:+.2f} (bound {bound:g})")
+    p = by.get("gen_power")
+    if p is not None:
+        d = 100.0 * (p["max"] - p["max_ref"]) / rated
+        if not abs(d) <= 2.0:
+            flags.append(f"largest power: {d:+.2f} % of rated (bound 2)")
+        if p["max_ref"] > 1.1 * rated:
+            flags.append(f"OpenFAST's largest power {p['max_ref'] / rated:.3f} x rated (> 1.1)")
+    if travel[0] > 0 and not abs(100.0 * (travel[1] / travel[0] - 1.0)) <= 10.0:
+        flags.append(f"pitch travel: {100.0 * (travel[1] / travel[0] - 1.0):+.1f} % (bound 10)")
+    return flags
+
+
+def _pitch_travel(t: np.ndarray, pitch: np.ndarray, window: tuple[float, float]) -> float:
+    """Blade 1's pitch travel over the window [deg]."""
+    k = (t >= window[0]) & (t <= window[1])
+    return float(np.degrees(np.abs(np.diff(np.asarray(pitch, float)[k])).sum()))
+
+
+def verify_openfast(turbine: linearize.Turbine, controller: str, fst: str | Path,
+                    out: str | Path, options: Mapping[str, Any] | None = None, *,
+                    openfast: str | Path | None = None, tmax: float | None = None,
+                    window: tuple[float, float | None] = (10.0, None),
+                    progress: bool = False) -> dict[str, Any]:
+    """Prove a design in the user's OpenFAST: export it, run OpenFAST on the user's deck with
+    it, run the same case on mpc-wt's plant, compare them channel by channel and flag every
+    difference beyond :data:`VERIFY_BOUNDS` (and the largest power beyond 2 % of rated, pitch
+    travel beyond 10 %, OpenFAST's largest power above 1.1 x rated).
+
+    Parameters
+    ----------
+    turbine : Turbine
+        The turbine the design is for (the deck's).
+    controller : str
+        An exportable kind (:func:`mpc_wt.registry.exportable`).
+    fst : str or Path
+        The user's deck (its main file); it is not written to.
+    out : str or Path
+        The folder for the library (``library/``), the deck's copies and OpenFAST's output
+        (``openfast/``), mpc-wt's run (``ours.nc``), ``verify.json`` and ``verify.png``.
+    options : mapping, optional
+        The kind's options (:func:`design_controller`'s).
+    openfast : str or Path, optional
+        The OpenFAST executable (else ``$MPCWT_OPENFAST``, else ``openfast`` on ``PATH``).
+    tmax : float, optional
+        The run's length [s] in place of the deck's ``TMax``.
+    window : (float, float or None)
+        The statistics' window [s] (None: to the end).
+    progress : bool
+        Show progress bars (OpenFAST's simulated time, then mpc-wt's run).
+
+    Returns
+    -------
+    dict
+        ``rows`` (:func:`mpc_wt.assessment.compare.compare_series`, OpenFAST the reference),
+        ``pitch_travel_deg`` (OpenFAST, mpc-wt), ``flags``, ``window_s``, ``files``.
+
+    Raises
+    ------
+    OpenFASTRunError
+        No OpenFAST executable, or OpenFAST did not finish (its last lines in the message).
+    ValueError
+        A kind that does not export, or a LIDAR kind (OpenFAST v5's InflowWind gives no
+        hub-mounted CW LIDAR's beams).
+    """
+    from mpc_wt.assessment.compare import compare_series
+    from mpc_wt.io.json_text import write_json
+    from mpc_wt.io.openfast_case import read_openfast_case
+    from mpc_wt.io.openfast_run import find_openfast, prepare_deck
+    from mpc_wt.plotting import plot_verify
+
+    exe = find_openfast(openfast)
+    out = Path(out)
+    ex = export_discon(turbine, controller, out / "library", options)
+    if _reads_lidar(ex.input_file):
+        raise ValueError(f"controller {controller!r} reads a LIDAR; OpenFAST v5's InflowWind "
+                         f"gives no hub-mounted CW LIDAR's beams: verify it without the LIDAR")
+    deck = prepare_deck(fst, out / "openfast", ex.library, ex.input_file, ex.dt, tmax=tmax)
+    of_path, of, ref = _openfast_run(exe, deck, tmax, progress)
+    case = read_openfast_case(deck, turbine=turbine)
+    res = run_openfast_case(case, "discon", library=ex.library, discon_in=ex.input_file,
+                            progress=progress)
+    ours = {n: res.channel(n) for n in res.channels()}
+    hi = window[1] if window[1] is not None else float(min(of.t[-1], res.t[-1]))
+    rows = compare_series(of.t, ref, res.t, ours, (window[0], hi))
+    travel = (_pitch_travel(of.t, ref["pitch_1"], (window[0], hi)),
+              _pitch_travel(res.t, ours["pitch_1"], (window[0], hi)))
+    flags = _verify_flags(rows, travel, turbine.operation.rated_power)
+    res.save(out / "ours.nc")
+    png = plot_verify(of.t, ref, res.t, ours, out / "verify.png",
+                      f"{controller} in {Path(fst).name}: OpenFAST and mpc-wt")
+    doc = {"controller": controller, "deck": str(Path(fst).resolve()), "openfast": str(exe),
+           "window_s": [window[0], hi], "rows": rows, "pitch_travel_deg": list(travel),
+           "flags": flags, "files": {"library": str(ex.library), "openfast_output": str(of_path),
+                                     "ours": str(out / "ours.nc"), "plot": str(png)}}
+    write_json(out / "verify.json", doc)
+    return doc
+
+
+def _openfast_run(exe: Path, deck: Path, tmax: float | None, progress: bool
+                  ) -> tuple[Path, Any, dict[str, np.ndarray]]:
+    """OpenFAST on a prepared deck: its output file, the series read and its channels by
+    mpc-wt's names."""
+    from mpc_wt.io.openfast_output import read_openfast_output, to_mpcwt_channels
+    from mpc_wt.io.openfast_run import run_openfast
+
+    with _time_bar(progress, "OpenFAST", tmax) as tick:
+        path = run_openfast(exe, deck, progress=tick)
+    series = read_openfast_output(path)
+    return path, series, to_mpcwt_channels(series, str(path))[0]
+
+
+@contextlib.contextmanager
+def _time_bar(show: bool, what: str, total: float | None) -> Iterator[Any]:
+    """A progress bar over a run's simulated time (a callable taking it), or a no-op."""
+    if not show:
+        yield None
+        return
+    from tqdm import tqdm
+
+    with tqdm(total=total, desc=what, unit="s") as bar:
+        def tick(t: float) -> None:
+            bar.update(max(t - bar.n, 0.0))
+        yield tick

@@ -219,7 +219,7 @@ LAYOUT = {
     "simulation": {"scenario", "loop", "compiled", "results", "preview", "solver_timing", "memory"},
     "assessment": {"fatigue", "performance", "series", "ultimate", "lidar", "compare"},
     "io": {"gain_tables", "rosco", "openfast_output", "discon_export", "openfast_case",
-           "json_text", "solver_sources"},
+           "json_text", "solver_sources", "openfast_run"},
 }
 
 

@@ -7,9 +7,7 @@ checkout; skipped without one) on its regression case ``5MW_Land_DLL_WTurb``."""
 from __future__ import annotations
 
 import os
-import re
 import shutil
-import subprocess
 from pathlib import Path
 
 import numpy as np
@@ -17,6 +15,8 @@ import pytest
 
 import linearize
 from mpc_wt.io.discon_export import find_compiler
+from mpc_wt.io.openfast_output import read_openfast_output
+from mpc_wt.io.openfast_run import prepare_deck, run_openfast
 from mpc_wt.run import export_discon, run_controller
 
 _SHARED = Path(__file__).resolve().parents[3] / "shared"
@@ -48,24 +48,10 @@ def test_the_schedule_starts_at_the_wind_of_the_torque_schedule(kind, wind):
 
 
 def _run_openfast(exe: str, lib, work: Path, tmax: float) -> dict[str, np.ndarray]:
-    shutil.copytree(_CASE / "5MW_Land_DLL_WTurb_v5", work / "case")
-    for d in ("5MW_Baseline", "wind"):
-        shutil.copytree(_CASE / d, work / d)
-    sd = work / "case" / "NRELOffshrBsline5MW_Onshore_ServoDyn.dat"
-    text = sd.read_text()
-    text = text.replace('"../5MW_Baseline/ServoData/DISCON.dll"', f'"{lib.library}"')
-    text = text.replace('"DISCON.IN"    DLL_InFile', f'"{lib.input_file}"    DLL_InFile')
-    text = text.replace('"default"     DLL_DT', f'{lib.dt}     DLL_DT')
-    sd.write_text(text)
-    fst = work / "case" / "5MW_Land_DLL_WTurb.fst"
-    text = re.sub(r"^\s*60\s+TMax", f"{tmax:g}   TMax", fst.read_text(), flags=re.M)
-    fst.write_text(re.sub(r"^\s*2\s+OutFileFmt", "1   OutFileFmt", text, flags=re.M))
-    run = subprocess.run([exe, str(fst)], capture_output=True, text=True, cwd=work / "case",
-                         timeout=600)
-    assert run.returncode == 0, run.stdout[-2000:]
-    lines = (work / "case" / "5MW_Land_DLL_WTurb.out").read_text().splitlines()
-    data = np.array([[float(v) for v in ln.split()] for ln in lines[8:]])
-    return {h: data[:, i] for i, h in enumerate(lines[6].split())}
+    deck = prepare_deck(_CASE / "5MW_Land_DLL_WTurb_v5" / "5MW_Land_DLL_WTurb.fst", work,
+                        lib.library, lib.input_file, lib.dt, tmax=tmax)
+    s = read_openfast_output(run_openfast(exe, deck))
+    return {"Time": s.t, **{n: s.data[:, i] for i, n in enumerate(s.names)}}
 
 
 @pytest.mark.skipif(_openfast() is None or find_compiler() is None or not _CASE.is_dir(),

@@ -63,7 +63,7 @@ def compare_series(t_ref: np.ndarray, ref: Mapping[str, np.ndarray], t: np.ndarr
     -------
     list of dict
         Per channel: ``channel``, ``mean_ref``, ``mean``, ``mean_diff_pct``, ``std_ref``,
-        ``std``, ``std_diff_pct``; for load channels (:data:`DEFAULT_CHANNELS` and the
+        ``std``, ``std_diff_pct``, ``max_ref``, ``max`` (the largest values); for load channels (:data:`DEFAULT_CHANNELS` and the
         blade-frame root moments, m = 10, with their Woehler exponent ``m``) also ``del_ref``, ``del``, ``del_diff_pct`` (1 Hz equivalent
         cycles over the window). A mean or DEL difference of a reference of zero is NaN.
 
@@ -85,7 +85,8 @@ def compare_series(t_ref: np.ndarray, ref: Mapping[str, np.ndarray], t: np.ndarr
     for c in names:
         a, b = np.asarray(ref[c], float)[kr], np.asarray(ours[c], float)[ko]
         row: dict[str, Any] = {"channel": c, "mean_ref": float(a.mean()), "mean": float(b.mean()),
-                               "std_ref": float(a.std()), "std": float(b.std())}
+                               "std_ref": float(a.std()), "std": float(b.std()),
+                               "max_ref": float(a.max()), "max": float(b.max())}
         row["mean_diff_pct"] = _pct(row["mean_ref"], row["mean"])
         row["std_diff_pct"] = _pct(row["std_ref"], row["std"])
         m = _BLADE_FRAME_M if c.startswith(("flapwise_", "edgewise_")) else \

@@ -1,5 +1,7 @@
 """``mpcwt compare-openfast``: an OpenFAST run reproduced on mpc-wt's plant and compared with
-it, channel by channel (means, standard deviations, DELs) with PSD overlays.
+it, channel by channel (means, standard deviations, DELs) with PSD overlays. ``mpcwt
+verify-openfast``: a design exported, run in the user's OpenFAST on the user's deck and on
+mpc-wt's plant, compared and its differences beyond stated bounds flagged.
 """
 from __future__ import annotations
 
@@ -11,7 +13,7 @@ from typing import Any
 import numpy as np
 
 import linearize
-from mpc_wt.cli.common import check_out_folder, to_json
+from mpc_wt.cli.common import check_out_folder, pairs, to_json
 from mpc_wt.errors import UsageError
 
 __all__ = ["add_parsers"]
@@ -59,6 +61,79 @@ def add_parsers(sub: Any) -> None:
                    help="folder for comparison.json, psd.png and our run (ours.nc)")
     p.add_argument("--json", action="store_true", help="print the rows as JSON")
     p.set_defaults(func=_compare)
+    _add_verify(sub)
+
+
+def _add_verify(sub: Any) -> None:
+    from mpc_wt.io.openfast_run import OPENFAST_ENV
+    from mpc_wt.run import VERIFY_BOUNDS
+
+    bounds = ", ".join(f"{what} {b:g}" for _, _, b, what in VERIFY_BOUNDS)
+    p = sub.add_parser(
+        "verify-openfast",
+        help="export a controller kind, run it in your OpenFAST on your deck and on mpc-wt's "
+             "plant, and flag where they differ",
+        description="Export KIND for the turbine, run OpenFAST on a copy of the deck's main "
+                    "and ServoDyn files pointed at the library (the deck is not written to), "
+                    "run the same case on mpc-wt's plant, print both side by side and flag "
+                    f"each difference beyond its bound ({bounds}; the largest power 2 %% of "
+                    "rated, pitch travel 10 %%, OpenFAST's largest power 1.1 x rated). Exit "
+                    "status 3 when a difference is flagged.")
+    p.add_argument("kind", help="an exportable controller kind (mpcwt controllers lists them)")
+    p.add_argument("fst", help="the deck's main file (.fst)")
+    p.add_argument("--turbine", default="nrel5mw",
+                   help="turbine name or file the design is for (default nrel5mw)")
+    p.add_argument("--openfast", default=None,
+                   help=f"the OpenFAST executable (default ${OPENFAST_ENV}, else openfast on "
+                        "PATH)")
+    p.add_argument("--tmax", type=float, default=None, help="run length [s] (default the "
+                                                             "deck's TMax)")
+    p.add_argument("--window", nargs=2, type=float, default=None, metavar=("FROM", "TO"),
+                   help="statistics window [s] (default: 10 s to the end)")
+    p.add_argument("--option", action="append", metavar="NAME=VALUE",
+                   help="an option of the kind (repeatable; YAML values)")
+    p.add_argument("--out", required=True, help="folder for the library, OpenFAST's run, "
+                                               "ours.nc, verify.json and verify.png")
+    p.add_argument("--json", action="store_true", help="print verify.json")
+    p.set_defaults(func=_verify)
+
+
+def _verify(args: argparse.Namespace) -> int:
+    from mpc_wt.run import verify_openfast
+
+    check_out_folder("--out", args.out)
+    if not Path(args.fst).is_file():
+        raise UsageError(f"fst: {args.fst} does not exist")
+    if args.tmax is not None and not args.tmax > 0:
+        raise UsageError(f"--tmax must be > 0 s, got {args.tmax:g}")
+    turbine = linearize.load_turbine(args.turbine)
+    window = tuple(args.window) if args.window else (10.0, None)
+    doc = verify_openfast(turbine, args.kind, args.fst, args.out,
+                          pairs(args.option, "--option") or None, openfast=args.openfast,
+                          tmax=args.tmax, window=window, progress=True)
+    if args.json:
+        print(to_json(doc))
+    else:
+        print(_verify_table(doc))
+    return 3 if doc["flags"] else 0
+
+
+def _verify_table(doc: dict[str, Any]) -> str:
+    w = doc["window_s"]
+    lines = [f"{doc['controller']} in OpenFAST ({doc['openfast']}) and on mpc-wt's plant, "
+             f"{w[0]:g}-{w[1]:g} s",
+             f"{'channel':24s} {'mean OF':>11s} {'mpc-wt':>11s} {'d%':>7s} {'std d%':>7s} "
+             f"{'max OF':>11s} {'mpc-wt':>11s} {'DEL d%':>7s}"]
+    for r in doc["rows"]:
+        d = f"{r['del_diff_pct']:7.1f}" if "del_diff_pct" in r else f"{'':7s}"
+        lines.append(f"{r['channel']:24s} {r['mean_ref']:11.5g} {r['mean']:11.5g} "
+                     f"{r['mean_diff_pct']:7.2f} {r['std_diff_pct']:7.1f} {r['max_ref']:11.5g} "
+                     f"{r['max']:11.5g} {d}")
+    a, b = doc["pitch_travel_deg"]
+    lines.append(f"pitch travel (blade 1): OpenFAST {a:.1f} deg, mpc-wt {b:.1f} deg")
+    lines += ([f"FLAG {f}" for f in doc["flags"]] or ["no difference beyond its bound"])
+    lines.append(f"wrote {doc['files']['plot']}, {Path(doc['files']['plot']).with_name('verify.json')}")
+    return "\n".join(lines)
 
 
 def _compare(args: argparse.Namespace) -> int:

@@ -19,6 +19,8 @@ tune         design parameters optimized over load cases: ``tune SPEC.yaml --out
 bench        ``bench mpc``: QP solver comparison
 compare-openfast  an OpenFAST case run on mpc-wt's plant, compared with its output:
              ``compare-openfast CASE.fst --outb CASE.outb [--wind FILE.bts]``
+verify-openfast  a kind exported and run in your OpenFAST and on mpc-wt's plant, differences
+             flagged: ``verify-openfast KIND CASE.fst --out DIR [--openfast PATH]``
 solver       the exported MPC's QP solver sources: ``solver fetch [--from FILE]``, ``status``
 
 ``--plugin MODULE`` (before the subcommand, repeatable) imports a module that registers
@@ -36,7 +38,8 @@ from typing import Sequence
 
 import linearize
 from mpc_wt.cli import campaign, compare, design, runs, solver, steady, wind
-from mpc_wt.errors import CampaignLockedError, ControllerLibraryError, UsageError
+from mpc_wt.errors import (CampaignLockedError, ControllerLibraryError, OpenFASTRunError,
+                           UsageError)
 
 __all__ = ["main", "build_parser"]
 
@@ -124,6 +127,10 @@ def main(argv: Sequence[str] | None = None) -> int:
             return 2                          # the library could not be loaded: input
         print(f"mpcwt {args.command}: run failed: {err}", file=sys.stderr)
         return 1
+    except OpenFASTRunError as err:            # none found: input; it failed: the run
+        print(f"mpcwt {args.command}: {'run failed' if err.ran else 'error'}: {err}",
+              file=sys.stderr)
+        return 1 if err.ran else 2
     except _ERRORS as err:
         print(f"mpcwt {args.command}: error: {err}", file=sys.stderr)
         return 2

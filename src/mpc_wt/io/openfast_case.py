@@ -55,6 +55,12 @@ class OpenFASTCase:
     steady_wind : (float, float) or None
         InflowWind's steady wind (``WindType = 1``): ``HWindSpeed`` [m/s] and ``PLExp`` [-],
         when the case runs in one (then ``wind_file`` is None).
+    dll_dt : float or None
+        ServoDyn's ``DLL_DT`` [s], the interval ServoDyn calls a library at (``default``:
+        the main file's ``DT``); None without a ServoDyn file.
+    individual_pitch : bool
+        ServoDyn's ``Ptch_Cntrl`` is 1: a library's individual pitch demands (records 42-44)
+        apply, else its collective one (record 45).
     """
 
     fst: Path
@@ -66,6 +72,8 @@ class OpenFASTCase:
     discon_in: Path | None = None
     notes: tuple[str, ...] = field(default_factory=tuple)
     steady_wind: tuple[float, float] | None = None
+    dll_dt: float | None = None
+    individual_pitch: bool = False
 
 
 def _flag(f: OpenFASTFile, key: str, default: bool) -> bool:
@@ -159,12 +167,27 @@ def read_openfast_case(fst: str | Path, *, wind: str | Path | None = None,
         for key in ("FlapDOF2", "TwFADOF2", "TwSSDOF2", "YawDOF"):
             if _flag(ed, key, False):
                 notes.append(f"ElastoDyn {key} is on; the plant has no such DOF")
+        dll_dt, ipc = _bladed_interface(main, srv)
         return OpenFASTCase(fst=fst, turbine=turbine, wind_file=wind_file,
                             duration=main.number("TMax", 0.0, 1e7),
                             x0=_initial_state(ed, turbine), config=cfg, discon_in=discon,
-                            notes=tuple(notes), steady_wind=steady)
+                            notes=tuple(notes), steady_wind=steady, dll_dt=dll_dt,
+                            individual_pitch=ipc)
     except linearize.TurbineFileError as err:
         raise ResultFileError(str(err)) from None
+
+
+def _bladed_interface(main: OpenFASTFile, srv: OpenFASTFile | None) -> tuple[float | None,
+                                                                             bool]:
+    """ServoDyn's ``DLL_DT`` (``default``: ServoDyn's ``DT``, whose ``default`` is the main
+    file's ``DT``) and whether ``Ptch_Cntrl`` is 1; (None, False) without a ServoDyn file."""
+    if srv is None or not srv.has("DLL_DT"):
+        return None, False
+    dt = srv.number("DLL_DT", 0.0) if not srv.is_default("DLL_DT") else \
+        srv.number("DT", 0.0) if srv.has("DT") and not srv.is_default("DT") else \
+        main.number("DT", 0.0)
+    ipc = srv.has("Ptch_Cntrl") and srv.integer("Ptch_Cntrl", 0, 1) == 1
+    return dt, ipc
 
 
 def _skewed_wake(ad: OpenFASTFile) -> bool:

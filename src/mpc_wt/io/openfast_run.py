@@ -1,0 +1,201 @@
+"""Running the user's OpenFAST on a deck with a controller library in it.
+
+mpc-wt ships no OpenFAST: :func:`find_openfast` takes the executable from the caller, from
+``$MPCWT_OPENFAST``, or from ``PATH``, in that order. :func:`prepare_deck` writes a copy of a
+deck's main file and ServoDyn file into a folder of the caller's, with every file they name
+made absolute (the other input files stay where they are, read in place) and ServoDyn's
+Bladed-interface lines pointed at an exported library (``DLL_FileName``, ``DLL_InFile``,
+``DLL_DT``, ``Ptch_Cntrl 1``): the user's deck is never written to. :func:`run_openfast` runs
+it and returns the output file, or raises with OpenFAST's own last lines.
+"""
+from __future__ import annotations
+
+import os
+import re
+import shutil
+import subprocess
+from pathlib import Path
+from typing import Any
+
+from mpc_wt.errors import OpenFASTRunError
+
+__all__ = ["OPENFAST_ENV", "find_openfast", "prepare_deck", "run_openfast"]
+
+#: the environment variable that names the OpenFAST executable
+OPENFAST_ENV = "MPCWT_OPENFAST"
+
+#: a line whose value is a quoted path: ``"path"   KEY  - description``
+_PATH_LINE = re.compile(r'^(\s*)"([^"]*)"(\s+)(\S+)(.*)$')
+#: the keys of file names in a main file and a ServoDyn file (a list of StC files included)
+_FILE_KEY = re.compile(r"(File|files|FileName|InFile)(\(\d\))?$")
+
+
+def find_openfast(path: str | Path | None = None) -> Path:
+    """The OpenFAST executable: ``path``, else ``$MPCWT_OPENFAST``, else ``openfast`` on
+    ``PATH``.
+
+    Parameters
+    ----------
+    path : str or Path, optional
+        Given by the user (an option).
+
+    Returns
+    -------
+    Path
+
+    Raises
+    ------
+    OpenFASTRunError
+        None of them is an executable file (naming what was tried and how to give one).
+    """
+    tried = []
+    for src, cand in (("the given path", path), (f"${OPENFAST_ENV}", os.environ.get(OPENFAST_ENV)),
+                      ("PATH", shutil.which("openfast"))):
+        if not cand:
+            tried.append(f"{src}: not set" if src != "PATH" else "PATH: no 'openfast'")
+            continue
+        p = Path(cand).expanduser()
+        if p.is_file() and os.access(p, os.X_OK):
+            return p.resolve()
+        tried.append(f"{src}: {p} is not an executable file")
+    raise OpenFASTRunError("no OpenFAST executable (" + "; ".join(tried) + "); pass its path "
+                           f"(--openfast PATH) or set {OPENFAST_ENV}", ran=False)
+
+
+def _absolute_paths(text: str, base: Path, keep: dict[str, str]) -> str:
+    """``text`` with every quoted file name of a file key made absolute against ``base``, and
+    the keys in ``keep`` given those values (quoted)."""
+    out = []
+    for line in text.splitlines():
+        m = _PATH_LINE.match(line)
+        if m and (m.group(4) in keep or _FILE_KEY.search(m.group(4))):
+            lead, value, gap, key, rest = m.groups()
+            if key in keep:
+                value = keep[key]
+            elif value.strip().lower() not in ("", "unused", "none") \
+                    and not Path(value).is_absolute():
+                value = str((base / value).resolve())
+            line = f'{lead}"{value}"{gap}{key}{rest}'
+        out.append(line)
+    return "\n".join(out) + "\n"
+
+
+def _set_value(text: str, key: str, value: str) -> str:
+    """``text`` with the value of ``key`` (its first word, quoted or not) replaced."""
+    pat = re.compile(rf'^(\s*)("[^"]*"|\S+)(\s+{re.escape(key)}\b.*)$', re.M)
+    new, n = pat.subn(lambda m: f"{m.group(1)}{value}{m.group(3)}", text, count=1)
+    if n != 1:
+        raise ValueError(f"no line with the key {key!r} in the file")
+    return new
+
+
+def prepare_deck(fst: str | Path, out: str | Path, library: str | Path, input_file: str | Path,
+                 dt: float, *, tmax: float | None = None) -> Path:
+    """A copy of a deck's main file and ServoDyn file in ``out`` that runs ``library``.
+
+    Parameters
+    ----------
+    fst : str or Path
+        The deck's main (``.fst``) file.
+    out : str or Path
+        The folder for the copies and OpenFAST's output (created).
+    library, input_file : str or Path
+        The controller library and its input file.
+    dt : float
+        The library's interval [s] (``DLL_DT``).
+    tmax : float, optional
+        ``TMax`` [s] in place of the deck's.
+
+    Returns
+    -------
+    Path
+        The copy of the main file (OpenFAST writes ``<its stem>.out``/``.outb`` beside it).
+
+    Raises
+    ------
+    FileNotFoundError
+        The main file, its ServoDyn file, the library or its input file is missing.
+    ValueError
+        A main file without ``ServoFile`` or a ServoDyn file without the Bladed-interface keys.
+    """
+    fst = Path(fst).resolve()
+    for what, p in (("deck's main file", fst), ("library", Path(library)),
+                    ("library's input file", Path(input_file))):
+        if not p.is_file():
+            raise FileNotFoundError(f"the {what} {p} does not exist")
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    main = fst.read_text(errors="replace")
+    m = re.search(r'^\s*"([^"]+)"\s+ServoFile\b', main, re.M)
+    if m is None:
+        raise ValueError(f"{fst}: no ServoFile line")
+    srv = (fst.parent / m.group(1)).resolve()
+    if not srv.is_file():
+        raise FileNotFoundError(f"{fst}: its ServoDyn file {srv} does not exist")
+    srv_copy = out / srv.name
+    text = _absolute_paths(srv.read_text(errors="replace"), srv.parent,
+                           {"DLL_FileName": str(Path(library).resolve()),
+                            "DLL_InFile": str(Path(input_file).resolve())})
+    text = _set_value(_set_value(text, "DLL_DT", f"{dt:.10g}"), "Ptch_Cntrl", "1")
+    for key, val in (("PCMode", "5"), ("VSContrl", "5")):
+        text = _set_value(text, key, val)
+    srv_copy.write_text(text)
+    main = _absolute_paths(main, fst.parent, {"ServoFile": str(srv_copy.resolve())})
+    if tmax is not None:
+        main = _set_value(main, "TMax", f"{float(tmax):.10g}")
+    copy = out / fst.name
+    copy.write_text(main)
+    for ext in (".out", ".outb"):          # an earlier run's output is not this run's
+        copy.with_suffix(ext).unlink(missing_ok=True)
+    return copy
+
+
+def run_openfast(exe: str | Path, fst: str | Path, *, timeout: float = 3600.0,
+                 progress: Any = None) -> Path:
+    """Run OpenFAST on a main file and return its output file.
+
+    Parameters
+    ----------
+    exe : str or Path
+        The executable (:func:`find_openfast`).
+    fst : str or Path
+        The main file (:func:`prepare_deck`'s copy); OpenFAST runs in its folder.
+    timeout : float
+        Longest run [s].
+    progress : callable, optional
+        Called with each simulated time OpenFAST reports [s].
+
+    Returns
+    -------
+    Path
+        ``<stem>.outb``, else ``<stem>.out``, beside ``fst``.
+
+    Raises
+    ------
+    OpenFASTRunError
+        It did not finish, timed out or wrote no output; the message holds its last lines.
+    """
+    fst = Path(fst).resolve()
+    log = fst.with_suffix(".log")
+    try:
+        with log.open("w") as fh:
+            proc = subprocess.Popen([str(exe), str(fst)], cwd=fst.parent, stdout=subprocess.PIPE,
+                                    stderr=subprocess.STDOUT, text=True, bufsize=1)
+            assert proc.stdout is not None
+            for line in proc.stdout:
+                fh.write(line)
+                m = re.search(r"Time:\s*([0-9.eE+-]+)\s+of", line)
+                if m and progress is not None:
+                    progress(float(m.group(1)))
+            code = proc.wait(timeout=timeout)
+    except (OSError, subprocess.TimeoutExpired) as err:
+        raise OpenFASTRunError(f"OpenFAST ({exe}) on {fst}: {err}") from err
+    tail = "\n".join(log.read_text(errors="replace").strip().splitlines()[-12:])
+    if code != 0:
+        raise OpenFASTRunError(f"OpenFAST ({exe}) on {fst} stopped (exit {code}); its last "
+                               f"lines (all in {log}):\n{tail}")
+    for ext in (".outb", ".out"):
+        if fst.with_suffix(ext).is_file():
+            return fst.with_suffix(ext)
+    raise OpenFASTRunError(f"OpenFAST ({exe}) on {fst} finished but wrote no output file; its "
+                           f"last lines (all in {log}):\n{tail}")
