@@ -645,9 +645,12 @@ def _verify_flags(rows: list[dict[str, Any]], travel: tuple[float, float],
 
 
 def _pitch_travel(t: np.ndarray, pitch: np.ndarray, window: tuple[float, float]) -> float:
-    """Blade 1's pitch travel over the window [deg]."""
+    """Blade 1's pitch travel over the window [deg]
+    (:func:`~mpc_wt.assessment.performance.pitch_duty`)."""
+    from mpc_wt.assessment.performance import pitch_duty
+
     k = (t >= window[0]) & (t <= window[1])
-    return float(np.degrees(np.abs(np.diff(np.asarray(pitch, float)[k])).sum()))
+    return pitch_duty(np.asarray(pitch, float)[k], 1.0)["pitch_travel_deg"]
 
 
 def verify_openfast(turbine: linearize.Turbine, controller: str, fst: str | Path,

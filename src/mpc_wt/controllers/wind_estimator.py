@@ -251,11 +251,9 @@ class WindSpeedEstimator:
         i, j = np.unravel_index(int(np.argmax(table.cp)), table.cp.shape)
         gain = 0.5 * self.rho * math.pi * self.radius**5 * float(table.cp[i, j]) \
             / float(tsr[i]) ** 3 / self.gear
-        eta = turbine.drivetrain.generator_efficiency * turbine.drivetrain.gearbox_efficiency
-        rated = op.rated_power / (eta * op.rated_rotor_speed_rad_s * self.gear)
         #: the first step's torque schedule where none is measured: K [N m s^2/rad^2] on the
         #: rotor speed, rated torque [N m], rated rotor speed [rad/s]
-        self.start_torque = (gain, rated, op.rated_rotor_speed_rad_s)
+        self.start_torque = (gain, turbine.rated_generator_torque, op.rated_rotor_speed_rad_s)
         self.reset()
 
     def reset(self) -> None:

@@ -5,9 +5,7 @@ one)."""
 from __future__ import annotations
 
 import json
-import os
 import re
-import shutil
 import stat
 from pathlib import Path
 
@@ -20,18 +18,10 @@ from mpc_wt.errors import OpenFASTRunError
 from mpc_wt.io.discon_export import find_compiler
 from mpc_wt.io.openfast_case import read_openfast_case
 from mpc_wt.io.openfast_run import OPENFAST_ENV, find_openfast, prepare_deck, run_openfast
+from openfast_here import SHARED, installed_openfast
 
-_SHARED = Path(__file__).resolve().parents[4] / "shared"
-_V5 = _SHARED / "validation" / "nrel5mw" / "openfast_rtest" / "5MW_Land_DLL_WTurb_v5"
+_V5 = SHARED / "validation" / "nrel5mw" / "openfast_rtest" / "5MW_Land_DLL_WTurb_v5"
 _FST = _V5 / "5MW_Land_DLL_WTurb.fst"
-_BINARY = _SHARED / "tools" / "openfast" / "bin" / "openfast"
-
-
-def _installed() -> str | None:
-    for cand in (os.environ.get(OPENFAST_ENV), shutil.which("openfast"), str(_BINARY)):
-        if cand and Path(cand).is_file() and os.access(cand, os.X_OK):
-            return cand
-    return None
 
 
 def _script(path: Path, body: str) -> Path:
@@ -129,7 +119,7 @@ def test_verify_openfast_without_openfast_exits_2_before_any_work(tmp_path, monk
     assert len(err.splitlines()) == 1 and not (tmp_path / "v").exists()
 
 
-@pytest.mark.skipif(_installed() is None or find_compiler() is None or not _FST.is_file(),
+@pytest.mark.skipif(installed_openfast() is None or find_compiler() is None or not _FST.is_file(),
                     reason="needs OpenFAST ($MPCWT_OPENFAST or openfast on PATH), a C "
                            "compiler and OpenFAST's v5 regression case")
 def test_verify_openfast_on_the_regression_case(tmp_path, capsys):
@@ -138,7 +128,7 @@ def test_verify_openfast_on_the_regression_case(tmp_path, capsys):
     verification's own bounds; over 10-60 s they agree within 0.25 %), the JSON and the plot
     are written, and the table prints each channel."""
     code = main(["verify-openfast", "baseline", str(_FST), "--out", str(tmp_path / "v"),
-                 "--openfast", _installed(), "--tmax", "20", "--window", "5", "20"])
+                 "--openfast", installed_openfast(), "--tmax", "20", "--window", "5", "20"])
     assert code in (0, 3)
     out = capsys.readouterr().out
     assert "gen_power" in out and "pitch travel" in out

@@ -6,8 +6,6 @@ in OpenFAST itself (the binary given by ``$MPCWT_OPENFAST``, on ``PATH``, or the
 checkout; skipped without one) on its regression case ``5MW_Land_DLL_WTurb``."""
 from __future__ import annotations
 
-import os
-import shutil
 from pathlib import Path
 
 import numpy as np
@@ -18,17 +16,9 @@ from mpc_wt.io.discon_export import find_compiler
 from mpc_wt.io.openfast_output import read_openfast_output
 from mpc_wt.io.openfast_run import prepare_deck, run_openfast
 from mpc_wt.run import export_discon, run_controller
+from openfast_here import SHARED, installed_openfast
 
-_SHARED = Path(__file__).resolve().parents[3] / "shared"
-_CASE = _SHARED / "validation" / "nrel5mw" / "openfast_rtest"
-
-
-def _openfast() -> str | None:
-    for cand in (os.environ.get("MPCWT_OPENFAST"), shutil.which("openfast"),
-                 str(_SHARED / "tools" / "openfast" / "bin" / "openfast")):
-        if cand and Path(cand).is_file() and os.access(cand, os.X_OK):
-            return cand
-    return None
+_CASE = SHARED / "validation" / "nrel5mw" / "openfast_rtest"
 
 
 @pytest.mark.parametrize("kind, wind", [("mpc", 7.0), ("mpc", 12.0), ("mpc", 20.0),
@@ -54,7 +44,7 @@ def _run_openfast(exe: str, lib, work: Path, tmax: float) -> dict[str, np.ndarra
     return {"Time": s.t, **{n: s.data[:, i] for i, n in enumerate(s.names)}}
 
 
-@pytest.mark.skipif(_openfast() is None or find_compiler() is None or not _CASE.is_dir(),
+@pytest.mark.skipif(installed_openfast() is None or find_compiler() is None or not _CASE.is_dir(),
                     reason="needs OpenFAST ($MPCWT_OPENFAST or openfast on PATH), a C "
                            "compiler and OpenFAST's regression case")
 def test_the_mpc_library_starts_in_openfast_at_its_torque_schedule(tmp_path):
@@ -65,6 +55,6 @@ def test_the_mpc_library_starts_in_openfast_at_its_torque_schedule(tmp_path):
     the measured torque, reached 13.04 rpm at 3 s and 5.88 MW)."""
     t = linearize.load_turbine("nrel5mw")
     lib = export_discon(t, "mpc", tmp_path / "lib")
-    out = _run_openfast(_openfast(), lib, tmp_path, 10.0)
+    out = _run_openfast(installed_openfast(), lib, tmp_path, 10.0)
     assert abs(out["GenTq"][0] - 43.09) <= 0.05 * 43.09, out["GenTq"][:3]
     assert out["RotSpeed"].max() <= 12.7 and out["GenPwr"].max() <= 1.05 * 5000.0
