@@ -6,6 +6,7 @@ from lidar.coherence import coherence_corner_model, rotor_coherence_model
 from lidar.cw import CWLidar, LidarMeasurement, LidarSensor
 from lidar.errors import FieldFileError
 from lidar.field import WindField
+from lidar.points import PointLidar
 from lidar.iec import (
            CONDITIONS,
            IEC_REFERENCE_SPEED,
@@ -40,7 +41,7 @@ from lidar.turbulence import (
 )
 
 __all__ = ["IECSite", "iec_field", "event_duration", "CONDITIONS", "IEC_REFERENCE_SPEED",
-           "IEC_TURBULENCE", "SamplerCache", "CWLidar", "LidarMeasurement", "LidarSensor",
+           "IEC_TURBULENCE", "SamplerCache", "CWLidar", "LidarMeasurement", "LidarSensor", "PointLidar",
            "rotor_coherence_model", "coherence_corner_model", "FieldFileError", "WindField", "Preview",
            "PreviewBuffer", "blade_effective_wind", "coherence", "coherence_bandwidth", "peak_lag", "preview",
            "preview_series", "rms_preview_error", "rotor_effective_wind", "TurbulenceSpec",

@@ -105,9 +105,11 @@ class PlantConfig:
         mass, and gravity, g (sin(t) cos(c) - sin(c) cos(t) cos(psi)) with shaft tilt t,
         precone c and azimuth psi (Jonkman 2007, NREL/TP-500-41958, sec. 3: ElastoDyn's
         blade kinematics; Hansen 2015, sec. 11.3). Gravity follows ``aero.gravity``; both
-        vanish without cone and tilt. Off by default: the observers of the controllers that
-        read the root moments (LQR-PIO's) were designed on moments without this 1P part
-        (with it, LQR-PIO's pitch travel through rated grows 3.5x); on in :meth:`openfast`.
+        vanish without cone and tilt. On by default, in the paper models (:meth:`madsen`,
+        :meth:`clemens`, :meth:`do`) and in :meth:`openfast`: a turbine's root-moment gauges
+        read them (about 1 MN m of the NREL 5-MW's 5-8 MN m at rated), and an observer of
+        the root moments designed without them misreads the wind (LQR-PIO's stopped the
+        rotor in OpenFAST's regression case).
     inplane_wind : bool
         The free wind's lateral and vertical components (a :class:`GridWind` with ``v`` and
         ``w``) in the blade elements' velocities (AeroDyn's relative wind; Jonkman 2007,
@@ -159,7 +161,7 @@ class PlantConfig:
     dofs: frozenset[str] = frozenset(DOF_NAMES)
     aero: AeroOptions = field(default_factory=AeroOptions)
     integration: str = "midpoint"
-    blade_body_forces: bool = False
+    blade_body_forces: bool = True
     inplane_wind: bool = True
     tower_shadow: bool = False
     unsteady_aero: bool = False

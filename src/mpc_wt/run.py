@@ -4,6 +4,7 @@ from __future__ import annotations
 import contextlib
 import dataclasses
 import logging
+import math
 import re
 from pathlib import Path
 from typing import Any, Iterator, Mapping, Sequence
@@ -531,7 +532,8 @@ def _case_interval(case: Any, dt: float) -> float:
 
 def run_openfast_case(case: Any, controller: str = "auto", *, library: str | Path | None = None,
                       discon_in: str | Path | None = None, config: Any = None,
-                      dt: float = 1.0 / 80.0, progress: bool = False) -> ClosedLoopResult:
+                      dt: float = 1.0 / 80.0, progress: bool = False,
+                      workdir: str | Path | None = None) -> ClosedLoopResult:
     """Run mpc-wt's plant through an OpenFAST case: its wind as the rotor meets it, its initial
     state, its degrees of freedom and aerodynamic options, and its controller.
 
@@ -553,11 +555,15 @@ def run_openfast_case(case: Any, controller: str = "auto", *, library: str | Pat
         Plant and controller step [s].
     progress : bool
         Show a progress bar.
+    workdir : str or Path, optional
+        The library's working folder (where it writes its files; default a temporary one).
 
     Returns
     -------
     ClosedLoopResult
-        ``meta`` holds the case, the controller and the wind's time shift.
+        ``meta`` holds the case, the controller and the wind's time shift. Where the case's
+        InflowWind has a single-point lidar (``SensorType`` 1), the library's lidar records
+        are filled from it as OpenFAST v5.0.0 fills them (:class:`lidar.PointLidar`).
 
     Raises
     ------
@@ -576,6 +582,7 @@ def run_openfast_case(case: Any, controller: str = "auto", *, library: str | Pat
     if controller == "auto":
         controller = "rosco" if case.discon_in is not None else "jonkman"
     turbine = case.turbine
+    wind, shift = case_grid_wind(case)
     if controller == "jonkman":
         gains = jonkman_gains()
         ctl: Any = BaselineController(turbine, gains, dt=dt)
@@ -587,8 +594,8 @@ def run_openfast_case(case: Any, controller: str = "auto", *, library: str | Pat
                              f"file (library={library!r}, discon_in={dis!r})")
         ctl = DisconController(lib, dis, turbine, dt=_case_interval(case, dt),
                                pitch_control="individual" if case.individual_pitch
-                               else "collective")
-    wind, shift = case_grid_wind(case)
+                               else "collective", lidar=_case_lidar(case, wind),
+                               workdir=workdir)
     params = linearize.plant_params(turbine, config or case.config)
     x0 = case.x0.copy()
     wg = x0[3]
@@ -601,6 +608,24 @@ def run_openfast_case(case: Any, controller: str = "auto", *, library: str | Pat
     return simulate_closed_loop(params, ctl, wind, case.duration, x0=x0, u0=u0, dt=dt,
                                 controller_dt=getattr(ctl, "dt", dt), progress=progress,
                                 meta=meta)
+
+
+def _case_lidar(case: Any, wind: Any) -> Any:
+    """InflowWind's single-point lidar of the case on its wind (:class:`lidar.PointLidar`), or
+    None where the case has no lidar; its CW and pulsed lidars are not made on mpc-wt's
+    plant."""
+    cfg = case.lidar
+    if cfg is None or not isinstance(wind, linearize.GridWind):
+        return None
+    if cfg["sensor_type"] != 1:
+        raise ValueError(f"{cfg['file']}: SensorType = {cfg['sensor_type']}; mpc-wt's plant "
+                         f"measures InflowWind's single-point lidar (SensorType 1) only")
+    g = case.turbine.geometry
+    f = lidar.WindField(t=wind.t, y=wind.y, z=wind.z, u=wind.u, v=wind.v, w=wind.w,
+                        mean_speed=float(lidar.WindField.load(case.wind_file).mean_speed),
+                        hub_height=g.hub_height)
+    hub = (-g.overhang * math.cos(g.shaft_tilt_rad), 0.0, g.hub_height)
+    return lidar.PointLidar(cfg["points"], cfg["interval"], hub).bind(f)
 
 
 #: what :func:`verify_openfast` flags: (row key, channel, bound, what it is), a difference of

@@ -1,5 +1,6 @@
 /* A Bladed-style test controller for tests/mpc_wt/controllers/test_discon.py: it appends every record it
- * receives (1..130) to <OUTNAME>.swap.csv, counts its calls in a global (one count per loaded
+ * receives (1..130) to <OUTNAME>.swap.csv (and, where the array holds them, OpenFAST's lidar
+ * records 2001-2016 to <OUTNAME>.lidar.csv), counts its calls in a global (one count per loaded
  * copy), answers fixed demands, and stops the run (aviFAIL = -1) at t >= 0.5 s when its input
  * file is named PROBE_STOP.IN; with PROBE_EXIT.IN it prints a line and calls exit(3) there, with
  * PROBE_CRASH.IN it prints a line and writes through a null pointer (a segfault). */
@@ -22,6 +23,16 @@ void DISCON(float *swap, int *fail, const char *infile, char *outname, char *msg
         for (k = 0; k < 130; k++) fprintf(f, ",%.9g", swap[k]);
         fprintf(f, ",%s\n", infile);
         fclose(f);
+    }
+    if (swap[128] >= 2016.0f) {
+        snprintf(path, sizeof path, "%s.lidar.csv", outname);
+        f = fopen(path, "a");
+        if (f) {
+            fprintf(f, "%d,%.9g", calls, swap[1]);
+            for (k = 2000; k < 2016; k++) fprintf(f, ",%.9g", swap[k]);
+            fprintf(f, "\n");
+            fclose(f);
+        }
     }
     swap[41] = 0.11f; swap[42] = 0.12f; swap[43] = 0.13f;   /* records 42-44 */
     swap[44] = 0.2f;                                        /* record 45 */

@@ -52,7 +52,7 @@ def test_blade_body_forces_are_the_hand_worked_moments(turbine: linearize.Turbin
     still = linearize.SteadyWind(0.0)
     on = _outputs(linearize.plant_params(turbine, PlantConfig(_RIGID, blade_body_forces=True)),
                   _state(omega, psi), still)
-    off = _outputs(linearize.plant_params(turbine, PlantConfig(_RIGID)), _state(omega, psi),
+    off = _outputs(linearize.plant_params(turbine, PlantConfig(_RIGID, blade_body_forces=False)), _state(omega, psi),
                    still)
     assert_allclose(on[_Z["flap_moment_1"]] - off[_Z["flap_moment_1"]], expected, rtol=0.01)
     # the forces act on the blade only: the rotor's torque and thrust are the same

@@ -160,7 +160,10 @@ def test_the_librarys_logging_channels_are_the_python_steps_signals(turbine, kin
     lib = run_controller(turbine, kind, wind, **kw)
     py = run_python(turbine, kind, wind, **kw)
     names = law_export(kind).log
-    assert set(names) <= set(lib.controller) and set(names) <= set(py.controller)
+    assert set(names) <= set(lib.controller)
+    # the MPC's lidar_wind_1..3 (each blade's sampled wind) are the library's alone: checked
+    # on a hand-worked field in tests/mpc_wt/io/test_openfast_lidar.py
+    assert {n for n in names if not n.startswith("lidar_wind_")} <= set(py.controller)
     for name in ("qp_fallback", "premise_clipped", "region"):
         if name in names:
             np.testing.assert_array_equal(lib.controller[name], py.controller[name])

@@ -32,6 +32,7 @@ from typing import Any
 
 import numpy as np
 
+from lidar import PointLidar
 from mpc_wt.controllers.base import ControllerBase
 from mpc_wt.controllers.discon_kernel import library_call
 from mpc_wt.errors import ControllerLibraryError
@@ -362,10 +363,13 @@ class DisconController(ControllerBase):
         (default). In a child process what it prints goes to a temporary log, whose last
         lines become the reason if it ends its process. Its ``aviFAIL`` messages are kept
         either way.
-    lidar : lidar.LidarSensor, optional
+    lidar : lidar.LidarSensor or lidar.PointLidar, optional
         A hub-mounted CW LIDAR (bound to the case's wind by the simulator) whose measurement
         fills OpenFAST's lidar records (:data:`LIDAR_RECORDS`): taken at the instrument's sample
-        rate and held between samples, as a LIDAR delivers them.
+        rate and held between samples, as a LIDAR delivers them. Or InflowWind's single-point
+        lidar, bound to the case's wind (:class:`lidar.PointLidar`): the records as OpenFAST v5
+        fills them (its type 1, the points' |V| and positions), taken where the time is an
+        exact multiple of its interval.
     isolate : bool
         Run the library in a child process, a new one per run (default): a library that ends
         its process fails the run with its exit status and last output instead of ending the
@@ -482,6 +486,7 @@ class DisconController(ControllerBase):
         self._last_pitch = np.full(3, self.turbine.operation.fine_pitch_rad)
         self._last_torque = 0.0
         self._lidar_next = -math.inf
+        self._lidar_pending: Any = None
         self._settings()
         if self.isolate:                     # a new process: the library's globals start over
             self._unload()
@@ -573,6 +578,8 @@ class DisconController(ControllerBase):
         float
             When the next sample is due [s].
         """
+        if isinstance(self.lidar, PointLidar):
+            return self._sample_points(t)
         self._lidar_next = t + 1.0 / self.lidar.instrument.sample_rate
         m = self.lidar.measure(np.array([t]), np.array([azimuth]), rotor_speed)
         ang = m.beam_azimuth_rad[0]
@@ -583,6 +590,21 @@ class DisconController(ControllerBase):
         v[2007:2010] = self.lidar.focus_distance
         v[2010:2013] = -r * np.sin(ang)
         v[2013:2016] = r * np.cos(ang)
+        return self._lidar_next
+
+    def _sample_points(self, t: float) -> float:
+        """InflowWind's single points as ServoDyn hands them to a library: measured where the
+        time is an exact multiple of the interval (:meth:`lidar.PointLidar.due`), the last
+        values held in between, and a call sees the measurement of the call before it (the
+        first call its own): in OpenFAST v5.0.0's regression case with a 0.1 s interval and
+        DLL_DT, a logging library's records at t equal InflowWind's sample at t - 0.1 s."""
+        pl = self.lidar
+        pending = self._lidar_pending
+        now = pl.records(t) if pl.due(t) or pending is None else None
+        rec = now if pending is None else pending
+        self._view[2000:2000 + rec.size] = rec
+        self._lidar_pending = now if now is not None else rec
+        self._lidar_next = t + 0.5 * self.dt  # at every call
         return self._lidar_next
 
     def _fill(self, t: float, meas: dict[str, Any]) -> None:

@@ -61,6 +61,11 @@ class OpenFASTCase:
     individual_pitch : bool
         ServoDyn's ``Ptch_Cntrl`` is 1: a library's individual pitch demands (records 42-44)
         apply, else its collective one (record 45).
+    lidar : dict or None
+        InflowWind's lidar where its ``SensorType`` is not 0: ``sensor_type``, ``points``
+        ((n, 3) from the hub [m]: ``FocalDistanceX/Y/Z`` plus ``RotorApexOffsetPos``),
+        ``interval`` (``MeasurementInterval`` [s]), ``gates`` and ``radial`` (``NumPulseGate``,
+        ``LidRadialVel``).
     """
 
     fst: Path
@@ -74,6 +79,7 @@ class OpenFASTCase:
     steady_wind: tuple[float, float] | None = None
     dll_dt: float | None = None
     individual_pitch: bool = False
+    lidar: dict[str, Any] | None = None
 
 
 def _flag(f: OpenFASTFile, key: str, default: bool) -> bool:
@@ -172,9 +178,32 @@ def read_openfast_case(fst: str | Path, *, wind: str | Path | None = None,
                             duration=main.number("TMax", 0.0, 1e7),
                             x0=_initial_state(ed, turbine), config=cfg, discon_in=discon,
                             notes=tuple(notes), steady_wind=steady, dll_dt=dll_dt,
-                            individual_pitch=ipc)
+                            individual_pitch=ipc, lidar=_lidar(main))
     except linearize.TurbineFileError as err:
         raise ResultFileError(str(err)) from None
+
+
+def _lidar(main: OpenFASTFile) -> dict[str, Any] | None:
+    """InflowWind's lidar (its ``SensorType`` 1-3), or None (none, or no InflowWind file)."""
+    inflow = main.file("InflowFile")
+    if inflow is None:
+        return None
+    iw = OpenFASTFile(inflow)
+    if not iw.has("SensorType") or iw.integer("SensorType", 0, 3) == 0:
+        return None
+    kind = iw.integer("SensorType", 0, 3)
+    n = iw.integer("NumBeam", 1, 5) if kind == 1 else 1
+    focal = np.stack([iw.numbers(f"FocalDistance{c}")[:n] for c in "XYZ"], axis=1)
+    if focal.shape != (n, 3):
+        raise ResultFileError(f"{inflow}: FocalDistanceX, Y and Z need {n} values each "
+                              f"(NumBeam), got {focal.shape[0]}")
+    offset = iw.numbers("RotorApexOffsetPos")[:3] if iw.has("RotorApexOffsetPos") else \
+        np.zeros(3)
+    return {"sensor_type": kind, "points": focal + offset,
+            "interval": iw.number("MeasurementInterval", 0.0),
+            "gates": iw.integer("NumPulseGate", 0, 5) if kind == 3 else 1,
+            "radial": iw.flag("LidRadialVel") if iw.has("LidRadialVel") else False,
+            "file": str(inflow)}
 
 
 def _bladed_interface(main: OpenFASTFile, srv: OpenFASTFile | None) -> tuple[float | None,

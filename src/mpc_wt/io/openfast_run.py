@@ -90,7 +90,8 @@ def _set_value(text: str, key: str, value: str) -> str:
 
 
 def prepare_deck(fst: str | Path, out: str | Path, library: str | Path, input_file: str | Path,
-                 dt: float, *, tmax: float | None = None) -> Path:
+                 dt: float, *, tmax: float | None = None,
+                 inflow: str | Path | None = None) -> Path:
     """A copy of a deck's main file and ServoDyn file in ``out`` that runs ``library``.
 
     Parameters
@@ -105,6 +106,9 @@ def prepare_deck(fst: str | Path, out: str | Path, library: str | Path, input_fi
         The library's interval [s] (``DLL_DT``).
     tmax : float, optional
         ``TMax`` [s] in place of the deck's.
+    inflow : str or Path, optional
+        An InflowWind file in place of the deck's ``InflowFile`` (e.g. one with a lidar; the
+        paths it names are its own folder's).
 
     Returns
     -------
@@ -140,7 +144,12 @@ def prepare_deck(fst: str | Path, out: str | Path, library: str | Path, input_fi
     for key, val in (("PCMode", "5"), ("VSContrl", "5")):
         text = _set_value(text, key, val)
     srv_copy.write_text(text)
-    main = _absolute_paths(main, fst.parent, {"ServoFile": str(srv_copy.resolve())})
+    swap = {"ServoFile": str(srv_copy.resolve())}
+    if inflow is not None:
+        if not Path(inflow).is_file():
+            raise FileNotFoundError(f"the InflowWind file {inflow} does not exist")
+        swap["InflowFile"] = str(Path(inflow).resolve())
+    main = _absolute_paths(main, fst.parent, swap)
     if tmax is not None:
         main = _set_value(main, "TMax", f"{float(tmax):.10g}")
     copy = out / fst.name

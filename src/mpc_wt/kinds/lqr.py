@@ -105,6 +105,11 @@ class LQRPIOOptions(Options):
                                   unit="m/s", lo=0.1, hi=5.0, flag="")
     schedule_time_constant: float = option(3.0, help="low-pass of the scheduling wind",
                                            unit="s", lo=0.0, hi=600.0, flag="")
+    moment_scale: float = option(10.0, help="the PI observer's scale of the blade root "
+                                 "moments, as a multiple of what one metre of flap tip "
+                                 "displacement gives (larger: the observer trusts the moments "
+                                 "less against the generator speed and the tower-top "
+                                 "acceleration)", unit="-", lo=0.0, lo_open=True)
     observer_signals: str = option("turbine", help="the PI observer's measurements: turbine "
                                    "(generator speed, tower-top fore-aft acceleration, blade "
                                    "root out-of-plane moments, as a turbine's controller gets "
@@ -343,8 +348,9 @@ def _lqr_pio_at(turbine: linearize.Turbine, model: linearize.LinearModel, wind: 
     lq = design_lqr(model, state_weights=w, output_weights=opts.output_weights(),
                     input_weights=iw, scales=scales)
     if opts.observer_signals == "turbine":
-        obs = design_pi_observer(model, q=opts.observer_q, measured=TURBINE_MEASURED,
-                                 scales=turbine_scales(model))
+        sy = {k: v * (opts.moment_scale if k.startswith("flap_moment") else 1.0)
+              for k, v in turbine_scales(model).items()}
+        obs = design_pi_observer(model, q=opts.observer_q, measured=TURBINE_MEASURED, scales=sy)
     else:
         obs = design_pi_observer(model, q=opts.observer_q, measured=PAPER_MEASURED)
     return LQRPIOController(model, turbine, lq, obs,

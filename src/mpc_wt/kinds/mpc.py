@@ -499,10 +499,13 @@ def _mpc_entries(ctl: Any, preview: Any = None) -> list[tuple[str, Any, str]]:
     return rows
 
 
-def _mpc_export(name: str, summary: str) -> LawExport:
-    """An MPC kind's export: the MPC law with DAQP, from its published distribution."""
-    return LawExport(name, summary, "mpc", _mpc_entries, sources=("mpc.c",), qp=True,
-                     log=("qp_fallback", "qp_solve_ms", "schedule_wind", "schedule_grid_wind"))
+def _mpc_export(name: str, summary: str, lidar: bool = False) -> LawExport:
+    """An MPC kind's export: the MPC law with DAQP, from its published distribution; with the
+    LIDAR, the last sample's wind at each blade logged too."""
+    log = ("qp_fallback", "qp_solve_ms", "schedule_wind", "schedule_grid_wind")
+    if lidar:
+        log += ("lidar_wind_1", "lidar_wind_2", "lidar_wind_3")
+    return LawExport(name, summary, "mpc", _mpc_entries, sources=("mpc.c",), qp=True, log=log)
 
 
 _MPC_GROUP = "the MPC controllers"
@@ -521,7 +524,8 @@ register("mpc-collective", MPCOptions, field_components="u", group=_MPC_GROUP,
 register("mpc-lidar", MPCLidarOptions, field_components="u", group=_MPC_GROUP,
          design=_design_mpc(False, True),
          export=_mpc_export("mpc-lidar", "the scheduled MPC with the per-blade preview of a "
-                            "hub-mounted CW LIDAR, read from OpenFAST's lidar records"),
+                            "hub-mounted CW LIDAR, read from OpenFAST's lidar records",
+                            lidar=True),
          summary="the individual-pitch MPC with a CW LIDAR's per-blade preview "
                  "(range weighting, LOS error and wind evolution on)")(_mpc(False, True))
 

@@ -19,3 +19,17 @@ def installed_openfast() -> str | None:
         return str(find_openfast())
     except OpenFASTRunError:
         return str(BINARY) if BINARY.is_file() and os.access(BINARY, os.X_OK) else None
+
+
+def exported(kind: str, folder: Path):
+    """The NREL 5-MW's ``kind`` exported into ``folder`` (:func:`mpc_wt.run.export_discon`);
+    the test skips without a C compiler."""
+    import pytest
+
+    import linearize
+    from mpc_wt.io.discon_export import find_compiler
+    from mpc_wt.run import export_discon
+
+    if find_compiler() is None:
+        pytest.skip("needs a C compiler")
+    return export_discon(linearize.load_turbine("nrel5mw"), kind, folder)

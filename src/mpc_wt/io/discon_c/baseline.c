@@ -207,21 +207,9 @@ static int ff_step(mw_ff *f, const mw_meas *m, double *pitch, char *msg)
 {
     double v;
     if (m->t >= f->next - 1e-9) {
-        double u, arrival;
-        int b;
-        if (m->lidar_beams != 3 || m->lidar_gates != 1) {
-            mw_msg(msg, "mpc-wt baseline: the LIDAR feedforward needs 3 beams and 1 pulse gate in "
-                   "the lidar records (avrSWAP 2002 and 2003 are %d and %d) at t = %g s",
-                   m->lidar_beams, m->lidar_gates, m->t);
-            return -1;
-        }
-        for (b = 0; b < 3; b++)
-            if (!mw_finite(m->los[b])) {
-                mw_msg(msg, "mpc-wt baseline: LIDAR line-of-sight speed %d (avrSWAP %d) is not "
-                       "finite at t = %g s", b + 1, 2005 + b, m->t);
-                return -1;
-            }
-        u = (m->los[0] / f->cos_cone + m->los[1] / f->cos_cone + m->los[2] / f->cos_cone) / 3.0;
+        double u, arrival, w[3], taken;
+        if (mw_lidar_winds(m, f->cos_cone, w, &taken, "baseline", msg)) return -1;
+        u = (w[0] + w[1] + w[2]) / 3.0;
         f->n_mean++;
         if (f->n_mean == 1)
             f->mean = u;
@@ -243,7 +231,7 @@ static int ff_step(mw_ff *f, const mw_meas *m, double *pitch, char *msg)
             f->x[1] = x1;
             f->vf = x0;
         }
-        arrival = m->t + f->tp;
+        arrival = taken + f->tp;
         if (f->len > 0 && arrival <= f->arr[f->len - 1]) arrival = f->arr[f->len - 1] + 1e-6;
         f->arr[f->len] = arrival;
         f->val[f->len] = f->vf;

@@ -132,6 +132,7 @@ static mw_ctrl *create(const char *path, const float *swap, char *msg)
 static void read_meas(const float *s, mw_meas *m)
 {
     m->t = s[1];
+    m->dt = s[2];
     m->pitch[0] = s[3];
     m->pitch[1] = s[32];
     m->pitch[2] = s[33];
@@ -145,16 +146,118 @@ static void read_meas(const float *s, mw_meas *m)
     m->tower_fa_acc = s[52];
     m->tower_ss_acc = s[53];
     m->azimuth = s[59];
-    m->lidar_type = m->lidar_beams = m->lidar_gates = 0;
-    m->los[0] = m->los[1] = m->los[2] = 0.0;
-    if (s[128] >= 2007.0f) {        /* record 129: the array's length; the lidar block fits */
+    m->lidar_type = m->lidar_beams = m->lidar_gates = m->lidar_n = 0;
+    if (s[128] >= 2004.0f) {        /* record 129: the array's length; the lidar block fits */
+        int n, i;
         m->lidar_type = (int)s[2000];
         m->lidar_beams = (int)s[2001];
         m->lidar_gates = (int)s[2002];
-        m->los[0] = s[2004];
-        m->los[1] = s[2005];
-        m->los[2] = s[2006];
+        n = m->lidar_beams * m->lidar_gates;
+        if (m->lidar_beams >= 0 && m->lidar_gates >= 0 && n <= MW_LIDAR_MAX
+            && 2004 + 4 * n <= (int)s[128]) {
+            m->lidar_n = n;
+            for (i = 0; i < n; i++) {
+                m->lidar_speed[i] = s[2004 + i];
+                m->lidar_y[i] = s[2004 + 2 * n + i];
+                m->lidar_z[i] = s[2004 + 3 * n + i];
+            }
+        } else {
+            m->lidar_n = -1;          /* more than a law reads, or past the array's end */
+        }
     }
+}
+
+/* the wind at the rotor's sample points, fitted as u(psi) = a0 + a1 cos(psi) + b1 sin(psi)
+ * over the points' azimuths about their centroid (psi from up toward -y, OpenFAST's and the
+ * rotor's sense); 0 when the points do not span the rotor (fewer than 3, or on one line) */
+static int fit_1p(const mw_meas *m, double c[3])
+{
+    double yc = 0.0, zc = 0.0, a[3][3] = {{0}}, r[3] = {0}, det;
+    int i, j, k, n = m->lidar_n;
+    if (n < 3) return 0;
+    for (i = 0; i < n; i++) {
+        yc += m->lidar_y[i] / n;
+        zc += m->lidar_z[i] / n;
+    }
+    for (i = 0; i < n; i++) {
+        double dy = m->lidar_y[i] - yc, dz = m->lidar_z[i] - zc, rad = sqrt(dy * dy + dz * dz);
+        double f[3];
+        if (!(rad > 1e-3)) return 0;
+        f[0] = 1.0;
+        f[1] = dz / rad;              /* cos(psi) */
+        f[2] = -dy / rad;             /* sin(psi) */
+        for (j = 0; j < 3; j++) {
+            r[j] += f[j] * m->lidar_speed[i];
+            for (k = 0; k < 3; k++) a[j][k] += f[j] * f[k];
+        }
+    }
+    det = a[0][0] * (a[1][1] * a[2][2] - a[1][2] * a[2][1])
+        - a[0][1] * (a[1][0] * a[2][2] - a[1][2] * a[2][0])
+        + a[0][2] * (a[1][0] * a[2][1] - a[1][1] * a[2][0]);
+    if (!(fabs(det) > 1e-6 * n * n * n)) return 0;
+    for (j = 0; j < 3; j++) {           /* Cramer's rule, column j replaced by r */
+        double b[3][3];
+        memcpy(b, a, sizeof(b));
+        for (k = 0; k < 3; k++) b[k][j] = r[k];
+        c[j] = (b[0][0] * (b[1][1] * b[2][2] - b[1][2] * b[2][1])
+                - b[0][1] * (b[1][0] * b[2][2] - b[1][2] * b[2][0])
+                + b[0][2] * (b[1][0] * b[2][1] - b[1][1] * b[2][0])) / det;
+    }
+    return 1;
+}
+
+/* Each blade's wind from the lidar records, by the configuration the records describe:
+ * - type 2, 3 beams, 1 gate: mpc-wt's hub-mounted CW lidar, one beam ahead of each blade,
+ *   line-of-sight speeds: u = v_LOS / cos(cone);
+ * - type 1 (InflowWind's single points, fixed in space), 1-5 beams: the speeds are the wind's
+ *   magnitude at the points; with 3 or more around the rotor, their 1P fit at each blade's
+ *   azimuth (blade k at record 60's azimuth + (k - 1) 120 deg), else their mean for every
+ *   blade;
+ * - type 2 or 3 with one beam (InflowWind's CW or pulsed lidar, LidRadialVel false: the
+ *   speed is its estimate of the wind along x): gate 1's speed for every blade.
+ * mpc-wt's host hands a sample over at the call it is taken; OpenFAST v5.0.0 at the call after
+ * (its records at t are InflowWind's at t - DLL_DT, at the first call its first), so an
+ * InflowWind lidar's sample is taken one interval (record 3) before the call. */
+int mw_lidar_winds(const mw_meas *m, double cos_cone, double u[3], double *taken,
+                   const char *who, char *msg)
+{
+    int i, b, n = m->lidar_n;
+    double c[3];
+    *taken = m->t;
+    if (n > 0)
+        for (i = 0; i < n; i++)
+            if (!mw_finite(m->lidar_speed[i])) {
+                mw_msg(msg, "mpc-wt %s: lidar speed %d (avrSWAP %d) is not finite at t = %g s",
+                       who, i + 1, 2005 + i, m->t);
+                return -1;
+            }
+    if (m->lidar_type == 2 && m->lidar_beams == 3 && m->lidar_gates == 1 && n == 3) {
+        for (b = 0; b < 3; b++) u[b] = m->lidar_speed[b] / cos_cone;
+        return 0;
+    }
+    if (m->t > 0.0 && m->dt > 0.0) *taken = m->t - m->dt;
+    if (m->lidar_type == 1 && n >= 1) {
+        if (fit_1p(m, c)) {
+            for (b = 0; b < 3; b++) {
+                double psi = m->azimuth + 2.0943951023931957 * b;
+                u[b] = c[0] + c[1] * cos(psi) + c[2] * sin(psi);
+            }
+        } else {
+            double s = 0.0;
+            for (i = 0; i < n; i++) s += m->lidar_speed[i] / n;
+            u[0] = u[1] = u[2] = s;
+        }
+        return 0;
+    }
+    if ((m->lidar_type == 2 || m->lidar_type == 3) && m->lidar_beams == 1 && n >= 1) {
+        u[0] = u[1] = u[2] = m->lidar_speed[0];
+        return 0;
+    }
+    mw_msg(msg, "mpc-wt %s: the lidar records (avrSWAP 2001-2003: type %d, %d beams, %d pulse "
+           "gates) are no lidar it reads: mpc-wt's CW lidar (type 2, 3 beams, 1 gate), "
+           "InflowWind's single points (type 1, 1-5 beams) or one CW or pulsed beam (type 2 or 3, "
+           "1 beam); t = %g s", who, m->lidar_type, m->lidar_beams, m->lidar_gates, m->t);
+    return -1;
 }
 
 /* the kind's logging channels at records L1 = record 63 on, their number in record 65, as

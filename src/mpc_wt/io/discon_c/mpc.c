@@ -52,7 +52,7 @@ typedef struct {
     mw_kalman kal;
 } mw_point;
 
-/* the LIDAR's per-blade preview: u_hat = v_LOS / cos(cone) per beam, the measured mean wind
+/* the LIDAR's per-blade preview: each blade's wind from the lidar records (mw_lidar_winds), the measured mean wind
  * (the average while fewer than tau / dt samples have come, then a first-order low-pass), a
  * ring of the last measurements and the preview of the next H_p steps from the measurements
  * taken T_p = D / V_m earlier, linear in time between them */
@@ -63,6 +63,7 @@ typedef struct {
     double mean, last;
     double *t, *u;                /* 2 cap times, 3 x 2 cap winds (each sample twice) */
     double *blade;                /* horizon x 3 */
+    double now[3];                /* the last sample's wind at each blade [m/s] */
 } mw_preview;
 
 typedef struct {
@@ -130,38 +131,24 @@ static void preview_reset(mw_preview *p)
 /* take this step's measurement and write the preview rows into p->blade; -1 on bad data */
 static int preview_step(mw_preview *p, const mw_meas *m, char *msg)
 {
-    double u[3], x, tp;
+    double u[3], x, tp, taken;
     int i, b, k, n, lo;
-    if (m->lidar_beams != 3 || m->lidar_gates != 1) {
-        mw_msg(msg, "mpc-wt mpc: the LIDAR preview needs 3 beams and 1 pulse gate in the lidar "
-               "records (avrSWAP 2002 and 2003 are %d and %d) at t = %g s", m->lidar_beams,
-               m->lidar_gates, m->t);
-        return -1;
+    if (mw_lidar_winds(m, p->cos_cone, u, &taken, "mpc", msg)) return -1;
+    if (taken > p->last) {          /* a new sample (a held one is not taken again) */
+        x = (u[0] + u[1] + u[2]) / 3.0;
+        p->n_mean++;
+        if (p->n_mean == 1)
+            p->mean = x;
+        else
+            p->mean += dmax(1.0 / p->n_mean, p->alpha) * (x - p->mean);
+        i = p->n % p->cap;
+        p->t[i] = p->t[i + p->cap] = taken;
+        for (b = 0; b < 3; b++)
+            p->u[b * 2 * p->cap + i] = p->u[b * 2 * p->cap + i + p->cap] = u[b];
+        for (b = 0; b < 3; b++) p->now[b] = u[b];
+        p->n++;
+        p->last = taken;
     }
-    for (b = 0; b < 3; b++) {
-        u[b] = m->los[b] / p->cos_cone;
-        if (!mw_finite(u[b])) {
-            mw_msg(msg, "mpc-wt mpc: LIDAR line-of-sight speed %d (avrSWAP %d) is not finite at "
-                   "t = %g s", b + 1, 2005 + b, m->t);
-            return -1;
-        }
-    }
-    if (!(m->t > p->last)) {
-        mw_msg(msg, "mpc-wt mpc: time %g s is not later than the last LIDAR sample %g s", m->t,
-               p->last);
-        return -1;
-    }
-    x = (u[0] + u[1] + u[2]) / 3.0;
-    p->n_mean++;
-    if (p->n_mean == 1)
-        p->mean = x;
-    else
-        p->mean += dmax(1.0 / p->n_mean, p->alpha) * (x - p->mean);
-    i = p->n % p->cap;
-    p->t[i] = p->t[i + p->cap] = m->t;
-    for (b = 0; b < 3; b++) p->u[b * 2 * p->cap + i] = p->u[b * 2 * p->cap + i + p->cap] = u[b];
-    p->n++;
-    p->last = m->t;
     n = p->n < p->cap ? p->n : p->cap;
     lo = p->n >= p->cap ? p->n % p->cap : 0;
     tp = p->fixed > 0 ? p->fixed : p->focus / dmax(p->mean, p->min_wind);
@@ -595,6 +582,10 @@ static int mpc_step(mw_ctrl *self, const mw_meas *m, mw_cmd *out, char *msg)
     out->log[1] = c->qp_ms;
     out->log[2] = c->sched.wind;
     out->log[3] = c->sched.grid[k];
+    if (c->pv.on) {                 /* lidar_wind_1..3: the last sample's wind at each blade */
+        out->nlog = 7;
+        for (i = 0; i < 3; i++) out->log[4 + i] = c->pv.now[i];
+    }
     return rc;
 }
 

@@ -37,8 +37,13 @@ int mw_get_word(const mw_input *in, const char *key, char *out, size_t n, char *
 int mw_get_int(const mw_input *in, const char *key, int lo, int hi, int *out, char *msg);
 
 /* ---- what a controller sees at a step ------------------------------------------------ */
+/* the most lidar measurements a law reads: InflowWind v5.0.0 gives at most 5 beams (single
+ * points) or 5 pulse gates */
+#define MW_LIDAR_MAX 5
+
 typedef struct {
     double t;              /* record 2 [s] */
+    double dt;             /* record 3, the communication interval [s] */
     double pitch[3];       /* records 4, 33, 34 [rad] */
     double gen_speed;      /* record 20 [rad/s] */
     double rotor_speed;    /* record 21 [rad/s] */
@@ -48,11 +53,18 @@ typedef struct {
     double tower_ss_acc;   /* record 54 [m/s^2] */
     double azimuth;        /* record 60 [rad] */
     double gen_power;      /* record 15 [W] */
-    /* OpenFAST's lidar block (records 2001-2500): sensor type, beams, pulse gates, then the
-     * line-of-sight speeds and the measurement points' x, y, z */
-    int lidar_type, lidar_beams, lidar_gates;
-    double los[3];         /* records 2005-2007 [m/s] */
+    /* OpenFAST's lidar block (records 2001-2500, InflowWind's lidar through ServoDyn's
+     * extended swap array): sensor type, beams, pulse gates, then n = beams x gates speeds and
+     * the n measurement points' x, then y, then z */
+    int lidar_type, lidar_beams, lidar_gates, lidar_n;
+    double lidar_speed[MW_LIDAR_MAX];   /* records 2005 .. 2004 + n [m/s] */
+    double lidar_y[MW_LIDAR_MAX], lidar_z[MW_LIDAR_MAX];   /* the points' y and z [m] */
 } mw_meas;
+
+/* each blade's wind from the lidar records (see discon.c) and when it was measured [s]; -1 with a message naming the
+ * records on a configuration no law reads or a speed that is not finite */
+int mw_lidar_winds(const mw_meas *m, double cos_cone, double u[3], double *taken,
+                   const char *who, char *msg);
 
 /* logging channels a kind returns beside its demands (Bladed's records 65 and L1 = record 63
  * on): each kind lists its own, in order, in its export (LawExport.log) */
