@@ -5,7 +5,8 @@ Run:  python benchmarks/openfast_verify_kinds.py CASE.fst --openfast PATH [--out
       [--kinds baseline mpc ...] [--tmax 60]
 
 CASE.fst is the v5 input of ``5MW_Land_DLL_WTurb`` (or any NREL 5-MW deck). The LIDAR kinds
-are left out: OpenFAST v5's InflowWind gives no hub-mounted CW LIDAR's beams.
+run with five single points on the design's ring written into a copy of the deck's InflowWind
+file, or with ``--lidar-inflow FILE`` (an InflowWind file with a single-point lidar).
 """
 from __future__ import annotations
 
@@ -16,7 +17,9 @@ from pathlib import Path
 import linearize
 from mpc_wt.run import verify_openfast
 
-KINDS = ("baseline", "baseline-ct", "ibc", "mpc", "mpc-collective", "lqr-pio", "ts")
+KINDS = ("baseline", "baseline-ct", "ibc", "mpc", "mpc-collective", "lqr-pio", "ts",
+         "mpc-lidar", "baseline+lidar-ff")
+LIDAR_KINDS = ("mpc-lidar", "baseline+lidar-ff")
 
 
 def _row(kind: str, doc: dict) -> str:
@@ -39,6 +42,7 @@ def main() -> None:
     ap.add_argument("--out", default="openfast-verify")
     ap.add_argument("--kinds", nargs="+", default=list(KINDS))
     ap.add_argument("--tmax", type=float, default=None)
+    ap.add_argument("--lidar-inflow", default=None)
     args = ap.parse_args()
     turbine = linearize.load_turbine("nrel5mw")
     print("| kind | mean power OpenFAST / mpc-wt [kW] | mean rotor speed [rpm] | largest power "
@@ -46,8 +50,10 @@ def main() -> None:
           "OpenFAST [MN m] (d%) | pitch travel [deg] | flags |")
     print("|---|---|---|---|---|---|---|---|---|")
     for kind in args.kinds:
+        lidar = kind in LIDAR_KINDS
         doc = verify_openfast(turbine, kind, args.fst, Path(args.out) / kind,
-                              openfast=args.openfast, tmax=args.tmax)
+                              openfast=args.openfast, tmax=args.tmax,
+                              inflow=args.lidar_inflow if lidar else None)
         print(_row(kind, doc), flush=True)
 
 

@@ -115,8 +115,8 @@ class PointLidar:
         Returns
         -------
         (4 + 4 n,) ndarray
-            Sensor type 1, n beams, 1 gate, 0, the n speeds |V| [m/s], then the points' x, y, z
-            in OpenFAST's frame [m].
+            Sensor type 1, n beams, 1 gate, 0, the n speeds ``|V|`` [m/s], then the points' x,
+            y, z in OpenFAST's frame [m].
 
         Raises
         ------

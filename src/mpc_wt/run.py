@@ -682,7 +682,7 @@ def verify_openfast(turbine: linearize.Turbine, controller: str, fst: str | Path
                     out: str | Path, options: Mapping[str, Any] | None = None, *,
                     openfast: str | Path | None = None, tmax: float | None = None,
                     window: tuple[float, float | None] = (10.0, None),
-                    progress: bool = False) -> dict[str, Any]:
+                    progress: bool = False, inflow: str | Path | None = None) -> dict[str, Any]:
     """Prove a design in the user's OpenFAST: export it, run OpenFAST on the user's deck with
     it, run the same case on mpc-wt's plant, compare them channel by channel and flag every
     difference beyond :data:`VERIFY_BOUNDS` (and the largest power beyond 2 % of rated, pitch
@@ -709,6 +709,10 @@ def verify_openfast(turbine: linearize.Turbine, controller: str, fst: str | Path
         The statistics' window [s] (None: to the end).
     progress : bool
         Show progress bars (OpenFAST's simulated time, then mpc-wt's run).
+    inflow : str or Path, optional
+        An InflowWind file in place of the deck's. A LIDAR kind on a deck whose InflowWind has
+        no single-point lidar (``SensorType 1``) runs with a copy of it that has five on the
+        design's ring (:func:`mpc_wt.io.openfast_run.write_lidar_inflow`).
 
     Returns
     -------
@@ -721,24 +725,20 @@ def verify_openfast(turbine: linearize.Turbine, controller: str, fst: str | Path
     OpenFASTRunError
         No OpenFAST executable, or OpenFAST did not finish (its last lines in the message).
     ValueError
-        A kind that does not export, or a LIDAR kind (OpenFAST v5's InflowWind gives no
-        hub-mounted CW LIDAR's beams).
+        A kind that does not export.
     """
     from mpc_wt.assessment.compare import compare_series
     from mpc_wt.io.json_text import write_json
-    from mpc_wt.io.openfast_case import read_openfast_case
     from mpc_wt.io.openfast_run import find_openfast, prepare_deck
     from mpc_wt.plotting import plot_verify
 
     exe = find_openfast(openfast)
     out = Path(out)
     ex = export_discon(turbine, controller, out / "library", options)
-    if _reads_lidar(ex.input_file):
-        raise ValueError(f"controller {controller!r} reads a LIDAR; OpenFAST v5's InflowWind "
-                         f"gives no hub-mounted CW LIDAR's beams: verify it without the LIDAR")
-    deck = prepare_deck(fst, out / "openfast", ex.library, ex.input_file, ex.dt, tmax=tmax)
+    deck = prepare_deck(fst, out / "openfast", ex.library, ex.input_file, ex.dt, tmax=tmax,
+                        inflow=inflow)
+    deck, case = _with_lidar(deck, out, ex, turbine, tmax)
     of_path, of, ref = _openfast_run(exe, deck, tmax, progress)
-    case = read_openfast_case(deck, turbine=turbine)
     res = run_openfast_case(case, "discon", library=ex.library, discon_in=ex.input_file,
                             progress=progress)
     ours = {n: res.channel(n) for n in res.channels()}
@@ -756,6 +756,39 @@ def verify_openfast(turbine: linearize.Turbine, controller: str, fst: str | Path
                                      "ours": str(out / "ours.nc"), "plot": str(png)}}
     write_json(out / "verify.json", doc)
     return doc
+
+
+def _with_lidar(deck: Path, out: Path, ex: Any, turbine: linearize.Turbine,
+                tmax: float | None) -> tuple[Path, Any]:
+    """The prepared deck and its case; for a LIDAR kind on a deck whose InflowWind has no
+    single-point lidar, the deck again with a copy of that file with the five single points the
+    kind reads (:func:`mpc_wt.io.openfast_run.lidar_points` on the design's focus distance and
+    cone, ``inflow.dat`` in ``out/openfast``)."""
+    from linearize.openfast import OpenFASTFile
+    from mpc_wt.io.openfast_case import read_openfast_case
+    from mpc_wt.io.openfast_run import lidar_points, prepare_deck, write_lidar_inflow
+
+    case = read_openfast_case(deck, turbine=turbine)
+    if not _reads_lidar(ex.input_file) or (case.lidar is not None
+                                            and case.lidar["sensor_type"] == 1):
+        return deck, case
+
+    m = re.search(r"^(?:lidar|ff)\s+(\S+)\s+(\S+)", ex.input_file.read_text(), re.M)
+    if m is None:
+        raise ValueError(f"{ex.input_file}: no 'lidar' or 'ff' key with the LIDAR's cone and "
+                         f"focus distance")
+    cos_cone, focus = float(m.group(1)), float(m.group(2))
+    inflow = OpenFASTFile(deck).file("InflowFile")
+    if inflow is None:
+        raise ValueError(f"{deck}: no InflowFile to give the LIDAR kind its lidar")
+    radius = focus * math.tan(math.acos(cos_cone))
+    iw = write_lidar_inflow(inflow, out / "openfast" / "inflow.dat",
+                            lidar_points(focus, radius), ex.dt)
+    log.info("the deck's InflowWind has no single-point lidar; %s has five on the design's "
+             "ring (%.1f m upwind, r = %.2f m)", iw, focus, radius)
+    deck = prepare_deck(deck, out / "openfast", ex.library, ex.input_file, ex.dt, tmax=tmax,
+                        inflow=iw)
+    return deck, read_openfast_case(deck, turbine=turbine)
 
 
 def _openfast_run(exe: Path, deck: Path, tmax: float | None, progress: bool

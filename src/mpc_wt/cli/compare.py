@@ -90,6 +90,9 @@ def _add_verify(sub: Any) -> None:
                                                              "deck's TMax)")
     p.add_argument("--window", nargs=2, type=float, default=None, metavar=("FROM", "TO"),
                    help="statistics window [s] (default: 10 s to the end)")
+    p.add_argument("--inflow", default=None, metavar="FILE",
+                   help="an InflowWind file in place of the deck's (a LIDAR kind needs one "
+                        "with a single-point lidar, SensorType 1)")
     p.add_argument("--option", action="append", metavar="NAME=VALUE",
                    help="an option of the kind (repeatable; YAML values)")
     p.add_argument("--out", required=True, help="folder for the library, OpenFAST's run, "
@@ -104,13 +107,16 @@ def _verify(args: argparse.Namespace) -> int:
     check_out_folder("--out", args.out)
     if not Path(args.fst).is_file():
         raise UsageError(f"fst: {args.fst} does not exist")
+    if args.inflow is not None and not Path(args.inflow).is_file():
+        raise UsageError(f"--inflow: {args.inflow} does not exist")
     if args.tmax is not None and not args.tmax > 0:
         raise UsageError(f"--tmax must be > 0 s, got {args.tmax:g}")
     turbine = linearize.load_turbine(args.turbine)
     window = tuple(args.window) if args.window else (10.0, None)
     doc = verify_openfast(turbine, args.kind, args.fst, args.out,
                           pairs(args.option, "--option") or None, openfast=args.openfast,
-                          tmax=args.tmax, window=window, progress=True)
+                          tmax=args.tmax, window=window, progress=True,
+                          inflow=args.inflow)
     if args.json:
         print(to_json(doc))
     else:

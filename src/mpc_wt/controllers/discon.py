@@ -368,7 +368,7 @@ class DisconController(ControllerBase):
         fills OpenFAST's lidar records (:data:`LIDAR_RECORDS`): taken at the instrument's sample
         rate and held between samples, as a LIDAR delivers them. Or InflowWind's single-point
         lidar, bound to the case's wind (:class:`lidar.PointLidar`): the records as OpenFAST v5
-        fills them (its type 1, the points' |V| and positions), taken where the time is an
+        fills them (its type 1, the points' ``|V|`` and positions), taken where the time is an
         exact multiple of its interval.
     isolate : bool
         Run the library in a child process, a new one per run (default): a library that ends

@@ -17,17 +17,21 @@ import subprocess
 from pathlib import Path
 from typing import Any
 
+import numpy as np
+
 from mpc_wt.errors import OpenFASTRunError
 
-__all__ = ["OPENFAST_ENV", "find_openfast", "prepare_deck", "run_openfast"]
+__all__ = ["OPENFAST_ENV", "find_openfast", "lidar_points", "prepare_deck", "run_openfast",
+           "write_lidar_inflow"]
 
 #: the environment variable that names the OpenFAST executable
 OPENFAST_ENV = "MPCWT_OPENFAST"
 
 #: a line whose value is a quoted path: ``"path"   KEY  - description``
 _PATH_LINE = re.compile(r'^(\s*)"([^"]*)"(\s+)(\S+)(.*)$')
-#: the keys of file names in a main file and a ServoDyn file (a list of StC files included)
-_FILE_KEY = re.compile(r"(File|files|FileName|InFile)(\(\d\))?$")
+#: the keys of file names in a main, ServoDyn or InflowWind file (a list of StC files
+#: included; InflowWind's FileName_BTS, FileName_Uni, FileName_u, ...)
+_FILE_KEY = re.compile(r"(File|files|FileName|InFile)(\(\d\))?$|^FileName_\w+$|^FilenameRoot$")
 
 
 def find_openfast(path: str | Path | None = None) -> Path:
@@ -157,6 +161,95 @@ def prepare_deck(fst: str | Path, out: str | Path, library: str | Path, input_fi
     for ext in (".out", ".outb"):          # an earlier run's output is not this run's
         copy.with_suffix(ext).unlink(missing_ok=True)
     return copy
+
+
+def _set_values(text: str, key: str, values: str) -> str:
+    """``text`` with every value before ``key`` on its line (one or several, comma-separated)
+    replaced by ``values``."""
+    pat = re.compile(rf'^(\s*)(\S.*?)(\s+{re.escape(key)}\b.*)$', re.M)
+    new, n = pat.subn(lambda m: f"{m.group(1)}{values}{m.group(3)}", text, count=1)
+    if n != 1:
+        raise ValueError(f"no line with the key {key!r} in the file")
+    return new
+
+
+def lidar_points(focus_distance: float, radius: float, n: int = 5) -> np.ndarray:
+    """``n`` InflowWind single points on the ring a hub-mounted CW lidar focuses on:
+    ``focus_distance`` upwind of the hub, ``radius`` from the shaft, at blade-1-up azimuths 0,
+    360 / n, ... deg (OpenFAST's frame: y = -r sin(psi), z = r cos(psi)).
+
+    Parameters
+    ----------
+    focus_distance, radius : float
+        [m], > 0.
+    n : int
+        Points, 3-5 (InflowWind's ``NumBeam`` at most 5; with 5 the LIDAR kinds' 1P fit is a
+        least-squares one and about as good as mpc-wt's CW lidar in OpenFAST's case).
+
+    Returns
+    -------
+    (n, 3) ndarray
+        x, y, z from the hub [m].
+    """
+    if not (focus_distance > 0 and radius > 0) or not 3 <= int(n) <= 5:
+        raise ValueError(f"lidar points need focus_distance > 0 m, radius > 0 m and 3-5 points, "
+                         f"got {focus_distance!r}, {radius!r}, {n!r}")
+    psi = 2.0 * np.pi * np.arange(int(n)) / int(n)
+    return np.stack([np.full(int(n), -float(focus_distance)), -radius * np.sin(psi),
+                     radius * np.cos(psi)], axis=1)
+
+
+def write_lidar_inflow(inflow: str | Path, out: str | Path, points: Any,
+                       interval: float) -> Path:
+    """A copy of an InflowWind file (v4 or v5 layout, with its LIDAR section) whose lidar is
+    single points (``SensorType 1``) at ``points`` measured every ``interval``, the files it
+    names made absolute: the lidar an exported LIDAR kind reads in OpenFAST.
+
+    Parameters
+    ----------
+    inflow : str or Path
+        The deck's InflowWind file (not written to).
+    out : str or Path
+        The copy's path.
+    points : (n, 3) array_like
+        x, y, z from the hub [m], 1-5 points upwind (:func:`lidar_points`).
+    interval : float
+        ``MeasurementInterval`` [s] (the library's ``DLL_DT``).
+
+    Returns
+    -------
+    Path
+
+    Raises
+    ------
+    FileNotFoundError
+        No such InflowWind file.
+    ValueError
+        A file without the LIDAR section's keys, or points InflowWind refuses.
+    """
+    import lidar as _lidar
+
+    inflow = Path(inflow)
+    if not inflow.is_file():
+        raise FileNotFoundError(f"the InflowWind file {inflow} does not exist")
+    pts = _lidar.PointLidar(points, float(interval)).points      # checked as InflowWind would
+    text = _absolute_paths(inflow.read_text(errors="replace"), inflow.parent.resolve(), {})
+    fmt = lambda col: ", ".join(f"{v:.4f}" for v in pts[:, col])  # noqa: E731
+    try:
+        for key, val in (("SensorType", "1"), ("NumPulseGate", "1"),
+                         ("NumBeam", str(pts.shape[0])), ("FocalDistanceX", fmt(0)),
+                         ("FocalDistanceY", fmt(1)), ("FocalDistanceZ", fmt(2)),
+                         ("RotorApexOffsetPos", "0, 0, 0"),
+                         ("MeasurementInterval", f"{float(interval):.10g}"),
+                         ("LidRadialVel", "False"), ("ConsiderHubMotion", "1")):
+            text = _set_values(text, key, val)
+    except ValueError as err:
+        raise ValueError(f"{inflow}: {err} (an InflowWind file with its LIDAR section, "
+                         f"OpenFAST v3 on)") from None
+    out = Path(out)
+    out.parent.mkdir(parents=True, exist_ok=True)
+    out.write_text(text)
+    return out
 
 
 def run_openfast(exe: str | Path, fst: str | Path, *, timeout: float = 3600.0,

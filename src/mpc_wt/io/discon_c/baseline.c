@@ -208,7 +208,7 @@ static int ff_step(mw_ff *f, const mw_meas *m, double *pitch, char *msg)
     double v;
     if (m->t >= f->next - 1e-9) {
         double u, arrival, w[3], taken;
-        if (mw_lidar_winds(m, f->cos_cone, w, &taken, "baseline", msg)) return -1;
+        if (mw_lidar_winds(m, f->cos_cone, 0.0, w, &taken, "baseline", msg)) return -1;
         u = (w[0] + w[1] + w[2]) / 3.0;
         f->n_mean++;
         if (f->n_mean == 1)

@@ -210,16 +210,17 @@ static int fit_1p(const mw_meas *m, double c[3])
  * - type 2, 3 beams, 1 gate: mpc-wt's hub-mounted CW lidar, one beam ahead of each blade,
  *   line-of-sight speeds: u = v_LOS / cos(cone);
  * - type 1 (InflowWind's single points, fixed in space), 1-5 beams: the speeds are the wind's
- *   magnitude at the points; with 3 or more around the rotor, their 1P fit at each blade's
- *   azimuth (blade k at record 60's azimuth + (k - 1) 120 deg), else their mean for every
- *   blade;
+ *   magnitude at the points; with 3 or more around the rotor, their 1P fit at the azimuth
+ *   each blade will have when the measured wind reaches it (blade k at record 60's azimuth +
+ *   (k - 1) 120 deg, turned on at the rotor speed over lead_s, the preview time, less the
+ *   sample's age), else their mean for every blade;
  * - type 2 or 3 with one beam (InflowWind's CW or pulsed lidar, LidRadialVel false: the
  *   speed is its estimate of the wind along x): gate 1's speed for every blade.
  * mpc-wt's host hands a sample over at the call it is taken; OpenFAST v5.0.0 at the call after
  * (its records at t are InflowWind's at t - DLL_DT, at the first call its first), so an
  * InflowWind lidar's sample is taken one interval (record 3) before the call. */
-int mw_lidar_winds(const mw_meas *m, double cos_cone, double u[3], double *taken,
-                   const char *who, char *msg)
+int mw_lidar_winds(const mw_meas *m, double cos_cone, double lead_s, double u[3],
+                   double *taken, const char *who, char *msg)
 {
     int i, b, n = m->lidar_n;
     double c[3];
@@ -238,8 +239,11 @@ int mw_lidar_winds(const mw_meas *m, double cos_cone, double u[3], double *taken
     if (m->t > 0.0 && m->dt > 0.0) *taken = m->t - m->dt;
     if (m->lidar_type == 1 && n >= 1) {
         if (fit_1p(m, c)) {
+            /* where blade b will be when the measured wind reaches the rotor, as mpc-wt's CW
+             * beams lead their blades by the rotor's turn over the preview time */
+            double ahead = m->rotor_speed * (lead_s - (m->t - *taken));
             for (b = 0; b < 3; b++) {
-                double psi = m->azimuth + 2.0943951023931957 * b;
+                double psi = m->azimuth + ahead + 2.0943951023931957 * b;
                 u[b] = c[0] + c[1] * cos(psi) + c[2] * sin(psi);
             }
         } else {

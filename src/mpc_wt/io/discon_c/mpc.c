@@ -133,7 +133,13 @@ static int preview_step(mw_preview *p, const mw_meas *m, char *msg)
 {
     double u[3], x, tp, taken;
     int i, b, k, n, lo;
-    if (mw_lidar_winds(m, p->cos_cone, u, &taken, "mpc", msg)) return -1;
+    if (p->n_mean == 0 && !(p->fixed > 0)) {   /* the first sample's own mean sets its lead */
+        if (mw_lidar_winds(m, p->cos_cone, 0.0, u, &taken, "mpc", msg)) return -1;
+        tp = p->focus / dmax((u[0] + u[1] + u[2]) / 3.0, p->min_wind);
+    } else {
+        tp = p->fixed > 0 ? p->fixed : p->focus / dmax(p->mean, p->min_wind);
+    }
+    if (mw_lidar_winds(m, p->cos_cone, tp, u, &taken, "mpc", msg)) return -1;
     if (taken > p->last) {          /* a new sample (a held one is not taken again) */
         x = (u[0] + u[1] + u[2]) / 3.0;
         p->n_mean++;

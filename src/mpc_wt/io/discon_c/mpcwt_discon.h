@@ -63,8 +63,8 @@ typedef struct {
 
 /* each blade's wind from the lidar records (see discon.c) and when it was measured [s]; -1 with a message naming the
  * records on a configuration no law reads or a speed that is not finite */
-int mw_lidar_winds(const mw_meas *m, double cos_cone, double u[3], double *taken,
-                   const char *who, char *msg);
+int mw_lidar_winds(const mw_meas *m, double cos_cone, double lead_s, double u[3],
+                   double *taken, const char *who, char *msg);
 
 /* logging channels a kind returns beside its demands (Bladed's records 65 and L1 = record 63
  * on): each kind lists its own, in order, in its export (LawExport.log) */
