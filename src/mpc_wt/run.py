@@ -765,6 +765,7 @@ def _with_lidar(deck: Path, out: Path, ex: Any, turbine: linearize.Turbine,
     kind reads (:func:`mpc_wt.io.openfast_run.lidar_points` on the design's focus distance and
     cone, ``inflow.dat`` in ``out/openfast``)."""
     from linearize.openfast import OpenFASTFile
+    from mpc_wt.io.discon_export import lidar_geometry
     from mpc_wt.io.openfast_case import read_openfast_case
     from mpc_wt.io.openfast_run import lidar_points, prepare_deck, write_lidar_inflow
 
@@ -773,11 +774,11 @@ def _with_lidar(deck: Path, out: Path, ex: Any, turbine: linearize.Turbine,
                                             and case.lidar["sensor_type"] == 1):
         return deck, case
 
-    m = re.search(r"^(?:lidar|ff)\s+(\S+)\s+(\S+)", ex.input_file.read_text(), re.M)
-    if m is None:
+    geo = lidar_geometry(ex.input_file)
+    if geo is None:
         raise ValueError(f"{ex.input_file}: no 'lidar' or 'ff' key with the LIDAR's cone and "
                          f"focus distance")
-    cos_cone, focus = float(m.group(1)), float(m.group(2))
+    cos_cone, focus = geo
     inflow = OpenFASTFile(deck).file("InflowFile")
     if inflow is None:
         raise ValueError(f"{deck}: no InflowFile to give the LIDAR kind its lidar")

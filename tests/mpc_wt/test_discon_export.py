@@ -732,3 +732,30 @@ def test_cli_design_lqr_pio_and_ts_then_export_discon(tmp_path, capsys):
     assert main(["export", str(t), "--format", "discon"]) != 0
     err = capsys.readouterr().err
     assert "[12.0, 25.0]" in err and "[12.0, 14.0, 16.0, 19.0, 22.0, 25.0]" in err
+
+
+def test_export_for_a_users_deck_writes_its_servodyn_and_inflowwind_files(tmp_path):
+    """A turbine read from an OpenFAST deck (the rosco package's NREL-5MW): the export writes a
+    copy of that deck's ServoDyn file pointed at the library, and for a LIDAR kind a copy of its
+    InflowWind file with five single points 54 m upwind on the CW lidar's ring (r = 54
+    tan(cone)); a turbine without a deck gets the note instead."""
+    pytest.importorskip("rosco")
+    from linearize.openfast import OpenFASTFile
+    from mpc_wt.controllers.discon import rosco_discon
+
+    fst = next(rosco_discon("NREL-5MW").parent.glob("*.fst"))
+    t = linearize.load_openfast(fst)
+    ex = export_discon(t, "baseline+lidar-ff", tmp_path / "ff", build=False)
+    srv = OpenFASTFile(ex.servodyn)
+    assert Path(srv.text("DLL_FileName")) == (tmp_path / "ff" / library_name(
+        "baseline+lidar-ff")).resolve()
+    assert srv.text("DLL_InFile") == str(ex.input_file.resolve())
+    iw = OpenFASTFile(ex.inflow)
+    assert iw.integer("SensorType") == 1 and iw.integer("NumBeam") == 5
+    x, y, z = (iw.numbers(f"FocalDistance{c}") for c in "XYZ")
+    np.testing.assert_allclose(x, -54.0, atol=1e-4)
+    np.testing.assert_allclose(np.hypot(y, z), 54.0 * math.tan(math.radians(41.19)), rtol=1e-3)
+    assert ex.inflow in ex.files()
+    plain = export_discon(linearize.load_turbine("nrel5mw"), "baseline", tmp_path / "b",
+                          build=False)
+    assert plain.inflow is None

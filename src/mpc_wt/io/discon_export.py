@@ -24,6 +24,7 @@ import importlib.resources
 import logging
 import math
 import os
+import re
 import shutil
 import subprocess
 import sys
@@ -38,7 +39,8 @@ from mpc_wt.errors import ControllerLibraryError
 __all__ = ["DisconExport", "LawExport", "COMMON_SOURCES", "SIGNAL_CODES", "export_controller",
            "export_design", "controller_input", "prepare_sources", "shipped_library",
            "shipped_input", "signal_codes", "build_library",
-           "find_compiler", "library_name", "servodyn_input", "SWAP_READ", "SWAP_WRITTEN"]
+           "find_compiler", "library_name", "lidar_geometry", "servodyn_input", "SWAP_READ",
+           "SWAP_WRITTEN"]
 
 log = logging.getLogger(__name__)
 
@@ -159,12 +161,15 @@ class DisconExport:
     library : Path or None
         The built library (None when it was not built: see ``note``).
     servodyn : Path or None
-        A ServoDyn input file of the turbine's packaged OpenFAST deck pointing at the library
-        (None when no deck is packaged for the turbine: see ``note``).
+        A ServoDyn input file pointing at the library, from the OpenFAST deck the turbine was
+        read from or the turbine's packaged one (None without either: see ``note``).
     dt : float
         The communication interval the design runs at [s] (ServoDyn's ``DLL_DT``).
     note : str
         What was not done and why (empty when everything was).
+    inflow : Path or None
+        For a LIDAR kind of a turbine read from an OpenFAST deck: a copy of the deck's
+        InflowWind file with the single-point lidar the kind reads.
     """
 
     kind: str
@@ -176,16 +181,17 @@ class DisconExport:
     servodyn: Path | None
     dt: float
     note: str = ""
+    inflow: Path | None = None
 
     def files(self) -> list[Path]:
-        """Every file the export wrote: the input file, the library and the ServoDyn file
-        (when made), the Makefile and the sources.
+        """Every file the export wrote: the input file, the library, the ServoDyn and
+        InflowWind files (when made), the Makefile and the sources.
 
         Returns
         -------
         list of Path
         """
-        made = [f for f in (self.library, self.servodyn) if f is not None]
+        made = [f for f in (self.library, self.servodyn, self.inflow) if f is not None]
         return [self.input_file, *made, self.makefile, *self.sources]
 
 
@@ -569,7 +575,19 @@ def shipped_input(controller: Any, export: LawExport, turbine: linearize.Turbine
     return path
 
 
+def _user_deck(turbine: linearize.Turbine) -> Path | None:
+    """The OpenFAST deck (main file) the turbine was read from, if it was."""
+    src = Path(str(getattr(turbine, "source", "") or ""))
+    return src if src.suffix.lower() == ".fst" and src.is_file() else None
+
+
 def _deck_servodyn(turbine: linearize.Turbine) -> Path | None:
+    deck = _user_deck(turbine)
+    if deck is not None:
+        from linearize.openfast import OpenFASTFile
+
+        p = OpenFASTFile(deck).file("ServoFile")
+        return p if p is not None and p.is_file() else None
     name = turbine.name
     if name.startswith("IEA-15-240-RWT"):
         root = importlib.resources.files("linearize") / "data" / "iea15mw"
@@ -584,6 +602,51 @@ def _deck_servodyn(turbine: linearize.Turbine) -> Path | None:
         p = deck / "NRELOffshrBsline5MW_Onshore_ServoDyn.dat"
         return p if p.is_file() else None
     return None
+
+
+def lidar_geometry(input_file: str | Path) -> tuple[float, float] | None:
+    """The LIDAR an exported library reads: cos(cone) and the focus distance [m] of its input
+    file's ``lidar`` (MPC) or ``ff`` (feedforward) key, where it turns one on; else None.
+
+    Parameters
+    ----------
+    input_file : str or Path
+        The export's input file.
+
+    Returns
+    -------
+    (float, float) or None
+    """
+    text = Path(input_file).read_text()
+    if re.search(r"^(feedforward|lidar_preview)\s+1\b", text, re.M) is None:
+        return None
+    m = re.search(r"^(?:lidar|ff)\s+(\S+)\s+(\S+)", text, re.M)
+    return None if m is None else (float(m.group(1)), float(m.group(2)))
+
+
+def _lidar_inflow(turbine: linearize.Turbine, input_file: Path, out: Path, dt: float,
+                  notes: list[str]) -> Path | None:
+    """For a LIDAR kind exported for a turbine read from an OpenFAST deck: a copy of the deck's
+    InflowWind file with five single points on the design's ring
+    (:func:`mpc_wt.io.openfast_run.write_lidar_inflow`)."""
+    geo = lidar_geometry(input_file)
+    deck = _user_deck(turbine)
+    if geo is None:
+        return None
+    if deck is None:
+        notes.append("the LIDAR kind needs a single-point lidar in InflowWind: see the docs' "
+                     "'LIDAR kinds in OpenFAST' for the lines")
+        return None
+    from linearize.openfast import OpenFASTFile
+    from mpc_wt.io.openfast_run import lidar_points, write_lidar_inflow
+
+    iw = OpenFASTFile(deck).file("InflowFile")
+    if iw is None or not iw.is_file():
+        notes.append(f"the deck {deck} names no InflowWind file: write its lidar yourself")
+        return None
+    cos_cone, focus = geo
+    return write_lidar_inflow(iw, out, lidar_points(focus, focus * math.tan(math.acos(cos_cone))),
+                              dt)
 
 
 def servodyn_input(template: str | Path, out: str | Path, library: str | Path,
@@ -687,16 +750,19 @@ def export_controller(controller: Any, export: LawExport, turbine: linearize.Tur
     template = _deck_servodyn(turbine)
     servodyn = None
     if template is None:
-        notes.append(f"no OpenFAST deck is packaged for {turbine.name}: set DLL_FileName, "
-                     f"DLL_InFile, DLL_ProcName and DLL_DT in your ServoDyn file yourself")
+        where = (f"the deck {_user_deck(turbine)} names no ServoDyn file" if _user_deck(turbine)
+                 else f"no OpenFAST deck is packaged for {turbine.name}")
+        notes.append(f"{where}: set DLL_FileName, DLL_InFile, DLL_ProcName and DLL_DT in your "
+                     f"ServoDyn file yourself")
     else:
         servodyn = servodyn_input(template, directory / f"ServoDyn_{stem}.dat",
                                   directory / lib_name, input_file, dt)
+    inflow = _lidar_inflow(turbine, input_file, directory / f"InflowWind_{stem}.dat", dt, notes)
     for n in notes:
         log.warning("%s", n)
     return DisconExport(kind=export.name, directory=directory, input_file=input_file,
                         sources=sources, makefile=makefile, library=library,
-                        servodyn=servodyn, dt=dt, note="; ".join(notes))
+                        servodyn=servodyn, dt=dt, note="; ".join(notes), inflow=inflow)
 
 
 def export_design(doc: Mapping[str, Any], export: LawExport, turbine: linearize.Turbine,
