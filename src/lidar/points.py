@@ -54,12 +54,17 @@ class PointLidar:
         points' there): x of the apex, y 0, z the hub height.
     field : WindField, optional
         What it measures (:meth:`bind`).
+    sensor_type : {1, 2}
+        1: single points, the wind's magnitude at each; 2: InflowWind's CW lidar, one beam
+        with ``LidRadialVel False`` (its estimate of the wind along x), taken here as the x
+        component at its focus point (InflowWind weights it along the beam).
     """
 
     points: Any
     interval: float
     hub: Any = (0.0, 0.0, 0.0)
     field: WindField | None = None
+    sensor_type: int = 1
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "points", _points("points", self.points))
@@ -71,6 +76,9 @@ class PointLidar:
         if hub.shape != (3,) or not np.all(np.isfinite(hub)):
             raise ValueError(f"hub must be a finite (x, y, z) [m], got {self.hub!r}")
         object.__setattr__(self, "hub", hub)
+        if self.sensor_type not in (1, 2) or (self.sensor_type == 2 and len(self.points) != 1):
+            raise ValueError(f"sensor_type must be 1 (single points) or 2 (one CW beam, one "
+                             f"point), got {self.sensor_type!r} with {len(self.points)} points")
 
     def bind(self, field: WindField) -> "PointLidar":
         """This lidar on ``field``.
@@ -88,7 +96,7 @@ class PointLidar:
         """
         if not isinstance(field, WindField):
             raise TypeError(f"field must be a WindField, got {type(field).__name__}")
-        return PointLidar(self.points, self.interval, self.hub, field)
+        return PointLidar(self.points, self.interval, self.hub, field, self.sensor_type)
 
     def due(self, t: float) -> bool:
         """Whether InflowWind measures at ``t``: ``interval * int(t / interval) == t``.
@@ -115,8 +123,8 @@ class PointLidar:
         Returns
         -------
         (4 + 4 n,) ndarray
-            Sensor type 1, n beams, 1 gate, 0, the n speeds ``|V|`` [m/s], then the points' x,
-            y, z in OpenFAST's frame [m].
+            The sensor type, n beams, 1 gate, 0, the n speeds (``|V|``, or u for the CW
+            beam) [m/s], then the points' x, y, z in OpenFAST's frame [m].
 
         Raises
         ------
@@ -131,9 +139,9 @@ class PointLidar:
         p = self.points
         tt = t - p[:, 0] / float(f.mean_speed)
         z = f.hub_height + p[:, 2]
-        uvw = np.stack(f.sample_components(tt, p[:, 1], z, "uvw"))
-        speed = np.sqrt(np.sum(uvw.astype(float) ** 2, axis=0))
+        uvw = np.stack(f.sample_components(tt, p[:, 1], z, "uvw")).astype(float)
+        speed = np.sqrt(np.sum(uvw ** 2, axis=0)) if self.sensor_type == 1 else uvw[0]
         pos = p + self.hub
         n = p.shape[0]
-        return np.concatenate([[1.0, float(n), 1.0, 0.0], speed, pos[:, 0], pos[:, 1],
-                               pos[:, 2]])
+        return np.concatenate([[float(self.sensor_type), float(n), 1.0, 0.0], speed, pos[:, 0],
+                               pos[:, 1], pos[:, 2]])

@@ -611,21 +611,24 @@ def run_openfast_case(case: Any, controller: str = "auto", *, library: str | Pat
 
 
 def _case_lidar(case: Any, wind: Any) -> Any:
-    """InflowWind's single-point lidar of the case on its wind (:class:`lidar.PointLidar`), or
-    None where the case has no lidar; its CW and pulsed lidars are not made on mpc-wt's
-    plant."""
+    """InflowWind's lidar of the case on its wind (:class:`lidar.PointLidar`: single points, or
+    the CW beam's x estimate at its focus), or None where the case has no lidar; the pulsed
+    lidar is not made on mpc-wt's plant."""
     cfg = case.lidar
     if cfg is None or not isinstance(wind, linearize.GridWind):
         return None
-    if cfg["sensor_type"] != 1:
-        raise ValueError(f"{cfg['file']}: SensorType = {cfg['sensor_type']}; mpc-wt's plant "
-                         f"measures InflowWind's single-point lidar (SensorType 1) only")
+    if cfg["sensor_type"] == 3 or (cfg["sensor_type"] == 2 and cfg["radial"]):
+        raise ValueError(f"{cfg['file']}: SensorType = {cfg['sensor_type']}"
+                         f"{', LidRadialVel True' if cfg['radial'] else ''}; mpc-wt's plant "
+                         f"measures InflowWind's single points (SensorType 1) and its CW lidar "
+                         f"with LidRadialVel False (SensorType 2)")
     g = case.turbine.geometry
     f = lidar.WindField(t=wind.t, y=wind.y, z=wind.z, u=wind.u, v=wind.v, w=wind.w,
                         mean_speed=float(lidar.WindField.load(case.wind_file).mean_speed),
                         hub_height=g.hub_height)
     hub = (-g.overhang * math.cos(g.shaft_tilt_rad), 0.0, g.hub_height)
-    return lidar.PointLidar(cfg["points"], cfg["interval"], hub).bind(f)
+    return lidar.PointLidar(cfg["points"], cfg["interval"], hub,
+                            sensor_type=cfg["sensor_type"]).bind(f)
 
 
 #: what :func:`verify_openfast` flags: (row key, channel, bound, what it is), a difference of

@@ -68,6 +68,18 @@ def test_point_lidar_records_hand_worked():
     assert pl.due(0.2) and not pl.due(0.3) and pl.due(0.0)
 
 
+def test_a_cw_beam_gives_the_wind_along_x_hand_worked():
+    """InflowWind's CW lidar with LidRadialVel False (SensorType 2, one beam): its estimate of
+    the wind along x, here the focus point's u (12 m/s in a uniform (12, 3, 4) m/s wind, not
+    |V| = 13); more than one point is refused, as InflowWind does for a CW lidar."""
+    pl = lidar.PointLidar([[-54.0, 0.0, 0.0]], 0.1, hub=(-5.0, 0.0, 90.0), sensor_type=2).bind(
+        _field(lambda z: np.full_like(z, 12.0), v=3.0, w=4.0))
+    np.testing.assert_allclose(pl.records(1.0), [2, 1, 1, 0, 12.0, -59.0, 0.0, 90.0],
+                               rtol=1e-6)
+    with pytest.raises(ValueError, match="one CW beam"):
+        lidar.PointLidar(_ring(3), 0.1, sensor_type=2)
+
+
 @pytest.mark.parametrize("bad, match", [
     (np.zeros((0, 3)), "1 <= n <= 5"), (np.zeros((6, 3)), "1 <= n <= 5"),
     (np.zeros((3, 2)), r"\(n, 3\)"), ([[54.0, 0.0, 0.0]], "upwind"),
@@ -82,17 +94,18 @@ def mpc_lidar(tmp_path_factory):
     return exported("mpc-lidar", tmp_path_factory.mktemp("mpcl") / "lib")
 
 
-@pytest.mark.parametrize("n", [1, 2, 3, 5])
-def test_the_library_reads_each_blade_at_its_azimuth(mpc_lidar, n):
+@pytest.mark.parametrize("n, kind", [(1, 1), (2, 1), (3, 1), (5, 1), (1, 2)])
+def test_the_library_reads_each_blade_at_its_azimuth(mpc_lidar, n, kind):
     """A linear shear u = 10 + 0.1 (z - 90) m/s and no v, w, measured at n fixed points: with
     3 or more around the rotor the MPC's blade winds (its logging channels lidar_wind_1..3) are
     the 1P fit at the azimuth each blade will have when that wind reaches it, 10 + 4.725
     cos(psi + omega (T_p - age) + (k - 1) 120 deg) m/s with T_p = 54 m / 10 m/s, exact for a
-    linear shear; with fewer, every blade gets the points' mean. The records at a call hold the
+    linear shear; with fewer, every blade gets the points' mean (a CW beam, SensorType 2: its
+    speed). The records at a call hold the
     sample of the call before (as OpenFAST hands them over), the first call's its own; the
     blade's azimuth is the call's."""
     t = linearize.load_turbine("nrel5mw")
-    pl = lidar.PointLidar(_ring(n), 0.1, hub=(-5.0, 0.0, 90.0)).bind(
+    pl = lidar.PointLidar(_ring(n), 0.1, hub=(-5.0, 0.0, 90.0), sensor_type=kind).bind(
         _field(lambda z: 10.0 + 0.1 * (z - 90.0)))
     ctl = DisconController(mpc_lidar.library, mpc_lidar.input_file, t, dt=0.1, lidar=pl,
                            isolate=False, log_names=("qp_fallback", "qp_solve_ms",
