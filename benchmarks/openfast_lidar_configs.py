@@ -27,7 +27,8 @@ import linearize
 import lidar
 from mpc_wt.assessment.fatigue import damage_equivalent_load
 from mpc_wt.controllers.discon import DisconController
-from mpc_wt.io.openfast_case import case_grid_wind, read_openfast_case
+from mpc_wt.io.openfast_case import case_grid_wind, case_wind_field, read_openfast_case
+from mpc_wt.io.openfast_run import lidar_points
 from mpc_wt.run import export_discon
 from mpc_wt.simulation.loop import simulate_closed_loop
 
@@ -37,31 +38,27 @@ FST = (SHARED / "validation" / "nrel5mw" / "openfast_rtest" / "5MW_Land_DLL_WTur
 R = 47.25
 
 
-def _sensor(config: str, case, wind, turbine):
+def _sensor(config: str, field, turbine):
     if config == "none":
         return None
     g = turbine.geometry
-    f = lidar.WindField(t=wind.t, y=wind.y, z=wind.z, u=wind.u, v=wind.v, w=wind.w,
-                        mean_speed=float(lidar.WindField.load(case.wind_file).mean_speed),
-                        hub_height=g.hub_height)
     if config == "cw":
-        return lidar.LidarSensor(lidar.CWLidar(g.tip_radius), evolution=False, field=f)
+        return lidar.LidarSensor(lidar.CWLidar(g.tip_radius), evolution=False, field=field)
     n = int(config[len("points"):])
-    psi = 2.0 * np.pi * np.arange(n) / n
-    r = R if n >= 3 else 0.0
-    pts = np.stack([np.full(n, -54.0), -r * np.sin(psi), r * np.cos(psi)], axis=1)
+    pts = lidar_points(54.0, R, n) if n >= 3 else np.array([[-54.0, 0.0, 0.0]])
     hub = (-g.overhang * math.cos(g.shaft_tilt_rad), 0.0, g.hub_height)
-    return lidar.PointLidar(pts, 0.1, hub).bind(f)
+    return lidar.PointLidar(pts, 0.1, hub).bind(field)
 
 
 def _run(kind: str, config: str, out: Path) -> dict[str, float]:
     turbine = linearize.load_turbine("nrel5mw")
     ex = export_discon(turbine, kind, out / kind, None)
     case = read_openfast_case(FST, turbine=turbine)
-    wind, _ = case_grid_wind(case)
+    field = case_wind_field(case)
+    wind, _ = case_grid_wind(case, field)
     ctl = DisconController(ex.library, ex.input_file, turbine, dt=ex.dt,
                            pitch_control="individual", isolate=False,
-                           lidar=_sensor(config, case, wind, turbine))
+                           lidar=_sensor(config, field[0], turbine))
     params = linearize.plant_params(turbine, case.config)
     x0 = case.x0.copy()
     u0 = np.array([x0[5], x0[6], x0[7], turbine.rated_generator_torque])

@@ -4,8 +4,6 @@ from __future__ import annotations
 import contextlib
 import dataclasses
 import logging
-import math
-import re
 from pathlib import Path
 from typing import Any, Iterator, Mapping, Sequence
 
@@ -574,7 +572,7 @@ def run_openfast_case(case: Any, controller: str = "auto", *, library: str | Pat
     """
     from mpc_wt.controllers.baseline import BaselineController, jonkman_gains
     from mpc_wt.controllers.discon import DisconController, rosco_library
-    from mpc_wt.io.openfast_case import case_grid_wind, describe
+    from mpc_wt.io.openfast_case import case_grid_wind, case_lidar, case_wind_field, describe
 
     if controller not in CASE_CONTROLLERS:
         raise ValueError(f"controller must be one of {list(CASE_CONTROLLERS)}, got "
@@ -582,7 +580,8 @@ def run_openfast_case(case: Any, controller: str = "auto", *, library: str | Pat
     if controller == "auto":
         controller = "rosco" if case.discon_in is not None else "jonkman"
     turbine = case.turbine
-    wind, shift = case_grid_wind(case)
+    field = case_wind_field(case) if case.steady_wind is None else None
+    wind, shift = case_grid_wind(case, field)
     if controller == "jonkman":
         gains = jonkman_gains()
         ctl: Any = BaselineController(turbine, gains, dt=dt)
@@ -594,7 +593,8 @@ def run_openfast_case(case: Any, controller: str = "auto", *, library: str | Pat
                              f"file (library={library!r}, discon_in={dis!r})")
         ctl = DisconController(lib, dis, turbine, dt=_case_interval(case, dt),
                                pitch_control="individual" if case.individual_pitch
-                               else "collective", lidar=_case_lidar(case, wind),
+                               else "collective",
+                               lidar=None if field is None else case_lidar(case, field[0]),
                                workdir=workdir)
     params = linearize.plant_params(turbine, config or case.config)
     x0 = case.x0.copy()
@@ -610,27 +610,6 @@ def run_openfast_case(case: Any, controller: str = "auto", *, library: str | Pat
                                 meta=meta)
 
 
-def _case_lidar(case: Any, wind: Any) -> Any:
-    """InflowWind's lidar of the case on its wind (:class:`lidar.PointLidar`: single points, or
-    the CW beam's x estimate at its focus), or None where the case has no lidar; the pulsed
-    lidar is not made on mpc-wt's plant."""
-    cfg = case.lidar
-    if cfg is None or not isinstance(wind, linearize.GridWind):
-        return None
-    if cfg["sensor_type"] == 3 or (cfg["sensor_type"] == 2 and cfg["radial"]):
-        raise ValueError(f"{cfg['file']}: SensorType = {cfg['sensor_type']}"
-                         f"{', LidRadialVel True' if cfg['radial'] else ''}; mpc-wt's plant "
-                         f"measures InflowWind's single points (SensorType 1) and its CW lidar "
-                         f"with LidRadialVel False (SensorType 2)")
-    g = case.turbine.geometry
-    f = lidar.WindField(t=wind.t, y=wind.y, z=wind.z, u=wind.u, v=wind.v, w=wind.w,
-                        mean_speed=float(lidar.WindField.load(case.wind_file).mean_speed),
-                        hub_height=g.hub_height)
-    hub = (-g.overhang * math.cos(g.shaft_tilt_rad), 0.0, g.hub_height)
-    return lidar.PointLidar(cfg["points"], cfg["interval"], hub,
-                            sensor_type=cfg["sensor_type"]).bind(f)
-
-
 #: what :func:`verify_openfast` flags: (row key, channel, bound, what it is), a difference of
 #: mpc-wt's run from OpenFAST's beyond the bound is flagged
 VERIFY_BOUNDS = (("mean_diff_pct", "gen_power", 1.0, "mean power [%]"),
@@ -641,13 +620,6 @@ VERIFY_BOUNDS = (("mean_diff_pct", "gen_power", 1.0, "mean power [%]"),
                  ("del_diff_pct", "lss_torque", 10.0, "shaft torque DEL [%]"),
                  ("del_diff_pct", "tower_base_fa_moment", 10.0, "tower base fore-aft DEL [%]"),
                  ("del_diff_pct", "tower_base_ss_moment", 10.0, "tower base side-side DEL [%]"))
-
-
-def _reads_lidar(input_file: Path) -> bool:
-    """Whether an exported library's input file turns on a LIDAR (the feedforward or the MPC's
-    preview)."""
-    return re.search(r"^(feedforward|lidar_preview)\s+1\b", input_file.read_text(),
-                     re.M) is not None
 
 
 def _verify_flags(rows: list[dict[str, Any]], travel: tuple[float, float],
@@ -768,28 +740,20 @@ def _with_lidar(deck: Path, out: Path, ex: Any, turbine: linearize.Turbine,
     kind reads (:func:`mpc_wt.io.openfast_run.lidar_points` on the design's focus distance and
     cone, ``inflow.dat`` in ``out/openfast``)."""
     from linearize.openfast import OpenFASTFile
-    from mpc_wt.io.discon_export import lidar_geometry
+    from mpc_wt.io.discon_export import lidar_geometry, lidar_inflow
     from mpc_wt.io.openfast_case import read_openfast_case
-    from mpc_wt.io.openfast_run import lidar_points, prepare_deck, write_lidar_inflow
+    from mpc_wt.io.openfast_run import prepare_deck
 
     case = read_openfast_case(deck, turbine=turbine)
-    if not _reads_lidar(ex.input_file) or (case.lidar is not None
-                                            and case.lidar["sensor_type"] == 1):
+    if lidar_geometry(ex.input_file) is None or (case.lidar is not None
+                                                 and case.lidar["sensor_type"] == 1):
         return deck, case
-
-    geo = lidar_geometry(ex.input_file)
-    if geo is None:
-        raise ValueError(f"{ex.input_file}: no 'lidar' or 'ff' key with the LIDAR's cone and "
-                         f"focus distance")
-    cos_cone, focus = geo
     inflow = OpenFASTFile(deck).file("InflowFile")
     if inflow is None:
         raise ValueError(f"{deck}: no InflowFile to give the LIDAR kind its lidar")
-    radius = focus * math.tan(math.acos(cos_cone))
-    iw = write_lidar_inflow(inflow, out / "openfast" / "inflow.dat",
-                            lidar_points(focus, radius), ex.dt)
+    iw = lidar_inflow(ex.input_file, inflow, out / "openfast" / "inflow.dat", ex.dt)
     log.info("the deck's InflowWind has no single-point lidar; %s has five on the design's "
-             "ring (%.1f m upwind, r = %.2f m)", iw, focus, radius)
+             "ring", iw)
     deck = prepare_deck(deck, out / "openfast", ex.library, ex.input_file, ex.dt, tmax=tmax,
                         inflow=iw)
     return deck, read_openfast_case(deck, turbine=turbine)

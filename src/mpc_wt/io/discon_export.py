@@ -39,7 +39,8 @@ from mpc_wt.errors import ControllerLibraryError
 __all__ = ["DisconExport", "LawExport", "COMMON_SOURCES", "SIGNAL_CODES", "export_controller",
            "export_design", "controller_input", "prepare_sources", "shipped_library",
            "shipped_input", "signal_codes", "build_library",
-           "find_compiler", "library_name", "lidar_geometry", "servodyn_input", "SWAP_READ",
+           "find_compiler", "library_name", "lidar_geometry", "lidar_inflow", "servodyn_input",
+           "SWAP_READ",
            "SWAP_WRITTEN"]
 
 log = logging.getLogger(__name__)
@@ -624,29 +625,58 @@ def lidar_geometry(input_file: str | Path) -> tuple[float, float] | None:
     return None if m is None else (float(m.group(1)), float(m.group(2)))
 
 
-def _lidar_inflow(turbine: linearize.Turbine, input_file: Path, out: Path, dt: float,
-                  notes: list[str]) -> Path | None:
-    """For a LIDAR kind exported for a turbine read from an OpenFAST deck: a copy of the deck's
-    InflowWind file with five single points on the design's ring
-    (:func:`mpc_wt.io.openfast_run.write_lidar_inflow`)."""
+def lidar_inflow(input_file: str | Path, inflow: str | Path, out: str | Path,
+                 dt: float) -> Path | None:
+    """A copy of an InflowWind file with the lidar an exported LIDAR kind reads; None for a
+    kind that reads no LIDAR.
+
+    Five single points on its design's ring, the focus distance D upwind at r = D tan(cone)
+    (:func:`mpc_wt.io.openfast_run.lidar_points`,
+    :func:`mpc_wt.io.openfast_run.write_lidar_inflow`).
+
+    Parameters
+    ----------
+    input_file : str or Path
+        The export's input file (:func:`lidar_geometry`).
+    inflow : str or Path
+        The deck's InflowWind file (not written to).
+    out : str or Path
+        The copy's path.
+    dt : float
+        ``MeasurementInterval`` [s] (the library's ``DLL_DT``).
+
+    Returns
+    -------
+    Path or None
+    """
+    from mpc_wt.io.openfast_run import lidar_points, write_lidar_inflow
+
     geo = lidar_geometry(input_file)
-    deck = _user_deck(turbine)
     if geo is None:
         return None
+    cos_cone, focus = geo
+    return write_lidar_inflow(inflow, out, lidar_points(focus, focus * math.tan(
+        math.acos(cos_cone))), dt)
+
+
+def _lidar_inflow(turbine: linearize.Turbine, input_file: Path, out: Path, dt: float,
+                  notes: list[str]) -> Path | None:
+    """For a LIDAR kind exported for a turbine read from an OpenFAST deck: :func:`lidar_inflow`
+    on the deck's InflowWind file (a note where it cannot be made)."""
+    if lidar_geometry(input_file) is None:
+        return None
+    deck = _user_deck(turbine)
     if deck is None:
         notes.append("the LIDAR kind needs a single-point lidar in InflowWind: see the docs' "
                      "'LIDAR kinds in OpenFAST' for the lines")
         return None
     from linearize.openfast import OpenFASTFile
-    from mpc_wt.io.openfast_run import lidar_points, write_lidar_inflow
 
     iw = OpenFASTFile(deck).file("InflowFile")
     if iw is None or not iw.is_file():
         notes.append(f"the deck {deck} names no InflowWind file: write its lidar yourself")
         return None
-    cos_cone, focus = geo
-    return write_lidar_inflow(iw, out, lidar_points(focus, focus * math.tan(math.acos(cos_cone))),
-                              dt)
+    return lidar_inflow(input_file, iw, out, dt)
 
 
 def servodyn_input(template: str | Path, out: str | Path, library: str | Path,

@@ -248,10 +248,9 @@ def _inflow(main: OpenFASTFile) -> tuple[Path | None, tuple[float, float] | None
     return iw.file("FileName_BTS"), None
 
 
-def case_grid_wind(case: OpenFASTCase) -> tuple[linearize.GridWind | linearize.SteadyWind,
-                                                  float]:
-    """The plant's wind for the case: the ``.bts`` field (u, v, w) as the rotor meets it, or
-    the case's steady power-law wind (no shift).
+def case_wind_field(case: OpenFASTCase) -> tuple[lidar.WindField, float]:
+    """The case's ``.bts`` field as the rotor meets it (u at least 0), for the plant
+    (:func:`case_grid_wind`) and a lidar (:func:`case_lidar`).
 
     InflowWind carries a full field past the turbine at its mean speed U, its grid's upwind
     edge starting at the tower: the wind at a point x downwind of the tower at time t is the
@@ -262,16 +261,23 @@ def case_grid_wind(case: OpenFASTCase) -> tuple[linearize.GridWind | linearize.S
     Parameters
     ----------
     case : OpenFASTCase
+        A case in a TurbSim field (not a steady wind).
 
     Returns
     -------
-    wind : linearize.GridWind or linearize.SteadyWind
-        Times from the shift on, as seen at the rotor.
+    field : lidar.WindField
+        Times from the shift on, as seen at the rotor; the file's mean speed, the turbine's
+        hub height.
     shift : float
         [s]
+
+    Raises
+    ------
+    ResultFileError
+        A steady-wind case, or a field shorter than the case.
     """
-    if case.steady_wind is not None:
-        return linearize.SteadyWind(*case.steady_wind), 0.0
+    if case.steady_wind is not None or case.wind_file is None:
+        raise ResultFileError(f"{case.fst}: the case runs in a steady wind, not a TurbSim field")
     f = lidar.WindField.load(case.wind_file)
     g = case.turbine.geometry
     u_ref = float(f.mean_speed)
@@ -282,9 +288,67 @@ def case_grid_wind(case: OpenFASTCase) -> tuple[linearize.GridWind | linearize.S
                               f"the case's {case.duration:g} s plus the {shift:.2f} s the "
                               f"field takes to reach the rotor")
     u = np.maximum(f.u[keep], 0.0).astype(np.float32)
-    wind = linearize.GridWind(t=f.t[keep] - f.t[0] - shift, y=f.y, z=f.z, u=u, v=f.v[keep],
-                              w=f.w[keep])
-    return wind, shift
+    return lidar.WindField(t=f.t[keep] - f.t[0] - shift, y=f.y, z=f.z, u=u, v=f.v[keep],
+                           w=f.w[keep], mean_speed=u_ref, hub_height=g.hub_height), shift
+
+
+def case_grid_wind(case: OpenFASTCase,
+                   field: tuple[lidar.WindField, float] | None = None
+                   ) -> tuple[linearize.GridWind | linearize.SteadyWind, float]:
+    """The plant's wind for the case: the ``.bts`` field (u, v, w) as the rotor meets it
+    (:func:`case_wind_field`), or the case's steady power-law wind (no shift).
+
+    Parameters
+    ----------
+    case : OpenFASTCase
+    field : (lidar.WindField, float), optional
+        :func:`case_wind_field`'s result, where it was read already.
+
+    Returns
+    -------
+    wind : linearize.GridWind or linearize.SteadyWind
+        Times from the shift on, as seen at the rotor.
+    shift : float
+        [s]
+    """
+    if case.steady_wind is not None:
+        return linearize.SteadyWind(*case.steady_wind), 0.0
+    f, shift = field if field is not None else case_wind_field(case)
+    return linearize.GridWind(t=f.t, y=f.y, z=f.z, u=f.u, v=f.v, w=f.w), shift
+
+
+def case_lidar(case: OpenFASTCase, field: lidar.WindField) -> lidar.PointLidar | None:
+    """The case's InflowWind lidar on its wind (:class:`lidar.PointLidar`: single points, or
+    the CW beam's x estimate at its focus), or None where the case has none.
+
+    Parameters
+    ----------
+    case : OpenFASTCase
+    field : lidar.WindField
+        The case's wind as the rotor meets it (:func:`case_wind_field`).
+
+    Returns
+    -------
+    lidar.PointLidar or None
+
+    Raises
+    ------
+    ValueError
+        InflowWind's pulsed lidar, or its CW lidar with ``LidRadialVel True``, which mpc-wt's
+        plant does not make.
+    """
+    cfg = case.lidar
+    if cfg is None:
+        return None
+    if cfg["sensor_type"] == 3 or (cfg["sensor_type"] == 2 and cfg["radial"]):
+        raise ValueError(f"{cfg['file']}: SensorType = {cfg['sensor_type']}"
+                         f"{', LidRadialVel True' if cfg['radial'] else ''}; mpc-wt's plant "
+                         f"measures InflowWind's single points (SensorType 1) and its CW lidar "
+                         f"with LidRadialVel False (SensorType 2)")
+    g = case.turbine.geometry
+    hub = (-g.overhang * math.cos(g.shaft_tilt_rad), 0.0, g.hub_height)
+    return lidar.PointLidar(cfg["points"], cfg["interval"], hub,
+                            sensor_type=cfg["sensor_type"]).bind(field)
 
 
 def describe(case: OpenFASTCase) -> dict[str, Any]:

@@ -225,13 +225,12 @@ int mw_lidar_winds(const mw_meas *m, double cos_cone, double lead_s, double u[3]
     int i, b, n = m->lidar_n;
     double c[3];
     *taken = m->t;
-    if (n > 0)
-        for (i = 0; i < n; i++)
-            if (!mw_finite(m->lidar_speed[i])) {
-                mw_msg(msg, "mpc-wt %s: lidar speed %d (avrSWAP %d) is not finite at t = %g s",
-                       who, i + 1, 2005 + i, m->t);
-                return -1;
-            }
+    for (i = 0; i < n; i++)
+        if (!mw_finite(m->lidar_speed[i])) {
+            mw_msg(msg, "mpc-wt %s: lidar speed %d (avrSWAP %d) is not finite at t = %g s",
+                   who, i + 1, 2005 + i, m->t);
+            return -1;
+        }
     if (m->lidar_type == 2 && m->lidar_beams == 3 && m->lidar_gates == 1 && n == 3) {
         for (b = 0; b < 3; b++) u[b] = m->lidar_speed[b] / cos_cone;
         return 0;
