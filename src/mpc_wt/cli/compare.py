@@ -76,8 +76,8 @@ def _add_verify(sub: Any) -> None:
         description="Export KIND for the turbine, run OpenFAST on a copy of the deck's main "
                     "and ServoDyn files pointed at the library (the deck is not written to), "
                     "run the same case on mpc-wt's plant, print both side by side and flag "
-                    f"each difference beyond its bound ({bounds}; the largest power 2 %% of "
-                    "rated, pitch travel 10 %%, OpenFAST's largest power 1.1 x rated). Exit "
+                    f"each difference beyond its bound ({bounds}; the largest power 2 % of "
+                    "rated, pitch travel 10 %, OpenFAST's largest power 1.1 x rated). Exit "
                     "status 3 when a difference is flagged.")
     p.add_argument("kind", help="an exportable controller kind (mpcwt controllers lists them)")
     p.add_argument("fst", help="the deck's main file (.fst)")

@@ -1415,6 +1415,14 @@ class ScheduledMPC(ControllerBase):
         side-side degree of freedom, and the generator torque's reaction drives it: on the
         IEA-15-240-RWT (0.24 Hz) ``mpc-lidar``'s tower side-side DEL at 9 m/s was 4.8x the
         baseline's without it (class B, seeds 11-12), 1.05-1.09x with it.
+    power_limit : float, optional
+        The electrical power [W] the torque command never exceeds at the measured generator
+        speed (the command held to ``power_limit / (efficiency x gen_speed)`` after the notch,
+        the generator's rate staying hard, the estimator given the torque so applied); default
+        None: the generator's torque limit only. The QP trades power against speed: in a gust
+        it holds the rotor back with torque up to the generator's maximum, which is power
+        above rated (1.18 x rated for the NREL 5-MW in OpenFAST's regression case without a
+        ceiling).
     region_floor : RegionFloor or bool, optional
         Choose the design also by the operating region the measurements tell
         (:class:`~mpc_wt.controllers.scheduling.RegionFloor`: the measured collective pitch
@@ -1432,7 +1440,8 @@ class ScheduledMPC(ControllerBase):
                  target_time_constant: float | None = 10.0, torque_law: Any = None,
                  below_rated: MPCSettings | None = None, torque_notch_hz: float | None = None,
                  torque_notch_q: float = 2.0, region_floor: Any = None,
-                 tower_notch_hz: float | None = None) -> None:
+                 tower_notch_hz: float | None = None,
+                 power_limit: float | None = None) -> None:
         from mpc_wt.controllers.scheduling import SCHEDULE_SOURCES, RegionFloor, WindSchedule
 
         if wind_source not in SCHEDULE_SOURCES:
@@ -1477,6 +1486,9 @@ class ScheduledMPC(ControllerBase):
             self._notch = SOSFilterBank(filter_sos(1.0 / st.dt, notch_hz=centres,
                                                    notch_q=torque_notch_q), 1)
         self._dq = turbine.generator.max_torque_rate * st.dt  # the torque's largest step
+        if power_limit is not None:
+            check_number("power_limit", power_limit, lo=0.0, lo_open=True, unit="W")
+        self.power_limit = None if power_limit is None else float(power_limit)
         if prebuild:
             for k in range(len(family.wind_mps)):
                 self.controller(k)
@@ -1602,9 +1614,14 @@ class ScheduledMPC(ControllerBase):
                 self.pitch_target_wind += a * (wp - self.pitch_target_wind)  # type: ignore
             ctl.set_target(*self._target(meas))
         u = ctl.step(t, meas)
-        if self._notch is not None:
+        if self._notch is not None or self.power_limit is not None:
             _, _, q_lo, q_hi = ctl._limits
-            q = min(max(float(self._notch.step(u[1])[0]), q_lo), q_hi)
+            q = float(u[1])
+            if self._notch is not None:
+                q = min(max(float(self._notch.step(q)[0]), q_lo), q_hi)
+            w = float(meas["gen_speed"])
+            if self.power_limit is not None and w > 0.0:
+                q = min(q, self.power_limit / (self._eff * w))
             last = ctl.applied_torque           # handed over on a switch
             if last is not None:                # the generator's rate stays hard
                 q = min(max(q, last - self._dq), last + self._dq)

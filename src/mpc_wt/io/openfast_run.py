@@ -22,7 +22,7 @@ import numpy as np
 from mpc_wt.errors import OpenFASTRunError
 
 __all__ = ["OPENFAST_ENV", "find_openfast", "lidar_points", "prepare_deck", "run_openfast",
-           "write_lidar_inflow"]
+           "write_lidar_inflow", "write_wind_deck"]
 
 #: the environment variable that names the OpenFAST executable
 OPENFAST_ENV = "MPCWT_OPENFAST"
@@ -86,7 +86,7 @@ def _absolute_paths(text: str, base: Path, keep: dict[str, str]) -> str:
 
 def _set_value(text: str, key: str, value: str) -> str:
     """``text`` with the value of ``key`` (its first word, quoted or not) replaced."""
-    pat = re.compile(rf'^(\s*)("[^"]*"|\S+)(\s+{re.escape(key)}\b.*)$', re.M)
+    pat = re.compile(rf'^(\s*)("[^"]*"|\S+)(\s+{re.escape(key)}(?=\s|$).*)$', re.M)
     new, n = pat.subn(lambda m: f"{m.group(1)}{value}{m.group(3)}", text, count=1)
     if n != 1:
         raise ValueError(f"no line with the key {key!r} in the file")
@@ -160,6 +160,80 @@ def prepare_deck(fst: str | Path, out: str | Path, library: str | Path, input_fi
     copy.write_text(main)
     for ext in (".out", ".outb"):          # an earlier run's output is not this run's
         copy.with_suffix(ext).unlink(missing_ok=True)
+    return copy
+
+
+def _named_file(main: str, fst: Path, key: str) -> Path:
+    """The file a main file names under ``key``, resolved against its folder."""
+    m = re.search(rf'^\s*"([^"]+)"\s+{re.escape(key)}\b', main, re.M)
+    if m is None:
+        raise ValueError(f"{fst}: no {key} line")
+    path = (fst.parent / m.group(1)).resolve()
+    if not path.is_file():
+        raise FileNotFoundError(f"{fst}: its {key} {path} does not exist")
+    return path
+
+
+def write_wind_deck(fst: str | Path, out: str | Path, bts: str | Path, *,
+                    tmax: float | None = None, start: Any = None) -> Path:
+    """A copy of a deck that runs in a TurbSim field of the caller's (e.g. one mpc-wt wrote
+    with :meth:`lidar.WindField.save`): its main, InflowWind (``WindType 3``,
+    ``FileName_BTS``) and ElastoDyn files in ``out``, the rest read in place.
+
+    Parameters
+    ----------
+    fst : str or Path
+        The deck's main file (not written to).
+    out : str or Path
+        The folder for the copies (created).
+    bts : str or Path
+        The ``.bts`` field.
+    tmax : float, optional
+        ``TMax`` [s] in place of the deck's.
+    start : linearize.OperatingPoint, optional
+        ElastoDyn's initial rotor speed, pitch, tower-top fore-aft and blade-tip out-of-plane
+        deflections from this trim (e.g. :func:`linearize.trim` at the field's mean speed), so
+        that the run starts where the turbine would be.
+
+    Returns
+    -------
+    Path
+        The copy of the main file.
+
+    Raises
+    ------
+    FileNotFoundError
+        The main file, its InflowWind or ElastoDyn file, or ``bts`` is missing.
+    ValueError
+        A file without the keys named above.
+    """
+    fst = Path(fst).resolve()
+    if not fst.is_file():
+        raise FileNotFoundError(f"the deck's main file {fst} does not exist")
+    if not Path(bts).is_file():
+        raise FileNotFoundError(f"the wind field {bts} does not exist")
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    main = fst.read_text(errors="replace")
+    iw, ed = _named_file(main, fst, "InflowFile"), _named_file(main, fst, "EDFile")
+    text = _absolute_paths(iw.read_text(errors="replace"), iw.parent,
+                           {"FileName_BTS": str(Path(bts).resolve())})
+    (out / iw.name).write_text(_set_value(text, "WindType", "3"))
+    text = _absolute_paths(ed.read_text(errors="replace"), ed.parent, {})
+    if start is not None:
+        text = _set_value(text, "RotSpeed", f"{start.rotor_speed_rad_s * 30.0 / np.pi:.6g}")
+        for i in (1, 2, 3):
+            if re.search(rf"\sBlPitch\({i}\)", text):
+                text = _set_value(text, f"BlPitch({i})", f"{np.degrees(start.pitch_rad):.6g}")
+        text = _set_value(text, "TTDspFA", f"{float(start.x[0]):.6g}")
+        text = _set_value(text, "OoPDefl", f"{float(np.mean(start.x[10:13])):.6g}")
+    (out / ed.name).write_text(text)
+    main = _absolute_paths(main, fst.parent, {"InflowFile": str((out / iw.name).resolve()),
+                                              "EDFile": str((out / ed.name).resolve())})
+    if tmax is not None:
+        main = _set_value(main, "TMax", f"{float(tmax):.10g}")
+    copy = out / fst.name
+    copy.write_text(main)
     return copy
 
 

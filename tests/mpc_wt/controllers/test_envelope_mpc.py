@@ -52,17 +52,21 @@ def test_below_rated_it_tracks_the_trim_at_the_wind_it_meets(turbine, tmp_path) 
     assert np.degrees(res.channel("pitch_1")[keep]).max() <= 0.1
 
 
-def test_a_step_through_rated_moves_no_actuator_beyond_its_rate(turbine, tmp_path) -> None:
-    """A uniform step from 10 to 14 m/s and back: no torque command moves faster than the
-    generator's rate limit, no pitch command asks the actuator (first order, time constant
-    tau) for more than its rate, (ref - pitch) / tau <= the limit, the rotor's peak stays below
-    the baseline's in the same step (measured 1.112 x rated against 1.131; 1.09 with the soft
-    speed limit at 1.028 x rated) and no QP fails."""
+def _step_through_rated(turbine, tmp_path, controller: str):
+    """A uniform step from 10 to 14 m/s and back (180 s)."""
     t = np.arange(0.0, 200.0, 0.05)
     wind = np.where((t >= 60.0) & (t < 120.0), 14.0, 10.0)
     path = _uniform_file(tmp_path / "step.npz", turbine, t, wind)
-    res = run_controller(turbine, "mpc", Scenario(wind_file=path, duration=180.0,
-                                                  shear_exponent=0.0))
+    return run_controller(turbine, controller, Scenario(wind_file=path, duration=180.0,
+                                                        shear_exponent=0.0))
+
+
+def test_a_step_through_rated_moves_no_actuator_beyond_its_rate(turbine, tmp_path) -> None:
+    """A uniform step from 10 to 14 m/s and back: no torque command moves faster than the
+    generator's rate limit, no pitch command asks the actuator (first order, time constant
+    tau) for more than its rate, (ref - pitch) / tau <= the limit, the electrical power stays
+    within 1.1 x rated (the ceiling is 1.08; 1.23 x rated without it) and no QP fails."""
+    res = _step_through_rated(turbine, tmp_path, "mpc")
     dt, every = 0.1, 8                      # the MPC's commands at 10 Hz in the 80 Hz record
     k = np.arange(len(res.t))[res.t >= 5.0][::every]
     assert np.diff(res.t[k]) == pytest.approx(dt)
@@ -71,10 +75,20 @@ def test_a_step_through_rated_moves_no_actuator_beyond_its_rate(turbine, tmp_pat
     assert np.abs(np.diff(torque)).max() <= gen.max_torque_rate * dt * (1 + 1e-6)
     demand = (res.channel("pitch_ref_1")[k] - res.channel("pitch_1")[k]) / pa.time_constant
     assert np.abs(demand).max() <= pa.max_rate_rad_s * (1 + 1e-6)
-    base = run_controller(turbine, "baseline", Scenario(wind_file=path, duration=180.0,
-                                                        shear_exponent=0.0))
-    assert res.channel("rotor_speed").max() < base.channel("rotor_speed").max()
+    assert res.channel("gen_power").max() <= 1.1 * turbine.operation.rated_power
     assert np.sum(res.controller["qp_fallback"] > 0) == 0
+
+
+@pytest.mark.xfail(strict=True, reason="with its power held to 1.08 x rated the MPC's torque "
+                   "no longer brakes the rotor in a 4 m/s step: its peak is 1.136 x rated "
+                   "against the baseline's 1.131 (1.120 with the torque at 1.23 x rated power); "
+                   "its torque rises 0.5 s after the baseline's, on the estimated wind")
+def test_a_step_through_rated_peaks_below_the_baseline(turbine, tmp_path) -> None:
+    """In the step from 10 to 14 m/s the rotor's peak stays below the baseline's in the same
+    step."""
+    res = _step_through_rated(turbine, tmp_path, "mpc")
+    base = _step_through_rated(turbine, tmp_path, "baseline")
+    assert res.channel("rotor_speed").max() < base.channel("rotor_speed").max()
 
 
 def test_an_extreme_gust_at_rated_wind_keeps_the_rotor_below_1p2_rated(turbine) -> None:
@@ -193,7 +207,8 @@ def test_cost_scales_follow_the_turbine() -> None:
 
 
 def test_the_torque_bound_and_the_torque_rate_weight_act(turbine, tmp_path) -> None:
-    """The 10-14 m/s step of the test above, three designs. With ``torque_limit: 1.0`` no
+    """The 10-14 m/s step of the test above, three designs without the power ceiling
+    (``power_limit: null``, ``speed_limit: 1.065``). With ``torque_limit: 1.0`` no
     torque command exceeds the rated torque, 5 MW / (0.944 x 122.91 rad/s) = 43.09 kN m by
     hand (without it the command reaches the generator's 47.4 kN m maximum). A torque-rate
     weight of 10 in every design (a 4 kN m move per step weighs as much as the scaled power
@@ -204,9 +219,12 @@ def test_the_torque_bound_and_the_torque_rate_weight_act(turbine, tmp_path) -> N
     path = _uniform_file(tmp_path / "step.npz", turbine, t, wind)
     sc = Scenario(wind_file=path, duration=180.0, shear_exponent=0.0)
     travel, peak = {}, {}
-    none = {"below_rated_weights": {"gen_torque_ref_rate": 0.0}}   # no rate weight anywhere
+    # no rate weight anywhere, and no power ceiling (which would hide both), the speed limit
+    # at 1.065 x rated (with the ceiling the default 1.1 lets the rotor carry the gust)
+    old = {"power_limit": None, "speed_limit": 1.065}
+    none = {"below_rated_weights": {"gen_torque_ref_rate": 0.0}, **old}
     for name, opts in (("free", none), ("bound", {**none, "torque_limit": 1.0}),
-                       ("rate", {"weights": {"gen_torque_ref_rate": 10.0}})):
+                       ("rate", {"weights": {"gen_torque_ref_rate": 10.0}, **old})):
         res = run_controller(turbine, "mpc", sc, options=opts)
         q = res.channel("gen_torque_ref")[res.t >= 5.0]
         travel[name], peak[name] = np.abs(np.diff(q)).sum(), q.max()

@@ -71,6 +71,7 @@ typedef struct {
     int n, collective, nzo, ip, has_law;
     mw_preview pv;
     double dt, target_tau, eff, qp_budget_ms;
+    double power_limit;           /* the electrical power's ceiling [W] (0: none) */
     double *trim_z, *trim_u, *zt, ut[4];
     int *signals, n_signals;
     double *y;
@@ -570,11 +571,16 @@ static int mpc_step(mw_ctrl *self, const mw_meas *m, mw_cmd *out, char *msg)
     }
     rc = point_step(c, &c->pt[k], m, u, msg);
     if (rc < 0) return rc;
-    if (c->has_notch) {             /* within the torque limits and the generator's rate */
+    if (c->has_notch || c->power_limit > 0.0) {
+        /* within the torque limits, the power ceiling and the generator's rate */
         mw_point *p = &c->pt[k];
-        double q;
-        mw_sos_step(&c->notch, &u[3], &q);
-        q = dmin(dmax(q, p->limits[2]), p->limits[3]);
+        double q = u[3];
+        if (c->has_notch) {
+            mw_sos_step(&c->notch, &u[3], &q);
+            q = dmin(dmax(q, p->limits[2]), p->limits[3]);
+        }
+        if (c->power_limit > 0.0 && m->gen_speed > 0.0)
+            q = dmin(q, c->power_limit / (c->eff * m->gen_speed));
         if (p->has_applied)         /* the last applied torque (handed over on a switch) */
             q = dmin(dmax(q, p->applied_torque - c->torque_rate * c->dt),
                      p->applied_torque + c->torque_rate * c->dt);
@@ -671,11 +677,19 @@ static int mpc_read(const mw_input *in, mw_ctrl *self, char *msg)
         return -1;
     }
     if (c->has_law && mw_torque_law_read(in, &c->law, msg)) return -1;
-    if (mw_get_int(in, "torque_notch", 0, 1, &c->has_notch, msg)) return -1;
-    if (c->has_notch) {
-        if (mw_sos_read(in, "mpc", "torque_notch_sos", "torque_notch_zi", 1, &c->notch, msg)
-            || mw_get(in, "torque_notch_rate", &c->torque_rate, msg))
-            return -1;
+    if (mw_get_int(in, "torque_notch", 0, 1, &c->has_notch, msg)
+        || mw_get(in, "power_limit", &c->power_limit, msg))
+        return -1;
+    if (!(c->power_limit >= 0.0)) {
+        mw_msg(msg, "mpc-wt mpc: input file '%s': key 'power_limit' must be >= 0 W (0: none), "
+               "got %g", in->path, c->power_limit);
+        return -1;
+    }
+    if (c->has_notch
+        && mw_sos_read(in, "mpc", "torque_notch_sos", "torque_notch_zi", 1, &c->notch, msg))
+        return -1;
+    if (c->has_notch || c->power_limit > 0.0) {
+        if (mw_get(in, "torque_notch_rate", &c->torque_rate, msg)) return -1;
         if (!(c->torque_rate > 0)) {
             mw_msg(msg, "mpc-wt mpc: input file '%s': key 'torque_notch_rate' must be > 0 N m/s, "
                    "got %g", in->path, c->torque_rate);
