@@ -657,7 +657,8 @@ def verify_openfast(turbine: linearize.Turbine, controller: str, fst: str | Path
                     out: str | Path, options: Mapping[str, Any] | None = None, *,
                     openfast: str | Path | None = None, tmax: float | None = None,
                     window: tuple[float, float | None] = (10.0, None),
-                    progress: bool = False, inflow: str | Path | None = None) -> dict[str, Any]:
+                    progress: bool = False, inflow: str | Path | None = None,
+                    values: Mapping[str, Any] | None = None) -> dict[str, Any]:
     """Prove a design in the user's OpenFAST: export it, run OpenFAST on the user's deck with
     it, run the same case on mpc-wt's plant, compare them channel by channel and flag every
     difference beyond :data:`VERIFY_BOUNDS` (and the largest power beyond 2 % of rated, pitch
@@ -688,6 +689,10 @@ def verify_openfast(turbine: linearize.Turbine, controller: str, fst: str | Path
         An InflowWind file in place of the deck's. A LIDAR kind on a deck whose InflowWind has
         no single-point lidar (``SensorType 1``) runs with a copy of it that has five on the
         design's ring (:func:`mpc_wt.io.openfast_run.write_lidar_inflow`).
+    values : mapping, optional
+        Keys of the deck's main file given these values in the copy both plants run
+        (:func:`mpc_wt.io.openfast_run.prepare_deck`), e.g. ``{"CompHydro": 0, "CompSub": 0,
+        "CompSeaSt": 0}``: an offshore deck fixed at its tower base.
 
     Returns
     -------
@@ -711,7 +716,7 @@ def verify_openfast(turbine: linearize.Turbine, controller: str, fst: str | Path
     out = Path(out)
     ex = export_discon(turbine, controller, out / "library", options)
     deck = prepare_deck(fst, out / "openfast", ex.library, ex.input_file, ex.dt, tmax=tmax,
-                        inflow=inflow)
+                        inflow=inflow, values=values)
     deck, case = _with_lidar(deck, out, ex, turbine, tmax)
     of_path, of, ref = _openfast_run(exe, deck, tmax, progress)
     res = run_openfast_case(case, "discon", library=ex.library, discon_in=ex.input_file,

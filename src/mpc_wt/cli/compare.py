@@ -95,6 +95,11 @@ def _add_verify(sub: Any) -> None:
                         "with a single-point lidar, SensorType 1)")
     p.add_argument("--option", action="append", metavar="NAME=VALUE",
                    help="an option of the kind (repeatable; YAML values)")
+    p.add_argument("--set", action="append", metavar="KEY=VALUE", dest="values",
+                   help="a value in the copies of the deck both plants run (repeatable): "
+                        "KEY of the main file, FILEKEY:KEY of the file it names under FILEKEY, "
+                        "e.g. --set CompHydro=0 --set EDFile:PtfmSgDOF=False (docs: offshore "
+                        "decks)")
     p.add_argument("--out", required=True, help="folder for the library, OpenFAST's run, "
                                                "ours.nc, verify.json and verify.png")
     p.add_argument("--json", action="store_true", help="print verify.json")
@@ -116,7 +121,7 @@ def _verify(args: argparse.Namespace) -> int:
     doc = verify_openfast(turbine, args.kind, args.fst, args.out,
                           pairs(args.option, "--option") or None, openfast=args.openfast,
                           tmax=args.tmax, window=window, progress=True,
-                          inflow=args.inflow)
+                          inflow=args.inflow, values=pairs(args.values, "--set") or None)
     if args.json:
         print(to_json(doc))
     else:
@@ -138,7 +143,8 @@ def _verify_table(doc: dict[str, Any]) -> str:
     a, b = doc["pitch_travel_deg"]
     lines.append(f"pitch travel (blade 1): OpenFAST {a:.1f} deg, mpc-wt {b:.1f} deg")
     lines += ([f"FLAG {f}" for f in doc["flags"]] or ["no difference beyond its bound"])
-    lines.append(f"wrote {doc['files']['plot']}, {Path(doc['files']['plot']).with_name('verify.json')}")
+    plot = doc["files"]["plot"]
+    lines.append(f"wrote {plot}, {Path(plot).with_name('verify.json')}")
     return "\n".join(lines)
 
 

@@ -10,12 +10,14 @@ it and returns the output file, or raises with OpenFAST's own last lines.
 """
 from __future__ import annotations
 
+import logging
+import math
 import os
 import re
 import shutil
 import subprocess
 from pathlib import Path
-from typing import Any
+from typing import Any, Mapping
 
 import numpy as np
 
@@ -27,11 +29,13 @@ __all__ = ["OPENFAST_ENV", "find_openfast", "lidar_points", "prepare_deck", "run
 #: the environment variable that names the OpenFAST executable
 OPENFAST_ENV = "MPCWT_OPENFAST"
 
+log = logging.getLogger(__name__)
+
 #: a line whose value is a quoted path: ``"path"   KEY  - description``
 _PATH_LINE = re.compile(r'^(\s*)"([^"]*)"(\s+)(\S+)(.*)$')
 #: the keys of file names in a main, ServoDyn or InflowWind file (a list of StC files
 #: included; InflowWind's FileName_BTS, FileName_Uni, FileName_u, ...)
-_FILE_KEY = re.compile(r"(File|files|FileName|InFile)(\(\d\))?$|^FileName_\w+$|^FilenameRoot$")
+_FILE_KEY = re.compile(r"(File|files|FileName|InFile)(\(\d\)|\d)?$|^FileName_\w+$|^FilenameRoot$")
 
 
 def find_openfast(path: str | Path | None = None) -> Path:
@@ -95,7 +99,8 @@ def _set_value(text: str, key: str, value: str) -> str:
 
 def prepare_deck(fst: str | Path, out: str | Path, library: str | Path, input_file: str | Path,
                  dt: float, *, tmax: float | None = None,
-                 inflow: str | Path | None = None) -> Path:
+                 inflow: str | Path | None = None,
+                 values: Mapping[str, Any] | None = None) -> Path:
     """A copy of a deck's main file and ServoDyn file in ``out`` that runs ``library``.
 
     Parameters
@@ -113,11 +118,19 @@ def prepare_deck(fst: str | Path, out: str | Path, library: str | Path, input_fi
     inflow : str or Path, optional
         An InflowWind file in place of the deck's ``InflowFile`` (e.g. one with a lidar; the
         paths it names are its own folder's).
+    values : mapping, optional
+        Keys given these values in the copies: ``KEY`` of the main file, ``FILEKEY:KEY`` of
+        the file the main file names under ``FILEKEY`` (copied too), e.g. ``{"CompHydro": 0,
+        "CompSub": 0, "CompSeaSt": 0, "EDFile:PtfmSgDOF": "False", ...}`` to run an offshore
+        deck fixed at its tower base.
 
     Returns
     -------
     Path
         The copy of the main file (OpenFAST writes ``<its stem>.out``/``.outb`` beside it).
+        Where ``dt`` is not a whole multiple of the deck's ``DT`` (ServoDyn refuses that), the
+        copy's ``DT`` is the largest step below the deck's that divides it, and a warning says
+        so (the IEA-15-240-RWT's 0.005 s against a library's 0.0125 s: 0.0041667 s).
 
     Raises
     ------
@@ -147,8 +160,23 @@ def prepare_deck(fst: str | Path, out: str | Path, library: str | Path, input_fi
     text = _set_value(_set_value(text, "DLL_DT", f"{dt:.10g}"), "Ptch_Cntrl", "1")
     for key, val in (("PCMode", "5"), ("VSContrl", "5")):
         text = _set_value(text, key, val)
+    by_file: dict[str, dict[str, str]] = {}
+    for key, val in (values or {}).items():
+        file_key, _, name = str(key).rpartition(":")
+        by_file.setdefault(file_key, {})[name] = str(val)
+    for key, val in by_file.pop("ServoFile", {}).items():
+        text = _set_value(text, key, val)
     srv_copy.write_text(text)
     swap = {"ServoFile": str(srv_copy.resolve())}
+    for file_key, vals in by_file.items():
+        if not file_key:
+            continue
+        src = _named_file(main, fst, file_key)
+        sub = _absolute_paths(src.read_text(errors="replace"), src.parent, {})
+        for key, val in vals.items():
+            sub = _set_value(sub, key, val)
+        (out / src.name).write_text(sub)
+        swap[file_key] = str((out / src.name).resolve())
     if inflow is not None:
         if not Path(inflow).is_file():
             raise FileNotFoundError(f"the InflowWind file {inflow} does not exist")
@@ -156,11 +184,33 @@ def prepare_deck(fst: str | Path, out: str | Path, library: str | Path, input_fi
     main = _absolute_paths(main, fst.parent, swap)
     if tmax is not None:
         main = _set_value(main, "TMax", f"{float(tmax):.10g}")
+    for key, val in by_file.get("", {}).items():
+        main = _set_value(main, key, val)
+    main = _step_dividing(main, fst, float(dt))
     copy = out / fst.name
     copy.write_text(main)
     for ext in (".out", ".outb"):          # an earlier run's output is not this run's
         copy.with_suffix(ext).unlink(missing_ok=True)
     return copy
+
+
+def _step_dividing(main: str, fst: Path, dt: float) -> str:
+    """``main`` with ``DT`` made a whole fraction of the library's interval ``dt`` where it is
+    not one (the largest such step below the deck's), with a warning."""
+    m = re.search(r"^\s*(\S+)\s+DT\s", main, re.M)
+    if m is None:
+        raise ValueError(f"{fst}: no DT line")
+    try:
+        step = float(m.group(1))
+    except ValueError:
+        raise ValueError(f"{fst}: DT = {m.group(1)!r} is not a number") from None
+    n = dt / step
+    if not step > 0 or abs(n - round(n)) <= 1e-9 * max(1.0, n):
+        return main
+    new = dt / math.ceil(n - 1e-9)
+    log.warning("%s: DT %g s is not a whole fraction of the library's interval %g s (DLL_DT): "
+                "the copy runs at DT %.10g s", fst, step, dt, new)
+    return _set_value(main, "DT", f"{new:.15g}")
 
 
 def _named_file(main: str, fst: Path, key: str) -> Path:
