@@ -690,9 +690,7 @@ def verify_openfast(turbine: linearize.Turbine, controller: str, fst: str | Path
         no single-point lidar (``SensorType 1``) runs with a copy of it that has five on the
         design's ring (:func:`mpc_wt.io.openfast_run.write_lidar_inflow`).
     values : mapping, optional
-        Keys of the deck's main file given these values in the copy both plants run
-        (:func:`mpc_wt.io.openfast_run.prepare_deck`), e.g. ``{"CompHydro": 0, "CompSub": 0,
-        "CompSeaSt": 0}``: an offshore deck fixed at its tower base.
+        Values in the deck's copies both plants run (``prepare_deck``'s ``values``).
 
     Returns
     -------
@@ -712,8 +710,7 @@ def verify_openfast(turbine: linearize.Turbine, controller: str, fst: str | Path
     from mpc_wt.io.openfast_run import find_openfast, prepare_deck
     from mpc_wt.plotting import plot_verify
 
-    exe = find_openfast(openfast)
-    out = Path(out)
+    exe, out = find_openfast(openfast), Path(out)
     ex = export_discon(turbine, controller, out / "library", options)
     deck = prepare_deck(fst, out / "openfast", ex.library, ex.input_file, ex.dt, tmax=tmax,
                         inflow=inflow, values=values)

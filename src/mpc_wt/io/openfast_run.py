@@ -147,36 +147,14 @@ def prepare_deck(fst: str | Path, out: str | Path, library: str | Path, input_fi
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     main = fst.read_text(errors="replace")
-    m = re.search(r'^\s*"([^"]+)"\s+ServoFile\b', main, re.M)
-    if m is None:
-        raise ValueError(f"{fst}: no ServoFile line")
-    srv = (fst.parent / m.group(1)).resolve()
-    if not srv.is_file():
-        raise FileNotFoundError(f"{fst}: its ServoDyn file {srv} does not exist")
+    srv = _named_file(main, fst, "ServoFile")
     srv_copy = out / srv.name
-    text = _absolute_paths(srv.read_text(errors="replace"), srv.parent,
-                           {"DLL_FileName": str(Path(library).resolve()),
-                            "DLL_InFile": str(Path(input_file).resolve())})
-    text = _set_value(_set_value(text, "DLL_DT", f"{dt:.10g}"), "Ptch_Cntrl", "1")
-    for key, val in (("PCMode", "5"), ("VSContrl", "5")):
-        text = _set_value(text, key, val)
-    by_file: dict[str, dict[str, str]] = {}
-    for key, val in (values or {}).items():
-        file_key, _, name = str(key).rpartition(":")
-        by_file.setdefault(file_key, {})[name] = str(val)
+    text = _servodyn_text(srv, library, input_file, dt)
+    by_file = _values_by_file(values)
     for key, val in by_file.pop("ServoFile", {}).items():
         text = _set_value(text, key, val)
     srv_copy.write_text(text)
-    swap = {"ServoFile": str(srv_copy.resolve())}
-    for file_key, vals in by_file.items():
-        if not file_key:
-            continue
-        src = _named_file(main, fst, file_key)
-        sub = _absolute_paths(src.read_text(errors="replace"), src.parent, {})
-        for key, val in vals.items():
-            sub = _set_value(sub, key, val)
-        (out / src.name).write_text(sub)
-        swap[file_key] = str((out / src.name).resolve())
+    swap = {"ServoFile": str(srv_copy.resolve()), **_value_copies(main, fst, out, by_file)}
     if inflow is not None:
         if not Path(inflow).is_file():
             raise FileNotFoundError(f"the InflowWind file {inflow} does not exist")
@@ -192,6 +170,43 @@ def prepare_deck(fst: str | Path, out: str | Path, library: str | Path, input_fi
     for ext in (".out", ".outb"):          # an earlier run's output is not this run's
         copy.with_suffix(ext).unlink(missing_ok=True)
     return copy
+
+
+def _servodyn_text(srv: Path, library: str | Path, input_file: str | Path, dt: float) -> str:
+    """A ServoDyn file's text with its Bladed interface pointed at ``library``."""
+    text = _absolute_paths(srv.read_text(errors="replace"), srv.parent,
+                           {"DLL_FileName": str(Path(library).resolve()),
+                            "DLL_InFile": str(Path(input_file).resolve())})
+    text = _set_value(_set_value(text, "DLL_DT", f"{dt:.10g}"), "Ptch_Cntrl", "1")
+    for key, val in (("PCMode", "5"), ("VSContrl", "5")):
+        text = _set_value(text, key, val)
+    return text
+
+
+def _values_by_file(values: Mapping[str, Any] | None) -> dict[str, dict[str, str]]:
+    """``{"KEY": v, "FILEKEY:KEY": w}`` as ``{"": {"KEY": "v"}, "FILEKEY": {"KEY": "w"}}``."""
+    by_file: dict[str, dict[str, str]] = {}
+    for key, val in (values or {}).items():
+        file_key, _, name = str(key).rpartition(":")
+        by_file.setdefault(file_key, {})[name] = str(val)
+    return by_file
+
+
+def _value_copies(main: str, fst: Path, out: Path,
+                  by_file: dict[str, dict[str, str]]) -> dict[str, str]:
+    """Copies in ``out`` of the files the main file names under each ``FILEKEY`` with their
+    values set; the main file's keys -> the copies' paths."""
+    swap = {}
+    for file_key, vals in by_file.items():
+        if not file_key:
+            continue
+        src = _named_file(main, fst, file_key)
+        sub = _absolute_paths(src.read_text(errors="replace"), src.parent, {})
+        for key, val in vals.items():
+            sub = _set_value(sub, key, val)
+        (out / src.name).write_text(sub)
+        swap[file_key] = str((out / src.name).resolve())
+    return swap
 
 
 def _step_dividing(main: str, fst: Path, dt: float) -> str:

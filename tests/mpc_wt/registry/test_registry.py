@@ -58,7 +58,7 @@ def test_registry_lists_every_kind_with_its_options() -> None:
     assert {o["name"] for o in rows["mpc"]["options"]} == {
         "backend", "formulation", "horizon", "estimator", "design_wind_mps", "schedule_step",
         "schedule_time_constant", "speed_limit", "kalman_wind_std", "kalman_flap_std",
-        "weights", "time_budget_ms", "torque_limit", "below_rated_speed_limit",
+        "weights", "time_budget_ms", "torque_limit", "power_limit", "below_rated_speed_limit",
         "below_rated_weights", "torque_notch_hz", "torque_notch_q", "tower_notch",
         "region_floor", "region3_pitch_deg"}
     assert rows["ibc"]["addon_to"] == ["baseline", "derate"]
