@@ -30,7 +30,8 @@ HEAD = ("| kind | mean power OpenFAST / mpc-wt [kW] | mean rotor speed [rpm] | l
         "|---|---|---|---|---|---|---|---|---|")
 
 
-def case_deck(fst: str, out: Path, speed: float, seed: int, tmax: float) -> Path:
+def case_deck(turbine: linearize.Turbine, fst: str, out: Path, speed: float, seed: int,
+              tmax: float) -> Path:
     """The deck of one speed: a class-A field of ``tmax`` + 30 s and the trim at ``speed``.
 
     The grid is 150 m wide and reaches 5.3 m above the ground (36 rows of 4.84 m), below the
@@ -43,7 +44,7 @@ def case_deck(fst: str, out: Path, speed: float, seed: int, tmax: float) -> Path
                                     dt=0.05, width=150.0, height=35 * 150.0 / 31, n_y=32,
                                     n_z=36)
         lidar.generate_field(spec, seed).save(bts)
-    start = linearize.trim(linearize.load_turbine("nrel5mw"), speed)
+    start = linearize.trim(turbine, speed)
     return write_wind_deck(fst, out / "deck", bts, tmax=tmax, start=start)
 
 
@@ -60,7 +61,7 @@ def main() -> None:
     for speed in args.speeds:
         seed = 800 + int(round(speed))
         out = Path(args.out) / f"{speed:g}mps"
-        deck = case_deck(args.fst, out, speed, seed, args.tmax)
+        deck = case_deck(turbine, args.fst, out, speed, seed, args.tmax)
         print(f"\n### {speed:g} m/s, class A, seed {seed}, {args.tmax:g} s\n\n{HEAD}", flush=True)
         for kind in args.kinds:
             doc = verify_openfast(turbine, kind, deck, out / kind, openfast=args.openfast,

@@ -196,17 +196,21 @@ def _value_copies(main: str, fst: Path, out: Path,
                   by_file: dict[str, dict[str, str]]) -> dict[str, str]:
     """Copies in ``out`` of the files the main file names under each ``FILEKEY`` with their
     values set; the main file's keys -> the copies' paths."""
-    swap = {}
-    for file_key, vals in by_file.items():
-        if not file_key:
-            continue
-        src = _named_file(main, fst, file_key)
-        sub = _absolute_paths(src.read_text(errors="replace"), src.parent, {})
-        for key, val in vals.items():
-            sub = _set_value(sub, key, val)
-        (out / src.name).write_text(sub)
-        swap[file_key] = str((out / src.name).resolve())
-    return swap
+    return {file_key: str(_file_copy(main, fst, out, file_key, vals))
+            for file_key, vals in by_file.items() if file_key}
+
+
+def _file_copy(main: str, fst: Path, out: Path, file_key: str, values: Mapping[str, str],
+               keep: dict[str, str] | None = None) -> Path:
+    """A copy in ``out`` of the file the main file names under ``file_key``: its file names
+    absolute (those in ``keep`` given those values), ``values`` set; its resolved path."""
+    src = _named_file(main, fst, file_key)
+    text = _absolute_paths(src.read_text(errors="replace"), src.parent, keep or {})
+    for key, val in values.items():
+        text = _set_value(text, key, val)
+    copy = out / src.name
+    copy.write_text(text)
+    return copy.resolve()
 
 
 def _step_dividing(main: str, fst: Path, dt: float) -> str:
@@ -280,21 +284,18 @@ def write_wind_deck(fst: str | Path, out: str | Path, bts: str | Path, *,
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     main = fst.read_text(errors="replace")
-    iw, ed = _named_file(main, fst, "InflowFile"), _named_file(main, fst, "EDFile")
-    text = _absolute_paths(iw.read_text(errors="replace"), iw.parent,
-                           {"FileName_BTS": str(Path(bts).resolve())})
-    (out / iw.name).write_text(_set_value(text, "WindType", "3"))
-    text = _absolute_paths(ed.read_text(errors="replace"), ed.parent, {})
+    iw = _file_copy(main, fst, out, "InflowFile", {"WindType": "3"},
+                    keep={"FileName_BTS": str(Path(bts).resolve())})
+    init: dict[str, str] = {}
     if start is not None:
-        text = _set_value(text, "RotSpeed", f"{start.rotor_speed_rad_s * 30.0 / np.pi:.6g}")
-        for i in (1, 2, 3):
-            if re.search(rf"\sBlPitch\({i}\)", text):
-                text = _set_value(text, f"BlPitch({i})", f"{np.degrees(start.pitch_rad):.6g}")
-        text = _set_value(text, "TTDspFA", f"{float(start.x[0]):.6g}")
-        text = _set_value(text, "OoPDefl", f"{float(np.mean(start.x[10:13])):.6g}")
-    (out / ed.name).write_text(text)
-    main = _absolute_paths(main, fst.parent, {"InflowFile": str((out / iw.name).resolve()),
-                                              "EDFile": str((out / ed.name).resolve())})
+        blades = re.findall(r"\sBlPitch\(\d\)", _named_file(main, fst, "EDFile").read_text(
+            errors="replace"))
+        init = {"RotSpeed": f"{start.rotor_speed_rad_s * 30.0 / np.pi:.6g}",
+                **{b.strip(): f"{np.degrees(start.pitch_rad):.6g}" for b in blades},
+                "TTDspFA": f"{float(start.x[0]):.6g}",
+                "OoPDefl": f"{float(np.mean(start.x[10:13])):.6g}"}
+    ed = _file_copy(main, fst, out, "EDFile", init)
+    main = _absolute_paths(main, fst.parent, {"InflowFile": str(iw), "EDFile": str(ed)})
     if tmax is not None:
         main = _set_value(main, "TMax", f"{float(tmax):.10g}")
     copy = out / fst.name
