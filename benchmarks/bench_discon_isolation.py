@@ -21,7 +21,8 @@ import time
 import linearize
 from mpc_wt.controllers.baseline import tune_baseline
 from mpc_wt.controllers.discon import DisconController, rosco_library
-from mpc_wt.io.gain_tables import baseline_table, export
+from mpc_wt.io.gain_tables import export
+from mpc_wt.kinds.baseline import baseline_table
 from mpc_wt.simulation.loop import simulate_closed_loop
 from mpc_wt.simulation.scenario import Scenario, make_wind
 

@@ -332,7 +332,9 @@ def assess_plots(runs: Sequence[tuple[str, np.ndarray, dict[str, np.ndarray]]],
 
 
 def plot_design(doc: dict[str, Any], path: str | Path) -> Path:
-    """The gains of a design document against wind speed (TS: against the vertex), as PNG.
+    """The gains of a design document as PNG, as its kind's table function asked
+    (:func:`mpc_wt.io.gain_tables.document`'s ``plot``): the columns it names against wind
+    speed, else the largest gains of ``K`` against wind speed or the vertex.
 
     Parameters
     ----------
@@ -351,18 +353,12 @@ def plot_design(doc: dict[str, Any], path: str | Path) -> Path:
     rows = np.asarray(s["rows"], dtype=float)
     x = rows[:, 0]
     fig, ax = plt.subplots(figsize=(7, 4))
-    scalar = {"baseline": (("kp", "ki"), "PI gain on generator speed [s], [-]"),
-              "ibc": (("gain",), "IBC gain [rad/(N m)]"),
-              "coleman-ipc": (("ki",), "IPC integral gain [rad/(N m s)]"),
-              "mpc": (("pitch",), "trim pitch the cost tracks [rad]"),
-              "mpc-collective": (("pitch",), "trim pitch the cost tracks [rad]"),
-              "mpc-lidar": (("pitch",), "trim pitch the cost tracks [rad]"),
-              "baseline+lidar-ff": (("filter_corner",), "feedforward filter corner [rad/s]")}
-    if doc["kind"] in scalar:
-        names, label = scalar[doc["kind"]]
-        for c in names:
+    hint = doc.get("plot") or {}
+    by_vertex = hint.get("x") == "vertex"
+    if hint.get("columns"):
+        for c in hint["columns"]:
             ax.plot(x, rows[:, s["columns"].index(c)], "o-", label=c)
-        ax.set_ylabel(label)
+        ax.set_ylabel(hint.get("label", "gain"))
     else:
         k = np.asarray(doc["matrices"]["K"]["data"])
         m = doc["matrices"]["K"]
@@ -371,9 +367,9 @@ def plot_design(doc: dict[str, Any], path: str | Path) -> Path:
         for j in big:
             lab = f"K[{m['rows'][j // len(m['cols'])]}, {m['cols'][j % len(m['cols'])]}]"
             v = flat[:, j] / max(np.abs(flat[:, j]).max(), 1e-300)
-            ax.plot(np.arange(len(x)) if doc["kind"] == "ts" else x, v, "o-", label=lab)
+            ax.plot(np.arange(len(x)) if by_vertex else x, v, "o-", label=lab)
         ax.set_ylabel("gain / its largest magnitude [-]")
-    ax.set_xlabel("vertex index (wind outer, power reduction inner)" if doc["kind"] == "ts"
+    ax.set_xlabel("vertex index (wind outer, power reduction inner)" if by_vertex
                   else "wind speed [m/s]")
     ax.set_title(f"{doc['kind']} gains, {doc['turbine']}")
     ax.grid(True, alpha=0.3)

@@ -402,7 +402,8 @@ def _run(args: argparse.Namespace) -> int:
 def _design_outputs(turbine: linearize.Turbine, out: Path) -> None:
     """The linear model family and the baseline's gain tables (CSV, JSON, ROSCO)."""
     from mpc_wt.controllers.baseline import tune_baseline
-    from mpc_wt.io.gain_tables import baseline_table, export
+    from mpc_wt.io.gain_tables import export
+    from mpc_wt.kinds.baseline import baseline_table
 
     fam = linearize.linearize_family(turbine, progress=True)
     fam.save(out / "linear_models.mat")

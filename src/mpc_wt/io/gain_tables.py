@@ -1,12 +1,15 @@
 """Gain tables: one document per designed controller, exported to CSV, JSON, MATLAB and ROSCO.
 
-A gain table is a JSON-able dict (``design.json`` in a design directory):
+The format only: each kind's module makes its own table (``baseline_table`` in
+:mod:`mpc_wt.kinds.baseline`, ``lqr_table`` in :mod:`mpc_wt.kinds.lqr`, ...) with
+:func:`document`. A gain table is a JSON-able dict (``design.json`` in a design directory):
 
     {"schema": "mpc-wt gain table", "schema_version": 1,
-     "kind": "baseline" | "lqr" | "ts" | "ibc" | "coleman-ipc",
+     "kind": "baseline" | "lqr" | "ts" | "ibc" | "coleman-ipc" | ...,
      "turbine": ..., "software": {"mpc_wt": version}, "settings": {...},
      "schedule": {"columns": [...], "units": [...], "rows": [[...], ...]},
-     "matrices": {name: {"unit": ..., "rows": [...], "cols": [...], "data": [[[...]]] }}}
+     "matrices": {name: {"unit": ..., "rows": [...], "cols": [...], "data": [[[...]]] }},
+     "plot": {...}}   (optional: how the design's plot draws it)
 
 ``schedule`` has one row per operating point (wind speed for the LQR family, premise vertex
 for TS with its membership breakpoints ``wind_grid`` / ``reduction_grid`` in ``settings``,
@@ -32,7 +35,6 @@ from __future__ import annotations
 
 import csv
 import json
-import math
 from pathlib import Path
 from typing import Any, Sequence
 
@@ -40,20 +42,30 @@ import numpy as np
 
 import linearize
 from mpc_wt._version import __version__
-from mpc_wt.controllers.baseline import effective_pi_gains
 from mpc_wt.errors import GainTableError
 from mpc_wt.io.json_text import write_json
 
-__all__ = ["SCHEMA_VERSION", "GainTableError", "baseline_table", "lqr_table", "ts_table",
-           "ibc_table", "coleman_ipc_table", "mpc_table", "lqr_pio_table", "lidar_ff_table", "design_turbine",
-           "save_design", "load_design", "export", "read_rosco", "FORMATS"]
+__all__ = ["SCHEMA_VERSION", "GainTableError", "document", "matrix", "unit_ratio",
+           "design_turbine", "save_design", "load_design", "export", "read_rosco", "FORMATS"]
 
 SCHEMA_VERSION = 1
 SCHEMA = "mpc-wt gain table"
 FORMATS = ("csv", "json", "mat", "rosco", "discon")
 
 
-def _unit_ratio(num: str, den: str) -> str:
+def unit_ratio(num: str, den: str) -> str:
+    """The unit of a gain from its numerator's and denominator's units.
+
+    Parameters
+    ----------
+    num, den : str
+        The units ("-" or "" for none).
+
+    Returns
+    -------
+    str
+        ``num/den``, parenthesised where ``den`` is compound; "-" where they are equal.
+    """
     if den in ("-", ""):
         return num
     if num == den:
@@ -61,299 +73,73 @@ def _unit_ratio(num: str, den: str) -> str:
     return f"{num}/({den})" if " " in den or "/" in den else f"{num}/{den}"
 
 
-def _doc(kind: str, turbine: linearize.Turbine, settings: dict[str, Any], columns: list[str],
-         units: list[str], rows: list[list[float]],
-         matrices: dict[str, dict[str, Any]]) -> dict[str, Any]:
-    return {"schema": SCHEMA, "schema_version": SCHEMA_VERSION, "kind": kind,
-            "turbine": turbine.name, "software": {"mpc_wt": __version__},
-            "settings": settings,
-            "schedule": {"columns": columns, "units": units,
-                         "rows": [[float(v) for v in r] for r in rows]},
-            "matrices": matrices}
+def document(kind: str, turbine: linearize.Turbine, settings: dict[str, Any],
+             columns: list[str], units: list[str], rows: list[list[float]],
+             matrices: dict[str, dict[str, Any]],
+             plot: dict[str, Any] | None = None) -> dict[str, Any]:
+    """A gain-table document: what a kind's table function returns.
+
+    Parameters
+    ----------
+    kind : str
+        The controller kind.
+    turbine : Turbine
+        The turbine designed for (its name is recorded).
+    settings : dict
+        The design's settings (JSON-able).
+    columns, units : list of str
+        The schedule's column names and units.
+    rows : list of list of float
+        The schedule, one row per operating point.
+    matrices : dict
+        Name -> :func:`matrix`.
+    plot : dict, optional
+        How :func:`mpc_wt.plotting.plot_design` draws it: ``{"columns": [...], "label": ...}``
+        plots those schedule columns against wind speed; otherwise the largest gains of the
+        matrix ``K`` normalised, against wind speed or, with ``{"x": "vertex"}``, the row
+        index.
+
+    Returns
+    -------
+    dict
+        The document (schema "mpc-wt gain table").
+    """
+    doc = {"schema": SCHEMA, "schema_version": SCHEMA_VERSION, "kind": kind,
+           "turbine": turbine.name, "software": {"mpc_wt": __version__},
+           "settings": settings,
+           "schedule": {"columns": columns, "units": units,
+                        "rows": [[float(v) for v in r] for r in rows]},
+           "matrices": matrices}
+    if plot is not None:
+        doc["plot"] = dict(plot)
+    return doc
 
 
-def _matrix(stack: np.ndarray, rows: Sequence[str], cols: Sequence[str], unit: str,
-            units: Sequence[str] | None = None) -> dict[str, Any]:
+def matrix(stack: np.ndarray, rows: Sequence[str], cols: Sequence[str], unit: str,
+           units: Sequence[str] | None = None) -> dict[str, Any]:
+    """A stack of gain matrices over the schedule's points, as a document's matrix entry.
+
+    Parameters
+    ----------
+    stack : array_like, shape (n_points, n_rows, n_cols)
+        The matrices.
+    rows, cols : sequence of str
+        Row and column names.
+    unit : str
+        The matrix's unit (one string).
+    units : sequence of str, optional
+        One unit per entry, row-major.
+
+    Returns
+    -------
+    dict
+        ``unit``, ``rows``, ``cols``, ``data`` (and ``units``).
+    """
     d = {"unit": unit, "rows": list(rows), "cols": list(cols),
          "data": np.asarray(stack, dtype=float).tolist()}
     if units is not None:
         d["units"] = list(units)
     return d
-
-
-def baseline_table(turbine: linearize.Turbine, gains: Any,
-                   winds: Sequence[float] | None = None) -> dict[str, Any]:
-    """The PI baseline (:class:`~mpc_wt.controllers.baseline.BaselineGains`) as a gain table: the pitch
-    gain schedule -- the gains the controller applies, :func:`~mpc_wt.controllers.baseline.effective_pi_gains`
-    (kp, ki / (1 + 2 theta / theta_K) of the DISCON form), not the design's kp GK(theta) --
-    at the trim pitch of each wind speed from rated (the first row: the wind at which the design's rated or
-    derated power is reached at fine pitch) to cut-out in 1 m/s steps, with the set points.
-
-    Parameters
-    ----------
-    turbine : Turbine
-        The turbine.
-    gains : BaselineGains
-        The design.
-    winds : sequence of float, optional
-        Wind speeds of the rows [m/s].
-
-    Returns
-    -------
-    dict
-        The gain-table document (schema "mpc-wt gain table"): kind, turbine, settings, the
-        schedule (columns with units, rows) and matrices.
-    """
-    op = turbine.operation
-    p_w = None if gains.power_fraction == 1.0 else gains.rated_power
-    if winds is None:
-        v0 = _rated_wind(turbine, p_w)
-        winds = np.r_[v0, np.arange(math.floor(v0) + 1.0, op.cut_out_wind + 0.5, 1.0)]
-    rows = []
-    for v in winds:
-        p = linearize.trim(turbine, float(v), p_w)
-        kp, ki = effective_pi_gains(gains.kp, gains.ki, gains.theta_k_rad, p.pitch_rad)
-        rows.append([float(v), p.pitch_rad, float(kp), float(ki), p.gen_torque,
-                     p.gen_speed_rad_s, p.power])
-    settings = {"kp": gains.kp, "ki": gains.ki, "theta_k_rad": gains.theta_k_rad,
-                "k_opt": gains.k_opt, "rated_gen_speed_rad_s": gains.rated_gen_speed_rad_s,
-                "rated_torque": gains.rated_torque, "rated_power": gains.rated_power,
-                "omega_n_rad_s": gains.omega_n_rad_s, "zeta": gains.zeta,
-                "power_fraction": gains.power_fraction, "min_pitch_rad": op.fine_pitch_rad,
-                "max_pitch_rad": turbine.pitch_actuator.max_pitch_rad,
-                "max_pitch_rate_rad_s": turbine.pitch_actuator.max_rate_rad_s,
-                "max_torque": turbine.generator.max_torque,
-                "min_torque": turbine.generator.min_torque,
-                "max_torque_rate": turbine.generator.max_torque_rate,
-                "min_gen_speed_rad_s": op.min_rotor_speed_rad_s
-                * turbine.drivetrain.gearbox_ratio,
-                "min_pitch_speeds_rad_s": list(gains.min_pitch_speeds),
-                "min_pitch_offsets_rad": list(gains.min_pitch_offsets),
-                "units": {"kp": "s", "ki": "-", "theta_k_rad": "rad",
-                          "k_opt": "N m/(rad/s)^2", "rated_torque": "N m", "rated_power": "W"}}
-    return _doc("baseline", turbine, settings,
-                ["wind_speed", "pitch", "kp", "ki", "gen_torque", "gen_speed", "power"],
-                ["m/s", "rad", "s", "-", "N m", "rad/s", "W"], rows, {})
-
-
-def _rated_wind(turbine: linearize.Turbine, power_W: float | None) -> float:
-    """The lowest wind at which ``power_W`` (default rated) is reached at fine pitch [m/s]."""
-    v_rated = linearize.rated_wind_speed(turbine)
-    if power_W is None:
-        return v_rated
-    from scipy.optimize import brentq
-
-    def short(v: float) -> float:
-        return linearize.trim(turbine, v).power - power_W
-
-    lo = turbine.operation.cut_in_wind
-    return float(brentq(short, lo, v_rated, xtol=1e-6)) if short(lo) < 0 else lo
-
-
-def lqr_table(turbine: linearize.Turbine, designs: Sequence[Any],
-              observers: Sequence[Any] | None = None,
-              state_units: Sequence[str] | None = None) -> dict[str, Any]:
-    """An LQR family (:func:`~mpc_wt.controllers.lqr.design_lqr_family`) as a gain table: operating
-    points per wind speed, the gains K (u - u0 = -K (x - x0)) and, when given, the PI observer
-    gains L1, L2 (Do et al. eqs 13-16).
-
-    Parameters
-    ----------
-    turbine : Turbine
-        The turbine.
-    designs : sequence of LQRDesign
-        One per wind.
-    observers : sequence of PIObserver, optional
-        The PI observers of the same models.
-    state_units : sequence of str, optional
-        Units of the states (default from the plant's tables).
-
-    Returns
-    -------
-    dict
-        The gain-table document (schema "mpc-wt gain table"): kind, turbine, settings, the
-        schedule (columns with units, rows) and matrices.
-    """
-    if not designs:
-        raise GainTableError("no LQR designs to tabulate")
-    d0 = designs[0]
-    su = list(state_units or [dict(zip(linearize.STATE_NAMES, linearize.STATE_UNITS)).get(
-        n, "-") for n in d0.states])
-    iu = dict(zip(linearize.INPUT_NAMES, linearize.INPUT_UNITS))
-    cols = ["wind_speed"] + [f"x0_{n}" for n in d0.states] + [f"u0_{n}" for n in d0.inputs]
-    units = ["m/s"] + su + [iu.get(n, "-") for n in d0.inputs]
-    rows = [[d.wind_mps, *d.x0, *d.u0] for d in designs]
-    mats = {"K": _matrix(np.array([d.K for d in designs]), d0.inputs, d0.states,
-                         "input unit / state unit",
-                         [_unit_ratio(iu.get(i, "-"), s) for i in d0.inputs for s in su])}
-    if observers:
-        o = observers[0]
-        nf = o.L2.shape[0]
-        mats["L1"] = _matrix(np.array([ob.L1 for ob in observers]), d0.states, o.measured,
-                             "state unit / measurement unit")
-        mats["L2"] = _matrix(np.array([ob.L2 for ob in observers]),
-                             [f"unknown_input_{k + 1}" for k in range(nf)], o.measured,
-                             "unknown-input unit / measurement unit")
-    settings = {"dt": d0.dt, "weights": d0.weights,
-                "gain_ratio_L2_L1": [ob.gain_ratio for ob in observers] if observers else None,
-                "convention": "u = u0 - K (x - x0); observer per Do et al. eqs 13-16"}
-    return _doc("lqr", turbine, settings, cols, units, rows, mats)
-
-
-def lqr_pio_table(turbine: linearize.Turbine, ctl: Any, kind: str = "lqr-pio",
-                  options: dict[str, Any] | None = None) -> dict[str, Any]:
-    """A scheduled LQR-PIO (:class:`~mpc_wt.controllers.lqr.ScheduledLQRPIO`) as a gain table:
-    :func:`lqr_table` of its designs from cut-in to cut-out, with each design's region and the
-    options it was built with (from which ``mpcwt export --format discon`` builds it again).
-
-    Parameters
-    ----------
-    turbine : Turbine
-        The turbine.
-    ctl : ScheduledLQRPIO
-        The design.
-    kind : str
-        Its kind.
-    options : dict, optional
-        The options it was built with.
-
-    Returns
-    -------
-    dict
-        The gain-table document.
-    """
-    pts = ctl.controllers
-    doc = lqr_table(turbine, [c.lqr for c in pts], [c.obs for c in pts])
-    doc["kind"] = kind
-    doc["schedule"]["columns"].append("region")
-    doc["schedule"]["units"].append("-")
-    for row, c in zip(doc["schedule"]["rows"], pts):
-        row.append(2.0 if c.region == "II" else 3.0)
-    doc["settings"].update({
-        "options": dict(options or {}), "dt": ctl.dt,
-        "schedule_time_constant": ctl.schedule.tau, "measured": list(pts[0].obs.measured),
-        "units": {"dt": "s", "schedule_time_constant": "s"}})
-    return doc
-
-
-def ts_table(turbine: linearize.Turbine, ts: Any, controller: Any,
-             observer: Any | None = None) -> dict[str, Any]:
-    """A TS design (:mod:`mpc_wt.controllers.takagi_sugeno`) as a gain table: one row per premise vertex (wind,
-    power reduction, equilibrium x0, u0), the PDC gains K_i and observer gains L_i, with the
-    membership breakpoints and the LMI settings and certificate.
-
-    Parameters
-    ----------
-    turbine : Turbine
-        The turbine.
-    ts : TSModel
-        The model.
-    controller : TSControllerDesign
-        The PDC gains.
-    observer : TSObserverDesign, optional
-        The observer gains.
-
-    Returns
-    -------
-    dict
-        The gain-table document (schema "mpc-wt gain table"): kind, turbine, settings, the
-        schedule (columns with units, rows) and matrices.
-    """
-    su = dict(zip(linearize.STATE_NAMES, linearize.STATE_UNITS))
-    st_units = [su.get(n, "-") for n in ts.states]
-    in_units = ["rad", "N m"]
-    vt = ts.vertices
-    cols = ["wind_speed", "power_reduction"] + [f"x0_{n}" for n in ts.states] + \
-        [f"u0_{n}" for n in ts.inputs]
-    units = ["m/s", "-"] + st_units + in_units
-    rows = [[vt[i, 0], vt[i, 1], *ts.x0[i], *ts.u0[i]] for i in range(ts.n_vertices)]
-    kcols = list(ts.states) + ([f"integral_{controller.integral_of}"]
-                               if controller.integral_of else [])
-    kunits = st_units + ([su.get(controller.integral_of, "-") + " s"]
-                         if controller.integral_of else [])
-    mats = {"K": _matrix(controller.K, ts.inputs, kcols, "input unit / state unit",
-                         [_unit_ratio(i, s) for i in in_units for s in kunits])}
-    settings = {"wind_grid": ts.wind_grid.tolist(), "reduction_grid": ts.reduction_grid.tolist(),
-                "membership": "product of piecewise-linear hats on wind_grid x reduction_grid",
-                "rated_power": ts.rated_power, "measured": list(ts.measured),
-                "decay_rate": controller.decay_rate, "disk_radius": controller.disk_radius,
-                "input_bounds": controller.input_bounds.tolist(), "solver": controller.solver,
-                "certificate_ok": controller.certificate.ok,
-                "convention": "u = sum_i h_i (u0_i - K_i (x_hat - x0_i)) (Clemens eq 7)"}
-    if observer is not None:
-        yunits = [su.get(n, "-") for n in ts.measured]
-        mats["L"] = _matrix(observer.L, list(ts.states) + ["wind"], list(ts.measured),
-                            "xi unit / measurement unit",
-                            [_unit_ratio(s, y) for s in st_units + ["m/s"] for y in yunits])
-        settings.update({"tau_v": observer.tau_v, "observer_decay_rate": observer.decay_rate,
-                         "observer_disk_radius": observer.disk_radius,
-                         "observer_certificate_ok": observer.certificate.ok})
-    return _doc("ts", turbine, settings, cols, units, rows, mats)
-
-
-def ibc_table(turbine: linearize.Turbine, gains: Any) -> dict[str, Any]:
-    """Individual blade control (:class:`~mpc_wt.controllers.ipc.IBCGains`) as a gain table: the
-    proportional gain per mean-pitch breakpoint, with its gain margin and 1P loop gain, and the
-    filters (high-pass corner, band-stop frequencies and Q) and power fade-in in ``settings``.
-
-    Parameters
-    ----------
-    turbine : Turbine
-        The turbine.
-    gains : IBCGains
-        The design.
-
-    Returns
-    -------
-    dict
-        The gain-table document (schema "mpc-wt gain table"): kind, turbine, settings, the
-        schedule (columns with units, rows) and matrices.
-    """
-    rows = [[w, p, k, gm if math.isfinite(gm) else 1e300, lg] for w, p, k, gm, lg in zip(
-        gains.wind_mps, gains.pitch_rad, gains.gain, gains.gain_margin, gains.loop_gain_1p)]
-    settings = {"dt": gains.dt, "highpass_hz": gains.highpass_hz,
-                "notch_hz": [h * gains.one_p_hz for h in gains.notch_harmonics],
-                "notch_harmonics": list(gains.notch_harmonics), "notch_q": gains.notch_q,
-                "weight_range": list(gains.weight_range), "rated_power": gains.rated_power,
-                "power_fraction": gains.power_fraction,
-                "rotor_speed_rad_s": gains.rotor_speed_rad_s,
-                "max_amplitude_rad": min(gains.max_amplitude_rad, 1e300),
-                "convention": "theta_i = theta_collective + w(P) BS(K(theta_mean) HP(M_flap_i)) "
-                              "(Pettas and Cheng sec. 3.1); gain margin 1e300: none"}
-    return _doc("ibc", turbine, settings,
-                ["wind_speed", "pitch", "gain", "gain_margin", "loop_gain_1p"],
-                ["m/s", "rad", "rad/(N m)", "-", "-"], rows, {})
-
-
-def coleman_ipc_table(turbine: linearize.Turbine, gains: Any) -> dict[str, Any]:
-    """Coleman-frame IPC (:class:`~mpc_wt.controllers.ipc.ColemanIPCGains`) as a gain table: integral
-    gain and azimuth offset per mean-pitch breakpoint.
-
-    Parameters
-    ----------
-    turbine : Turbine
-        The turbine.
-    gains : ColemanIPCGains
-        The design.
-
-    Returns
-    -------
-    dict
-        The gain-table document (schema "mpc-wt gain table"): kind, turbine, settings, the
-        schedule (columns with units, rows) and matrices.
-    """
-    rows = [[w, p, k, a, gm] for w, p, k, a, gm in zip(
-        gains.wind_mps, gains.pitch_rad, gains.ki, gains.azimuth_offset_rad, gains.gain_margin)]
-    settings = {"crossover_rad_s": gains.crossover_rad_s,
-                "max_amplitude_rad": gains.max_amplitude_rad,
-                "weight_range": list(gains.weight_range), "rated_power": gains.rated_power,
-                "power_fraction": gains.power_fraction,
-                "convention": "theta_cs = -K_I R(-phi) int M_cs dt, M_cs = 2/3 sum M_i "
-                              "[cos psi_i, sin psi_i]; theta_i += theta_c cos psi_i + theta_s "
-                              "sin psi_i"}
-    return _doc("coleman-ipc", turbine, settings,
-                ["wind_speed", "pitch", "ki", "azimuth_offset", "gain_margin"],
-                ["m/s", "rad", "rad/(N m s)", "rad", "-"], rows, {})
 
 
 def _check(doc: Any, where: str) -> dict[str, Any]:
@@ -372,94 +158,8 @@ def _check(doc: Any, where: str) -> dict[str, Any]:
     return doc
 
 
-def mpc_table(turbine: linearize.Turbine, ctl: Any, kind: str,
-              options: dict[str, Any] | None = None) -> dict[str, Any]:
-    """A scheduled MPC's design as a table: one row per grid wind with the trim the cost
-    tracks there (pitch, torque, rotor speed, power) and its Kalman filter's spectral radius;
-    the settings hold the kind's options (from which the design is built again), the MPC's
-    horizon and period, the notch on its torque command (centre, None: none; Q), and its
-    region floor (the pitch above which and the rotor speed above which the measurements
-    choose a design inside region 3, and that design's wind; None: none).
-
-    Parameters
-    ----------
-    turbine : Turbine
-        The turbine.
-    ctl : ScheduledMPC
-        The design.
-    kind : str
-        Its kind (``mpc``, ``mpc-collective``, ``mpc-lidar``).
-    options : dict, optional
-        The options it was built with.
-
-    Returns
-    -------
-    dict
-        The gain-table document.
-    """
-    rows = []
-    for k, v in enumerate(ctl._grid):
-        m = ctl.controller(k)
-        z0, outs = m.model.z0, list(m.model.outputs)
-        rows.append([float(v), float(np.mean(m.model.u0[:3])), float(m.model.u0[3]),
-                     float(z0[outs.index("rotor_speed")]), float(z0[outs.index("gen_power")]),
-                     float(m.estimator.spectral_radius) if m.estimator is not None else
-                     float("nan")])
-    st = ctl.settings
-    settings = {"options": dict(options or {}), "dt": st.dt, "horizon": st.horizon,
-                "control_horizon": st.hu, "schedule_time_constant": ctl.schedule.tau,
-                "target_time_constant": ctl.target_tau,
-                "torque_notch_hz": ctl.torque_notch_hz, "torque_notch_q": ctl.torque_notch_q,
-                "tower_notch_hz": ctl.tower_notch_hz,
-                "region_floor": None if ctl.region_floor is None else {
-                    "pitch_above": ctl.region_floor.pitch_threshold,
-                    "pitch_counts_above_rotor_speed": ctl.region_floor.pitch_min_speed
-                    * ctl.region_floor.rated_speed,
-                    "rotor_speed_above": ctl.region_floor.speed_margin
-                    * ctl.region_floor.rated_speed,
-                    "region3_wind": ctl.region_floor.region3_wind},
-                "units": {"dt": "s", "schedule_time_constant": "s",
-                          "target_time_constant": "s", "torque_notch_hz": "Hz",
-                          "tower_notch_hz": "Hz", "region_floor": "rad, rad/s, m/s"}}
-    return _doc(kind, turbine, settings,
-                ["wind_speed", "pitch", "gen_torque", "rotor_speed", "gen_power",
-                 "estimator_spectral_radius"], ["m/s", "rad", "N m", "rad/s", "W", "-"], rows,
-                {})
 
 
-def lidar_ff_table(turbine: linearize.Turbine, ctl: Any, kind: str,
-                   options: dict[str, Any] | None = None) -> dict[str, Any]:
-    """The LIDAR feedforward's design as a table over mean wind: the filter corner of the
-    turbulence model and the static pitch curve the feedforward follows; the settings hold the
-    kind's options (from which it is built again), the baseline's PI gains and the filter.
-
-    Parameters
-    ----------
-    turbine : Turbine
-        The turbine.
-    ctl : LidarFeedforward
-        The design.
-    kind : str
-        Its kind (``baseline+lidar-ff``).
-    options : dict, optional
-        The options it was built with.
-
-    Returns
-    -------
-    dict
-        The gain-table document.
-    """
-    winds = np.asarray(ctl.corner_winds, float)
-    pitch = np.interp(winds, ctl.curve_v, ctl.curve_pitch)
-    rows = [[float(v), float(c), float(p)] for v, c, p in zip(winds, ctl.corners, pitch)]
-    g = ctl.base.gains
-    settings = {"options": dict(options or {}), "kp": g.kp, "ki": g.ki,
-                "filter_order": ctl.order, "sample_dt": ctl.sample_dt,
-                "lead_s": ctl.lead_given, "focus_distance": ctl.sensor.focus_distance,
-                "units": {"kp": "s", "ki": "-", "sample_dt": "s", "lead_s": "s",
-                          "focus_distance": "m"}}
-    return _doc(kind, turbine, settings, ["wind_speed", "filter_corner", "static_pitch"],
-                ["m/s", "rad/s", "rad"], rows, {})
 
 
 def save_design(doc: dict[str, Any], out_dir: str | Path) -> Path:
@@ -598,7 +298,6 @@ def design_turbine(doc: dict[str, Any], turbine: linearize.Turbine | None = None
 
 def _write_rosco(doc: dict[str, Any], out: Path,
                  turbine: linearize.Turbine | None = None) -> list[Path]:
-    from mpc_wt.controllers.baseline import tune_baseline
     from mpc_wt.io.rosco import write_rosco_discon
 
     if doc["kind"] not in ("baseline", "coleman-ipc"):
@@ -608,9 +307,12 @@ def _write_rosco(doc: dict[str, Any], out: Path,
                              f"for ROSCO, or use csv/json/mat")
     t = design_turbine(doc, turbine)
     if doc["kind"] == "coleman-ipc":
-        frac = float(doc["settings"].get("power_fraction", 1.0))
-        base = baseline_table(t, tune_baseline(t, power_fraction=frac))
-        return write_rosco_discon(t, base, out, ipc=doc)
+        base = doc["settings"].get("baseline")
+        if base is None:
+            raise GainTableError("this coleman-ipc design holds no baseline gain table for "
+                                 "ROSCO's pitch schedule (saved by an older mpc-wt): design it "
+                                 "again with `mpcwt design coleman-ipc --out DIR`")
+        return write_rosco_discon(t, _check(base, "its baseline"), out, ipc=doc)
     return write_rosco_discon(t, doc, out)
 
 

@@ -354,11 +354,11 @@ def rosco_values(turbine: linearize.Turbine, doc: dict[str, Any],
     ----------
     turbine : Turbine
     doc : dict
-        A baseline (or derated baseline) gain table (:func:`mpc_wt.io.gain_tables.baseline_table`).
+        A baseline (or derated baseline) gain table (:func:`mpc_wt.kinds.baseline.baseline_table`).
     perf_file : str
         ``PerfFileName``, relative to the DISCON.IN.
     ipc : dict, optional
-        A Coleman IPC gain table (:func:`mpc_wt.io.gain_tables.coleman_ipc_table`): ``IPC_ControlMode``
+        A Coleman IPC gain table (:func:`mpc_wt.kinds.ipc.coleman_ipc_table`): ``IPC_ControlMode``
         1 with its integral gain (median over its schedule) and azimuth offset.
 
     Returns

@@ -3,8 +3,11 @@ constant power or constant torque in region III, and derated (Pettas and Cheng).
 from __future__ import annotations
 
 import logging
+import math
 from dataclasses import dataclass
-from typing import Any, Optional
+from typing import Any, Optional, Sequence
+
+import numpy as np
 
 
 import linearize
@@ -12,6 +15,7 @@ from mpc_wt.registry.context import BuildContext, Built
 from mpc_wt.registry.options import REQUIRED, Options, option
 from mpc_wt.registry.registry import register
 from mpc_wt.simulation.scenario import Scenario, start_wind
+from mpc_wt.io import gain_tables as gt
 from mpc_wt.io.discon_export import LawExport
 from mpc_wt.kinds.common import baseline_entries
 
@@ -73,7 +77,6 @@ def _derate_preset(mt: Any) -> dict[str, Any]:
 def _design_baseline(turbine: linearize.Turbine, *, omega_n_rad_s: float | None = None,
                      zeta: float = 0.7, power_fraction: float = 1.0) -> tuple[dict, str]:
     from mpc_wt.controllers.baseline import tune_baseline
-    from mpc_wt.io.gain_tables import baseline_table
 
     doc = baseline_table(turbine, tune_baseline(turbine, omega_n_rad_s=omega_n_rad_s, zeta=zeta,
                                                 power_fraction=power_fraction))
@@ -101,3 +104,77 @@ register("derate", DerateOptions, field_components="u", pattern=r"derate(\d+(?:\
          operating_point=derated_trim,
          summary="the baseline derated to NN % of rated power, PI re-tuned")(
     baseline_build("constant_power"))
+
+
+
+# -- the gain table ----------------------------------------------------------------------------
+def baseline_table(turbine: linearize.Turbine, gains: Any,
+                   winds: Sequence[float] | None = None) -> dict[str, Any]:
+    """The PI baseline (:class:`~mpc_wt.controllers.baseline.BaselineGains`) as a gain table: the pitch
+    gain schedule -- the gains the controller applies, :func:`~mpc_wt.controllers.baseline.effective_pi_gains`
+    (kp, ki / (1 + 2 theta / theta_K) of the DISCON form), not the design's kp GK(theta) --
+    at the trim pitch of each wind speed from rated (the first row: the wind at which the design's rated or
+    derated power is reached at fine pitch) to cut-out in 1 m/s steps, with the set points.
+
+    Parameters
+    ----------
+    turbine : Turbine
+        The turbine.
+    gains : BaselineGains
+        The design.
+    winds : sequence of float, optional
+        Wind speeds of the rows [m/s].
+
+    Returns
+    -------
+    dict
+        The gain-table document (schema "mpc-wt gain table"): kind, turbine, settings, the
+        schedule (columns with units, rows) and matrices.
+    """
+    from mpc_wt.controllers.baseline import effective_pi_gains
+
+    op = turbine.operation
+    p_w = None if gains.power_fraction == 1.0 else gains.rated_power
+    if winds is None:
+        v0 = _rated_wind(turbine, p_w)
+        winds = np.r_[v0, np.arange(math.floor(v0) + 1.0, op.cut_out_wind + 0.5, 1.0)]
+    rows = []
+    for v in winds:
+        p = linearize.trim(turbine, float(v), p_w)
+        kp, ki = effective_pi_gains(gains.kp, gains.ki, gains.theta_k_rad, p.pitch_rad)
+        rows.append([float(v), p.pitch_rad, float(kp), float(ki), p.gen_torque,
+                     p.gen_speed_rad_s, p.power])
+    settings = {"kp": gains.kp, "ki": gains.ki, "theta_k_rad": gains.theta_k_rad,
+                "k_opt": gains.k_opt, "rated_gen_speed_rad_s": gains.rated_gen_speed_rad_s,
+                "rated_torque": gains.rated_torque, "rated_power": gains.rated_power,
+                "omega_n_rad_s": gains.omega_n_rad_s, "zeta": gains.zeta,
+                "power_fraction": gains.power_fraction, "min_pitch_rad": op.fine_pitch_rad,
+                "max_pitch_rad": turbine.pitch_actuator.max_pitch_rad,
+                "max_pitch_rate_rad_s": turbine.pitch_actuator.max_rate_rad_s,
+                "max_torque": turbine.generator.max_torque,
+                "min_torque": turbine.generator.min_torque,
+                "max_torque_rate": turbine.generator.max_torque_rate,
+                "min_gen_speed_rad_s": op.min_rotor_speed_rad_s
+                * turbine.drivetrain.gearbox_ratio,
+                "min_pitch_speeds_rad_s": list(gains.min_pitch_speeds),
+                "min_pitch_offsets_rad": list(gains.min_pitch_offsets),
+                "units": {"kp": "s", "ki": "-", "theta_k_rad": "rad",
+                          "k_opt": "N m/(rad/s)^2", "rated_torque": "N m", "rated_power": "W"}}
+    return gt.document("baseline", turbine, settings,
+                ["wind_speed", "pitch", "kp", "ki", "gen_torque", "gen_speed", "power"],
+                ["m/s", "rad", "s", "-", "N m", "rad/s", "W"], rows, {},
+                       plot={"columns": ["kp", "ki"], "label": "PI gain on generator speed [s], [-]"})
+
+
+def _rated_wind(turbine: linearize.Turbine, power_W: float | None) -> float:
+    """The lowest wind at which ``power_W`` (default rated) is reached at fine pitch [m/s]."""
+    v_rated = linearize.rated_wind_speed(turbine)
+    if power_W is None:
+        return v_rated
+    from scipy.optimize import brentq
+
+    def short(v: float) -> float:
+        return linearize.trim(turbine, v).power - power_W
+
+    lo = turbine.operation.cut_in_wind
+    return float(brentq(short, lo, v_rated, xtol=1e-6)) if short(lo) < 0 else lo

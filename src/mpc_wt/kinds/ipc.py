@@ -14,6 +14,7 @@ from mpc_wt.controllers.ipc import IBC_LOOP_GAIN
 from mpc_wt.registry.context import BuildContext, Built
 from mpc_wt.registry.options import Options, option
 from mpc_wt.registry.registry import register
+from mpc_wt.io import gain_tables as gt
 from mpc_wt.io.discon_export import LawExport
 from mpc_wt.kinds.common import baseline_entries
 
@@ -22,7 +23,6 @@ log = logging.getLogger(__name__)
 def _design_ibc(turbine: linearize.Turbine, *, power_fraction: float = 1.0,
                 loop_gain: float | None = None) -> tuple[dict, str]:
     from mpc_wt.controllers.ipc import tune_ibc
-    from mpc_wt.io.gain_tables import ibc_table
 
     g = tune_ibc(turbine, power_fraction=power_fraction, loop_gain_1p=loop_gain)
     doc = ibc_table(turbine, g)
@@ -36,7 +36,6 @@ def _design_ibc(turbine: linearize.Turbine, *, power_fraction: float = 1.0,
 def _design_coleman(turbine: linearize.Turbine, *, power_fraction: float = 1.0
                     ) -> tuple[dict, str]:
     from mpc_wt.controllers.ipc import tune_coleman_ipc
-    from mpc_wt.io.gain_tables import coleman_ipc_table
 
     g = tune_coleman_ipc(turbine, power_fraction=power_fraction)
     return coleman_ipc_table(turbine, g), (f"{g.ki.size} points, gain margin >= "
@@ -176,3 +175,79 @@ def _build_coleman(ctx: BuildContext, opts: ColemanIPCOptions, base: Built) -> B
             "azimuth_offset_rad": g.azimuth_offset_rad.tolist(), **opts.to_dict()}
     return Built(ColemanIPCController(base.controller, g), base.controller_dt, base.preview,
                  {**base.meta, "coleman_ipc": meta}, base.power_fraction)
+
+
+
+# -- the gain table ----------------------------------------------------------------------------
+def ibc_table(turbine: linearize.Turbine, gains: Any) -> dict[str, Any]:
+    """Individual blade control (:class:`~mpc_wt.controllers.ipc.IBCGains`) as a gain table: the
+    proportional gain per mean-pitch breakpoint, with its gain margin and 1P loop gain, and the
+    filters (high-pass corner, band-stop frequencies and Q) and power fade-in in ``settings``.
+
+    Parameters
+    ----------
+    turbine : Turbine
+        The turbine.
+    gains : IBCGains
+        The design.
+
+    Returns
+    -------
+    dict
+        The gain-table document (schema "mpc-wt gain table"): kind, turbine, settings, the
+        schedule (columns with units, rows) and matrices.
+    """
+    rows = [[w, p, k, gm if math.isfinite(gm) else 1e300, lg] for w, p, k, gm, lg in zip(
+        gains.wind_mps, gains.pitch_rad, gains.gain, gains.gain_margin, gains.loop_gain_1p)]
+    settings = {"dt": gains.dt, "highpass_hz": gains.highpass_hz,
+                "notch_hz": [h * gains.one_p_hz for h in gains.notch_harmonics],
+                "notch_harmonics": list(gains.notch_harmonics), "notch_q": gains.notch_q,
+                "weight_range": list(gains.weight_range), "rated_power": gains.rated_power,
+                "power_fraction": gains.power_fraction,
+                "rotor_speed_rad_s": gains.rotor_speed_rad_s,
+                "max_amplitude_rad": min(gains.max_amplitude_rad, 1e300),
+                "convention": "theta_i = theta_collective + w(P) BS(K(theta_mean) HP(M_flap_i)) "
+                              "(Pettas and Cheng sec. 3.1); gain margin 1e300: none"}
+    return gt.document("ibc", turbine, settings,
+                ["wind_speed", "pitch", "gain", "gain_margin", "loop_gain_1p"],
+                ["m/s", "rad", "rad/(N m)", "-", "-"], rows, {},
+                       plot={"columns": ["gain"], "label": "IBC gain [rad/(N m)]"})
+
+
+def coleman_ipc_table(turbine: linearize.Turbine, gains: Any) -> dict[str, Any]:
+    """Coleman-frame IPC (:class:`~mpc_wt.controllers.ipc.ColemanIPCGains`) as a gain table: integral
+    gain and azimuth offset per mean-pitch breakpoint; ``settings["baseline"]`` holds the
+    baseline's gain table (:func:`mpc_wt.kinds.baseline.baseline_table`) of the same power
+    fraction, ROSCO's pitch schedule in its ``rosco`` export.
+
+    Parameters
+    ----------
+    turbine : Turbine
+        The turbine.
+    gains : ColemanIPCGains
+        The design.
+
+    Returns
+    -------
+    dict
+        The gain-table document (schema "mpc-wt gain table"): kind, turbine, settings, the
+        schedule (columns with units, rows) and matrices.
+    """
+    from mpc_wt.controllers.baseline import tune_baseline
+    from mpc_wt.kinds.baseline import baseline_table
+
+    rows = [[w, p, k, a, gm] for w, p, k, a, gm in zip(
+        gains.wind_mps, gains.pitch_rad, gains.ki, gains.azimuth_offset_rad, gains.gain_margin)]
+    base = baseline_table(turbine, tune_baseline(turbine, power_fraction=gains.power_fraction))
+    settings = {"crossover_rad_s": gains.crossover_rad_s,
+                "max_amplitude_rad": gains.max_amplitude_rad,
+                "weight_range": list(gains.weight_range), "rated_power": gains.rated_power,
+                "power_fraction": gains.power_fraction,
+                "convention": "theta_cs = -K_I R(-phi) int M_cs dt, M_cs = 2/3 sum M_i "
+                              "[cos psi_i, sin psi_i]; theta_i += theta_c cos psi_i + theta_s "
+                              "sin psi_i",
+                "baseline": base}
+    return gt.document("coleman-ipc", turbine, settings,
+                ["wind_speed", "pitch", "ki", "azimuth_offset", "gain_margin"],
+                ["m/s", "rad", "rad/(N m s)", "rad", "-"], rows, {},
+                       plot={"columns": ["ki"], "label": "IPC integral gain [rad/(N m s)]"})

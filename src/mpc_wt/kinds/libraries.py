@@ -213,7 +213,7 @@ def _export_rosco(turbine: linearize.Turbine, power_fraction: float) -> str:
     """Our baseline design as a ROSCO DISCON.IN in a folder kept for the process (removed when
     it exits)."""
     from mpc_wt.controllers.baseline import tune_baseline
-    from mpc_wt.io.gain_tables import baseline_table
+    from mpc_wt.kinds.baseline import baseline_table
     from mpc_wt.io.rosco import write_rosco_discon
 
     out = _process_folder("mpcwt_rosco_export_")

@@ -13,6 +13,7 @@ from mpc_wt.registry.context import BuildContext, Built
 from mpc_wt.registry.options import Options, option
 from mpc_wt.registry.registry import register
 from mpc_wt.kinds.baseline import BaselineOptions, baseline_build
+from mpc_wt.io import gain_tables as gt
 from mpc_wt.io.discon_export import LawExport
 from mpc_wt.kinds.common import LidarOptions, baseline_entries
 
@@ -45,7 +46,6 @@ class LidarFFOptions(Options):
 def _design_lidar_ff(turbine: linearize.Turbine) -> tuple[dict, str]:
     """The baseline with the LIDAR feedforward, default options, as a table over mean wind
     (``mpcwt design baseline+lidar-ff``; ``mpcwt export --format discon`` builds it again)."""
-    from mpc_wt.io.gain_tables import lidar_ff_table
     from mpc_wt.registry.context import DEFAULT_CACHE
 
     ctx = BuildContext(turbine=turbine, params=linearize.plant_params(turbine),
@@ -124,3 +124,41 @@ def _build_lidar_ff(ctx: BuildContext, opts: LidarFFOptions, base: Built) -> Bui
             "focus_distance_m": cw.focus_distance, "evolution": opts.lidar.evolution}
     return Built(ctl, base.controller_dt, base.preview, {**base.meta, "lidar_ff": meta},
                  base.power_fraction)
+
+
+
+# -- the gain table ----------------------------------------------------------------------------
+def lidar_ff_table(turbine: linearize.Turbine, ctl: Any, kind: str,
+                   options: dict[str, Any] | None = None) -> dict[str, Any]:
+    """The LIDAR feedforward's design as a table over mean wind: the filter corner of the
+    turbulence model and the static pitch curve the feedforward follows; the settings hold the
+    kind's options (from which it is built again), the baseline's PI gains and the filter.
+
+    Parameters
+    ----------
+    turbine : Turbine
+        The turbine.
+    ctl : LidarFeedforward
+        The design.
+    kind : str
+        Its kind (``baseline+lidar-ff``).
+    options : dict, optional
+        The options it was built with.
+
+    Returns
+    -------
+    dict
+        The gain-table document.
+    """
+    winds = np.asarray(ctl.corner_winds, float)
+    pitch = np.interp(winds, ctl.curve_v, ctl.curve_pitch)
+    rows = [[float(v), float(c), float(p)] for v, c, p in zip(winds, ctl.corners, pitch)]
+    g = ctl.base.gains
+    settings = {"options": dict(options or {}), "kp": g.kp, "ki": g.ki,
+                "filter_order": ctl.order, "sample_dt": ctl.sample_dt,
+                "lead_s": ctl.lead_given, "focus_distance": ctl.sensor.focus_distance,
+                "units": {"kp": "s", "ki": "-", "sample_dt": "s", "lead_s": "s",
+                          "focus_distance": "m"}}
+    return gt.document(kind, turbine, settings, ["wind_speed", "filter_corner", "static_pitch"],
+                ["m/s", "rad/s", "rad"], rows, {},
+                plot={"columns": ["filter_corner"], "label": "feedforward filter corner [rad/s]"})

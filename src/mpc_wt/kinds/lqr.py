@@ -4,7 +4,7 @@ from __future__ import annotations
 import logging
 import math
 from dataclasses import dataclass
-from typing import Any, Optional
+from typing import Any, Optional, Sequence
 
 import numpy as np
 
@@ -12,6 +12,7 @@ import linearize
 from mpc_wt.registry.context import BuildContext, Built
 from mpc_wt.registry.options import Options, option
 from mpc_wt.registry.registry import register
+from mpc_wt.io import gain_tables as gt
 from mpc_wt.io.discon_export import LawExport, signal_codes
 from mpc_wt.kinds.common import (baseline_entries, check_design_wind, envelope_family, law_entries,
                                  wind_estimator, windest_entries)
@@ -29,7 +30,6 @@ def _design_lqr(turbine: linearize.Turbine, *, winds: Any = None,
         design_lqr_family,
         design_pi_observer,
     )
-    from mpc_wt.io.gain_tables import lqr_table
 
     winds = np.arange(12.0, 25.5, 1.0) if winds is None else np.asarray(winds, float)
     fam = linearize.linearize_family(turbine, winds, config=linearize.PlantConfig.do(),
@@ -190,7 +190,6 @@ def _design_lqr_pio(turbine: linearize.Turbine) -> tuple[dict, str]:
     """The scheduled LQR-PIO with the default options, as a table of its designs from cut-in
     to cut-out (``mpcwt design lqr-pio``; ``mpcwt export --format discon`` builds it again from
     the table's options)."""
-    from mpc_wt.io.gain_tables import lqr_pio_table
     from mpc_wt.registry.context import DEFAULT_CACHE
 
     ctx = BuildContext(turbine=turbine, params=linearize.plant_params(turbine),
@@ -371,3 +370,91 @@ def _lqr_pio_at(turbine: linearize.Turbine, model: linearize.LinearModel, wind: 
                             torque_law=BaselineController(turbine, base)
                             if (region == "II" and opts.region2_torque == "baseline")
                             or (region == "III" and stall_guard) else None)
+
+
+
+# -- the gain table ----------------------------------------------------------------------------
+def lqr_table(turbine: linearize.Turbine, designs: Sequence[Any],
+              observers: Sequence[Any] | None = None,
+              state_units: Sequence[str] | None = None) -> dict[str, Any]:
+    """An LQR family (:func:`~mpc_wt.controllers.lqr.design_lqr_family`) as a gain table: operating
+    points per wind speed, the gains K (u - u0 = -K (x - x0)) and, when given, the PI observer
+    gains L1, L2 (Do et al. eqs 13-16).
+
+    Parameters
+    ----------
+    turbine : Turbine
+        The turbine.
+    designs : sequence of LQRDesign
+        One per wind.
+    observers : sequence of PIObserver, optional
+        The PI observers of the same models.
+    state_units : sequence of str, optional
+        Units of the states (default from the plant's tables).
+
+    Returns
+    -------
+    dict
+        The gain-table document (schema "mpc-wt gain table"): kind, turbine, settings, the
+        schedule (columns with units, rows) and matrices.
+    """
+    if not designs:
+        raise gt.GainTableError("no LQR designs to tabulate")
+    d0 = designs[0]
+    su = list(state_units or [dict(zip(linearize.STATE_NAMES, linearize.STATE_UNITS)).get(
+        n, "-") for n in d0.states])
+    iu = dict(zip(linearize.INPUT_NAMES, linearize.INPUT_UNITS))
+    cols = ["wind_speed"] + [f"x0_{n}" for n in d0.states] + [f"u0_{n}" for n in d0.inputs]
+    units = ["m/s"] + su + [iu.get(n, "-") for n in d0.inputs]
+    rows = [[d.wind_mps, *d.x0, *d.u0] for d in designs]
+    mats = {"K": gt.matrix(np.array([d.K for d in designs]), d0.inputs, d0.states,
+                         "input unit / state unit",
+                         [gt.unit_ratio(iu.get(i, "-"), s) for i in d0.inputs for s in su])}
+    if observers:
+        o = observers[0]
+        nf = o.L2.shape[0]
+        mats["L1"] = gt.matrix(np.array([ob.L1 for ob in observers]), d0.states, o.measured,
+                             "state unit / measurement unit")
+        mats["L2"] = gt.matrix(np.array([ob.L2 for ob in observers]),
+                             [f"unknown_input_{k + 1}" for k in range(nf)], o.measured,
+                             "unknown-input unit / measurement unit")
+    settings = {"dt": d0.dt, "weights": d0.weights,
+                "gain_ratio_L2_L1": [ob.gain_ratio for ob in observers] if observers else None,
+                "convention": "u = u0 - K (x - x0); observer per Do et al. eqs 13-16"}
+    return gt.document("lqr", turbine, settings, cols, units, rows, mats)
+
+
+def lqr_pio_table(turbine: linearize.Turbine, ctl: Any, kind: str = "lqr-pio",
+                  options: dict[str, Any] | None = None) -> dict[str, Any]:
+    """A scheduled LQR-PIO (:class:`~mpc_wt.controllers.lqr.ScheduledLQRPIO`) as a gain table:
+    :func:`lqr_table` of its designs from cut-in to cut-out, with each design's region and the
+    options it was built with (from which ``mpcwt export --format discon`` builds it again).
+
+    Parameters
+    ----------
+    turbine : Turbine
+        The turbine.
+    ctl : ScheduledLQRPIO
+        The design.
+    kind : str
+        Its kind.
+    options : dict, optional
+        The options it was built with.
+
+    Returns
+    -------
+    dict
+        The gain-table document.
+    """
+    pts = ctl.controllers
+    doc = lqr_table(turbine, [c.lqr for c in pts], [c.obs for c in pts])
+    doc["kind"] = kind
+    doc["schedule"]["columns"].append("region")
+    doc["schedule"]["units"].append("-")
+    for row, c in zip(doc["schedule"]["rows"], pts):
+        row.append(2.0 if c.region == "II" else 3.0)
+    doc["settings"].update({
+        "options": dict(options or {}), "dt": ctl.dt,
+        "schedule_time_constant": ctl.schedule.tau, "measured": list(pts[0].obs.measured),
+        "units": {"dt": "s", "schedule_time_constant": "s"}})
+    return doc

@@ -15,6 +15,7 @@ import linearize
 from mpc_wt.registry.context import BuildContext, Built
 from mpc_wt.registry.options import Options, option
 from mpc_wt.registry.registry import register
+from mpc_wt.io import gain_tables as gt
 from mpc_wt.io.discon_export import LawExport, signal_codes
 from mpc_wt.kinds.common import (LidarOptions, baseline_entries, check_design_wind,
                                  envelope_family, floor_entries, wind_estimator,
@@ -367,7 +368,6 @@ def _design_mpc(collective: bool, with_lidar: bool = False) -> Any:
     kind = "mpc-lidar" if with_lidar else "mpc-collective" if collective else "mpc"
 
     def design(turbine: linearize.Turbine) -> tuple[dict, str]:
-        from mpc_wt.io.gain_tables import mpc_table
         from mpc_wt.registry.context import DEFAULT_CACHE
 
         ctx = BuildContext(turbine=turbine, params=linearize.plant_params(turbine),
@@ -576,3 +576,60 @@ def _build_torque_law(ctx: BuildContext, opts: TorqueLawOptions, base: Built) ->
                          fine_band=math.radians(opts.fine_band_deg))
     return Built(ctl, base.controller_dt, base.preview,
                  {**base.meta, "torque_law": opts.to_dict()}, base.power_fraction)
+
+
+
+# -- the gain table ----------------------------------------------------------------------------
+def mpc_table(turbine: linearize.Turbine, ctl: Any, kind: str,
+              options: dict[str, Any] | None = None) -> dict[str, Any]:
+    """A scheduled MPC's design as a table: one row per grid wind with the trim the cost
+    tracks there (pitch, torque, rotor speed, power) and its Kalman filter's spectral radius;
+    the settings hold the kind's options (from which the design is built again), the MPC's
+    horizon and period, the notch on its torque command (centre, None: none; Q), and its
+    region floor (the pitch above which and the rotor speed above which the measurements
+    choose a design inside region 3, and that design's wind; None: none).
+
+    Parameters
+    ----------
+    turbine : Turbine
+        The turbine.
+    ctl : ScheduledMPC
+        The design.
+    kind : str
+        Its kind (``mpc``, ``mpc-collective``, ``mpc-lidar``).
+    options : dict, optional
+        The options it was built with.
+
+    Returns
+    -------
+    dict
+        The gain-table document.
+    """
+    rows = []
+    for k, v in enumerate(ctl._grid):
+        m = ctl.controller(k)
+        z0, outs = m.model.z0, list(m.model.outputs)
+        rows.append([float(v), float(np.mean(m.model.u0[:3])), float(m.model.u0[3]),
+                     float(z0[outs.index("rotor_speed")]), float(z0[outs.index("gen_power")]),
+                     float(m.estimator.spectral_radius) if m.estimator is not None else
+                     float("nan")])
+    st = ctl.settings
+    settings = {"options": dict(options or {}), "dt": st.dt, "horizon": st.horizon,
+                "control_horizon": st.hu, "schedule_time_constant": ctl.schedule.tau,
+                "target_time_constant": ctl.target_tau,
+                "torque_notch_hz": ctl.torque_notch_hz, "torque_notch_q": ctl.torque_notch_q,
+                "tower_notch_hz": ctl.tower_notch_hz,
+                "region_floor": None if ctl.region_floor is None else {
+                    "pitch_above": ctl.region_floor.pitch_threshold,
+                    "pitch_counts_above_rotor_speed": ctl.region_floor.pitch_min_speed
+                    * ctl.region_floor.rated_speed,
+                    "rotor_speed_above": ctl.region_floor.speed_margin
+                    * ctl.region_floor.rated_speed,
+                    "region3_wind": ctl.region_floor.region3_wind},
+                "units": {"dt": "s", "schedule_time_constant": "s",
+                          "target_time_constant": "s", "torque_notch_hz": "Hz",
+                          "tower_notch_hz": "Hz", "region_floor": "rad, rad/s, m/s"}}
+    return gt.document(kind, turbine, settings,
+                ["wind_speed", "pitch", "gen_torque", "rotor_speed", "gen_power",
+                 "estimator_spectral_radius"], ["m/s", "rad", "N m", "rad/s", "W", "-"], rows,
+                {}, plot={"columns": ["pitch"], "label": "trim pitch the cost tracks [rad]"})

@@ -13,6 +13,7 @@ import linearize
 from mpc_wt.registry.context import BuildContext, Built
 from mpc_wt.registry.options import Options, option
 from mpc_wt.registry.registry import register
+from mpc_wt.io import gain_tables as gt
 from mpc_wt.io.discon_export import LawExport, signal_codes
 from mpc_wt.kinds.common import law_entries
 
@@ -54,7 +55,6 @@ def _design_ts(turbine: linearize.Turbine, *, winds: Any = None,
         build_ts_model,
     )
     from mpc_wt.controllers.takagi_sugeno.model import DEFAULT_WIND_GRID
-    from mpc_wt.io.gain_tables import ts_table
 
     grid = DEFAULT_WIND_GRID if winds is None else winds
     ts = build_ts_model(turbine, [float(v) for v in grid], list(reductions),
@@ -220,3 +220,60 @@ def _build_ts(ctx: BuildContext, opts: TSOptions) -> Built:
     return Built(ctl, meta={"ts": {"vertices": ts.n_vertices, "decay_rate": c.decay_rate,
                                    "observer_decay_rate": o.decay_rate,
                                    "apc_frequency_Hz": opts.apc_frequency}})
+
+
+
+# -- the gain table ----------------------------------------------------------------------------
+def ts_table(turbine: linearize.Turbine, ts: Any, controller: Any,
+             observer: Any | None = None) -> dict[str, Any]:
+    """A TS design (:mod:`mpc_wt.controllers.takagi_sugeno`) as a gain table: one row per premise vertex (wind,
+    power reduction, equilibrium x0, u0), the PDC gains K_i and observer gains L_i, with the
+    membership breakpoints and the LMI settings and certificate.
+
+    Parameters
+    ----------
+    turbine : Turbine
+        The turbine.
+    ts : TSModel
+        The model.
+    controller : TSControllerDesign
+        The PDC gains.
+    observer : TSObserverDesign, optional
+        The observer gains.
+
+    Returns
+    -------
+    dict
+        The gain-table document (schema "mpc-wt gain table"): kind, turbine, settings, the
+        schedule (columns with units, rows) and matrices.
+    """
+    su = dict(zip(linearize.STATE_NAMES, linearize.STATE_UNITS))
+    st_units = [su.get(n, "-") for n in ts.states]
+    in_units = ["rad", "N m"]
+    vt = ts.vertices
+    cols = ["wind_speed", "power_reduction"] + [f"x0_{n}" for n in ts.states] + \
+        [f"u0_{n}" for n in ts.inputs]
+    units = ["m/s", "-"] + st_units + in_units
+    rows = [[vt[i, 0], vt[i, 1], *ts.x0[i], *ts.u0[i]] for i in range(ts.n_vertices)]
+    kcols = list(ts.states) + ([f"integral_{controller.integral_of}"]
+                               if controller.integral_of else [])
+    kunits = st_units + ([su.get(controller.integral_of, "-") + " s"]
+                         if controller.integral_of else [])
+    mats = {"K": gt.matrix(controller.K, ts.inputs, kcols, "input unit / state unit",
+                         [gt.unit_ratio(i, s) for i in in_units for s in kunits])}
+    settings = {"wind_grid": ts.wind_grid.tolist(), "reduction_grid": ts.reduction_grid.tolist(),
+                "membership": "product of piecewise-linear hats on wind_grid x reduction_grid",
+                "rated_power": ts.rated_power, "measured": list(ts.measured),
+                "decay_rate": controller.decay_rate, "disk_radius": controller.disk_radius,
+                "input_bounds": controller.input_bounds.tolist(), "solver": controller.solver,
+                "certificate_ok": controller.certificate.ok,
+                "convention": "u = sum_i h_i (u0_i - K_i (x_hat - x0_i)) (Clemens eq 7)"}
+    if observer is not None:
+        yunits = [su.get(n, "-") for n in ts.measured]
+        mats["L"] = gt.matrix(observer.L, list(ts.states) + ["wind"], list(ts.measured),
+                            "xi unit / measurement unit",
+                            [gt.unit_ratio(s, y) for s in st_units + ["m/s"] for y in yunits])
+        settings.update({"tau_v": observer.tau_v, "observer_decay_rate": observer.decay_rate,
+                         "observer_disk_radius": observer.disk_radius,
+                         "observer_certificate_ok": observer.certificate.ok})
+    return gt.document("ts", turbine, settings, cols, units, rows, mats, plot={"x": "vertex"})

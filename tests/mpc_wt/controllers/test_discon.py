@@ -272,7 +272,8 @@ def test_exported_discon_is_read_by_roscos_library(turbine, tmp_path) -> None:
     steady 18 m/s, 5 MW within 1 %), and it refuses the same file with ``VS_Rgn2K`` left out
     (naming it): its reader checks what ours writes."""
     from mpc_wt.controllers.baseline import tune_baseline
-    from mpc_wt.io.gain_tables import baseline_table, export
+    from mpc_wt.io.gain_tables import export
+    from mpc_wt.kinds.baseline import baseline_table
 
     discon, perf = export(baseline_table(turbine, tune_baseline(turbine)), "rosco", tmp_path)
     assert sorted(_discon_keys(discon)) == sorted(_discon_keys(rosco_discon()))
@@ -297,7 +298,8 @@ def test_roscos_library_runs_the_exported_iea15_minimum_pitch(tmp_path) -> None:
     import math
 
     from mpc_wt.controllers.baseline import tune_baseline
-    from mpc_wt.io.gain_tables import baseline_table, export
+    from mpc_wt.io.gain_tables import export
+    from mpc_wt.kinds.baseline import baseline_table
 
     iea = linearize.load_turbine("iea15mw")
     discon, _ = export(baseline_table(iea, tune_baseline(iea)), "rosco", tmp_path)
@@ -317,7 +319,8 @@ def test_exported_discon_is_complete_for_roscos_reader(turbine, tmp_path,
     load_from_txt, read_DISCON = rosco_utilities.load_from_txt, rosco_utilities.read_DISCON
 
     from mpc_wt.controllers.baseline import tune_baseline
-    from mpc_wt.io.gain_tables import baseline_table, export
+    from mpc_wt.io.gain_tables import export
+    from mpc_wt.kinds.baseline import baseline_table
 
     discon, perf = export(baseline_table(turbine, tune_baseline(turbine)), "rosco", tmp_path)
     ours, ref = read_DISCON(str(discon)), read_DISCON(str(rosco_discon()))
@@ -360,7 +363,8 @@ def test_exported_coleman_ipc_through_rosco_acts_as_ours(turbine, tmp_path) -> N
     pitch travel within 20 % (measured +3.9 % and -2 %; both cut the baseline's DEL by ~20 %)."""
     from mpc_wt.assessment.series import assess_series
     from mpc_wt.controllers.ipc import tune_coleman_ipc
-    from mpc_wt.io.gain_tables import coleman_ipc_table, export
+    from mpc_wt.io.gain_tables import export
+    from mpc_wt.kinds.ipc import coleman_ipc_table
 
     discon, _ = export(coleman_ipc_table(turbine, tune_coleman_ipc(turbine)), "rosco", tmp_path)
     out = {}

@@ -22,7 +22,8 @@ from mpc_wt.controllers.baseline import BaselineController, tune_baseline
 from mpc_wt.controllers.derating import aep_change, steady_power_curve
 from mpc_wt.controllers.filters import SOSFilterBank, filter_sos
 from mpc_wt.controllers.ipc import tune_coleman_ipc, tune_ibc
-from mpc_wt.io.gain_tables import coleman_ipc_table, export, ibc_table, load_design, save_design
+from mpc_wt.io.gain_tables import export, load_design, save_design
+from mpc_wt.kinds.ipc import coleman_ipc_table, ibc_table
 from mpc_wt.simulation.scenario import Scenario
 
 DUR = 150.0       # s per closed-loop run; the first TRANSIENT s are left out of the metrics

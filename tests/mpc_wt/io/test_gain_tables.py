@@ -15,14 +15,9 @@ from mpc_wt.cli import main
 from mpc_wt.controllers.baseline import tune_baseline
 from mpc_wt.controllers.lqr import design_lqr_family, design_pi_observer
 from mpc_wt.errors import GainTableError
-from mpc_wt.io.gain_tables import (
-    baseline_table,
-    export,
-    load_design,
-    lqr_table,
-    read_rosco,
-    save_design,
-)
+from mpc_wt.io.gain_tables import export, load_design, read_rosco, save_design
+from mpc_wt.kinds.baseline import baseline_table
+from mpc_wt.kinds.lqr import lqr_table
 
 
 @pytest.fixture(scope="module")
@@ -191,3 +186,64 @@ def test_cli_design_and_export(tmp_path, capsys) -> None:
     assert main(["design", "ts", "--wind", "14,30", "--out", str(tmp_path / "t2")]) == 2
     assert "30" in capsys.readouterr().err
     assert main(["export", str(tmp_path / "none"), "--format", "csv"]) == 2
+
+
+def test_the_format_holds_no_kinds_table() -> None:
+    """A kind's gain table is made in its kind module; the format module names no kind's
+    table function (each kind is one place)."""
+    import mpc_wt.io.gain_tables as gt
+    import mpc_wt.kinds.baseline as kb
+    import mpc_wt.kinds.lqr as kl
+
+    tables = [n for n in dir(gt) if n.endswith("_table") and callable(getattr(gt, n))]
+    assert tables == []
+    assert kb.baseline_table.__module__ == "mpc_wt.kinds.baseline"
+    assert kl.lqr_pio_table.__module__ == "mpc_wt.kinds.lqr"
+
+
+def test_the_design_plot_follows_the_documents_hint(base_doc, lqr_doc, tmp_path) -> None:
+    """The baseline's table asks for its kp and ki against wind speed; a document without a
+    hint (the LQR family) is drawn from its largest gains of K; the lines drawn are the
+    document's own numbers."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from mpc_wt.plotting import plot_design
+
+    assert base_doc["plot"]["columns"] == ["kp", "ki"]
+    seen = []
+    orig = plt.Figure.savefig
+
+    def keep(fig, *a, **k):
+        seen.append([(ln.get_label(), ln.get_xydata().copy()) for ln in fig.axes[0].lines])
+        return orig(fig, *a, **k)
+
+    plt.Figure.savefig = keep
+    try:
+        plot_design(base_doc, tmp_path / "b.png")
+        plot_design(lqr_doc[0], tmp_path / "l.png")
+    finally:
+        plt.Figure.savefig = orig
+    rows = np.asarray(base_doc["schedule"]["rows"])
+    (lab_kp, xy_kp), (lab_ki, xy_ki) = seen[0]
+    assert (lab_kp, lab_ki) == ("kp", "ki")
+    np.testing.assert_array_equal(xy_kp, rows[:, [0, 2]])
+    np.testing.assert_array_equal(xy_ki, rows[:, [0, 3]])
+    assert all(lab.startswith("K[") for lab, _ in seen[1])
+    assert (tmp_path / "b.png").stat().st_size > 1000
+
+
+def test_a_coleman_design_without_its_baseline_is_refused_for_rosco(turbine, tmp_path) -> None:
+    """ROSCO's pitch schedule of a Coleman IPC export is the baseline table the design holds;
+    a document without it names the command that makes it again."""
+    from mpc_wt.controllers.ipc import tune_coleman_ipc
+    from mpc_wt.kinds.ipc import coleman_ipc_table
+
+    doc = coleman_ipc_table(turbine, tune_coleman_ipc(turbine, winds=[16.0]))
+    assert doc["settings"]["baseline"]["kind"] == "baseline"
+    old = json.loads(json.dumps(doc))
+    del old["settings"]["baseline"]
+    with pytest.raises(GainTableError, match="mpcwt design coleman-ipc"):
+        export(old, "rosco", tmp_path)
