@@ -95,7 +95,7 @@ def test_our_model_through_lin_drives_mpc_and_lqr(our_set, turbine) -> None:
     """A model read back from .lin files is used where our own are: model.modes(), the LQR
     and the MPC (which needs Madsen's outputs: they are there under our names)."""
     from mpc_wt.controllers.lqr import design_lqr
-    from mpc_wt.controllers.mpc import MPC
+    from mpc_wt.controllers.mpc import MPC, MPCSettings
 
     paths, _, original = our_set
     m = read_lin(paths[0])
@@ -104,9 +104,12 @@ def test_our_model_through_lin_drives_mpc_and_lqr(our_set, turbine) -> None:
         assert a["frequency_Hz"] == pytest.approx(b["frequency_Hz"], rel=1e-12)
     d = design_lqr(m, state_weights={"rotor_speed": 1.0})
     assert np.all(np.linalg.eigvals(m.A - m.B_u[:, :3] @ d.K).real < 0)
-    MPC(m, turbine)
+    MPC(m, turbine, MPCSettings(estimator="full-state"))
+    with pytest.raises(ValueError, match=r"no process-noise default for the model's states "
+                                         r"\['tower_ss_displacement'.*estimator='full-state'"):
+        MPC(m, turbine)                   # the estimator knows the states of Madsen's model
     with pytest.raises(ValueError, match="model lacks Madsen outputs"):
-        MPC(read_lin(DATA / "FASTLin.lin"), turbine)
+        MPC(read_lin(DATA / "FASTLin.lin"), turbine, MPCSettings(estimator="full-state"))
 
 
 def test_public_openfast_set_mbc3_against_collective_input() -> None:

@@ -178,7 +178,10 @@ class KalmanEstimator:
             raise ValueError(f"model lacks the measured outputs {missing}")
         unknown = [n for n in model.states if n not in _STATE_NOISE]
         if unknown:
-            raise ValueError(f"no process-noise default for states {unknown}")
+            raise ValueError(f"the Kalman estimator has no process-noise default for the "
+                             f"model's states {unknown} (it knows {sorted(_STATE_NOISE)}): "
+                             f"reduce the model to those states, or run the MPC on the true "
+                             f"states (MPCSettings(estimator='full-state'))")
         self.signals = tuple(std)
         iy = [model.outputs.index(n) for n in self.signals]
         nx, nd = model.A.shape[0], model.B_d.shape[1]

@@ -198,6 +198,10 @@ def pitch_drive_scale_ratio(turbine: linearize.Turbine,
     return (turbine.pitch_actuator.max_rate_rad_s / ref) ** exponent
 
 
+#: The MPC's state sources: its Kalman estimator on measured signals, or the plant's true states.
+ESTIMATORS = ("kalman", "full-state")
+
+
 @dataclass(frozen=True)
 class MPCSettings:
     """Every setting of the MPC, validated once (replaces the MPC's keyword arguments).
@@ -239,11 +243,13 @@ class MPCSettings:
         The QP's upper bound on the generator torque [N m] (default None: the generator's
         maximum). At the rated torque the MPC cannot hold the rotor with torque beyond rated
         power: above rated speed it must pitch, as a region-3 controller does.
-    estimator : None, "kalman" or KalmanEstimator
-        None (default): full-state information from the harness (``meas["state"]``), as in the
-        paper. "kalman": a :class:`~mpc_wt.controllers.estimator.KalmanEstimator` on the same model estimates
-        the states and the blade-effective winds from measured signals; without a preview the
-        disturbance over the horizon is held at the wind estimate.
+    estimator : "kalman", "full-state" or KalmanEstimator
+        "kalman" (default, as the kind's option ``estimator``): a
+        :class:`~mpc_wt.controllers.estimator.KalmanEstimator` on the same model estimates the
+        states and the blade-effective winds from measured signals (what a turbine's controller
+        has); without a preview the disturbance over the horizon is held at the wind estimate.
+        "full-state": the plant's true states from the harness (``meas["state"]``), Madsen et
+        al.'s assumption, an idealization no turbine has.
     estimator_settings : dict
         Keyword arguments of the "kalman" estimator (``wind_std_per_step``,
         ``measurement_std``; :class:`~mpc_wt.controllers.estimator.KalmanEstimator`).
@@ -273,7 +279,7 @@ class MPCSettings:
     slack_weight: float = 1e4
     slack_linear: float = 1e3
     max_torque: float | None = None
-    estimator: Any = None
+    estimator: Any = "kalman"
     estimator_settings: dict[str, Any] = field(default_factory=dict)
     time_budget_ms: float | None = None
 
@@ -304,8 +310,10 @@ class MPCSettings:
         if self.time_budget_ms is not None:
             check_number("time_budget_ms", self.time_budget_ms, lo=0.0, lo_open=True,
                          unit="ms")
-        if isinstance(self.estimator, str) and self.estimator != "kalman":
-            raise ValueError(f"estimator must be None, 'kalman' or a KalmanEstimator, got "
+        from mpc_wt.controllers.estimator import KalmanEstimator
+
+        if self.estimator not in ESTIMATORS and not isinstance(self.estimator, KalmanEstimator):
+            raise ValueError(f"estimator must be one of {ESTIMATORS} or a KalmanEstimator, got "
                              f"{self.estimator!r}")
 
     @property
@@ -543,11 +551,12 @@ class MPC(ControllerBase):
             raise ValueError(f"model lacks Madsen outputs {missing}")
         self.model = m.select(outputs=zsel)
         estimator = st.estimator
-        if isinstance(estimator, str):
+        if estimator == "kalman":
             from mpc_wt.controllers.estimator import KalmanEstimator
 
             estimator = KalmanEstimator(m, **st.estimator_settings)
-        self.estimator = estimator
+        #: the state estimator; None: the plant's true states (``estimator="full-state"``)
+        self.estimator = None if estimator == "full-state" else estimator
         self.x_names = m.states
         # "auto": use meas["preview"] when the harness gives one; from_turbine sets None/"lidar"
         self.preview: str | None = "auto"
@@ -1446,7 +1455,7 @@ class ScheduledMPC(ControllerBase):
 
         if wind_source not in SCHEDULE_SOURCES:
             raise ValueError(f"wind_source must be 'estimator' or 'preview', got {wind_source!r}")
-        st = settings or MPCSettings(estimator="kalman")
+        st = settings or MPCSettings()
         self.settings = st
         self.family, self.turbine = family, turbine
         self.wind_source = wind_source

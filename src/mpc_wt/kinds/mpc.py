@@ -15,6 +15,7 @@ import linearize
 from mpc_wt.registry.context import BuildContext, Built
 from mpc_wt.registry.options import Options, option
 from mpc_wt.registry.registry import register
+from mpc_wt.controllers.mpc import ESTIMATORS
 from mpc_wt.io import gain_tables as gt
 from mpc_wt.io.discon_export import LawExport, signal_codes
 from mpc_wt.kinds.common import (LidarOptions, baseline_entries, check_design_wind,
@@ -100,7 +101,9 @@ POWER_LIMIT = 1.08
 
 @dataclass(frozen=True)
 class MPCOptions(Options):
-    """Madsen et al.'s MPC at 10 Hz (:class:`mpc_wt.MPCSettings` holds the full set)."""
+    """Madsen et al.'s MPC at 10 Hz, scheduled over mean wind: the kind's configuration. Each
+    grid design is an :class:`mpc_wt.MPC` whose :class:`mpc_wt.MPCSettings` these options
+    make; a setting both take has the same name and default (the state estimated by default)."""
 
     backend: Optional[str] = option(None, help="QP solver (default DAQP when installed, else "
                                     "OSQP)", choices=(None, "osqp", "daqp"))
@@ -111,7 +114,7 @@ class MPCOptions(Options):
                             "measured signals (rotor and generator speed, pitch, flap moments, "
                             "tower-top acceleration); full-state: the plant's true states, an "
                             "idealization no turbine has (labelled so in results)",
-                            choices=("kalman", "full-state"))
+                            choices=ESTIMATORS)
     design_wind_mps: Optional[float] = option(None, help="one design at this mean wind "
                                               "(Madsen's single-point design); default: "
                                               "designs from cut-in to cut-out scheduled on the "
@@ -231,7 +234,7 @@ def _mpc_settings(opts: MPCOptions, collective: bool, preview: bool) -> Any:
             defaults.update(NO_PREVIEW_WEIGHTS)
     return MPCSettings(horizon=opts.horizon, backend=opts.backend,
                        formulation=opts.formulation,
-                       estimator=None if opts.estimator == "full-state" else opts.estimator,
+                       estimator=opts.estimator,
                        estimator_settings={
                            "wind_std_per_step": opts.kalman_wind_std,
                            "measurement_std": {f"flap_moment_{b}": opts.kalman_flap_std

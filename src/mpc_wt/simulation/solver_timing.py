@@ -142,7 +142,7 @@ def _record_closed_loop(t: Any, model: Any, steps: int, res: dict[str, Any],
     """The closed loop on the default backend, recording each step's measurements and QP data
     and timing the whole controller step in the loop."""
     dt = 0.1
-    ctl = MPC(model, t, MPCSettings(dt=dt))
+    ctl = MPC(model, t, MPCSettings(estimator="full-state", dt=dt))
     rec: dict[str, Any] = {"z": [], "meas": [], "controller": ctl}
     step_times: list[float] = []
     step0 = ctl.step
@@ -197,12 +197,12 @@ def _replay(model: Any, t: Any, backend: str, form: str, rec: dict[str, Any],
     """Our backend: the whole controller step replayed on the recorded measurements (its own
     warm starts and previous commands, as in the loop, without the plant between the steps);
     then the recorded QPs solved in order for the move error."""
-    c = MPC(model, t, MPCSettings(backend=backend, formulation=form))
+    c = MPC(model, t, MPCSettings(estimator="full-state", backend=backend, formulation=form))
     be = c.qp_backend
     # DAQP through its C interface runs inside the compiled step: its solve alone is timed
     # through DAQP's Python Model on a twin controller (the same iterates, tested)
     twin = c if getattr(be, "direct", None) is None else \
-        MPC(model, t, MPCSettings(backend=backend, formulation=form,
+        MPC(model, t, MPCSettings(estimator="full-state", backend=backend, formulation=form,
                                   solver_options={"interface": "python"}))
     attr = "ext" if backend == "osqp" else "model"
     timer = _Timed(getattr(twin.qp_backend, attr), "solve")

@@ -57,8 +57,8 @@ def test_estimator_follows_the_true_state_on_the_linear_model(model) -> None:
 
 def test_estimator_bad_input(model, turbine) -> None:
     md = model.discretize(0.1) if model.dt is None else model
-    with pytest.raises(ValueError, match="estimator must be None, 'kalman' or a "
-                                         "KalmanEstimator, got 'ekf'"):
+    with pytest.raises(ValueError, match="estimator must be one of \\('kalman', "
+                                         "'full-state'\\) or a KalmanEstimator, got 'ekf'"):
         MPC(model, turbine, MPCSettings(estimator="ekf", backend="osqp"))
     with pytest.raises(ValueError, match="wind_std_per_step must be finite and > 0 m/s, got 0"):
         KalmanEstimator(md, wind_std_per_step=0)
@@ -104,3 +104,25 @@ def test_scheduled_mpc_bad_input(turbine: linearize.Turbine) -> None:
         ScheduledMPC(fam, turbine, wind_source="mast")
     with pytest.raises(ValueError, match="time_constant must be finite and >= 0 s, got -1"):
         ScheduledMPC(fam, turbine, time_constant=-1.0)
+
+
+def test_the_kinds_options_and_the_mpcs_settings_agree_on_every_shared_default() -> None:
+    """One configuration: a setting both the kind's options (``mpcwt run --controller mpc``,
+    campaign specs) and the MPC on a linear model take has one default, and names its
+    state source with the same words; the MPC estimates its state by default, as a turbine's
+    controller must (the true states are asked for by name)."""
+    import dataclasses
+
+    from mpc_wt.controllers.mpc import ESTIMATORS
+    from mpc_wt.kinds.mpc import MPCOptions
+
+    opts = {f.name: f.default for f in dataclasses.fields(MPCOptions)}
+    st = MPCSettings()
+    shared = [n for n in opts if n in {f.name for f in dataclasses.fields(MPCSettings)}
+              and n != "weights"]
+    assert set(shared) >= {"horizon", "backend", "formulation", "estimator", "time_budget_ms"}
+    for name in shared:
+        assert getattr(st, name) == opts[name], name
+    assert st.estimator == "kalman" and ESTIMATORS == ("kalman", "full-state")
+    field = {f.name: f for f in dataclasses.fields(MPCOptions)}["estimator"]
+    assert tuple(field.metadata["choices"]) == ESTIMATORS

@@ -55,7 +55,7 @@ def test_long_horizon_converges_to_discrete_lqr(model, turbine: linearize.Turbin
     # cross term C'QD, input weight R + D'QD (python-control dlqr)
     import control
 
-    ctl = MPC(model, turbine, MPCSettings(horizon=200, control_horizon=200, backend="osqp"))
+    ctl = MPC(model, turbine, MPCSettings(estimator="full-state", horizon=200, control_horizon=200, backend="osqp"))
     q, r = ctl._weights()
     m = ctl.model
     qx = m.C_z.T @ q @ m.C_z
@@ -68,7 +68,7 @@ def test_long_horizon_converges_to_discrete_lqr(model, turbine: linearize.Turbin
 
 
 def test_qp_solution_equals_the_unconstrained_one_when_nothing_binds(model, turbine) -> None:
-    ctl = MPC(model, turbine, MPCSettings(backend="osqp"))
+    ctl = MPC(model, turbine, MPCSettings(estimator="full-state", backend="osqp"))
     x = np.zeros(8)
     x[2] = 0.005                                     # small rotor overspeed [rad/s]
     plan, status = ctl.solve(x)
@@ -80,7 +80,7 @@ def test_qp_solution_equals_the_unconstrained_one_when_nothing_binds(model, turb
 
 
 def test_constraints_hold_when_they_bind(model, turbine: linearize.Turbine) -> None:
-    ctl = MPC(model, turbine, MPCSettings(backend="osqp"))
+    ctl = MPC(model, turbine, MPCSettings(estimator="full-state", backend="osqp"))
     x = np.zeros(8)
     x[2] = 0.3                                       # large overspeed: the pitch rate binds
     plan, status = ctl.solve(x)
@@ -99,7 +99,7 @@ def test_constraints_hold_when_they_bind(model, turbine: linearize.Turbine) -> N
 
 
 def test_collective_variant(model, turbine: linearize.Turbine) -> None:
-    ctl = MPC(model, turbine, MPCSettings(collective=True, backend="osqp"))
+    ctl = MPC(model, turbine, MPCSettings(estimator="full-state", collective=True, backend="osqp"))
     x = np.zeros(8)
     x[2] = 0.01
     pitch, tq = ctl.step(0.0, {"state": np.r_[model.x0 + x,
@@ -124,7 +124,7 @@ def test_negative_weight_is_rejected() -> None:
 
 
 def test_preview_of_wrong_shape(model, turbine) -> None:
-    ctl = MPC(model, turbine, MPCSettings(backend="osqp"))
+    ctl = MPC(model, turbine, MPCSettings(estimator="full-state", backend="osqp"))
     with pytest.raises(ValueError, match=r"d_preview has shape \(10, 3\); expected \(H_p, n_d\)"):
         ctl.solve(np.zeros(8), np.zeros((10, 3)))
     with pytest.raises(ValueError, match=r"x has shape \(7,\)"):
@@ -136,7 +136,7 @@ def test_mpc_in_the_loop_respects_limits(turbine: linearize.Turbine,
     from mpc_wt.simulation.loop import simulate_closed_loop
 
     op = linearize.trim(turbine, 18.0)
-    ctl = MPC(model, turbine, MPCSettings(backend="osqp"))
+    ctl = MPC(model, turbine, MPCSettings(estimator="full-state", backend="osqp"))
     r = simulate_closed_loop(params, ctl, linearize.SteadyWind(18.0, 0.2), 30.0, x0=op.x,
                              u0=op.u, controller_dt=0.1)
     late = r.t > 5
@@ -152,8 +152,8 @@ def test_daqp_backend_agrees_with_osqp(model, turbine, overspeed: float) -> None
     pytest.importorskip("daqp")
     x = np.zeros(8)
     x[2] = overspeed
-    a, sa = MPC(model, turbine, MPCSettings(backend="osqp")).solve(x)
-    b, sb = MPC(model, turbine, MPCSettings(backend="daqp")).solve(x)
+    a, sa = MPC(model, turbine, MPCSettings(estimator="full-state", backend="osqp")).solve(x)
+    b, sb = MPC(model, turbine, MPCSettings(estimator="full-state", backend="daqp")).solve(x)
     assert sa == sb == "solved"
     # First moves agree within 0.01 deg pitch and 0.1 % of rated torque
     assert np.abs(a[0, :3] - b[0, :3]).max() < math.radians(0.01)
@@ -162,7 +162,7 @@ def test_daqp_backend_agrees_with_osqp(model, turbine, overspeed: float) -> None
 
 def test_unknown_backend(model, turbine) -> None:
     with pytest.raises(ValueError, match="backend must be 'osqp' or 'daqp'"):
-        MPC(model, turbine, MPCSettings(backend="qpoases"))
+        MPC(model, turbine, MPCSettings(estimator="full-state", backend="qpoases"))
 
 
 def test_lidar_preview_reduces_asymmetric_loads(turbine: linearize.Turbine,
@@ -183,7 +183,7 @@ def test_lidar_preview_reduces_asymmetric_loads(turbine: linearize.Turbine,
     for label, prev in (("none", None), ("lidar", LidarPreview(lidar.LidarSensor(lid, field=f), 15, 0.1,
                                                    preview_time=54.0 / 18.0))):
         # OSQP: runs where DAQP is not installed (both give the same moves, tested above)
-        r = simulate_closed_loop(params, MPC(model, turbine, MPCSettings(backend="osqp")), gw,
+        r = simulate_closed_loop(params, MPC(model, turbine, MPCSettings(estimator="full-state", backend="osqp")), gw,
                                  70.0, x0=op.x, u0=op.u, controller_dt=0.1, preview=prev)
         late = r.t > 10.0
         frot = float(r.channel("rotor_speed")[late].mean()) / (2 * math.pi)
@@ -201,8 +201,8 @@ def test_lidar_preview_reduces_asymmetric_loads(turbine: linearize.Turbine,
 
 
 def test_from_turbine_matches_the_explicit_model(model, turbine) -> None:
-    ctl = MPC.from_turbine(turbine, 18.0, MPCSettings(horizon=15, backend="osqp"))
-    ref = MPC(model, turbine, MPCSettings(backend="osqp"))
+    ctl = MPC.from_turbine(turbine, 18.0, MPCSettings(estimator="full-state", horizon=15, backend="osqp"))
+    ref = MPC(model, turbine, MPCSettings(estimator="full-state", backend="osqp"))
     x = np.zeros(8)
     x[2] = 0.05
     assert_allclose(ctl.solve(x)[0], ref.solve(x)[0], atol=1e-9)
@@ -257,8 +257,8 @@ def test_soft_speed_limit_far_away_changes_nothing(model, turbine, backend: str)
     x = np.zeros(8)
     x[2], x[0] = 0.01, 0.02
     a, sa = MPC(model, turbine,
-                MPCSettings(backend=backend, max_rotor_speed=w0 + 1.0)).solve(x)
-    b, _ = MPC(model, turbine, MPCSettings(backend=backend)).solve(x)
+                MPCSettings(estimator="full-state", backend=backend, max_rotor_speed=w0 + 1.0)).solve(x)
+    b, _ = MPC(model, turbine, MPCSettings(estimator="full-state", backend=backend)).solve(x)
     assert sa == "solved"
     assert np.abs(a[:, :3] - b[:, :3]).max() < math.radians(0.01)
     assert np.abs(a[:, 3] - b[:, 3]).max() < 0.001 * turbine.rated_generator_torque
@@ -270,11 +270,11 @@ def test_soft_speed_limit_keeps_the_qp_feasible(model, turbine, backend: str) ->
     w0 = model.z0[model.outputs.index("rotor_speed")]
     x = np.zeros(8)
     x[2], x[3] = 0.03, 0.03 * turbine.drivetrain.gearbox_ratio
-    soft = MPC(model, turbine, MPCSettings(backend=backend, max_rotor_speed=w0 + 0.02))
+    soft = MPC(model, turbine, MPCSettings(estimator="full-state", backend=backend, max_rotor_speed=w0 + 0.02))
     plan, status = soft.solve(x)
     assert status == "solved"
     assert soft._last_slack == pytest.approx(0.01, abs=1e-5)
-    free, _ = MPC(model, turbine, MPCSettings(backend=backend)).solve(x)
+    free, _ = MPC(model, turbine, MPCSettings(estimator="full-state", backend=backend)).solve(x)
     s_soft, s_free = _speeds(soft, x, plan), _speeds(soft, x, free)
     assert np.all(s_soft <= s_free + 1e-6)
     assert (s_free - s_soft).max() > 1e-3       # the limit acts: the rotor is slowed faster
@@ -304,8 +304,8 @@ def test_sparse_formulation_gives_the_condensed_moves(model, turbine, seed: int,
     x = rng.normal(size=8) * 0.02 * size
     d = rng.normal(size=(15, 3)) * 0.5 * size
     up = rng.normal(size=4) * np.r_[0.005, 0.005, 0.005, 1000.0] * size
-    cond = MPC(model, turbine, MPCSettings(max_rotor_speed=soft, backend="osqp"))
-    sparse = MPC(model, turbine, MPCSettings(formulation="sparse", max_rotor_speed=soft,
+    cond = MPC(model, turbine, MPCSettings(estimator="full-state", max_rotor_speed=soft, backend="osqp"))
+    sparse = MPC(model, turbine, MPCSettings(estimator="full-state", formulation="sparse", max_rotor_speed=soft,
                                              backend="osqp"))
     a, sa = cond.solve(x, d, up)
     b, sb = sparse.solve(x, d, up)
@@ -332,12 +332,12 @@ def test_osqp_without_an_answer_is_resolved_exactly(model, turbine, caplog) -> N
     x = rng.normal(size=8) * 0.02 * size
     d = rng.normal(size=(15, 3)) * 0.5 * size
     up = rng.normal(size=4) * np.r_[0.005, 0.005, 0.005, 1000.0] * size
-    sparse = MPC(model, turbine, MPCSettings(formulation="sparse", max_rotor_speed=1.35,
+    sparse = MPC(model, turbine, MPCSettings(estimator="full-state", formulation="sparse", max_rotor_speed=1.35,
                                              backend="osqp", solver_options={"max_iter": 10}))
     with caplog.at_level(logging.WARNING, logger="mpc_wt.controllers.qp"):
         b, sb = sparse.solve(x, d, up)
     assert "re-solved by Clarabel: solved" in caplog.text
-    a, sa = MPC(model, turbine, MPCSettings(max_rotor_speed=1.35, backend="daqp")).solve(x, d, up)
+    a, sa = MPC(model, turbine, MPCSettings(estimator="full-state", max_rotor_speed=1.35, backend="daqp")).solve(x, d, up)
     assert sa == sb == "solved"
     assert np.abs(a[0, :3] - b[0, :3]).max() < math.radians(0.01)
     assert abs(a[0, 3] - b[0, 3]) < 0.001 * 43093.55
@@ -347,18 +347,18 @@ def test_sparse_formulation_is_sparse(model, turbine) -> None:
     # the point of the formulation: P and A stay block-banded (nnz linear in the horizon)
     nnz = []
     for hp in (10, 20, 40):
-        c = MPC(model, turbine, MPCSettings(horizon=hp, formulation="sparse", backend="osqp"))
+        c = MPC(model, turbine, MPCSettings(estimator="full-state", horizon=hp, formulation="sparse", backend="osqp"))
         nnz.append(c._sparse_nnz)
     assert nnz[2] - nnz[1] == pytest.approx(2 * (nnz[1] - nnz[0]), rel=0.05)
-    dense = MPC(model, turbine, MPCSettings(horizon=40, backend="osqp"))
+    dense = MPC(model, turbine, MPCSettings(estimator="full-state", horizon=40, backend="osqp"))
     assert dense._h_s.size + dense._a_gen_s.size > 5 * nnz[2] / 2
 
 
 def test_bad_formulation(model, turbine) -> None:
     with pytest.raises(ValueError, match="formulation must be 'condensed' or 'sparse', got 'x'"):
-        MPC(model, turbine, MPCSettings(formulation="x", backend="osqp"))
+        MPC(model, turbine, MPCSettings(estimator="full-state", formulation="x", backend="osqp"))
     with pytest.raises(ValueError, match="formulation='sparse' needs backend='osqp'"):
-        MPC(model, turbine, MPCSettings(formulation="sparse", backend="daqp"))
+        MPC(model, turbine, MPCSettings(estimator="full-state", formulation="sparse", backend="daqp"))
 
 
 @pytest.mark.parametrize("formulation", ["condensed", "sparse"])
@@ -366,8 +366,8 @@ def test_osqp_public_interface_fallback_gives_the_same_moves(model, turbine,
                                                               formulation: str) -> None:
     # the compiled-object fast path and OSQP's public interface solve the same problem
     rng = np.random.default_rng(3)
-    fast = MPC(model, turbine, MPCSettings(formulation=formulation, backend="osqp"))
-    slow = MPC(model, turbine, MPCSettings(formulation=formulation, backend="osqp"))
+    fast = MPC(model, turbine, MPCSettings(estimator="full-state", formulation=formulation, backend="osqp"))
+    slow = MPC(model, turbine, MPCSettings(estimator="full-state", formulation=formulation, backend="osqp"))
     slow.qp_backend.fast = False
     for _ in range(20):
         x = rng.normal(size=8) * 0.03
@@ -384,7 +384,7 @@ def test_warm_start_never_holds_subnormal_numbers(model, turbine,
     from mpc_wt.simulation.loop import simulate_closed_loop
     from mpc_wt.simulation.scenario import Scenario, make_wind
 
-    c = MPC(model, turbine, MPCSettings(backend="osqp"))
+    c = MPC(model, turbine, MPCSettings(estimator="full-state", backend="osqp"))
     wind, _ = make_wind(turbine, Scenario(18.0, "A", 1, 80.0, 0.2))
     op = linearize.trim(turbine, 18.0)
     seen = []
@@ -404,7 +404,7 @@ def test_warm_start_never_holds_subnormal_numbers(model, turbine,
 def test_step_rejects_a_state_of_the_wrong_length(model, turbine) -> None:
     with pytest.raises(ValueError,
                        match=r"meas\['state'\] has shape \(5,\); expected the plant's \(23,\)"):
-        MPC(model, turbine, MPCSettings(backend="osqp")).step(0.0, {"state": np.zeros(5)})
+        MPC(model, turbine, MPCSettings(estimator="full-state", backend="osqp")).step(0.0, {"state": np.zeros(5)})
 
 
 @pytest.mark.parametrize("rows", [15, 4, 1])
@@ -426,8 +426,8 @@ def test_step_with_a_preview_equals_the_qp_of_its_deviations(model, turbine, row
     pv = Preview(np.arange(rows) * 0.1, blade.astype(np.float32).astype(float),
                  blade.mean(axis=1), np.ones(rows, bool))
     for backend, opts in (("daqp", {}), ("daqp", {"interface": "python"}), ("osqp", {})):
-        a = MPC(model, turbine, MPCSettings(backend=backend, solver_options=opts))
-        b = MPC(model, turbine, MPCSettings(backend=backend))
+        a = MPC(model, turbine, MPCSettings(estimator="full-state", backend=backend, solver_options=opts))
+        b = MPC(model, turbine, MPCSettings(estimator="full-state", backend=backend))
         pitch, torque = a.step(0.0, {"state": x_full, "preview": pv})
         plan, status = b.solve(dx, pv.blade[np.minimum(np.arange(15), rows - 1)] - model.d0
                                if rows < 15 else pv.blade - model.d0)
@@ -448,7 +448,7 @@ def test_factored_step_map_equals_the_full_map(model, turbine, seed: int) -> Non
 
     rng = np.random.default_rng(seed)
     for form in ("condensed", "sparse"):
-        c = MPC(model, turbine, MPCSettings(backend="osqp", formulation=form))
+        c = MPC(model, turbine, MPCSettings(estimator="full-state", backend="osqp", formulation=form))
         nv, nc = len(c._c), len(c._lo)
         w = c._w_orig                        # W of the unshifted QP; shift it as the MPC does
         yt, const, sgn, kmap = _bound_map(np.vstack([w[:nv], w[nv:nv + nc], w[nv + nc:]]), nv)
