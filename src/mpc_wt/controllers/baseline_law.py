@@ -26,6 +26,12 @@ __all__ = ["SIGNALS", "N_STATE", "N_PARAMS", "law_parameters", "law_step", "torq
 
 _JIT = dict(cache=True, error_model="numpy")
 
+#: The torque law is in region 3 where the pitch (less the minimum-pitch schedule's offset)
+#: stands this far above the fine pitch, or the speed at rated [rad]: Jonkman et al.'s
+#: VS_Rgn3MP, 1 deg on the NREL 5-MW, whose fine pitch is 0 (sec. 7.1); counted from the
+#: turbine's own fine pitch, so that a turbine whose region-2 pitch is not 0 stays in region 2.
+REGION3_PITCH_MARGIN = math.radians(1.0)
+
 #: the law's signals, in the order of the recorded columns (BaselineController.signals)
 SIGNALS = ("gen_speed_filtered", "speed_error", "pitch_integral", "gain_schedule",
            "pitch_command", "torque_command")
@@ -33,7 +39,7 @@ SIGNALS = ("gen_speed_filtered", "speed_error", "pitch_integral", "gain_schedule
 # parameter vector layout
 (_A, _W_RATED_SET, _KP, _KI, _THETA_K, _DT, _P_MIN, _P_MAX, _RATE, _TQ_RATE, _TQ_MAX,
  _W_CUTIN, _W_RGN2, _W_TRANS, _W_RATED, _W_SYNC, _SLOPE15, _SLOPE25, _K_OPT, _TQ_CAP,
- _P_RATED, _ETA, _TQ_RATED, _CONST_POWER, _ONE_DEG, _I_GEN_SPEED, _N_MIN_PITCH) = range(27)
+ _P_RATED, _ETA, _TQ_RATED, _CONST_POWER, _RGN3_PITCH, _I_GEN_SPEED, _N_MIN_PITCH) = range(27)
 #: length of the parameter vector's fixed part; the minimum-pitch schedule's speeds and offsets
 #: follow it (``par[_N_MIN_PITCH]`` points each)
 N_PARAMS = 27
@@ -72,9 +78,10 @@ def law_parameters(ctl: Any, gen_speed_index: int = -1) -> np.ndarray:
     par[[_TQ_MAX, _W_CUTIN, _W_RGN2, _W_TRANS, _W_RATED, _W_SYNC, _SLOPE15, _SLOPE25]] = (
         ctl.tq_max, ctl.w_cutin, ctl.w_rgn2, ctl.w_trans, ctl.w_rated, ctl.w_sync, ctl.slope15,
         ctl.slope25)
-    par[[_K_OPT, _TQ_CAP, _P_RATED, _ETA, _TQ_RATED, _CONST_POWER, _ONE_DEG, _I_GEN_SPEED]] = (
+    par[[_K_OPT, _TQ_CAP, _P_RATED, _ETA, _TQ_RATED, _CONST_POWER, _RGN3_PITCH, _I_GEN_SPEED]] = (
         g.k_opt, ctl.tq_cap, g.rated_power, ctl.turbine.drivetrain.generator_efficiency,
-        g.rated_torque, float(ctl.region3 == "constant_power"), math.radians(1.0),
+        g.rated_torque, float(ctl.region3 == "constant_power"),
+        ctl.pitch_min + REGION3_PITCH_MARGIN,
         gen_speed_index)
     return par
 
@@ -83,7 +90,7 @@ def law_parameters(ctl: Any, gen_speed_index: int = -1) -> np.ndarray:
 def torque(w, pitch, p3, par):  # pragma: no cover - compiled
     """Generator torque demand [N m] at filtered generator speed ``w`` [rad/s] and collective
     pitch [rad], with ``p3`` [W] in place of rated power in region 3."""
-    if w >= par[_W_RATED] or pitch >= par[_ONE_DEG]:
+    if w >= par[_W_RATED] or pitch >= par[_RGN3_PITCH]:
         if par[_CONST_POWER] != 0.0:
             return p3 / par[_ETA] / max(w, 1e-6)
         return par[_TQ_RATED] * p3 / par[_P_RATED]

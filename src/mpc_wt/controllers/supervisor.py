@@ -43,6 +43,7 @@ import numpy as np
 
 import linearize
 from mpc_wt.controllers.base import ControllerBase
+from mpc_wt.controllers.baseline_law import REGION3_PITCH_MARGIN
 
 _log = logging.getLogger(__name__)
 
@@ -353,7 +354,7 @@ class TorqueLawGuard(ControllerBase):
     """
 
     def __init__(self, controller: Any, turbine: linearize.Turbine, *,
-                 fine_band: float = math.radians(1.0)) -> None:
+                 fine_band: float = REGION3_PITCH_MARGIN) -> None:
         from mpc_wt.controllers.baseline import BaselineController
 
         band = float(fine_band)

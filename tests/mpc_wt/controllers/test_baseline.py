@@ -203,3 +203,32 @@ def test_a_bad_minimum_pitch_schedule_is_refused(gains, speeds, offsets) -> None
 
     with pytest.raises(ValueError, match="min_pitch_speeds and min_pitch_offsets"):
         dataclasses.replace(gains, min_pitch_speeds=speeds, min_pitch_offsets=offsets)
+
+
+@pytest.mark.parametrize("shipped", [False, True], ids=["python", "library"])
+def test_a_turbine_whose_fine_pitch_is_one_degree_stays_in_region_2(turbine, shipped) -> None:
+    """Jonkman et al.'s torque law switches to region 3 at 1 deg of pitch (VS_Rgn3MP) on a
+    turbine whose fine pitch is 0; counted from the turbine's own fine pitch, a turbine at
+    1 deg of fine pitch stays in region 2 at 9 m/s: its rotor runs at the trim's speed (the
+    trim solves the same turbine at fine pitch; 1 % asked) instead of braking at rated torque.
+    The NREL 5-MW with its fine pitch raised to 1 deg is that turbine; both of the baseline's
+    laws (the Python step, and the library the kind ships) are checked."""
+    import dataclasses
+
+    from mpc_wt.run import run_controller
+
+    t1 = dataclasses.replace(turbine, operation=dataclasses.replace(
+        turbine.operation, fine_pitch_rad=math.radians(1.0)))
+    op = linearize.trim(t1, 9.0)
+    assert op.pitch_rad == pytest.approx(math.radians(1.0), abs=1e-9)
+    if shipped:
+        res = run_controller(t1, "baseline", 9.0, duration=60.0, turbulence="steady")
+    else:
+        ctl = BaselineController(t1, tune_baseline(t1))
+        res = simulate_closed_loop(linearize.plant_params(t1), ctl,
+                                   linearize.SteadyWind(9.0), 60.0, x0=op.x, u0=op.u)
+    late = res.t > 40.0
+    assert res.channel("rotor_speed")[late].mean() == pytest.approx(op.rotor_speed_rad_s,
+                                                                     rel=0.01)
+    pitch = np.asarray(res.channel("pitch_1"))[late]
+    assert np.all(pitch < math.radians(1.5))

@@ -44,7 +44,7 @@ static double dmax(double a, double b) { return a > b ? a : b; }
 double mw_law_torque(const mw_law *c, double w, double pitch, double p3)
 {
     double tq;
-    if (w >= c->w_rated || pitch >= c->one_deg) {
+    if (w >= c->w_rated || pitch >= c->rgn3_pitch) {
         if (c->constant_power) return p3 / c->eta / dmax(w, 1e-6);
         return c->tq_rated * p3 / c->p_rated;
     }
@@ -129,7 +129,8 @@ int mw_law_read(const mw_input *in, const char *pre, mw_law *c, char *msg)
     }
     c->a = exp(-2.0 * MW_PI * corner_hz * c->dt);
     c->constant_power = cp != 0.0;
-    c->one_deg = MW_PI / 180.0;
+    /* region 3 at 1 deg above the fine pitch (Jonkman's VS_Rgn3MP, from the turbine's own) */
+    c->rgn3_pitch = c->p_min + MW_PI / 180.0;
     return read_min_pitch(in, pre, c, msg);
 }
 

@@ -125,7 +125,7 @@ double *mw_getp_alloc_n(const mw_input *in, const char *prefix, const char *key,
 typedef struct {
     double a, w_set, kp, ki, theta_k, dt, p_min, p_max, rate, tq_rate, tq_max;
     double w_cutin, w_rgn2, w_trans, w_rated, w_sync, slope15, slope25, k_opt, tq_cap;
-    double p_rated, eta, tq_rated, one_deg;
+    double p_rated, eta, tq_rated, rgn3_pitch;
     int constant_power;
     /* the minimum-pitch schedule: filtered generator speeds and pitch above p_min */
     int mp_n;
