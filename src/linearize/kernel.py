@@ -307,23 +307,26 @@ def evaluate_plant_vw(x, u, wind, ext, p, hint, mode):  # pragma: no cover - com
             fe[i] = ge[i] - p.c_e * x[20 + i] - ke * x[17 + i]
         cpl = p.s_e / p.m_e * (fe[0] + fe[1] + fe[2])
         j_cut = 3.0 * p.s_e * p.s_e / p.m_e
-    # drivetrain (Madsen eq 11), rotor inertia less what the edge modes carry
+    # drivetrain (Madsen eq 11), rotor inertia less what the edge modes carry; the gearbox's
+    # loss brakes the high-speed side, as ElastoDyn's GBoxEff does while generating: the
+    # generator torque tq asks tq / eta_gbx of the gearbox, and the electrical power is
+    # eta_gen tq w_gen (ServoDyn's GenEff)
     if dof_gen:
         if dof_dt:
             qs = p.k_shaft * th + p.c_shaft * (wr - wg / p.ngear)
             dwr = (torque - qs - cpl) / (p.j_rot - j_cut)
-            dwg = (qs / p.ngear - tq) / p.j_gen
+            dwg = (qs / p.ngear - tq / p.eta_gbx) / p.j_gen
             dth = wr - wg / p.ngear
         else:
             jt = p.j_rot + p.ngear * p.ngear * p.j_gen
-            dwr = (torque - p.ngear * tq - cpl) / (jt - j_cut)
+            dwr = (torque - p.ngear * tq / p.eta_gbx - cpl) / (jt - j_cut)
             dwg = p.ngear * dwr
             dth = 0.0 * dwr
     else:
         dwr = 0.0 * wr
         dwg = 0.0 * wr
         dth = 0.0 * wr
-        qs = p.k_shaft * th if dof_dt else p.ngear * tq
+        qs = p.k_shaft * th if dof_dt else p.ngear * tq / p.eta_gbx
     edd = np.zeros(3, dtype=x.dtype)
     if dof_edge:
         for i in range(3):
@@ -332,7 +335,7 @@ def evaluate_plant_vw(x, u, wind, ext, p, hint, mode):  # pragma: no cover - com
         # rotor side: J_r Omega' + S_e sum q'' = Q_aero - Q_shaft
         qs = torque - p.j_rot * dwr - p.s_e * (edd[0] + edd[1] + edd[2])
     # reaction torque on the nacelle about +x (rotor and generator spin the same way)
-    m_react = tq + (1.0 - 1.0 / p.ngear) * qs
+    m_react = tq + (1.0 - p.eta_gbx / p.ngear) * qs
     # tower fore-aft + blade flap (inertially coupled)
     omega2 = wr * wr
     kq = p.k_b + omega2 * p.k_cf

@@ -304,7 +304,7 @@ class PlantConfig:
 _Pack = namedtuple("_Pack", [
     "dof", "flags", "opt", "nb", "rho", "grav", "rtip", "rhub", "zhub", "cone", "tilt",
     "r", "w", "chord", "twist", "af", "phi_flap", "table", "alpha0", "dalpha",
-    "ngear", "eta_gen", "j_rot", "j_gen", "k_shaft", "c_shaft",
+    "ngear", "eta_gen", "eta_gbx", "j_rot", "j_gen", "k_shaft", "c_shaft",
     "m_fa", "k_fa", "c_fa", "hub_fa", "slope_fa", "m_ss", "k_ss", "c_ss", "hub_ss", "slope_ss",
     "m_b", "k_b", "k_cf", "c_b", "m_c", "s1", "s_phi_r", "i_edge",
     "tau_p", "rate_p", "min_p", "max_p", "min_tq", "max_tq",
@@ -558,7 +558,7 @@ def _derive_plant_params(turbine: Turbine, cfg: PlantConfig) -> PlantParams:
         chord=b.chord,
         twist=b.twist_rad, af=b.airfoil, phi_flap=phi_el, table=tab.table, alpha0=tab.alpha0,
         dalpha=tab.dalpha, ngear=t.drivetrain.gearbox_ratio,
-        eta_gen=t.drivetrain.generator_efficiency * t.drivetrain.gearbox_efficiency,
+        eta_gen=t.drivetrain.generator_efficiency, eta_gbx=t.drivetrain.gearbox_efficiency,
         j_rot=rotor_inertia, j_gen=t.drivetrain.generator_inertia,
         k_shaft=t.drivetrain.shaft_stiffness, c_shaft=t.drivetrain.shaft_damping,
         m_fa=m_fa, k_fa=k_fa, c_fa=c_fa, hub_fa=hub_fa, slope_fa=slope_fa,

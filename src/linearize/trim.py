@@ -183,7 +183,7 @@ def _aero(params: PlantParams, v: float, omega: float, pitch: float,
     if _deflection_matters(params):
         ngear = params.turbine.drivetrain.gearbox_ratio
         for _ in range(_DEFLECTION_STEPS):
-            u[3] = z[22] / ngear
+            u[3] = params.turbine.drivetrain.gearbox_efficiency * z[22] / ngear
             if params.dof("drivetrain"):
                 x[4] = z[22] / params.pack.k_shaft
             x, _, z = _displacement_step(params, x, u, v, omega, shear)
@@ -293,6 +293,9 @@ def trim(turbine: Turbine, wind_mps: float, power_W: float | None = None, *,
     dt = turbine.drivetrain
     ngear = dt.gearbox_ratio
     eta = dt.generator_efficiency * dt.gearbox_efficiency
+    # the generator torque that holds an aerodynamic torque q: eta_gbx q / N (the gearbox's
+    # loss on the high-speed side, :mod:`linearize.kernel`)
+    egb = dt.gearbox_efficiency
     cone = turbine.geometry.precone_rad if p.config.aero.cone else 0.0
     rproj = turbine.geometry.tip_radius * math.cos(cone)
     fine = op.fine_pitch_rad
@@ -302,16 +305,16 @@ def trim(turbine: Turbine, wind_mps: float, power_W: float | None = None, *,
     omega = min(max(w_opt, op.min_rotor_speed_rad_s), op.rated_rotor_speed_rad_s)
     q_fine, _ = _aero(p, v, omega, fine, shear)
     if (omega <= op.min_rotor_speed_rad_s * (1 + 1e-12) and w_opt < omega
-            and _aero(p, op.cut_in_wind, op.min_rotor_speed_rad_s, fine, shear)[0] / ngear
+            and _aero(p, op.cut_in_wind, op.min_rotor_speed_rad_s, fine, shear)[0] * egb / ngear
             < turbine.generator.min_torque):
         fine = _best_pitch(p, v, omega, fine, shear)
         q_fine, _ = _aero(p, v, omega, fine, shear)
-        if q_fine / ngear < turbine.generator.min_torque:
+        if egb * q_fine / ngear < turbine.generator.min_torque:
             raise TrimError(
                 f"at {v:g} m/s the rotor cannot run at its minimum speed "
                 f"{omega * 30 / math.pi:.3g} rpm: the aerodynamic torque is at most "
                 f"{q_fine:.4g} N m (pitch {math.degrees(fine):.2f} deg), below the generator's "
-                f"minimum {turbine.generator.min_torque * ngear:.4g} N m (low-speed shaft); "
+                f"minimum {turbine.generator.min_torque * ngear / egb:.4g} N m (low-speed shaft); "
                 f"raise cut-in above {v:g} m/s")
     p_fine = eta * q_fine * omega
     if p_fine <= cap * (1 + 1e-12):
@@ -337,7 +340,7 @@ def trim(turbine: Turbine, wind_mps: float, power_W: float | None = None, *,
         if resid(hi) > 0:
             raise TrimError(f"cannot shed enough power at {v:g} m/s even at maximum pitch")
         pitch = brentq(resid, fine, hi, xtol=1e-14, rtol=4 * np.finfo(float).eps, maxiter=200)
-    tg = q_target / ngear
+    tg = egb * q_target / ngear
     if tg > turbine.generator.max_torque * (1 + 1e-9):
         raise TrimError(f"trim at {v:g} m/s needs generator torque {tg:g} N m, above the "
                         f"limit {turbine.generator.max_torque:g} N m")
@@ -346,8 +349,8 @@ def trim(turbine: Turbine, wind_mps: float, power_W: float | None = None, *,
     area = math.pi * rproj**2
     return OperatingPoint(
         wind_mps=v, region=region, pitch_rad=float(pitch), rotor_speed_rad_s=omega,
-        gen_speed_rad_s=omega * ngear, gen_torque=tg, power=eta * tg * omega * ngear,
-        aero_power=q * omega, aero_torque=q, thrust=thrust, tsr=omega * rproj / v if v > 0 else 0,
+        gen_speed_rad_s=omega * ngear, gen_torque=tg,
+        power=dt.generator_efficiency * tg * omega * ngear, aero_power=q * omega, aero_torque=q, thrust=thrust, tsr=omega * rproj / v if v > 0 else 0,
         cp=q * omega / (0.5 * turbine.environment.air_density * area * v**3),
         ct=thrust / (0.5 * turbine.environment.air_density * area * v**2),
         x=x, u=u, power_reference=pref, shear_exponent=shear)
@@ -410,13 +413,12 @@ def operating_point(turbine: Turbine, wind_mps: float, rotor_speed_rad_s: float,
     dt = turbine.drivetrain
     ngear = dt.gearbox_ratio
     q, _ = _aero(p, v, omega, pitch, shear)
-    tg = q / ngear
+    tg = dt.gearbox_efficiency * q / ngear
     if not 0.0 <= tg <= turbine.generator.max_torque * (1 + 1e-9):
         raise TrimError(f"at {v:g} m/s, {omega:g} rad/s and pitch {pitch:g} rad the generator "
                         f"torque balancing the rotor would be {tg:g} N m; allowed: 0.."
                         f"{turbine.generator.max_torque:g} N m")
     x, u, z = _equilibrium(p, v, omega, pitch, tg, shear)
-    eta = dt.generator_efficiency * dt.gearbox_efficiency
     cone = turbine.geometry.precone_rad if p.config.aero.cone else 0.0
     rproj = turbine.geometry.tip_radius * math.cos(cone)
     area = math.pi * rproj**2
@@ -424,8 +426,8 @@ def operating_point(turbine: Turbine, wind_mps: float, rotor_speed_rad_s: float,
     qdyn = 0.5 * turbine.environment.air_density * area
     return OperatingPoint(
         wind_mps=v, region="given", pitch_rad=pitch, rotor_speed_rad_s=omega,
-        gen_speed_rad_s=omega * ngear, gen_torque=tg, power=eta * tg * omega * ngear,
-        aero_power=qa * omega, aero_torque=qa, thrust=thrust,
+        gen_speed_rad_s=omega * ngear, gen_torque=tg,
+        power=dt.generator_efficiency * tg * omega * ngear, aero_power=qa * omega, aero_torque=qa, thrust=thrust,
         tsr=omega * rproj / v if v > 0 else 0.0,
         cp=qa * omega / (qdyn * v**3) if v > 0 else 0.0,
         ct=thrust / (qdyn * v**2) if v > 0 else 0.0,

@@ -3,10 +3,11 @@
 An extended Kalman filter on the drivetrain's one-degree-of-freedom model with the wind as a
 random walk, the estimator of ROSCO's ``WE_Mode = 2`` in its simplest form:
 
-    J d omega / dt = Q_a(v, omega, theta) - N Q_g,      dv / dt = w,
+    J d omega / dt = Q_a(v, omega, theta) - N Q_g / eta_gb,      dv / dt = w,
     Q_a = 1/2 rho pi R_p^2 v^3 C_P(lambda, theta) / omega,      lambda = omega R_p / v,
 
-with J the rotor's and the generator's inertia on the low-speed shaft, N the gearbox ratio,
+with J the rotor's and the generator's inertia on the low-speed shaft, N the gearbox ratio and
+eta_gb its efficiency (its loss brakes the rotor, as ElastoDyn's GBoxEff does),
 R_p = R cos(precone) the projected radius and C_P the turbine's steady power coefficient
 (:func:`linearize.rotor_performance`, a smooth bicubic fit). It measures the rotor speed
 omega; the collective pitch theta and the generator torque Q_g enter as known inputs. So it uses
@@ -232,6 +233,8 @@ class WindSpeedEstimator:
         self.radius = g.tip_radius * math.cos(g.precone_rad)
         self.rho = turbine.environment.air_density
         self.gear = turbine.drivetrain.gearbox_ratio
+        #: the low-speed shaft's torque per unit of generator torque, N / eta_gb
+        self.torque_ratio = self.gear / turbine.drivetrain.gearbox_efficiency
         params = linearize.plant_params(turbine)
         self.inertia = params.rotor_inertia + self.gear**2 * turbine.drivetrain.generator_inertia
         op = turbine.operation
@@ -244,13 +247,13 @@ class WindSpeedEstimator:
         self._spline = (np.ascontiguousarray(tx, float), np.ascontiguousarray(ty, float),
                         np.ascontiguousarray(c, float), *spline.degrees)
         s = self.settings
-        self._k = np.array([self.radius, self.rho, self.gear, self.inertia, self.dt,
+        self._k = np.array([self.radius, self.rho, self.torque_ratio, self.inertia, self.dt,
                             (s.torque_model_std / self.inertia) ** 2 * self.dt,
                             s.wind_std_per_sqrt_s**2 * self.dt, s.speed_std**2,
                             *self.wind_range, tsr[0], tsr[-1]])
         i, j = np.unravel_index(int(np.argmax(table.cp)), table.cp.shape)
         gain = 0.5 * self.rho * math.pi * self.radius**5 * float(table.cp[i, j]) \
-            / float(tsr[i]) ** 3 / self.gear
+            / float(tsr[i]) ** 3 / self.torque_ratio
         #: the first step's torque schedule where none is measured: K [N m s^2/rad^2] on the
         #: rotor speed, rated torque [N m], rated rotor speed [rad/s]
         self.start_torque = (gain, turbine.rated_generator_torque, op.rated_rotor_speed_rad_s)
@@ -311,7 +314,8 @@ class WindSpeedEstimator:
         """The wind at which the aerodynamic torque balances the generator's, or the nearest
         end of the turbine's wind range."""
         lo, hi = self.wind_range
-        f = (lambda v: self.aero_torque(v, rotor_speed, pitch)[0] - self.gear * gen_torque)
+        f = (lambda v: self.aero_torque(v, rotor_speed, pitch)[0]
+             - self.torque_ratio * gen_torque)
         a, b = f(lo), f(hi)
         if a * b < 0.0:
             return float(brentq(f, lo, hi, xtol=1e-6))

@@ -293,7 +293,7 @@ _FROM_DESIGN = {
     "PC_GS_KP": "baseline kp at each pitch", "PC_GS_KI": "baseline ki at each pitch",
     "PC_MaxPit": "pitch limit", "PC_MinPit": "fine pitch", "PC_MaxRat": "pitch rate limit",
     "PC_MinRat": "pitch rate limit", "PC_RefSpd": "rated generator speed",
-    "PC_FinePit": "fine pitch", "VS_GenEff": "generator x gearbox efficiency",
+    "PC_FinePit": "fine pitch", "VS_GenEff": "generator efficiency (ServoDyn's GenEff)",
     "VS_ArSatTq": "rated torque", "VS_MaxRat": "torque rate limit",
     "VS_MaxTq": "torque limit", "VS_MinTq": "torque limit",
     "VS_MinOMSpd": "minimum generator speed", "VS_Rgn2K": "K of the torque law",
@@ -380,7 +380,10 @@ def rosco_values(turbine: linearize.Turbine, doc: dict[str, Any],
     winds, dq, j_tot = _rotor_poles(turbine)
     v_rated = linearize.rated_wind_speed(turbine)
     vs_kp, vs_ki = _torque_pi(turbine, j_tot, float(np.interp(v_rated, winds, dq)))
-    eff = dr.generator_efficiency * dr.gearbox_efficiency
+    # ROSCO's VS_GenEff is the generator's (mechanical to electrical on the high-speed shaft,
+    # ServoDyn's GenEff), without the gearbox's: it holds VS_RtPwr electrical with
+    # VS_RtTq = VS_RtPwr / (VS_GenEff omega_g)
+    eff = dr.generator_efficiency
     region3 = doc.get("settings", {}).get("region3", "constant_power")
     rated_gen = st["rated_gen_speed_rad_s"]
     fine = st["min_pitch_rad"]

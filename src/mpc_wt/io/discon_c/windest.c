@@ -175,7 +175,7 @@ int mw_windest_read(const mw_input *in, const char *pre, mw_windest *e, char *ms
     }
     e->radius = k[0];
     e->rho = k[1];
-    e->gear = k[2];
+    e->gear = k[2]; /* the low-speed shaft torque per generator torque, N / eta_gearbox */
     e->inertia = k[3];
     e->dt = k[4];
     e->q0 = k[5];
