@@ -940,6 +940,11 @@ def _control(ed: OpenFASTFile, srv: OpenFASTFile | None, dis: OpenFASTFile | Non
     fine = dis.number("PC_FinePit", -0.6, 0.6) if dis.has("PC_FinePit") else pmin
     rec.read("fine pitch", fine / _DEG, "deg", dis,
              "PC_FinePit" if dis.has("PC_FinePit") else "PC_MinPit")
+    if fine < pmin:
+        raise TurbineFileError(f"{dis.where('PC_FinePit')}: the fine pitch "
+                               f"{fine / _DEG:.4g} deg is below the minimum pitch "
+                               f"{pmin / _DEG:.4g} deg ({dis.where('PC_MinPit')}): the "
+                               f"region-2 pitch must be one the actuator can reach")
     ci, why_ci = DEFAULTS["cut_in_wind"]
     co, why_co = DEFAULTS["cut_out_wind"]
     rec.default("cut-in wind", ci, "m/s", why_ci)

@@ -194,6 +194,34 @@ def _aero(params: PlantParams, v: float, omega: float, pitch: float,
 _DEFLECTION_STEPS = 8
 
 
+def _source(turbine: Turbine, quantity: str) -> str:
+    """`` (file:line key)`` of a quantity the turbine's loader read, or "" (YAML turbines)."""
+    for e in turbine.report.entries:
+        if e.quantity == quantity and not e.source.startswith("default"):
+            return f" ({e.source})"
+    return ""
+
+
+def _torque_limit_message(turbine: Turbine, v: float, omega: float, pitch: float,
+                          tg: float) -> str:
+    """Why a trim needs more generator torque than the turbine allows, where the limit and
+    the region's pitch came from, and what would trim it."""
+    op = turbine.operation
+    rpm = 30.0 / math.pi
+    msg = (f"trim at {v:g} m/s needs generator torque {tg:g} N m, above the limit "
+           f"{turbine.generator.max_torque:g} N m{_source(turbine, 'maximum generator torque')}")
+    if omega < op.rated_rotor_speed_rad_s * (1 - 1e-9):
+        msg += (f": at pitch {math.degrees(pitch):.3g} deg"
+                f"{_source(turbine, 'fine pitch')} the rotor reaches rated power at "
+                f"{omega * rpm:.4g} rpm, below its rated speed "
+                f"{op.rated_rotor_speed_rad_s * rpm:.4g} rpm; a region-2 pitch at which "
+                f"the optimal tip-speed ratio reaches rated speed first, or a torque limit of "
+                f"at least {tg:.6g} N m, trims it")
+    else:
+        msg += f"; a torque limit of at least {tg:.6g} N m trims it"
+    return msg
+
+
 def _deflection_matters(params: PlantParams) -> bool:
     """Whether the loads depend on the blades' deflection (``deflected_blades`` with a blade
     DOF)."""
@@ -299,6 +327,12 @@ def trim(turbine: Turbine, wind_mps: float, power_W: float | None = None, *,
     cone = turbine.geometry.precone_rad if p.config.aero.cone else 0.0
     rproj = turbine.geometry.tip_radius * math.cos(cone)
     fine = op.fine_pitch_rad
+    if fine < turbine.pitch_actuator.min_pitch_rad - 1e-12:
+        raise TrimError(f"the fine pitch {math.degrees(fine):.4g} deg"
+                        f"{_source(turbine, 'fine pitch')} is below the pitch actuator's "
+                        f"minimum {math.degrees(turbine.pitch_actuator.min_pitch_rad):.4g} deg"
+                        f"{_source(turbine, 'minimum pitch')}: the region-2 pitch must be one "
+                        f"the actuator can reach")
 
     lam = _tsr_opt(p, shear)
     w_opt = lam * v / rproj
@@ -342,8 +376,7 @@ def trim(turbine: Turbine, wind_mps: float, power_W: float | None = None, *,
         pitch = brentq(resid, fine, hi, xtol=1e-14, rtol=4 * np.finfo(float).eps, maxiter=200)
     tg = egb * q_target / ngear
     if tg > turbine.generator.max_torque * (1 + 1e-9):
-        raise TrimError(f"trim at {v:g} m/s needs generator torque {tg:g} N m, above the "
-                        f"limit {turbine.generator.max_torque:g} N m")
+        raise TrimError(_torque_limit_message(turbine, v, omega, pitch, tg))
     x, u, z = _equilibrium(p, v, omega, pitch, tg, shear)
     q, thrust = float(z[22]), float(z[23])
     area = math.pi * rproj**2

@@ -271,6 +271,9 @@ AD = "NRELOffshrBsline5MW_Onshore_AeroDyn15.dat"
     ("NRELOffshrBsline5MW_AeroDyn_blade.dat", "1.3667000E+00 -8.1531745E-04", "1.3667000E+00 xyz",
      r"AeroDyn_blade.dat: line \d+: .* is not a row of numbers"),
     ("DISCON.IN", "VS_RtPwr", "VS_RatedPower", r"DISCON.IN: key 'VS_RtPwr' not found"),
+    ("DISCON.IN", "0.000000000000      ! PC_FinePit", "-0.05000000000      ! PC_FinePit",
+     r"DISCON.IN:68 PC_FinePit: the fine pitch -2.865 deg is below the minimum pitch 0 deg "
+     r"\(.*DISCON.IN:64 PC_MinPit\)"),
     ("Airfoils/DU21_A17.dat", "NumAlf", "NumAlpha", r"DU21_A17.dat: key 'NumAlf' not found"),
 ])
 def test_bad_deck_names_file_and_key(deck_copy, file, old, new, match) -> None:

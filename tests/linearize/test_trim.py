@@ -3,6 +3,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -181,3 +182,37 @@ def test_operating_point_off_schedule_balances_the_torque(turbine: linearize.Tur
 def test_operating_point_bad_input(turbine: linearize.Turbine, args, match: str) -> None:
     with pytest.raises((ValueError, TrimError), match=match):
         linearize.operating_point(turbine, *args)
+
+
+def test_a_trim_blocked_by_the_torque_limit_names_the_keys_and_what_would_work(tmp_path) -> None:
+    """The IEA-15 deck with its fine pitch lowered to -4 deg in a copy (as the IEA-22's
+    PC_FinePit is): rated power comes at 6.4 rpm, below rated speed, where the torque exceeds
+    VS_MaxTq. The error names the torque limit's and the fine pitch's file, line and key, the
+    rotor speed against rated, and the torque limit that would trim it."""
+    import shutil
+
+    src = Path(linearize.__file__).parent / "data" / "iea15mw"
+    shutil.copytree(src, tmp_path / "iea15")
+    dis = tmp_path / "iea15" / "IEA-15-240-RWT-Monopile" / "IEA-15-240-RWT-Monopile_DISCON.IN"
+    text = dis.read_text().replace("0.000000000000      ! PC_FinePit",
+                                   "-0.069813170080     ! PC_FinePit")
+    text = text.replace("0.000000000000      ! PC_MinPit", "-0.069813170080     ! PC_MinPit")
+    dis.write_text(text)
+    t = linearize.load_turbine(tmp_path / "iea15" / "turbine.yaml")
+    with pytest.raises(linearize.TrimError) as err:
+        for v in np.arange(9.0, 13.0, 0.25):
+            linearize.trim(t, float(v))
+    msg = str(err.value)
+    assert "IEA-15-240-RWT-Monopile_DISCON.IN:84 VS_MaxTq" in msg
+    assert "IEA-15-240-RWT-Monopile_DISCON.IN:68 PC_FinePit" in msg
+    assert "below its rated speed 7.56 rpm" in msg and "a torque limit of at least" in msg
+
+
+def test_a_fine_pitch_below_the_actuators_minimum_is_refused(turbine) -> None:
+    """A region-2 pitch the actuator cannot reach: the trim says so (it reported an
+    equilibrium it could not reach, d(pitch_1)/dt != 0)."""
+    t = dataclasses.replace(turbine, operation=dataclasses.replace(
+        turbine.operation, fine_pitch_rad=math.radians(-1.0)))
+    with pytest.raises(TrimError, match=r"the fine pitch -1 deg is below the pitch actuator's "
+                                        r"minimum 0 deg"):
+        trim(t, 8.0)

@@ -140,3 +140,23 @@ def test_a_geared_deck_holds_its_electrical_rated_power() -> None:
     late = res.t >= 30.0
     assert res.channel("gen_power")[late].mean() == pytest.approx(2.8e6, rel=0.005)
     assert res.channel("gen_torque")[late].mean() == pytest.approx(2.42485e4, rel=0.005)
+
+
+def test_a_main_job_that_cannot_trim_says_why_and_leaves_no_folder(tmp_path, capsys) -> None:
+    """``mpcwt run`` on a deck whose trim the torque limit blocks (the IEA-15 with fine and
+    minimum pitch at -4 deg in a copy): exit 2, the error names VS_MaxTq's file, line and key,
+    and the output folder it would have made is not left behind empty."""
+    import shutil
+
+    src = Path(linearize.__file__).parent / "data" / "iea15mw"
+    shutil.copytree(src, tmp_path / "iea15")
+    dis = tmp_path / "iea15" / "IEA-15-240-RWT-Monopile" / "IEA-15-240-RWT-Monopile_DISCON.IN"
+    text = dis.read_text()
+    for key in ("PC_FinePit", "PC_MinPit"):
+        text = text.replace(f"0.000000000000      ! {key}", f"-0.069813170080     ! {key}")
+    dis.write_text(text)
+    out = tmp_path / "job"
+    assert main(["run", "--turbine", str(tmp_path / "iea15" / "turbine.yaml"), "--duration",
+                 "0", "--out", str(out)]) == 2
+    assert "DISCON.IN:84 VS_MaxTq" in capsys.readouterr().err
+    assert not out.exists()

@@ -391,11 +391,17 @@ def assess_table(rows: list[dict[str, Any]]) -> str:
 def _run(args: argparse.Namespace) -> int:
     out = check_out_folder("--out", args.out)
     turbine = linearize.load_turbine(args.turbine)
+    made = not out.exists()
     out.mkdir(parents=True, exist_ok=True)
-    _steady_outputs(turbine, out)
-    _design_outputs(turbine, out)
-    if args.duration > 0:
-        _comparison_runs(turbine, args, out)
+    try:
+        _steady_outputs(turbine, out)
+        _design_outputs(turbine, out)
+        if args.duration > 0:
+            _comparison_runs(turbine, args, out)
+    except BaseException:
+        if made and not any(out.iterdir()):     # a failure before anything was written
+            out.rmdir()
+        raise
     return 0
 
 
