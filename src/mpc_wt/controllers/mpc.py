@@ -511,7 +511,8 @@ class MPC(ControllerBase):
         For the actuator limits.
     settings : MPCSettings, optional
         Horizons, weights, backend, formulation, soft limits, estimator (default
-        ``MPCSettings()``).
+        ``MPCSettings()``: the Kalman estimator on measured signals; ``estimator="full-state"``
+        for the plant's true states, Madsen et al.'s assumption).
 
     Raises
     ------

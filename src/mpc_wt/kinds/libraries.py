@@ -173,11 +173,66 @@ def _build_rosco(ctx: BuildContext, opts: RoscoOptions) -> Built:
         discon_in = ctx.cache.get(ctx.turbine, ("rosco-export", opts.power_fraction),
                                   lambda: _export_rosco(ctx.turbine, opts.power_fraction))
     ours = opts.discon_in is None
+    if not ours and opts.discon_in != "shipped":
+        rosco_file_check(Path(discon_in))
     return _discon_built(ctx, rosco_library(), discon_in, opts, "rosco",
                          power_fraction=opts.power_fraction if ours else 1.0,
                          design=("ours" if ours else
                                  "shipped" if opts.discon_in == "shipped" else "file"),
                          **source)
+
+
+def _rosco_keys(path: Path) -> list[str]:
+    """The keys of a ROSCO input file's ``value ! key - description`` lines."""
+    keys = []
+    for line in path.read_text(errors="replace").splitlines():
+        head, bang, tail = line.partition("!")
+        if bang and head.strip() and tail.split():
+            keys.append(tail.split()[0])
+    return keys
+
+
+def rosco_file_check(path: Path) -> list[str]:
+    """The keys the installed ROSCO's own NREL 5-MW input file has and ``path`` lacks, logged
+    as a warning with the installed version: a file written for another ROSCO release (ROSCO
+    stops on the ones it requires: "Missing or default values are not allowed for ...").
+
+    Parameters
+    ----------
+    path : Path
+        A ``DISCON.IN``.
+
+    Returns
+    -------
+    list of str
+        The missing keys (empty: none).
+
+    Raises
+    ------
+    FileNotFoundError
+        If ``path`` does not exist.
+    """
+    from importlib.metadata import PackageNotFoundError, version
+
+    from mpc_wt.controllers.discon import rosco_discon
+
+    if not path.is_file():
+        raise FileNotFoundError(f"discon_in: {path} does not exist")
+    ref = rosco_discon("NREL-5MW")
+    have = set(_rosco_keys(path))
+    missing = [k for k in _rosco_keys(ref) if k not in have]
+    if missing:
+        try:
+            installed = version("rosco")
+        except PackageNotFoundError:  # pragma: no cover - rosco_discon needs the package
+            installed = "?"
+        log.warning("%s lacks %d keys of the installed ROSCO %s's own input files (%s): it was "
+                    "written for another ROSCO release, and ROSCO stops on those it requires "
+                    "('Missing or default values are not allowed for ...'); write it again with "
+                    "ROSCO %s's toolbox, or add them with the values of %s", path, len(missing),
+                    installed, ", ".join(missing[:8]) + (", ..." if len(missing) > 8 else ""),
+                    installed, ref)
+    return missing
 
 
 def _process_folder(prefix: str) -> Path:

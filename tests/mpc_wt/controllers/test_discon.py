@@ -418,3 +418,28 @@ def test_roscos_runtime_exit_on_a_missing_table_fails_the_run_only(turbine, tmp_
     res = run_controller(turbine, "rosco", Scenario(12.0, "steady", 1, 2.0),
                          options={"discon_in": "shipped"})
     assert res.t[-1] == pytest.approx(2.0)
+
+
+def test_a_discon_in_of_another_rosco_release_is_named_with_its_missing_keys(turbine, tmp_path,
+                                                                             caplog) -> None:
+    """ROSCO's shipped NREL-5MW DISCON.IN without ``F_VSRefSpdCornerFreq`` (as a file of an
+    older ROSCO is): before the run the kind warns with the key, the installed ROSCO's version
+    and what to do; ROSCO itself then refuses the file with its own message, which the run
+    reports. The shipped files of the rosco wheel's decks lack no key."""
+    import logging
+    from importlib.metadata import version
+
+    from mpc_wt.kinds.libraries import rosco_file_check
+
+    lines = [ln for ln in rosco_discon().read_text().splitlines()
+             if "F_VSRefSpdCornerFreq" not in ln]
+    old = tmp_path / "DISCON.IN"
+    old.write_text("\n".join(lines) + "\n")
+    with caplog.at_level(logging.WARNING, logger="mpc_wt.kinds.libraries"):
+        assert rosco_file_check(old) == ["F_VSRefSpdCornerFreq"]
+    assert f"installed ROSCO {version('rosco')}" in caplog.text
+    assert "F_VSRefSpdCornerFreq" in caplog.text and "write it again" in caplog.text
+    assert rosco_file_check(rosco_discon("IEA-15-240-RWT")) == []
+    with pytest.raises(ControllerLibraryError, match="F_VSRefSpdCornerFreq"):
+        run_controller(turbine, "rosco", Scenario(12.0, "steady", 1, 2.0),
+                       options={"discon_in": str(old)})
