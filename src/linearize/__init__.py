@@ -33,6 +33,7 @@ from linearize.params import (
     PlantConfig,
     PlantParams,
     plant_params,
+    check_plant_step,
     structural_frequencies,
 )
 from linearize.performance import (
@@ -59,7 +60,7 @@ __all__ = [
     "OUTPUT_NAMES", "OUTPUT_UNITS", "STATE_NAMES", "STATE_UNITS", "GridWind", "PlantConfig",
     "PlantParams", "PlantStepper", "SimulationDivergedError", "SimulationResult", "SteadyWind",
     "element_wind",
-    "plant_outputs", "plant_params", "plant_rhs", "rk4_simulate", "structural_frequencies",
+    "plant_outputs", "plant_params", "plant_rhs", "rk4_simulate", "structural_frequencies", "check_plant_step",
     "optimal_tsr", "rotor_average", "steady_coefficients", "OperatingPoint", "TrimError",
     "operating_point", "max_torque_pitch",
     "operating_schedule", "rated_wind_speed", "trim", "Turbine", "TurbineFileError",

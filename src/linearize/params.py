@@ -669,6 +669,50 @@ def _twisted_modes(t: Turbine, cfg: PlantConfig, s: FloatArray, mu: FloatArray,
             "ses": float(np.trapezoid(mu * phi_e * s * np.sin(tw), s))}
 
 
+#: RK4 integrates an undamped mode stably while omega h stays below 2 sqrt(2); the plant's
+#: step is refused a little before that bound, where the mode's decay is already wrong.
+RK4_OMEGA_H = 2.8
+
+
+def check_plant_step(params: PlantParams, dt: float) -> None:
+    """Refuse a plant step that cannot integrate the turbine's drivetrain torsion mode.
+
+    The shaft's torsion mode, f = sqrt(K_shaft / J_eq) / (2 pi) with J_eq the rotor's and the
+    generator's inertias in series, is the stiffest state of the plant; RK4 at step ``dt``
+    diverges where 2 pi f dt > :data:`RK4_OMEGA_H`. A deck's stiffness meant for a rigid
+    drivetrain (ElastoDyn's ``DrTrDOF`` False with a large ``DTTorSpr``) lands there.
+
+    Parameters
+    ----------
+    params : PlantParams
+        The plant.
+    dt : float
+        The plant's step [s].
+
+    Raises
+    ------
+    ValueError
+        Naming the mode's frequency, the stiffness and where it came from, the step, and the
+        largest step or stiffness that would integrate.
+    """
+    if not (params.dof("drivetrain") and params.dof("generator")):
+        return
+    pk = params.pack
+    j_eq = pk.j_rot * pk.j_gen * pk.ngear**2 / (pk.j_rot + pk.j_gen * pk.ngear**2)
+    omega = math.sqrt(pk.k_shaft / j_eq)
+    if omega * dt <= RK4_OMEGA_H:
+        return
+    src = params.turbine.report.source("shaft stiffness")
+    k_max = (RK4_OMEGA_H / dt) ** 2 * j_eq
+    raise ValueError(
+        f"the drivetrain's torsion mode at {omega / (2 * math.pi):.4g} Hz (shaft stiffness "
+        f"{pk.k_shaft:.4g} N m/rad{f', {src}' if src else ''}) is beyond what the plant's step "
+        f"of {dt:g} s integrates ({RK4_OMEGA_H / dt / (2 * math.pi):.3g} Hz at most): a step "
+        f"of at most {RK4_OMEGA_H / omega:.3g} s, or a shaft stiffness of at most "
+        f"{k_max:.4g} N m/rad (a deck's rigid drivetrain, DrTrDOF False, is not modelled as "
+        f"one inertia yet)")
+
+
 def structural_frequencies(params: PlantParams, rotor_speed_rad_s: float = 0.0) -> dict[str, float]:
     """Natural frequencies of the structural modes without aerodynamics [Hz].
 

@@ -78,6 +78,7 @@ from linearize.params import (
     STATE_NAMES,
     STATE_UNITS,
     PlantParams,
+    check_plant_step,
     n_u,
     n_x,
     n_z,
@@ -339,6 +340,7 @@ class PlantStepper:
         if not isinstance(wind, (SteadyWind, GridWind)):
             raise TypeError(f"wind must be SteadyWind or GridWind, got {type(wind).__name__}")
         wind.check_covers(params, duration)
+        check_plant_step(params, self.dt)
         self.params = params
         self._kind, self._wpar, self._grid = wind._kernel_args()
         self._pack = params.pack

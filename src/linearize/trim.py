@@ -196,10 +196,8 @@ _DEFLECTION_STEPS = 8
 
 def _source(turbine: Turbine, quantity: str) -> str:
     """`` (file:line key)`` of a quantity the turbine's loader read, or "" (YAML turbines)."""
-    for e in turbine.report.entries:
-        if e.quantity == quantity and not e.source.startswith("default"):
-            return f" ({e.source})"
-    return ""
+    src = turbine.report.source(quantity)
+    return f" ({src})" if src else ""
 
 
 def _torque_limit_message(turbine: Turbine, v: float, omega: float, pitch: float,

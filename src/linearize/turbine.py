@@ -645,6 +645,24 @@ class LoadReport:
     entries: tuple[ReportEntry, ...] = ()
     notes: tuple[str, ...] = ()
 
+    def source(self, quantity: str) -> str:
+        """Where a quantity came from (``file:line key``), or "" when it was not read from a
+        file (a default, or a YAML turbine's report, which is empty).
+
+        Parameters
+        ----------
+        quantity : str
+            The entry's quantity, e.g. ``"shaft stiffness"``.
+
+        Returns
+        -------
+        str
+        """
+        for e in self.entries:
+            if e.quantity == quantity and not e.source.startswith("default"):
+                return e.source
+        return ""
+
     @property
     def defaulted(self) -> tuple[ReportEntry, ...]:
         """The entries that were not in the files."""

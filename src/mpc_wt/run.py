@@ -17,7 +17,7 @@ from mpc_wt.registry.context import DEFAULT_CACHE, BuildContext, Built, DesignCa
 from mpc_wt.registry.options import Options
 from mpc_wt.registry.registry import API_NAMING, Naming, Selection, law_export, resolve
 from mpc_wt.simulation.memory import RunMemory, check_run_memory, estimate_run_memory
-from mpc_wt.simulation.loop import simulate_closed_loop
+from mpc_wt.simulation.loop import PLANT_DT, simulate_closed_loop
 from mpc_wt.simulation.results import ClosedLoopResult
 from mpc_wt.simulation.scenario import (DEFAULT_FIELDS, FieldMemo, Scenario, lidar_field,
                                        make_wind, start_wind)
@@ -304,6 +304,7 @@ def run_controller(turbine: linearize.Turbine, controller: str, scenario: Scenar
     scenario = _scenario_of(scenario, dict(turbulence=turbulence, seed=seed, duration=duration,
                                            shear_exponent=shear_exponent, condition=condition))
     params = linearize.plant_params(turbine, linearize.PlantConfig().with_switches(plant))
+    linearize.check_plant_step(params, PLANT_DT)       # before the design, which can take long
     built, op, wind = build_controller(turbine, controller, scenario, options, cache=cache,
                                        naming=naming, params=params, samplers=samplers,
                                        fields=fields, shipped=shipped)

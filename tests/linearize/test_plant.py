@@ -437,3 +437,31 @@ def test_the_stage_samples_a_linear_field_exactly(params: linearize.PlantParams,
         assert_allclose(u[i], expected, rtol=1e-6, atol=1e-6)
         assert_allclose(vw[0, i], 2.0 * expected, rtol=1e-6, atol=1e-6)
         assert_allclose(vw[1, i], -expected, rtol=1e-6, atol=1e-6)
+
+
+def test_a_drivetrain_the_step_cannot_integrate_is_named_before_anything_runs() -> None:
+    """The IEA-15 deck with a rigid drivetrain's stiffness (DTTorSpr 1e12 N m/rad, as the
+    IEA-22 deck has with DrTrDOF False): its torsion mode, sqrt(K / J_eq) / 2 pi with the
+    rotor's and generator's inertias in series = 117.7 Hz, is beyond RK4's reach at 1/80 s
+    (2.8 / h = 35.7 Hz). The stepper refuses it naming the key, its file and line, and the
+    largest step and stiffness that would do; the packaged IEA-15 (31 Hz) runs; run_controller
+    says so before it designs anything (it diverged at t = 0.0375 s after the designs)."""
+    import dataclasses
+
+    from mpc_wt.run import run_controller
+
+    t = linearize.load_turbine("iea15mw")
+    stiff = dataclasses.replace(t, drivetrain=dataclasses.replace(t.drivetrain,
+                                                                  shaft_stiffness=1e12))
+    p = linearize.plant_params(stiff)
+    pk = p.pack
+    j_eq = pk.j_rot * pk.j_gen * pk.ngear**2 / (pk.j_rot + pk.j_gen * pk.ngear**2)
+    f = math.sqrt(1e12 / j_eq) / (2 * math.pi)
+    assert f == pytest.approx(117.7, abs=0.1)
+    with pytest.raises(ValueError, match=r"torsion mode at 117.7 Hz \(shaft stiffness 1e\+12 "
+                                         r"N m/rad, IEA-15-240-RWT-Monopile_ElastoDyn.dat:\d+ "
+                                         r"DTTorSpr\).*a step of at most 0.00378 s"):
+        linearize.PlantStepper(p, linearize.SteadyWind(10.0), 1 / 80, 1.0)
+    linearize.PlantStepper(linearize.plant_params(t), linearize.SteadyWind(10.0), 1 / 80, 1.0)
+    with pytest.raises(ValueError, match="DTTorSpr"):
+        run_controller(stiff, "mpc", 12.0, duration=10.0, turbulence="steady")

@@ -396,9 +396,13 @@ def _run(loop: _Loop, stepper: linearize.PlantStepper, ratio: int, bar: Any,
             bar.update(min(800, n - bar.n))
 
 
+#: The plant's integration step [s] (80 Hz: OpenFAST's step for the NREL 5-MW deck, 1/80 s).
+PLANT_DT = 1.0 / 80.0
+
+
 def simulate_closed_loop(params: linearize.PlantParams, controller: Any,
                          wind: linearize.SteadyWind | linearize.GridWind, duration: float, *,
-                         x0: np.ndarray, u0: np.ndarray, dt: float = 1.0 / 80.0,
+                         x0: np.ndarray, u0: np.ndarray, dt: float = PLANT_DT,
                          controller_dt: float | None = None, progress: bool = False,
                          preview: LidarPreview | None = None,
                          meta: dict[str, Any] | None = None,
