@@ -209,12 +209,12 @@ def _torque_limit_message(turbine: Turbine, v: float, omega: float, pitch: float
     msg = (f"trim at {v:g} m/s needs generator torque {tg:g} N m, above the limit "
            f"{turbine.generator.max_torque:g} N m{_source(turbine, 'maximum generator torque')}")
     if omega < op.rated_rotor_speed_rad_s * (1 - 1e-9):
-        msg += (f": at pitch {math.degrees(pitch):.3g} deg"
-                f"{_source(turbine, 'fine pitch')} the rotor reaches rated power at "
-                f"{omega * rpm:.4g} rpm, below its rated speed "
-                f"{op.rated_rotor_speed_rad_s * rpm:.4g} rpm; a region-2 pitch at which "
-                f"the optimal tip-speed ratio reaches rated speed first, or a torque limit of "
-                f"at least {tg:.6g} N m, trims it")
+        msg += (f": on the optimal tip-speed ratio of its fine pitch "
+                f"{math.degrees(op.fine_pitch_rad):.3g} deg{_source(turbine, 'fine pitch')} "
+                f"the rotor runs at {omega * rpm:.4g} rpm (pitch {math.degrees(pitch):.3g} deg), "
+                f"below its rated speed {op.rated_rotor_speed_rad_s * rpm:.4g} rpm, when rated "
+                f"power comes; a region-2 pitch whose optimal tip-speed ratio reaches rated "
+                f"speed first, or a torque limit of at least {tg:.6g} N m, trims it")
     else:
         msg += f"; a torque limit of at least {tg:.6g} N m trims it"
     return msg
