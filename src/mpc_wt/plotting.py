@@ -356,8 +356,9 @@ def plot_design(doc: dict[str, Any], path: str | Path) -> Path:
     hint = doc.get("plot") or {}
     by_vertex = hint.get("x") == "vertex"
     if hint.get("columns"):
+        scale = float(hint.get("scale", 1.0))
         for c in hint["columns"]:
-            ax.plot(x, rows[:, s["columns"].index(c)], "o-", label=c)
+            ax.plot(x, scale * rows[:, s["columns"].index(c)], "o-", label=c)
         ax.set_ylabel(hint.get("label", "gain"))
     else:
         k = np.asarray(doc["matrices"]["K"]["data"])
@@ -371,7 +372,7 @@ def plot_design(doc: dict[str, Any], path: str | Path) -> Path:
         ax.set_ylabel("gain / its largest magnitude [-]")
     ax.set_xlabel("vertex index (wind outer, power reduction inner)" if by_vertex
                   else "wind speed [m/s]")
-    ax.set_title(f"{doc['kind']} gains, {doc['turbine']}")
+    ax.set_title(f"{hint.get('title', doc['kind'] + ' gains')}, {doc['turbine']}", fontsize=9)
     ax.grid(True, alpha=0.3)
     ax.legend(fontsize=7)
     return save_figure(fig, path)

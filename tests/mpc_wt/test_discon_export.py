@@ -759,3 +759,23 @@ def test_export_for_a_users_deck_writes_its_servodyn_and_inflowwind_files(tmp_pa
     plain = export_discon(linearize.load_turbine("nrel5mw"), "baseline", tmp_path / "b",
                           build=False)
     assert plain.inflow is None
+
+
+def test_a_design_with_nan_gains_is_refused_at_export_naming_the_key(tmp_path, capsys):
+    """A saved baseline design whose kp was made NaN (``design.json`` edited): ``mpcwt export
+    --format discon`` stops with exit 2 naming the key, before writing or compiling anything
+    (it wrote ``kp nan`` and compiled a library its own reader then refused)."""
+    import json
+
+    from mpc_wt.cli import main
+
+    d = tmp_path / "design"
+    assert main(["design", "baseline", "--out", str(d)]) == 0
+    doc = json.loads((d / "design.json").read_text())
+    doc["settings"]["kp"] = float("nan")
+    (d / "design.json").write_text(json.dumps(doc))
+    capsys.readouterr()
+    assert main(["export", str(d), "--format", "discon", "--out", str(d / "lib")]) == 2
+    err = capsys.readouterr().err
+    assert "'kp'" in err and "not finite" in err
+    assert not (d / "lib" / "mpcwt_baseline.in").exists()

@@ -269,9 +269,18 @@ def controller_input(controller: Any, export: LawExport, turbine: linearize.Turb
     Raises
     ------
     ValueError
-        A controller the kind's law does not take (from its ``entries``).
+        A controller the kind's law does not take (from its ``entries``), or a design number
+        that is not finite (NaN or infinite gains), naming its key.
     """
     entries = export.entries(controller, preview)
+    for k, v, doc in entries:
+        bad = ~np.isfinite(np.asarray(v, float).ravel())
+        if bad.any():
+            i = int(np.argmax(bad))
+            raise ValueError(f"{export.name}: the design's '{k}' ({doc}) has "
+                             f"{int(bad.sum())} value(s) that are not finite numbers (value "
+                             f"{i + 1}: {np.asarray(v, float).ravel()[i]!r}); its library would "
+                             f"refuse the file: the design is broken, make it again")
     from mpc_wt._version import __version__
 
     head = [f"# mpc-wt {__version__}: controller '{export.name}' for {turbine.name}",

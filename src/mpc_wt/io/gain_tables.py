@@ -95,9 +95,10 @@ def document(kind: str, turbine: linearize.Turbine, settings: dict[str, Any],
         Name -> :func:`matrix`.
     plot : dict, optional
         How :func:`mpc_wt.plotting.plot_design` draws it: ``{"columns": [...], "label": ...}``
-        plots those schedule columns against wind speed; otherwise the largest gains of the
-        matrix ``K`` normalised, against wind speed or, with ``{"x": "vertex"}``, the row
-        index.
+        plots those schedule columns (times ``scale``, default 1) against wind speed;
+        otherwise the largest gains of the matrix ``K`` normalised, against wind speed or, with
+        ``{"x": "vertex"}``, the row index; ``title`` names what is drawn (default "KIND
+        gains").
 
     Returns
     -------

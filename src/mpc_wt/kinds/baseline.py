@@ -163,7 +163,10 @@ def baseline_table(turbine: linearize.Turbine, gains: Any,
     return gt.document("baseline", turbine, settings,
                 ["wind_speed", "pitch", "kp", "ki", "gen_torque", "gen_speed", "power"],
                 ["m/s", "rad", "s", "-", "N m", "rad/s", "W"], rows, {},
-                       plot={"columns": ["kp", "ki"], "label": "PI gain on generator speed [s], [-]"})
+                       plot={"columns": ["kp", "ki"],
+                             "label": "PI gains as applied: kp [s], ki [-]",
+                             "title": "baseline: the small-signal PI gains of the DISCON form, "
+                                      "kp and ki / (1 + 2 theta / theta_K)"})
 
 
 def _rated_wind(turbine: linearize.Turbine, power_W: float | None) -> float:

@@ -211,7 +211,8 @@ def ibc_table(turbine: linearize.Turbine, gains: Any) -> dict[str, Any]:
     return gt.document("ibc", turbine, settings,
                 ["wind_speed", "pitch", "gain", "gain_margin", "loop_gain_1p"],
                 ["m/s", "rad", "rad/(N m)", "-", "-"], rows, {},
-                       plot={"columns": ["gain"], "label": "IBC gain [rad/(N m)]"})
+                       plot={"columns": ["gain"], "label": "IBC gain [rad/(N m)]",
+                             "title": "ibc: the gain scheduled on the mean pitch"})
 
 
 def coleman_ipc_table(turbine: linearize.Turbine, gains: Any) -> dict[str, Any]:

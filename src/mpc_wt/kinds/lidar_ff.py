@@ -161,4 +161,5 @@ def lidar_ff_table(turbine: linearize.Turbine, ctl: Any, kind: str,
                           "focus_distance": "m"}}
     return gt.document(kind, turbine, settings, ["wind_speed", "filter_corner", "static_pitch"],
                 ["m/s", "rad/s", "rad"], rows, {},
-                plot={"columns": ["filter_corner"], "label": "feedforward filter corner [rad/s]"})
+                plot={"columns": ["filter_corner"], "label": "feedforward filter corner [rad/s]",
+                      "title": f"{kind}: the filter corner over mean wind"})

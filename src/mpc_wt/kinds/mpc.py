@@ -635,4 +635,6 @@ def mpc_table(turbine: linearize.Turbine, ctl: Any, kind: str,
     return gt.document(kind, turbine, settings,
                 ["wind_speed", "pitch", "gen_torque", "rotor_speed", "gen_power",
                  "estimator_spectral_radius"], ["m/s", "rad", "N m", "rad/s", "W", "-"], rows,
-                {}, plot={"columns": ["pitch"], "label": "trim pitch the cost tracks [rad]"})
+                {}, plot={"columns": ["pitch"], "scale": 180.0 / math.pi,
+                      "label": "trim pitch the cost tracks [deg]",
+                      "title": f"{kind}: the trim pitch of each grid design"})
