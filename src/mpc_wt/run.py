@@ -303,8 +303,7 @@ def run_controller(turbine: linearize.Turbine, controller: str, scenario: Scenar
     """
     scenario = _scenario_of(scenario, dict(turbulence=turbulence, seed=seed, duration=duration,
                                            shear_exponent=shear_exponent, condition=condition))
-    params = linearize.plant_params(turbine, linearize.PlantConfig().with_switches(plant))
-    linearize.check_plant_step(params, PLANT_DT)       # before the design, which can take long
+    params = _checked_plant(turbine, plant)            # before the design, which can take long
     built, op, wind = build_controller(turbine, controller, scenario, options, cache=cache,
                                        naming=naming, params=params, samplers=samplers,
                                        fields=fields, shipped=shipped)
@@ -313,6 +312,14 @@ def run_controller(turbine: linearize.Turbine, controller: str, scenario: Scenar
         params, _supervised(built.controller, turbine, supervisor, meta), wind,
         scenario.duration, x0=op.x, u0=op.u, controller_dt=built.controller_dt,
         preview=built.preview, progress=progress, meta=meta), controller)
+
+
+def _checked_plant(turbine: linearize.Turbine,
+                   plant: Mapping[str, bool] | None) -> linearize.PlantParams:
+    """The plant's parameters, refused if its step cannot integrate the drivetrain or blades."""
+    params = linearize.plant_params(turbine, linearize.PlantConfig().with_switches(plant))
+    linearize.check_plant_step(params, PLANT_DT)
+    return params
 
 
 def _run_meta(controller: str, scenario: Scenario, turbine: linearize.Turbine, built: Built,
