@@ -640,6 +640,7 @@ def load_openfast(fst: str | Path | None = None, *, elastodyn: str | Path | None
                                            "kg m^2", ed, "NacYIner"))
     geometry = _with_nacelle_cm(geometry, ed, nac_mass, yaw_br)
     operation, generator, pitch = _control(ed, srv, dis, drive, rec)
+    rigid = _rigid_dofs(ed, rec)
     if gravity_src[0].has(gravity_src[1]):
         g = rec.read("gravity", gravity_src[0].number(gravity_src[1], 0, 20), "m/s^2",
                      *gravity_src)
@@ -656,9 +657,37 @@ def load_openfast(fst: str | Path | None = None, *, elastodyn: str | Path | None
             blade=blade_aero, polars=polars, blade_structure=bstruct, tower_structure=tstruct,
             mode_shapes=ModeShapes(tower_fa1=tmodes[0], tower_ss1=tmodes[1],
                                    blade_flap1=bmodes[0], blade_edge1=bmodes[1]),
-            report=LoadReport(tuple(rec.entries), tuple(notes)))
+            rigid_dofs=rigid, report=LoadReport(tuple(rec.entries), tuple(notes)))
     except ValueError as err:
         raise TurbineFileError(f"{source}: {err}") from err
+
+
+#: the plant's degrees of freedom and the ElastoDyn switch of each (its first mode)
+ELASTODYN_DOFS = {"tower_fa": "TwFADOF1", "tower_ss": "TwSSDOF1", "drivetrain": "DrTrDOF",
+                  "generator": "GenDOF", "blade_flap": "FlapDOF1", "blade_edge": "EdgeDOF"}
+
+
+#: the switches a turbine read from a deck holds rigid in every run and design; the others
+#: are reported (the TS and LQR-PIO designs are built on the tower's and blades' states)
+RIGID_FROM_DECK = ("drivetrain", "generator")
+
+
+def _rigid_dofs(ed: OpenFASTFile, rec: _Recorder) -> tuple[str, ...]:
+    """The plant's degrees of freedom that ElastoDyn's switches hold rigid (a drivetrain with
+    ``DrTrDOF`` False is one inertia: its ``DTTorSpr`` is not a spring the plant steps); the
+    tower and blade switches set to False are noted, their DOFs left flexible."""
+    off = sorted(d for d, key in ELASTODYN_DOFS.items() if ed.has(key) and not ed.flag(key))
+    rigid = tuple(d for d in off if d in RIGID_FROM_DECK)
+    if rigid:
+        keys = ", ".join(ed.where(ELASTODYN_DOFS[d]) for d in rigid)
+        rec.entries.append(ReportEntry("rigid degrees of freedom", ", ".join(rigid),
+                                       f"{keys} False (the plant holds them rigid)"))
+    kept = [d for d in off if d not in RIGID_FROM_DECK]
+    if kept:
+        rec.notes.append(f"{ed.path.name}: {', '.join(ed.where(ELASTODYN_DOFS[d]) for d in kept)}"
+                         f" False: the plant's {', '.join(kept)} stay flexible (in every run "
+                         f"but an OpenFAST case's, which follows the switches)")
+    return rigid
 
 
 def _check_main(main: OpenFASTFile) -> None:

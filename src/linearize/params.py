@@ -423,15 +423,32 @@ def plant_params(turbine: Turbine, config: PlantConfig | None = None) -> PlantPa
     turbine : Turbine
         The turbine.
     config : PlantConfig, optional
-        Degrees of freedom and aerodynamic options (default: all on).
+        Degrees of freedom and aerodynamic options (default: all on). The degrees of freedom
+        the turbine holds rigid (:attr:`Turbine.rigid_dofs`, an OpenFAST deck's ElastoDyn
+        switches) are left out of it: ``PlantParams.config`` is the configuration in effect.
 
     Returns
     -------
     PlantParams
         The plant's parameters.
+
+    Raises
+    ------
+    ValueError
+        If the turbine's ``rigid_dofs`` names a degree of freedom the plant does not have.
     """
-    cfg = config or PlantConfig()
+    cfg = _without_rigid(turbine, config or PlantConfig())
     return _DERIVED.get((id(turbine), cfg), lambda: _derive_plant_params(turbine, cfg))
+
+
+def _without_rigid(turbine: Turbine, cfg: PlantConfig) -> PlantConfig:
+    """``cfg`` without the degrees of freedom the turbine holds rigid."""
+    rigid = set(turbine.rigid_dofs)
+    unknown = sorted(rigid - set(DOF_NAMES))
+    if unknown:
+        raise ValueError(f"Turbine.rigid_dofs has unknown names {unknown}; allowed "
+                         f"{list(DOF_NAMES)}")
+    return replace(cfg, dofs=cfg.dofs - rigid) if cfg.dofs & rigid else cfg
 
 
 def _derive_plant_params(turbine: Turbine, cfg: PlantConfig) -> PlantParams:
@@ -679,8 +696,9 @@ def check_plant_step(params: PlantParams, dt: float) -> None:
 
     The shaft's torsion mode, f = sqrt(K_shaft / J_eq) / (2 pi) with J_eq the rotor's and the
     generator's inertias in series, is the stiffest state of the plant; RK4 at step ``dt``
-    diverges where 2 pi f dt > :data:`RK4_OMEGA_H`. A deck's stiffness meant for a rigid
-    drivetrain (ElastoDyn's ``DrTrDOF`` False with a large ``DTTorSpr``) lands there.
+    diverges where 2 pi f dt > :data:`RK4_OMEGA_H`. A rigid drivetrain's stiffness given as a
+    spring (a large ``DTTorSpr`` with the DOF on) lands there; a deck's ``DrTrDOF False`` holds
+    the drivetrain rigid (:attr:`Turbine.rigid_dofs`), with no torsion mode to step.
 
     Parameters
     ----------
@@ -709,8 +727,7 @@ def check_plant_step(params: PlantParams, dt: float) -> None:
         f"{pk.k_shaft:.4g} N m/rad{f', {src}' if src else ''}) is beyond what the plant's step "
         f"of {dt:g} s integrates ({RK4_OMEGA_H / dt / (2 * math.pi):.3g} Hz at most): a step "
         f"of at most {RK4_OMEGA_H / omega:.3g} s, or a shaft stiffness of at most "
-        f"{k_max:.4g} N m/rad (a deck's rigid drivetrain, DrTrDOF False, is not modelled as "
-        f"one inertia yet)")
+        f"{k_max:.4g} N m/rad")
 
 
 def structural_frequencies(params: PlantParams, rotor_speed_rad_s: float = 0.0) -> dict[str, float]:

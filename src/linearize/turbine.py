@@ -701,6 +701,11 @@ class Turbine:
         Distributed tower properties.
     mode_shapes : ModeShapes
         The assumed modes.
+    rigid_dofs : tuple of str
+        The plant's degrees of freedom the turbine's data holds rigid, sorted (names of
+        :data:`linearize.DOF_NAMES`; an OpenFAST deck's ElastoDyn switches, e.g.
+        ``("drivetrain",)`` for ``DrTrDOF False``): :func:`linearize.plant_params` leaves them
+        out of every configuration. Empty for a turbine whose every DOF is flexible.
     report : LoadReport
         What was read from where.
     """
@@ -721,9 +726,15 @@ class Turbine:
     blade_structure: BladeStructure
     tower_structure: TowerStructure
     mode_shapes: ModeShapes
+    rigid_dofs: tuple[str, ...] = field(default=(), metadata={"digest_at_default": False})
     report: LoadReport = field(default_factory=LoadReport, compare=False)
 
     def __post_init__(self) -> None:
+        rigid = tuple(self.rigid_dofs)
+        if any(not isinstance(d, str) for d in rigid) or list(rigid) != sorted(set(rigid)):
+            raise ValueError(f"rigid_dofs must be a sorted tuple of distinct DOF names, got "
+                             f"{self.rigid_dofs!r}")
+        object.__setattr__(self, "rigid_dofs", rigid)
         g = self.geometry
         b = self.blade
         if b.layout == "nodes":
@@ -799,6 +810,9 @@ def _feed(h: Any, obj: Any) -> None:
         for f in fields(obj):
             if not f.compare:           # provenance (a turbine's source path, its load report)
                 continue
+            if (f.metadata.get("digest_at_default") is False
+                    and getattr(obj, f.name) == f.default):
+                continue                # a field added later, at its default: the digest of before
             h.update(f.name.encode())
             _feed(h, getattr(obj, f.name))
     elif isinstance(obj, np.ndarray):

@@ -184,6 +184,33 @@ def test_the_iea22_deck_as_published_loads_and_says_what_blocks_its_trim() -> No
     assert "a torque limit of at least" in msg
 
 
+def test_the_dofs_a_deck_switches_off_are_rigid_in_the_plant() -> None:
+    """ElastoDyn's drivetrain switch is the plant's: the IEA-22 deck's drivetrain (DrTrDOF
+    False with DTTorSpr 1e12 N m/rad, a 117 Hz spring the plant's step cannot integrate) is
+    one inertia, so its plant passes the step check; the NREL-2.8-127 deck's drivetrain is
+    rigid and its tower switches (TwFADOF1, TwSSDOF1 False) are noted, the tower left
+    flexible; the rosco wheel's NREL 5-MW deck's DOFs all flexible. The report names each
+    switch's file and line. In a closed loop on the NREL-2.8-127 the generator turns at
+    exactly GBRatio = 97 times the rotor."""
+    t22 = linearize.load_turbine(IEA22)
+    assert t22.rigid_dofs == ("drivetrain",)
+    assert "IEA-22-280-RWT_ElastoDyn.dat:12 DrTrDOF" in t22.report.source(
+        "rigid degrees of freedom")
+    p22 = linearize.plant_params(t22)
+    assert not p22.dof("drivetrain") and p22.dof("generator")
+    linearize.check_plant_step(p22, 1 / 80)
+    t28 = linearize.load_turbine(CASES / "NREL_2p8_127" / "NREL-2p8-127.fst")
+    assert t28.rigid_dofs == ("drivetrain",)
+    assert any("TwFADOF1" in n and "TwSSDOF1" in n and "stay flexible" in n
+               for n in t28.report.notes)
+    assert linearize.load_turbine(CASES / "NREL-5MW" / "NREL-5MW.fst").rigid_dofs == ()
+    res = run_controller(t28, "baseline", 8.0, duration=10.0, turbulence="steady")
+    assert t28.drivetrain.gearbox_ratio == 97.0                      # the deck's GBRatio
+    names = linearize.STATE_NAMES
+    rotor, gen = res.x[:, names.index("rotor_speed")], res.x[:, names.index("gen_speed")]
+    np.testing.assert_allclose(gen, 97.0 * rotor, rtol=1e-12)
+
+
 @pytest.mark.xfail(strict=True, reason="ROSCO's minimum-pitch table (PS_BldPitchMin, PS_Mode 1) "
                    "is not yet read as the region-2 pitch: at the deck's fine pitch of -4.01 deg "
                    "rated power comes at 5.8 rpm, below rated speed 7.06 rpm, and the torque "

@@ -1361,6 +1361,14 @@ def drivetrain_frequency(turbine: linearize.Turbine, wind_mps: float | None = No
     return float(modes[0]["frequency_Hz"])
 
 
+def _gen_speed(model: linearize.LinearModel) -> float:
+    """A linear model's generator speed at its operating point [rad/s]: its state, or with a
+    rigid drivetrain (no ``gen_speed`` state) its output."""
+    if "gen_speed" in model.states:
+        return float(model.x0[model.states.index("gen_speed")])
+    return float(model.z0[model.outputs.index("gen_speed")])
+
+
 class ScheduledMPC(ControllerBase):
     """MPC scheduled over a :class:`linearize.LinearModelFamily` on a measured mean wind.
 
@@ -1486,8 +1494,7 @@ class ScheduledMPC(ControllerBase):
         self._law = LawTorque(torque_law, st.dt) if torque_law is not None else None
         self._ip = linearize.MADSEN_OUTPUTS.index("gen_power")
         m0 = family.models[0]
-        self._eff = float(m0.z0[m0.outputs.index("gen_power")]
-                          / (m0.u0[3] * m0.x0[m0.states.index("gen_speed")]))
+        self._eff = float(m0.z0[m0.outputs.index("gen_power")] / (m0.u0[3] * _gen_speed(m0)))
         self.torque_notch_hz, self.torque_notch_q = torque_notch_hz, float(torque_notch_q)
         self.tower_notch_hz = tower_notch_hz
         self._notch: SOSFilterBank | None = None

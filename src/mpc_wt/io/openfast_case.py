@@ -22,7 +22,7 @@ import numpy as np
 
 import lidar
 import linearize
-from linearize.openfast import OpenFASTFile
+from linearize.openfast import ELASTODYN_DOFS, OpenFASTFile
 from linearize.openfast_channels import blade_frame_moment
 from mpc_wt.errors import ResultFileError
 
@@ -88,9 +88,7 @@ def _flag(f: OpenFASTFile, key: str, default: bool) -> bool:
 
 def _dofs(ed: OpenFASTFile) -> frozenset[str]:
     """The plant's DOFs from ElastoDyn's flags (first modes; the pitch as commanded)."""
-    on = {"tower_fa": "TwFADOF1", "tower_ss": "TwSSDOF1", "drivetrain": "DrTrDOF",
-          "generator": "GenDOF", "blade_flap": "FlapDOF1", "blade_edge": "EdgeDOF"}
-    return frozenset(d for d, key in on.items() if _flag(ed, key, True))
+    return frozenset(d for d, key in ELASTODYN_DOFS.items() if _flag(ed, key, True))
 
 
 def _initial_state(ed: OpenFASTFile, turbine: linearize.Turbine) -> np.ndarray:

@@ -341,7 +341,10 @@ def test_the_notch_takes_the_drivetrain_out_of_the_shaft_torque(turbine) -> None
 
 def test_torque_notch_options_are_checked(turbine) -> None:
     """A centre at or above the controller's Nyquist frequency is refused naming the option;
-    0 turns the notch off; a direct drive's mode (the IEA-15's, above 4 Hz) gets none."""
+    0 turns the notch off; a direct drive's mode (the IEA-15's with a flexible shaft, above
+    4 Hz) gets none, and a rigid drivetrain (its deck's DrTrDOF False) has no mode."""
+    import dataclasses
+
     from mpc_wt.controllers import drivetrain_frequency
 
     with pytest.raises(ValueError, match="torque_notch_hz = 6 Hz must be below"):
@@ -349,7 +352,10 @@ def test_torque_notch_options_are_checked(turbine) -> None:
     built, _, _ = build_controller(turbine, "mpc", Scenario(13.0), {"torque_notch_hz": 0.0})
     assert built.designed.torque_notch_hz is None
     assert built.meta["mpc"]["torque_notch_hz"] is None
-    assert drivetrain_frequency(linearize.load_turbine("iea15mw")) > 4.0
+    iea15 = linearize.load_turbine("iea15mw")
+    assert drivetrain_frequency(dataclasses.replace(iea15, rigid_dofs=())) > 4.0
+    with pytest.raises(ValueError, match="no drivetrain torsion mode"):
+        drivetrain_frequency(iea15)
 
 
 @pytest.mark.parametrize("kind, opts, above", [
