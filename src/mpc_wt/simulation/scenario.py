@@ -515,8 +515,24 @@ def _load_field(path: str, mtime_ns: int) -> lidar.WindField:
     return lidar.WindField.load(path)
 
 
+#: The largest mean wind a wind file may blow [m/s]: IEC 61400-1's 50-year extreme of class I
+#: (1.4 V_ref = 70 m/s).
+MAX_FILE_WIND = 70.0
+
+#: How far a file's header mean wind may lie from its data's mean at the hub (a fraction of
+#: the data's): a field made for another wind, or a header edited, is refused.
+HEADER_TOLERANCE = 0.5
+
+
 def read_wind_file(path: str) -> lidar.WindField:
-    """A wind file's field (the last two read are kept: the trim and the run read it once).
+    """A wind file's field, its wind checked as ``--wind`` is (the last two read are kept:
+    the trim and the run read it once).
+
+    The mean of the longitudinal wind at the grid point nearest the hub (over the file's
+    time) must be finite and in (0, :data:`MAX_FILE_WIND`] m/s (the wind blows downwind,
+    along +x), and the header's mean wind (TurbSim's hub speed, the ``.npz``'s
+    ``mean_speed``) within :data:`HEADER_TOLERANCE` of it: the header sets the frozen
+    turbulence's speed and a campaign's wind bin.
 
     Parameters
     ----------
@@ -531,9 +547,30 @@ def read_wind_file(path: str) -> lidar.WindField:
     ------
     lidar.FieldFileError
         A missing, truncated or broken file.
+    ValueError
+        A wind out of range or against its header, naming the file and both values.
     """
     p = check_wind_file(path)
-    return _load_field(str(p.resolve()), p.stat().st_mtime_ns)
+    f = _load_field(str(p.resolve()), p.stat().st_mtime_ns)
+    _check_field_wind(str(path), f)
+    return f
+
+
+def _check_field_wind(name: str, f: lidar.WindField) -> None:
+    """:func:`read_wind_file`'s check of the wind a file blows."""
+    iy = int(np.argmin(np.abs(f.y)))
+    iz = int(np.argmin(np.abs(f.z - f.hub_height)))
+    hub = float(np.mean(f.u[:, iy, iz], dtype=float))
+    where = f"at the grid point nearest the hub (y {f.y[iy]:g} m, z {f.z[iz]:g} m)"
+    if not (math.isfinite(hub) and 0.0 < hub <= MAX_FILE_WIND):
+        raise ValueError(f"wind_file {name!r}: its mean wind {where} is {hub:.4g} m/s; a wind "
+                         f"file must blow downwind (+x) with a mean in (0, {MAX_FILE_WIND:g}] "
+                         f"m/s")
+    if abs(f.mean_speed - hub) > HEADER_TOLERANCE * hub:
+        raise ValueError(f"wind_file {name!r}: its header's mean wind {f.mean_speed:.4g} m/s "
+                         f"disagrees with its data's {hub:.4g} m/s {where} (allowed within "
+                         f"{HEADER_TOLERANCE:.0%}): a field made for another wind, or an "
+                         f"edited header")
 
 
 #: The first seconds of a wind file whose rotor-disc mean wind sets the plant's start [s].
@@ -559,23 +596,29 @@ def start_wind(turbine: linearize.Turbine, scenario: Scenario) -> float:
     """
     if scenario.wind_file is None:
         return float(scenario.wind_mps)         # type: ignore[arg-type]
-    f = read_wind_file(scenario.wind_file)
+    f = _rotor_field(turbine, scenario.wind_file)
     first = f.t <= f.t[0] + START_WINDOW
     u = lidar.rotor_effective_wind(f, turbine.geometry.tip_radius)[first].mean()
     op = turbine.operation
     return float(min(max(u, op.cut_in_wind), op.cut_out_wind))
 
 
-def _file_wind(turbine: linearize.Turbine, scenario: Scenario
-               ) -> tuple[linearize.GridWind, lidar.WindField]:
-    """The plant's wind from the scenario's file, checked to cover the rotor and the run."""
-    f = read_wind_file(str(scenario.wind_file))
+def _rotor_field(turbine: linearize.Turbine, name: str) -> lidar.WindField:
+    """A wind file's field, checked to cover the turbine's rotor."""
+    f = read_wind_file(name)
     r, hub = turbine.geometry.tip_radius, turbine.geometry.hub_height
-    name = scenario.wind_file
     if f.y[0] > -r or f.y[-1] < r or f.z[0] > hub - r or f.z[-1] < hub + r:
         raise ValueError(f"wind_file {name!r}: its grid (y {f.y[0]:g}..{f.y[-1]:g} m, z "
                          f"{f.z[0]:g}..{f.z[-1]:g} m) does not cover the rotor (radius {r:g} m "
                          f"at hub height {hub:g} m)")
+    return f
+
+
+def _file_wind(turbine: linearize.Turbine, scenario: Scenario
+               ) -> tuple[linearize.GridWind, lidar.WindField]:
+    """The plant's wind from the scenario's file, checked to cover the rotor and the run."""
+    name = str(scenario.wind_file)
+    f = _rotor_field(turbine, name)
     if f.t[-1] - f.t[0] < scenario.duration:
         raise ValueError(f"wind_file {name!r} holds {f.t[-1] - f.t[0]:g} s of wind; the run's "
                          f"duration is {scenario.duration:g} s")

@@ -3,6 +3,7 @@ controller kind; the plant starts from the trim at the rotor-disc mean of the fi
 bad files and flags are named."""
 from __future__ import annotations
 
+import re
 from pathlib import Path
 
 import numpy as np
@@ -89,3 +90,38 @@ def test_bad_wind_files_are_named(bts: Path, tmp_path: Path,
     with pytest.raises(SystemExit):
         main(["simulate", "--wind-file", str(bts), "--wind", "12", "--out",
               str(tmp_path / "x.nc")])
+
+
+def _edited(bts: Path, path: Path, **change) -> Path:
+    """A copy of the fixture's field with fields replaced, saved as ``path``."""
+    import dataclasses
+
+    f = lidar.WindField.load(bts)
+    dataclasses.replace(f, **{k: v(f) for k, v in change.items()}).save(path)
+    return path
+
+
+@pytest.mark.parametrize("suffix", [".bts", ".npz"])
+def test_a_wind_file_is_checked_as_the_wind_flag_is(bts: Path, tmp_path: Path, suffix: str,
+                                                    capsys: pytest.CaptureFixture[str]) -> None:
+    """A file whose wind blows upwind (-15 m/s under a header of 15), whose header says 1000
+    m/s over data of 15, or whose wind is 1000 m/s is refused before anything runs (exit 2),
+    naming the file and the values (it simulated silently at 0 MW, was binned at 1000 m/s, or
+    diverged at t = 0.49 s); a grid that lies above the rotor is named with the file."""
+    upwind = _edited(bts, tmp_path / f"upwind{suffix}", u=lambda f: -f.u)
+    header = _edited(bts, tmp_path / f"header{suffix}", mean_speed=lambda f: 1000.0)
+    fast = _edited(bts, tmp_path / f"fast{suffix}", u=lambda f: f.u * (1000.0 / 15.0),
+                   mean_speed=lambda f: 1000.0)
+    high = _edited(bts, tmp_path / f"high{suffix}", z=lambda f: f.z + 400.0,
+                   hub_height=lambda f: f.hub_height + 400.0)
+    cases = [(upwind, r"upwind\S*: its mean wind at the grid point nearest the hub .* is "
+                      r"-1[45]\.\d+ m/s; a wind file must blow downwind"),
+             (header, r"header's mean wind 1000 m/s disagrees with its data's 1[45]\.\d+ m/s"),
+             (fast, r"its mean wind .* is 9\d\d\.?\d* m/s; .* in \(0, 70\] m/s"),
+             (high, r"high\S*: its grid \(y .* m, z 4\d\d.* does not cover the rotor")]
+    for path, msg in cases:
+        out = tmp_path / "x.nc"
+        assert main(["simulate", "--wind-file", str(path), "--duration", "2", "--out",
+                     str(out)]) == 2
+        assert re.search(msg, capsys.readouterr().err), path.name
+        assert not out.exists()
