@@ -303,7 +303,7 @@ def run_controller(turbine: linearize.Turbine, controller: str, scenario: Scenar
     """
     scenario = _scenario_of(scenario, dict(turbulence=turbulence, seed=seed, duration=duration,
                                            shear_exponent=shear_exponent, condition=condition))
-    params = _checked_plant(turbine, plant)            # before the design, which can take long
+    params = _checked_case(turbine, plant, scenario, supervisor)   # before the design
     built, op, wind = build_controller(turbine, controller, scenario, options, cache=cache,
                                        naming=naming, params=params, samplers=samplers,
                                        fields=fields, shipped=shipped)
@@ -314,9 +314,22 @@ def run_controller(turbine: linearize.Turbine, controller: str, scenario: Scenar
         preview=built.preview, progress=progress, meta=meta), controller)
 
 
-def _checked_plant(turbine: linearize.Turbine,
-                   plant: Mapping[str, bool] | None) -> linearize.PlantParams:
-    """The plant's parameters, refused if its step cannot integrate the drivetrain or blades."""
+#: The supervisor's events, each at a time [s] that must fall within the run.
+SUPERVISOR_EVENTS = ("shutdown_at", "grid_loss_at", "pitch_fault_at")
+
+
+def _checked_case(turbine: linearize.Turbine, plant: Mapping[str, bool] | None,
+                  scenario: Scenario, supervisor: Mapping[str, Any] | None
+                  ) -> linearize.PlantParams:
+    """The plant's parameters, refused if its step cannot integrate the drivetrain; a
+    supervisor event at or after the run's end refused (it would never happen)."""
+    for key in SUPERVISOR_EVENTS:
+        at = (supervisor or {}).get(key)
+        if isinstance(at, (int, float)) and not isinstance(at, bool) \
+                and at >= scenario.duration:
+            raise ValueError(f"supervisor {key} = {at:g} s is at or after the run's end "
+                             f"({scenario.duration:g} s): the event would not happen; allowed "
+                             f"0 <= {key} < {scenario.duration:g} s")
     params = linearize.plant_params(turbine, linearize.PlantConfig().with_switches(plant))
     linearize.check_plant_step(params, PLANT_DT)
     return params

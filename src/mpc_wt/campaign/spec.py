@@ -76,6 +76,13 @@ _REPORT_KEYS = {"paper", "notes", "psd_wind", "cs_wind", "sweep", "title"}
 #: the most seeds per wind a spec may give, and the most cases a campaign may hold (a spec
 #: over them is a mistake, not a study: 100,000 cases of 600 s take months on 2 cores)
 MAX_SEEDS = 1000
+
+#: The largest seed: the campaign index stores seeds as SQLite integers (64-bit signed).
+MAX_SEED = 2**63 - 1
+
+#: The shortest assessed time of a case after its transient [s]: the assessment's floor
+#: (:func:`mpc_wt.campaign.task.assess_case` refuses less).
+MIN_ASSESSED_S = 10.0
 MAX_CASES = 100_000
 
 
@@ -130,6 +137,25 @@ def _number(key: str, val: Any, lo: float | None = None, hi: float | None = None
         raise _fail(key, str(err).removeprefix(f"{key} ")) from None
 
 
+def _assessed(key: str, val: Any) -> float:
+    """A case's assessed duration after its transient [s]: at least :data:`MIN_ASSESSED_S`,
+    at most :data:`MAX_DURATION_S`."""
+    d = _number(key, val, 0.0, MAX_DURATION_S, lo_open=True)
+    if d < MIN_ASSESSED_S:
+        raise _fail(key, f"the time assessed after the transient must be at least "
+                         f"{MIN_ASSESSED_S:g} s (the fatigue and statistics need it), got {d:g}")
+    return d
+
+
+def _events_within(key: str, sup: Mapping[str, Any], duration: float) -> None:
+    """Refuse a supervisor event (``*_at``, counted from the transient's end) at or after the
+    end of a case's assessed time: it would not happen."""
+    for k, at in sup.items():
+        if k.endswith("_at") and isinstance(at, (int, float)) and at >= duration:
+            raise _fail(f"{key}.{k}", f"{at:g} s is at or after the case's end ({duration:g} s "
+                                      f"after the transient): the event would not happen")
+
+
 def _winds(key: str, val: Any) -> tuple[float, ...]:
     """A list of mean winds [m/s], or {start, stop, step} (stop included)."""
     if isinstance(val, Mapping):
@@ -163,6 +189,9 @@ def _seeds(key: str, val: Any) -> tuple[int, ...]:
     if isinstance(val, (list, tuple)) and val:
         if not all(isinstance(s, int) and not isinstance(s, bool) and s >= 0 for s in val):
             raise _fail(key, f"seeds must be integers >= 0, got {list(val)}")
+        big = [s for s in val if s > MAX_SEED]
+        if big:
+            raise _fail(key, f"seeds must be at most 2**63 - 1 = {MAX_SEED}, got {big[0]}")
         if len(set(val)) != len(val):
             raise _fail(key, f"repeated seeds {list(val)}")
         if len(val) > MAX_SEEDS:
@@ -958,12 +987,14 @@ def _load_case(i: int, raw: Any, top: Mapping[str, Any]) -> LoadCase:
         raise _fail(f"{key}.fatigue", f"must be true or false, got {fatigue!r}")
     sup = {**top["supervisor"], **_supervisor(f"{key}.supervisor", raw.get("supervisor"),
                                               top["turbine"])}
+    duration = _assessed(f"{key}.duration", raw.get(
+        "duration", top["duration"] if turbulent else 60.0))
+    _events_within(f"{key}.supervisor", sup, duration)
     return LoadCase(
         dlc=dlc, condition=cond, winds=_winds(f"{key}.winds", raw.get("winds", top.get(
             "winds"))), seeds=_seeds(f"{key}.seeds", raw.get("seeds", top["seeds"])),
         signs=tuple(int(g) for g in signs), turbulence=turb, family=family, fatigue=fatigue,
-        duration=_number(f"{key}.duration", raw.get(
-            "duration", top["duration"] if turbulent else 60.0), 0.0, lo_open=True),
+        duration=duration,
         transient=_number(f"{key}.transient", raw.get("transient", top["transient"]), 0.0),
         event_at=_number(f"{key}.event_at", raw.get("event_at", 10.0), 0.0),
         supervisor=sup, extrapolate=extrapolate)
@@ -981,8 +1012,8 @@ def _file_load_case(key: str, raw: Mapping[str, Any], top: Mapping[str, Any], dl
         raise _fail(f"{key}.turbulence", f"with wind_files, one class or intensity that labels "
                                          f"the files in the tables, got {list(turb)}")
     transient = _number(f"{key}.transient", raw.get("transient", top["transient"]), 0.0)
-    duration = (None if "duration" not in raw else
-                _number(f"{key}.duration", raw["duration"], 0.0, lo_open=True))
+    duration = (None if "duration" not in raw else _assessed(f"{key}.duration",
+                                                             raw["duration"]))
     files = _wind_files(f"{key}.wind_files", raw["wind_files"], top.get("base"), transient,
                         duration)
     extrapolate = raw.get("extrapolate", False)
@@ -992,6 +1023,7 @@ def _file_load_case(key: str, raw: Mapping[str, Any], top: Mapping[str, Any], dl
             raise _fail(f"{key}.{k}", f"must be true or false, got {v!r}")
     sup = {**top["supervisor"], **_supervisor(f"{key}.supervisor", raw.get("supervisor"),
                                               top["turbine"])}
+    _events_within(f"{key}.supervisor", sup, min(f.duration for f in files) - transient)
     return LoadCase(
         dlc=dlc, condition="ntm", winds=tuple(sorted({f.wind_mps for f in files})),
         seeds=tuple(f.index for f in files), signs=(1,), turbulence=turb, family=family,
@@ -1032,8 +1064,9 @@ def _wind_files(key: str, raw: Any, base: Path | None, transient: float,
             raise _fail(k, str(err)) from None
         length = float(f.t[-1] - f.t[0])
         sim = length - FILE_MARGIN_S if duration is None else duration + transient
-        if sim <= transient or sim > length:
-            need = (f"the transient {transient:g} s plus {FILE_MARGIN_S:g} s" if duration is None
+        if sim < transient + MIN_ASSESSED_S or sim > length:
+            need = (f"the transient {transient:g} s, {MIN_ASSESSED_S:g} s to assess and "
+                    f"{FILE_MARGIN_S:g} s" if duration is None
                     else f"the transient and duration, {duration + transient:g} s")
             raise _fail(k, f"{str(name)!r} holds {length:g} s of wind; it must hold {need}")
         v = (round(float(f.mean_speed)) if wind is None else
@@ -1063,6 +1096,7 @@ def _load_cases(raw: Mapping[str, Any], duration: float, transient: float,
     if "load_cases" not in raw:
         if "winds" not in raw:
             raise _fail("winds", "missing (required: name, winds or load_cases, controllers)")
+        _events_within("supervisor", sup, duration)
         return (LoadCase(dlc="1.2", condition="ntm", winds=_winds("winds", raw["winds"]),
                          seeds=_seeds("seeds", top["seeds"]), signs=(1,),
                          turbulence=_turbulence("turbulence", top["turbulence"]), family="N",
@@ -1319,8 +1353,7 @@ def spec_from_dict(raw: Mapping[str, Any], base: Path | None = None,
     name = check_name("name", raw["name"])
     plugins = _plugins(raw.get("plugins", []), import_plugins, base)
     turbine, thash = turbine_files_hash(str(raw.get("turbine", "nrel5mw")), base)
-    duration = _number("duration", raw.get("duration", 600.0), 0.0, MAX_DURATION_S,
-                       lo_open=True)
+    duration = _assessed("duration", raw.get("duration", 600.0))
     transient = _number("transient", raw.get("transient", 60.0), 0.0)
     lidar = _lidar("lidar", raw.get("lidar", {}))
     ctls = _controllers(raw["controllers"], lidar, bool(plugins) and not import_plugins, base)

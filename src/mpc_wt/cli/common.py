@@ -5,6 +5,7 @@ import argparse
 import csv
 import math
 import os
+import tempfile
 from pathlib import Path
 from typing import Any, Sequence
 
@@ -48,6 +49,8 @@ def check_out_file(flag: str, value: str, suffix: str) -> Path:
         Naming the option, the path and what is allowed.
     """
     out = Path(value)
+    if value.endswith(("/", os.sep)) or out.is_dir():
+        raise UsageError(f"{flag} {value}: is a folder; name a file ending in {suffix}")
     if out.suffix == "":
         out = out.with_suffix(suffix)
     check_suffix(str(out), flag, (suffix,))
@@ -168,8 +171,12 @@ def check_suffix(path: str | None, name: str, allowed: Sequence[str]) -> None:
     folder = out.parent
     if not folder.is_dir():
         raise UsageError(f"{name} {path}: the folder {folder} does not exist")
-    if not os.access(folder, os.W_OK):
-        raise UsageError(f"{name} {path}: the folder {folder} is not writable")
+    try:        # a file made and removed: os.access answers yes for root, even in /proc
+        with tempfile.TemporaryFile(dir=folder):
+            pass
+    except OSError as err:
+        raise UsageError(f"{name} {path}: the folder {folder} is not writable "
+                         f"({err.strerror or err})") from None
 
 
 def schedule(turbine: linearize.Turbine, winds: np.ndarray, power_W: float | None,

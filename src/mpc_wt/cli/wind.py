@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import argparse
+import math
 from typing import Any
 
 import linearize
@@ -73,6 +74,7 @@ def _generate(args: argparse.Namespace) -> int:
     from mpc_wt.cli.common import check_suffix
 
     check_suffix(args.out, "--out", (".bts", ".npz"))
+    _check_size(args)
     if args.condition is not None:
         return _generate_condition(args)
     turb: str | float = args.turbulence_class if args.ti is None else args.ti
@@ -89,6 +91,30 @@ def _generate(args: argparse.Namespace) -> int:
     print(f"wrote {out}: {u.shape[0]} steps x {u.shape[1]} x {u.shape[2]} points, "
           f"hub TI {u[:, u.shape[1] // 2, u.shape[2] // 2].std() / args.mean:.3f}")
     return 0
+
+
+def _check_size(args: argparse.Namespace) -> None:
+    """Refuse a field too long, too fine or too large for the memory available, before any
+    work (3 wind components in float32, about twice that while generated)."""
+    from mpc_wt.simulation.memory import FIELD_PEAK, RunMemory, check_run_memory
+    from mpc_wt.simulation.scenario import MAX_DURATION_S
+
+    if not (math.isfinite(args.duration) and 0.0 < args.duration <= MAX_DURATION_S):
+        raise UsageError(f"--duration must be in (0, {MAX_DURATION_S:g}] s (3 h), got "
+                         f"{args.duration:g}")
+    if not (math.isfinite(args.dt) and 0.0 < args.dt <= 1.0):
+        raise UsageError(f"--dt must be in (0, 1] s, got {args.dt:g}")
+    if not 2 <= args.n <= MAX_GRID_POINTS:
+        raise UsageError(f"--n must be between 2 and {MAX_GRID_POINTS} grid points per side, "
+                         f"got {args.n}")
+    one = (args.duration / args.dt + 1) * args.n**2 * 4.0 * 3
+    check_run_memory(RunMemory(FIELD_PEAK * one, 0.0),
+                     what=f"{args.duration:g} s field of {args.n} x {args.n} points every "
+                          f"{args.dt:g} s")
+
+
+#: The finest grid ``wind generate`` makes (points per side; TurbSim's fields are 10-64).
+MAX_GRID_POINTS = 256
 
 
 def _generate_condition(args: argparse.Namespace) -> int:

@@ -46,6 +46,15 @@ def _spec(**over):
     ({"seeds": 0}, "seeds"),
     ({"seeds": [1, 1]}, "seeds"),
     ({"duration": float("nan")}, "duration"),
+    # every case then failed at run time, "transient 60 s leaves 6 s" (exit 1, not 2)
+    ({"duration": 6}, "duration: the time assessed after the transient must be at least 10 s"),
+    # accepted, and the grid loss never happened
+    ({"supervisor": {"grid_loss_at": 500}}, "supervisor.grid_loss_at: 500 s is at or after"),
+    ({"load_cases": [{"dlc": "4.2", "condition": "eog", "winds": [12],
+                      "supervisor": {"shutdown_at": 60}}]},
+     "load_cases[0].supervisor.shutdown_at: 60 s is at or after the case's end"),
+    # an OverflowError from SQLite after the designs
+    ({"seeds": [1, 99999999999999999999999]}, "seeds: seeds must be at most 2\\*\\*63 - 1"),
     ({"turbulence": "D"}, "turbulence"),
     ({"turbulence": [0.12, 1.5]}, "turbulence[1]"),
     ({"controllers": ["baseline", "fuzzy"]}, "controllers[1].controller"),

@@ -27,6 +27,8 @@ def no_simulation(monkeypatch):
     ("no/such/folder/x.nc", r"--out no/such/folder/x.nc: the folder no/such/folder does not "
                             r"exist"),
     ("x.csv", r"--out must end in .nc; got 'x.csv'"),
+    # checked only after the simulation, with a raw errno on the temporary name
+    ("/proc/x.nc", r"--out /proc/x.nc: the folder /proc is not writable"),
 ])
 def test_simulate_checks_its_output_before_simulating(capsys, no_simulation, out, match) -> None:
     assert main(["simulate", "--wind", "12", "--duration", "5", "--out", out]) == 2
@@ -34,9 +36,43 @@ def test_simulate_checks_its_output_before_simulating(capsys, no_simulation, out
 
 
 def test_simulate_refuses_a_folder_as_output(capsys, no_simulation, tmp_path) -> None:
+    """A folder named as the output file, with or without its suffix or a trailing slash, is
+    refused (``--out o/`` wrote ``o.nc`` beside the folder)."""
     (tmp_path / "r.nc").mkdir()
-    assert main(["simulate", "--wind", "12", "--out", str(tmp_path / "r.nc")]) == 2
-    assert "is a folder" in capsys.readouterr().err
+    (tmp_path / "o").mkdir()
+    for out in (str(tmp_path / "r.nc"), str(tmp_path / "o"), f"{tmp_path / 'o'}/"):
+        assert main(["simulate", "--wind", "12", "--out", out]) == 2
+        assert "is a folder" in capsys.readouterr().err
+    assert not (tmp_path / "o.nc").exists()
+
+
+@pytest.mark.parametrize("argv, match", [
+    (["--n", "100000"], "--n must be between 2 and 256 grid points per side, got 100000"),
+    (["--duration", "1e9"], "--duration must be in (0, 10800] s (3 h), got 1e+09"),
+    (["--n", "200", "--duration", "10800"], "10800 s field of 200 x 200 points every 0.05 s "
+                                            "needs about 207.81 GB of memory"),
+])
+def test_wind_generate_bounds(capsys, monkeypatch, tmp_path, argv, match) -> None:
+    """Refused before any field is made, exit 2 (tracebacks asking numpy for 218 TiB and
+    149 GiB)."""
+    import lidar
+
+    monkeypatch.setattr(lidar, "generate_field", lambda *a, **k: pytest.fail("generated"))
+    monkeypatch.setattr("mpc_wt.simulation.memory.available_memory", lambda: 24e9)
+    assert main(["wind", "generate", "--mean", "12", "--out", str(tmp_path / "w.npz"),
+                 *argv]) == 2
+    assert match in capsys.readouterr().err
+
+
+def test_an_event_after_the_runs_end_is_refused(capsys, tmp_path) -> None:
+    """``--grid-loss-at 500`` in a 5 s run: refused naming the event and the run's end (it
+    ran, with no event and no warning)."""
+    out = tmp_path / "g.nc"
+    assert main(["simulate", "--wind", "12", "--duration", "5", "--grid-loss-at", "500",
+                 "--out", str(out)]) == 2
+    assert ("supervisor grid_loss_at = 500 s is at or after the run's end (5 s)"
+            in capsys.readouterr().err)
+    assert not out.exists()
 
 
 @pytest.mark.parametrize("argv, match", [
