@@ -77,6 +77,9 @@ _REPORT_KEYS = {"paper", "notes", "psd_wind", "cs_wind", "sweep", "title"}
 #: over them is a mistake, not a study: 100,000 cases of 600 s take months on 2 cores)
 MAX_SEEDS = 1000
 
+#: At most this many mean winds in a load case.
+MAX_WINDS = 1000
+
 #: The largest seed: the campaign index stores seeds as SQLite integers (64-bit signed).
 MAX_SEED = 2**63 - 1
 
@@ -163,11 +166,17 @@ def _winds(key: str, val: Any) -> tuple[float, ...]:
         if extra or {"start", "stop"} - set(val):
             raise _fail(key, f"a range needs start, stop and optionally step; got keys "
                              f"{sorted(val)}")
-        a = _number(f"{key}.start", val["start"], 0.0, lo_open=True)
-        b = _number(f"{key}.stop", val["stop"], a)
+        a = _number(f"{key}.start", val["start"], 0.0, 60.0, lo_open=True)
+        b = _number(f"{key}.stop", val["stop"], a, 60.0)
         s = _number(f"{key}.step", val.get("step", 1.0), 0.0, lo_open=True)
-        out = [round(a + i * s, 6) for i in range(int(math.floor((b - a) / s + 1e-9)) + 1)]
+        n = int(math.floor((b - a) / s + 1e-9)) + 1
+        if n > MAX_WINDS:
+            raise _fail(f"{key}.step", f"{s:g} m/s from {a:g} to {b:g} m/s makes {n} mean winds, "
+                                       f"more than {MAX_WINDS}")
+        out = [round(a + i * s, 6) for i in range(n)]
     elif isinstance(val, (list, tuple)):
+        if len(val) > MAX_WINDS:
+            raise _fail(key, f"at most {MAX_WINDS} mean winds, got {len(val)}")
         out = [_number(f"{key}[{i}]", v, 0.0, 60.0, lo_open=True) for i, v in enumerate(val)]
     else:
         out = [_number(key, val, 0.0, 60.0, lo_open=True)]

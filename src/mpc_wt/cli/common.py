@@ -100,6 +100,10 @@ def add_turbine(p: argparse.ArgumentParser) -> None:
     p.add_argument("--turbine", default="nrel5mw", help=TURBINE_HELP)
 
 
+#: The most values a ``START:STOP:STEP`` range may make.
+MAX_RANGE = 1000
+
+
 def parse_range(text: str, name: str) -> np.ndarray:
     """Parse ``START:STOP:STEP`` (STOP included), ``START:STOP`` (step 1) or ``A,B,C``.
 
@@ -131,9 +135,14 @@ def parse_range(text: str, name: str) -> np.ndarray:
             if not all(math.isfinite(v) for v in parts) or s <= 0 or b < a:
                 raise ValueError
             n = int(math.floor((b - a) / s + 1e-9)) + 1
+            if n > MAX_RANGE:
+                raise UsageError(f"{name} {text}: makes {n} values, more than {MAX_RANGE}; "
+                                 f"give a larger STEP")
             vals = a + s * np.arange(n)
         else:
             vals = np.array([float(p) for p in text.split(",")])
+    except UsageError:
+        raise
     except ValueError:
         raise UsageError(f"{name} must be START:STOP:STEP with STEP > 0 and STOP >= START, "
                          f"or a comma list of numbers; got {text!r}") from None

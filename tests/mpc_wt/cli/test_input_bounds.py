@@ -93,6 +93,10 @@ def test_simulate_bounds(capsys, no_simulation, tmp_path, argv, match) -> None:
       "controllers": [f"derate{p}" for p in range(50, 100, 5)]},
      r"the spec makes 210000 cases, more than 100000"),
     ({"duration": 1e9}, r"duration: must be .*10800"),
+    # refused after 89.5 s and 1.56 GB, naming the seeds
+    ({"winds": {"start": 5, "stop": 25, "step": 1e-6}},
+     r"winds.step: 1e-06 m/s from 5 to 25 m/s makes 20000001 mean winds, more than 1000"),
+    ({"winds": {"start": 5, "stop": 600}}, r"winds.stop: must be .*60"),
 ])
 def test_campaign_bounds(over, match) -> None:
     with pytest.raises(SpecError, match=match):
@@ -263,3 +267,11 @@ def test_an_output_folder_that_is_a_file_is_refused_first(capsys, no_simulation,
     assert len(err) == 1 and str(tmp_path / "f") in err[0]
     assert "is a file" in err[0]
     assert (tmp_path / "f").read_text() == "mine\n"
+
+
+def test_a_range_flag_that_makes_millions_of_values_is_refused(capsys, tmp_path) -> None:
+    """``--wind 5:25:0.000001`` makes 2e7 winds: refused at once, naming the flag."""
+    assert main(["design", "lqr", "--wind", "5:25:0.000001", "--out",
+                 str(tmp_path / "d")]) == 2
+    assert ("--wind 5:25:0.000001: makes 20000001 values, more than 1000"
+            in capsys.readouterr().err)
