@@ -1,7 +1,7 @@
 """``python -m mpc_wt.cli``: the ``mpcwt`` command."""
 import sys
 
-from mpc_wt.cli.main import main
+from mpc_wt.cli import main
 
 if __name__ == "__main__":
     sys.exit(main())

@@ -514,10 +514,12 @@ class _Warming:
 
 def _progress_bar(n: int, desc: str, progress: bool) -> Any:
     """The run's progress bar: named by what runs; on a process's first run it says
-    "compiling kernels (first run only)" and shows no ETA until the first steps are done."""
+    "loading kernels (compiled once per machine)" and shows no ETA until the first steps are
+    done (every command is a new process: the kernels load from numba's cache, or compile the
+    first time on a machine)."""
     if _WARM[0] or not progress:
         return tqdm(total=n, desc=desc, unit="step", disable=not progress, mininterval=0.5)
-    bar = tqdm(total=n, desc="compiling kernels (first run only)", unit="step",
+    bar = tqdm(total=n, desc="loading kernels (compiled once per machine)", unit="step",
                mininterval=0.5, bar_format="{desc}: {n_fmt}/{total_fmt} {unit} [{elapsed}]")
     return _Warming(bar, desc)
 

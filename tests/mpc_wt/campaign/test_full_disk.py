@@ -13,7 +13,7 @@ import pytest
 
 from mpc_wt.campaign import run_campaign, spec_from_dict
 from mpc_wt.campaign.store import CampaignStore
-from mpc_wt.cli.main import main
+from mpc_wt.cli import main
 from mpc_wt.errors import CampaignIndexError
 from mpc_wt.simulation.results import ClosedLoopResult
 

@@ -21,7 +21,7 @@ PLUGIN = textwrap.dedent('''
 
 
 def _cli(args: list[str], env: dict[str, str]) -> subprocess.CompletedProcess:
-    code = f"from mpc_wt.cli.main import main; raise SystemExit(main({args!r}))"
+    code = f"from mpc_wt.cli import main; raise SystemExit(main({args!r}))"
     return subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
                           env=env, timeout=300)
 
@@ -120,7 +120,7 @@ def test_a_spec_another_user_wrote_runs_only_with_trust(tmp_path: Path, capsys) 
     """A spec file owned by another user (uid 65534) is refused before any of it runs, naming
     the file and its owner; ``--trust`` runs it; a plugin beside the spec that another user
     wrote is named too."""
-    from mpc_wt.cli.main import main
+    from mpc_wt.cli import main
 
     spec = tmp_path / "spec.yaml"
     spec.write_text("name: foreign\nduration: 10\ntransient: 0\nwinds: [12]\nseeds: 1\n"

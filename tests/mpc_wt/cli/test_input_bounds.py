@@ -7,7 +7,7 @@ import pytest
 
 import linearize
 from mpc_wt.campaign import SpecError, spec_from_dict
-from mpc_wt.cli.main import main
+from mpc_wt.cli import main
 
 BASE = {"name": "t", "duration": 20, "transient": 5, "winds": [14], "seeds": 1,
         "controllers": ["baseline"]}

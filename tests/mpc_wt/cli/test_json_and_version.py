@@ -13,7 +13,7 @@ import pytest
 
 from mpc_wt import __version__
 from mpc_wt.cli.common import to_json
-from mpc_wt.cli.main import main
+from mpc_wt.cli import main
 
 
 def _strict(text: str):

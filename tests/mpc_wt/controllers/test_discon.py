@@ -175,7 +175,7 @@ def test_runs_leave_no_temporary_files(tmp_path) -> None:
     (tmp_path / "tmp").mkdir()
     for extra in (["--discon-in", "shipped"], []):
         done = subprocess.run(
-            [sys.executable, "-c", "from mpc_wt.cli.main import main; raise SystemExit(main())",
+            [sys.executable, "-c", "from mpc_wt.cli import main; raise SystemExit(main())",
              "simulate", "--controller", "rosco", *extra, "--wind", "12", "--turbulence",
              "steady", "--duration", "1", "--out", str(tmp_path / "r.nc")],
             capture_output=True, text=True, env=env, timeout=600)

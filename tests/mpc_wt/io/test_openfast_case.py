@@ -23,7 +23,7 @@ import linearize
 from linearize.openfast_channels import blade_frame_moment
 from mpc_wt.assessment.compare import compare_series
 from mpc_wt.assessment.fatigue import damage_equivalent_load
-from mpc_wt.cli.main import main
+from mpc_wt.cli import main
 from mpc_wt.io.openfast_case import aeromap_comparison, read_openfast_case
 from mpc_wt.io.openfast_output import read_openfast_output, to_mpcwt_channels
 from mpc_wt.run import run_openfast_case

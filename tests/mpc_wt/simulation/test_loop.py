@@ -170,7 +170,7 @@ def test_first_run_says_it_compiles_and_shows_no_eta(monkeypatch) -> None:
 
     monkeypatch.setattr(lp, "_WARM", [False])
     bar = lp._progress_bar(1600, "simulate baseline", True)
-    assert bar.desc.startswith("compiling kernels (first run only)")
+    assert bar.desc.startswith("loading kernels (compiled once per machine)")
     assert "remaining" not in bar.bar_format
     bar.update(800)
     assert bar.desc.startswith("simulate baseline") and bar.bar_format is None
