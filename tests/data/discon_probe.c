@@ -3,10 +3,12 @@
  * records 2001-2016 to <OUTNAME>.lidar.csv), counts its calls in a global (one count per loaded
  * copy), answers fixed demands, and stops the run (aviFAIL = -1) at t >= 0.5 s when its input
  * file is named PROBE_STOP.IN; with PROBE_EXIT.IN it prints a line and calls exit(3) there, with
- * PROBE_CRASH.IN it prints a line and writes through a null pointer (a segfault). */
+ * PROBE_CRASH.IN it prints a line and writes through a null pointer (a segfault); with
+ * PROBE_HANG.IN it blocks for good there, with PROBE_SPIN.IN it loops for good. */
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 static int calls = 0;
 
@@ -51,5 +53,11 @@ void DISCON(float *swap, int *fail, const char *infile, char *outname, char *msg
         printf("probe: about to crash\n");
         fflush(stdout);
         *(volatile int *)0 = 1;
+    }
+    if (strstr(infile, "PROBE_HANG.IN") && swap[1] >= 0.5f) {
+        for (;;) pause();
+    }
+    if (strstr(infile, "PROBE_SPIN.IN") && swap[1] >= 0.5f) {
+        for (volatile unsigned long n = 0;; n++) { }
     }
 }

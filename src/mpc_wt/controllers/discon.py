@@ -22,6 +22,7 @@ import logging
 import math
 import mmap
 import os
+import select
 import shutil
 import struct
 import subprocess
@@ -45,6 +46,10 @@ log = logging.getLogger(__name__)
 #: Length of the swap array: the Bladed records, ROSCO's extended block from 1001, and room for
 #: the logging channels a library may return.
 SWAP_SIZE = 3300
+
+#: The longest a library in a child process may take for one call, or to load [s]: ROSCO's
+#: calls take microseconds and its first call, which reads its input file, milliseconds.
+CALL_TIMEOUT_S = 30.0
 _MSG_LEN = 1025
 _OUT_LEN = 4097
 #: Records the host writes (1-based, as the interface numbers them) -> what they hold.
@@ -217,8 +222,10 @@ class _ChildLibrary:
     """A controller library loaded in a child process (:mod:`.discon_child`); what it prints
     goes to a log whose last lines become the reason when it ends its process."""
 
-    def __init__(self, library: Path, infile: str, outname: str) -> None:
+    def __init__(self, library: Path, infile: str, outname: str,
+                 timeout: float = 0.0) -> None:
         self.library = library
+        self.timeout = float(timeout)
         self.alive = True
         fd, self.log = tempfile.mkstemp(prefix="mpcwt_discon_", suffix=".log")
         os.close(fd)
@@ -237,6 +244,7 @@ class _ChildLibrary:
             stdin=subprocess.PIPE, stdout=subprocess.PIPE, env=env)
         assert self.proc.stdin is not None and self.proc.stdout is not None
         self._w, self._r = self.proc.stdin.fileno(), self.proc.stdout.fileno()
+        self._wait("to load")
         head = _read_exact(self._r, 2)
         with contextlib.suppress(OSError):       # both have it mapped (or the child failed)
             os.unlink(shared)
@@ -260,6 +268,7 @@ class _ChildLibrary:
             os.write(self._w, b"c")
         except OSError:                               # a broken pipe: the child has gone
             raise self.died(f"at t = {t:g} s") from None
+        self._wait(f"its call at t = {t:g} s")
         head = _read_exact(self._r, 8)
         if head is None:
             raise self.died(f"at t = {t:g} s")
@@ -269,6 +278,21 @@ class _ChildLibrary:
             raise self.died(f"at t = {t:g} s")
         view[:] = self._swap
         return fail, text.decode(errors="replace").strip()
+
+    def _wait(self, what: str) -> None:
+        """Wait for the child's answer at most ``timeout`` s (0: forever); a library that
+        blocks or loops is stopped and named."""
+        if self.timeout <= 0:
+            return
+        ready, _, _ = select.select([self._r], [], [], self.timeout)
+        if ready:
+            return
+        self.proc.kill()
+        self.proc.wait()
+        self.close()
+        raise ControllerLibraryError(
+            f"controller library {self.library.name} did not answer {what} within "
+            f"{self.timeout:g} s (call_timeout): it blocks or loops; it was stopped")
 
     def died(self, when: str) -> ControllerLibraryError:
         """The error for a child that ended: its exit status or signal and its last output."""
@@ -379,6 +403,10 @@ class DisconController(ControllerBase):
         The names of the logging channels the library returns (record 65 counts them, their
         values from record :data:`LOG_START` on), recorded as signals; a channel without a
         name is ``log_<i>``. The host offers :data:`LOG_ROOM` of them (record 62).
+    call_timeout : float
+        In a child process: the longest a call (and the loading) may take [s] before the
+        library is stopped and the run fails naming it (default :data:`CALL_TIMEOUT_S`; 0:
+        no limit). In this process a call cannot be stopped.
 
     Raises
     ------
@@ -391,7 +419,8 @@ class DisconController(ControllerBase):
                  dt: float = 1.0 / 80.0, pitch_control: str = "individual",
                  workdir: str | Path | None = None, root_name: str = "mpcwt_discon",
                  quiet: bool = True, lidar: Any = None, isolate: bool = True,
-                 log_names: tuple[str, ...] = ()) -> None:
+                 log_names: tuple[str, ...] = (),
+                 call_timeout: float = CALL_TIMEOUT_S) -> None:
         self.library = Path(library).resolve()
         self.discon_in = Path(discon_in).resolve()
         _check_library(self.library)
@@ -414,6 +443,10 @@ class DisconController(ControllerBase):
         self.lidar = lidar
         self.isolate = bool(isolate)
         self.log_names = tuple(log_names)
+        if not (math.isfinite(call_timeout) and call_timeout >= 0):
+            raise ValueError(f"call_timeout must be a finite number of seconds >= 0 (0: no "
+                             f"limit), got {call_timeout!r}")
+        self.call_timeout = float(call_timeout)
         self._fds: tuple[int, int] | None = None
         self._lib: Any = None
         self._fast: tuple[Any, ...] | None = None
@@ -425,7 +458,8 @@ class DisconController(ControllerBase):
         self._status = 0
         self._warned = False
         if self.isolate:                     # fail early on a bad library, in a child
-            _ChildLibrary(self.library, str(self.discon_in), "mpcwt_check").close()
+            _ChildLibrary(self.library, str(self.discon_in), "mpcwt_check",
+                          self.call_timeout).close()
         else:
             self._load()
 
@@ -491,7 +525,7 @@ class DisconController(ControllerBase):
         if self.isolate:                     # a new process: the library's globals start over
             self._unload()
             self._lib = _ChildLibrary(self.library, self._infile.decode(),
-                                      self._outname.decode())
+                                      self._outname.decode(), self.call_timeout)
         self.messages = []
         self.signals = {}
         # the step's compiled call (the closed loop's own): a library in this process

@@ -8,6 +8,7 @@ from typing import Any, Optional
 
 
 import linearize
+from mpc_wt.controllers.discon import CALL_TIMEOUT_S
 from mpc_wt.registry.context import BuildContext, Built
 from mpc_wt.registry.options import REQUIRED, Options, option
 from mpc_wt.registry.registry import register
@@ -21,6 +22,8 @@ log = logging.getLogger(__name__)
 _ISOLATE = ("run the library in a child process of its own, so that a library that exits or "
             "crashes fails the case only (about 0.1 ms per call); false loads it in this "
             "process, uncontained")
+_TIMEOUT = ("in a child process: the longest one call or the loading may take before the "
+            "library is stopped and the case fails naming it (0: no limit)")
 
 
 @dataclass(frozen=True)
@@ -39,6 +42,7 @@ class DisconOptions(Options):
     lidar: LidarOptions = option(LidarOptions(), help="CW LIDAR settings (focus_distance, "
                                  "noise_std, ...)", flag="")
     isolate: bool = option(True, help=_ISOLATE, flag="")
+    call_timeout: float = option(CALL_TIMEOUT_S, help=_TIMEOUT, unit="s", lo=0.0)
 
 
 @dataclass(frozen=True)
@@ -57,6 +61,7 @@ class RoscoOptions(Options):
     discon_dt: float = option(1.0 / 80.0, help="communication interval, a multiple of the "
                               "plant step", unit="s", lo=0.0, lo_open=True, hi=1.0)
     isolate: bool = option(True, help=_ISOLATE, flag="")
+    call_timeout: float = option(CALL_TIMEOUT_S, help=_TIMEOUT, unit="s", lo=0.0)
 
 
 def _discon_built(ctx: BuildContext, library: Any, discon_in: Any, opts: Any,
@@ -69,7 +74,8 @@ def _discon_built(ctx: BuildContext, library: Any, discon_in: Any, opts: Any,
         meta["lidar"] = {**opts.lidar.given(), "evolution": opts.lidar.evolution}
     ctl = DisconController(library, discon_in, ctx.turbine, dt=opts.discon_dt,
                            pitch_control=opts.pitch_control, lidar=sensor,
-                           isolate=opts.isolate)
+                           isolate=opts.isolate,
+                           call_timeout=opts.call_timeout)
     return Built(ctl, controller_dt=opts.discon_dt,
                  meta={kind: {"library": str(ctl.library), "discon_in": str(ctl.discon_in),
                               "pitch_control": opts.pitch_control, "dt": opts.discon_dt,

@@ -165,6 +165,37 @@ def test_a_library_that_ends_its_process_fails_the_run_only(probe, tmp_path, tur
         tempfile.tempdir = None
 
 
+@pytest.mark.parametrize("infile", ["PROBE_HANG.IN", "PROBE_SPIN.IN"])
+def test_a_library_that_blocks_or_loops_is_stopped_and_named(probe, tmp_path, turbine,
+                                                            monkeypatch, infile) -> None:
+    """A library that blocks (``pause()``) or busy-loops in its call at 0.5 s: its child is
+    stopped after the call timeout (1 s here), the run fails naming the library, the call's
+    time and the option, the samples before are kept and no temporary file is left (it hung
+    ``mpcwt simulate`` until killed, and a campaign's case stayed submitted)."""
+    import time
+
+    monkeypatch.setenv("TMPDIR", str(tmp_path / "tmp"))
+    (tmp_path / "tmp").mkdir()
+    tempfile.tempdir = None
+    try:
+        (tmp_path / infile).write_text("x\n")
+        p = linearize.plant_params(turbine)
+        op = linearize.trim(turbine, 12.0, params=p)
+        ctl = DisconController(probe, tmp_path / infile, turbine, call_timeout=1.0)
+        t0 = time.perf_counter()
+        with pytest.raises(ControllerLibraryError,
+                           match=r"libprobe.so did not answer its call at t = 0.5 s within "
+                                 r"1 s \(call_timeout\): it blocks or loops") as exc:
+            simulate_closed_loop(p, ctl, linearize.SteadyWind(12.0), 2.0, x0=op.x, u0=op.u)
+        assert time.perf_counter() - t0 < 20.0
+        assert exc.value.partial.t[-1] == pytest.approx(0.4875)
+        assert list((tmp_path / "tmp").iterdir()) == []
+    finally:
+        tempfile.tempdir = None
+    with pytest.raises(ValueError, match="call_timeout must be a finite number"):
+        DisconController(probe, tmp_path / infile, turbine, call_timeout=-1.0)
+
+
 def test_runs_leave_no_temporary_files(tmp_path) -> None:
     """``mpcwt simulate`` with ROSCO as shipped and as exported from our design, each in its
     own process as a user runs it: afterwards the temporary folder holds nothing."""
