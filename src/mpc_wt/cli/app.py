@@ -34,6 +34,7 @@ from __future__ import annotations
 import argparse
 import logging
 import sys
+from pathlib import Path
 from typing import Sequence
 
 import linearize
@@ -107,7 +108,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     try:
         from mpc_wt.registry.registry import load_plugins
 
-        load_plugins(_plugins(argv))
+        load_plugins(_plugins(argv), folder=Path.cwd())     # as ``python -m`` finds them
     except ImportError as err:
         print(f"mpcwt: error: --plugin: {err}", file=sys.stderr)
         return 2

@@ -566,7 +566,8 @@ def load_plugins(modules: Sequence[str] = (), folder: str | Path | None = None) 
     Raises
     ------
     ImportError
-        Naming the module that does not import.
+        Naming the module that does not import, and why: not found, a syntax error (file and
+        line), or what it raised while imported (``SystemExit`` included).
     """
     _load_entry_points()
     done = []
@@ -579,6 +580,15 @@ def load_plugins(modules: Sequence[str] = (), folder: str | Path | None = None) 
             importlib.import_module(mod)
         except ImportError as err:
             raise ImportError(f"controller plugin {mod!r} does not import: {err}") from err
+        except SyntaxError as err:
+            raise ImportError(f"controller plugin {mod!r} does not import: a syntax error at "
+                              f"{err.filename}:{err.lineno}: {err.msg}") from err
+        except SystemExit as err:
+            raise ImportError(f"controller plugin {mod!r} does not import: it raised "
+                              f"SystemExit({err.code!r}) while imported") from err
+        except Exception as err:
+            raise ImportError(f"controller plugin {mod!r} does not import: it raised "
+                              f"{type(err).__name__}: {err}") from err
         finally:
             if path and sys.path[:1] == path:
                 del sys.path[0]

@@ -275,3 +275,51 @@ def test_a_range_flag_that_makes_millions_of_values_is_refused(capsys, tmp_path)
                  str(tmp_path / "d")]) == 2
     assert ("--wind 5:25:0.000001: makes 20000001 values, more than 1000"
             in capsys.readouterr().err)
+
+
+@pytest.mark.parametrize("source, match", [
+    ("def f(:\n", r"does not import: a syntax error at .*broken_plugin.py:1: invalid syntax"),
+    ("raise SystemExit(0)\n", r"does not import: it raised SystemExit\(0\) while imported"),
+    ("raise RuntimeError('no licence')\n", r"it raised RuntimeError: no licence"),
+    (None, r"does not import: No module named 'broken_plugin'"),
+])
+def test_a_plugin_that_does_not_import_is_one_line(capsys, monkeypatch, tmp_path, source,
+                                                   match) -> None:
+    """``--plugin MODULE`` is found in the folder the command runs in (it needed
+    ``PYTHONPATH=.``); one that does not import exits 2 with one line (a syntax error was a
+    traceback; ``SystemExit(0)`` made ``simulate`` exit 0 with no output and no file)."""
+    import re
+    import sys
+
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.delitem(sys.modules, "broken_plugin", raising=False)
+    if source is not None:
+        (tmp_path / "broken_plugin.py").write_text(source)
+    assert main(["--plugin", "broken_plugin", "simulate", "--wind", "12", "--duration", "2",
+                 "--out", str(tmp_path / "x.nc")]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and re.search(match, err), err
+    assert not (tmp_path / "x.nc").exists()
+
+
+def test_a_plugin_in_the_commands_folder_registers(capsys, monkeypatch, tmp_path) -> None:
+    """A plugin module beside the user, given by name, registers its kind for the command."""
+    import json
+    import sys
+
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.delitem(sys.modules, "here_plugin", raising=False)
+    (tmp_path / "here_plugin.py").write_text(
+        "from dataclasses import dataclass\n"
+        "from mpc_wt.registry import Built, Options, register\n\n"
+        "@dataclass(frozen=True)\nclass HereOptions(Options):\n    pass\n\n"
+        "@register('here-plugin-kind', HereOptions, summary='a kind from the current folder')\n"
+        "def build(ctx, opts):\n    raise NotImplementedError\n")
+    try:
+        assert main(["--plugin", "here_plugin", "controllers", "--json"]) == 0
+        assert "here-plugin-kind" in [k["name"] for k in json.loads(capsys.readouterr().out)]
+    finally:
+        from mpc_wt.registry import registry
+
+        registry._KINDS.pop("here-plugin-kind", None)
+        registry._PLUGINS_LOADED.discard("here_plugin")
