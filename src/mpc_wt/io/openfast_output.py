@@ -86,8 +86,49 @@ def read_openfast_output(path: str | Path) -> OpenFASTSeries:
     return _read_text(p)
 
 
+def check_line_end(p: Path, text: str, sep: str | None = None) -> None:
+    """Refuse a text file cut while it was written, whose last number may be cut too
+    (``4100.5`` read as ``4``).
+
+    OpenFAST ends every line of its text output (``sep`` None): a last line without a line
+    end is cut. Other tools' CSV files (``sep=","``) often lack the last line end: there the
+    last line is cut when its last field is shorter than every one of the 50 rows before in
+    that column.
+
+    Parameters
+    ----------
+    p : Path
+        The file, for the message.
+    text : str
+        Its content.
+    sep : str, optional
+        The CSV's separator; None for OpenFAST's text output.
+
+    Raises
+    ------
+    ResultFileError
+        Naming the file and the cut line.
+    """
+    if not text or text.endswith(("\n", "\r")):
+        return
+    lines = text.splitlines()
+    last = lines[-1]
+    if sep is not None:
+        before = [ln.split(sep) for ln in lines[-51:-1][1:] if ln.strip()]
+        k = len(last.split(sep)) - 1
+        widths = [len(r[k].strip()) for r in before if len(r) > k]
+        if not widths or len(last.split(sep)[k].strip()) >= min(widths):
+            return
+    raise ResultFileError(f"{p}: line {len(lines)} ends without a line end "
+                          f"({last.strip()[-40:]!r}): the file was cut while it was written, "
+                          f"and its last number may be cut; remove the line or write the "
+                          f"file again")
+
+
 def _read_text(p: Path) -> OpenFASTSeries:
-    lines = p.read_text(errors="replace").splitlines()
+    text = p.read_text(errors="replace")
+    check_line_end(p, text)
+    lines = text.splitlines()
     head = None
     for i, ln in enumerate(lines[:40]):
         toks = ln.split()

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import contextlib
 import csv
+import io
 import json
 import os
 import uuid
@@ -332,6 +333,26 @@ def _load_any(path: Path, time_column: str) -> tuple[np.ndarray, dict[str, np.nd
     return res.t, {n: res.channel(n) for n in res.channels()}
 
 
+#: A CSV time column's unit, from its header (``time [ms]``), in seconds.
+TIME_UNITS = {"s": 1.0, "sec": 1.0, "ms": 1e-3, "min": 60.0}
+
+
+def _seconds(path: Path, header: str, unit: str | None, t: np.ndarray) -> np.ndarray:
+    """A CSV's time column in seconds: by the unit its header gives; without one, a median
+    step above 1 s is refused (a run in ms would have its energy 1000x)."""
+    if unit is not None:
+        if unit not in TIME_UNITS:
+            raise ResultFileError(f"{path}: time column {header!r}: unit {unit!r}; allowed "
+                                  f"{sorted(TIME_UNITS)}")
+        return t * TIME_UNITS[unit]
+    step = float(np.median(np.diff(t))) if t.size > 1 else 0.0
+    if step > 1.0:
+        raise ResultFileError(f"{path}: time column {header!r} steps by {step:g} per sample, "
+                              f"more than 1 s: if it is in ms, say so in its header "
+                              f"('{header} [ms]'); a run's time is in s")
+    return t
+
+
 def _load_csv(path: Path, time_column: str, log: Any) -> tuple[np.ndarray,
                                                                dict[str, np.ndarray]]:
     """A CSV run; columns with OpenFAST channel names are mapped to ours in SI."""
@@ -339,21 +360,28 @@ def _load_csv(path: Path, time_column: str, log: Any) -> tuple[np.ndarray,
         CHANNEL_MAP,
         DEFAULT_UNITS,
         OpenFASTSeries,
+        check_line_end,
         split_csv_header,
         to_mpcwt_channels,
     )
 
     if not path.is_file():
         raise ResultFileError(f"{path}: file not found")
-    with path.open(newline="") as fh:
-        rows = list(csv.reader(fh))
+    text = path.read_text(errors="replace")
+    check_line_end(path, text, sep=",")
+    rows = list(csv.reader(io.StringIO(text, newline="")))
     if not rows:
         raise ResultFileError(f"{path}: empty file")
     head = [h.strip() for h in rows[0]]
+    twice = sorted({h for h in head if head.count(h) > 1})
+    if twice:
+        raise ResultFileError(f"{path}: the columns {twice} appear more than once; a column's "
+                              f"name must say which signal it holds")
     split = [split_csv_header(h) for h in head]
     bare = [n for n, _ in split]
-    if time_column not in head and time_column == "time" and "Time" in bare:
-        time_column = head[bare.index("Time")]
+    if time_column not in head and time_column in ("time", "Time") and \
+            ("Time" in bare or "time" in bare):
+        time_column = head[bare.index("Time" if "Time" in bare else "time")]
     if time_column not in head:
         raise ResultFileError(f"{path}: no time column {time_column!r}; columns {head}")
     try:
@@ -363,6 +391,7 @@ def _load_csv(path: Path, time_column: str, log: Any) -> tuple[np.ndarray,
     if data.ndim != 2 or data.shape[1] != len(head):
         raise ResultFileError(f"{path}: ragged rows")
     it = head.index(time_column)
+    data[:, it] = _seconds(path, head[it], split[it][1], data[:, it])
     if any(n in CHANNEL_MAP for n in bare):
         names = tuple(n for k, n in enumerate(bare) if k != it)
         units = tuple((u if u is not None else DEFAULT_UNITS.get(n, "-"))

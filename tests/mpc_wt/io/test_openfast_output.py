@@ -124,6 +124,38 @@ def test_bad_openfast_files_are_named(tmp_path, series) -> None:
         load_series(tmp_path / "r.txt")
 
 
+def test_files_cut_or_mislabelled_are_refused(tmp_path, series) -> None:
+    """A text output or CSV cut in the middle of a number (its last line without a line end:
+    the last RotTorq was read as 4 instead of about 4100), a CSV with two columns of one
+    name, a CSV whose time steps by 50 per sample without a unit (ms: energy 1000x) are
+    refused naming the file and what is wrong; the same CSV with ``time [ms]`` in its header
+    is read in seconds."""
+    t, ch, units = series
+    good = write_openfast_output(tmp_path / "g.out", t, ch, units)
+    text = good.read_text()
+    cut = tmp_path / "cut.out"
+    cut.write_text(text.rstrip("\n")[:-3])
+    with pytest.raises(ResultFileError, match=r"cut.out: line \d+ ends without a line end"):
+        load_series(cut)
+    rows = "\n".join(f"{a:.2f},{b:.1f},{5e6:.1f}" for a, b in zip(t, ch["RootMyb1"] * 1e3))
+    (tmp_path / "cut.csv").write_text("time,flap_moment_1,gen_power\n" + rows[:-4])
+    with pytest.raises(ResultFileError, match=r"cut.csv: line 2001 ends without a line end"):
+        load_series(tmp_path / "cut.csv")
+    (tmp_path / "two.csv").write_text("time,flap_moment_1,flap_moment_1\n" + rows + "\n")
+    with pytest.raises(ResultFileError, match=r"the columns \['flap_moment_1'\] appear more "
+                                              r"than once"):
+        load_series(tmp_path / "two.csv")
+    ms = "\n".join(f"{1000 * a:.1f},{b:.1f},{5e6:.1f}" for a, b in zip(t, ch["RootMyb1"]))
+    (tmp_path / "ms.csv").write_text("time,flap_moment_1,gen_power\n" + ms + "\n")
+    with pytest.raises(ResultFileError, match=r"time column 'time' steps by 50 per sample, more "
+                                              r"than 1 s: if it is in ms"):
+        load_series(tmp_path / "ms.csv")
+    (tmp_path / "ms2.csv").write_text("time [ms],flap_moment_1,gen_power\n" + ms + "\n")
+    t2, cols = load_series(tmp_path / "ms2.csv")
+    np.testing.assert_allclose(t2, t, atol=1e-9)
+    assert set(cols) == {"flap_moment_1", "gen_power"}
+
+
 def test_assess_cli_names_unknown_channel_of_openfast_run(tmp_path, series, capsys) -> None:
     t, ch, units = series
     p = write_openfast_output(tmp_path / "run.out", t, ch, units)
