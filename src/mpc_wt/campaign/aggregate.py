@@ -77,7 +77,7 @@ def _load(root: Path) -> tuple[CampaignSpec, list[CaseRow], list[CaseRow]]:
         shown = "; ".join(f"{cid} ({why})" for cid, why in changed[:5])
         more = f" and {len(changed) - 5} more" if len(changed) > 5 else ""
         raise ResultFileError(
-            f"{root}: {len(changed)} case file(s) do not match the checksum recorded when they "
+            f"{root}: {len(changed)} case(s) do not match the checksum recorded when they "
             f"were written: {shown}{more}; resuming the campaign (mpcwt campaign run SPEC "
             f"--out {root}) computes them again")
     if "spec_raw" not in meta:

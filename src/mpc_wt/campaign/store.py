@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import contextlib
 import fcntl
+import hashlib
 import json
 import logging
 import os
@@ -64,7 +65,8 @@ CREATE TABLE IF NOT EXISTS cases (
     wall_s REAL,
     worker TEXT,
     updated REAL NOT NULL,
-    sha256 TEXT
+    sha256 TEXT,
+    metrics_sha256 TEXT
 );
 """
 
@@ -134,6 +136,16 @@ class CaseRow:
             return self.turbulence
 
 
+def _text_sha256(text: str) -> str:
+    return hashlib.sha256(text.encode()).hexdigest()
+
+
+def _metrics_match(metrics: str | None, recorded: str | None) -> bool:
+    """Whether a case's metrics are as recorded (an index of before metrics checksums were
+    kept, or a row without metrics, has nothing to check)."""
+    return recorded is None or metrics is None or _text_sha256(metrics) == recorded
+
+
 class CampaignStore:
     """Open (and create) a campaign directory.
 
@@ -180,10 +192,12 @@ class CampaignStore:
             if lock:
                 self.db.executescript(_SCHEMA)
                 cols = {r[1] for r in self.db.execute("PRAGMA table_info(cases)")}
-                if "sha256" not in cols:    # an index written before checksums were kept
-                    self.db.execute("ALTER TABLE cases ADD COLUMN sha256 TEXT")
-            self._has_sha = "sha256" in {r[1] for r in
-                                         self.db.execute("PRAGMA table_info(cases)")}
+                for col in ("sha256", "metrics_sha256"):    # an index of before they were kept
+                    if col not in cols:
+                        self.db.execute(f"ALTER TABLE cases ADD COLUMN {col} TEXT")
+            cols = {r[1] for r in self.db.execute("PRAGMA table_info(cases)")}
+            self._has_sha = "sha256" in cols
+            self._has_msha = "metrics_sha256" in cols
         except sqlite3.DatabaseError as err:       # not a database, disk full, read-only ...
             self.close()
             raise CampaignIndexError(f"{index}: cannot be used as a campaign index: {err} "
@@ -321,20 +335,23 @@ class CampaignStore:
             In insertion order.
         """
         out, first_sums = [], []
-        for cid, status, file, cj, sha in self.db.execute(
-                "SELECT case_id, status, file, case_json, sha256 FROM cases "
+        msha = "metrics_sha256" if self._has_msha else "NULL"
+        for cid, status, file, cj, sha, metrics, mhash in self.db.execute(
+                f"SELECT case_id, status, file, case_json, sha256, metrics, {msha} FROM cases "
                 "WHERE status != 'stale' ORDER BY rowid").fetchall():
             if status == "done" and file and (self.root / file).is_file():
                 if sha is None:
                     first_sums.append((file_sha256(self.root / file), cid))
                     continue
-                if file_sha256(self.root / file) == sha:
+                edited = not _metrics_match(metrics, mhash)
+                if file_sha256(self.root / file) == sha and not edited:
                     continue
                 moved = (self.root / file).with_suffix(".changed.nc")
                 os.replace(self.root / file, moved)
                 log.warning("case %s: %s does not match the checksum recorded when it was "
-                            "written (changed or cut short since); computing the case again "
-                            "(the file is kept as %s)", cid, file, moved.name)
+                            "written (%s since); computing the case again (the file is kept "
+                            "as %s)", cid, "its metrics in the index" if edited else file,
+                            "edited" if edited else "changed or cut short", moved.name)
             out.append(Case.from_dict(json.loads(cj)))
         if first_sums:
             with self._tx():
@@ -385,14 +402,17 @@ class CampaignStore:
         if not self._has_sha:
             return []
         bad = []
-        for cid, file, sha in self.db.execute(
-                "SELECT case_id, file, sha256 FROM cases WHERE status = 'done' AND file IS NOT "
-                "NULL ORDER BY rowid"):
+        msha = "metrics_sha256" if self._has_msha else "NULL"
+        for cid, file, sha, metrics, mhash in self.db.execute(
+                f"SELECT case_id, file, sha256, metrics, {msha} FROM cases WHERE status = "
+                "'done' AND file IS NOT NULL ORDER BY rowid"):
             path = self.root / file
             if not path.is_file():
                 bad.append((cid, f"{file}: missing"))
             elif sha is not None and file_sha256(path) != sha:
                 bad.append((cid, f"{file}: changed or cut short since it was recorded"))
+            elif not _metrics_match(metrics, mhash):
+                bad.append((cid, "its metrics in index.sqlite: edited since they were recorded"))
         return bad
 
     def mark_submitted(self, case_ids: Iterable[str]) -> None:
@@ -423,13 +443,14 @@ class CampaignStore:
         now = time.time()
         with self._tx():
             if outcome["status"] == "done":
+                text = json.dumps(outcome["metrics"])
                 self.db.execute(
                     "UPDATE cases SET status='done', file=?, metrics=?, error=NULL, "
                     "traceback=NULL, software_version=?, spec_hash=?, wall_s=?, worker=?, "
-                    "updated=?, sha256=? WHERE case_id=?",
-                    (outcome["file"], json.dumps(outcome["metrics"]),
-                     outcome.get("software_version"), spec_hash, outcome.get("wall_s"),
-                     outcome.get("worker"), now, outcome.get("sha256"), case_id))
+                    "updated=?, sha256=?, metrics_sha256=? WHERE case_id=?",
+                    (outcome["file"], text, outcome.get("software_version"), spec_hash,
+                     outcome.get("wall_s"), outcome.get("worker"), now, outcome.get("sha256"),
+                     _text_sha256(text), case_id))
             else:
                 self.db.execute(
                     "UPDATE cases SET status='failed', error=?, traceback=?, "

@@ -150,7 +150,7 @@ def _verify_table(doc: dict[str, Any]) -> str:
 
 def _compare(args: argparse.Namespace) -> int:
     from mpc_wt.assessment.compare import compare_series
-    from mpc_wt.io.openfast_case import read_openfast_case
+    from mpc_wt.io.openfast_case import check_case_output, read_openfast_case
     from mpc_wt.io.openfast_output import read_openfast_output, to_mpcwt_channels
     from mpc_wt.run import run_openfast_case
 
@@ -160,6 +160,7 @@ def _compare(args: argparse.Namespace) -> int:
     turbine = linearize.load_turbine(args.turbine) if args.turbine else None
     case = read_openfast_case(args.fst, wind=args.wind, turbine=turbine)
     of = read_openfast_output(args.outb)
+    check_case_output(case, of, str(args.outb))
     cols_of, _ = to_mpcwt_channels(of, str(args.outb))
     t_of = of.t
     config = linearize.PlantConfig() if args.plant == "default" else None

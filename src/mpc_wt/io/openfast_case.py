@@ -181,6 +181,50 @@ def read_openfast_case(fst: str | Path, *, wind: str | Path | None = None,
         raise ResultFileError(str(err)) from None
 
 
+def check_case_output(case: OpenFASTCase, series: Any, name: str) -> None:
+    """Refuse an OpenFAST output that is not the case's: its time step against the main
+    file's ``DT_Out`` (``DT`` by default), its end against ``TMax``, and the hub wind it
+    records (``Wind1VelX``, where written) against the case's (InflowWind's steady
+    ``HWindSpeed`` or the TurbSim file's mean), within 25 %.
+
+    Parameters
+    ----------
+    case : OpenFASTCase
+        The case (:func:`read_openfast_case`).
+    series : OpenFASTSeries
+        Its output, read (:func:`mpc_wt.io.openfast_output.read_openfast_output`).
+    name : str
+        The output file, for the message.
+
+    Raises
+    ------
+    ResultFileError
+        Naming the output, the case and the quantity that differs, with both values.
+    """
+    main = OpenFASTFile(case.fst)
+    dt_out = (main.number("DT", 0.0) if not main.has("DT_Out") or main.is_default("DT_Out")
+              else main.number("DT_Out", 0.0))
+    t = np.asarray(series.t, dtype=float)
+    step = float(np.median(np.diff(t))) if t.size > 1 else 0.0
+    why = None
+    if abs(step - dt_out) > 1e-6 * max(dt_out, 1e-9):
+        why = (f"it steps by {step:g} s; the case writes every {dt_out:g} s "
+               f"({main.where('DT_Out') if main.has('DT_Out') else main.where('DT')})")
+    elif abs(t[-1] - case.duration) > 1.5 * max(step, 1e-9):
+        why = f"it ends at {t[-1]:g} s; the case runs to {case.duration:g} s ({main.where('TMax')})"
+    elif "Wind1VelX" in series.names:
+        hub = float(np.mean(series.data[:, series.names.index("Wind1VelX")]))
+        want = (case.steady_wind[0] if case.steady_wind is not None else
+                float(lidar.WindField.load(case.wind_file).mean_speed) if case.wind_file
+                else None)
+        if want is not None and abs(hub - want) > 0.25 * want:
+            why = (f"its hub wind Wind1VelX averages {hub:.4g} m/s; the case's wind is "
+                   f"{want:.4g} m/s")
+    if why is not None:
+        raise ResultFileError(f"{name}: not the output of {case.fst.name}: {why}; compare a "
+                              f"case with its own output")
+
+
 def _lidar(main: OpenFASTFile) -> dict[str, Any] | None:
     """InflowWind's lidar (its ``SensorType`` 1-3), or None (none, or no InflowWind file)."""
     inflow = main.file("InflowFile")

@@ -685,7 +685,7 @@ def test_changed_or_cut_files_are_found_by_checksum_and_computed_again(tmp_path,
     res.save(scaled)
     data = cut.read_bytes()
     cut.write_bytes(data[:800_000] if len(data) > 800_000 else data[: len(data) // 2])
-    with pytest.raises(ResultFileError, match=r"2 case file\(s\) do not match the checksum") as e:
+    with pytest.raises(ResultFileError, match=r"2 case\(s\) do not match the checksum") as e:
         make_report(tmp_path)
     assert all(k in str(e.value) for k in rows)
     with caplog.at_level(logging.WARNING, logger="mpc_wt.campaign.store"):
@@ -696,6 +696,40 @@ def test_changed_or_cut_files_are_found_by_checksum_and_computed_again(tmp_path,
     with CampaignStore(tmp_path) as st_:
         again = {r.case_id: r.metrics["channels"]["flap_moment_1"]["del"] for r in st_.rows()}
     assert again == before
+    make_report(tmp_path)
+
+
+def test_metrics_edited_in_the_index_are_found_by_checksum(tmp_path, caplog):
+    """A finished case's DEL edited in index.sqlite (its file untouched): the report refuses,
+    naming the case and its metrics; resuming computes the case again (logged) and the report
+    then holds the computed DEL, not the edited one (the edited number went into the report)."""
+    import logging
+    import sqlite3
+
+    from mpc_wt.campaign.report import make_report
+    from mpc_wt.errors import ResultFileError
+
+    spec = _spec(winds=[12])
+    run_campaign(spec, tmp_path, engine="serial", progress=False)
+    with CampaignStore(tmp_path) as st_:
+        (row,) = st_.rows()
+    true_del = row.metrics["channels"]["flap_moment_1"]["del"]
+    edited = json.loads(json.dumps(row.metrics))
+    edited["channels"]["flap_moment_1"]["del"] = 0.5 * true_del
+    with sqlite3.connect(tmp_path / "index.sqlite") as db:
+        db.execute("UPDATE cases SET metrics=? WHERE case_id=?",
+                   (json.dumps(edited), row.case_id))
+    with pytest.raises(ResultFileError, match=rf"1 case\(s\) do not match the checksum .*"
+                                              rf"{row.case_id} \(its metrics in index.sqlite: "
+                                              rf"edited"):
+        make_report(tmp_path)
+    with caplog.at_level(logging.WARNING, logger="mpc_wt.campaign.store"):
+        s = run_campaign(spec, tmp_path, engine="serial", progress=False)
+    assert (s.submitted, s.done) == (1, 1)
+    assert any("its metrics in the index" in m for m in caplog.messages)
+    with CampaignStore(tmp_path) as st_:
+        (again,) = st_.rows()
+    assert again.metrics["channels"]["flap_moment_1"]["del"] == true_del
     make_report(tmp_path)
 
 

@@ -13,6 +13,7 @@ from __future__ import annotations
 import dataclasses
 import json
 import math
+import re
 from pathlib import Path
 
 import numpy as np
@@ -143,6 +144,36 @@ def test_compare_openfast_command_names_what_is_missing(capsys, tmp_path) -> Non
     assert "flapwise_moment_1" in out and "20 s to 60 s" in out
     assert (tmp_path / "psd.png").stat().st_size > 10_000
     assert (tmp_path / "comparison.json").is_file() and (tmp_path / "ours.nc").is_file()
+
+
+@_NO_WIND
+def test_compare_openfast_refuses_another_cases_output(capsys, tmp_path) -> None:
+    """The regression case against the AeroMap case's output (1 s steps against the case's
+    DT_Out 0.00625 s), against its own output cut at 30 s (TMax 60 s) and against its output
+    with the hub wind doubled: each refused before our plant runs, exit 2, naming the output,
+    the case and both values (it compared, with differences up to 720 %, and exited 0)."""
+    from mpc_wt.io.openfast_output import write_openfast_output
+
+    of = read_openfast_output(OUTB)
+    keep = of.t <= 30.0
+    cut = write_openfast_output(tmp_path / "cut.outb", of.t[keep],
+                                {n: of.data[keep, i] for i, n in enumerate(of.names)},
+                                dict(zip(of.names, of.units)))
+    iw = of.names.index("Wind1VelX")
+    windy = write_openfast_output(tmp_path / "windy.outb", of.t,
+                                  {n: of.data[:, i] * (2.0 if i == iw else 1.0)
+                                   for i, n in enumerate(of.names)},
+                                  dict(zip(of.names, of.units)))
+    for outb, why in ((AEROMAP, r"it steps by 1 s; the case writes every 0.00625 s "
+                                r"\(5MW_Land_DLL_WTurb.fst:\d+ DT_Out\)"),
+                      (cut, r"it ends at 30 s; the case runs to 60 s"),
+                      (windy, r"its hub wind Wind1VelX averages 2\d.\d+ m/s; the case's wind is "
+                              r"12 m/s")):
+        assert main(["compare-openfast", str(FST), "--outb", str(outb), "--wind", str(BTS),
+                     "--turbine", "nrel5mw"]) == 2
+        err = capsys.readouterr().err
+        assert re.search(rf"{outb.name}: not the output of 5MW_Land_DLL_WTurb.fst: {why}", err), \
+            err
 
 
 @pytest.mark.skipif(not AEROMAP.is_file(), reason="the regression case's AeroMap is absent")
