@@ -41,8 +41,13 @@ class CampaignLockedError(RuntimeError):
 
 
 class CampaignIndexError(ValueError):
-    """A campaign's ``index.sqlite`` that is not an SQLite database, or that cannot be opened
-    or written (a full disk, a read-only folder)."""
+    """A campaign's ``index.sqlite`` that is not an SQLite database (``storage`` False: the
+    command line exits 2), or that cannot be written (a full disk, a read-only folder;
+    ``storage`` True: exit 1, the run failed)."""
+
+    def __init__(self, message: str, *, storage: bool = False) -> None:
+        super().__init__(message)
+        self.storage = storage
 
 
 class RunTooLargeError(ValueError):

@@ -136,6 +136,14 @@ class CaseRow:
             return self.turbulence
 
 
+def _storage_error(err: sqlite3.DatabaseError) -> bool:
+    """Whether SQLite could not write (a full disk, a read-only file or folder, an I/O
+    error), as against a file that is not an index."""
+    text = str(err).lower()
+    return isinstance(err, sqlite3.OperationalError) and any(
+        w in text for w in ("full", "readonly", "read-only", "disk i/o", "unable to open"))
+
+
 def _text_sha256(text: str) -> str:
     return hashlib.sha256(text.encode()).hexdigest()
 
@@ -200,6 +208,11 @@ class CampaignStore:
             self._has_msha = "metrics_sha256" in cols
         except sqlite3.DatabaseError as err:       # not a database, disk full, read-only ...
             self.close()
+            if _storage_error(err):
+                raise CampaignIndexError(
+                    f"{index}: cannot be written: {err} (free space or make it writable, "
+                    f"then run the same command again to resume: every case recorded before "
+                    f"is kept)", storage=True) from None
             raise CampaignIndexError(f"{index}: cannot be used as a campaign index: {err} "
                                      f"(a damaged index: move it away and run the campaign "
                                      f"again; its finished case files are reused)") from None
@@ -524,7 +537,8 @@ class _Tx:
     def _failed(self, err: sqlite3.Error) -> CampaignIndexError:
         return CampaignIndexError(
             f"{self.index}: cannot be written: {err} (free space or make it writable, then "
-            f"run the same command again to resume: every case recorded before is kept)")
+            f"run the same command again to resume: every case recorded before is kept)",
+            storage=True)
 
     def __enter__(self) -> sqlite3.Connection:
         try:

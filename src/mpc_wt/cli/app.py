@@ -39,8 +39,8 @@ from typing import Sequence
 
 import linearize
 from mpc_wt.cli import campaign, compare, design, runs, solver, steady, wind
-from mpc_wt.errors import (CampaignLockedError, ControllerLibraryError, OpenFASTRunError,
-                           UsageError)
+from mpc_wt.errors import (CampaignIndexError, CampaignLockedError, ControllerLibraryError,
+                           OpenFASTRunError, UsageError)
 
 __all__ = ["main", "build_parser"]
 
@@ -132,6 +132,10 @@ def main(argv: Sequence[str] | None = None) -> int:
         print(f"mpcwt {args.command}: {'run failed' if err.ran else 'error'}: {err}",
               file=sys.stderr)
         return 1 if err.ran else 2
+    except CampaignIndexError as err:         # a full disk: the run failed; damaged: input
+        print(f"mpcwt {args.command}: {'run failed' if err.storage else 'error'}: {err}",
+              file=sys.stderr)
+        return 1 if err.storage else 2
     except _ERRORS as err:
         print(f"mpcwt {args.command}: error: {err}", file=sys.stderr)
         return 2

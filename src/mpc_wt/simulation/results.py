@@ -236,11 +236,18 @@ class ClosedLoopResult:
         path = Path(path)
         if not path.is_file():
             raise ResultFileError(f"{path}: file not found")
+        with path.open("rb") as fh:
+            magic = fh.read(4)
+        if magic[:3] != b"CDF" or magic[3:] not in (b"\x01", b"\x02"):
+            raise ResultFileError(f"{path}: not an mpc-wt result file: it does not begin as a "
+                                  f"netCDF-3 file does (its first bytes {magic!r}; mpc-wt "
+                                  f"writes netCDF-3)")
         try:
             with xr.open_dataset(path, engine="scipy") as ds:
                 ds = ds.load()
         except Exception as err:  # noqa: BLE001 - any reader failure means a broken file
-            raise ResultFileError(f"{path}: not a readable result file ({err})") from err
+            first = str(err).strip().splitlines()[0] if str(err).strip() else type(err).__name__
+            raise ResultFileError(f"{path}: not a readable result file ({first})") from err
         ver = ds.attrs.get("schema_version")
         if isinstance(ver, (np.integer, int)):
             ver = int(ver)

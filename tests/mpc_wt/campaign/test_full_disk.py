@@ -72,10 +72,10 @@ def test_an_index_on_a_full_disk_stops_with_one_line_and_resumes(monkeypatch, tm
 
     spec.write_text(yaml.safe_dump(SPEC))
     args = ["campaign", "run", str(spec), "--out", str(out), "--engine", "serial"]
-    assert main(args) == 2
+    assert main(args) == 1                     # the run failed (errors.md), not the input
     err = [ln for ln in capsys.readouterr().err.strip().splitlines()
            if not ln.startswith("campaign disk:")]      # the progress bar
-    assert len(err) == 1 and err[0].startswith("mpcwt campaign: error: ")
+    assert len(err) == 1 and err[0].startswith("mpcwt campaign: run failed: ")
     assert f"{out / 'index.sqlite'}: cannot be written: database or disk is full" in err[0]
     assert "run the same command again to resume" in err[0]
     monkeypatch.undo()
@@ -88,3 +88,39 @@ def test_an_index_on_a_full_disk_stops_with_one_line_and_resumes(monkeypatch, tm
     assert sorted(r.case_id for r in rows) == sorted({r.case_id for r in rows})
     assert [r.status for r in rows] == ["done"] * 3
     assert summary.reused == 1                  # the case whose record was lost: its file
+
+
+def test_an_index_that_cannot_be_opened_for_a_full_disk_is_not_called_damaged(
+        monkeypatch, tmp_path: Path, capsys) -> None:
+    """Opening the index on a full disk: exit 1 and "free space ... resume" (it said exit 2,
+    "a damaged index: move it away"); an index that is not a database: exit 2, damaged."""
+    import yaml
+
+    import mpc_wt.campaign.store as store
+
+    spec = tmp_path / "s.yaml"
+    spec.write_text(yaml.safe_dump(SPEC))
+    out = tmp_path / "c"
+    args = ["campaign", "run", str(spec), "--out", str(out), "--engine", "serial"]
+    real = sqlite3.connect
+
+    class _Full:
+        def __init__(self, *a, **k):
+            self._db = real(*a, **k)
+
+        def execute(self, sql, *a):
+            if sql.startswith("PRAGMA journal_mode"):
+                raise sqlite3.OperationalError("database or disk is full")
+            return self._db.execute(sql, *a)
+
+        def __getattr__(self, name):
+            return getattr(self._db, name)
+    monkeypatch.setattr(store.sqlite3, "connect", _Full)
+    assert main(args) == 1
+    err = capsys.readouterr().err
+    assert "index.sqlite: cannot be written: database or disk is full (free space" in err
+    assert "damaged" not in err
+    monkeypatch.undo()
+    (out / "index.sqlite").write_bytes(b"not a database" * 100)
+    assert main(args) == 2
+    assert "a damaged index: move it away" in capsys.readouterr().err

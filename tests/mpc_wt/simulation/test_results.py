@@ -46,6 +46,16 @@ def test_broken_result_files(run18: ClosedLoopResult, tmp_path: Path) -> None:
         ClosedLoopResult.load(tmp_path / "cut.nc")
     with pytest.raises(ResultFileError, match="file not found"):
         ClosedLoopResult.load(tmp_path / "none.nc")
+    # a garbage header: one line (it was several ending in a hint to install netCDF4)
+    (tmp_path / "junk.nc").write_bytes(b"GARBAGEHEADER" + raw[13:])
+    with pytest.raises(ResultFileError) as err:
+        ClosedLoopResult.load(tmp_path / "junk.nc")
+    assert "\n" not in str(err.value) and "netcdf4" not in str(err.value).lower()
+    assert "junk.nc: not an mpc-wt result file: it does not begin as a netCDF-3 file" \
+        in str(err.value)
+    with pytest.raises(ResultFileError) as err:
+        ClosedLoopResult.load(tmp_path / "cut.nc")
+    assert "\n" not in str(err.value)
     with pytest.raises(KeyError, match=r"no channel 'gen_powr'"):
         run18.channel("gen_powr")
 
