@@ -9,12 +9,10 @@ import errno
 import sqlite3
 from pathlib import Path
 
-import pytest
 
 from mpc_wt.campaign import run_campaign, spec_from_dict
 from mpc_wt.campaign.store import CampaignStore
 from mpc_wt.cli import main
-from mpc_wt.errors import CampaignIndexError
 from mpc_wt.simulation.results import ClosedLoopResult
 
 SPEC = {"name": "disk", "duration": 10, "transient": 0, "winds": [12, 16, 20], "seeds": 1,
