@@ -45,6 +45,29 @@ DEFAULT_CHANNELS = {"flap_moment_1": 10.0, "flap_moment_2": 10.0, "flap_moment_3
                     "shaft_bending_blade1": 4.0}
 
 
+#: The start of a run the statistics leave out by default [s]: the controller's and the
+#: plant's start-up transient (at most a tenth of the run, for short runs).
+START_TRANSIENT_S = 60.0
+
+
+def default_window_start(t0: float, t_end: float) -> float:
+    """Where a run's statistics begin by default: :data:`START_TRANSIENT_S` after its start,
+    or a tenth of its length if that is shorter (``mpcwt run``'s table, ``comparison.json``
+    and ``mpcwt assess`` alike).
+
+    Parameters
+    ----------
+    t0, t_end : float
+        The run's first and last time [s].
+
+    Returns
+    -------
+    float
+        [s].
+    """
+    return t0 + min(START_TRANSIENT_S, 0.1 * (t_end - t0))
+
+
 #: how far a time step may differ from the run's median step, relative to it: a text time
 #: column rounded to its last digit (0.0062, 0.0063 for 160 Hz) stays within it, a lost sample
 #: (a step of 2x) or a gap does not

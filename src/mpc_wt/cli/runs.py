@@ -295,8 +295,9 @@ def _add_assess(sub: Any) -> None:
     p.add_argument("--channels", help="comma list of channels (default: blade, tower, shaft)")
     p.add_argument("--m", type=float, default=None, help="Woehler exponent for all channels")
     p.add_argument("--time-column", default="time", help="CSV time column (default time)")
-    p.add_argument("--t-start", type=float, default=0.0,
-                   help="discard samples before this time, e.g. the start-up transient [s]")
+    p.add_argument("--t-start", type=float, default=None,
+                   help="discard samples before this time [s] (default: the first 60 s, or "
+                        "a tenth of a shorter run, as mpcwt run's table; 0 keeps all)")
     p.add_argument("--del-convention", default="range-1hz",
                    choices=tuple(DEL_CONVENTIONS),
                    help="DEL as ranges over 1 Hz equivalent cycles (default; IEC, MLife), as "
@@ -308,7 +309,12 @@ def _add_assess(sub: Any) -> None:
 
 
 def _assess(args: argparse.Namespace) -> int:
-    from mpc_wt.assessment.series import DEFAULT_CHANNELS, assess_series, reductions
+    from mpc_wt.assessment.series import (
+        DEFAULT_CHANNELS,
+        assess_series,
+        default_window_start,
+        reductions,
+    )
     from mpc_wt.plotting import assess_plots
     from mpc_wt.simulation.results import load_series
 
@@ -318,9 +324,10 @@ def _assess(args: argparse.Namespace) -> int:
     rows, runs = [], []
     for path in args.runs:
         t, cols = load_series(path, args.time_column)
-        keep = t >= args.t_start
+        start = default_window_start(t[0], t[-1]) if args.t_start is None else args.t_start
+        keep = t >= start
         if keep.sum() < 3:
-            raise UsageError(f"--t-start = {args.t_start:g} s leaves fewer than 3 samples of "
+            raise UsageError(f"--t-start = {start:g} s leaves fewer than 3 samples of "
                              f"{path} (it ends at {t[-1]:g} s)")
         t, cols = t[keep], {k: v[keep] for k, v in cols.items()}
         if chans is None and not set(cols) & set(DEFAULT_CHANNELS):
@@ -328,7 +335,7 @@ def _assess(args: argparse.Namespace) -> int:
                              f"{sorted(cols)}, channels {sorted(DEFAULT_CHANNELS)}; name any "
                              f"numeric column with --channels NAME[,NAME...]")
         res = assess_series(t, cols, chans, args.m, convention=args.del_convention)
-        row = {"run": str(path), **res}
+        row = {"run": str(path), "window_s": [float(t[0]), float(t[-1])], **res}
         if rows:
             row["relative_to_first"] = reductions(rows[0], res)
         rows.append(row)
@@ -371,8 +378,10 @@ def assess_table(rows: list[dict[str, Any]]) -> str:
     names = [Path(r["run"]).stem for r in rows]
     head = f"{'quantity':34s} {'unit':5s}" + "".join(f" {n[:12]:>12s}" for n in names)
     head += "".join(f" {'d% ' + n[:8]:>12s}" for n in names[1:])
-    lines = [f"{len(rows)} run(s); changes against {names[0]}" if len(rows) > 1 else
-             f"{names[0]}, {rows[0]['duration_s']:.0f} s", head]
+    w = rows[0].get("window_s")
+    window = f"; statistics over {w[0]:g}-{w[1]:g} s" if w else ""
+    lines = [(f"{len(rows)} run(s); changes against {names[0]}" if len(rows) > 1 else
+              f"{names[0]}, {rows[0]['duration_s']:.0f} s") + window, head]
     items = [(f"DEL {c} (m = {d['m']:g})", "kN m", 1e-3, lambda r, c=c: r["channels"].get(
         c, {}).get("del")) for c, d in rows[0]["channels"].items()]
     items += [(label, unit, f, lambda r, k=k: r.get(k)) for k, label, unit, f in _ASSESS_ROWS
@@ -453,7 +462,7 @@ MAIN_JOB_WHY = {"mpc-lidar": "the kind's envelope-tuned default moves the pitch 
 
 def _comparison_runs(turbine: linearize.Turbine, args: argparse.Namespace, out: Path) -> None:
     """The controllers on one field, assessed and compared in one table and plots."""
-    from mpc_wt.assessment.series import assess_series
+    from mpc_wt.assessment.series import assess_series, default_window_start
     from mpc_wt.plotting import assess_plots, plot_comparison
     from mpc_wt.run import run_controller
 
@@ -472,20 +481,26 @@ def _comparison_runs(turbine: linearize.Turbine, args: argparse.Namespace, out: 
                              samplers=samplers)
         fname = name.replace("+", "_") + "_run.nc"
         res.save(out / fname)
-        keep = res.t >= min(60.0, 0.1 * args.duration)
+        keep = res.t >= default_window_start(res.t[0], res.t[-1])
         cols = {n: res.channel(n)[keep] for n in res.channels()}
         a = assess_series(res.t[keep], cols)
-        rows.append(_comparison_row(name, a, cols, res.controller.get("qp_solve_ms"), fname,
-                                    (res.meta.get("mpc") or {}).get("backend")))
+        rows.append({**_comparison_row(name, a, cols, res.controller.get("qp_solve_ms"),
+                                       fname, (res.meta.get("mpc") or {}).get("backend")),
+                     "window_s": [float(res.t[keep][0]), float(res.t[keep][-1])]})
         runs.append((name, res.t[keep], cols))
     samplers.clear()
     (out / "comparison.json").write_text(to_json(rows))
     made = assess_plots(runs, out) + plot_comparison(runs, out / "comparison.png")
+    w = rows[0]["window_s"]
     print(f"# {args.duration:g} s at {args.wind:g} m/s, turbulence {args.turbulence}, seed "
-          f"{args.seed}, the same field for all")
+          f"{args.seed}, the same field for all; statistics over {w[0]:g}-{w[1]:g} s (the "
+          f"start's transient left out, as mpcwt assess does); DELs at 1 Hz equivalent "
+          f"cycles, blade flap m = 10, tower-base fore-aft and shaft bending m = 4")
     print(f"{'controller':20s} {'P mean':>8s} {'P std':>8s} {'speed std':>9s} "
           f"{'pitch':>7s} {'DEL flap':>9s} {'DEL tower':>9s} {'DEL shaft':>9s} "
           f"{'QP med/p99':>17s}")
+    print(f"{'':20s} {'':>8s} {'':>8s} {'rotor':>9s} {'travel':>7s} {'root':>9s} "
+          f"{'base FA':>9s} {'bending':>9s} {'':>17s}")
     print(f"{'':20s} {'[MW]':>8s} {'[kW]':>8s} {'[rpm]':>9s} {'[deg]':>7s} {'[MN m]':>9s} "
           f"{'[MN m]':>9s} {'[MN m]':>9s} {'[ms], solver':>17s}")
     for r in rows:
