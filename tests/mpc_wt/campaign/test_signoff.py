@@ -391,3 +391,24 @@ def test_a_constant_paired_difference_has_no_standard_error(ref, shift) -> None:
     g = gov["other"]
     assert g["change_pct"] == pytest.approx(100.0 * shift / np.mean(ref), abs=1e-9)
     assert g["change_se_pct"] == pytest.approx(0.0, abs=1e-9)
+
+
+def test_the_campaigns_guide_counts_the_studies_cases_as_their_specs_do() -> None:
+    """docs/guide/campaigns.md's case counts (the commands' comments and the table's first
+    cells) against the specs in benchmarks/studies (they said 16, 56 and 72 or 36 cases of
+    specs that make 20, 74 and 42)."""
+    from pathlib import Path
+
+    import yaml
+
+    root = Path(__file__).resolve().parents[3]
+    text = (root / "docs" / "guide" / "campaigns.md").read_text()
+    for name, row in (("madsen", "Madsen"), ("do", "Do"), ("clemens", "Clemens"),
+                      ("pettas", "Pettas")):
+        spec = spec_from_dict(yaml.safe_load((root / "benchmarks" / "studies" /
+                                              f"{name}.yaml").read_text()))
+        n = len(spec.cases())
+        said = re.search(rf"studies/{name}\.yaml .*# (\d+) cases", text)
+        assert said and int(said.group(1)) == n, (name, n)
+        cell = re.search(rf"^\| {row}: [^|]*\| (\d+), ", text, flags=re.M)
+        assert cell and int(cell.group(1)) == n, (name, n)
