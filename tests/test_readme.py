@@ -1,5 +1,6 @@
-"""The README's Python blocks run as they are (each in a fresh interpreter), and the README
-stays a front page: short, with no development history in it."""
+"""The README's Python blocks run as they are (each in a fresh interpreter; the docs' in
+``test_docs_blocks.py``), and the README stays a front page: short, with no development
+history in it."""
 from __future__ import annotations
 
 import re
@@ -12,9 +13,6 @@ import pytest
 ROOT = Path(__file__).resolve().parents[1]
 README = ROOT / "README.md"
 BLOCKS = re.findall(r"```python\n(.*?)```", README.read_text(), flags=re.S)
-#: the newcomer's first page: its Python blocks run as they are too
-START = re.findall(r"```python\n(.*?)```", (ROOT / "docs" / "getting-started.md").read_text(),
-                   flags=re.S)
 
 
 def test_the_readme_has_python_examples() -> None:
@@ -24,13 +22,6 @@ def test_the_readme_has_python_examples() -> None:
 @pytest.mark.parametrize("index", range(len(BLOCKS)))
 def test_readme_python_block_runs(index: int, tmp_path: Path) -> None:
     done = subprocess.run([sys.executable, "-c", BLOCKS[index]], cwd=tmp_path,
-                          capture_output=True, text=True, timeout=600)
-    assert done.returncode == 0, done.stderr[-3000:]
-
-
-@pytest.mark.parametrize("index", range(len(START)))
-def test_getting_started_python_block_runs(index: int, tmp_path: Path) -> None:
-    done = subprocess.run([sys.executable, "-c", START[index]], cwd=tmp_path,
                           capture_output=True, text=True, timeout=600)
     assert done.returncode == 0, done.stderr[-3000:]
 

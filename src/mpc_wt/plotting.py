@@ -214,7 +214,8 @@ def plot_scan_pattern(beam_azimuth_rad: np.ndarray, blade_azimuth_rad: np.ndarra
 
 
 def plot_cs_ellipses(items: list[tuple[str, Any, np.ndarray, np.ndarray]], path: str | Path,
-                     load_label: str = "tower-base fore-aft moment [MN m]") -> Path:
+                     load_label: str = "tower-base fore-aft moment [MN m]",
+                     case: str = "") -> Path:
     """Do et al. (2020) fig. 4: load-power samples and their 95 % ellipses for several runs.
 
     ``items``: (label, CSMeasures, load samples, power samples) per run.
@@ -227,6 +228,8 @@ def plot_cs_ellipses(items: list[tuple[str, Any, np.ndarray, np.ndarray]], path:
         The PNG file.
     load_label : str
         Axis label of the load.
+    case : str
+        The case the runs are of (turbine, wind, turbulence, seed, window), in the title.
 
     Returns
     -------
@@ -234,7 +237,7 @@ def plot_cs_ellipses(items: list[tuple[str, Any, np.ndarray, np.ndarray]], path:
         The PNG file.
     """
     plt = pyplot()
-    fig, ax = plt.subplots(figsize=(7.0, 5.0), dpi=120)
+    fig, ax = plt.subplots(figsize=(7.0, 5.6), dpi=120)
     for k, (label, cs, x, y) in enumerate(items):
         step = max(1, len(x) // 3000)
         ax.plot(np.asarray(x)[::step] / 1e6, np.asarray(y)[::step] / 1e6, ".", ms=1.5,
@@ -246,18 +249,22 @@ def plot_cs_ellipses(items: list[tuple[str, Any, np.ndarray, np.ndarray]], path:
         ax.plot(cs.cs3 / 1e6, cs.cs4 / 1e6, "+", color=f"C{k}", ms=10)
     ax.set_xlabel(load_label)
     ax.set_ylabel("generator power [MW]")
-    ax.set_title("Covariance ellipses (95 %, s = 5.99), Do et al. 2020")
+    ax.set_title("Covariance ellipses (95 %, s = 5.99), Do et al. 2020"
+                 + (f"\n{case}" if case else ""), fontsize=9)
     # CS5 is the major axis's angle in the samples' own units (eq. 26): the axes here are
-    # scaled apart, so the drawn tilt is larger than that angle.
-    ax.text(0.01, 0.01, "CS5: major axis to load axis in N m and W (Do et al. eq. 26); "
-            "axes not to the same scale", transform=ax.transAxes, fontsize=7, color="0.35")
-    ax.legend(fontsize=7)
+    # scaled apart, so the drawn tilt is larger than that angle. Legend and note below the
+    # axes, off the samples.
+    leg = ax.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.13), ncol=1,
+                    frameon=False, title="CS5: major axis to load axis in N m and W (Do et "
+                    "al. eq. 26); axes not to the same scale", title_fontsize=7)
+    leg.get_title().set_color("0.35")
     ax.grid(alpha=0.3)
+    fig.subplots_adjust(bottom=0.30)
     return save_figure(fig, path)
 
 
 def plot_psd_comparison(items: list[tuple[str, np.ndarray, np.ndarray]], rotor_hz: float,
-                        path: str | Path, ylabel: str) -> Path:
+                        path: str | Path, ylabel: str, case: str = "") -> Path:
     """PSDs of one channel for several runs, with 1P, 3P, 6P marked.
 
     Parameters
@@ -270,6 +277,8 @@ def plot_psd_comparison(items: list[tuple[str, np.ndarray, np.ndarray]], rotor_h
         The PNG file.
     ylabel : str
         Axis label of the PSD.
+    case : str
+        The case the runs are of, in the title.
 
     Returns
     -------
@@ -277,21 +286,25 @@ def plot_psd_comparison(items: list[tuple[str, np.ndarray, np.ndarray]], rotor_h
         The PNG file.
     """
     plt = pyplot()
-    fig, ax = plt.subplots(figsize=(7.0, 4.2), dpi=120)
+    fig, ax = plt.subplots(figsize=(7.0, 4.4), dpi=120)
     for label, f, p in items:
         ax.loglog(f[1:], p[1:], lw=1.0, label=label)
     for n in (1, 3, 6):
         ax.axvline(n * rotor_hz, color="0.5", ls=":", lw=0.8)
-        ax.text(n * rotor_hz, ax.get_ylim()[1], f"{n}P", fontsize=7, va="top")
+        # in axes coordinates a little below the frame: the labels stay inside it
+        ax.text(n * rotor_hz, 0.97, f"{n}P", fontsize=7, va="top", ha="left",
+                transform=ax.get_xaxis_transform())
     ax.set_xlabel("frequency [Hz]")
     ax.set_ylabel(ylabel)
-    ax.legend(fontsize=8)
+    if case:
+        ax.set_title(case, fontsize=9)
+    ax.legend(fontsize=8, loc="lower left")
     ax.grid(alpha=0.3, which="both")
     return save_figure(fig, path)
 
 
 def assess_plots(runs: Sequence[tuple[str, np.ndarray, dict[str, np.ndarray]]],
-                 out_dir: str | Path) -> list[str]:
+                 out_dir: str | Path, case: str = "") -> list[str]:
     """CS ellipses (Do et al. fig. 4) and flap-moment PSDs of several runs, as PNG.
 
     Parameters
@@ -300,6 +313,8 @@ def assess_plots(runs: Sequence[tuple[str, np.ndarray, dict[str, np.ndarray]]],
         Label, time [s] and channels of each run.
     out_dir : str or Path
         Folder of ``cs_ellipses.png`` and ``psd_flap_moment_1.png`` (created).
+    case : str
+        The case the runs are of (turbine, wind, turbulence, seed, window), in the titles.
 
     Returns
     -------
@@ -315,7 +330,7 @@ def assess_plots(runs: Sequence[tuple[str, np.ndarray, dict[str, np.ndarray]]],
               c["tower_base_fa_moment"], c["gen_power"]) for name, _, c in runs
              if "tower_base_fa_moment" in c and "gen_power" in c]
     if items:
-        made.append(str(plot_cs_ellipses(items, d / "cs_ellipses.png")))
+        made.append(str(plot_cs_ellipses(items, d / "cs_ellipses.png", case=case)))
     spectra = []
     frot = 0.2
     for name, t, c in runs:
@@ -327,7 +342,7 @@ def assess_plots(runs: Sequence[tuple[str, np.ndarray, dict[str, np.ndarray]]],
                 frot = float(c["rotor_speed"].mean()) / (2 * math.pi)
     if spectra:
         made.append(str(plot_psd_comparison(spectra, frot, d / "psd_flap_moment_1.png",
-                                             "flap moment PSD [(N m)^2/Hz]")))
+                                             "flap moment PSD [(N m)^2/Hz]", case=case)))
     return made
 
 
@@ -379,10 +394,11 @@ def plot_design(doc: dict[str, Any], path: str | Path) -> Path:
 
 
 def plot_comparison(runs: Sequence[tuple[str, np.ndarray, dict[str, np.ndarray]]],
-                    path: str | Path, window_s: float = 120.0) -> list[str]:
+                    path: str | Path, window_s: float = 120.0, case: str = "") -> list[str]:
     """Electrical power, rotor speed, collective pitch, blade-1 flap moment and tower-base
     fore-aft moment of several runs, stacked panels over the last ``window_s`` of the runs (a
-    readable stretch), each run's mean and standard deviation over the whole run in its legend.
+    readable stretch), each run's mean and standard deviation over the samples given in its
+    legend, beside the panel.
 
     Parameters
     ----------
@@ -392,6 +408,8 @@ def plot_comparison(runs: Sequence[tuple[str, np.ndarray, dict[str, np.ndarray]]
         The PNG file.
     window_s : float
         Length of the stretch shown [s] (the whole run when shorter).
+    case : str
+        The case the runs are of (turbine, wind, turbulence, seed), in the title.
 
     Returns
     -------
@@ -405,7 +423,7 @@ def plot_comparison(runs: Sequence[tuple[str, np.ndarray, dict[str, np.ndarray]]
               ("flap_moment_1", 1e-6, "flap moment, blade 1", "MN m"),
               ("tower_base_fa_moment", 1e-6, "tower-base fore-aft moment", "MN m"))
     shown = [p for p in panels if any(p[0] in cols for _, _, cols in runs)]
-    fig, axes = plt.subplots(len(shown), 1, figsize=(9, 1.9 * len(shown) + 0.8), sharex=True,
+    fig, axes = plt.subplots(len(shown), 1, figsize=(12, 1.9 * len(shown) + 0.9), sharex=True,
                              squeeze=False)
     t_end = max(float(t[-1]) for _, t, _ in runs)
     t0 = max(min(float(t[0]) for _, t, _ in runs), t_end - window_s)
@@ -418,12 +436,14 @@ def plot_comparison(runs: Sequence[tuple[str, np.ndarray, dict[str, np.ndarray]]
             ax.plot(t[keep], x[keep], lw=0.8,
                     label=f"{label}: {x.mean():#.3g} ± {x.std():#.2g} {unit}")
         ax.set_ylabel(f"{name} [{unit}]", fontsize=8)
-        ax.legend(loc="upper right", fontsize=6.5, framealpha=0.8)
+        ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=7, frameon=False)
         ax.grid(alpha=0.3)
     axes[-1, 0].set_xlabel("time [s]")
     axes[-1, 0].set_xlim(t0, t_end)
-    fig.suptitle(f"last {t_end - t0:.0f} s shown; legend: mean ± std over each whole run",
-                 fontsize=9)
+    a = min(float(t[0]) for _, t, _ in runs)
+    fig.suptitle((f"{case}; " if case else "") + f"last {t_end - t0:.0f} s shown; legend: "
+                 f"mean ± std over {a:g}-{t_end:g} s", fontsize=9)
+    fig.subplots_adjust(right=0.72)
     p = save_figure(fig, path)
     return [str(p)]
 

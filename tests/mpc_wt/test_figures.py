@@ -96,7 +96,8 @@ def test_comparison_shows_power_and_a_readable_window(figures, tmp_path) -> None
     cols = {"gen_power": 5e6 + 1e5 * np.sin(t), "rotor_speed": 1.2 + 0.01 * np.sin(t),
             "pitch_1": 0.1 + 0.01 * np.sin(t), "flap_moment_1": 6e6 + 1e6 * np.sin(t),
             "tower_base_fa_moment": 5e7 + 5e6 * np.sin(t)}
-    plotting.plot_comparison([("a", t, cols), ("b", t, cols)], tmp_path / "c.png")
+    plotting.plot_comparison([("a", t, cols), ("b", t, cols)], tmp_path / "c.png",
+                             case="NREL 5-MW, 18 m/s, turbulence A, seed 1")
     fig = figures[-1]
     _check(fig)
     axes = fig.axes
@@ -104,6 +105,12 @@ def test_comparison_shows_power_and_a_readable_window(figures, tmp_path) -> None
     lo, hi = axes[-1].get_xlim()
     assert hi - lo < 130.0
     assert "MW" in axes[0].get_legend().get_texts()[0].get_text()
+    # the case in the title; the statistics' window said; each legend beside its panel
+    title = fig._suptitle.get_text()
+    assert title.startswith("NREL 5-MW, 18 m/s, turbulence A, seed 1;") and "0-599.95 s" in title
+    renderer = fig.canvas.get_renderer()
+    for ax in axes:
+        assert ax.get_legend().get_window_extent(renderer).x0 >= ax.bbox.x1
 
 
 def test_cs_ellipses_show_the_measures_with_units(figures, tmp_path) -> None:
@@ -150,3 +157,12 @@ def test_the_main_jobs_assessment_figures(figures, tmp_path) -> None:
     marks = [txt.get_text() for txt in figures[1].axes[0].texts]
     assert marks == ["1P", "3P", "6P"]
     assert figures[1].axes[0].texts[0].get_position()[0] == pytest.approx(0.2)
+    renderer = figures[1].canvas.get_renderer()
+    ax = figures[1].axes[0]
+    for txt in ax.texts:                          # the marks' labels inside the frame
+        assert txt.get_window_extent(renderer).y1 <= ax.bbox.y1
+    ax = figures[0].axes[0]                       # the ellipses' legend below the samples
+    assert ax.get_legend().get_window_extent(figures[0].canvas.get_renderer()).y1 <= ax.bbox.y0
+    made = plotting.assess_plots(runs, tmp_path, case="NREL 5-MW, 18 m/s, seed 1, 60-300 s")
+    assert figures[-2].axes[0].get_title().endswith("NREL 5-MW, 18 m/s, seed 1, 60-300 s")
+    assert figures[-1].axes[0].get_title() == "NREL 5-MW, 18 m/s, seed 1, 60-300 s"

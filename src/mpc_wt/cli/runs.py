@@ -490,8 +490,11 @@ def _comparison_runs(turbine: linearize.Turbine, args: argparse.Namespace, out: 
         runs.append((name, res.t[keep], cols))
     samplers.clear()
     (out / "comparison.json").write_text(to_json(rows))
-    made = assess_plots(runs, out) + plot_comparison(runs, out / "comparison.png")
     w = rows[0]["window_s"]
+    case = (f"{turbine.name}, {args.wind:g} m/s, turbulence {args.turbulence}, seed "
+            f"{args.seed}")
+    made = (assess_plots(runs, out, case=f"{case}, {w[0]:g}-{w[1]:g} s")
+            + plot_comparison(runs, out / "comparison.png", case=case))
     print(f"# {args.duration:g} s at {args.wind:g} m/s, turbulence {args.turbulence}, seed "
           f"{args.seed}, the same field for all; statistics over {w[0]:g}-{w[1]:g} s (the "
           f"start's transient left out, as mpcwt assess does); DELs at 1 Hz equivalent "
