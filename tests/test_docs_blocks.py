@@ -47,3 +47,49 @@ def test_a_docs_pages_python_blocks_run(page: str, tmp_path: Path) -> None:
                           text=True, timeout=900, env={**__import__("os").environ,
                                                        "MPLBACKEND": "Agg"})
     assert done.returncode == 0, f"{page}:\n{done.stderr[-3000:]}"
+
+
+BASH = re.compile(r"^```(?:bash|sh|console)\n(?P<code>.*?)^```", flags=re.S | re.M)
+
+
+def _commands() -> list[tuple[str, str]]:
+    """Every ``mpcwt ...`` line of the README's and the docs' shell blocks (a line continued
+    with a backslash joined; a trailing comment dropped), but usage synopses (``[--flag X]``,
+    ``a|b``, ``...``)."""
+    out = []
+    for page in [ROOT / "README.md", *sorted((ROOT / "docs").rglob("*.md"))]:
+        if "_build" in page.parts:
+            continue
+        for m in BASH.finditer(page.read_text()):
+            text = m.group("code").replace("\\\n", " ")
+            for line in text.splitlines():
+                for part in line.split("&&"):
+                    cmd = part.split(" #")[0].strip()
+                    if cmd.startswith("mpcwt ") and not any(c in cmd for c in "[|") \
+                            and "..." not in cmd:
+                        out.append((str(page.relative_to(ROOT)), cmd))
+    return out
+
+
+COMMANDS = _commands()
+
+
+def test_the_docs_shell_blocks_hold_commands() -> None:
+    assert len(COMMANDS) >= 20
+
+
+@pytest.mark.parametrize("page, cmd", COMMANDS, ids=[f"{p}: {c[:60]}" for p, c in COMMANDS])
+def test_a_docs_command_parses(page: str, cmd: str) -> None:
+    """Each documented command is one ``mpcwt`` accepts as written: its subcommand, flags and
+    choices (the commands run for minutes to hours; their runs are the studies')."""
+    import shlex
+
+    from mpc_wt.cli.app import _plugins, build_parser
+    from mpc_wt.registry.registry import load_plugins
+
+    argv = shlex.split(cmd)[1:]
+    load_plugins([p for p in _plugins(argv) if (ROOT / f"{p}.py").is_file()])
+    try:
+        build_parser().parse_args(argv)
+    except SystemExit as stop:
+        assert stop.code == 0, f"{page}: `{cmd}` is refused by the parser"
