@@ -1,27 +1,27 @@
 """The ``mpcwt`` command line: one module per command group, each adding its parsers.
 
-Subcommands
------------
-run          the main job on a turbine: steady operating table, C_P surface, baseline run
-trim         steady operating points against wind speed (table or ``--json``)
-linearize    linear models over mean wind, saved as .mat/.npz/.json (``--json`` summary)
-aero         rotor aerodynamics: ``aero cp-surface --out FILE.csv [--plot FILE.png]``
-simulate     closed loop of any registered controller kind: ``simulate --controller baseline
-             --wind 18 --out RUN``
-controllers  the registered controller kinds and their options
-assess       DELs, CS1-CS5, pitch duty, energy of runs or CSV time series
-wind         turbulent wind fields: ``wind generate --mean 18 --class A --out FIELD.bts``
-lidar        CW LIDAR preview: ``lidar evaluate --field FIELD [--focus 54] [--json]``
-design       gain synthesis: ``design baseline|lqr|ts|ibc|coleman-ipc [...] --out DIR``
-export       gain tables: ``export DIR --format csv|json|mat|rosco``
-campaign     load-case campaigns on Dask: ``campaign run SPEC.yaml``, ``status``, ``report``
-tune         design parameters optimized over load cases: ``tune SPEC.yaml --out DIR``
-bench        ``bench mpc``: QP solver comparison
-compare-openfast  an OpenFAST case run on mpc-wt's plant, compared with its output:
-             ``compare-openfast CASE.fst --outb CASE.outb [--wind FILE.bts]``
-verify-openfast  a kind exported and run in your OpenFAST and on mpc-wt's plant, differences
-             flagged: ``verify-openfast KIND CASE.fst --out DIR [--openfast PATH]``
-solver       the exported MPC's QP solver sources: ``solver fetch [--from FILE]``, ``status``
+Subcommands::
+
+    run          the main job on a turbine: steady operating table, C_P surface, baseline run
+    trim         steady operating points against wind speed (table or --json)
+    linearize    linear models over mean wind, saved as .mat/.npz/.json (--json summary)
+    aero         rotor aerodynamics: aero cp-surface --out FILE.csv [--plot FILE.png]
+    simulate     closed loop of any registered controller kind: simulate --controller
+                 baseline --wind 18 --out RUN
+    controllers  the registered controller kinds and their options
+    assess       DELs, CS1-CS5, pitch duty, energy of runs or CSV time series
+    wind         turbulent wind fields: wind generate --mean 18 --class A --out FIELD.bts
+    lidar        CW LIDAR preview: lidar evaluate --field FIELD [--focus 54] [--json]
+    design       gain synthesis: design baseline|lqr|ts|ibc|coleman-ipc [...] --out DIR
+    export       gain tables: export DIR --format csv|json|mat|rosco
+    campaign     load-case campaigns on Dask: campaign run SPEC.yaml, status, report
+    tune         design parameters optimized over load cases: tune SPEC.yaml --out DIR
+    bench        bench mpc: QP solver comparison
+    compare-openfast  an OpenFAST case run on mpc-wt's plant, compared with its output:
+                 compare-openfast CASE.fst --outb CASE.outb [--wind FILE.bts]
+    verify-openfast  a kind exported and run in your OpenFAST and on mpc-wt's plant,
+                 differences flagged: verify-openfast KIND CASE.fst --out DIR
+    solver       the exported MPC's QP solver sources: solver fetch [--from FILE], status
 
 ``--plugin MODULE`` (before the subcommand, repeatable) imports a module that registers
 controller kinds, which ``simulate`` and campaign specs can then use.
