@@ -439,6 +439,9 @@ def _comparison_row(name: str, a: dict[str, Any], cols: dict[str, np.ndarray],
                     qp: Any, fname: str, solver: str | None = None) -> dict[str, Any]:
     return {"controller": name, "power_mean_MW": a["power_mean_W"] / 1e6,
             "power_std_kW": a["power_std_W"] / 1e3,
+            "power_max_MW": float(np.max(cols["gen_power"])) / 1e6,
+            "rotor_speed_max_rpm": float(np.max(cols["rotor_speed"])) * 30 / math.pi,
+            "gen_torque_max_kNm": float(np.max(cols["gen_torque"])) / 1e3,
             "rotor_speed_std_rpm": float(np.std(cols["rotor_speed"])) * 30 / math.pi,
             "rotor_speed_min_rpm": float(np.min(cols["rotor_speed"])) * 30 / math.pi,
             "pitch_travel_deg": a["pitch_travel_deg"],
@@ -499,18 +502,19 @@ def _comparison_runs(turbine: linearize.Turbine, args: argparse.Namespace, out: 
           f"{args.seed}, the same field for all; statistics over {w[0]:g}-{w[1]:g} s (the "
           f"start's transient left out, as mpcwt assess does); DELs at 1 Hz equivalent "
           f"cycles, blade flap m = 10, tower-base fore-aft and shaft bending m = 4")
-    print(f"{'controller':20s} {'P mean':>8s} {'P std':>8s} {'speed std':>9s} "
-          f"{'pitch':>7s} {'DEL flap':>9s} {'DEL tower':>9s} {'DEL shaft':>9s} "
+    print(f"{'controller':20s} {'P mean':>8s} {'P std':>8s} {'P max':>7s} {'speed std':>9s} "
+          f"{'max':>6s} {'pitch':>7s} {'DEL flap':>9s} {'DEL tower':>9s} {'DEL shaft':>9s} "
           f"{'QP med/p99':>17s}")
-    print(f"{'':20s} {'':>8s} {'':>8s} {'rotor':>9s} {'travel':>7s} {'root':>9s} "
-          f"{'base FA':>9s} {'bending':>9s} {'':>17s}")
-    print(f"{'':20s} {'[MW]':>8s} {'[kW]':>8s} {'[rpm]':>9s} {'[deg]':>7s} {'[MN m]':>9s} "
-          f"{'[MN m]':>9s} {'[MN m]':>9s} {'[ms], solver':>17s}")
+    print(f"{'':20s} {'':>8s} {'':>8s} {'':>7s} {'rotor':>9s} {'rotor':>6s} {'travel':>7s} "
+          f"{'root':>9s} {'base FA':>9s} {'bending':>9s} {'':>17s}")
+    print(f"{'':20s} {'[MW]':>8s} {'[kW]':>8s} {'[MW]':>7s} {'[rpm]':>9s} {'[rpm]':>6s} "
+          f"{'[deg]':>7s} {'[MN m]':>9s} {'[MN m]':>9s} {'[MN m]':>9s} {'[ms], solver':>17s}")
     for r in rows:
         qp = (f"{r['qp_median_ms']:.2f}/{r['qp_p99_ms']:.2f} {r['qp_solver'] or ''}".rstrip()
               if r["qp_median_ms"] is not None else "-")
         print(f"{r['controller']:20s} {r['power_mean_MW']:8.3f} {r['power_std_kW']:8.1f} "
-              f"{r['rotor_speed_std_rpm']:9.3f} {r['pitch_travel_deg']:7.0f} "
+              f"{r['power_max_MW']:7.3f} {r['rotor_speed_std_rpm']:9.3f} "
+              f"{r['rotor_speed_max_rpm']:6.2f} {r['pitch_travel_deg']:7.0f} "
               f"{r.get('del_flap_moment_1_MNm', float('nan')):9.3f} "
               f"{r.get('del_tower_base_fa_moment_MNm', float('nan')):9.3f} "
               f"{r.get('del_shaft_bending_blade1_MNm', float('nan')):9.3f} {qp:>17s}")

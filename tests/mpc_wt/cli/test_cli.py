@@ -59,6 +59,19 @@ def test_run_writes_table_and_plots(tmp_path: Path, capsys: pytest.CaptureFixtur
     rows = json.loads((tmp_path / "comparison.json").read_text())
     assert [r["controller"] for r in rows] == ["baseline", "baseline+lidar-ff", "mpc-lidar"]
     assert rows[2]["qp_median_ms"] > 0 and rows[0]["qp_median_ms"] is None
+    # the largest power, rotor speed and torque over the window each row states, read back
+    # from the run it names
+    from mpc_wt.simulation.results import ClosedLoopResult
+
+    for r in rows:
+        res = ClosedLoopResult.load(tmp_path / r["file"])
+        k = (res.t >= r["window_s"][0]) & (res.t <= r["window_s"][1])
+        assert r["window_s"] == [3.0, 30.0]                 # a tenth of a 30 s run
+        assert r["power_max_MW"] == pytest.approx(res.channel("gen_power")[k].max() / 1e6)
+        assert r["rotor_speed_max_rpm"] == pytest.approx(
+            res.channel("rotor_speed")[k].max() * 30 / np.pi)
+        assert r["gen_torque_max_kNm"] == pytest.approx(res.channel("gen_torque")[k].max() / 1e3)
+    assert "statistics over 3-30 s" in out and "P max" in out
     assert "mpc-lidar" in out and "QP med/p99" in out
     # the MPC line names its solver: DAQP, the default, is a core dependency
     assert rows[2]["qp_solver"] == "daqp"
