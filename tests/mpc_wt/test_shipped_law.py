@@ -23,11 +23,18 @@ _FIELDS = FieldMemo()
 _KW = dict(duration=30.0, turbulence="A", seed=23, fields=_FIELDS)
 
 
+#: the exportable kinds whose options have no default, with theirs
+_REQUIRED = {"derate": ("derate80", None), "apc": ("apc", {"apc_frequency": 0.05})}
+
+
 @pytest.mark.parametrize("kind", sorted(exportable()))
 def test_the_shipped_run_is_the_users_export_run(turbine, kind, tmp_path):
     """Every exportable kind, 30 s of class-A turbulence at 14 m/s: the shipped run and the run
     of the user's export of the same design give the same demands to the last bit, and both
     say which law ran."""
+    if kind in _REQUIRED:
+        _the_shipped_run_from_its_own_trim(turbine, *_REQUIRED[kind], tmp_path)
+        return
     shipped = run_controller(turbine, kind, 14.0, shipped=True, **_KW)
     assert shipped.meta["law"] == "shipped"
     ex = export_discon(turbine, kind, tmp_path / "export")
@@ -39,15 +46,38 @@ def test_the_shipped_run_is_the_users_export_run(turbine, kind, tmp_path):
     np.testing.assert_array_equal(shipped.u, user.u)        # the same law on the same inputs
 
 
+def _the_shipped_run_from_its_own_trim(turbine, kind, options, tmp_path):
+    """A kind that starts from a trim of its own (derated, a power reference): the user's
+    export run by the host from that start, on the same wind."""
+    from mpc_wt.controllers.discon import DisconController
+    from mpc_wt.run import build_controller
+    from mpc_wt.simulation.loop import simulate_closed_loop
+    from mpc_wt.simulation.scenario import Scenario
+
+    sc = Scenario(14.0, turbulence="A", seed=23, duration=30.0)
+    built, op, field = build_controller(turbine, kind, sc, options, shipped=True,
+                                        fields=_FIELDS)
+    assert built.meta["law"] == "shipped"
+    ex = export_discon(turbine, kind, tmp_path / "export", options)
+    user = DisconController(ex.library, ex.input_file, turbine, dt=ex.dt, isolate=False)
+    runs = [simulate_closed_loop(linearize.plant_params(turbine), c, field, sc.duration,
+                                 x0=op.x, u0=op.u, controller_dt=ex.dt)
+            for c in (built.controller, user)]
+    np.testing.assert_array_equal(runs[0].u, runs[1].u)
+
+
 def test_the_python_step_stays_where_the_library_takes_no_such_design(turbine):
-    """An MPC on OSQP (the library solves with DAQP) and IBC on a derated baseline (the
-    library's IBC is on the full-power baseline) keep their Python step, and say so."""
+    """An MPC on OSQP (the library solves with DAQP) keeps its Python step and says so; the
+    baseline's compositions (derated, with IBC or Coleman IPC on it, active power control) run
+    the baseline's library."""
     r = run_controller(turbine, "mpc", 14.0, {"backend": "osqp"}, shipped=True, duration=2.0,
                        turbulence="A", seed=23)
     assert r.meta["law"] == "python"
-    r = run_controller(turbine, "derate80+ibc", 14.0, shipped=True, duration=2.0,
-                       turbulence="A", seed=23)
-    assert "law" not in r.meta                 # no shipped law for this composition
+    for kind, opts in (("derate80+ibc", None), ("derate70+coleman-ipc", None),
+                       ("coleman-ipc", None), ("apc", {"apc_frequency": 0.1})):
+        r = run_controller(turbine, kind, 14.0, opts, shipped=True, duration=2.0,
+                           turbulence="A", seed=23)
+        assert r.meta["law"] == "shipped", kind
     r = run_controller(turbine, "baseline", 14.0, duration=2.0, turbulence="A", seed=23)
     assert r.meta["law"] == "shipped"          # the library unless the Python step is asked
     r = run_controller(turbine, "baseline", 14.0, duration=2.0, turbulence="A", seed=23,

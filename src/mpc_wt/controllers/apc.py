@@ -3,18 +3,60 @@
 from __future__ import annotations
 
 import math
-from typing import Callable
+from dataclasses import dataclass
 
 from linearize.validate import check_number
 
-__all__ = ["check_weight_range", "apc_reference", "power_weight"]
+__all__ = ["check_weight_range", "apc_reference", "power_weight", "PowerReduction",
+           "PowerReference"]
+
+
+@dataclass(frozen=True)
+class PowerReduction:
+    """Delta P(t) = offset + amplitude sin(2 pi f_r t) (Clemens eq 11) [-]; call with t [s].
+
+    Parameters
+    ----------
+    frequency_hz : float
+        f_r [Hz].
+    amplitude : float
+        [-]
+    offset : float
+        [-]
+    """
+
+    frequency_hz: float
+    amplitude: float
+    offset: float
+
+    def __call__(self, t: float) -> float:
+        return self.offset + self.amplitude * math.sin(2.0 * math.pi * self.frequency_hz * t)
+
+
+@dataclass(frozen=True)
+class PowerReference:
+    """The power reference P_r (1 - Delta P(t)) [W]; call with t [s].
+
+    Parameters
+    ----------
+    rated_power_W : float
+        P_r [W].
+    reduction : PowerReduction
+        Delta P.
+    """
+
+    rated_power_W: float
+    reduction: PowerReduction
+
+    def __call__(self, t: float) -> float:
+        return self.rated_power_W * (1.0 - self.reduction(t))
 
 
 # --------------------------------------------------------------------------------------------
 # Active power control reference
 # --------------------------------------------------------------------------------------------
 def apc_reference(frequency_hz: float, *, amplitude: float = 0.375, offset: float = 0.375
-                  ) -> Callable[[float], float]:
+                  ) -> PowerReduction:
     """Power reduction Delta P(t) = offset + amplitude sin(2 pi f_r t) (Clemens eq 11); the
     power reference is P_r (1 - Delta P).
 
@@ -34,7 +76,7 @@ def apc_reference(frequency_hz: float, *, amplitude: float = 0.375, offset: floa
 
     Returns
     -------
-    callable
+    PowerReduction
         t [s] -> Delta P(t) [-].
 
     Raises
@@ -55,7 +97,7 @@ def apc_reference(frequency_hz: float, *, amplitude: float = 0.375, offset: floa
     if o + a >= 1.0:
         raise ValueError(f"offset + amplitude = {o + a:g}: the power reference would fall to "
                          f"{100 * (1 - o - a):.0f} % of rated; need offset + amplitude < 1")
-    return lambda t: o + a * math.sin(2.0 * math.pi * f * t)
+    return PowerReduction(f, a, o)
 
 
 def power_weight(power_W: float, rated_power_W: float, weight_range: tuple[float, float]) -> float:

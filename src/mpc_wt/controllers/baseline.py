@@ -467,6 +467,9 @@ class BaselineController(ControllerBase):
                 gains = sched[-1]
         else:
             self._sched_f = None
+        #: the designs the gains are scheduled over (active power control), by fraction
+        self.gain_schedule: tuple[BaselineGains, ...] = (
+            tuple(sched) if gain_schedule is not None else ())
         self.gains = gains or tune_baseline(turbine)
         self.dt = float(dt)
         self.region3 = region3

@@ -74,8 +74,8 @@ class LawExport:
     log : tuple of str
         The logging channels the law returns (records 65 and 63 on), in order: the signals a
         shipped run records beside the host's.
-    base : str, optional
-        For an add-on: the base its export is made on (another base keeps the Python step).
+    base : str or tuple of str, optional
+        For an add-on: the bases its export is made on (another base keeps the Python step).
     rebuilt : bool
         A saved design of the kind exports by building it again from its options (False:
         from its gain table).
@@ -91,7 +91,7 @@ class LawExport:
     sources: tuple[str, ...] = ()
     qp: bool = False
     log: tuple[str, ...] = ()
-    base: str | None = None
+    base: str | tuple[str, ...] | None = None
     rebuilt: bool = True
     check_saved: Callable[[Mapping[str, Any]], None] | None = None
 

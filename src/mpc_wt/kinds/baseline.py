@@ -102,6 +102,8 @@ register("baseline-ct", BaselineOptions, field_components="u",
 register("derate", DerateOptions, field_components="u", pattern=r"derate(\d+(?:\.\d+)?)",
          pattern_options=_derate_preset, pattern_help="derateNN (NN % of rated power)",
          operating_point=derated_trim,
+         export=LawExport("derate", "the baseline derated to a fraction of rated power, its PI "
+                          "re-tuned", "baseline", _baseline_input),
          summary="the baseline derated to NN % of rated power, PI re-tuned")(
     baseline_build("constant_power"))
 

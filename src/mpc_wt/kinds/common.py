@@ -152,7 +152,8 @@ def check_design_wind(turbine: linearize.Turbine, v: float) -> float:
 # wind estimator's and a schedule's region floor ------------------------------------------
 
 
-def baseline_entries(ctl: Any, prefix: str = "") -> list[tuple[str, Any, str]]:
+def baseline_entries(ctl: Any, prefix: str = "", *, schedule: bool = False
+                     ) -> list[tuple[str, Any, str]]:
     """The numbers of a :class:`~mpc_wt.controllers.baseline.BaselineController` as input-file
     entries: the baseline law's, which every law's torque schedule is.
 
@@ -162,6 +163,9 @@ def baseline_entries(ctl: Any, prefix: str = "") -> list[tuple[str, Any, str]]:
         The design.
     prefix : str
         Before every key (``law.`` for the torque schedule in another law).
+    schedule : bool
+        Allow a power reference and a gain schedule (active power control), whose entries
+        the caller adds.
 
     Returns
     -------
@@ -178,7 +182,7 @@ def baseline_entries(ctl: Any, prefix: str = "") -> list[tuple[str, Any, str]]:
     if type(ctl) is not BaselineController:
         raise ValueError(f"the baseline export takes a BaselineController, got "
                          f"{type(ctl).__name__}")
-    if ctl.power_reference is not None or ctl._sched_f is not None:
+    if not schedule and (ctl.power_reference is not None or ctl.gain_schedule):
         raise ValueError("a baseline with a power reference or a gain schedule (active power "
                          "control) does not export yet: export the plain design")
     g, tb = ctl.gains, ctl.turbine

@@ -123,7 +123,7 @@ def _check_saved_ibc(doc: Any) -> None:
 IBC_EXPORT = LawExport(
     "ibc", "Pettas and Cheng's individual blade control on the baseline: each blade's root "
     "moment filtered, scaled by the gain scheduled on the mean pitch, faded in with the power",
-    "baseline", _ibc_entries, base="baseline",
+    "baseline", _ibc_entries, base=("baseline", "derate"),
     log=("ibc_weight", "ibc_gain", "ibc_pitch_1", "ibc_pitch_2", "ibc_pitch_3"),
     check_saved=_check_saved_ibc)
 
@@ -162,8 +162,43 @@ class ColemanIPCOptions(Options):
                                              unit="-", lo=0.0, flag="")
 
 
+def _coleman_entries(ctl: Any, preview: Any = None) -> list[tuple[str, Any, str]]:
+    """A :class:`~mpc_wt.controllers.ipc.ColemanIPCController` on the baseline: the baseline's
+    law and the IPC's gain schedule, power fade-in and limits."""
+    from mpc_wt.controllers.ipc import ColemanIPCController
+
+    if type(ctl) is not ColemanIPCController:
+        raise ValueError(f"the coleman-ipc export takes a ColemanIPCController, got "
+                         f"{type(ctl).__name__}")
+    g = ctl.gains
+    return baseline_entries(ctl.collective) + [
+        ("feedforward", 0.0, "no LIDAR feedforward"),
+        ("ibc", 0.0, "no individual blade control"),
+        ("coleman_ipc", 1.0, "1: Coleman-frame integral IPC on the collective command"),
+        ("coleman_settings", np.array([g.weight_range[0], g.weight_range[1], g.rated_power,
+                                       math.exp(-ctl.dt / ctl.power_tau), ctl.pitch_min,
+                                       ctl.pitch_max, ctl.step_max / ctl.dt,
+                                       min(g.max_amplitude_rad, 1e300)], float),
+         "the fade-in's power fractions [-], the power it refers to [W], the power filter's "
+         "pole, pitch min, max [rad], pitch rate [rad/s], the largest cyclic amplitude [rad]"),
+        ("coleman_pitch", np.asarray(g.pitch_rad, float), "mean pitch of the gain schedule "
+                                                          "[rad]"),
+        ("coleman_ki", np.asarray(g.ki, float), "integral gain [rad/(N m s)]"),
+        ("coleman_azimuth_offset", np.asarray(g.azimuth_offset_rad, float),
+         "azimuth offset phi that decouples tilt and yaw [rad]"),
+    ]
+
+
+#: Coleman IPC's export: the baseline's law with the IPC on its collective command
+COLEMAN_EXPORT = LawExport(
+    "coleman-ipc", "Coleman-frame integral IPC on the baseline: the blades' root moments to "
+    "tilt and yaw, integrated to a cyclic pitch with the gain scheduled on the mean pitch, "
+    "faded in with the power", "baseline", _coleman_entries, base=("baseline", "derate"),
+    log=("ipc_weight", "ipc_tilt_moment", "ipc_yaw_moment", "ipc_pitch_cos", "ipc_pitch_sin"))
+
+
 @register("coleman-ipc", ColemanIPCOptions, field_components="u", addon_to=("baseline", "derate"),
-          default_base="baseline", design=_design_coleman,
+          default_base="baseline", design=_design_coleman, export=COLEMAN_EXPORT,
           summary="tilt/yaw integral IPC on a baseline (coleman-ipc, derateNN+coleman-ipc)")
 def _build_coleman(ctx: BuildContext, opts: ColemanIPCOptions, base: Built) -> Built:
     from mpc_wt.controllers.ipc import ColemanIPCController, tune_coleman_ipc

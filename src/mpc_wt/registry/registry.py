@@ -300,7 +300,8 @@ class Selection:
         base = getattr(ex, "base", None)
         if base is None:
             return ex if not self.addons else None
-        return ex if len(self.addons) == 1 and self.base.name == base else None
+        bases = (base,) if isinstance(base, str) else tuple(base)
+        return ex if len(self.addons) == 1 and self.base.name in bases else None
 
     @property
     def field_components(self) -> str:

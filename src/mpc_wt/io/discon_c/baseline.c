@@ -28,11 +28,26 @@ typedef struct {
     int has_ff_last;
 } mw_ff;
 
+/* active power control (Clemens et al. 2022, eq 11): the power reference
+ * P_r (1 - offset - amplitude sin(2 pi f t)) replaces rated power above rated; the PI's gains
+ * KP GK(theta), KI GK(theta) of the designs at several power fractions interpolated on the
+ * reference's fraction (the integral in pitch units, so a gain change moves no command), and
+ * each change of the reference moving the pitch by dP_ref / (eta dP/dtheta) */
+#define MW_APC_MAX 16
+typedef struct {
+    int on, n, saturated;
+    double freq, amp, offset, p_full;
+    double f[MW_APC_MAX], kp[MW_APC_MAX], ki[MW_APC_MAX], thk[MW_APC_MAX], dpdt[MW_APC_MAX];
+    double p_ref, p_ref_last, gk;
+} mw_apc;
+
 typedef struct {
     mw_ctrl base;
     mw_law law;
     mw_ff ff;
     mw_ibc ibc;
+    mw_cipc cipc;
+    mw_apc apc;
     /* state */
     double w_filt, integral, last_pitch, last_tq;
     int started;
@@ -263,11 +278,100 @@ static int ff_step(mw_ff *f, const mw_meas *m, double *pitch, char *msg)
     return 0;
 }
 
+/* the power reference at t [W]; -1 with msg outside (0, rated power] */
+static int apc_reference(mw_apc *a, const mw_law *c, double t, char *msg)
+{
+    double p = a->p_full * (1.0 - (a->offset + a->amp * sin(2.0 * MW_PI * a->freq * t)));
+    if (!(mw_finite(p) && p > 0.0 && p <= c->p_rated * (1.0 + 1e-9))) {
+        mw_msg(msg, "mpc-wt apc: the power reference at t = %g s is %g W; allowed: (0, rated "
+               "power %g W]", t, p, c->p_rated);
+        return -1;
+    }
+    a->p_ref = p;
+    return 0;
+}
+
+/* the scheduled PI step of active power control: the pitch command [rad] */
+static double apc_pitch(mw_baseline *b, double err, double pitch_meas, int first, double *off)
+{
+    const mw_law *c = &b->law;
+    mw_apc *a = &b->apc;
+    double kps[MW_APC_MAX], kis[MW_APC_MAX], dps[MW_APC_MAX], kp, ki, ff = 0.0, p_lo, p, step;
+    double frac = a->p_ref / a->p_full;
+    int j;
+    for (j = 0; j < a->n; j++) {
+        double gks = 1.0 / (1.0 + b->last_pitch / a->thk[j]);
+        kps[j] = a->kp[j] * gks;
+        kis[j] = a->ki[j] * gks;
+        dps[j] = a->dpdt[j] / gks;
+    }
+    kp = mw_interp(frac, a->f, kps, a->n);
+    ki = mw_interp(frac, a->f, kis, a->n);
+    a->gk = kp / c->kp;
+    if (first) {
+        b->integral = pitch_meas - kp * err;
+        a->p_ref_last = a->p_ref;
+    }
+    ff = (a->p_ref - a->p_ref_last) / c->eta / mw_interp(frac, a->f, dps, a->n);
+    a->p_ref_last = a->p_ref;
+    *off = mw_law_min_pitch_offset(c, b->w_filt);
+    p_lo = c->p_min + *off;
+    b->integral = dmin(dmax(b->integral + ki * err * c->dt + ff, p_lo), c->p_max);
+    p = dmin(dmax(kp * err + b->integral, p_lo), c->p_max);
+    step = c->rate * c->dt;
+    p = dmin(dmax(p, b->last_pitch - step), b->last_pitch + step);
+    a->saturated = p <= p_lo + 1e-9 && err < 0.0;
+    return p;
+}
+
+/* the DISCON-form PI step: the pitch command [rad] */
+static double pi_pitch(mw_baseline *b, double err, double pitch_meas, int first, double ffd,
+                       double *off)
+{
+    const mw_law *c = &b->law;
+    double gk = 1.0 / (1.0 + b->last_pitch / c->theta_k), lo, hi, p, step, p_lo;
+    if (first) b->integral = (pitch_meas / gk - c->kp * err) / c->ki;
+    b->integral += err * c->dt + ffd / (gk * c->ki);
+    *off = mw_law_min_pitch_offset(c, b->w_filt);
+    p_lo = c->p_min + *off;
+    lo = p_lo / (gk * c->ki);
+    hi = c->p_max / (gk * c->ki);
+    b->integral = dmin(dmax(b->integral, lo), hi);
+    p = gk * (c->kp * err + c->ki * b->integral);
+    p = dmin(dmax(p, p_lo), c->p_max);
+    step = c->rate * c->dt;
+    return dmin(dmax(p, b->last_pitch - step), b->last_pitch + step);
+}
+
+/* the add-ons on the collective command p: IBC or Coleman IPC, with their logging channels */
+static int addons_step(mw_baseline *b, const mw_meas *m, double p, mw_cmd *out, char *msg)
+{
+    double pc[3] = {p, p, p};
+    int i, n = out->nlog;
+    if (b->ibc.on) {                /* ibc_weight, ibc_gain, ibc_pitch_1..3 */
+        if (mw_ibc_step(&b->ibc, m, b->law.dt, pc, out->pitch, msg)) return -1;
+        out->log[n] = b->ibc.weight;
+        out->log[n + 1] = b->ibc.gain;
+        for (i = 0; i < 3; i++) out->log[n + 2 + i] = b->ibc.u[i];
+        out->nlog = n + 5;
+    } else if (b->cipc.on) {        /* ipc_weight, ipc_tilt_moment, ipc_yaw_moment,
+                                       ipc_pitch_cos, ipc_pitch_sin */
+        if (mw_cipc_step(&b->cipc, m, b->law.dt, pc, out->pitch, msg)) return -1;
+        out->log[n] = b->cipc.weight;
+        out->log[n + 1] = b->cipc.tilt;
+        out->log[n + 2] = b->cipc.yaw;
+        out->log[n + 3] = b->cipc.cyc_c;
+        out->log[n + 4] = b->cipc.cyc_s;
+        out->nlog = n + 5;
+    }
+    return 0;
+}
+
 static int baseline_step(mw_ctrl *self, const mw_meas *m, mw_cmd *out, char *msg)
 {
     mw_baseline *b = (mw_baseline *)self;
     const mw_law *c = &b->law;
-    double w = m->gen_speed, pitch_meas, err, gk, lo, hi, p, step, tq, off, p_lo, ffd = 0.0;
+    double w = m->gen_speed, pitch_meas, err, p, tq, off, p3 = c->p_rated, ffd = 0.0;
     int first = !b->started;
     if (b->ff.on) {
         double ff;
@@ -287,26 +391,21 @@ static int baseline_step(mw_ctrl *self, const mw_meas *m, mw_cmd *out, char *msg
                "finite at t = %g s", m->t);
         return -1;
     }
+    if (b->apc.on && apc_reference(&b->apc, c, m->t, msg)) return -1;
     if (first) {
         b->w_filt = w;
         b->last_pitch = pitch_meas;
     }
     b->w_filt = c->a * b->w_filt + (1 - c->a) * w;
     err = b->w_filt - c->w_set;
-    gk = 1.0 / (1.0 + b->last_pitch / c->theta_k);
-    if (first) b->integral = (pitch_meas / gk - c->kp * err) / c->ki;
-    b->integral += err * c->dt + ffd / (gk * c->ki);
-    off = mw_law_min_pitch_offset(c, b->w_filt);
-    p_lo = c->p_min + off;
-    lo = p_lo / (gk * c->ki);
-    hi = c->p_max / (gk * c->ki);
-    b->integral = dmin(dmax(b->integral, lo), hi);
-    p = gk * (c->kp * err + c->ki * b->integral);
-    p = dmin(dmax(p, p_lo), c->p_max);
-    step = c->rate * c->dt;
-    p = dmin(dmax(p, b->last_pitch - step), b->last_pitch + step);
+    if (b->apc.on) {
+        p = apc_pitch(b, err, pitch_meas, first, &off);
+        p3 = b->apc.p_ref;
+    } else {
+        p = pi_pitch(b, err, pitch_meas, first, ffd, &off);
+    }
     b->last_pitch = p;
-    tq = dmin(mw_law_torque(c, b->w_filt, p - off, c->p_rated), c->tq_max);
+    tq = dmin(mw_law_torque(c, b->w_filt, p - off, p3), c->tq_max);
     if (!first) {
         double d = c->tq_rate * c->dt;
         tq = dmin(dmax(tq, b->last_tq - d), b->last_tq + d);
@@ -323,16 +422,13 @@ static int baseline_step(mw_ctrl *self, const mw_meas *m, mw_cmd *out, char *msg
         out->log[3] = b->ff.corner;
         out->nlog = 4;
     }
-    if (b->ibc.on) {                /* ibc_weight, ibc_gain, ibc_pitch_1..3 */
-        double pc[3] = {p, p, p};
-        int i, n = out->nlog;
-        if (mw_ibc_step(&b->ibc, m, c->dt, pc, out->pitch, msg)) return -1;
-        out->log[n] = b->ibc.weight;
-        out->log[n + 1] = b->ibc.gain;
-        for (i = 0; i < 3; i++) out->log[n + 2 + i] = b->ibc.u[i];
-        out->nlog = n + 5;
+    if (b->apc.on) {                /* power_reference, apc_saturated, gain_schedule */
+        out->log[0] = b->apc.p_ref;
+        out->log[1] = (double)b->apc.saturated;
+        out->log[2] = b->apc.gk;
+        out->nlog = 3;
     }
-    return 0;
+    return addons_step(b, m, p, out, msg);
 }
 
 static void baseline_destroy(mw_ctrl *self)
@@ -345,6 +441,7 @@ static void baseline_destroy(mw_ctrl *self)
     free(b->ff.arr);
     free(b->ff.val);
     mw_ibc_free(&b->ibc);
+    mw_cipc_free(&b->cipc);
     free(self);
 }
 
@@ -386,6 +483,43 @@ static int ff_read(const mw_input *in, mw_ff *f, char *msg)
     return 0;
 }
 
+/* key "apc": frequency [Hz], amplitude, offset [-], the power the reference refers to [W];
+ * "apc_schedule": per design (by increasing power fraction) its fraction, kp [s], ki [-],
+ * theta_K [rad], dP/dtheta at fine pitch [W/rad] */
+static int apc_read(const mw_input *in, mw_apc *a, char *msg)
+{
+    double v[4], *sch;
+    int n = 0, j, bad = 0;
+    if (mw_getp_vec(in, "", "apc", v, 4, msg)
+        || !(sch = mw_getp_alloc(in, "", "apc_schedule", &n, msg)))
+        return -1;
+    if (n % 5 || n == 0 || n / 5 > MW_APC_MAX) bad = 1;
+    a->n = n / 5;
+    for (j = 0; !bad && j < a->n; j++) {
+        a->f[j] = sch[5 * j];
+        a->kp[j] = sch[5 * j + 1];
+        a->ki[j] = sch[5 * j + 2];
+        a->thk[j] = sch[5 * j + 3];
+        a->dpdt[j] = sch[5 * j + 4];
+        if (!(a->f[j] > 0 && a->f[j] <= 1) || (j > 0 && !(a->f[j] > a->f[j - 1]))
+            || !(a->thk[j] != 0) || !(a->dpdt[j] != 0)) bad = 1;
+    }
+    free(sch);
+    a->freq = v[0];
+    a->amp = v[1];
+    a->offset = v[2];
+    a->p_full = v[3];
+    if (bad || !(a->freq >= 0) || !(a->amp >= 0) || !(a->p_full > 0)) {
+        mw_msg(msg, "mpc-wt apc: input file '%s': key 'apc' needs a frequency >= 0 Hz, an "
+               "amplitude >= 0 and the power > 0 W; 'apc_schedule' 1 to %d designs of 5 values, "
+               "their power fractions increasing in (0, 1], theta_K and dP/dtheta non-zero",
+               in->path, MW_APC_MAX);
+        return -1;
+    }
+    a->on = 1;
+    return 0;
+}
+
 mw_ctrl *mw_baseline_new(const mw_input *in, char *msg)
 {
     mw_baseline *b = (mw_baseline *)calloc(1, sizeof(mw_baseline));
@@ -394,11 +528,14 @@ mw_ctrl *mw_baseline_new(const mw_input *in, char *msg)
         return NULL;
     }
     {
-        int ff = 0, ibc = 0;
+        int ff = 0, ibc = 0, cipc = 0;
         if (mw_law_read(in, "", &b->law, msg) || mw_get_int(in, "feedforward", 0, 1, &ff, msg)
             || (ff && ff_read(in, &b->ff, msg))
             || (mw_has(in, "ibc") && mw_get_int(in, "ibc", 0, 1, &ibc, msg))
-            || (ibc && mw_ibc_read(in, &b->ibc, msg))) {
+            || (ibc && mw_ibc_read(in, &b->ibc, msg))
+            || (mw_has(in, "coleman_ipc") && mw_get_int(in, "coleman_ipc", 0, 1, &cipc, msg))
+            || (cipc && mw_cipc_read(in, &b->cipc, msg))
+            || (mw_has(in, "apc") && apc_read(in, &b->apc, msg))) {
             baseline_destroy(&b->base);
             return NULL;
         }

@@ -14,6 +14,8 @@
 static double dmin(double a, double b) { return a < b ? a : b; }
 static double dmax(double a, double b) { return a > b ? a : b; }
 
+#define MW_PI_3 1.04719755119659774615  /* pi / 3 */
+
 void mw_sos_step(mw_sos *f, const double *x, double *y)
 {
     int c, k, nch = f->nch;
@@ -151,4 +153,113 @@ void mw_ibc_free(mw_ibc *b)
     free(b->gg);
     mw_sos_free(&b->hp);
     mw_sos_free(&b->bs);
+}
+
+/* ---- Coleman-frame integral IPC ------------------------------------------------------ */
+/* the low-passed electrical power's fade-in weight (no seed while the power is 0) */
+static double fade_in(double *p_filt, int *has_p, double alpha, double p, double rated,
+                      double lo, double hi)
+{
+    if (*has_p || p > 0.0) {
+        *p_filt = *has_p ? alpha * *p_filt + (1.0 - alpha) * p : p;
+        *has_p = 1;
+    }
+    return dmin(dmax((*p_filt / rated - lo) / (hi - lo), 0.0), 1.0);
+}
+
+int mw_cipc_step(mw_cipc *b, const mw_meas *m, double dt, const double *pc, double *out,
+                 char *msg)
+{
+    double psi = m->azimuth, c[3], s[3], w, k, phi, cp, sp, amp, c_mean, c_new, budget;
+    double d = b->rate * dt;
+    int i;
+    if (!mw_finite(m->flap[0] + m->flap[1] + m->flap[2]) || !mw_finite(psi)
+        || !mw_finite(m->gen_power)) {
+        mw_msg(msg, "mpc-wt coleman-ipc: measured blade root out-of-plane moments (records "
+               "30-32), azimuth (60) or electrical power (15) are not finite at t = %g s", m->t);
+        return -1;
+    }
+    for (i = 0; i < 3; i++) {
+        c[i] = cos(psi + i * 2.0 * MW_PI_3);
+        s[i] = sin(psi + i * 2.0 * MW_PI_3);
+    }
+    /* Coleman transform (Bossanyi 2003): M_tilt, M_yaw = 2/3 sum M_i (cos, sin) psi_i */
+    b->tilt = 2.0 / 3.0 * (m->flap[0] * c[0] + m->flap[1] * c[1] + m->flap[2] * c[2]);
+    b->yaw = 2.0 / 3.0 * (m->flap[0] * s[0] + m->flap[1] * s[1] + m->flap[2] * s[2]);
+    w = fade_in(&b->p_filt, &b->has_p, b->p_alpha, m->gen_power, b->rated, b->w_lo, b->w_hi);
+    c_mean = (pc[0] + pc[1] + pc[2]) / 3.0;
+    k = mw_interp(c_mean, b->gp, b->gk, b->ng);
+    phi = mw_interp(c_mean, b->gp, b->gphi, b->ng);
+    cp = cos(phi);
+    sp = sin(phi);
+    b->th_c -= w * k * (cp * b->tilt + sp * b->yaw) * dt;
+    b->th_s -= w * k * (-sp * b->tilt + cp * b->yaw) * dt;
+    amp = hypot(b->th_c, b->th_s);
+    if (amp > b->amp) {             /* anti-windup: the amplitude clamped */
+        b->th_c *= b->amp / amp;
+        b->th_s *= b->amp / amp;
+    }
+    b->weight = w;
+    b->cyc_c = w * b->th_c;
+    b->cyc_s = w * b->th_s;
+    if (!b->has_last) {             /* from the measured pitch at the first step */
+        b->c_last = (m->pitch[0] + m->pitch[1] + m->pitch[2]) / 3.0;
+        for (i = 0; i < 3; i++) b->a_last[i] = m->pitch[i] - b->c_last;
+        b->has_last = 1;
+    }
+    /* the collective's part moves first within the rate, the cyclic within what is left */
+    c_new = dmin(dmax(c_mean, b->c_last - d), b->c_last + d);
+    budget = d - fabs(c_new - b->c_last);
+    for (i = 0; i < 3; i++) {
+        double du = b->cyc_c * c[i] + b->cyc_s * s[i];
+        double a = dmin(dmax(pc[i] - c_mean + du, b->a_last[i] - budget), b->a_last[i] + budget);
+        out[i] = dmin(dmax(c_new + a, b->pmin), b->pmax);
+    }
+    b->c_last = c_new;
+    for (i = 0; i < 3; i++) b->a_last[i] = out[i] - c_new;
+    return 0;
+}
+
+int mw_cipc_read(const mw_input *in, mw_cipc *b, char *msg)
+{
+    double v[8];
+    int i;
+    memset(b, 0, sizeof(*b));
+    if (mw_getp_vec(in, "", "coleman_settings", v, 8, msg)
+        || !(b->gp = mw_getp_alloc(in, "", "coleman_pitch", &b->ng, msg))
+        || !(b->gk = mw_getp_alloc_n(in, "", "coleman_ki", b->ng, msg))
+        || !(b->gphi = mw_getp_alloc_n(in, "", "coleman_azimuth_offset", b->ng, msg)))
+        return -1;
+    b->w_lo = v[0];
+    b->w_hi = v[1];
+    b->rated = v[2];
+    b->p_alpha = v[3];
+    b->pmin = v[4];
+    b->pmax = v[5];
+    b->rate = v[6];
+    b->amp = v[7];
+    if (!(b->w_hi > b->w_lo) || !(b->rated > 0) || !(b->p_alpha >= 0 && b->p_alpha < 1)
+        || !(b->pmax >= b->pmin) || !(b->rate > 0) || !(b->amp > 0)) {
+        mw_msg(msg, "mpc-wt coleman-ipc: input file '%s': key 'coleman_settings' needs the "
+               "weight's power fractions increasing, rated power > 0, power filter pole in "
+               "[0, 1), pitch min <= max, a rate > 0 and a largest amplitude > 0", in->path);
+        return -1;
+    }
+    for (i = 1; i < b->ng; i++) {
+        if (!(b->gp[i] > b->gp[i - 1])) {
+            mw_msg(msg, "mpc-wt coleman-ipc: input file '%s': key 'coleman_pitch' must "
+                   "increase (value %d is %g after %g)", in->path, i + 1, b->gp[i],
+                   b->gp[i - 1]);
+            return -1;
+        }
+    }
+    b->on = 1;
+    return 0;
+}
+
+void mw_cipc_free(mw_cipc *b)
+{
+    free(b->gp);
+    free(b->gk);
+    free(b->gphi);
 }

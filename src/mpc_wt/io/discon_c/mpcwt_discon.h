@@ -173,6 +173,21 @@ void mw_ibc_free(mw_ibc *b);
 /* the blades' pitch demands from the collective ones pc; -1 with msg on a non-finite input */
 int mw_ibc_step(mw_ibc *b, const mw_meas *m, double dt, const double *pc, double *out,
                 char *msg);
+/* Coleman-frame integral IPC added to a collective command (ibc.c): the blades' root moments
+ * to tilt and yaw, rotated by the scheduled azimuth offset, integrated with the scheduled gain
+ * (amplitude clamped), faded in with the low-passed power, back to the blades; the
+ * collective's part within the pitch rate first, the cyclic within what is left */
+typedef struct {
+    int on, ng, has_p, has_last;
+    double *gp, *gk, *gphi;
+    double w_lo, w_hi, rated, p_alpha, pmin, pmax, rate, amp, p_filt;
+    double th_c, th_s, c_last, a_last[3];
+    double weight, tilt, yaw, cyc_c, cyc_s;   /* this step's weight, moments, cyclic pitch */
+} mw_cipc;
+int mw_cipc_read(const mw_input *in, mw_cipc *b, char *msg);
+void mw_cipc_free(mw_cipc *b);
+int mw_cipc_step(mw_cipc *b, const mw_meas *m, double dt, const double *pc, double *out,
+                 char *msg);
 /* whether the input file has a key */
 int mw_has(const mw_input *in, const char *key);
 
