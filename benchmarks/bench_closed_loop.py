@@ -17,6 +17,7 @@ import lidar
 import linearize
 from mpc_wt.assessment.fatigue import damage_equivalent_load
 from mpc_wt.controllers.baseline import BaselineController, tune_baseline
+from mpc_wt.run import law_controller
 from mpc_wt.simulation.loop import simulate_closed_loop
 
 
@@ -32,11 +33,12 @@ def main() -> int:
     f = lidar.generate_field(lidar.TurbulenceSpec(18.0, "A", duration=610.0), 1)
     gw = linearize.GridWind(t=f.t, y=f.y, z=f.z, u=np.maximum(f.u, 0.0))
     op = linearize.trim(t, 18.0)
-    simulate_closed_loop(p, BaselineController(t, g), gw, 2.0, x0=op.x, u0=op.u)
+    ctl = law_controller(BaselineController(t, g), "baseline", t)
+    simulate_closed_loop(p, ctl, gw, 2.0, x0=op.x, u0=op.u)
     times = []
     for _ in range(3):
         t0 = time.perf_counter()
-        r = simulate_closed_loop(p, BaselineController(t, g), gw, 600.0, x0=op.x, u0=op.u)
+        r = simulate_closed_loop(p, ctl, gw, 600.0, x0=op.x, u0=op.u)
         times.append(time.perf_counter() - t0)
     res["closed_loop_600s_best_s"] = min(times)
     res["closed_loop_600s_median_s"] = float(np.median(times))

@@ -46,7 +46,7 @@ import numpy as np
 import linearize
 from mpc_wt.controllers.baseline import BaselineController, tune_baseline
 from mpc_wt.controllers.mpc import MPC
-from mpc_wt.run import build_controller
+from mpc_wt.run import build_controller, law_controller
 from mpc_wt.simulation.loop import simulate_closed_loop
 from mpc_wt.simulation.scenario import Scenario
 from mpc_wt.simulation.solver_timing import _Timed
@@ -78,10 +78,10 @@ def _plant(t: Any, wind: Any, op: Any, repeat: int) -> dict[str, float]:
 
 def _baseline(t: Any, wind: Any, op: Any, repeat: int, compiled: bool = True) -> float:
     p, g = linearize.plant_params(t), tune_baseline(t)
-    simulate_closed_loop(p, BaselineController(t, g), wind, 2.0, x0=op.x, u0=op.u,
-                         compiled=compiled)
-    return _best(lambda: simulate_closed_loop(p, BaselineController(t, g), wind, DURATION,
-                                              x0=op.x, u0=op.u, compiled=compiled), repeat)
+    ctl = law_controller(BaselineController(t, g), "baseline", t)
+    simulate_closed_loop(p, ctl, wind, 2.0, x0=op.x, u0=op.u, compiled=compiled)
+    return _best(lambda: simulate_closed_loop(p, ctl, wind, DURATION, x0=op.x, u0=op.u,
+                                              compiled=compiled), repeat)
 
 
 #: The paper's point design of the MPC (the former default): like for like with earlier runs.

@@ -16,6 +16,7 @@ import numpy as np
 import lidar
 import linearize
 from mpc_wt.controllers.baseline import BaselineController
+from mpc_wt.run import law_controller
 from mpc_wt.simulation.loop import simulate_closed_loop
 
 CONFIGS = (("default plant", {}),
@@ -45,7 +46,7 @@ def main() -> int:
         params = linearize.plant_params(turbine, cfg)
         times = []
         for k in range(args.repeat + 1):       # the first run compiles
-            ctl = BaselineController(turbine)
+            ctl = law_controller(BaselineController(turbine), "baseline", turbine)
             t0 = time.perf_counter()
             simulate_closed_loop(params, ctl, wind, args.duration, x0=op.x, u0=op.u)
             if k:

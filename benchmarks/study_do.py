@@ -23,6 +23,7 @@ from mpc_wt import SimulationDivergedError, simulate_closed_loop
 from mpc_wt.assessment.fatigue import damage_equivalent_load
 from mpc_wt.assessment.performance import cs_measures
 from mpc_wt.controllers.baseline import BaselineController, tune_baseline
+from mpc_wt.run import law_controller
 from mpc_wt.controllers.lqr import (
     REGION3_SCALES,
     REGION3_WEIGHTS,
@@ -75,7 +76,8 @@ def main() -> int:
     for seed in (int(s) for s in args.seeds.split(",")):
         wind, _ = make_wind(tb, Scenario(v, "C", seed, dur, 0.2))
         for name, spec in cases.items():
-            ctl = BaselineController(tb, gains, region3="constant_torque") if spec is None \
+            ctl = law_controller(BaselineController(tb, gains, region3="constant_torque"),
+                                 "baseline", tb) if spec is None \
                 else _fsf(model, tb, *spec)
             try:
                 r = simulate_closed_loop(params, ctl, wind, dur, x0=op.x, u0=op.u, progress=True)

@@ -57,6 +57,7 @@ _WHERE = {
     "register": "mpc_wt.registry.registry",
     "build_controller": "mpc_wt.run",
     "export_discon": "mpc_wt.run",
+    "law_controller": "mpc_wt.run",
     "run_controller": "mpc_wt.run",
     "simulate_closed_loop": "mpc_wt.simulation.loop",
     "LidarPreview": "mpc_wt.simulation.preview",
@@ -77,7 +78,8 @@ __all__ = ["__version__", "controllers", "registry", "DEFAULT_CHANNELS", "assess
            "IBCController", "apc_reference", "tune_coleman_ipc", "tune_ibc", "LidarPreview",
            "simulate_closed_loop", "LQRPIOController", "design_lqr", "design_lqr_family",
            "design_pi_observer", "TSController", "build_ts_model", "design_ts_controller",
-           "design_ts_observer", "WindSpeedEstimator", "tune", "export_discon"]
+           "design_ts_observer", "WindSpeedEstimator", "tune", "export_discon",
+           "law_controller"]
 
 
 def __getattr__(name: str) -> Any:

@@ -12,6 +12,7 @@ from threadpoolctl import threadpool_limits
 
 import lidar
 import linearize
+from mpc_wt.controllers.base import DesignBase
 from mpc_wt.errors import RunTooLargeError
 from mpc_wt.registry.context import DEFAULT_CACHE, BuildContext, Built, DesignCache, design_digest
 from mpc_wt.registry.options import Options
@@ -23,6 +24,7 @@ from mpc_wt.simulation.scenario import (DEFAULT_FIELDS, FieldMemo, Scenario, lid
                                        make_wind, start_wind)
 
 __all__ = ["run_controller", "build_controller", "design_controller", "export_discon",
+           "export_controller", "law_controller",
            "run_openfast_case", "run_warnings", "verify_openfast", "CASE_CONTROLLERS",
            "VALIDITY_SIGNALS", "VERIFY_BOUNDS"]
 
@@ -81,7 +83,9 @@ def design_controller(turbine: linearize.Turbine, controller: str,
         The turbine's plant parameters, if already derived.
     shipped : bool
         The design run as it is shipped, where the kind has a shipped law; False (default):
-        the design's Python objects (what an export writes out).
+        the design's Python objects (what an export writes out). A design without a step of
+        its own (:class:`~mpc_wt.controllers.base.DesignBase`: the baseline, derated, APC,
+        IBC, Coleman IPC, the LIDAR feedforward) runs as shipped either way.
 
     Returns
     -------
@@ -119,7 +123,7 @@ def _design(turbine: linearize.Turbine, sel: Selection, opts: Sequence[Options],
     key = ("built", sel.name, tuple(repr(o) for o in opts))
     built = cache.get(turbine, key, make)
     export = sel.export
-    if not shipped or export is None:
+    if export is None or not (shipped or isinstance(built.controller, DesignBase)):
         return built, bool(made)
     from mpc_wt.kinds.common import run_as_shipped
 
@@ -165,7 +169,8 @@ def build_controller(turbine: linearize.Turbine, controller: str, scenario: Scen
         none).
     shipped : bool
         Run a kind that exports as it is shipped, its compiled C law (default); False: the
-        design's Python step (:func:`design_controller`), for studies of the design itself.
+        design's Python step (:func:`design_controller`), for studies of the design itself,
+        where it has one.
 
     Returns
     -------
@@ -495,6 +500,50 @@ def export_controller(controller: Any, kind: str, turbine: linearize.Turbine, ou
                                 compiler=compiler, source=source, preview=preview)
 
 
+def law_controller(controller: Any, kind: str, turbine: linearize.Turbine, *,
+                   lidar: Any = None, preview: Any = None) -> Any:
+    """A controller object a kind builds (a design changed by hand, a derated baseline, a
+    :class:`~mpc_wt.controllers.baseline.BaselineController` of your gains) run by its kind's
+    shipped law: its numbers in the law's input file, the compiled library called in this
+    process as OpenFAST's ServoDyn calls it (what ``run_controller`` runs).
+
+    Parameters
+    ----------
+    controller : object
+        The design (of the type the kind builds; ``Built.designed``).
+    kind : str
+        Its kind (one of :func:`mpc_wt.registry.exportable`; a design's ``kind`` attribute
+        names it).
+    turbine : Turbine
+        Its turbine.
+    lidar : lidar.LidarSensor, optional
+        The LIDAR whose measurements fill the lidar records (default: the design's
+        ``sensor``, if it has one: the LIDAR feedforward).
+    preview : LidarPreview, optional
+        The design's LIDAR preview (the MPC with LIDAR).
+
+    Returns
+    -------
+    mpc_wt.controllers.discon.DisconController
+        A controller for :func:`~mpc_wt.simulation.loop.simulate_closed_loop`, at the design's
+        period (``dt``).
+
+    Raises
+    ------
+    ValueError
+        A kind that does not export, or a controller its law does not take.
+    ControllerLibraryError
+        No C compiler, or the build failed.
+    """
+    from mpc_wt.io import discon_export as dx
+    from mpc_wt.kinds.common import shipped_host
+
+    export = law_export(kind)
+    dx.prepare_sources(export)
+    return shipped_host(controller, export, turbine, preview,
+                        lidar=lidar if lidar is not None else getattr(controller, "sensor", None))
+
+
 def export_saved_design(doc: Mapping[str, Any], turbine: linearize.Turbine, out: str | Path,
                         *, build: bool = True, compiler: str | None = None) -> Any:
     """Export a saved design (a gain-table document of ``mpcwt design``) as a library: a
@@ -604,8 +653,8 @@ def run_openfast_case(case: Any, controller: str = "auto", *, library: str | Pat
     field = case_wind_field(case) if case.steady_wind is None else None
     wind, shift = case_grid_wind(case, field)
     if controller == "jonkman":
-        gains = jonkman_gains()
-        ctl: Any = BaselineController(turbine, gains, dt=dt)
+        ctl: Any = law_controller(BaselineController(turbine, jonkman_gains(), dt=dt),
+                                  "baseline", turbine)
     else:
         lib = rosco_library() if controller == "rosco" else library
         dis = discon_in if discon_in is not None else case.discon_in

@@ -8,6 +8,7 @@ import pytest
 import lidar
 import linearize
 from mpc_wt.controllers.baseline import BaselineController, tune_baseline
+from mpc_wt.run import law_controller
 from mpc_wt.simulation.loop import simulate_closed_loop
 
 
@@ -25,5 +26,6 @@ def _field(v: float, turb, seed: int) -> tuple[linearize.GridWind, lidar.WindFie
 def run18(turbine: linearize.Turbine, params: linearize.PlantParams, gains):
     gw, _ = _field(18.0, "A", 1)
     op = linearize.trim(turbine, 18.0)
-    return simulate_closed_loop(params, BaselineController(turbine, gains), gw, 600.0,
+    ctl = law_controller(BaselineController(turbine, gains), "baseline", turbine)
+    return simulate_closed_loop(params, ctl, gw, 600.0,
                                 x0=op.x, u0=op.u)

@@ -624,16 +624,17 @@ def test_sanitized_libraries_run_60_s_clean(baseline_export, mpc_export, mpc_lid
 
 
 def test_kinds_that_do_not_export_are_named(nrel5mw, tmp_path):
-    with pytest.raises(ValueError, match="baseline"):
-        export_discon(nrel5mw, "coleman-ipc", tmp_path)
+    with pytest.raises(ValueError, match="does not export.*'coleman-ipc'"):
+        export_discon(nrel5mw, "rosco", tmp_path)
     with pytest.raises(ValueError, match="LIDAR"):
         from mpc_wt.io.discon_export import controller_input
         from mpc_wt.run import design_controller
         controller_input(design_controller(nrel5mw, "mpc-lidar")[0].controller,
                          law_export("mpc"), nrel5mw)
-    assert "baseline" in exportable()
+    assert {"baseline", "derate", "ibc", "coleman-ipc", "apc"} <= set(exportable())
+    assert law_export("derate80+ibc") is law_export("ibc")     # on a derated baseline too
     with pytest.raises(ValueError, match="the kinds that do: .*'ibc'"):
-        law_export("derate80+ibc")        # IBC exports on the full-power baseline
+        law_export("mpc+ibc")
 
 
 def test_servodyn_template_without_the_keys(tmp_path, baseline_export):
@@ -646,8 +647,8 @@ def test_servodyn_template_without_the_keys(tmp_path, baseline_export):
 
 def test_cli_design_then_export_discon(tmp_path, capsys):
     """``mpcwt design baseline`` then ``mpcwt export --format discon``: the library of the
-    saved gains (a derated design keeps its derated rated power); a Coleman IPC design is
-    refused with the kinds that export."""
+    saved gains (a derated design keeps its derated rated power); a Coleman IPC design
+    exports, but not one on a derated baseline (the saved design cannot say its base)."""
     from mpc_wt.cli import main
 
     d = tmp_path / "design"
@@ -661,9 +662,12 @@ def test_cli_design_then_export_discon(tmp_path, capsys):
     assert (d / "lib" / "ServoDyn_mpcwt_baseline.dat").is_file()
     i = tmp_path / "coleman"
     assert main(["design", "coleman-ipc", "--out", str(i)]) == 0
+    assert main(["export", str(i), "--format", "discon"]) == 0
+    assert re.search(r"^coleman_ipc\s+1", (i / "mpcwt_coleman_ipc.in").read_text(), re.M)
+    assert main(["design", "coleman-ipc", "--power-fraction", "0.8", "--out", str(i)]) == 0
     assert main(["export", str(i), "--format", "discon"]) != 0
     err = capsys.readouterr().err
-    assert "controller kind 'coleman-ipc' does not export" in err and "baseline" in err
+    assert "derated baseline (power fraction 0.8)" in err and "derate80+coleman-ipc" in err
 
 
 def test_cli_design_mpc_then_export_discon(tmp_path, capsys):

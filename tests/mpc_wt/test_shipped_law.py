@@ -67,9 +67,9 @@ def _the_shipped_run_from_its_own_trim(turbine, kind, options, tmp_path):
 
 
 def test_the_python_step_stays_where_the_library_takes_no_such_design(turbine):
-    """An MPC on OSQP (the library solves with DAQP) keeps its Python step and says so; the
-    baseline's compositions (derated, with IBC or Coleman IPC on it, active power control) run
-    the baseline's library."""
+    """An MPC on OSQP (the library solves with DAQP) keeps its Python step and says so, and
+    ``shipped=False`` runs the MPC's; the baseline's compositions (derated, with IBC or Coleman
+    IPC on it, active power control) run the baseline's library, also with ``shipped=False``."""
     r = run_controller(turbine, "mpc", 14.0, {"backend": "osqp"}, shipped=True, duration=2.0,
                        turbulence="A", seed=23)
     assert r.meta["law"] == "python"
@@ -81,6 +81,9 @@ def test_the_python_step_stays_where_the_library_takes_no_such_design(turbine):
     r = run_controller(turbine, "baseline", 14.0, duration=2.0, turbulence="A", seed=23)
     assert r.meta["law"] == "shipped"          # the library unless the Python step is asked
     r = run_controller(turbine, "baseline", 14.0, duration=2.0, turbulence="A", seed=23,
+                       shipped=False)
+    assert r.meta["law"] == "shipped"          # the baseline's family has no Python step
+    r = run_controller(turbine, "mpc", 14.0, duration=2.0, turbulence="A", seed=23,
                        shipped=False)
     assert "law" not in r.meta
 

@@ -6,7 +6,7 @@ from typing import Any, Protocol
 
 import numpy as np
 
-__all__ = ["ControllerBase", "Controller"]
+__all__ = ["ControllerBase", "Controller", "DesignBase"]
 
 
 class ControllerBase:
@@ -41,6 +41,45 @@ class ControllerBase:
             Generator torque command [N m].
         """
         raise NotImplementedError
+
+
+class DesignBase:
+    """Base of the designs whose law runs as it is shipped: their numbers are the input of a
+    compiled C law (the kind's export), which the host calls as OpenFAST's ServoDyn does; the
+    design itself has no step. :func:`mpc_wt.run.law_controller` (or ``run_controller``,
+    campaigns, the command line) runs it.
+
+    ``kind`` names the controller kind whose law runs the design.
+    """
+
+    kind: str = ""
+
+    def _not_a_controller(self) -> TypeError:
+        return TypeError(
+            f"{type(self).__name__} is a design: its law is the compiled C law its kind "
+            f"exports; run it with mpc_wt.run.law_controller(design, {self.kind!r}, turbine) "
+            f"(or mpc_wt.run.run_controller)")
+
+    def reset(self) -> None:
+        """A design has no state; raises :class:`TypeError` naming the way to run it."""
+        raise self._not_a_controller()
+
+    def step(self, t: float, meas: dict[str, Any]) -> tuple[np.ndarray, float]:
+        """A design has no step; raises :class:`TypeError` naming the way to run it.
+
+        Parameters
+        ----------
+        t : float
+            Time [s].
+        meas : dict
+            Measurements.
+
+        Returns
+        -------
+        tuple
+            Never.
+        """
+        raise self._not_a_controller()
 
 
 class Controller(Protocol):

@@ -36,14 +36,8 @@ from typing import Any, Callable, Sequence
 import numpy as np
 
 import linearize
-from mpc_wt.controllers.base import ControllerBase
-from mpc_wt.controllers.baseline_law import (
-    N_STATE,
-    SIGNALS,
-    law_parameters,
-    law_step,
-    min_pitch_offset,
-)
+from mpc_wt.controllers.base import DesignBase
+from mpc_wt.controllers.baseline_law import law_parameters, min_pitch_offset
 from mpc_wt.controllers.baseline_law import torque as law_torque
 
 __all__ = ["BaselineGains", "tune_baseline", "tune_baseline_schedule", "BaselineController",
@@ -396,12 +390,13 @@ def tune_baseline_schedule(turbine: linearize.Turbine,
     return tuple(tune_baseline(turbine, power_fraction=f, **kwargs) for f in fr)
 
 
-class BaselineController(ControllerBase):
-    """NREL 5-MW style baseline (torque law + gain-scheduled PI pitch) as a harness controller.
-
-    ``step(t, meas)`` takes a measurement dict with at least ``gen_speed`` [rad/s] and
-    ``pitch`` (3,) [rad] and returns (pitch_ref (3,), gen_torque_ref) and stores its internal
-    signals in ``.signals``. Call at the plant rate (``dt``).
+class BaselineController(DesignBase):
+    """The NREL 5-MW style baseline's design (torque law + gain-scheduled PI pitch): its gains,
+    the torque law's breakpoints, limits and period, as its compiled law reads them. The law
+    runs as it is shipped (:func:`mpc_wt.run.law_controller`, ``run_controller``): a
+    first-order low-pass on the generator speed, the PI on the filtered speed error with
+    GK(theta) at the previous command, anti-windup and a bumpless start at the measured pitch,
+    the pitch-rate limit, the torque law of regions 1.5, 2, 2.5 and 3 with its rate limit.
 
     Derated gains (``gains.power_fraction`` < 1) cap the torque law at the derated rated torque
     at rated speed. Region 2.5 is the NREL line from the synchronous speed to (rated speed,
@@ -409,14 +404,14 @@ class BaselineController(ControllerBase):
     region-2 torque is capped at the rated torque instead (a constant-torque region 2.5 in which
     the rotor speeds up to rated, as in Pettas and Cheng fig. 5).
 
-    Active power control: ``power_reference(t)`` [W] replaces rated power in region 3, and with
-    ``gain_schedule`` (designs at several power fractions, :func:`tune_baseline_schedule`) the
-    effective gains KP GK(theta), KI GK(theta) of the designs are interpolated on P_ref / P_r
-    (integral kept in pitch units, so a gain change moves no command), and with ``feedforward``
-    each change of the reference moves the pitch by dP_ref / (eta dP/dtheta), dP/dtheta from the
-    same designs at the present pitch (the pitch loop then only corrects). A reference outside
-    (0, rated power] raises ``ValueError``; while the rotor is below rated speed at fine pitch
-    the wind cannot give the reference (signal ``apc_saturated`` = 1).
+    Active power control (the ``apc`` kind): ``power_reference(t)`` [W] replaces rated power in
+    region 3, and with ``gain_schedule`` (designs at several power fractions,
+    :func:`tune_baseline_schedule`) the effective gains KP GK(theta), KI GK(theta) of the designs
+    are interpolated on P_ref / P_r (integral kept in pitch units, so a gain change moves no
+    command), and each change of the reference moves the pitch by dP_ref / (eta dP/dtheta),
+    dP/dtheta from the same designs at the present pitch (the pitch loop then only corrects).
+    A reference outside (0, rated power] stops the run naming it; while the rotor is below
+    rated speed at fine pitch the wind cannot give the reference (signal ``apc_saturated`` = 1).
 
     Parameters
     ----------
@@ -432,20 +427,20 @@ class BaselineController(ControllerBase):
         Corner of the generator-speed low-pass [Hz].
     slip_pct : float
         Region 2.5 width, in percent of rated generator speed.
-    power_reference : callable, optional
-        t [s] -> power reference [W] (active power control).
+    power_reference : PowerReference, optional
+        t [s] -> power reference [W] (active power control,
+        :class:`mpc_wt.controllers.apc.PowerReference`).
     gain_schedule : sequence of BaselineGains, optional
         Designs at several power fractions, interpolated on the reference.
-    feedforward : bool
-        Pitch feedforward on changes of the power reference.
     """
+
+    kind = "baseline"
 
     def __init__(self, turbine: linearize.Turbine, gains: BaselineGains | None = None, *,
                  dt: float = 1.0 / 80.0, region3: str = "constant_power",
                  filter_hz: float = 0.25, slip_pct: float = 10.0,
                  power_reference: Callable[[float], float] | None = None,
-                 gain_schedule: Sequence[BaselineGains] | None = None,
-                 feedforward: bool = True) -> None:
+                 gain_schedule: Sequence[BaselineGains] | None = None) -> None:
         if region3 not in ("constant_power", "constant_torque"):
             raise ValueError(f"region3 must be 'constant_power' or 'constant_torque', got "
                              f"{region3!r}")
@@ -456,25 +451,16 @@ class BaselineController(ControllerBase):
                              f"{dt:g} s, got {filter_hz!r}")
         self.turbine = turbine
         self.power_reference = power_reference
-        self.feedforward = bool(feedforward)
-        if gain_schedule is not None:
-            sched = sorted(gain_schedule, key=lambda g: g.power_fraction)
-            if not sched:
-                raise ValueError("gain_schedule must hold at least one BaselineGains")
-            self._sched_f: np.ndarray | None = np.array([g.power_fraction for g in sched])
-            self._sched = np.array([[g.kp, g.ki, g.theta_k_rad, g.dpdtheta_0] for g in sched])
-            if gains is None:
-                gains = sched[-1]
-        else:
-            self._sched_f = None
+        sched = sorted(gain_schedule or (), key=lambda g: g.power_fraction)
+        if gain_schedule is not None and not sched:
+            raise ValueError("gain_schedule must hold at least one BaselineGains")
         #: the designs the gains are scheduled over (active power control), by fraction
-        self.gain_schedule: tuple[BaselineGains, ...] = (
-            tuple(sched) if gain_schedule is not None else ())
-        self.gains = gains or tune_baseline(turbine)
+        self.gain_schedule: tuple[BaselineGains, ...] = tuple(sched)
+        self.gains = gains or (sched[-1] if sched else tune_baseline(turbine))
+        if power_reference is not None or sched:
+            self.kind = "apc"
         self.dt = float(dt)
         self.region3 = region3
-        g = self.gains
-        n = turbine.drivetrain.gearbox_ratio
         self.wc = 2 * math.pi * filter_hz
         #: the speed low-pass's pole at dt [-]
         self.filter_pole = math.exp(-self.wc * self.dt)
@@ -485,9 +471,15 @@ class BaselineController(ControllerBase):
         self.tq_max = turbine.generator.max_torque
         #: the largest below-rated trim pitch [rad], set by the first LawTorque on this law
         self.below_rated_pitch: float | None = None
-        # torque-law breakpoints (report sec. 7.3, DISCON): rated speed 99 % of the set point
-        # region 1.5 runs from the minimum rotor speed to 30 % above it on the generator (the
-        # NREL 5-MW's 670 and 871 rpm)
+        self._breakpoints(slip_pct)
+        self._par = law_parameters(self)
+
+    def _breakpoints(self, slip_pct: float) -> None:
+        """The torque law's breakpoints (report sec. 7.3, DISCON): rated speed 99 % of the set
+        point, region 1.5 from the minimum rotor speed to 30 % above it on the generator (the
+        NREL 5-MW's 670 and 871 rpm), and the minimum-pitch schedule."""
+        g, turbine = self.gains, self.turbine
+        n = turbine.drivetrain.gearbox_ratio
         self.w_cutin = turbine.operation.min_rotor_speed_rad_s * n
         self.w_rgn2 = REGION15_SPAN * self.w_cutin
         self.w_rated = 0.99 * g.rated_gen_speed_rad_s
@@ -509,20 +501,6 @@ class BaselineController(ControllerBase):
         self.min_pitch_speeds: tuple[float, ...] = (g.min_pitch_speeds or
                                                     (self.w_cutin, self.w_rgn2))
         self.min_pitch_offsets: tuple[float, ...] = g.min_pitch_offsets or (0.0, 0.0)
-        self._par = law_parameters(self)
-        self._cmd, self._sig = np.zeros(4), np.zeros(len(SIGNALS))
-        self.reset()
-
-    def reset(self) -> None:
-        """Forget the filter, integral and last commands."""
-        #: the law's state (:mod:`mpc_wt.controllers.baseline_law`): filtered speed, integral,
-        #: last pitch, last torque, started (0 / 1)
-        self._st = np.zeros(N_STATE)
-        #: an add-on's feedforward pitch [rad], set before each step (None: none); its change
-        #: from step to step enters the integral, so the PI stays consistent with it
-        self.pitch_feedforward: float | None = None
-        self._ff_last: float | None = None
-        self.signals: dict[str, float] = {}
 
     def min_pitch(self, w_filt: float) -> float:
         """The PI's lower pitch limit at a filtered generator speed: fine pitch plus the
@@ -540,72 +518,11 @@ class BaselineController(ControllerBase):
         """
         return self.pitch_min + float(min_pitch_offset(float(w_filt), self._par))
 
-    @property
-    def started(self) -> bool:
-        """Whether the controller has stepped since its last reset."""
-        return bool(self._st[4])
-
-    @property
-    def w_filt(self) -> float | None:
-        """Filtered generator speed [rad/s] (None before the first step)."""
-        return float(self._st[0]) if self.started else None
-
-    @property
-    def integral(self) -> float:
-        """The PI's integral state (DISCON form: of the speed error [rad]; with a gain schedule
-        in pitch units [rad])."""
-        return float(self._st[1])
-
-    @property
-    def last_pitch(self) -> float | None:
-        """The last pitch command [rad] (None before the first step)."""
-        return float(self._st[2]) if self.started else None
-
-    @property
-    def last_torque(self) -> float | None:
-        """The last torque command [N m] (None before the first step)."""
-        return float(self._st[3]) if self.started else None
-
-    def compiled_law(self, gen_speed_index: int) -> tuple[np.ndarray, np.ndarray] | None:
-        """The law's state and parameters for the closed loop compiled with the plant
-        (:mod:`mpc_wt.simulation.compiled`), or None where it does not apply: a power reference, a
-        gain schedule, an add-on's feedforward, a subclass or a ``step`` replaced on the
-        instance (a wrapper that times or records the calls): those run through :meth:`step`.
-
-        Parameters
-        ----------
-        gen_speed_index : int
-            Index of the generator speed in the plant's outputs.
-
-        Returns
-        -------
-        (state, params) or None
-        """
-        if (type(self) is not BaselineController or "step" in vars(self)
-                or self.power_reference is not None or self._sched_f is not None
-                or self.pitch_feedforward is not None):
-            return None
-        return self._st.copy(), law_parameters(self, gen_speed_index)
-
-    def adopt_compiled_state(self, state: np.ndarray, signals: np.ndarray) -> None:
-        """Take the state a compiled run left (:meth:`compiled_law`'s layout) and its last
-        signals, so the controller reads as if :meth:`step` had run.
-
-        Parameters
-        ----------
-        state : (5,) ndarray
-            Filtered speed, integral, last pitch, last torque, started (0 / 1).
-        signals : (6,) ndarray
-            The last step's signals (:data:`mpc_wt.controllers.baseline_law.SIGNALS`).
-        """
-        if state[4] == 0.0:                 # never stepped
-            return
-        self._st[:] = state
-        self.signals = {k: float(v) for k, v in zip(SIGNALS, signals)}
-
     def torque(self, w: float, pitch: float, power: float | None = None) -> float:
-        """Generator torque demand for a filtered generator speed and the collective pitch;
-        ``power`` replaces rated power in region 3 (active power control) [W].
+        """The torque law: generator torque demand for a filtered generator speed and the
+        collective pitch; ``power`` replaces rated power in region 3 (active power control)
+        [W]. The steady curves of a design (:mod:`mpc_wt.controllers.derating`) and other
+        designs' torque schedules (:class:`LawTorque`) read it.
 
         Parameters
         ----------
@@ -623,95 +540,6 @@ class BaselineController(ControllerBase):
         """
         p3 = self.gains.rated_power if power is None else power
         return float(law_torque(float(w), float(pitch), float(p3), self._par))
-
-    def _ff_step(self) -> float:
-        """The feedforward pitch's change since the last step [rad]."""
-        ff = self.pitch_feedforward
-        if ff is None:
-            self._ff_last = None
-            return 0.0
-        d = 0.0 if self._ff_last is None else ff - self._ff_last
-        self._ff_last = ff
-        return d
-
-    def _reference(self, t: float) -> float | None:
-        if self.power_reference is None:
-            return None
-        p = float(self.power_reference(t))
-        if not (math.isfinite(p) and 0.0 < p <= self.gains.rated_power * (1 + 1e-9)):
-            raise ValueError(f"power_reference({t:g} s) = {p!r} W must be in (0, rated power "
-                             f"{self.gains.rated_power:g} W]")
-        return p
-
-    def step(self, t: float, meas: dict[str, Any]) -> tuple[np.ndarray, float]:
-        # One control step; returns (pitch_ref (3,) [rad], gen_torque_ref [N m]).
-        w = float(meas["gen_speed"])
-        if not math.isfinite(w):
-            raise ValueError(f"measurement gen_speed is not finite at t = {t:g} s: {w!r}")
-        p1, p2, p3 = meas["pitch"]
-        pitch_meas = float(p1 + p2 + p3) / 3.0
-        p_ref = self._reference(t)
-        if self._sched_f is None:
-            # DISCON form, the law of mpc_wt.controllers.baseline_law
-            power = self.gains.rated_power if p_ref is None else p_ref
-            law_step(w, pitch_meas, self._ff_step(), power, self._st, self._par, self._cmd,
-                     self._sig)
-            cmd, tq, err = float(self._cmd[0]), float(self._cmd[3]), float(self._sig[1])
-            self.signals = dict(zip(SIGNALS, self._sig.tolist()))
-        else:
-            cmd, tq, err = self._scheduled_step(w, pitch_meas, p_ref)
-        if p_ref is not None:
-            self.signals["power_reference"] = p_ref
-            p_lo = self.pitch_min + float(min_pitch_offset(float(self._st[0]), self._par))
-            self.signals["apc_saturated"] = float(cmd <= p_lo + 1e-9 and err < 0.0)
-        return np.array((cmd, cmd, cmd)), tq
-
-    def _scheduled_step(self, w: float, pitch_meas: float, p_ref: float | None
-                        ) -> tuple[float, float, float]:
-        """The step with gains scheduled on P_ref / P_r and pitch (active power control): the
-        integral is kept in pitch units (ROSCO form) so that a gain change moves no command.
-        Returns (pitch command [rad], torque command [N m], speed error [rad/s])."""
-        st, g = self._st, self.gains
-        first = st[4] == 0.0
-        if first:
-            st[0], st[2] = w, pitch_meas
-        a = self.filter_pole
-        st[0] = a * st[0] + (1 - a) * w
-        w_filt, last_pitch = float(st[0]), float(st[2])
-        err = w_filt - g.rated_gen_speed_rad_s
-        frac = p_ref / (g.rated_power / g.power_fraction) if p_ref is not None \
-            else g.power_fraction
-        gks = 1.0 / (1.0 + last_pitch / self._sched[:, 2])
-        kp = float(np.interp(frac, self._sched_f, self._sched[:, 0] * gks))
-        ki = float(np.interp(frac, self._sched_f, self._sched[:, 1] * gks))
-        gk = kp / g.kp
-        if first:
-            st[1] = pitch_meas - kp * err
-            self._p_ref_last = p_ref
-        ff = 0.0
-        if self.feedforward and p_ref is not None:
-            # pitch that sheds the reference change at this operating point:
-            # d theta = d P_aero / (dP/dtheta), dP/dtheta = (dP/dtheta)_0 / GK
-            dpdt = float(np.interp(frac, self._sched_f, self._sched[:, 3] / gks))
-            eta = self.turbine.drivetrain.generator_efficiency
-            ff = (p_ref - self._p_ref_last) / eta / dpdt
-            self._p_ref_last = p_ref
-        off = float(min_pitch_offset(w_filt, self._par))
-        p_lo = self.pitch_min + off
-        integral = min(max(float(st[1]) + ki * err * self.dt + ff + self._ff_step(),
-                           p_lo), self.pitch_max)
-        cmd = min(max(kp * err + integral, p_lo), self.pitch_max)
-        step = self.rate * self.dt
-        cmd = min(max(cmd, last_pitch - step), last_pitch + step)
-        tq = min(self.torque(w_filt, cmd - off, p_ref), self.tq_max)
-        if not first:
-            d = self.tq_rate * self.dt
-            tq = min(max(tq, float(st[3]) - d), float(st[3]) + d)
-        st[1], st[2], st[3], st[4] = integral, cmd, tq, 1.0
-        self.signals = {"gen_speed_filtered": w_filt, "speed_error": err,
-                        "pitch_integral": integral, "gain_schedule": gk,
-                        "pitch_command": cmd, "torque_command": tq}
-        return cmd, tq, err
 
 
 class LawTorque:

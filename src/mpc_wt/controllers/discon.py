@@ -463,6 +463,23 @@ class DisconController(ControllerBase):
         else:
             self._load()
 
+    def design_identity(self) -> tuple[Any, ...]:
+        """What the library runs, for a design's digest
+        (:func:`mpc_wt.registry.context.design_digest`): the library's bytes and its input
+        file's text (not the folders they sit in), the interval, the pitch control and the
+        logging channels' names.
+
+        Returns
+        -------
+        tuple
+            SHA-256 of the library, the input file's text, dt, pitch control, channel names.
+        """
+        import hashlib
+
+        lib = hashlib.sha256(self.library.read_bytes()).hexdigest()
+        return (lib, self.discon_in.read_text(errors="replace"), self.dt, self.pitch_control,
+                self.log_names)
+
     # -- library lifetime --------------------------------------------------------------------
     def _load(self) -> None:
         self._unload()

@@ -45,10 +45,10 @@ from scipy import signal
 
 import linearize
 from linearize.validate import check_number
-from mpc_wt.controllers.apc import check_weight_range, power_weight
-from mpc_wt.controllers.base import ControllerBase
+from mpc_wt.controllers.apc import check_weight_range
+from mpc_wt.controllers.base import DesignBase
 from mpc_wt.controllers.baseline import BaselineController, check_power_fraction
-from mpc_wt.controllers.filters import SOSFilterBank, filter_sos
+from mpc_wt.controllers.filters import filter_sos
 
 __all__ = ["IBC_LOOP_GAIN", "COLEMAN_MAX_AMPLITUDE_DEG", "CYCLIC_RATE_FRACTION",
            "cyclic_amplitude_limit_deg", "ibc_loop_gain", "IBCGains", "tune_ibc",
@@ -436,10 +436,11 @@ def _gain_margin(loop: Any, k: float) -> float:
     return lo
 
 
-class _PitchAddOn(ControllerBase):
-    """What IBC and Coleman IPC share: the collective controller underneath, the power
-    fade-in weight (power filtered over ``power_tau`` = 1 s), and pitch limits and rate on the
-    summed command. Subclasses reset their own state in ``_reset_own``."""
+class _PitchAddOn(DesignBase):
+    """What the IBC and Coleman IPC designs share: the collective controller's design
+    underneath, the power fade-in weight (power low-passed over ``power_tau`` = 1 s; no seed
+    while the measured power is 0, as at ServoDyn's first call), and the pitch limits and
+    rate on the summed command."""
 
     power_tau = 1.0
 
@@ -450,76 +451,17 @@ class _PitchAddOn(ControllerBase):
         pa = collective.turbine.pitch_actuator
         self.pitch_min, self.pitch_max = collective.pitch_min, pa.max_pitch_rad
         self.step_max = pa.max_rate_rad_s * self.dt
-        self.reset()
-
-    def _reset_own(self) -> None:
-        pass
-
-    def reset(self) -> None:
-        """Forget filters, integrals, power filter and last commands (and reset the
-        collective)."""
-        self.collective.reset()
-        self._p_filt: float | None = None
-        self._last: np.ndarray | None = None
-        self.signals: dict[str, float] = {}
-        self._reset_own()
-
-    def _limit(self, pc: Any, u: tuple[float, float, float], meas: dict[str, Any]
-               ) -> np.ndarray:
-        """The collective ``pc`` (3,) plus the add-on's ``u`` within the pitch limits and,
-        from the last command (the measured pitch at the first step), the rate limit
-        (scalar arithmetic: three blades)."""
-        lo_p, hi_p, d = self.pitch_min, self.pitch_max, self.step_max
-        last = (np.asarray(meas["pitch"], float) if self._last is None
-                else self._last).tolist()
-        out = []
-        for c, du, prev in zip(pc.tolist(), u, last):
-            v = min(max(c + du, lo_p), hi_p)
-            out.append(min(max(v, prev - d), prev + d))
-        self._last = cmd = np.array(out)
-        return cmd
-
-    def _limit_collective_first(self, pc: Any, u: tuple[float, float, float],
-                                meas: dict[str, Any]) -> np.ndarray:
-        """As :meth:`_limit`, but the rate is the collective's first: the collective part
-        moves towards ``pc``'s mean by at most the rate step, and the add-on's part of each
-        blade moves by at most what that leaves (the sum then within the limits). A cyclic
-        pitch at 1P of amplitude A needs A Omega of the rate: on the IEA-15 (2 deg/s, 0.79
-        rad/s) a 2.5 deg cyclic needs all of it, and a gust found the collective without rate
-        (1.44 x rated at 13 m/s). Returns the commands (3,) [rad]."""
-        lo_p, hi_p, d = self.pitch_min, self.pitch_max, self.step_max
-        c = (float(pc[0]) + float(pc[1]) + float(pc[2])) / 3.0
-        if self._last is None:
-            p = [float(x) for x in meas["pitch"]]
-            self._c_last = (p[0] + p[1] + p[2]) / 3.0
-            self._a_last = (p[0] - self._c_last, p[1] - self._c_last, p[2] - self._c_last)
-        c_new = min(max(c, self._c_last - d), self._c_last + d)
-        budget = d - abs(c_new - self._c_last)
-        a_new = tuple(min(max(float(pcb) - c + du, a0 - budget), a0 + budget)
-                      for pcb, du, a0 in zip(pc.tolist(), u, self._a_last))
-        out = [min(max(c_new + a, lo_p), hi_p) for a in a_new]
-        self._c_last = c_new
-        self._a_last = tuple(o - c_new for o in out)
-        self._last = cmd = np.array(out)
-        return cmd
-
-    def _weight(self, meas: dict[str, Any]) -> float:
-        p = float(meas["gen_power"])
-        a = math.exp(-self.dt / self.power_tau)
-        if self._p_filt is None and p <= 0.0:   # no power yet (ServoDyn's first call sends 0):
-            return power_weight(0.0, self.gains.rated_power, self.gains.weight_range)  # no seed
-        self._p_filt = p if self._p_filt is None else a * self._p_filt + (1 - a) * p
-        return power_weight(self._p_filt, self.gains.rated_power, self.gains.weight_range)
 
 
 class IBCController(_PitchAddOn):
-    """Individual blade control on top of a collective controller (Pettas and Cheng fig. 3).
+    """The design of individual blade control on top of a collective controller (Pettas and
+    Cheng fig. 3), run by its shipped law (the ``ibc`` kind).
 
     ``collective`` is the baseline (or derated baseline) that regulates rotor speed and power;
-    this class adds the per-blade pitch w(P) BS(K(theta_mean) HP(M_i)) (less its mean over the
-    blades, see below) to its collective command and enforces the pitch limits and rate on the
-    sum. Signals: the collective's, plus ``ibc_weight``, ``ibc_gain`` and ``ibc_pitch_1..3``
-    [rad].
+    the law adds the per-blade pitch w(P) BS(K(theta_mean) HP(M_i)) (less its mean over the
+    blades, see below; each blade's within ``max_amplitude_rad``) to its collective command
+    and enforces the pitch limits and rate on the sum. The filters start at the steady state of
+    their first input. Signals: ``ibc_weight``, ``ibc_gain`` and ``ibc_pitch_1..3`` [rad].
 
     ``remove_collective=True`` (default) subtracts the blades' mean IBC pitch: the loops act on
     the cyclic content only and leave thrust and torque to the collective controller. The
@@ -531,47 +473,28 @@ class IBCController(_PitchAddOn):
     Parameters
     ----------
     collective : BaselineController
-        The collective controller.
+        The collective controller's design.
     gains : IBCGains
         From :func:`tune_ibc` at the collective's dt.
     remove_collective : bool
         Subtract the blades' mean IBC pitch (cyclic action only).
     """
 
+    kind = "ibc"
+
     def __init__(self, collective: BaselineController, gains: IBCGains, *,
                  remove_collective: bool = True) -> None:
+        from scipy.signal import sosfilt_zi
+
         self.remove_collective = bool(remove_collective)
         if abs(collective.dt - gains.dt) > 1e-12:
             raise ValueError(f"IBC gains were designed for dt = {gains.dt:g} s, the collective "
                              f"controller runs at {collective.dt:g} s")
-        self._hp = SOSFilterBank(gains.input_sos(), 3)
-        self._bs = SOSFilterBank(gains.output_sos(), 3)
+        #: the input high-pass's and output band-stop's sections (n, 6) and their state at a
+        #: unit input's steady state (n, 2)
+        self.input_sos, self.output_sos = gains.input_sos(), gains.output_sos()
+        self.input_zi, self.output_zi = sosfilt_zi(self.input_sos), sosfilt_zi(self.output_sos)
         super().__init__(collective, gains)
-
-    def _reset_own(self) -> None:
-        self._hp.reset()
-        self._bs.reset()
-
-    def step(self, t: float, meas: dict[str, Any]) -> tuple[np.ndarray, float]:
-        # One control step; returns (pitch_ref (3,) [rad], gen_torque_ref [N m]).
-        pc, tq = self.collective.step(t, meas)
-        m = np.asarray(meas["flap_moment"], float)
-        if m.shape != (3,) or not all(map(math.isfinite, m.tolist())):
-            raise ValueError(f"measurement flap_moment must be 3 finite moments [N m] at "
-                             f"t = {t:g} s, got {meas['flap_moment']!r}")
-        w = self._weight(meas)
-        p1, p2, p3 = pc.tolist()
-        k = self.gains.gain_at((p1 + p2 + p3) / 3.0)
-        u1, u2, u3 = (w * self._bs.step(k * self._hp.step(m))).tolist()
-        if self.remove_collective:
-            mean = (u1 + u2 + u3) / 3.0
-            u1, u2, u3 = u1 - mean, u2 - mean, u3 - mean
-        a = self.gains.max_amplitude_rad
-        u1, u2, u3 = min(max(u1, -a), a), min(max(u2, -a), a), min(max(u3, -a), a)
-        cmd = self._limit(pc, (u1, u2, u3), meas)
-        self.signals = {**self.collective.signals, "ibc_weight": w, "ibc_gain": k,
-                        "ibc_pitch_1": u1, "ibc_pitch_2": u2, "ibc_pitch_3": u3}
-        return cmd, tq
 
 
 # --------------------------------------------------------------------------------------------
@@ -729,54 +652,25 @@ def tune_coleman_ipc(turbine: linearize.Turbine, *, winds: Any = None,
 
 
 class ColemanIPCController(_PitchAddOn):
-    """Coleman-frame integral IPC (tilt and yaw to zero) on top of a collective controller.
+    """The design of Coleman-frame integral IPC (tilt and yaw to zero) on top of a collective
+    controller, run by its shipped law (the ``coleman-ipc`` kind): the blades' root moments to
+    tilt and yaw (M_tilt, M_yaw = 2/3 sum M_i (cos, sin) psi_i, Bossanyi 2003), rotated by the
+    scheduled azimuth offset phi, integrated with the scheduled gain K_I (the amplitude
+    clamped at ``max_amplitude_rad``: anti-windup), faded in with the power and sent back to
+    the blades. The collective part moves towards its command within the rate step first, the
+    cyclic within what that leaves: a cyclic pitch at 1P of amplitude A needs A Omega of the
+    rate, and on the IEA-15 (2 deg/s, 0.79 rad/s) a 2.5 deg cyclic needs all of it (a gust
+    found the collective without rate: 1.44 x rated at 13 m/s).
 
-    Signals: the collective's, plus ``ipc_weight``, ``ipc_tilt_moment``, ``ipc_yaw_moment``
-    [N m] and ``ipc_pitch_cos``, ``ipc_pitch_sin`` [rad].
+    Signals: ``ipc_weight``, ``ipc_tilt_moment``, ``ipc_yaw_moment`` [N m] and
+    ``ipc_pitch_cos``, ``ipc_pitch_sin`` [rad].
 
     Parameters
     ----------
     collective : BaselineController
-        The collective controller.
+        The collective controller's design.
     gains : ColemanIPCGains
         From :func:`tune_coleman_ipc`.
     """
 
-    def _reset_own(self) -> None:
-        self._theta_cs = (0.0, 0.0)
-
-    def step(self, t: float, meas: dict[str, Any]) -> tuple[np.ndarray, float]:
-        # One control step; returns (pitch_ref (3,) [rad], gen_torque_ref [N m]).
-        pc, tq = self.collective.step(t, meas)
-        psi = float(meas["azimuth"])
-        try:                                  # scalar arithmetic: three blades, no arrays
-            m1, m2, m3 = (float(x) for x in meas["flap_moment"])
-            ok = all(map(math.isfinite, (m1, m2, m3, psi)))
-        except (TypeError, ValueError):
-            ok = False
-        if not ok:
-            raise ValueError(f"measurements flap_moment (3,) and azimuth must be finite at "
-                             f"t = {t:g} s, got {meas['flap_moment']!r}, {meas['azimuth']!r}")
-        a2, a3 = psi + 2 * math.pi / 3, psi + 4 * math.pi / 3
-        c1, c2, c3 = math.cos(psi), math.cos(a2), math.cos(a3)
-        s1, s2, s3 = math.sin(psi), math.sin(a2), math.sin(a3)
-        tilt = 2.0 / 3.0 * (m1 * c1 + m2 * c2 + m3 * c3)       # Coleman transform
-        yaw = 2.0 / 3.0 * (m1 * s1 + m2 * s2 + m3 * s3)
-        w = self._weight(meas)
-        ki, phi = self.gains.at((float(pc[0]) + float(pc[1]) + float(pc[2])) / 3.0)
-        cp, sp = math.cos(phi), math.sin(phi)                   # R(-phi) [tilt, yaw]
-        th_c, th_s = self._theta_cs
-        th_c -= w * ki * (cp * tilt + sp * yaw) * self.dt
-        th_s -= w * ki * (-sp * tilt + cp * yaw) * self.dt
-        amp = math.hypot(th_c, th_s)
-        if amp > self.gains.max_amplitude_rad:            # anti-windup: clamp the amplitude
-            th_c *= self.gains.max_amplitude_rad / amp
-            th_s *= self.gains.max_amplitude_rad / amp
-        self._theta_cs = (th_c, th_s)
-        pc_, ps_ = w * th_c, w * th_s
-        cmd = self._limit_collective_first(
-            pc, (pc_ * c1 + ps_ * s1, pc_ * c2 + ps_ * s2, pc_ * c3 + ps_ * s3), meas)
-        self.signals = {**self.collective.signals, "ipc_weight": w,
-                        "ipc_tilt_moment": tilt, "ipc_yaw_moment": yaw,
-                        "ipc_pitch_cos": pc_, "ipc_pitch_sin": ps_}
-        return cmd, tq
+    kind = "coleman-ipc"

@@ -12,13 +12,13 @@ it reaches the rotor, t + T_p, with T_p = focus distance / the measured mean win
 time t the feedforward pitch is the static pitch curve theta_ss(v) of the trim at the filtered
 wind due at t + tau, tau = the actuator's time constant + the filter's delay (1.4 / omega_c for
 the second order, 1 / omega_c for the first), so the pitch arrives when the wind does. Its
-change enters the PI's integral at every step
-(:attr:`mpc_wt.controllers.baseline.BaselineController.pitch_feedforward`), so the feedback acts
-on what the feedforward leaves and the two never fight.
+change enters the PI's integral at every step, so the feedback acts on what the feedforward
+leaves and the two never fight. The law is the baseline's C law with its feedforward
+(``mpc_wt/io/discon_c/baseline.c``), reading the beams from OpenFAST's lidar records; this
+module designs it.
 """
 from __future__ import annotations
 
-import bisect
 import logging
 import math
 from typing import Any
@@ -26,8 +26,7 @@ from typing import Any
 import numpy as np
 
 import linearize
-from mpc_wt.controllers.base import ControllerBase
-from mpc_wt.controllers.filters import MeanTracker
+from mpc_wt.controllers.base import DesignBase
 
 __all__ = ["LidarFeedforward", "static_pitch_curve", "rews_coherence_corner",
            "corner_within_preview", "model_corner_table"]
@@ -59,8 +58,9 @@ def static_pitch_curve(turbine: linearize.Turbine, power_W: float | None = None
     return v, np.array([p.pitch_rad for p in pts])
 
 
-class LidarFeedforward(ControllerBase):
-    """The baseline PI with LIDAR collective pitch feedforward.
+class LidarFeedforward(DesignBase):
+    """The design of the baseline PI with LIDAR collective pitch feedforward, run by its shipped
+    law (the ``lidar-ff`` kind) on the LIDAR records.
 
     Everything it uses in operation is measured: the rotor-effective wind estimate (mean of the
     three beams), and its own mean over about 10 minutes (``mean_time_constant``), which sets the preview
@@ -100,6 +100,7 @@ class LidarFeedforward(ControllerBase):
                  corner: Any, lead_s: float | None = None, sample_dt: float = 0.1,
                  filter_order: int = 2, power_W: float | None = None,
                  mean_time_constant: float = 600.0) -> None:
+        self.kind = "baseline+lidar-ff"
         if isinstance(corner, (int, float)):
             cw_, cc = np.array([0.0, 1.0]), np.array([float(corner)] * 2)
         else:
@@ -119,112 +120,7 @@ class LidarFeedforward(ControllerBase):
         self.lead_given = lead_s
         self.sample_dt = float(sample_dt)
         self.mean_time_constant = float(mean_time_constant)
-        self._mean = MeanTracker(mean_time_constant, self.sample_dt)
         self.curve_v, self.curve_pitch = static_pitch_curve(turbine, power_W)
-        self.reset()
-
-    def reset(self) -> None:
-        """Forget the measurements and the filter; reset the base."""
-        self.base.reset()
-        self._arrival: list[float] = []
-        self._v: list[float] = []
-        self._vf: float | None = None
-        self._mean.reset()
-        self._vm: float | None = None             # the measured mean wind
-        self._x = np.zeros(2)                     # second-order filter state (value, rate)
-        self._next = -math.inf
-        self._w_disc = math.nan                   # the corner the filter is discretized at
-        self.corner = math.nan
-        self.lead = math.nan
-        self.preview_time = math.nan
-        self.raised = 0                           # samples with the corner raised
-        self.signals: dict[str, float] = {}
-
-    def _set_corner(self, vm: float) -> None:
-        """Corner, lead and preview time at the measured mean wind ``vm``."""
-        self.preview_time = self.sensor.focus_distance / vm
-        w = float(np.interp(vm, self.corner_winds, self.corners))
-        if self.lead_given is None:
-            need = _fitting_corner(self.preview_time, self.tau_act, self.order, self.sample_dt)
-            if w < need:
-                w = need if math.isfinite(need) else w
-                self.raised += 1
-            self.lead = self.tau_act + FILTER_DELAY[self.order] / w
-        else:
-            self.lead = self.lead_given
-        self.corner = w
-        if not abs(w - self._w_disc) <= 0.005 * w:       # the filter at the new corner
-            a = np.array([[0.0, 1.0], [-w * w, -1.4 * w]])
-            from scipy.linalg import expm
-            e = expm(np.block([[a, np.array([[0.0], [w * w]])], [np.zeros((1, 3))]])
-                     * self.sample_dt)
-            self._phi, self._gam = e[:2, :2], e[:2, 2]
-            self._w_disc = w
-
-    def _sample(self, t: float, meas: dict[str, Any]) -> None:
-        m = self.sensor.measure(np.array([t]), np.array([float(meas["azimuth"])]),
-                                float(meas["rotor_speed"]))
-        u = float(np.mean(m.u_hat[0]))
-        self._vm = self._mean.update(u)
-        self._set_corner(max(self._vm, 0.5))
-        if self._vf is None:
-            self._vf = u
-            self._x = np.array([u, 0.0])
-        elif self.order == 1:
-            a = math.exp(-self.corner * self.sample_dt)
-            self._vf = a * self._vf + (1.0 - a) * u
-        else:                                 # x'' = w^2 (u - x) - 2 zeta w x', exact ZOH
-            self._x = self._phi @ self._x + self._gam * u
-            self._vf = float(self._x[0])
-        arrival = t + self.preview_time
-        if self._arrival and arrival <= self._arrival[-1]:
-            arrival = self._arrival[-1] + 1e-6
-        self._arrival.append(arrival)
-        self._v.append(self._vf)
-        if len(self._arrival) > 4096:               # keep what is still to arrive
-            keep = int(np.searchsorted(self._arrival, t - 1.0))
-            del self._arrival[:keep], self._v[:keep]
-
-    def step(self, t: float, meas: dict[str, Any]) -> tuple[np.ndarray, float]:
-        """Sample the LIDAR when due, set the feedforward pitch, step the PI.
-
-        Parameters
-        ----------
-        t : float
-            Control time; the LIDAR samples when a sample period has passed [s].
-        meas : dict
-            The harness's measurements; ``azimuth`` and ``rotor_speed`` aim the beams.
-
-        Returns
-        -------
-        pitch_ref : (3,) ndarray
-            The PI's command with the feedforward in its integral [rad].
-        gen_torque_ref : float
-            The baseline's torque demand [N m].
-        """
-        if t >= self._next - 1e-9:
-            self._sample(t, meas)
-            self._next = t + self.sample_dt
-        v = _interp_list(t + self.lead, self._arrival, self._v)
-        ff = float(np.interp(v, self.curve_v, self.curve_pitch))
-        self.base.pitch_feedforward = ff
-        out = self.base.step(t, meas)
-        self.signals = {**self.base.signals, "ff_wind": v, "ff_pitch": ff,
-                        "ff_mean_wind": float(self._vm or math.nan),
-                        "ff_corner": self.corner}
-        return out
-
-
-def _interp_list(x: float, xs: list[float], ys: list[float]) -> float:
-    """``np.interp(x, xs, ys)`` for increasing Python lists without copying them to arrays
-    (held at the end values outside ``xs``)."""
-    k = bisect.bisect_right(xs, x)
-    if k == 0:
-        return ys[0]
-    if k == len(xs):
-        return ys[-1]
-    x0, x1 = xs[k - 1], xs[k]
-    return ys[k - 1] + (ys[k] - ys[k - 1]) * (x - x0) / (x1 - x0)
 
 
 def model_corner_table(lidar_model: Any, turbine: linearize.Turbine, turbulence: str | float = "A",

@@ -13,7 +13,7 @@ from mpc_wt.registry.options import REQUIRED, Options, option
 from mpc_wt.registry.registry import register
 from mpc_wt.simulation.scenario import Scenario, start_wind
 from mpc_wt.io.discon_export import LawExport
-from mpc_wt.kinds.common import baseline_entries
+from mpc_wt.kinds.common import BASELINE_LOG, baseline_entries
 
 log = logging.getLogger(__name__)
 
@@ -79,7 +79,7 @@ def _apc_entries(ctl: Any, preview: Any = None) -> list[tuple[str, Any, str]]:
           export=LawExport("apc", "Clemens et al.'s active power control: the baseline "
                            "following P_r (1 - Delta P(t)), its PI scheduled on the reference",
                            "baseline", _apc_entries,
-                           log=("power_reference", "apc_saturated", "gain_schedule")),
+                           log=(*BASELINE_LOG, "power_reference", "apc_saturated")),
           summary="the baseline following P_r (1 - Delta P(t)), PI scheduled on the reference")
 def _build_apc(ctx: BuildContext, opts: APCOptions) -> Built:
     from mpc_wt.controllers.apc import PowerReference, apc_reference

@@ -17,7 +17,7 @@ from mpc_wt.registry.registry import register
 from mpc_wt.simulation.scenario import Scenario, start_wind
 from mpc_wt.io import gain_tables as gt
 from mpc_wt.io.discon_export import LawExport
-from mpc_wt.kinds.common import baseline_entries
+from mpc_wt.kinds.common import BASELINE_LOG, baseline_entries
 
 log = logging.getLogger(__name__)
 
@@ -91,19 +91,20 @@ def _baseline_input(ctl: Any, preview: Any) -> list[tuple[str, Any, str]]:
 
 register("baseline", BaselineOptions, field_components="u", design=_design_baseline,
          export=LawExport("baseline", "the tuned PI pitch loop and torque law, constant power "
-                          "in region III", "baseline", _baseline_input, rebuilt=False),
+                          "in region III", "baseline", _baseline_input, rebuilt=False,
+                          log=BASELINE_LOG),
          summary="tuned PI pitch and torque law, constant power in region III (80 Hz)"
          )(baseline_build("constant_power"))
 register("baseline-ct", BaselineOptions, field_components="u",
          export=LawExport("baseline-ct", "the baseline with constant torque in region III",
-                          "baseline", _baseline_input, rebuilt=False),
+                          "baseline", _baseline_input, rebuilt=False, log=BASELINE_LOG),
          summary="the baseline with constant torque in region III (Do et al.'s PI)"
          )(baseline_build("constant_torque"))
 register("derate", DerateOptions, field_components="u", pattern=r"derate(\d+(?:\.\d+)?)",
          pattern_options=_derate_preset, pattern_help="derateNN (NN % of rated power)",
          operating_point=derated_trim,
          export=LawExport("derate", "the baseline derated to a fraction of rated power, its PI "
-                          "re-tuned", "baseline", _baseline_input),
+                          "re-tuned", "baseline", _baseline_input, log=BASELINE_LOG),
          summary="the baseline derated to NN % of rated power, PI re-tuned")(
     baseline_build("constant_power"))
 

@@ -39,23 +39,70 @@ def run_as_shipped(ctx: BuildContext, export: Any, built: Built) -> Built:
     Built
         The library's host as the controller, the design in ``design``; or ``built`` with
         ``meta["law"] = "python"``.
+
+    Raises
+    ------
+    ValueError
+        A design that has no step of its own (:class:`~mpc_wt.controllers.base.DesignBase`)
+        and that its law does not take.
+    """
+    from mpc_wt.controllers.base import DesignBase
+
+    try:
+        ctl = shipped_host(built.controller, export, ctx.turbine, built.preview,
+                           lidar=built.sensors[-1] if built.sensors else None)
+    except ValueError as err:
+        if isinstance(built.controller, DesignBase):
+            raise
+        log.info("%s: the design does not export (%s); its Python step runs", export.name, err)
+        return dataclasses.replace(built, meta={**built.meta, "law": "python"})
+    return dataclasses.replace(built, controller=ctl, controller_dt=ctl.dt, preview=None,
+                               design=built.controller,
+                               meta={**built.meta, "law": "shipped",
+                                     "library": ctl.library.name})
+
+
+def shipped_host(design: Any, export: Any, turbine: linearize.Turbine, preview: Any = None, *,
+                 lidar: Any = None) -> Any:
+    """The host of a design's shipped law in this process: its numbers in its law's input
+    file (:func:`mpc_wt.io.discon_export.shipped_input`), its compiled library
+    (:func:`~mpc_wt.io.discon_export.shipped_library`), called as OpenFAST's ServoDyn calls it.
+
+    Parameters
+    ----------
+    design : object
+        The design (of the type its kind builds).
+    export : LawExport
+        Its kind's export.
+    turbine : Turbine
+        Its turbine.
+    preview : LidarPreview, optional
+        The design's LIDAR preview (the MPC with LIDAR).
+    lidar : lidar.LidarSensor, optional
+        The LIDAR whose measurements fill the lidar records (the LIDAR kinds).
+
+    Returns
+    -------
+    DisconController
+        The host (``isolate=False``), at the design's period, reset for its first call.
+
+    Raises
+    ------
+    ValueError
+        A design the law does not take.
     """
     from mpc_wt.controllers.discon import DisconController
     from mpc_wt.io.discon_export import shipped_input, shipped_library
 
-    try:
-        infile = shipped_input(built.controller, export, ctx.turbine, built.preview)
-    except ValueError as err:
-        log.info("%s: the design does not export (%s); its Python step runs", export.name, err)
-        return dataclasses.replace(built, meta={**built.meta, "law": "python"})
-    dt = float(built.controller.dt)
-    ctl = DisconController(shipped_library(export), infile, ctx.turbine, dt=dt,
-                           lidar=built.sensors[-1] if built.sensors else None,
-                           isolate=False, log_names=export.log)
-    return dataclasses.replace(built, controller=ctl, controller_dt=dt, preview=None,
-                               design=built.controller,
-                               meta={**built.meta, "law": "shipped",
-                                     "library": ctl.library.name})
+    infile = shipped_input(design, export, turbine, preview)
+    host = DisconController(shipped_library(export), infile, turbine, dt=float(design.dt),
+                            lidar=lidar, isolate=False, log_names=export.log)
+    host.reset()                                 # ready for its first call
+    return host
+
+
+#: the logging channels of the baseline's law, which every law on it returns first
+BASELINE_LOG = ("gen_speed_filtered", "speed_error", "pitch_integral", "gain_schedule")
 
 
 _CW = "lidar.CWLidar setting (unset: its default)"

@@ -16,7 +16,7 @@ from mpc_wt.registry.options import Options, option
 from mpc_wt.registry.registry import register
 from mpc_wt.io import gain_tables as gt
 from mpc_wt.io.discon_export import LawExport
-from mpc_wt.kinds.common import baseline_entries
+from mpc_wt.kinds.common import BASELINE_LOG, baseline_entries
 
 log = logging.getLogger(__name__)
 
@@ -99,23 +99,27 @@ def _ibc_entries(ctl: Any, preview: Any = None) -> list[tuple[str, Any, str]]:
         ("ibc_gain_pitch", np.asarray(g.pitch_rad, float), "mean pitch of the gain schedule "
                                                            "[rad]"),
         ("ibc_gain", np.asarray(g.gain, float), "gain [rad/(N m)]"),
-        ("ibc_input_sos", ctl._hp.sos.ravel(), "input (high-pass) sections b0 b1 b2 a0 a1 a2"),
-        ("ibc_input_zi", np.asarray(ctl._hp._zi1, float).ravel(),
+        ("ibc_input_sos", np.asarray(ctl.input_sos, float).ravel(),
+         "input (high-pass) sections b0 b1 b2 a0 a1 a2"),
+        ("ibc_input_zi", np.asarray(ctl.input_zi, float).ravel(),
          "their state at a unit input's steady state"),
-        ("ibc_output_sos", ctl._bs.sos.ravel(), "output (band-stop, low-pass) sections"),
-        ("ibc_output_zi", np.asarray(ctl._bs._zi1, float).ravel(),
+        ("ibc_output_sos", np.asarray(ctl.output_sos, float).ravel(),
+         "output (band-stop, low-pass) sections"),
+        ("ibc_output_zi", np.asarray(ctl.output_zi, float).ravel(),
          "their state at a unit input's steady state"),
     ]
 
 
-def _check_saved_ibc(doc: Any) -> None:
-    """A saved IBC design exports when it is on the full-power baseline."""
+def _check_saved_full_power(doc: Any) -> None:
+    """A saved add-on design exports when it is on the full-power baseline (the export builds
+    it again with its kind's default base)."""
     frac = doc["settings"].get("power_fraction", 1.0)
     if frac != 1.0:
+        kind = doc.get("kind")
         raise ValueError(
-            f"this IBC design is on a derated baseline (power fraction {frac:g}); the library "
-            f"exports IBC on the full-power baseline: design it without --power-fraction, or "
-            f"export an IBCController on your derated baseline with "
+            f"this {kind} design is on a derated baseline (power fraction {frac:g}); a saved "
+            f"design exports on the full-power baseline: export derate{100 * frac:g}+{kind} "
+            f"with mpc_wt.run.export_discon, or your own {kind} controller object with "
             f"mpc_wt.run.export_controller")
 
 
@@ -124,8 +128,9 @@ IBC_EXPORT = LawExport(
     "ibc", "Pettas and Cheng's individual blade control on the baseline: each blade's root "
     "moment filtered, scaled by the gain scheduled on the mean pitch, faded in with the power",
     "baseline", _ibc_entries, base=("baseline", "derate"),
-    log=("ibc_weight", "ibc_gain", "ibc_pitch_1", "ibc_pitch_2", "ibc_pitch_3"),
-    check_saved=_check_saved_ibc)
+    log=(*BASELINE_LOG, "ibc_weight", "ibc_gain", "ibc_pitch_1", "ibc_pitch_2",
+         "ibc_pitch_3"),
+    check_saved=_check_saved_full_power)
 
 
 @register("ibc", IBCOptions, field_components="u", addon_to=("baseline", "derate"),
@@ -194,7 +199,9 @@ COLEMAN_EXPORT = LawExport(
     "coleman-ipc", "Coleman-frame integral IPC on the baseline: the blades' root moments to "
     "tilt and yaw, integrated to a cyclic pitch with the gain scheduled on the mean pitch, "
     "faded in with the power", "baseline", _coleman_entries, base=("baseline", "derate"),
-    log=("ipc_weight", "ipc_tilt_moment", "ipc_yaw_moment", "ipc_pitch_cos", "ipc_pitch_sin"))
+    log=(*BASELINE_LOG, "ipc_weight", "ipc_tilt_moment", "ipc_yaw_moment", "ipc_pitch_cos",
+         "ipc_pitch_sin"),
+    check_saved=_check_saved_full_power)
 
 
 @register("coleman-ipc", ColemanIPCOptions, field_components="u", addon_to=("baseline", "derate"),

@@ -15,7 +15,7 @@ from mpc_wt.registry.registry import register
 from mpc_wt.kinds.baseline import BaselineOptions, baseline_build
 from mpc_wt.io import gain_tables as gt
 from mpc_wt.io.discon_export import LawExport
-from mpc_wt.kinds.common import LidarOptions, baseline_entries
+from mpc_wt.kinds.common import BASELINE_LOG, LidarOptions, baseline_entries
 
 log = logging.getLogger(__name__)
 
@@ -87,8 +87,9 @@ def _ff_entries(ctl: Any, preview: Any = None) -> list[tuple[str, Any, str]]:
 #: The LIDAR feedforward's export: the baseline's law with the feedforward in its integral
 LIDAR_FF_EXPORT = LawExport(
     "baseline+lidar-ff", "the baseline with the collective pitch feedforward of a hub-mounted "
-    "CW LIDAR, read from OpenFAST's lidar records", "baseline", _ff_entries, base="baseline",
-    log=("ff_wind", "ff_pitch", "ff_mean_wind", "ff_corner"))
+    "CW LIDAR, read from OpenFAST's lidar records", "baseline", _ff_entries,
+    base=("baseline", "derate"),
+    log=(*BASELINE_LOG, "ff_wind", "ff_pitch", "ff_mean_wind", "ff_corner"))
 
 
 @register("lidar-ff", LidarFFOptions, addon_to=("baseline", "derate"), default_base="baseline",

@@ -48,7 +48,9 @@ def design_digest(obj: Any) -> str:
     (walked through dataclasses, containers and object attributes; a turbine by its content,
     not the file it was read from; solver handles, compiled functions, modules, the wind a LIDAR
     is bound to, the design's own solve times (``*_time_s``), classes marked ``__design__ =
-    False`` and the attributes a class names in ``__not_design__`` are skipped).
+    False`` and the attributes a class names in ``__not_design__`` are skipped; an object with a
+    ``design_identity()`` method is digested by what it returns: a controller library by its
+    bytes and its input file's text, not the folders it was copied to).
 
     Two builds give equal digests when they hold the same gains, models and QP data; a design
     that read the case (its mean wind, its field) differs from case to case.
@@ -106,23 +108,32 @@ def design_digest(obj: Any) -> str:
                 return
             seen.add(id(o))
             h.update(type(o).__name__.encode())
-            if dataclasses.is_dataclass(o):
-                items = {f.name: getattr(o, f.name) for f in dataclasses.fields(o)}
-            else:
-                items = dict(getattr(o, "__dict__", {}))
-                for name in getattr(type(o), "__slots__", ()):
-                    if hasattr(o, name):
-                        items[name] = getattr(o, name)
-            skip = set(getattr(type(o), "__not_design__", ()))
-            for k in sorted(items):
-                if k.startswith("__") or k.endswith("_time_s") or k in skip \
-                        or callable(items[k]) and not hasattr(items[k], "__dict__"):
-                    continue                # (a design's own solve time is no design data)
+            for k, v in _design_items(o):
                 h.update(k.encode())
-                walk(items[k], depth + 1)
+                walk(v, depth + 1)
 
     walk(obj, 0)
     return h.hexdigest()
+
+
+def _design_items(o: Any) -> list[tuple[str, Any]]:
+    """An object's design data by name, in order: what its ``design_identity()`` returns, or
+    its fields (dataclass, ``__dict__``, ``__slots__``) without the skipped ones (see
+    :func:`design_digest`)."""
+    ident = getattr(o, "design_identity", None)
+    if callable(ident):                         # what the object says its design is
+        return [("design_identity", ident())]
+    if dataclasses.is_dataclass(o):
+        items = {f.name: getattr(o, f.name) for f in dataclasses.fields(o)}
+    else:
+        items = dict(getattr(o, "__dict__", {}))
+        for name in getattr(type(o), "__slots__", ()):
+            if hasattr(o, name):
+                items[name] = getattr(o, name)
+    skip = set(getattr(type(o), "__not_design__", ()))
+    return [(k, items[k]) for k in sorted(items)
+            if not (k.startswith("__") or k.endswith("_time_s") or k in skip
+                    or callable(items[k]) and not hasattr(items[k], "__dict__"))]
 
 
 class DesignCache:

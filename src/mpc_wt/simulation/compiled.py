@@ -1,29 +1,21 @@
-"""Closed loops compiled with the plant: the baseline's law, and any Bladed-style library
-loaded in this process.
+"""Closed loops compiled with the plant around a Bladed-style controller library loaded in
+this process.
 
 A closed loop in Python pays some 30 µs a plant step around an ~80 µs plant step: the
-measurement dict, the controller's call, the command checks, the signals. For the baseline PI
-and torque law at the plant's rate that is more than the law itself. This module runs the whole
-loop (RK4 step, the law, the command checks, the generator's torque-rate limit, the signals and
-the envelope check) in one compiled call per block of steps.
+measurement dict, the controller's call, the command checks, the signals. For a law called at
+the plant's rate (the baseline's) that is more than the law itself. This module runs the whole
+loop (RK4 step, the library's call, the command checks, the generator's torque-rate limit, the
+signals and the envelope check) in one compiled call per block of steps.
 
 It is the same loop as :func:`mpc_wt.simulation.loop.simulate_closed_loop`'s Python path,
-operation for operation, around the same law (:mod:`mpc_wt.controllers.baseline_law`, which
-:class:`~mpc_wt.controllers.baseline.BaselineController` runs too), so the two paths agree to
-the last bit (the test compares them over turbulent runs in regions 2 and 3). It applies only
-where the law is exactly that: no power reference, gain schedule or add-on feedforward
-(:meth:`~mpc_wt.controllers.baseline.BaselineController.compiled_law` says None otherwise),
-and no LIDAR.
-
-A controller library (:class:`~mpc_wt.controllers.discon.DisconController` with
-``isolate=False`` and no LIDAR) runs in the same compiled loop: the swap records filled from
-the plant's outputs, ``DISCON`` called through its function pointer, the demands read back, as
+operation for operation: the swap records filled from the plant's outputs, ``DISCON`` called
+through its function pointer, the demands read back, as
 :meth:`~mpc_wt.controllers.discon.DisconController.step` does them, record for record, so the
-two paths agree to the last bit (tested).
+two paths agree to the last bit (tested). It applies to a
+:class:`~mpc_wt.controllers.discon.DisconController` with ``isolate=False`` (every shipped law).
 """
 from __future__ import annotations
 
-import math
 from typing import Any
 
 import numba as nb
@@ -32,10 +24,9 @@ import numpy as np
 from linearize.jitcache import key_caches_on_callees
 from linearize import STATE_NAMES
 from linearize.kernel import step_kernel
-from mpc_wt.controllers.baseline_law import law
 from mpc_wt.controllers.discon_kernel import library_call
 
-__all__ = ["run_steps", "run_library_steps"]
+__all__ = ["run_library_steps"]
 
 _JIT = dict(cache=True, error_model="numpy")
 
@@ -57,67 +48,13 @@ def _hold(k, cmd, u, held, act, counts):  # pragma: no cover - compiled
 
 
 @nb.njit(**_JIT)
-def _loop(k0, k1, ratio, h, pk, kind, wpar, grid, hint, dphi, lim, xs, us, zs, u, held, st,
-          par, sigs, act, counts):  # pragma: no cover - compiled
-    """Plant steps k0..k1-1 of the closed loop (simulate._run's order). ``u`` holds the
-    applied inputs, ``held`` the commanded torque, ``act`` the torque step per plant step and
-    the actuator ranges (pitch lo, hi, torque lo, hi), ``counts`` the commands out of range
-    and the first step with one. Returns (steps done, -1 | the state leaving the envelope |
-    -2 for a non-finite generator speed | -3 for a non-finite command)."""
-    cmd = np.empty(4)
-    for k in range(k0, k1):
-        t = k * h
-        us[k] = u
-        bad = step_kernel(t, xs[k], u, h, pk, kind, wpar, grid, hint, dphi, lim, xs[k + 1],
-                          zs[k])
-        if k % ratio == 0:
-            if law(zs[k], st, par, cmd, sigs[k]) != 0:
-                return k, -2
-            if not (math.isfinite(cmd[0]) and math.isfinite(cmd[3])):
-                return k, -3
-            _hold(k, cmd, u, held, act, counts)
-        else:
-            sigs[k] = sigs[k - 1]
-        u[3] += min(max(held[0] - u[3], -act[0]), act[0])
-        if bad >= 0:
-            return k + 1, bad
-    return k1, -1
-
-
-def run_steps(k0: int, k1: int, ratio: int, stepper: Any, arrays: tuple[np.ndarray, ...]
-              ) -> tuple[int, int]:
-    """Run plant steps ``k0`` to ``k1 - 1`` of a compiled closed loop.
-
-    Parameters
-    ----------
-    k0, k1 : int
-        The block of steps.
-    ratio : int
-        Plant steps per controller step.
-    stepper : linearize.PlantStepper
-        The plant and its BEM warm start (advanced in place).
-    arrays : tuple of ndarray
-        (xs, us, zs, u, held, state, params, signals, actuator, counts), see :func:`_loop`;
-        written in place.
-
-    Returns
-    -------
-    done : int
-        Steps done (k1, or the step after a divergence).
-    flag : int
-        -1, the index of the state that left its envelope, -2 for a non-finite generator
-        speed or -3 for a non-finite command (both at step ``done``).
-    """
-    h, pk, kind, wpar, grid, hint, dphi, lim = stepper.kernel_args()
-    done, flag = _loop(k0, k1, ratio, h, pk, kind, wpar, grid, hint, dphi, lim, *arrays)
-    return int(done), int(flag)
-
-
-@nb.njit(**_JIT)
 def _library_loop(k0, k1, ratio, h, pk, kind, wpar, grid, hint, dphi, lim, xs, us, zs, u,
                   held, fn, swap, fail, bufs, rec, zi, hub, lib, gate, sigs, act, counts
                   ):  # pragma: no cover - compiled
-    """:func:`_loop` with a controller library's call in place of the law. ``gate`` holds
+    """Plant steps k0..k1-1 of the closed loop around a controller library's call
+    (simulate._run's order). ``u`` holds the applied inputs, ``held`` the commanded torque,
+    ``act`` the torque step per plant step and the actuator ranges (pitch lo, hi, torque lo,
+    hi), ``counts`` the commands out of range and the first step with one. ``gate`` holds
     where the host takes a call step back before the plant steps: a rotor speed above
     ``gate[0]`` or the step ``gate[1]`` (a supervisor's trip), and, with ``gate[3]`` set, the
     time ``gate[2]`` of the next LIDAR sample. Returns (steps done, -1 | the state leaving the

@@ -203,55 +203,6 @@ def _check_rates(duration: float, dt: float, controller_dt: float | None
     return n, ratio, cdt
 
 
-def _compiled_law(loop: _Loop, compiled: bool) -> Any:
-    """The controller's compiled law (state, parameters) when the loop can run compiled: a
-    controller that offers one (the plain baseline) and no LIDAR; else None."""
-    offer = getattr(loop.controller, "compiled_law", None)
-    if not compiled or loop.preview is not None or not callable(offer):
-        return None
-    return offer(_IDX[0])
-
-
-def _run_compiled(loop: _Loop, stepper: linearize.PlantStepper, ratio: int, bar: Any,
-                  law: tuple[np.ndarray, np.ndarray]) -> None:
-    """:func:`_run` for a controller with a compiled law (:mod:`mpc_wt.simulation.compiled`): the
-    same steps in blocks of 800 compiled steps; the same errors, counts and signals."""
-    from mpc_wt.controllers.baseline_law import SIGNALS
-    from mpc_wt.simulation.compiled import run_steps
-
-    n, dt = loop.n, loop.dt
-    loop.xs[0] = loop.x
-    sigs = np.zeros((n + 1, len(SIGNALS)))
-    held, counts = np.array([loop.u_tq]), np.zeros(2, dtype=np.int64)
-    act = np.array([loop.rate, loop._p_lo, loop._p_hi, loop._q_lo, loop._q_hi])
-    arrays = (loop.xs, loop.us, loop.zs, loop.u, held, *law, sigs, act, counts)
-    loop.sig = {name: sigs[:, i] for i, name in enumerate(SIGNALS)}
-    try:
-        for k in range(0, n, 800):
-            done, flag = run_steps(k, min(k + 800, n), ratio, stepper, arrays)
-            loop.k_done = done
-            if flag in (-2, -3):
-                what = (f"measurement gen_speed is not finite at t = {done * dt:g} s: "
-                        f"{float(loop.zs[done, _IDX[0]])!r}" if flag == -2 else
-                        f"controller returned pitch {sigs[done, 4]!r}, torque "
-                        f"{sigs[done, 5]!r} at t = {done * dt:g} s: need 3 finite pitch "
-                        f"angles [rad] and a finite torque [N m]")
-                raise ValueError(what)
-            if flag >= 0:
-                raise _Diverged(done, flag, float(loop.xs[done, flag]))
-            bar.update(min(k + 800, n) - k)
-        loop.us[n] = loop.u
-        loop.zs[n] = stepper.outputs(n * dt, loop.xs[n], loop.u)
-        sigs[n] = sigs[n - 1]
-    finally:
-        loop.clipped, loop.u_tq = int(counts[0]), float(held[0])
-        loop.controller.adopt_compiled_state(law[0], sigs[max(loop.k_done - 1, 0)])
-        if counts[0]:
-            log.warning("controller command out of the actuator range at t = %g s: the plant "
-                        "clips it; the count is in result.meta['commands_clipped']",
-                        counts[1] * dt)
-
-
 def _compiled_library(loop: _Loop, compiled: bool, ratio: int) -> Any:
     """The controller library's host, its arrays for the compiled loop and the supervisor
     around it (a library loaded in this process, alone or under a supervisor that is
@@ -349,14 +300,9 @@ def _adopt_library(loop: _Loop, ctl: Any, call: tuple[Any, ...], sup: Any, sigs:
 
 def _advance(loop: _Loop, stepper: linearize.PlantStepper, ratio: int, bar: Any,
              compiled: bool) -> str:
-    """The whole run: compiled where the controller offers a law (:func:`_run_compiled`) or is
-    a library loaded in this process (:func:`_run_library`), else in Python (:func:`_run`);
-    says which (``meta["loop"]``)."""
-    law = _compiled_law(loop, compiled)
-    call = None if law is not None else _compiled_library(loop, compiled, ratio)
-    if law is not None:
-        _run_compiled(loop, stepper, ratio, bar, law)
-        return "compiled"
+    """The whole run: compiled where the controller is a library loaded in this process
+    (:func:`_run_library`), else in Python (:func:`_run`); says which (``meta["loop"]``)."""
+    call = _compiled_library(loop, compiled, ratio)
     if call is not None:
         return _run_library(loop, stepper, ratio, bar, call)
     _run(loop, stepper, ratio, bar)
@@ -433,7 +379,7 @@ def simulate_closed_loop(params: linearize.PlantParams, controller: Any,
     meta : dict, optional
         Configuration stored with the result.
     compiled : bool
-        A compiled law (the plain baseline) or a library in this process (alone or under a
+        A controller library in this process (every shipped law; alone or under a
         supervisor, with or without a LIDAR) runs in a loop compiled with the plant (the same
         loop to the last bit; default); False: Python.
 

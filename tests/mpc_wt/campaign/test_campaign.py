@@ -807,6 +807,7 @@ KIND_WITH_A_CODE_DEFAULT = '''
 import dataclasses
 from mpc_wt.registry import Built, Options, register
 from mpc_wt.controllers.baseline import BaselineController, tune_baseline
+from mpc_wt.run import law_controller
 
 #: a default that lives in code, not in an option: no case hash covers it
 GAIN_SCALE = 1.0
@@ -819,7 +820,7 @@ class NoOptions(Options):
 def build(ctx, opts):
     g = tune_baseline(ctx.turbine)
     g = dataclasses.replace(g, kp=g.kp * GAIN_SCALE, ki=g.ki * GAIN_SCALE)
-    return Built(BaselineController(ctx.turbine, g))
+    return Built(law_controller(BaselineController(ctx.turbine, g), "baseline", ctx.turbine))
 '''
 
 

@@ -12,6 +12,7 @@ from numpy.testing import assert_allclose
 import lidar
 import linearize
 from mpc_wt.controllers.baseline import BaselineController, tune_baseline
+from mpc_wt.run import law_controller
 from mpc_wt.simulation.loop import ClosedLoopResult, simulate_closed_loop
 
 
@@ -73,7 +74,8 @@ def test_region2_tracks_optimal_tsr(turbine: linearize.Turbine, params: lineariz
     # rotor at its minimum speed and gusts are not followed.)
     gw, f = _field(8.0, 0.12, 3)
     op = linearize.trim(turbine, 8.0)
-    r = simulate_closed_loop(params, BaselineController(turbine, gains), gw, 600.0,
+    r = simulate_closed_loop(params, law_controller(BaselineController(turbine, gains),
+                                                    "baseline", turbine), gw, 600.0,
                              x0=op.x, u0=op.u)
     late = r.t > 60.0
     rews = np.interp(r.t[late], f.t, lidar.rotor_effective_wind(f, 63.0))
@@ -153,8 +155,9 @@ def iea15_low_wind() -> dict[float, tuple[ClosedLoopResult, linearize.OperatingP
     out = {}
     for v in (3.5, 5.0, 6.0):
         op = linearize.trim(tb, v)
-        out[v] = (simulate_closed_loop(p, BaselineController(tb, gains), linearize.SteadyWind(v),
-                                       150.0, x0=op.x, u0=op.u), op)
+        ctl = law_controller(BaselineController(tb, gains), "baseline", tb)
+        out[v] = (simulate_closed_loop(p, ctl, linearize.SteadyWind(v), 150.0, x0=op.x,
+                                       u0=op.u), op)
     return out
 
 
@@ -205,14 +208,12 @@ def test_a_bad_minimum_pitch_schedule_is_refused(gains, speeds, offsets) -> None
         dataclasses.replace(gains, min_pitch_speeds=speeds, min_pitch_offsets=offsets)
 
 
-@pytest.mark.parametrize("shipped", [False, True], ids=["python", "library"])
-def test_a_turbine_whose_fine_pitch_is_one_degree_stays_in_region_2(turbine, shipped) -> None:
+def test_a_turbine_whose_fine_pitch_is_one_degree_stays_in_region_2(turbine) -> None:
     """Jonkman et al.'s torque law switches to region 3 at 1 deg of pitch (VS_Rgn3MP) on a
     turbine whose fine pitch is 0; counted from the turbine's own fine pitch, a turbine at
     1 deg of fine pitch stays in region 2 at 9 m/s: its rotor runs at the trim's speed (the
     trim solves the same turbine at fine pitch; 1 % asked) instead of braking at rated torque.
-    The NREL 5-MW with its fine pitch raised to 1 deg is that turbine; both of the baseline's
-    laws (the Python step, and the library the kind ships) are checked."""
+    The NREL 5-MW with its fine pitch raised to 1 deg is that turbine."""
     import dataclasses
 
     from mpc_wt.run import run_controller
@@ -221,12 +222,7 @@ def test_a_turbine_whose_fine_pitch_is_one_degree_stays_in_region_2(turbine, shi
         turbine.operation, fine_pitch_rad=math.radians(1.0)))
     op = linearize.trim(t1, 9.0)
     assert op.pitch_rad == pytest.approx(math.radians(1.0), abs=1e-9)
-    if shipped:
-        res = run_controller(t1, "baseline", 9.0, duration=60.0, turbulence="steady")
-    else:
-        ctl = BaselineController(t1, tune_baseline(t1))
-        res = simulate_closed_loop(linearize.plant_params(t1), ctl,
-                                   linearize.SteadyWind(9.0), 60.0, x0=op.x, u0=op.u)
+    res = run_controller(t1, "baseline", 9.0, duration=60.0, turbulence="steady")
     late = res.t > 40.0
     assert res.channel("rotor_speed")[late].mean() == pytest.approx(op.rotor_speed_rad_s,
                                                                      rel=0.01)

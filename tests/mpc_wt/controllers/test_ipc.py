@@ -19,6 +19,7 @@ from mpc_wt.assessment.series import assess_series, lifetime_comparison
 from mpc_wt.registry import resolve
 from mpc_wt.controllers.apc import apc_reference
 from mpc_wt.controllers.baseline import BaselineController, tune_baseline
+from mpc_wt.run import law_controller
 from mpc_wt.controllers.derating import aep_change, steady_power_curve
 from mpc_wt.controllers.filters import SOSFilterBank, filter_sos
 from mpc_wt.controllers.ipc import tune_coleman_ipc, tune_ibc
@@ -134,24 +135,30 @@ def test_coleman_ipc_gains(turbine) -> None:
 
 
 def test_coleman_ipc_gives_the_collective_the_rate_first(turbine) -> None:
-    """Hand-worked: the NREL 5-MW's 8 deg/s at 80 Hz is 0.1 deg a step. From a collective of
-    10 deg with a cyclic of +2 / -1 / -1 deg, a collective demand 1 deg higher with a cyclic
-    demand of +2.5 / -1.25 / -1.25 deg moves the collective by 0.1 deg and leaves the cyclic
-    where it was (no rate left); a demand 0.04 deg higher leaves 0.06 deg a blade for the
-    cyclic, which asks for 0.5 deg more on blade 1 (and none on the others)."""
+    """Hand-worked, on the shipped law: the NREL 5-MW's 8 deg/s at 80 Hz is 0.1 deg a step.
+    At the first call (ServoDyn's: no power yet, so the IPC's weight is 0 and it asks for no
+    cyclic) the blades stand at 12 / 9 / 9 deg, a collective of 10 deg with a cyclic of
+    +2 / -1 / -1 deg. With the generator at its set point the baseline's collective stays at
+    10 deg (its bumpless start), and the whole rate step returns the cyclic toward 0:
+    11.9 / 9.1 / 9.1 deg. With the generator 60 rad/s above it the collective asks for more
+    than the rate step (the PI's integral step kI GK e dt = 0.22 deg): it takes the whole step
+    (10.1 deg) and the cyclic stays where it was: 12.1 / 9.1 / 9.1 deg. Float32 records:
+    1e-6 rad."""
     from mpc_wt.controllers.ipc import ColemanIPCController
 
-    c = ColemanIPCController(BaselineController(turbine, tune_baseline(turbine)),
-                             tune_coleman_ipc(turbine, winds=[14.0, 20.0]))
-    d = math.degrees(c.step_max)
-    assert d == pytest.approx(0.1, rel=1e-9)
-    meas = {"pitch": np.radians([12.0, 9.0, 9.0])}
-    up = np.radians([11.0, 11.0, 11.0])
-    cmd = c._limit_collective_first(up, tuple(np.radians([2.5, -1.25, -1.25])), meas)
-    assert_allclose(np.degrees(cmd), [12.1, 9.1, 9.1], atol=1e-12)
-    cmd = c._limit_collective_first(np.radians([10.14] * 3), tuple(np.radians([2.5, -1, -1])),
-                                    meas)
-    assert_allclose(np.degrees(cmd), [12.1 + 0.04 + 0.06, 9.14, 9.14], atol=1e-12)
+    base = BaselineController(turbine, tune_baseline(turbine))
+    design = ColemanIPCController(base, tune_coleman_ipc(turbine, winds=[14.0, 20.0]))
+    assert math.degrees(design.step_max) == pytest.approx(0.1, rel=1e-9)
+    ctl = law_controller(design, "coleman-ipc", turbine)
+    w_set = base.gains.rated_gen_speed_rad_s
+    for speed, expect in ((w_set, [11.9, 9.1, 9.1]), (w_set + 60.0, [12.1, 9.1, 9.1])):
+        ctl.reset()
+        meas = {"pitch": np.radians([12.0, 9.0, 9.0]), "gen_speed": speed,
+                "rotor_speed": speed / turbine.drivetrain.gearbox_ratio,
+                "flap_moment": np.zeros(3), "edge_moment": np.zeros(3), "azimuth": 0.0,
+                "gen_power": 5e6}
+        cmd, _ = ctl.step(0.0, meas)
+        assert_allclose(cmd, np.radians(expect), atol=1e-6)
 
 
 def test_the_cyclic_amplitude_follows_the_pitch_drives(turbine) -> None:
@@ -402,10 +409,21 @@ def test_apc_reference_above_available_power_is_an_error(turbine) -> None:
 
 
 def test_power_reference_above_rated_is_an_error(turbine) -> None:
-    ctl = BaselineController(turbine, power_reference=lambda t: 6e6)
+    """A power reference above rated power stops the shipped law at the step, naming it."""
+    from mpc_wt.controllers.apc import PowerReduction, PowerReference
+    from mpc_wt.controllers.baseline import tune_baseline_schedule
+    from mpc_wt.errors import ControllerLibraryError
+
+    sched = tune_baseline_schedule(turbine, fractions=(0.5, 1.0))
+    design = BaselineController(turbine, gain_schedule=sched,
+                                power_reference=PowerReference(5e6, PowerReduction(0.0, 0.0, -0.2)))
+    ctl = law_controller(design, "apc", turbine)
     op = linearize.trim(turbine, 15.0)
-    meas = {"gen_speed": op.gen_speed_rad_s, "pitch": np.full(3, op.pitch_rad)}
-    with pytest.raises(ValueError, match=r"power_reference\(0 s\) = 6000000.0 W must be in"):
+    meas = {"gen_speed": op.gen_speed_rad_s, "pitch": np.full(3, op.pitch_rad),
+            "rotor_speed": op.rotor_speed_rad_s, "flap_moment": np.zeros(3),
+            "edge_moment": np.zeros(3)}
+    with pytest.raises(ControllerLibraryError, match=r"power reference at t = 0 s is 6e\+06 W; "
+                                                     r"allowed: \(0, rated power 5e\+06 W\]"):
         ctl.step(0.0, meas)
 
 

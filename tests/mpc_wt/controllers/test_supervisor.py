@@ -10,6 +10,7 @@ import pytest
 import lidar
 import linearize
 from mpc_wt.controllers.baseline import BaselineController
+from mpc_wt.run import law_controller
 from mpc_wt.controllers.supervisor import Supervisor
 from mpc_wt.simulation.loop import simulate_closed_loop
 
@@ -24,6 +25,12 @@ def _run(turbine, ctl, wind, op, duration):
                                 u0=op.u)
 
 
+
+def _baseline(turbine):
+    """The baseline's shipped law."""
+    return law_controller(BaselineController(turbine), "baseline", turbine)
+
+
 def test_shutdown_reaches_feather_in_the_expected_time(turbine, steady18) -> None:
     """From the trim pitch at 18 m/s (about 15 deg) to feather (90 deg) at the actuator's 8
     deg/s: (90 - theta_0) / 8 s after the trip, plus the actuator's first-order lag (0.1 s
@@ -32,7 +39,7 @@ def test_shutdown_reaches_feather_in_the_expected_time(turbine, steady18) -> Non
     rotor slows down."""
     op, wind = steady18
     pa = turbine.pitch_actuator
-    sup = Supervisor(BaselineController(turbine), turbine, shutdown_at=2.0, torque_ramp_s=4.0)
+    sup = Supervisor(_baseline(turbine), turbine, shutdown_at=2.0, torque_ramp_s=4.0)
     res = _run(turbine, sup, wind, op, 16.0)
     pitch = np.column_stack([res.channel(f"pitch_{i}") for i in (1, 2, 3)])
     theta0 = pitch[int(2.0 / res.meta["dt"])].mean()
@@ -59,7 +66,7 @@ def test_overspeed_stop_trips_at_the_limit(turbine) -> None:
     f = lidar.iec_field("eog", 13.0, site, t_start=5.0, n=12)
     wind = linearize.GridWind(t=f.t, y=f.y, z=f.z, u=f.u)
     op = linearize.trim(turbine, 13.0)
-    sup = Supervisor(BaselineController(turbine), turbine, overspeed=1.01)
+    sup = Supervisor(_baseline(turbine), turbine, overspeed=1.01)
     res = _run(turbine, sup, wind, op, 25.0)
     limit = 1.01 * turbine.operation.rated_rotor_speed_rad_s
     speed = res.channel("rotor_speed")
@@ -73,7 +80,7 @@ def test_overspeed_stop_trips_at_the_limit(turbine) -> None:
 
 def test_grid_loss_drops_the_torque_at_once(turbine, steady18) -> None:
     op, wind = steady18
-    sup = Supervisor(BaselineController(turbine), turbine, grid_loss_at=1.0)
+    sup = Supervisor(_baseline(turbine), turbine, grid_loss_at=1.0)
     res = _run(turbine, sup, wind, op, 3.0)
     dt = res.meta["dt"]
     tq = res.channel("gen_torque")
@@ -103,7 +110,7 @@ def test_grid_loss_drops_the_torque_at_once(turbine, steady18) -> None:
 ])
 def test_bad_settings_are_named(turbine, kwargs, match) -> None:
     with pytest.raises(ValueError, match=match):
-        Supervisor(BaselineController(turbine), turbine, **kwargs)
+        Supervisor(_baseline(turbine), turbine, **kwargs)
 
 
 @pytest.mark.parametrize("fault", ["seized", "runaway"])
@@ -117,7 +124,7 @@ def test_pitch_fault_on_one_blade_and_the_protection(turbine, steady18, fault) -
     at 3 s; the torque ramps to zero."""
     op, wind = steady18
     pa = turbine.pitch_actuator
-    sup = Supervisor(BaselineController(turbine), turbine, pitch_fault_at=2.0,
+    sup = Supervisor(_baseline(turbine), turbine, pitch_fault_at=2.0,
                      pitch_fault=fault, pitch_fault_blade=2, fault_detect_s=1.0,
                      torque_ramp_s=4.0)
     res = _run(turbine, sup, wind, op, 9.0)
@@ -146,7 +153,7 @@ def test_a_pitch_fault_at_an_azimuth(turbine, steady18, blade, target) -> None:
     speed 1.27 rad/s x 12.5 ms = 0.9 deg), and less than a revolution (4.9 s at 18 m/s) after
     ``pitch_fault_at``; the protection then trips fault_detect_s later."""
     op, wind = steady18
-    sup = Supervisor(BaselineController(turbine), turbine, pitch_fault_at=2.0,
+    sup = Supervisor(_baseline(turbine), turbine, pitch_fault_at=2.0,
                      pitch_fault="seized", pitch_fault_blade=blade, fault_detect_s=1.0,
                      pitch_fault_azimuth_deg=target)
     res = _run(turbine, sup, wind, op, 9.0)

@@ -33,19 +33,22 @@ def lqr_doc(turbine: linearize.Turbine):
 
 
 def _identified_gains(turbine, gains, pitch: float) -> tuple[float, float]:
-    """The controller's effective (KP, KI) at ``pitch``, measured from its commands: start
-    bumpless at that pitch and rated speed, feed a small generator-speed step for 5 s and fit
-    command = theta_0 + KP e + KI int e dt to the filtered error e the controller reports (a
-    black-box identification, independent of the export's formula)."""
+    """The controller's effective (KP, KI) at ``pitch``, measured from the shipped law's
+    commands: start bumpless at that pitch and rated speed, feed a small generator-speed step
+    (1e-3 rad/s: the swap records are float32, 7.6e-6 rad/s apart at rated speed) for 5 s
+    and fit
+    command = theta_0 + KP e + KI int e dt to the filtered error e the law logs (a black-box
+    identification, independent of the export's formula)."""
     from mpc_wt.controllers.baseline import BaselineController
+    from mpc_wt.run import law_controller
 
-    c = BaselineController(turbine, gains)
-    c.reset()
+    c = law_controller(BaselineController(turbine, gains), "baseline", turbine)
     w0 = gains.rated_gen_speed_rad_s
-    meas = {"pitch": np.full(3, pitch), "gen_speed": w0}
+    meas = {"pitch": np.full(3, pitch), "gen_speed": w0, "rotor_speed": 1.0,
+            "flap_moment": np.zeros(3), "edge_moment": np.zeros(3)}
     cmd, err = [float(c.step(0.0, meas)[0][0])], [c.signals["speed_error"]]
     for k in range(1, 400):
-        cmd.append(float(c.step(k * c.dt, {**meas, "gen_speed": w0 + 1e-4})[0][0]))
+        cmd.append(float(c.step(k * c.dt, {**meas, "gen_speed": w0 + 1e-3})[0][0]))
         err.append(c.signals["speed_error"])
     e = np.array(err)
     a = np.c_[e, np.cumsum(e) * c.dt, np.ones_like(e)]

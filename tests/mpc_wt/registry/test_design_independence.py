@@ -83,7 +83,7 @@ def _design(turbine: linearize.Turbine, kind: str, options: dict) -> tuple[str, 
     from mpc_wt.run import design_controller
 
     built, _ = design_controller(turbine, kind, options, cache=DesignCache())
-    return design_digest(built.controller), built
+    return design_digest(built.designed), built
 
 
 @pytest.mark.parametrize("reads", ["scenario", "field", "op"])

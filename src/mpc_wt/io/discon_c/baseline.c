@@ -38,7 +38,7 @@ typedef struct {
     int on, n, saturated;
     double freq, amp, offset, p_full;
     double f[MW_APC_MAX], kp[MW_APC_MAX], ki[MW_APC_MAX], thk[MW_APC_MAX], dpdt[MW_APC_MAX];
-    double p_ref, p_ref_last, gk;
+    double p_ref, p_ref_last;
 } mw_apc;
 
 typedef struct {
@@ -49,7 +49,7 @@ typedef struct {
     mw_cipc cipc;
     mw_apc apc;
     /* state */
-    double w_filt, integral, last_pitch, last_tq;
+    double w_filt, integral, last_pitch, last_tq, gk;
     int started;
 } mw_baseline;
 
@@ -307,7 +307,7 @@ static double apc_pitch(mw_baseline *b, double err, double pitch_meas, int first
     }
     kp = mw_interp(frac, a->f, kps, a->n);
     ki = mw_interp(frac, a->f, kis, a->n);
-    a->gk = kp / c->kp;
+    b->gk = kp / c->kp;
     if (first) {
         b->integral = pitch_meas - kp * err;
         a->p_ref_last = a->p_ref;
@@ -330,6 +330,7 @@ static double pi_pitch(mw_baseline *b, double err, double pitch_meas, int first,
 {
     const mw_law *c = &b->law;
     double gk = 1.0 / (1.0 + b->last_pitch / c->theta_k), lo, hi, p, step, p_lo;
+    b->gk = gk;
     if (first) b->integral = (pitch_meas / gk - c->kp * err) / c->ki;
     b->integral += err * c->dt + ffd / (gk * c->ki);
     *off = mw_law_min_pitch_offset(c, b->w_filt);
@@ -414,19 +415,24 @@ static int baseline_step(mw_ctrl *self, const mw_meas *m, mw_cmd *out, char *msg
     b->started = 1;
     out->pitch[0] = out->pitch[1] = out->pitch[2] = p;
     out->torque = tq;
-    out->nlog = 0;
+    /* gen_speed_filtered, speed_error, pitch_integral (of the speed error [rad]; in pitch
+     * units [rad] with active power control), gain_schedule */
+    out->log[0] = b->w_filt;
+    out->log[1] = err;
+    out->log[2] = b->integral;
+    out->log[3] = b->gk;
+    out->nlog = 4;
     if (b->ff.on) {                 /* ff_wind, ff_pitch, ff_mean_wind, ff_corner */
-        out->log[0] = b->ff.wind;
-        out->log[1] = b->ff.ff_last;
-        out->log[2] = b->ff.mean;
-        out->log[3] = b->ff.corner;
-        out->nlog = 4;
+        out->log[4] = b->ff.wind;
+        out->log[5] = b->ff.ff_last;
+        out->log[6] = b->ff.mean;
+        out->log[7] = b->ff.corner;
+        out->nlog = 8;
     }
-    if (b->apc.on) {                /* power_reference, apc_saturated, gain_schedule */
-        out->log[0] = b->apc.p_ref;
-        out->log[1] = (double)b->apc.saturated;
-        out->log[2] = b->apc.gk;
-        out->nlog = 3;
+    if (b->apc.on) {                /* power_reference, apc_saturated */
+        out->log[4] = b->apc.p_ref;
+        out->log[5] = (double)b->apc.saturated;
+        out->nlog = 6;
     }
     return addons_step(b, m, p, out, msg);
 }

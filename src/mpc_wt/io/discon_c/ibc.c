@@ -16,6 +16,39 @@ static double dmax(double a, double b) { return a > b ? a : b; }
 
 #define MW_PI_3 1.04719755119659774615  /* pi / 3 */
 
+/* the low-passed electrical power's fade-in weight (no seed while the power is 0) */
+static double fade_in(double *p_filt, int *has_p, double alpha, double p, double rated,
+                      double lo, double hi)
+{
+    if (*has_p || p > 0.0) {
+        *p_filt = *has_p ? alpha * *p_filt + (1.0 - alpha) * p : p;
+        *has_p = 1;
+    }
+    return dmin(dmax((*p_filt / rated - lo) / (hi - lo), 0.0), 1.0);
+}
+
+/* the add-ons' common settings (the fade-in's power fractions, the power, the power filter's
+ * pole, the pitch limits and rate) are usable */
+static int settings_ok(const double *v)
+{
+    return v[1] > v[0] && v[2] > 0 && v[3] >= 0 && v[3] < 1 && v[5] >= v[4] && v[6] > 0;
+}
+
+/* a schedule's breakpoints increase; -1 with msg naming the key */
+static int increasing(const mw_input *in, const char *who, const char *key, const double *x,
+                      int n, char *msg)
+{
+    int i;
+    for (i = 1; i < n; i++) {
+        if (!(x[i] > x[i - 1])) {
+            mw_msg(msg, "mpc-wt %s: input file '%s': key '%s' must increase (value %d is %g "
+                   "after %g)", who, in->path, key, i + 1, x[i], x[i - 1]);
+            return -1;
+        }
+    }
+    return 0;
+}
+
 void mw_sos_step(mw_sos *f, const double *x, double *y)
 {
     int c, k, nch = f->nch;
@@ -80,12 +113,7 @@ int mw_ibc_step(mw_ibc *b, const mw_meas *m, double dt, const double *pc, double
                "electrical power (15) are not finite at t = %g s", m->t);
         return -1;
     }
-    if (b->has_p || m->gen_power > 0.0) {  /* no power yet (ServoDyn's first call): no seed */
-        b->p_filt = b->has_p ? b->p_alpha * b->p_filt + (1.0 - b->p_alpha) * m->gen_power
-                             : m->gen_power;
-        b->has_p = 1;
-    }
-    w = dmin(dmax((b->p_filt / b->rated - b->w_lo) / (b->w_hi - b->w_lo), 0.0), 1.0);
+    w = fade_in(&b->p_filt, &b->has_p, b->p_alpha, m->gen_power, b->rated, b->w_lo, b->w_hi);
     k = mw_interp((pc[0] + pc[1] + pc[2]) / 3.0, b->gp, b->gg, b->ng);
     mw_sos_step(&b->hp, m->flap, hp);
     for (i = 0; i < 3; i++) hp[i] *= k;
@@ -110,7 +138,6 @@ int mw_ibc_step(mw_ibc *b, const mw_meas *m, double dt, const double *pc, double
 int mw_ibc_read(const mw_input *in, mw_ibc *b, char *msg)
 {
     double v[9];
-    int i;
     memset(b, 0, sizeof(*b));
     if (mw_getp_vec(in, "", "ibc_settings", v, 9, msg)
         || !(b->gp = mw_getp_alloc(in, "", "ibc_gain_pitch", &b->ng, msg))
@@ -127,22 +154,14 @@ int mw_ibc_read(const mw_input *in, mw_ibc *b, char *msg)
     b->rate = v[6];
     b->remove_mean = v[7] != 0.0;
     b->amp = v[8];
-    if (!(b->w_hi > b->w_lo) || !(b->rated > 0) || !(b->p_alpha >= 0 && b->p_alpha < 1)
-        || !(b->pmax >= b->pmin) || !(b->rate > 0) || (v[7] != 0.0 && v[7] != 1.0)
-        || !(b->amp > 0)) {
+    if (!settings_ok(v) || (v[7] != 0.0 && v[7] != 1.0) || !(b->amp > 0)) {
         mw_msg(msg, "mpc-wt ibc: input file '%s': key 'ibc_settings' needs the weight's power "
                "fractions increasing, rated power > 0, power filter pole in [0, 1), pitch min "
                "<= max, a rate > 0, the mean removal 0 or 1 and a largest amplitude > 0",
                in->path);
         return -1;
     }
-    for (i = 1; i < b->ng; i++) {
-        if (!(b->gp[i] > b->gp[i - 1])) {
-            mw_msg(msg, "mpc-wt ibc: input file '%s': key 'ibc_gain_pitch' must increase "
-                   "(value %d is %g after %g)", in->path, i + 1, b->gp[i], b->gp[i - 1]);
-            return -1;
-        }
-    }
+    if (increasing(in, "ibc", "ibc_gain_pitch", b->gp, b->ng, msg)) return -1;
     b->on = 1;
     return 0;
 }
@@ -156,17 +175,6 @@ void mw_ibc_free(mw_ibc *b)
 }
 
 /* ---- Coleman-frame integral IPC ------------------------------------------------------ */
-/* the low-passed electrical power's fade-in weight (no seed while the power is 0) */
-static double fade_in(double *p_filt, int *has_p, double alpha, double p, double rated,
-                      double lo, double hi)
-{
-    if (*has_p || p > 0.0) {
-        *p_filt = *has_p ? alpha * *p_filt + (1.0 - alpha) * p : p;
-        *has_p = 1;
-    }
-    return dmin(dmax((*p_filt / rated - lo) / (hi - lo), 0.0), 1.0);
-}
-
 int mw_cipc_step(mw_cipc *b, const mw_meas *m, double dt, const double *pc, double *out,
                  char *msg)
 {
@@ -223,7 +231,6 @@ int mw_cipc_step(mw_cipc *b, const mw_meas *m, double dt, const double *pc, doub
 int mw_cipc_read(const mw_input *in, mw_cipc *b, char *msg)
 {
     double v[8];
-    int i;
     memset(b, 0, sizeof(*b));
     if (mw_getp_vec(in, "", "coleman_settings", v, 8, msg)
         || !(b->gp = mw_getp_alloc(in, "", "coleman_pitch", &b->ng, msg))
@@ -238,21 +245,13 @@ int mw_cipc_read(const mw_input *in, mw_cipc *b, char *msg)
     b->pmax = v[5];
     b->rate = v[6];
     b->amp = v[7];
-    if (!(b->w_hi > b->w_lo) || !(b->rated > 0) || !(b->p_alpha >= 0 && b->p_alpha < 1)
-        || !(b->pmax >= b->pmin) || !(b->rate > 0) || !(b->amp > 0)) {
+    if (!settings_ok(v) || !(b->amp > 0)) {
         mw_msg(msg, "mpc-wt coleman-ipc: input file '%s': key 'coleman_settings' needs the "
                "weight's power fractions increasing, rated power > 0, power filter pole in "
                "[0, 1), pitch min <= max, a rate > 0 and a largest amplitude > 0", in->path);
         return -1;
     }
-    for (i = 1; i < b->ng; i++) {
-        if (!(b->gp[i] > b->gp[i - 1])) {
-            mw_msg(msg, "mpc-wt coleman-ipc: input file '%s': key 'coleman_pitch' must "
-                   "increase (value %d is %g after %g)", in->path, i + 1, b->gp[i],
-                   b->gp[i - 1]);
-            return -1;
-        }
-    }
+    if (increasing(in, "coleman-ipc", "coleman_pitch", b->gp, b->ng, msg)) return -1;
     b->on = 1;
     return 0;
 }
