@@ -26,7 +26,7 @@ from mpc_wt.simulation.scenario import (DEFAULT_FIELDS, FieldMemo, Scenario, lid
 __all__ = ["run_controller", "build_controller", "design_controller", "export_discon",
            "export_controller", "law_controller",
            "run_openfast_case", "run_warnings", "verify_openfast", "CASE_CONTROLLERS",
-           "VALIDITY_SIGNALS", "VERIFY_BOUNDS"]
+           "VALIDITY_SIGNALS", "VERIFY_BOUNDS", "POWER_BOUND"]
 
 log = logging.getLogger(__name__)
 
@@ -316,7 +316,7 @@ def run_controller(turbine: linearize.Turbine, controller: str, scenario: Scenar
     return _warned(simulate_closed_loop(
         params, _supervised(built.controller, turbine, supervisor, meta), wind,
         scenario.duration, x0=op.x, u0=op.u, controller_dt=built.controller_dt,
-        preview=built.preview, progress=progress, meta=meta), controller)
+        preview=built.preview, progress=progress, meta=meta), controller, turbine)
 
 
 #: The supervisor's events, each at a time [s] that must fall within the run.
@@ -360,13 +360,18 @@ def _supervised(ctl: Any, turbine: linearize.Turbine, supervisor: Mapping[str, A
     return Supervisor(ctl, turbine, **dict(supervisor))
 
 
-def _warned(res: ClosedLoopResult, controller: str) -> ClosedLoopResult:
+def _warned(res: ClosedLoopResult, controller: str, turbine: linearize.Turbine
+            ) -> ClosedLoopResult:
     """``res`` with its :func:`run_warnings` in ``meta["run_warnings"]``, each logged."""
-    res.meta["run_warnings"] = run_warnings(res)
+    res.meta["run_warnings"] = run_warnings(res, turbine.operation.rated_power)
     for w in res.meta["run_warnings"]:
         log.warning("%s: %s", controller, w)
     return res
 
+
+#: The largest electrical power a grid takes from a turbine in power production, a fraction of
+#: its rated power: a run above it is warned (:func:`run_warnings`), the sign-off bounds it.
+POWER_BOUND = 1.1
 
 #: controller signals that flag a step outside the design's validity: signal -> what it means
 VALIDITY_SIGNALS = {
@@ -388,15 +393,17 @@ VALIDITY_SIGNALS = {
 PINNED_WARN_SHARE = 0.01
 
 
-def run_warnings(res: Any) -> list[str]:
+def run_warnings(res: Any, rated_power_W: float | None = None) -> list[str]:
     """Where a run left its controller's validity, one line each, with how often: commands the
     actuators' limits clipped, steps with the generator torque pinned at its maximum (more
-    than :data:`PINNED_WARN_SHARE` of them), and the steps a controller flagged
-    (:data:`VALIDITY_SIGNALS`).
+    than :data:`PINNED_WARN_SHARE` of them), the steps a controller flagged
+    (:data:`VALIDITY_SIGNALS`), and the electrical power above :data:`POWER_BOUND` x rated.
 
     Parameters
     ----------
     res : ClosedLoopResult
+    rated_power_W : float, optional
+        The turbine's rated power [W] (None: the power is not checked).
 
     Returns
     -------
@@ -418,6 +425,14 @@ def run_warnings(res: Any) -> list[str]:
         n = int(np.count_nonzero(np.asarray(sig) != 0))
         if n:
             out.append(f"{what} in {n} of {len(sig)} steps ({100.0 * n / len(sig):.1f} %)")
+    if rated_power_W and "gen_power" in res.channels():
+        p = np.asarray(res.channel("gen_power")) / rated_power_W
+        n = int(np.count_nonzero(p > POWER_BOUND))
+        if n:
+            k = int(np.argmax(p))
+            out.append(f"the electrical power passed {POWER_BOUND:g} x rated in {n} of {p.size} "
+                       f"steps ({n * float(np.median(np.diff(res.t))):g} s); largest "
+                       f"{p[k]:.3f} x rated at t = {res.t[k]:g} s")
     return out
 
 

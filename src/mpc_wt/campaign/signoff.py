@@ -234,6 +234,14 @@ def _change_se(b: Mapping[str, Any], ref: Mapping[str, Any]) -> float | None:
     return 100.0 * se / abs(ref["design"])
 
 
+def _largest(done: Sequence[tuple[CaseRow, Any]], channel: str) -> tuple[float, str] | None:
+    """The largest value of ``channel`` over finished cases that record its extremes, and
+    the case's id; None where none does."""
+    ex = [(r.metrics["extremes"][channel]["max"], r.case_id) for r, _ in done
+          if channel in r.metrics.get("extremes", {})]
+    return max(ex) if ex else None
+
+
 def signoff_rows(spec: CampaignSpec, rows: Sequence[CaseRow],
                  failed: Sequence[CaseRow] = ()) -> list[dict[str, Any]]:
     """Rotor overspeed, stops and pitch-rate demand per controller and DLC.
@@ -251,7 +259,9 @@ def signoff_rows(spec: CampaignSpec, rows: Sequence[CaseRow],
     -------
     list of dict
         ``controller``, ``dlc``, ``cases``, ``failed``, ``rotor_speed_max_rel`` (largest rotor
-        speed / rated), ``rotor_speed_max_case``, ``overspeed_limit_rel`` (the supervisor's,
+        speed / rated), ``rotor_speed_max_case``, ``power_max_rel`` and ``torque_max_rel``
+        (largest electrical power and generator torque / rated, where the cases record them)
+        with their ``*_case``, ``overspeed_limit_rel`` (the supervisor's,
         None without protection), ``overspeed_margin_pct`` (limit minus largest, in % of
         rated), ``overspeed_stops`` (cases stopped by the protection), ``stops`` (cases in
         which any stop sequence ran), ``pitch_rate_max_degps``, ``pitch_rate_max_rel`` (of the
@@ -267,11 +277,15 @@ def signoff_rows(spec: CampaignSpec, rows: Sequence[CaseRow],
         done = [(r, c) for r, c in items if r.status == "done" and r.metrics]
         row: dict[str, Any] = {"controller": ctl, "dlc": dlc, "cases": len(done),
                                "failed": len(items) - len(done)}
-        ex = [(r.metrics["extremes"]["rotor_speed"]["max"], r.case_id) for r, _ in done
-              if "rotor_speed" in r.metrics.get("extremes", {})]
+        ex = _largest(done, "rotor_speed")
         if ex:
-            w, case = max(ex)
+            w, case = ex
             row.update(rotor_speed_max_rel=w / rated, rotor_speed_max_case=case)
+        for ch, key, ref in (("gen_power", "power", tb.operation.rated_power),
+                             ("gen_torque", "torque", tb.rated_generator_torque)):
+            peak = _largest(done, ch)
+            if peak:
+                row.update({f"{key}_max_rel": peak[0] / ref, f"{key}_max_case": peak[1]})
         lims = {(c.supervisor or {}).get("overspeed") for _, c in done if c is not None}
         lim = min((x for x in lims if x is not None), default=None)
         row["overspeed_limit_rel"] = lim

@@ -83,6 +83,11 @@ def load_case_turbine(ref: str) -> Any:
     return linearize.load_turbine(ref)
 
 
+#: The channels whose extremes every case records beside its load channels: what a grid, a
+#: generator and the protection bound (the sign-off's largest rotor speed, power and torque).
+PEAKS = ("rotor_speed", "gen_power", "gen_torque")
+
+
 def case_metrics(t: np.ndarray, cols: dict[str, np.ndarray], channels: dict[str, float],
                  transient: float, convention: str = "range-1hz", *,
                  extremes_of: Sequence[str] = ()) -> dict[str, Any]:
@@ -111,7 +116,7 @@ def case_metrics(t: np.ndarray, cols: dict[str, np.ndarray], channels: dict[str,
     -------
     dict
         JSON-safe metrics (:func:`mpc_wt.assessment.series.assess_series` plus rotor-speed statistics and
-        ``extremes``: each channel's and the rotor speed's maximum and minimum and their times,
+        ``extremes``: each channel's and :data:`PEAKS`' maximum and minimum and their times,
         :func:`mpc_wt.assessment.ultimate.case_extremes`); with a supervisor in the loop
         ``supervisor_state`` (the largest :data:`mpc_wt.controllers.supervisor.STATES` code after the
         transient) and ``supervisor_trip_s`` (when it tripped, even within the transient); for
@@ -135,7 +140,7 @@ def case_metrics(t: np.ndarray, cols: dict[str, np.ndarray], channels: dict[str,
     out = assess_series(t[k], sub, channels, convention=convention)
     # ultimate loads: each channel's extremes and when
     out["extremes"] = case_extremes(t[k], sub, [
-        n for n in dict.fromkeys((*channels, *extremes_of, "rotor_speed")) if n in sub])
+        n for n in dict.fromkeys((*channels, *extremes_of, *PEAKS)) if n in sub])
     if "rotor_speed" in sub:
         out["rotor_speed_mean_rad_s"] = float(sub["rotor_speed"].mean())
         out["rotor_speed_std_rad_s"] = float(sub["rotor_speed"].std())

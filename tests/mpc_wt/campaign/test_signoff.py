@@ -273,6 +273,12 @@ def test_signoff_campaign_end_to_end(tmp_path) -> None:
     assert so[("baseline", "2.3")]["stops"] == 1 and so[("baseline", "1.2")]["stops"] == 0
     assert so[("derate80", "2.3")]["overspeed_limit_rel"] == 1.25
     assert ("derate80", "1.4") not in so
+    # the largest electrical power and torque of DLC 1.2, from the files (after the transient)
+    for ch, key, ref in (("gen_power", "power", 5e6), ("gen_torque", "torque", 43093.5515)):
+        peak = max(float(res.channel(ch)[res.t >= res.t[0] + spec.transient].max())
+                   for cid, r in rows.items() if cid.startswith("baseline__dlc1.2__")
+                   for res in [ClosedLoopResult.load(tmp_path / r.file)])
+        assert so[("baseline", "1.2")][f"{key}_max_rel"] == pytest.approx(peak / ref, rel=1e-6)
     # a tuning objective (relative_metrics) reads the fatigue load case only: at its one wind
     # the weighted power ratio is the seed means' ratio (the 2.3 gust cases at 13.4 m/s, with
     # the same turbulence letter, are left out)

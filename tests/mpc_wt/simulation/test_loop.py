@@ -216,3 +216,25 @@ def test_a_moment_at_the_torque_limit_is_counted_not_warned() -> None:
     assert run_warnings(res(10)) == []
     assert run_warnings(res(11)) == ["the generator torque sat at its maximum in 11 of 1001 "
                                      "steps (1.1 %)"]
+
+
+def test_electrical_power_above_the_grids_bound_is_warned() -> None:
+    """Hand-made: 1001 steps at 80 Hz of 5 MW with 40 steps at 5.6 MW (1.12 x rated, from
+    t = 5 s) warn once, with the count, the time above and the peak; 5.5 MW (1.1 x) is within
+    the bound; without the rated power the power is not checked."""
+    from types import SimpleNamespace
+
+    from mpc_wt.run import POWER_BOUND, run_warnings
+
+    t = np.arange(1001) / 80.0
+    p = np.full(t.size, 5e6)
+    p[400:440] = 5.6e6
+
+    def res(power):
+        return SimpleNamespace(meta={}, t=t, controller={}, channels=lambda: ["gen_power"],
+                               channel=lambda name: power)
+    assert POWER_BOUND == 1.1
+    assert run_warnings(res(p), 5e6) == ["the electrical power passed 1.1 x rated in 40 of 1001 "
+                                         "steps (0.5 s); largest 1.120 x rated at t = 5 s"]
+    assert run_warnings(res(np.minimum(p, 5.5e6)), 5e6) == []
+    assert run_warnings(res(p)) == []
