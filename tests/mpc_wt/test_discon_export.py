@@ -296,11 +296,10 @@ def test_cli_design_ibc_then_export_discon(tmp_path, capsys):
 
 def test_designs_that_know_more_than_measurements_do_not_export(nrel5mw, tmp_path):
     """The paper's measurement set (flap displacements, which no swap record carries; TS's
-    tower-top displacements take the same check), a TS power reduction over time and a
-    single-point LQR are refused by name."""
+    tower-top displacements take the same check) and a single-point LQR are refused by
+    name."""
     for kind, opts, words in (
             ("lqr-pio", {"observer_signals": "paper"}, "flap_1"),
-            ("ts", {"apc_frequency": 0.1}, "apc_frequency"),
             ("lqr-pio", {"design_wind_mps": 18.0}, "design_wind_mps")):
         with pytest.raises(ValueError, match=words):
             export_discon(nrel5mw, kind, tmp_path / kind, opts, build=False)

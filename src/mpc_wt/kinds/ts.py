@@ -117,10 +117,14 @@ def _ts_entries(ctl: Any, preview: Any = None) -> list[tuple[str, Any, str]]:
 
     if type(ctl) is not TSController:
         raise ValueError(f"the TS export takes a TSController, got {type(ctl).__name__}")
-    if ctl.power_reduction is not None or ctl._v_given is not None:
-        raise ValueError("a TS design with a power reduction over time (apc_frequency) or a "
-                         "given initial wind does not export: the library takes its power "
-                         "from the torque schedule and starts from the measured pitch")
+    from mpc_wt.controllers.apc import PowerReduction
+
+    dp = ctl.power_reduction
+    if (dp is not None and not isinstance(dp, PowerReduction)) or ctl._v_given is not None:
+        raise ValueError("a TS design with a power reduction other than Clemens et al.'s "
+                         "sinusoid (mpc_wt.controllers.apc.PowerReduction) or a given initial "
+                         "wind does not export: the library computes Delta P(t) from the time "
+                         "and starts from the measured pitch")
     ts, gen, pa = ctl.ts, ctl.turbine.generator, ctl.turbine.pitch_actuator
     codes = signal_codes(ts.measured, "TS observer")
     n, nx = ctl._phi.shape[1], len(ts.states)
@@ -158,6 +162,10 @@ def _ts_entries(ctl: Any, preview: Any = None) -> list[tuple[str, Any, str]]:
         ("u0", np.asarray(ts.u0, float).ravel(), "vertex inputs [rad, N m]"),
         ("gain", kk.ravel(), "vertex gains K_i (inputs x gain columns, row-major)"),
     ]
+    if dp is not None:
+        rows.append(("apc", np.array([dp.frequency_hz, dp.amplitude, dp.offset], float),
+                     "power reduction Delta P = offset + amplitude sin(2 pi f t): f [Hz], "
+                     "amplitude, offset [-]"))
     if ctl._law is not None:
         rows += law_entries(ctl._law)
     return rows
@@ -183,7 +191,8 @@ def _check_saved_ts(doc: Any) -> None:
 TS_EXPORT = LawExport(
     "ts", "Clemens et al.'s Takagi-Sugeno controller and wind observer, observing the tower-top "
     "accelerations and the rotor and generator speeds", "ts", _ts_entries, sources=("ts.c",),
-    log=("wind_est", "premise_clipped"), check_saved=_check_saved_ts)
+    log=("wind_est", "premise_clipped", "power_reduction", "power_ref"),
+    check_saved=_check_saved_ts)
 
 
 @register("ts", TSOptions, field_components="u", design=_design_ts, export=TS_EXPORT,

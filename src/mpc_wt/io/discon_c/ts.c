@@ -25,6 +25,8 @@ typedef struct {
     mw_ctrl base;
     int nv, nw, nr, n, nu, ny, nk, nt, ki, src, own_torque, has_law, started;
     double dt, limits[5], rated_power;
+    int apc;                        /* a power reduction over time (eq 11) */
+    double apc_f, apc_a, apc_o;     /* Delta P = offset + amplitude sin(2 pi f t) */
     double *wg, *rg, *phi, *gam, *x0, *u0, *kk, *eq_wind, *eq_pitch;
     int *terms, *signals, n_signals;
     /* state and scratch */
@@ -90,11 +92,11 @@ static void start(mw_ts *c, double pitch)
     c->started = 1;
 }
 
-/* the observer over the last period (blended zero-order-hold maps) */
-static void observe(mw_ts *c)
+/* the observer over the last period (blended zero-order-hold maps), at power reduction dp */
+static void observe(mw_ts *c, double dp)
 {
     int n = c->n, m = c->nu + c->ny + 1, k, i, j;
-    memberships(c, c->xi[n - 1], 0.0, c->h);
+    memberships(c, c->xi[n - 1], dp, c->h);
     for (j = 0; j < c->nu; j++) c->w[j] = c->u[j];
     for (j = 0; j < c->ny; j++) c->w[c->nu + j] = c->y[j];
     c->w[c->nu + c->ny] = 1.0;
@@ -114,12 +116,13 @@ static void observe(mw_ts *c)
     memcpy(c->xi, c->xn, (size_t)n * sizeof(double));
 }
 
-/* the parallel-distributed law at the new estimate; returns the integral to keep */
-static double law_pdc(mw_ts *c, double *out)
+/* the parallel-distributed law at the new estimate and power reduction dp; returns the
+ * integral to keep */
+static double law_pdc(mw_ts *c, double dp, double *out)
 {
     int n = c->n, nx = n - 1, i, r, j;
     double q = c->q, v = c->xi[n - 1], top = c->wg[c->nw - 1];
-    memberships(c, v, 0.0, c->h);
+    memberships(c, v, dp, c->h);
     if (c->ki >= 0) {
         double ref = 0.0;
         for (i = 0; i < c->nv; i++) ref += c->h[i] * c->x0[(size_t)i * nx + c->ki];
@@ -138,7 +141,7 @@ static double law_pdc(mw_ts *c, double *out)
     }
     if (c->nw > 1 && v > top) {       /* beyond the last vertex its pitch schedule goes on */
         double w0, w1, slope = 0.0;
-        int kb = hat(c->rg, c->nr, 0.0, &w0, &w1), b;
+        int kb = hat(c->rg, c->nr, dp, &w0, &w1), b;
         for (b = 0; b < 2; b++) {
             int ib = kb + b, last = (c->nw - 1) * c->nr + ib, prev = (c->nw - 2) * c->nr + ib;
             double wb = b == 0 ? w0 : w1;
@@ -154,7 +157,7 @@ static double law_pdc(mw_ts *c, double *out)
 static int ts_step(mw_ctrl *self, const mw_meas *m, mw_cmd *out, char *msg)
 {
     mw_ts *c = (mw_ts *)self;
-    double raw[2], pitch, torque, q, lo, hi;
+    double raw[2], pitch, torque, q, lo, hi, dp = 0.0;
     int b, clipped;
     if (mw_signals_get(m, c->signals, c->n_signals, c->y, "ts", msg)) return -1;
     if (!mw_finite(m->pitch[0] + m->pitch[1] + m->pitch[2]) || !mw_finite(m->gen_speed)) {
@@ -163,10 +166,12 @@ static int ts_step(mw_ctrl *self, const mw_meas *m, mw_cmd *out, char *msg)
         return -1;
     }
     if (!c->started) start(c, (m->pitch[0] + m->pitch[1] + m->pitch[2]) / 3.0);
-    clipped = outside(c->wg, c->nw, c->xi[c->n - 1]) || outside(c->rg, c->nr, 0.0);
-    observe(c);
+    if (c->apc) dp = c->apc_o + c->apc_a * sin(2.0 * 3.14159265358979323846 * c->apc_f * m->t);
+    clipped = outside(c->wg, c->nw, c->xi[c->n - 1]) || outside(c->rg, c->nr, dp);
+    observe(c, dp);
     clipped = clipped || outside(c->wg, c->nw, c->xi[c->n - 1]);
-    q = law_pdc(c, raw);
+    q = law_pdc(c, dp, raw);
+    dp = dmin(dmax(dp, c->rg[0]), c->rg[c->nr - 1]);
     lo = c->limits[0];
     hi = c->limits[1];
     if (c->limits[4] >= 0.0) {     /* what the actuator can follow from the measured pitch */
@@ -188,14 +193,16 @@ static int ts_step(mw_ctrl *self, const mw_meas *m, mw_cmd *out, char *msg)
     c->u[0] = pitch;
     c->u[1] = torque;
     if (c->has_law) {          /* the torque from the baseline's schedule, the pitch from TS */
-        torque = mw_torque_law_step(&c->law, m->gen_speed, pitch, c->rated_power);
+        torque = mw_torque_law_step(&c->law, m->gen_speed, pitch, c->rated_power * (1.0 - dp));
         c->u[1] = torque;
     }
     for (b = 0; b < 3; b++) out->pitch[b] = pitch;
     out->torque = torque;
-    out->nlog = 2;                  /* wind_est, premise_clipped */
+    out->nlog = 4;                  /* wind_est, premise_clipped, power_reduction, power_ref */
     out->log[0] = c->xi[c->n - 1];
     out->log[1] = clipped;
+    out->log[2] = dp;
+    out->log[3] = c->rated_power * (1.0 - dp);
     return 0;
 }
 
@@ -317,6 +324,19 @@ static int ts_read(const mw_input *in, mw_ctrl *self, char *msg)
         }
     }
     if (c->has_law && mw_torque_law_read(in, &c->law, msg)) return -1;
+    if (mw_has(in, "apc")) {        /* f [Hz], amplitude, offset of Delta P(t) */
+        double a[3];
+        if (mw_getp_vec(in, "", "apc", a, 3, msg)) return -1;
+        if (!(a[0] >= 0 && mw_finite(a[0]) && mw_finite(a[1]) && mw_finite(a[2]))) {
+            mw_msg(msg, "mpc-wt ts: input file '%s': key 'apc' needs a frequency >= 0 Hz and a "
+                   "finite amplitude and offset (got %g %g %g)", in->path, a[0], a[1], a[2]);
+            return -1;
+        }
+        c->apc = 1;
+        c->apc_f = a[0];
+        c->apc_a = a[1];
+        c->apc_o = a[2];
+    }
     c->xi = (double *)calloc((size_t)c->n, sizeof(double));
     c->xn = (double *)calloc((size_t)c->n, sizeof(double));
     c->w = (double *)calloc((size_t)(c->nu + c->ny + 1), sizeof(double));
