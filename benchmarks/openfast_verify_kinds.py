@@ -4,6 +4,9 @@
 Run:  python benchmarks/openfast_verify_kinds.py CASE.fst --openfast PATH [--out DIR]
       [--kinds baseline mpc ...] [--tmax 60]
 
+``apc`` and ``ts-apc`` are active power control and TS with the power reduction of Clemens et
+al. eq 11, both at f_r = 0.05 Hz.
+
 CASE.fst is the v5 input of ``5MW_Land_DLL_WTurb`` (or any NREL 5-MW deck). The LIDAR kinds
 run with five single points on the design's ring written into a copy of the deck's InflowWind
 file, or with ``--lidar-inflow FILE`` (an InflowWind file with a single-point lidar).
@@ -18,7 +21,10 @@ import linearize
 from mpc_wt.run import verify_openfast
 
 KINDS = ("baseline", "baseline-ct", "ibc", "mpc", "mpc-collective", "lqr-pio", "ts",
-         "mpc-lidar", "baseline+lidar-ff")
+         "mpc-lidar", "baseline+lidar-ff", "coleman-ipc", "derate80", "apc", "ts-apc")
+#: the rows that are a kind with options: row -> (kind, options)
+WITH_OPTIONS = {"apc": ("apc", {"apc_frequency": 0.05}),
+                "ts-apc": ("ts", {"apc_frequency": 0.05})}
 LIDAR_KINDS = ("mpc-lidar", "baseline+lidar-ff")
 
 
@@ -49,12 +55,13 @@ def main() -> None:
           "[kW] | blade 1 out-of-plane DEL d% | shaft torque DEL d% | tower base fore-aft DEL "
           "OpenFAST [MN m] (d%) | pitch travel [deg] | flags |")
     print("|---|---|---|---|---|---|---|---|---|")
-    for kind in args.kinds:
+    for row in args.kinds:
+        kind, options = WITH_OPTIONS.get(row, (row, None))
         lidar = kind in LIDAR_KINDS
-        doc = verify_openfast(turbine, kind, args.fst, Path(args.out) / kind,
+        doc = verify_openfast(turbine, kind, args.fst, Path(args.out) / row, options,
                               openfast=args.openfast, tmax=args.tmax,
                               inflow=args.lidar_inflow if lidar else None)
-        print(_row(kind, doc), flush=True)
+        print(_row(row, doc), flush=True)
 
 
 if __name__ == "__main__":
