@@ -39,11 +39,11 @@ def nrel5mw():
     return linearize.load_turbine("nrel5mw")
 
 
-def _export_fixture(kind: str, folder: str):
+def _export_fixture(kind: str, folder: str, options: dict | None = None):
     """A module-scoped fixture: ``kind`` exported (and built) for the NREL 5-MW."""
     @pytest.fixture(scope="module")
     def exported(nrel5mw, tmp_path_factory):
-        return export_discon(nrel5mw, kind, tmp_path_factory.mktemp(folder))
+        return export_discon(nrel5mw, kind, tmp_path_factory.mktemp(folder), options)
     return exported
 
 
@@ -54,6 +54,9 @@ mpc_lidar_export = _export_fixture("mpc-lidar", "mpc_lidar")
 lqr_export = _export_fixture("lqr-pio", "lqr")
 ibc_export = _export_fixture("ibc", "ibc")
 ts_export = _export_fixture("ts", "ts")
+coleman_export = _export_fixture("coleman-ipc", "coleman")
+apc_export = _export_fixture("apc", "apc", {"apc_frequency": 0.05})
+ts_apc_export = _export_fixture("ts", "ts_apc", {"apc_frequency": 0.05})
 
 
 def _discon(ex):
@@ -587,11 +590,13 @@ def _asan_runtime() -> str | None:
 
 @pytest.mark.skipif(_asan_runtime() is None, reason="no AddressSanitizer runtime (libasan)")
 def test_sanitized_libraries_run_60_s_clean(baseline_export, mpc_export, mpc_lidar_export,
-                                             lqr_export, ts_export, ibc_export, tmp_path):
-    """The baseline, the MPC, the MPC with LIDAR preview, the LQR-PIO, the TS controller and
-    IBC built with -fsanitize=address,undefined (any report aborts), 60 s of turbulent closed loop
-    each in a process that loads the sanitizer runtime first: exit 0, no report, no warning
-    from the library."""
+                                             lqr_export, ts_export, ibc_export, coleman_export,
+                                             apc_export, ts_apc_export, tmp_path):
+    """The baseline, the MPC, the MPC with LIDAR preview, the LQR-PIO, the TS controller (also
+    with its power reduction), IBC, Coleman IPC and active power control built with
+    -fsanitize=address,undefined (any report aborts), 60 s of turbulent closed loop each in a
+    process that loads the sanitizer runtime first: exit 0, no report, no warning from the
+    library."""
     # each law's library (the kinds of one law share it) built with the sanitizers
     libs = {}
     for ex in (baseline_export, mpc_export, lqr_export, ts_export):
@@ -600,10 +605,12 @@ def test_sanitized_libraries_run_60_s_clean(baseline_export, mpc_export, mpc_lid
         for p in ex.sources:
             shutil.copy(p, d / p.relative_to(ex.directory))
         libs[ex.kind] = build_library(d, ex.kind, sanitize=True, name="libasan_mpcwt.so")
-    law = {"mpc-lidar": "mpc", "ibc": "baseline"}
+    law = {"mpc-lidar": "mpc", "ibc": "baseline", "coleman-ipc": "baseline",
+           "apc": "baseline"}
+    exports = (baseline_export, mpc_export, mpc_lidar_export, lqr_export, ts_export,
+               ibc_export, coleman_export, apc_export, ts_apc_export)
     runs = [dict(_discon(ex), discon_library=str(libs[law.get(ex.kind, ex.kind)]))
-            for ex in (baseline_export, mpc_export, mpc_lidar_export, lqr_export, ts_export,
-                       ibc_export)]
+            for ex in exports]
     script = textwrap.dedent(f"""
         import linearize
         from mpc_wt.run import run_controller
@@ -619,7 +626,7 @@ def test_sanitized_libraries_run_60_s_clean(baseline_export, mpc_export, mpc_lid
                          env=env, timeout=600)
     assert out.returncode == 0, out.stderr[-3000:]
     assert "AddressSanitizer" not in out.stderr and "runtime error" not in out.stderr
-    assert out.stdout.count("steps 4801 warnings 0") == 6, out.stdout
+    assert out.stdout.count("steps 4801 warnings 0") == len(exports), out.stdout
 
 
 def test_kinds_that_do_not_export_are_named(nrel5mw, tmp_path):
