@@ -568,6 +568,45 @@ def test_bad_lqr_and_ts_input_files_name_the_key(nrel5mw, lqr_export, ts_export,
         assert w in msg, (w, msg)
 
 
+@pytest.mark.parametrize("kind, edit, words", [
+    ("coleman-ipc", lambda t: re.sub(r"\ncoleman_pitch +\S+", "\ncoleman_pitch 9", t),
+     ["'coleman_pitch'", "must increase"]),
+    ("coleman-ipc", lambda t: t.replace("\ncoleman_settings ",
+                                        "\ncoleman_settings 0.95 0.8 5e6 0.9 0 1.5 0.1 0.03 # "),
+     ["'coleman_settings'", "power fractions increasing"]),
+    ("coleman-ipc", lambda t: re.sub(r"\nibc +0", "\nibc 1\nibc_settings 0.8 0.95 5e6 0.9 0 "
+                                        "1.5 0.1 1 0.03\nibc_gain_pitch 0 0.3\nibc_gain 1e-8 "
+                                        "1e-8\nibc_input_sos 1 0 0 1 0 0\nibc_input_zi 0 0\n"
+                                        "ibc_output_sos 1 0 0 1 0 0\nibc_output_zi 0 0\n#", t),
+     ["'ibc' and 'coleman_ipc' are both 1"]),
+    ("apc", lambda t: t.replace("\napc_schedule ", "\napc_schedule 1 2 3 # "),
+     ["'apc_schedule'", "designs of 5 values"]),
+    ("apc", lambda t: t.replace("\napc ", "\napc -0.1 0.375 0.375 5e6 # "),
+     ["'apc'", "frequency >= 0 Hz"]),
+])
+def test_bad_coleman_and_apc_input_files_name_the_key(nrel5mw, coleman_export, apc_export,
+                                                       tmp_path, kind, edit, words):
+    """A corrupt Coleman IPC or APC input file (a schedule that does not increase, settings out
+    of range, IBC and Coleman IPC both on, a schedule of the wrong length, a negative
+    frequency) stops the first call with aviFAIL < 0 and a message naming the file and the
+    key."""
+    ex = coleman_export if kind == "coleman-ipc" else apc_export
+    text = edit(ex.input_file.read_text())
+    assert text != ex.input_file.read_text()
+    path = tmp_path / "bad.in"
+    path.write_text(text)
+    ctl = DisconController(ex.library, path, nrel5mw, dt=ex.dt)
+    ctl.reset()
+    with pytest.raises(ControllerLibraryError) as err:
+        ctl.step(0.0, {"gen_speed": 120.0, "rotor_speed": 1.2, "pitch": np.zeros(3),
+                       "flap_moment": np.zeros(3), "edge_moment": np.zeros(3)})
+    ctl.finalize()
+    msg = str(err.value)
+    assert "aviFAIL = -1" in msg and "bad.in" in msg
+    for w in words:
+        assert w in msg, (w, msg)
+
+
 def test_non_finite_speed_stops_with_the_record(baseline_export, tmp_path):
     lib = _Lib(_copy(baseline_export.library, tmp_path, "nan.so"))
     inp = baseline_export.input_file

@@ -545,6 +545,12 @@ mw_ctrl *mw_baseline_new(const mw_input *in, char *msg)
             baseline_destroy(&b->base);
             return NULL;
         }
+        if (ibc && cipc) {
+            mw_msg(msg, "mpc-wt baseline: input file '%s': keys 'ibc' and 'coleman_ipc' are both "
+                   "1; the law adds one of them to its collective command", in->path);
+            baseline_destroy(&b->base);
+            return NULL;
+        }
     }
     b->base.dt = b->law.dt;
     b->base.step = baseline_step;
