@@ -521,17 +521,36 @@ def test_bad_input_file_fails_with_the_file_and_key(nrel5mw, baseline_export, tm
         path.write_text(text)
     ctl = DisconController(baseline_export.library, baseline_export.input_file, nrel5mw)
     ctl.discon_in = path                      # the host checks the file exists: bypass it
-    ctl.reset()
-    with pytest.raises(ControllerLibraryError) as err:
-        ctl.step(0.0, {"gen_speed": 120.0, "rotor_speed": 1.2, "pitch": np.zeros(3),
-                       "flap_moment": np.zeros(3), "edge_moment": np.zeros(3)})
-    ctl.finalize()
-    msg = str(err.value)
+    msg = _first_call_error(ctl)
     assert "aviFAIL = -1" in msg
     for w in words:
         assert w in msg, (w, msg)
     if text is not None:
         assert "bad.in" in msg
+
+
+def _first_call_error(ctl):
+    """The message of the ControllerLibraryError the library's first call raises."""
+    ctl.reset()
+    with pytest.raises(ControllerLibraryError) as err:
+        ctl.step(0.0, {"gen_speed": 120.0, "rotor_speed": 1.2, "pitch": np.zeros(3),
+                       "flap_moment": np.zeros(3), "edge_moment": np.zeros(3)})
+    ctl.finalize()
+    return str(err.value)
+
+
+def _first_call_names_the_key(turbine, ex, edit, words, tmp_path):
+    """The export's input file edited by ``edit``: the library's first call stops with
+    aviFAIL < 0 and a message naming the file and each of ``words``."""
+    text = edit(ex.input_file.read_text())
+    assert text != ex.input_file.read_text()
+    path = tmp_path / "bad.in"
+    path.write_text(text)
+    ctl = DisconController(ex.library, path, turbine, dt=ex.dt)
+    msg = _first_call_error(ctl)
+    assert "aviFAIL = -1" in msg and "bad.in" in msg
+    for w in words:
+        assert w in msg, (w, msg)
 
 
 @pytest.mark.parametrize("kind, edit, words", [
@@ -552,20 +571,7 @@ def test_bad_lqr_and_ts_input_files_name_the_key(nrel5mw, lqr_export, ts_export,
     """A corrupt LQR-PIO or TS input file stops the first call with aviFAIL < 0 and a message
     naming the file and the key."""
     ex = lqr_export if kind == "lqr-pio" else ts_export
-    text = edit(ex.input_file.read_text())
-    assert text != ex.input_file.read_text()
-    path = tmp_path / "bad.in"
-    path.write_text(text)
-    ctl = DisconController(ex.library, path, nrel5mw, dt=ex.dt)
-    ctl.reset()
-    with pytest.raises(ControllerLibraryError) as err:
-        ctl.step(0.0, {"gen_speed": 120.0, "rotor_speed": 1.2, "pitch": np.zeros(3),
-                       "flap_moment": np.zeros(3), "edge_moment": np.zeros(3)})
-    ctl.finalize()
-    msg = str(err.value)
-    assert "aviFAIL = -1" in msg and "bad.in" in msg
-    for w in words:
-        assert w in msg, (w, msg)
+    _first_call_names_the_key(nrel5mw, ex, edit, words, tmp_path)
 
 
 @pytest.mark.parametrize("kind, edit, words", [
@@ -591,20 +597,7 @@ def test_bad_coleman_and_apc_input_files_name_the_key(nrel5mw, coleman_export, a
     frequency) stops the first call with aviFAIL < 0 and a message naming the file and the
     key."""
     ex = coleman_export if kind == "coleman-ipc" else apc_export
-    text = edit(ex.input_file.read_text())
-    assert text != ex.input_file.read_text()
-    path = tmp_path / "bad.in"
-    path.write_text(text)
-    ctl = DisconController(ex.library, path, nrel5mw, dt=ex.dt)
-    ctl.reset()
-    with pytest.raises(ControllerLibraryError) as err:
-        ctl.step(0.0, {"gen_speed": 120.0, "rotor_speed": 1.2, "pitch": np.zeros(3),
-                       "flap_moment": np.zeros(3), "edge_moment": np.zeros(3)})
-    ctl.finalize()
-    msg = str(err.value)
-    assert "aviFAIL = -1" in msg and "bad.in" in msg
-    for w in words:
-        assert w in msg, (w, msg)
+    _first_call_names_the_key(nrel5mw, ex, edit, words, tmp_path)
 
 
 def test_non_finite_speed_stops_with_the_record(baseline_export, tmp_path):

@@ -1,15 +1,18 @@
-"""Controllers: the laws that run in the closed loop, and their synthesis.
+"""Controllers: the designs and their synthesis, and the laws that run in Python.
 
 Each module holds one kind of controller with its design functions (all in
-``mpc_wt.controllers``): the tuned baseline PI and torque law (``baseline``, its law compiled in
-``baseline_law``), Madsen's MPC (``mpc`` on the QP backends of ``qp``, the Kalman estimator of
-``estimator``), Do et al.'s LQR with a PI observer (``lqr``), Clemens et al.'s Takagi-Sugeno
-controller and wind observer (``takagi_sugeno``), individual blade control and Coleman IPC
-(``ipc``), active power control (``apc``), down-regulation (``derating``), LIDAR collective
-pitch feedforward (``lidar_feedforward``), the rotor-effective wind from measurements
-(``wind_estimator``), the supervisor (``supervisor``) and Bladed-style DISCON libraries in the
-loop (``discon``, its compiled call ``discon_kernel``). Every controller offers ``reset()`` and
-``step(t, measurements)`` (:class:`~mpc_wt.controllers.base.Controller`).
+``mpc_wt.controllers``): the tuned baseline PI and torque law (``baseline``, its torque curve
+compiled in ``baseline_law``), Madsen's MPC (``mpc`` on the QP backends of ``qp``, the Kalman
+estimator of ``estimator``), Do et al.'s LQR with a PI observer (``lqr``), Clemens et al.'s
+Takagi-Sugeno controller and wind observer (``takagi_sugeno``), individual blade control and
+Coleman IPC (``ipc``), active power control (``apc``), down-regulation (``derating``), LIDAR
+collective pitch feedforward (``lidar_feedforward``), the rotor-effective wind from
+measurements (``wind_estimator``), the supervisor (``supervisor``) and Bladed-style DISCON
+libraries in the loop (``discon``, its compiled call ``discon_kernel``). A controller offers
+``reset()`` and ``step(t, measurements)`` (:class:`~mpc_wt.controllers.base.Controller`); the
+baseline's family (baseline, IBC, Coleman IPC, LIDAR feedforward) are designs
+(:class:`~mpc_wt.controllers.base.DesignBase`) whose law is their kind's C law
+(:func:`mpc_wt.run.law_controller`).
 
 The controller kinds, their options and their builds are registered in :mod:`mpc_wt.kinds`;
 the plugin API (``register``, ``Options``, ``option``, ``Built``, ``BuildContext``, ``kinds``,

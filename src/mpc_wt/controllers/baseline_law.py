@@ -24,29 +24,26 @@ _JIT = dict(cache=True, error_model="numpy")
 REGION3_PITCH_MARGIN = math.radians(1.0)
 
 # parameter vector layout
-(_A, _W_RATED_SET, _KP, _KI, _THETA_K, _DT, _P_MIN, _P_MAX, _RATE, _TQ_RATE, _TQ_MAX,
- _W_CUTIN, _W_RGN2, _W_TRANS, _W_RATED, _W_SYNC, _SLOPE15, _SLOPE25, _K_OPT, _TQ_CAP,
- _P_RATED, _ETA, _TQ_RATED, _CONST_POWER, _RGN3_PITCH, _I_GEN_SPEED, _N_MIN_PITCH) = range(27)
+(_W_CUTIN, _W_RGN2, _W_TRANS, _W_RATED, _W_SYNC, _SLOPE15, _SLOPE25, _K_OPT, _TQ_CAP,
+ _P_RATED, _ETA, _TQ_RATED, _CONST_POWER, _RGN3_PITCH, _N_MIN_PITCH) = range(15)
 #: length of the parameter vector's fixed part; the minimum-pitch schedule's speeds and offsets
 #: follow it (``par[_N_MIN_PITCH]`` points each)
-N_PARAMS = 27
+N_PARAMS = 15
 
 
-def law_parameters(ctl: Any, gen_speed_index: int = -1) -> np.ndarray:
-    """The parameter vector of a baseline controller's law.
+def law_parameters(ctl: Any) -> np.ndarray:
+    """The parameter vector of a baseline design's torque law and minimum-pitch schedule.
 
     Parameters
     ----------
     ctl : BaselineController
-        The controller (its gains, breakpoints, limits and period).
-    gen_speed_index : int
-        Index of the generator speed in the plant's outputs (-1: unused).
+        The design (its gains and breakpoints).
 
     Returns
     -------
     (N_PARAMS + 2 k,) ndarray
         The fixed part, then the minimum-pitch schedule's k speeds [rad/s] and offsets above
-        the minimum pitch [rad] (the controller's ``min_pitch_speeds``, ``min_pitch_offsets``).
+        the minimum pitch [rad] (the design's ``min_pitch_speeds``, ``min_pitch_offsets``).
     """
     g = ctl.gains
     ws, offs = np.array(ctl.min_pitch_speeds, float), np.array(ctl.min_pitch_offsets, float)
@@ -54,17 +51,13 @@ def law_parameters(ctl: Any, gen_speed_index: int = -1) -> np.ndarray:
     par = np.empty(N_PARAMS + 2 * k)
     par[_N_MIN_PITCH] = k
     par[N_PARAMS:N_PARAMS + k], par[N_PARAMS + k:] = ws, offs
-    par[[_A, _W_RATED_SET, _KP, _KI, _THETA_K, _DT, _P_MIN, _P_MAX, _RATE, _TQ_RATE]] = (
-        ctl.filter_pole, g.rated_gen_speed_rad_s, g.kp, g.ki, g.theta_k_rad, ctl.dt,
-        ctl.pitch_min, ctl.pitch_max, ctl.rate, ctl.tq_rate)
-    par[[_TQ_MAX, _W_CUTIN, _W_RGN2, _W_TRANS, _W_RATED, _W_SYNC, _SLOPE15, _SLOPE25]] = (
-        ctl.tq_max, ctl.w_cutin, ctl.w_rgn2, ctl.w_trans, ctl.w_rated, ctl.w_sync, ctl.slope15,
+    par[[_W_CUTIN, _W_RGN2, _W_TRANS, _W_RATED, _W_SYNC, _SLOPE15, _SLOPE25]] = (
+        ctl.w_cutin, ctl.w_rgn2, ctl.w_trans, ctl.w_rated, ctl.w_sync, ctl.slope15,
         ctl.slope25)
-    par[[_K_OPT, _TQ_CAP, _P_RATED, _ETA, _TQ_RATED, _CONST_POWER, _RGN3_PITCH, _I_GEN_SPEED]] = (
+    par[[_K_OPT, _TQ_CAP, _P_RATED, _ETA, _TQ_RATED, _CONST_POWER, _RGN3_PITCH]] = (
         g.k_opt, ctl.tq_cap, g.rated_power, ctl.turbine.drivetrain.generator_efficiency,
         g.rated_torque, float(ctl.region3 == "constant_power"),
-        ctl.pitch_min + REGION3_PITCH_MARGIN,
-        gen_speed_index)
+        ctl.pitch_min + REGION3_PITCH_MARGIN)
     return par
 
 

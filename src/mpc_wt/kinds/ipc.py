@@ -76,6 +76,16 @@ class IBCOptions(Options):
                                                 lo_open=True, hi=20.0, flag="")
 
 
+def _addon_settings(ctl: Any) -> list[float]:
+    """What IBC's and Coleman IPC's settings share, in their laws' order: the fade-in's power
+    fractions, the power it refers to [W], the power low-pass's pole, the pitch limits [rad]
+    and rate [rad/s] on the summed command."""
+    g = ctl.gains
+    return [g.weight_range[0], g.weight_range[1], g.rated_power,
+            math.exp(-ctl.dt / ctl.power_tau), ctl.pitch_min, ctl.pitch_max,
+            ctl.step_max / ctl.dt]
+
+
 def _ibc_entries(ctl: Any, preview: Any = None) -> list[tuple[str, Any, str]]:
     """An :class:`~mpc_wt.controllers.ipc.IBCController` on the baseline: the baseline's law
     and the IBC's gain schedule, filters (second-order sections and their unit-step states),
@@ -88,10 +98,7 @@ def _ibc_entries(ctl: Any, preview: Any = None) -> list[tuple[str, Any, str]]:
     return baseline_entries(ctl.collective) + [
         ("feedforward", 0.0, "no LIDAR feedforward"),
         ("ibc", 1.0, "1: individual blade control on the collective command"),
-        ("ibc_settings", np.array([g.weight_range[0], g.weight_range[1], g.rated_power,
-                                   math.exp(-ctl.dt / ctl.power_tau), ctl.pitch_min,
-                                   ctl.pitch_max, ctl.step_max / ctl.dt,
-                                   float(ctl.remove_collective),
+        ("ibc_settings", np.array([*_addon_settings(ctl), float(ctl.remove_collective),
                                    min(g.max_amplitude_rad, 1e300)], float),
          "the fade-in's power fractions [-], the power it refers to [W], the power filter's "
          "pole, pitch min, max [rad], pitch rate [rad/s], 1: the blades' mean removed, each "
@@ -180,9 +187,7 @@ def _coleman_entries(ctl: Any, preview: Any = None) -> list[tuple[str, Any, str]
         ("feedforward", 0.0, "no LIDAR feedforward"),
         ("ibc", 0.0, "no individual blade control"),
         ("coleman_ipc", 1.0, "1: Coleman-frame integral IPC on the collective command"),
-        ("coleman_settings", np.array([g.weight_range[0], g.weight_range[1], g.rated_power,
-                                       math.exp(-ctl.dt / ctl.power_tau), ctl.pitch_min,
-                                       ctl.pitch_max, ctl.step_max / ctl.dt,
+        ("coleman_settings", np.array([*_addon_settings(ctl),
                                        min(g.max_amplitude_rad, 1e300)], float),
          "the fade-in's power fractions [-], the power it refers to [W], the power filter's "
          "pole, pitch min, max [rad], pitch rate [rad/s], the largest cyclic amplitude [rad]"),

@@ -16,21 +16,28 @@ static double dmax(double a, double b) { return a > b ? a : b; }
 
 #define MW_PI_3 1.04719755119659774615  /* pi / 3 */
 
-/* the low-passed electrical power's fade-in weight (no seed while the power is 0) */
-static double fade_in(double *p_filt, int *has_p, double alpha, double p, double rated,
-                      double lo, double hi)
+/* the low-passed electrical power's fade-in weight (no seed while the power is 0, as at
+ * ServoDyn's first call) */
+static double fade_in(mw_addon *a, double p)
 {
-    if (*has_p || p > 0.0) {
-        *p_filt = *has_p ? alpha * *p_filt + (1.0 - alpha) * p : p;
-        *has_p = 1;
+    if (a->has_p || p > 0.0) {
+        a->p_filt = a->has_p ? a->p_alpha * a->p_filt + (1.0 - a->p_alpha) * p : p;
+        a->has_p = 1;
     }
-    return dmin(dmax((*p_filt / rated - lo) / (hi - lo), 0.0), 1.0);
+    return dmin(dmax((a->p_filt / a->rated - a->w_lo) / (a->w_hi - a->w_lo), 0.0), 1.0);
 }
 
-/* the add-ons' common settings (the fade-in's power fractions, the power, the power filter's
- * pole, the pitch limits and rate) are usable */
-static int settings_ok(const double *v)
+/* the add-ons' common settings v[0..6] (the fade-in's power fractions, the power, the power
+ * filter's pole, the pitch limits and rate) into a; 0 where they are unusable */
+static int addon_read(const double *v, mw_addon *a)
 {
+    a->w_lo = v[0];
+    a->w_hi = v[1];
+    a->rated = v[2];
+    a->p_alpha = v[3];
+    a->pmin = v[4];
+    a->pmax = v[5];
+    a->rate = v[6];
     return v[1] > v[0] && v[2] > 0 && v[3] >= 0 && v[3] < 1 && v[5] >= v[4] && v[6] > 0;
 }
 
@@ -113,7 +120,7 @@ int mw_ibc_step(mw_ibc *b, const mw_meas *m, double dt, const double *pc, double
                "electrical power (15) are not finite at t = %g s", m->t);
         return -1;
     }
-    w = fade_in(&b->p_filt, &b->has_p, b->p_alpha, m->gen_power, b->rated, b->w_lo, b->w_hi);
+    w = fade_in(&b->a, m->gen_power);
     k = mw_interp((pc[0] + pc[1] + pc[2]) / 3.0, b->gp, b->gg, b->ng);
     mw_sos_step(&b->hp, m->flap, hp);
     for (i = 0; i < 3; i++) hp[i] *= k;
@@ -127,8 +134,8 @@ int mw_ibc_step(mw_ibc *b, const mw_meas *m, double dt, const double *pc, double
     b->weight = w;
     b->gain = k;
     for (i = 0; i < 3; i++) {
-        double prev = b->has_last ? b->last[i] : m->pitch[i], d = b->rate * dt;
-        double v = dmin(dmax(pc[i] + u[i], b->pmin), b->pmax);
+        double prev = b->has_last ? b->last[i] : m->pitch[i], d = b->a.rate * dt;
+        double v = dmin(dmax(pc[i] + u[i], b->a.pmin), b->a.pmax);
         out[i] = b->last[i] = dmin(dmax(v, prev - d), prev + d);
     }
     b->has_last = 1;
@@ -145,16 +152,9 @@ int mw_ibc_read(const mw_input *in, mw_ibc *b, char *msg)
         || mw_sos_read(in, "ibc", "ibc_input_sos", "ibc_input_zi", 3, &b->hp, msg)
         || mw_sos_read(in, "ibc", "ibc_output_sos", "ibc_output_zi", 3, &b->bs, msg))
         return -1;
-    b->w_lo = v[0];
-    b->w_hi = v[1];
-    b->rated = v[2];
-    b->p_alpha = v[3];
-    b->pmin = v[4];
-    b->pmax = v[5];
-    b->rate = v[6];
     b->remove_mean = v[7] != 0.0;
     b->amp = v[8];
-    if (!settings_ok(v) || (v[7] != 0.0 && v[7] != 1.0) || !(b->amp > 0)) {
+    if (!addon_read(v, &b->a) || (v[7] != 0.0 && v[7] != 1.0) || !(b->amp > 0)) {
         mw_msg(msg, "mpc-wt ibc: input file '%s': key 'ibc_settings' needs the weight's power "
                "fractions increasing, rated power > 0, power filter pole in [0, 1), pitch min "
                "<= max, a rate > 0, the mean removal 0 or 1 and a largest amplitude > 0",
@@ -179,7 +179,7 @@ int mw_cipc_step(mw_cipc *b, const mw_meas *m, double dt, const double *pc, doub
                  char *msg)
 {
     double psi = m->azimuth, c[3], s[3], w, k, phi, cp, sp, amp, c_mean, c_new, budget;
-    double d = b->rate * dt;
+    double d = b->a.rate * dt;
     int i;
     if (!mw_finite(m->flap[0] + m->flap[1] + m->flap[2]) || !mw_finite(psi)
         || !mw_finite(m->gen_power)) {
@@ -194,7 +194,7 @@ int mw_cipc_step(mw_cipc *b, const mw_meas *m, double dt, const double *pc, doub
     /* Coleman transform (Bossanyi 2003): M_tilt, M_yaw = 2/3 sum M_i (cos, sin) psi_i */
     b->tilt = 2.0 / 3.0 * (m->flap[0] * c[0] + m->flap[1] * c[1] + m->flap[2] * c[2]);
     b->yaw = 2.0 / 3.0 * (m->flap[0] * s[0] + m->flap[1] * s[1] + m->flap[2] * s[2]);
-    w = fade_in(&b->p_filt, &b->has_p, b->p_alpha, m->gen_power, b->rated, b->w_lo, b->w_hi);
+    w = fade_in(&b->a, m->gen_power);
     c_mean = (pc[0] + pc[1] + pc[2]) / 3.0;
     k = mw_interp(c_mean, b->gp, b->gk, b->ng);
     phi = mw_interp(c_mean, b->gp, b->gphi, b->ng);
@@ -221,7 +221,7 @@ int mw_cipc_step(mw_cipc *b, const mw_meas *m, double dt, const double *pc, doub
     for (i = 0; i < 3; i++) {
         double du = b->cyc_c * c[i] + b->cyc_s * s[i];
         double a = dmin(dmax(pc[i] - c_mean + du, b->a_last[i] - budget), b->a_last[i] + budget);
-        out[i] = dmin(dmax(c_new + a, b->pmin), b->pmax);
+        out[i] = dmin(dmax(c_new + a, b->a.pmin), b->a.pmax);
     }
     b->c_last = c_new;
     for (i = 0; i < 3; i++) b->a_last[i] = out[i] - c_new;
@@ -237,15 +237,8 @@ int mw_cipc_read(const mw_input *in, mw_cipc *b, char *msg)
         || !(b->gk = mw_getp_alloc_n(in, "", "coleman_ki", b->ng, msg))
         || !(b->gphi = mw_getp_alloc_n(in, "", "coleman_azimuth_offset", b->ng, msg)))
         return -1;
-    b->w_lo = v[0];
-    b->w_hi = v[1];
-    b->rated = v[2];
-    b->p_alpha = v[3];
-    b->pmin = v[4];
-    b->pmax = v[5];
-    b->rate = v[6];
     b->amp = v[7];
-    if (!settings_ok(v) || !(b->amp > 0)) {
+    if (!addon_read(v, &b->a) || !(b->amp > 0)) {
         mw_msg(msg, "mpc-wt coleman-ipc: input file '%s': key 'coleman_settings' needs the "
                "weight's power fractions increasing, rated power > 0, power filter pole in "
                "[0, 1), pitch min <= max, a rate > 0 and a largest amplitude > 0", in->path);

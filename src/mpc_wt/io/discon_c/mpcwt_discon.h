@@ -160,12 +160,20 @@ int mw_sos_read(const mw_input *in, const char *who, const char *key, const char
 void mw_sos_step(mw_sos *f, const double *x, double *y);
 void mw_sos_free(mw_sos *f);
 
+/* what IBC and Coleman IPC share (ibc.c): the fade-in's power fractions, the power it refers
+ * to, the power low-pass's pole and state, and the limits on the summed command */
+typedef struct {
+    int has_p;
+    double w_lo, w_hi, rated, p_alpha, pmin, pmax, rate, p_filt;
+} mw_addon;
+
 /* individual blade control added to a collective command (ibc.c) */
 typedef struct {
-    int on, ng, remove_mean, has_p, has_last;
+    int on, ng, remove_mean, has_last;
     double *gp, *gg;
     mw_sos hp, bs;
-    double w_lo, w_hi, rated, p_alpha, pmin, pmax, rate, amp, p_filt, last[3];
+    mw_addon a;
+    double amp, last[3];
     double weight, gain, u[3];    /* this step's fade-in weight, gain and blade additions */
 } mw_ibc;
 int mw_ibc_read(const mw_input *in, mw_ibc *b, char *msg);
@@ -178,9 +186,10 @@ int mw_ibc_step(mw_ibc *b, const mw_meas *m, double dt, const double *pc, double
  * (amplitude clamped), faded in with the low-passed power, back to the blades; the
  * collective's part within the pitch rate first, the cyclic within what is left */
 typedef struct {
-    int on, ng, has_p, has_last;
+    int on, ng, has_last;
     double *gp, *gk, *gphi;
-    double w_lo, w_hi, rated, p_alpha, pmin, pmax, rate, amp, p_filt;
+    mw_addon a;
+    double amp;
     double th_c, th_s, c_last, a_last[3];
     double weight, tilt, yaw, cyc_c, cyc_s;   /* this step's weight, moments, cyclic pitch */
 } mw_cipc;
