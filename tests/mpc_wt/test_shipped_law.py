@@ -180,12 +180,10 @@ def test_the_compiled_loop_hands_the_supervisor_and_the_lidar_their_steps(
         assert np.any(slow.controller["supervisor_state"] > 0), "the case must trip"
 
 
-@pytest.mark.parametrize("kind, wind", [("mpc", 14.0), ("mpc-lidar", 14.0), ("ts", 10.0),
-                                        ("lqr-pio", 8.0), ("lqr-pio", 16.0), ("ibc", 18.0),
+@pytest.mark.parametrize("kind, wind", [("mpc", 14.0), ("mpc-lidar", 14.0), ("ibc", 18.0),
                                         ("baseline+lidar-ff", 16.0)])
 def test_the_librarys_logging_channels_are_the_python_steps_signals(turbine, kind, wind):
-    """The shipped MPC's fallback level and schedule winds, LQR-PIO's region and schedule
-    winds, the TS controller's wind estimate and premise clips, the IBC's weight, gain and
+    """The shipped MPC's fallback level and schedule winds, the IBC's weight, gain and
     blade pitch and the LIDAR feedforward's wind, pitch, mean wind and corner, returned as
     logging channels, are the Python step's signals (the winds to the float32 of the swap array:
     1e-5 m/s); the QP's solve time is a positive reading of the library's own clock."""

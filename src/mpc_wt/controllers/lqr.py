@@ -16,8 +16,9 @@ A_e = [[A, N], [0, 0]], C_e = [C, 0] (eq 13), observer gains [L1; L2] by LQR on 
 (A_e', C_e') with Q_obs = diag(I_n, q I_r), R_obs = I_m (eq 16). The design checks that A_e - L C_e
 is stable (eq 15) and reports ||L2||_F / ||L1||_F, which q >> 1 makes large ("high gain").
 
-:class:`LQRPIOController` runs both in the simulation harness: the observer discretized (zero-order
-hold on its input u and measurement y) at the controller period, the pitch commands
+:class:`LQRPIOController` holds both as the kind's shipped C law runs them: the observer
+discretized (zero-order hold on its input u and measurement y) at the controller period, the
+pitch commands
 u = u0 - K x_hat - K_f f_hat (the unknown-input feedforward K_f cancels the steady effect of the
 estimated wind on the regulated outputs, a disturbance-accommodating term; ``feedforward=False``
 drops it), generator torque constant at its operating-point value (Do's region III strategy) or
@@ -29,15 +30,13 @@ import math
 from dataclasses import dataclass, field
 from typing import Any, Mapping, Sequence
 
-import numba as nb
 import numpy as np
 import scipy.linalg
 
 import linearize
 from linearize.validate import check_number
-from mpc_wt.controllers.base import ControllerBase
+from mpc_wt.controllers.base import DesignBase
 from mpc_wt.controllers.baseline import LawTorque
-from mpc_wt.controllers.estimator import SignalReader
 from mpc_wt.errors import SynthesisError
 
 __all__ = ["LQRDesign", "PIObserver", "design_lqr", "design_lqr_family", "design_pi_observer",
@@ -421,8 +420,18 @@ def design_pi_observer(model: linearize.LinearModel, *,
                       gain_ratio=ratio, measured=tuple(measured), y0=y0, q=float(q))
 
 
-class LQRPIOController(ControllerBase):
-    """LQR state feedback on PI-observer estimates (Do et al. Fig. 2) for the harness.
+class LQRPIOController(DesignBase):
+    """The design of LQR state feedback on PI-observer estimates (Do et al. Fig. 2) at one
+    operating point, run by its shipped law (the ``lqr-pio`` kind's C law,
+    ``mpc_wt/io/discon_c/lqr.c``, as a schedule of this one design;
+    :func:`mpc_wt.run.law_controller` runs it).
+
+    The law updates the observer over each period (its zero-order hold at ``dt``, eq 13 with
+    the measurements' deviations from the operating point), commands u = u0 - K (x_hat - x0)
+    - K_f f_hat on the gain's inputs, each pitch within the actuator's limits and within its
+    rate times its time constant of that blade's measured pitch (the command the actuator can
+    follow; the observer is fed this command, not one whose gap it would read as wind), the
+    torque by the region.
 
     Parameters
     ----------
@@ -449,10 +458,16 @@ class LQRPIOController(ControllerBase):
         Add the unknown-input feedforward -K_f f_hat (default True).
     regulated : names of states whose steady deviation the feedforward cancels (least squares;
         default rotor speed).
+
+    Notes
+    -----
+    The torque by region: region III holds the operating point's torque (Do et al.'s constant
+    torque), capped by the torque law where one is given (below rated speed at fine pitch the
+    law asks less: a rotor slowed by a lull is not braked into a stall); region II follows the
+    law (or K_opt Omega_g^2 on the raw generator speed).
     """
 
-    #: the step's output buffer, not design data
-    __not_design__ = ("_ubuf",)
+    kind = "lqr-pio"
 
     def __init__(self, model: linearize.LinearModel, turbine: linearize.Turbine,
                  lqr: LQRDesign, observer: PIObserver, *, dt: float = 1.0 / 80.0,
@@ -472,7 +487,6 @@ class LQRPIOController(ControllerBase):
         # the torque law's speed filter pole at our period
         self._law = LawTorque(torque_law, dt) if torque_law is not None else None
         self.model, self.turbine, self.lqr, self.obs = model, turbine, lqr, observer
-        self._read = SignalReader(observer.measured)
         self.dt, self.region, self.k_opt = float(dt), region, k_opt
         nx, nf = model.A.shape[0], observer.L2.shape[0]
         nu_all = model.B_u.shape[1]
@@ -506,114 +520,13 @@ class LQRPIOController(ControllerBase):
         # how far a command may lead the measured pitch: a first-order actuator (time
         # constant tau) then moves at most at its rate
         self._reach = pa.max_rate_rad_s * pa.time_constant if pa.time_constant > 0 else math.inf
-        self._ubuf = np.empty(nu_all)
-        self._d0_mean = float(np.mean(model.d0))
-        self.reset()
-
-    def reset(self) -> None:
-        self.xe = np.zeros(self._nx + self._nf)
-        self._u_dev = np.zeros(self._nu_all)
-        if self._law is not None:
-            self._law.reset()
-        self.signals: dict[str, float] = {}
-
-    def hand_over(self, other: "LQRPIOController") -> None:
-        """Continue from another design's observer estimate, last command and filtered speed
-        (gain scheduling), carried over in absolute units.
-
-        Parameters
-        ----------
-        other : LQRPIOController
-            The design being replaced (same model structure, another operating point).
-        """
-        offset = np.concatenate([other.model.x0 - self.model.x0,
-                                 (other.model.d0 - self.model.d0)[:other._nf]])
-        if offset.size != self.xe.size:
-            raise ValueError(f"hand_over needs the same model structure: {other.xe.size} "
-                             f"observer states against {self.xe.size}")
-        self.xe = other.xe + offset
-        self._u_dev = other._u_dev + other.model.u0 - self.model.u0
-        if self._law is not None and other._law is not None:
-            self._law.w_filt = other._law.w_filt
-
-    def step(self, t: float, meas: dict[str, Any]) -> tuple[np.ndarray, float]:
-        # One control step: observer update, then u = u0 - K (x_hat - x0) (+ feedforward).
-        y = self._read(meas)
-        u = self._ubuf
-        if not _lqr_pio_step(self._ad, self._bd, self._gain, self.xe, self._u_dev, y,
-                             self.obs.y0, self.model.u0, self._iu_arr, self._pitch_lim, u):
-            raise ValueError(f"non-finite measurement at t = {t:g} s: "
-                             f"{dict(zip(self.obs.measured, y - self.obs.y0))}")
-        # the command the actuator can follow: first order (time constant tau) at most at its
-        # rate, so (ref - measured pitch) / tau stays within the rate; the observer is fed
-        # this command, not one the actuator cannot take (whose gap it would read as wind)
-        pitch = u[:3].copy()
-        reach, pm = self._reach, meas["pitch"]
-        for b in range(3):
-            pitch[b] = min(max(pitch[b], pm[b] - reach), pm[b] + reach)
-        g = self.turbine.generator
-        torque = min(max(self._torque(meas, pitch), g.min_torque), g.max_torque)
-        self._u_dev = np.array([pitch[0], pitch[1], pitch[2], torque]) - self.model.u0
-        fh = self.xe[self._nx:]
-        self.signals = {"wind_est": (float(fh[0] + fh[1] + fh[2]) / 3.0 + self._d0_mean)
-                        if self._nf >= 3 else float(fh[0]),
-                        "pitch_ref_1": float(pitch[0]), "torque_ref": torque}
-        return pitch, torque
-
-    def _torque(self, meas: dict[str, Any], pitch: np.ndarray) -> float:
-        """The generator torque demand of the region (see ``region`` and ``torque_law``):
-        region III holds the operating point's torque (Do et al.'s constant torque), capped by
-        the torque law where one is given (below rated speed at fine pitch the law asks less:
-        a rotor slowed by a lull is not braked into a stall); region II follows the law (or
-        K_opt Omega_g^2)."""
-        if self.region == "III" and self.torque_law is None:
-            return float(self.model.u0[3])
-        w = float(meas["gen_speed"])
-        if self.torque_law is None:
-            return float(self.k_opt * w ** 2)
-        assert self._law is not None
-        q = self._law(w, float(pitch.sum()) / pitch.size)
-        return min(q, float(self.model.u0[3])) if self.region == "III" else q
 
 
-@nb.njit(cache=True, nogil=True)
-def _lqr_pio_step(ad: np.ndarray, bd: np.ndarray, gain: np.ndarray, xe: np.ndarray,
-                  u_dev: np.ndarray, y: np.ndarray, y0: np.ndarray, u0: np.ndarray,
-                  iu: np.ndarray, pitch_lim: np.ndarray,
-                  u: np.ndarray) -> bool:  # pragma: no cover (compiled)
-    """:meth:`LQRPIOController.step`'s linear part in place: the observer over the last period,
-    xe = A_d xe + B_d [u_dev; y - y0], then the command u = u0, u[iu] -= [K K_f] xe, its
-    pitch clipped to ``pitch_lim``. False, with nothing changed, on a non-finite measurement."""
-    n, nu, ny = xe.shape[0], u_dev.shape[0], y.shape[0]
-    for j in range(ny):
-        if not np.isfinite(y[j]):
-            return False
-    new = np.empty(n)
-    for i in range(n):
-        acc = 0.0
-        for k in range(n):
-            acc += ad[i, k] * xe[k]
-        for k in range(nu):
-            acc += bd[i, k] * u_dev[k]
-        for j in range(ny):
-            acc += bd[i, nu + j] * (y[j] - y0[j])
-        new[i] = acc
-    xe[:] = new
-    for k in range(u0.shape[0]):
-        u[k] = u0[k]
-    for r in range(iu.shape[0]):
-        acc = 0.0
-        for k in range(n):
-            acc += gain[r, k] * xe[k]
-        u[iu[r]] -= acc
-    for k in range(3):
-        u[k] = min(max(u[k], pitch_lim[0]), pitch_lim[1])
-    return True
-
-
-class ScheduledLQRPIO(ControllerBase):
-    """LQR-PIO designs over a grid of mean winds, one acting at a time, chosen on a measured
-    mean wind (:class:`~mpc_wt.controllers.scheduling.WindSchedule`: the rotor-effective wind
+class ScheduledLQRPIO(DesignBase):
+    """The design of LQR-PIO over a grid of mean winds, run by its shipped law (the
+    ``lqr-pio`` kind's C law; :func:`mpc_wt.run.law_controller` runs a design made by hand):
+    one design acting at a time, chosen on a measured mean wind
+    (:class:`~mpc_wt.controllers.scheduling.WindSchedule`: the rotor-effective wind
     estimated from rotor speed, pitch and generator torque, low-passed, with hysteresis).
 
     Below the rated wind each design is Do et al.'s region II (the torque law, the LQR on the
@@ -636,7 +549,13 @@ class ScheduledLQRPIO(ControllerBase):
         Beyond the midpoint between grid winds [m/s].
     wind_estimator : WindSpeedEstimator, optional
         The scheduling wind's estimator at the controllers' ``dt`` (default: made here).
+
+    Notes
+    -----
+    The law logs ``region`` (2 or 3), ``schedule_wind`` and ``schedule_grid_wind`` [m/s].
     """
+
+    kind = "lqr-pio"
 
     def __init__(self, controllers: Sequence[LQRPIOController], winds: Any,
                  turbine: linearize.Turbine, *, time_constant: float = 30.0,
@@ -655,42 +574,3 @@ class ScheduledLQRPIO(ControllerBase):
         self.winds = w
         self.schedule = WindSchedule(w, turbine, self.dt, time_constant=time_constant,
                                      hysteresis=hysteresis, estimator=wind_estimator)
-        self.reset()
-
-    @property
-    def switches(self) -> int:
-        """Switches between designs since the last reset."""
-        return self.schedule.switches
-
-    def reset(self) -> None:
-        """Forget the wind and every design's state."""
-        self.schedule.reset()
-        for c in self.controllers:
-            c.reset()
-        self.signals: dict[str, float] = {}
-
-    def step(self, t: float, meas: dict[str, Any]) -> tuple[np.ndarray, float]:
-        """Update the schedule, hand over on a switch, step the acting design.
-
-        Parameters
-        ----------
-        t : float
-            [s]
-        meas : dict
-            The harness's measurements.
-
-        Returns
-        -------
-        pitch_ref : (3,) ndarray
-            [rad]
-        gen_torque_ref : float
-            [N m]
-        """
-        k, ctl = self.schedule.acting(meas, self.controllers.__getitem__)
-        out = ctl.step(t, meas)
-        self.signals = dict(ctl.signals, schedule_wind=float(self.schedule.wind or math.nan),
-                            schedule_grid_wind=float(self.winds[k]),
-                            region=2.0 if ctl.region == "II" else 3.0,
-                            schedule_outside=float(self.schedule.outside),
-                            estimator_outside=float(self.schedule.estimator_outside))
-        return out

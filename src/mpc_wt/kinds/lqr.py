@@ -121,11 +121,6 @@ class LQRPIOOptions(Options):
                                  "tip displacement gives (larger: the observer trusts the "
                                  "moments less against the generator speed and the tower-top "
                                  "acceleration)", unit="-", lo=0.0, lo_open=True)
-    observer_signals: str = option("turbine", help="the PI observer's measurements: turbine "
-                                   "(generator speed, tower-top fore-aft acceleration, blade "
-                                   "root out-of-plane moments, as a turbine's controller gets "
-                                   "them; exportable) or paper (Do et al.'s tower-top and flap "
-                                   "displacements)", choices=("turbine", "paper"))
     region2_torque: str = option("baseline", help="region-II torque: the baseline's schedule "
                                  "(1.5/2/2.5 on filtered speed, as the PI it is compared with) "
                                  "or Do's bare K_opt Omega_g^2 on raw speed",
@@ -227,11 +222,13 @@ def _lqr_point(c: Any, k: int) -> list[tuple[str, Any, str]]:
 def _lqr_entries(ctl: Any, preview: Any = None) -> list[tuple[str, Any, str]]:
     """The numbers of a :class:`~mpc_wt.controllers.lqr.ScheduledLQRPIO` as input-file
     entries: the wind schedule, the torque law and every design's observer and gains."""
-    from mpc_wt.controllers.lqr import ScheduledLQRPIO
+    from mpc_wt.controllers.lqr import LQRPIOController, ScheduledLQRPIO
 
+    if type(ctl) is LQRPIOController:           # one design: a schedule of one point
+        ctl = ScheduledLQRPIO([ctl], [ctl.model.wind_mps], ctl.turbine)
     if type(ctl) is not ScheduledLQRPIO:
-        raise ValueError(f"the LQR-PIO export takes the scheduled design (ScheduledLQRPIO), got "
-                         f"{type(ctl).__name__}: leave design_wind_mps unset")
+        raise ValueError(f"the LQR-PIO export takes a ScheduledLQRPIO or an LQRPIOController, "
+                         f"got {type(ctl).__name__}")
     pts = ctl.controllers
     signals = pts[0].obs.measured
     if any(c.obs.measured != signals for c in pts):
@@ -289,10 +286,13 @@ def _build_lqr_pio(ctx: BuildContext, opts: LQRPIOOptions) -> Built:
     turbine = ctx.turbine
     if opts.design_wind_mps is not None:
         v = check_design_wind(turbine, opts.design_wind_mps)
-        ctl: Any = _lqr_pio_at(turbine, linearize.linearize(turbine, v,
-                                                            config=linearize.PlantConfig.do()),
-                               v, opts, tune_baseline(turbine))
+        point = _lqr_pio_at(turbine, linearize.linearize(turbine, v,
+                                                         config=linearize.PlantConfig.do()),
+                            v, opts, tune_baseline(turbine))
         winds = [v]
+        ctl: Any = ScheduledLQRPIO([point], winds, turbine,     # one design: nothing switches
+                                   time_constant=opts.schedule_time_constant,
+                                   wind_estimator=wind_estimator(ctx, 1.0 / 80.0))
     else:
         fam = envelope_family(ctx, "do", opts.schedule_step)
         winds = [float(w) for w in fam.wind_mps]
@@ -337,7 +337,6 @@ def _lqr_pio_at(turbine: linearize.Turbine, model: linearize.LinearModel, wind: 
     constant torque is capped by that law, as a scheduled design needs in lulls)."""
     from mpc_wt.controllers.baseline import BaselineController
     from mpc_wt.controllers.lqr import (
-        PAPER_MEASURED,
         REGION2_SCALES,
         REGION3_SCALES,
         TURBINE_MEASURED,
@@ -357,12 +356,9 @@ def _lqr_pio_at(turbine: linearize.Turbine, model: linearize.LinearModel, wind: 
     scales.update({f"pitch_rate_{i}": turbine.pitch_actuator.max_rate_rad_s for i in (1, 2, 3)})
     lq = design_lqr(model, state_weights=w, output_weights=opts.output_weights(),
                     input_weights=iw, scales=scales)
-    if opts.observer_signals == "turbine":
-        sy = {k: v * (opts.moment_scale if k.startswith("flap_moment") else 1.0)
-              for k, v in turbine_scales(model).items()}
-        obs = design_pi_observer(model, q=opts.observer_q, measured=TURBINE_MEASURED, scales=sy)
-    else:
-        obs = design_pi_observer(model, q=opts.observer_q, measured=PAPER_MEASURED)
+    sy = {k: v * (opts.moment_scale if k.startswith("flap_moment") else 1.0)
+          for k, v in turbine_scales(model).items()}
+    obs = design_pi_observer(model, q=opts.observer_q, measured=TURBINE_MEASURED, scales=sy)
     return LQRPIOController(model, turbine, lq, obs,
                             region=region,
                             k_opt=base.k_opt if region == "II" else None,

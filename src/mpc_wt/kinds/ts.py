@@ -93,12 +93,6 @@ class TSOptions(Options):
         "most half the tower's first fore-aft frequency, whose loop decays with the "
         "controller's)",
         unit="1/s", lo=0.0, lo_open=True, flag="")
-    observer_signals: str = option("turbine", help="the wind observer's measurements: "
-                                   "turbine (tower-top fore-aft and side-side accelerations, "
-                                   "rotor and generator speed, as a turbine's controller gets "
-                                   "them; exportable) or paper (Clemens et al.'s tower-top "
-                                   "displacements in place of the accelerations)",
-                                   choices=("turbine", "paper"))
     generator_torque: str = option("baseline", help="baseline: the baseline's torque "
                                    "schedule (power-optimal tip-speed ratio below rated, "
                                    "constant power above), the TS law setting the pitch; ts: "
@@ -117,14 +111,7 @@ def _ts_entries(ctl: Any, preview: Any = None) -> list[tuple[str, Any, str]]:
 
     if type(ctl) is not TSController:
         raise ValueError(f"the TS export takes a TSController, got {type(ctl).__name__}")
-    from mpc_wt.controllers.apc import PowerReduction
-
     dp = ctl.power_reduction
-    if (dp is not None and not isinstance(dp, PowerReduction)) or ctl._v_given is not None:
-        raise ValueError("a TS design with a power reduction other than Clemens et al.'s "
-                         "sinusoid (mpc_wt.controllers.apc.PowerReduction) or a given initial "
-                         "wind does not export: the library computes Delta P(t) from the time "
-                         "and starts from the measured pitch")
     ts, gen, pa = ctl.ts, ctl.turbine.generator, ctl.turbine.pitch_actuator
     codes = signal_codes(ts.measured, "TS observer")
     n, nx = ctl._phi.shape[1], len(ts.states)
@@ -199,14 +186,9 @@ TS_EXPORT = LawExport(
           summary="Clemens et al.'s Takagi-Sugeno controller and wind observer (LMI gains)")
 def _build_ts(ctx: BuildContext, opts: TSOptions) -> Built:
     from mpc_wt.controllers.apc import apc_reference
-    from mpc_wt.controllers.takagi_sugeno import (
-        CLEMENS_MEASURED,
-        TURBINE_MEASURED,
-        TSController,
-        build_ts_model,
-    )
+    from mpc_wt.controllers.takagi_sugeno import TURBINE_MEASURED, TSController, build_ts_model
 
-    measured = TURBINE_MEASURED if opts.observer_signals == "turbine" else CLEMENS_MEASURED
+    measured = TURBINE_MEASURED
 
     law = None
     if opts.generator_torque == "baseline":

