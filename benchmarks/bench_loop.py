@@ -12,15 +12,13 @@ points, 20 Hz), all DOFs, one core:
 - the envelope MPC below rated: ``mpc-lidar`` 600 s at 8 m/s, its loop and its own step;
 - the scheduled kinds, which know only measurements (``mpc``, ``mpc-lidar`` on the Kalman
   estimator and the wind they estimate or the LIDAR measures; ``lqr-pio`` over its 24 designs),
-  each beside its former point design (``mpc``/``mpc-lidar`` at the case's 18 m/s on the
-  plant's true states: ``design_wind_mps: 18, estimator: full-state``; ``lqr-pio`` designed at
-  18 m/s): 600 s wall time, the cost per controller step in the first and the last minute (a
-  loop whose cost grows with elapsed time shows a ratio above 1), and each controller's own
-  step replayed on its loop's measurements;
-- the MPC's whole step (measurements and preview in, commands out), replayed on the recorded
-  measurements with each backend (DAQP, OSQP), median and p99, for the paper's design and the
-  scheduled one, in this process and (paper's design) in a few fresh ones, against DAQP's solve
-  alone through its own Python interface;
+  each beside its point design (the case's 18 m/s: ``design_wind_mps: 18``), every one run by
+  its shipped law: 600 s wall time, the cost per controller step in the first and the last
+  minute (a loop whose cost grows with elapsed time shows a ratio above 1), and each law's
+  step (the library's call through the host) replayed on its loop's measurements;
+- the MPC-with-LIDAR law's whole step (measurements and lidar records in, commands out),
+  replayed on the recorded measurements, median and p99, for the point design and the
+  scheduled one, in this process and (point design) in a few fresh ones;
 - peak resident memory of ``mpcwt simulate`` for 600 s (baseline and mpc-lidar), every signal
   kept and written, each in its own process;
 - with ``--signoff DIR``: a finished sign-off campaign's wall time (its start to its last
@@ -45,11 +43,9 @@ import numpy as np
 
 import linearize
 from mpc_wt.controllers.baseline import BaselineController, tune_baseline
-from mpc_wt.controllers.mpc import MPC
 from mpc_wt.run import build_controller, law_controller
 from mpc_wt.simulation.loop import simulate_closed_loop
 from mpc_wt.simulation.scenario import Scenario
-from mpc_wt.simulation.solver_timing import _Timed
 
 DURATION = 600.0
 
@@ -84,16 +80,16 @@ def _baseline(t: Any, wind: Any, op: Any, repeat: int, compiled: bool = True) ->
                                               compiled=compiled), repeat)
 
 
-#: The paper's point design of the MPC (the former default): like for like with earlier runs.
-ORACLE = {"design_wind_mps": 18.0, "estimator": "full-state"}
+#: The paper's point design (the case's 18 m/s).
+POINT = {"design_wind_mps": 18.0}
 
 #: Loops timed per controller step: name -> (kind, options). Each scheduled kind beside its
-#: former point design (the case's 18 m/s; the MPC on the plant's true states).
-LOOPS = {"mpc_lidar_oracle": ("mpc-lidar", ORACLE), "mpc_lidar": ("mpc-lidar", None),
-         "mpc_oracle": ("mpc", ORACLE), "mpc": ("mpc", None),
-         "lqr_pio_point": ("lqr-pio", {"design_wind_mps": 18.0}), "lqr_pio": ("lqr-pio", None)}
-#: scheduled loop -> its former point design
-FORMER = {"mpc_lidar": "mpc_lidar_oracle", "mpc": "mpc_oracle", "lqr_pio": "lqr_pio_point"}
+#: point design.
+LOOPS = {"mpc_lidar_point": ("mpc-lidar", POINT), "mpc_lidar": ("mpc-lidar", None),
+         "mpc_point": ("mpc", POINT), "mpc": ("mpc", None),
+         "lqr_pio_point": ("lqr-pio", POINT), "lqr_pio": ("lqr-pio", None)}
+#: scheduled loop -> its point design
+FORMER = {"mpc_lidar": "mpc_lidar_point", "mpc": "mpc_point", "lqr_pio": "lqr_pio_point"}
 
 
 def _timed_loop(t: Any, kind: str, options: Any, wind_mps: float = 18.0) -> dict[str, Any]:
@@ -112,7 +108,8 @@ def _timed_loop(t: Any, kind: str, options: Any, wind_mps: float = 18.0) -> dict
     ctl.step = step
     t0 = time.perf_counter()
     simulate_closed_loop(linearize.plant_params(t), ctl, wind, DURATION, x0=op.x, u0=op.u,
-                         controller_dt=built.controller_dt, preview=built.preview)
+                         controller_dt=built.controller_dt, preview=built.preview,
+                         compiled=False)
     wall = time.perf_counter() - t0
     del ctl.step
     s = np.diff(np.array(stamps))
@@ -124,29 +121,19 @@ def _timed_loop(t: Any, kind: str, options: Any, wind_mps: float = 18.0) -> dict
             "rec": rec}
 
 
-def _whole_step(t: Any, rec: list[tuple[float, dict[str, Any]]], backend: str,
+def _whole_step(t: Any, rec: list[tuple[float, dict[str, Any]]],
                 options: Any = None) -> dict[str, float]:
-    """The MPC's step replayed on the recorded measurements and preview (its own warm starts).
-    With DAQP and the paper's design, also DAQP's solve alone through its own Python ``Model``
-    on a twin controller (the reference the step is held against: the solver's cost)."""
-    opts = {**(ORACLE if options is None else options), "backend": backend}
-    out, c = _replay(t, "mpc-lidar", opts, rec)
-    if backend == "daqp" and isinstance(c, MPC):
-        twin = MPC(c.model, t, c.settings.replace(solver_options={"interface": "python"}))
-        timer = _Timed(twin.qp_backend.model, "solve")
-        twin.qp_backend.model = timer
-        twin.reset()
-        for tt, meas in rec:
-            twin.step(tt, meas)
-        out["daqp_model_solve_median_us"] = float(np.median(timer.times[10:]) * 1e6)
-    return out
+    """The MPC-with-LIDAR law's step replayed on the recorded measurements (its own state),
+    the point design by default."""
+    return _replay(t, "mpc-lidar", POINT if options is None else options, rec)[0]
 
 
 def _replay(t: Any, kind: str, options: Any, rec: list[tuple[float, dict[str, Any]]]
             ) -> tuple[dict[str, float], Any]:
-    """A controller's own step (estimators, schedule, law or QP) replayed on its loop's
-    recorded measurements: median, p99 and max [us], and the controller."""
-    built, _, _ = build_controller(t, kind, Scenario(18.0, "A", 1, 10.0), options)
+    """A law's step (the library's call through the host: estimators, schedule, QP) replayed
+    on its loop's recorded measurements (the LIDAR's on the loop's field): median, p99 and max
+    [us], and the controller."""
+    built, _, _ = build_controller(t, kind, Scenario(18.0, "A", 1, DURATION), options)
     c = built.controller
     c.reset()
     times = []
@@ -222,7 +209,7 @@ def main() -> int:
     if args.replay:
         rec = pickle.loads(Path(args.replay).read_bytes())
         tb = linearize.load_turbine()
-        print(json.dumps({b: _whole_step(tb, rec, b) for b in ("daqp", "osqp")}))
+        print(json.dumps({"library": _whole_step(tb, rec)}))
         return 0
     res: dict[str, Any] = {"date": time.strftime("%Y-%m-%d %H:%M"),
                            "machine": f"{platform.node()} {platform.machine()}",
@@ -246,10 +233,9 @@ def main() -> int:
     res["mpc_lidar_8mps"] = m
     res["mpc_lidar_8mps_realtime"] = DURATION / m["s"]
     res["step_replay"]["mpc_lidar_8mps"] = _replay(t, "mpc-lidar", None, rec8)[0]
-    rec = recs["mpc_lidar_oracle"]
-    res["whole_step"] = {b: _whole_step(t, rec, b) for b in ("daqp", "osqp")}
-    res["whole_step_scheduled"] = {b: _whole_step(t, recs["mpc_lidar"], b, {})
-                                   for b in ("daqp", "osqp")}
+    rec = recs["mpc_lidar_point"]
+    res["whole_step"] = {"library": _whole_step(t, rec)}
+    res["whole_step_scheduled"] = {"library": _whole_step(t, recs["mpc_lidar"], {})}
     res["whole_step_processes"] = _whole_step_processes(rec, args.step_processes)
     for k in ("plant_compiled", "plant_stepper", "baseline", "baseline_python", *LOOPS):
         res[f"{k}_realtime"] = DURATION / res[f"{k}_s"]
@@ -268,9 +254,9 @@ def main() -> int:
                      ("plant_stepper", "plant alone, PlantStepper from Python"),
                      ("baseline", "baseline closed loop (80 Hz), compiled"),
                      ("baseline_python", "the same, Python loop (compiled=False)"),
-                     ("mpc_lidar_oracle", "mpc-lidar, the paper's design (10 Hz)"),
+                     ("mpc_lidar_point", "mpc-lidar, the paper's design (10 Hz)"),
                      ("mpc_lidar", "mpc-lidar, scheduled on measurements"),
-                     ("mpc_oracle", "mpc, the paper's design (10 Hz)"),
+                     ("mpc_point", "mpc, the paper's design (10 Hz)"),
                      ("mpc", "mpc, scheduled on measurements"),
                      ("lqr_pio_point", "lqr-pio, one design at 18 m/s (80 Hz)"),
                      ("lqr_pio", "lqr-pio, scheduled (80 Hz)")):
@@ -285,32 +271,25 @@ def main() -> int:
               f"{res[k]['last_over_first']:.2f})")
     w8, s8 = res["mpc_lidar_8mps"], res["step_replay"]["mpc_lidar_8mps"]
     print(f"full-envelope mpc-lidar at 18 m/s: {res['mpc_lidar_s']:.2f} s, "
-          f"{res['mpc_lidar_realtime']:.1f}x real time; its whole step (replayed, DAQP) median "
-          f"{res['whole_step_scheduled']['daqp']['median_us']:.1f} us, p99 "
-          f"{res['whole_step_scheduled']['daqp']['p99_us']:.0f} us")
+          f"{res['mpc_lidar_realtime']:.1f}x real time; its law's whole step (replayed) median "
+          f"{res['whole_step_scheduled']['library']['median_us']:.1f} us, p99 "
+          f"{res['whole_step_scheduled']['library']['p99_us']:.0f} us")
     print(f"mpc-lidar at 8 m/s (below rated): {w8['s']:.2f} s, "
           f"{res['mpc_lidar_8mps_realtime']:.1f}x real time; its step median "
           f"{s8['median_us']:.1f} us, p99 {s8['p99_us']:.0f} us")
     for k, former in FORMER.items():
         a, b0 = res["step_replay"][k], res["step_replay"][former]
         print(f"{k} step (replayed) median {a['median_us']:.1f} us, p99 {a['p99_us']:.0f} us;"
-              f" former design {b0['median_us']:.1f} us, p99 {b0['p99_us']:.0f} us; loop "
-              f"{res[k + '_s'] / res[former + '_s']:.3f} x the former's")
-    for b, w in res["whole_step_scheduled"].items():
-        print(f"scheduled MPC whole step (estimators, schedule, QP), {b:5s}: median "
-              f"{w['median_us']:6.1f} us, p99 {w['p99_us']:6.1f} us")
-    for b, w in res["whole_step"].items():
-        print(f"MPC whole step, paper's design, {b:5s}: median {w['median_us']:6.1f} us, "
+              f" point design {b0['median_us']:.1f} us, p99 {b0['p99_us']:.0f} us; loop "
+              f"{res[k + '_s'] / res[former + '_s']:.3f} x the point design's")
+    for name, key in (("scheduled", "whole_step_scheduled"), ("paper's design", "whole_step")):
+        w = res[key]["library"]
+        print(f"MPC-with-LIDAR law's whole step, {name}: median {w['median_us']:6.1f} us, "
               f"p99 {w['p99_us']:6.1f} us, max {w['max_us']:6.0f} us (this process)")
-    ref = res["whole_step"]["daqp"]["daqp_model_solve_median_us"]
-    print(f"  DAQP's solve alone through its Python Model: median {ref:.1f} us; whole step / "
-          f"that {res['whole_step']['daqp']['median_us'] / ref:.2f}")
-    for b in ("daqp", "osqp"):
-        med = [r[b]["median_us"] for r in res["whole_step_processes"]]
-        p99 = [r[b]["p99_us"] for r in res["whole_step_processes"]]
-        print(f"  {b} in {len(med)} fresh processes: medians "
-              f"{', '.join(f'{v:.1f}' for v in med)} us; p99 {', '.join(f'{v:.0f}' for v in p99)}"
-              f" us")
+    med = [r["library"]["median_us"] for r in res["whole_step_processes"]]
+    p99 = [r["library"]["p99_us"] for r in res["whole_step_processes"]]
+    print(f"  in {len(med)} fresh processes: medians {', '.join(f'{v:.1f}' for v in med)} us; "
+          f"p99 {', '.join(f'{v:.0f}' for v in p99)} us")
     so = res.get("signoff")
     if so:
         print(f"sign-off campaign {args.signoff}: {so['done']} of {so['cases']} cases done, wall "

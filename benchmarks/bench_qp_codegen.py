@@ -5,9 +5,10 @@
 Run:  python benchmarks/bench_qp_codegen.py [--kind mpc-lidar] [--wind 18] [--seed 31]
                                             [--duration 120] [--repeat 5] [--json]
 
-The kind's Python design runs once on mpc-wt's plant (class A; the seed is one no design or
-tuning saw) and every QP it solves is recorded (:meth:`mpc_wt.MPC.qp`: Hessian, constraint
-rows, the step's linear term and bounds) with the design's own solution. Both solvers are then
+The kind's shipped law runs once on mpc-wt's plant (class A; the seed is one no design or
+tuning saw); at each controller step the QP of the acting grid design at the plant's state
+and the law's previous command is recorded (:meth:`mpc_wt.MPC.qp`: Hessian, constraint rows,
+the step's linear term and bounds) with the design's own solution. Both solvers are then
 compiled in C (``cc -O2``) and replay the same QPs in the order the run solved them, each grid
 design on a workspace set up once, warm-started from its last solve:
 
@@ -40,10 +41,8 @@ import numpy as np
 import scipy.sparse as sp
 
 import linearize
-from mpc_wt.controllers import mpc as mpc_mod
 from mpc_wt.io.discon_export import find_compiler
 from mpc_wt.io.solver_sources import daqp_sources
-from mpc_wt.run import run_controller
 from mpc_wt.simulation.scenario import Scenario
 
 HARNESS = r"""
@@ -150,7 +149,10 @@ OSQP_BODY = r"""
 
 
 def record_qps(kind: str, scenario: Scenario) -> tuple[list[dict], dict]:
-    """Every QP the kind's Python design solves over the scenario, with its solution.
+    """The QPs of the kind's design along the shipped law's run of the scenario: at each
+    controller step the QP of the acting grid design (the law's logged grid wind) at the
+    plant's state deviation and the law's previous command (the disturbance at the operating
+    point), with the design's solution.
 
     Parameters
     ----------
@@ -164,26 +166,38 @@ def record_qps(kind: str, scenario: Scenario) -> tuple[list[dict], dict]:
     list of dict
         Per solve: the design's id, its QP (:meth:`MPC.qp`) and its scaled solution.
     dict
-        The shipped library's run of the same case: its DISCON call and logged QP times.
+        The shipped library's run of the same case: its logged QP times.
     """
+    from mpc_wt.run import build_controller
+    from mpc_wt.simulation.loop import simulate_closed_loop
+
     turbine = linearize.load_turbine()
+    built, op, field = build_controller(turbine, kind, scenario)
+    design, host = built.design, built.controller
+    grid = list(design._grid)
     records: list[dict] = []
-    orig = mpc_mod.MPC._solve_z
+    last: dict[int, np.ndarray] = {}
+    step0 = host.step
 
-    def recording(self, *a, **k):
-        v, status = orig(self, *a, **k)
-        if v is not None:
-            records.append({"design": id(self), "qp": {k2: np.array(v2) for k2, v2 in
-                                                       self.qp().items()},
-                            "v": np.array(v)})
-        return v, status
-
-    mpc_mod.MPC._solve_z = recording
-    try:
-        run_controller(turbine, kind, scenario, shipped=False)
-    finally:
-        mpc_mod.MPC._solve_z = orig
-    res = run_controller(turbine, kind, scenario)
+    def step(t, meas):
+        k = grid.index(host.signals["schedule_grid_wind"]) if host.signals else 0
+        m = design.controller(k)
+        idx = [linearize.STATE_NAMES.index(n) for n in m.model.states]
+        x = np.asarray(meas["state"])[idx] - m.model.x0
+        up = last.get(k, np.zeros(m._nu))
+        plan, _ = m.solve(x, None, up)
+        if plan is not None:                     # the scaled solution: the solver's vector
+            records.append({"design": id(m), "qp": {k2: np.array(v2) for k2, v2 in
+                                                    m.qp().items()},
+                            "v": np.array(m._vbuf)})
+        pitch, torque = step0(t, meas)
+        u = np.r_[pitch, torque] - m.model.u0
+        last[k] = np.array([u[0], u[3]]) if m.collective else u
+        return pitch, torque
+    host.step = step
+    res = simulate_closed_loop(linearize.plant_params(turbine), host, field, scenario.duration,
+                               x0=op.x, u0=op.u, controller_dt=built.controller_dt,
+                               compiled=False)
     qp_ms = np.asarray(res.channel("qp_solve_ms"), float)
     return records, {"qp_solve_us": qp_ms[np.isfinite(qp_ms) & (qp_ms > 0)] * 1e3,
                      "rated_torque": turbine.rated_generator_torque}

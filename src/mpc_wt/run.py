@@ -12,7 +12,6 @@ from threadpoolctl import threadpool_limits
 
 import lidar
 import linearize
-from mpc_wt.controllers.base import DesignBase
 from mpc_wt.errors import RunTooLargeError
 from mpc_wt.registry.context import DEFAULT_CACHE, BuildContext, Built, DesignCache, design_digest
 from mpc_wt.registry.options import Options
@@ -54,17 +53,18 @@ def _condition(raw: Mapping[str, Any] | None) -> dict[str, Any]:
 def design_controller(turbine: linearize.Turbine, controller: str,
                       options: Mapping[str, Any] | None = None, *,
                       cache: DesignCache = DEFAULT_CACHE, naming: Naming = API_NAMING,
-                      params: linearize.PlantParams | None = None,
-                      shipped: bool = False) -> tuple[Built, bool]:
+                      params: linearize.PlantParams | None = None) -> tuple[Built, bool]:
     """The design of a controller for a turbine: made once and kept in ``cache`` (keyed on the
     turbine's content, the name and the options), so that every case after the first runs the
-    same design (``reset()`` between runs). The build sees the turbine, its options and the
-    harness's step only (:class:`~mpc_wt.registry.context.BuildContext`).
+    same design. The build sees the turbine, its options and the harness's step only
+    (:class:`~mpc_wt.registry.context.BuildContext`).
 
-    With ``shipped``, a kind that exports (:func:`mpc_wt.registry.exportable`) runs as it is
-    shipped: its design's numbers in the input file of its compiled C law, which the host
-    calls as OpenFAST's ServoDyn does (:class:`~mpc_wt.controllers.discon.DisconController`, in
-    this process).
+    A kind that exports (:func:`mpc_wt.registry.exportable`) gives its design's objects (what
+    an export writes out; :class:`~mpc_wt.controllers.base.DesignBase`, no step): a run
+    (:func:`build_controller`, :func:`run_controller`) runs them as they are shipped, their
+    numbers in the input file of the kind's compiled C law, which the host calls as
+    OpenFAST's ServoDyn does (:class:`~mpc_wt.controllers.discon.DisconController`, in this
+    process).
 
     Parameters
     ----------
@@ -81,11 +81,6 @@ def design_controller(turbine: linearize.Turbine, controller: str,
         How error messages name options.
     params : PlantParams, optional
         The turbine's plant parameters, if already derived.
-    shipped : bool
-        The design run as it is shipped, where the kind has a shipped law; False (default):
-        the design's Python objects (what an export writes out). A design without a step of
-        its own (:class:`~mpc_wt.controllers.base.DesignBase`: the baseline, derated, APC,
-        IBC, Coleman IPC, the LIDAR feedforward) runs as shipped either way.
 
     Returns
     -------
@@ -96,14 +91,14 @@ def design_controller(turbine: linearize.Turbine, controller: str,
         True when it was made now, False when it came from the cache.
     """
     sel = resolve(controller)
-    return _design(turbine, sel, sel.options(options, naming), cache, params, shipped)
+    return _design(turbine, sel, sel.options(options, naming), cache, params)
 
 
 def _design(turbine: linearize.Turbine, sel: Selection, opts: Sequence[Options],
             cache: DesignCache, params: linearize.PlantParams | None,
             shipped: bool = False) -> tuple[Built, bool]:
     """The design of a resolved selection with checked options (see design_controller); with
-    ``shipped``, that design run as it is shipped where its last part has a shipped law."""
+    ``shipped``, that design run as it is shipped where the selection has a shipped law."""
     made: list[bool] = []
 
     def make() -> Built:
@@ -120,10 +115,12 @@ def _design(turbine: linearize.Turbine, sel: Selection, opts: Sequence[Options],
         built.meta["design"] = {"digest": design_digest(built.controller)}
         return built
 
+    export = sel.export
+    if shipped and export is None and sel.addons and sel.base.export is not None:
+        return _wrapping_the_shipped_base(turbine, sel, opts, cache, params)
     key = ("built", sel.name, tuple(repr(o) for o in opts))
     built = cache.get(turbine, key, make)
-    export = sel.export
-    if export is None or not (shipped or isinstance(built.controller, DesignBase)):
+    if export is None or not shipped:
         return built, bool(made)
     from mpc_wt.kinds.common import run_as_shipped
 
@@ -133,15 +130,38 @@ def _design(turbine: linearize.Turbine, sel: Selection, opts: Sequence[Options],
                      lambda: run_as_shipped(ctx, export, built)), bool(made)
 
 
+def _wrapping_the_shipped_base(turbine: linearize.Turbine, sel: Selection,
+                               opts: Sequence[Options], cache: DesignCache,
+                               params: linearize.PlantParams | None) -> tuple[Built, bool]:
+    """A selection whose add-ons do not export around a base that does (the MPC's torque-law
+    guard): the base run as it is shipped, the add-ons built around its host."""
+    base, new = _design(turbine, dataclasses.replace(sel, addons=()), opts[:1], cache, params,
+                        shipped=True)
+
+    def make() -> Built:
+        ctx = BuildContext(turbine=turbine, params=params or linearize.plant_params(turbine),
+                           cache=cache)
+        built = base
+        for kind, o in zip(sel.addons, opts[1:]):
+            built = kind.build(ctx, o, built)
+        built.sensors = list(base.sensors) + list(ctx.sensors)
+        return built
+
+    key = ("shipped", sel.name, tuple(repr(o) for o in opts), base.meta["design"]["digest"])
+    return cache.get(turbine, key, make), new
+
+
 def build_controller(turbine: linearize.Turbine, controller: str, scenario: Scenario,
                      options: Mapping[str, Any] | None = None, *,
                      cache: DesignCache = DEFAULT_CACHE, naming: Naming = API_NAMING,
                      params: linearize.PlantParams | None = None,
                      samplers: lidar.SamplerCache | None = None,
-                     fields: FieldMemo | None = None, shipped: bool = True
+                     fields: FieldMemo | None = None
                      ) -> tuple[Built, linearize.OperatingPoint, Any]:
-    """The controller's design (:func:`design_controller`, from the cache when it is there),
-    the scenario's trim point and wind, and the design's LIDARs bound to the wind they see.
+    """The controller's design (:func:`design_controller`, from the cache when it is there) as
+    it runs: a kind that exports as it is shipped, its compiled C law called through the host
+    (``meta["law"]``); the scenario's trim point and wind; the design's LIDARs bound to the
+    wind they see.
 
     Parameters
     ----------
@@ -167,10 +187,6 @@ def build_controller(turbine: linearize.Turbine, controller: str, scenario: Scen
         Keeps the scenario's fields for the next run of the same scenario (default: the
         process's :data:`~mpc_wt.simulation.scenario.DEFAULT_FIELDS`; ``FieldMemo(0)`` keeps
         none).
-    shipped : bool
-        Run a kind that exports as it is shipped, its compiled C law (default); False: the
-        design's Python step (:func:`design_controller`), for studies of the design itself,
-        where it has one.
 
     Returns
     -------
@@ -190,7 +206,7 @@ def build_controller(turbine: linearize.Turbine, controller: str, scenario: Scen
     sel = resolve(controller)
     opts = sel.options(options, naming)
     op = _operating_point(turbine, sel, opts, scenario)
-    built, new = _design(turbine, sel, opts, cache, params, shipped)
+    built, new = _design(turbine, sel, opts, cache, params, shipped=True)
     comps = sel.field_components
     lidars = len(built.sensors) + (built.preview is not None)
     fields = DEFAULT_FIELDS if fields is None else fields
@@ -246,8 +262,7 @@ def run_controller(turbine: linearize.Turbine, controller: str, scenario: Scenar
                    turbulence: str | float | None = None, seed: int | None = None,
                    duration: float | None = None, shear_exponent: float | None = None,
                    condition: Mapping[str, Any] | None = None,
-                   plant: Mapping[str, bool] | None = None,
-                   shipped: bool = True) -> ClosedLoopResult:
+                   plant: Mapping[str, bool] | None = None) -> ClosedLoopResult:
     """Trim, build the controller, generate the scenario's wind and simulate.
 
     Parameters
@@ -288,8 +303,6 @@ def run_controller(turbine: linearize.Turbine, controller: str, scenario: Scenar
     plant : mapping of str to bool, optional
         The plant's effects switched from their defaults (``meta["plant"]``), e.g.
         ``{"twisted_modes": True}`` (:meth:`linearize.PlantConfig.with_switches`).
-    shipped : bool
-        An exportable kind runs its C law (default; ``meta["law"]``); False: its Python step.
 
     Returns
     -------
@@ -311,7 +324,7 @@ def run_controller(turbine: linearize.Turbine, controller: str, scenario: Scenar
     params = _checked_case(turbine, plant, scenario, supervisor)   # before the design
     built, op, wind = build_controller(turbine, controller, scenario, options, cache=cache,
                                        naming=naming, params=params, samplers=samplers,
-                                       fields=fields, shipped=shipped)
+                                       fields=fields)
     meta = _run_meta(controller, scenario, turbine, built, op, plant)
     return _warned(simulate_closed_loop(
         params, _supervised(built.controller, turbine, supervisor, meta), wind,

@@ -13,7 +13,6 @@ import linearize
 from mpc_wt.io.discon_export import find_compiler
 from mpc_wt.run import export_discon, run_controller
 from mpc_wt.simulation.scenario import FieldMemo
-from servodyn_measures import run_python
 
 pytestmark = pytest.mark.skipif(find_compiler() is None,
                                 reason="no C compiler ($CC, cc, gcc, clang) to build the law")
@@ -35,18 +34,18 @@ def test_a_turbulent_case_near_rated_stays_below_1p1_rated_power(turbine, kind):
     assert abs(held.channel("gen_power").mean() / free.channel("gen_power").mean() - 1) < 0.01
 
 
-def test_the_library_and_the_python_law_hold_the_same_ceiling(turbine):
-    """Where the ceiling binds (class A, 14 m/s, 30 s, ceiling at 1.0 x rated so that it binds
-    often) the library's torque command is the Python law's within 1 N m."""
-    kw = dict(duration=30.0, turbulence="A", seed=31, fields=_FIELDS)
-    opts = {"power_limit": 1.0}
-    lib = run_controller(turbine, "mpc", 14.0, opts, **kw)
-    py = run_python(turbine, "mpc", 14.0, opts, **kw)
-    q_lib, q_py = lib.channel("gen_torque_ref"), py.channel("gen_torque_ref")
-    w = lib.channel("gen_speed")
-    bound = RATED_W / (0.944 * w)         # 94.4 % generator efficiency (Jonkman et al. 2009)
-    assert np.mean(q_lib >= 0.995 * bound) > 0.05, "the ceiling must bind in this case"
-    np.testing.assert_allclose(q_lib, q_py, rtol=0, atol=1.0)
+def test_where_the_ceiling_binds_the_power_stays_at_it(turbine):
+    """With the ceiling at 1.0 x rated (class A, 14 m/s, 30 s), so that it binds often (the
+    torque command at the rated power's torque at the measured speed, 94.4 % generator
+    efficiency from Jonkman et al. 2009, in more than a twentieth of the steps): the largest
+    electrical power within 1 % of rated (the speed moves within the controller's 0.1 s step;
+    measured 0.76 %)."""
+    lib = run_controller(turbine, "mpc", 14.0, {"power_limit": 1.0}, duration=30.0,
+                         turbulence="A", seed=31, fields=_FIELDS)
+    q, w = lib.channel("gen_torque_ref"), lib.channel("gen_speed")
+    bound = RATED_W / (0.944 * w)
+    assert np.mean(q >= 0.995 * bound) > 0.05, "the ceiling must bind in this case"
+    assert lib.channel("gen_power").max() <= 1.01 * RATED_W
 
 
 def test_a_negative_ceiling_in_the_input_file_is_refused_by_name(turbine, tmp_path):

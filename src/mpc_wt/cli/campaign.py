@@ -88,7 +88,9 @@ def _bench_mpc(args: argparse.Namespace) -> int:
 
     if args.steps < 10:
         raise UsageError(f"--steps must be >= 10, got {args.steps}")
-    res = run_solver_benchmark(args.steps, progress=not args.json)
+    from mpc_wt.run import law_controller
+
+    res = run_solver_benchmark(law_controller, args.steps, progress=not args.json)
     print(to_json(res) if args.json else format_table(res))
     if args.plot:
         plot_solver_times(res, args.plot)

@@ -11,15 +11,17 @@ M_tilt^2 + M_yaw^2 for every azimuth (eqs 8, 9, 21). Constraints (eqs 12, 15): p
 and rate per blade (the rate through the model's pitch-rate outputs), generator torque and its
 rate, all on absolute values about the operating point.
 
-Solvers: OSQP on the condensed QP (inputs only, the default) or on the sparse
-formulation (predicted states as variables, dynamics as equality rows), or DAQP (dual active
-set) on the condensed QP. All matrices are built and factorized once per operating point. The
-variables are shifted to the unconstrained optimum, which like every QP vector of a step is
-affine in the step's data (state, previous command, preview): one precomputed map gives the
-bounds, the linear term stays zero, and when no constraint binds the warm-started solver stops
-at once. The status is checked every step: on failure (or a solve over ``time_budget_ms``) the
-previous plan shifted by one step is applied, else the previous command is held; the fallback
-used is recorded in ``signals`` and logged, and the steps are counted (``fallbacks``).
+The design's QP (:meth:`MPC.solve`, for studies and checks of the design): OSQP on the
+condensed QP (inputs only) or on the sparse formulation (predicted states as variables,
+dynamics as equality rows), or DAQP (dual active set) on the condensed QP. All matrices are
+built and factorized once per operating point. The variables are shifted to the
+unconstrained optimum, which like every QP vector of a step is affine in the step's data
+(state, previous command, preview): one precomputed map gives the bounds, the linear term
+stays zero, and when no constraint binds the warm-started solver stops at once.
+
+The MPC runs as it is shipped: the condensed QP's data of every design is the input of the
+``mpc`` kind's C law (``mpc_wt/io/discon_c/mpc.c``, DAQP), which estimates the state, solves
+the QP at 10 Hz and takes its fallback there (:class:`ScheduledMPC`).
 """
 from __future__ import annotations
 
@@ -28,7 +30,6 @@ import dataclasses
 import functools
 import logging
 import math
-import time
 from dataclasses import dataclass, field
 from types import SimpleNamespace
 from typing import Any
@@ -39,7 +40,7 @@ import numpy as np
 import linearize
 from linearize.jitcache import key_caches_on_callees
 from linearize.validate import check_number
-from mpc_wt.controllers.base import ControllerBase
+from mpc_wt.controllers.base import DesignBase
 from mpc_wt.controllers.baseline import LawTorque
 from mpc_wt.controllers.filters import SOSFilterBank, filter_sos
 from mpc_wt.controllers.qp import check_backend, daqp_update_solve, default_backend, make_backend
@@ -500,8 +501,11 @@ def _group(name: str) -> str:
     return name
 
 
-class MPC(ControllerBase):
-    """Linear MPC on a discretized :class:`linearize.LinearModel` (Madsen et al. eqs 20-23).
+class MPC(DesignBase):
+    """The design of a linear MPC on a discretized :class:`linearize.LinearModel` (Madsen et
+    al. eqs 20-23): its QP, set up once, with :meth:`solve` for one QP at a given state; run
+    by its shipped law (the ``mpc`` kind's C law, ``mpc_wt/io/discon_c/mpc.c``, as a schedule
+    of this one design: :func:`mpc_wt.run.law_controller`).
 
     Parameters
     ----------
@@ -523,6 +527,7 @@ class MPC(ControllerBase):
 
     #: run-time handles into the solver's workspace, not design data
     __not_design__ = ("_daqp",)
+    kind = "mpc"
 
     def __init__(self, model: linearize.LinearModel, turbine: linearize.Turbine,
                  settings: MPCSettings | None = None) -> None:
@@ -559,8 +564,6 @@ class MPC(ControllerBase):
         #: the state estimator; None: the plant's true states (``estimator="full-state"``)
         self.estimator = None if estimator == "full-state" else estimator
         self.x_names = m.states
-        # "auto": use meas["preview"] when the harness gives one; from_turbine sets None/"lidar"
-        self.preview: str | None = "auto"
         self._x_idx = np.array([linearize.STATE_NAMES.index(n) for n in m.states])
         self._n_full = len(linearize.STATE_NAMES)
         self._x_idx = self._x_idx.astype(np.int64)
@@ -570,11 +573,13 @@ class MPC(ControllerBase):
         self._ucol = np.array([0, 0, 0, 1] if self.collective else [0, 1, 2, 3], np.int64)
         self._pack()
         self._warm_kernels()
-        self.reset()
+        self.qp_backend.reset()
+        self._last_slack = 0.0
+        self.set_target()
 
     @classmethod
     def from_turbine(cls, turbine: linearize.Turbine, wind_mps: float,
-                     settings: MPCSettings | None = None, *, preview: str | None = None,
+                     settings: MPCSettings | None = None, *,
                      family: linearize.LinearModelFamily | None = None) -> "MPC":
         """Madsen's MPC for ``turbine`` at the mean wind ``wind_mps`` in a few words.
 
@@ -590,9 +595,6 @@ class MPC(ControllerBase):
             Mean wind [m/s], within the operating range (or the family's).
         settings : MPCSettings, optional
             The MPC's settings.
-        preview : {None, "lidar"}
-            "lidar": the controller requires a preview (``meas["preview"]``) every step; None
-            holds the disturbance at the operating point and ignores any preview.
         family : LinearModelFamily, optional
             Take the model from it instead of linearizing.
 
@@ -604,10 +606,8 @@ class MPC(ControllerBase):
         Raises
         ------
         ValueError
-            A wind outside the range, or an unknown preview mode.
+            A wind outside the range.
         """
-        if preview not in (None, "lidar"):
-            raise ValueError(f"preview must be None or 'lidar', got {preview!r}")
         if family is not None:
             model = family.at(wind_mps)
         else:
@@ -618,9 +618,7 @@ class MPC(ControllerBase):
                                  f"operating range {op.cut_in_wind:g}..{op.cut_out_wind:g} m/s, "
                                  f"got {wind_mps!r}")
             model = linearize.linearize(turbine, v, config=linearize.PlantConfig.madsen())
-        ctl = cls(model, turbine, settings)
-        ctl.preview = preview
-        return ctl
+        return cls(model, turbine, settings)
 
     # ------------------------------------------------------------------------------------
     def _weights(self) -> tuple[np.ndarray, np.ndarray]:
@@ -1013,22 +1011,6 @@ class MPC(ControllerBase):
         self.qp_backend.setup(p_s, np.zeros(nv), a_s, 0)
 
     # ------------------------------------------------------------------------------------
-    def reset(self) -> None:
-        """Forget the previous plan and command."""
-        self._plan: np.ndarray | None = None
-        self._u_prev: np.ndarray | None = None
-        #: the generator torque applied over the last step when it differs from the command
-        #: (a filter after the MPC, :class:`ScheduledMPC`'s torque notch) [N m]: the
-        #: estimator's input; None: the command
-        self.applied_torque: float | None = None
-        self.qp_backend.reset()
-        self._last_slack = 0.0
-        self.fallbacks = 0                  # steps that took the fallback since the reset
-        if getattr(self, "estimator", None) is not None:
-            self.estimator.reset()
-        self.set_target()
-        self.signals: dict[str, float] = {}
-
     def set_target(self, z_target: np.ndarray | None = None,
                    u_target: np.ndarray | None = None) -> None:
         """The steady state the cost tracks from the next step on, in absolute units: the
@@ -1037,9 +1019,9 @@ class MPC(ControllerBase):
         default, and after :meth:`reset`): the operating point of the model.
 
         Below rated wind the operating point of a grid wind is not where the turbine should be
-        at another wind: a scheduled MPC sets the trim at the wind it measures
-        (:class:`ScheduledMPC`), so that it tracks the power-optimal speed and torque there
-        instead of holding the grid point's power.
+        at another wind: the shipped law of a scheduled MPC (:class:`ScheduledMPC`) sets the
+        trim at the wind it measures, so that it tracks the power-optimal speed and torque
+        there instead of holding the grid point's power.
 
         Parameters
         ----------
@@ -1063,12 +1045,6 @@ class MPC(ControllerBase):
                 r[nzo], r[nzo + 1] = (du[0] + du[1] + du[2]) / 3.0, du[3]
             else:
                 r[nzo:] = du
-
-    def _u_abs(self, du: np.ndarray) -> np.ndarray:
-        u0 = self.model.u0
-        if self.collective:
-            return np.array([u0[0] + du[0]] * 3 + [u0[3] + du[1]])
-        return u0 + du
 
     def solve(self, x: np.ndarray, d_preview: np.ndarray | None = None,
               u_prev: np.ndarray | None = None) -> tuple[np.ndarray | None, str]:
@@ -1206,129 +1182,6 @@ class MPC(ControllerBase):
         return {"H": self._h_s, "q": qs, "A": self._a_gen_s, "lo": lo[nb:], "hi": hi[nb:],
                 "lo_box": lo[:nb], "hi_box": hi[:nb], "scale": self._su.copy()}
 
-    def step(self, t: float, meas: dict[str, Any]) -> tuple[np.ndarray, float]:
-        """Harness step with full-state information (``meas["state"]``) and, optionally, a
-        LIDAR preview (``meas["preview"]``, per-blade winds) as the disturbance.
-
-        Parameters
-        ----------
-        t : float
-            Time [s].
-        meas : dict
-            The harness's measurements (:mod:`mpc_wt.simulation.loop`).
-
-        Returns
-        -------
-        pitch_ref : (3,) ndarray
-            Blade pitch commands [rad].
-        gen_torque_ref : float
-            Generator torque command [N m].
-        """
-        nx, z = self._nx, self._z
-        dprev, st = None, _EMPTY
-        if self.estimator is not None:
-            u_dev = (np.zeros(len(self.model.u0)) if self._u_prev is None
-                     else self._u_abs(self._u_prev) - self.model.u0)
-            if self.applied_torque is not None:
-                u_dev[3] = self.applied_torque - self.model.u0[3]
-            xe, dhat = self.estimator.update(self.estimator.measurement(meas), u_dev)
-            z[1:1 + nx] = xe
-            dprev = dhat
-            self.signals_est = dict(zip(self._wind_est_names, (dhat + self.model.d0).tolist()))
-        else:
-            st = meas.get("state")
-            if st is None:
-                raise ValueError("the MPC needs full-state information: meas['state'] (or "
-                                 "estimator='kalman')")
-            st = np.asarray(st, dtype=float)
-            if st.shape != (self._n_full,):
-                raise ValueError(f"meas['state'] has shape {st.shape}; expected the plant's "
-                                 f"({self._n_full},)")
-        pv = meas.get("preview")
-        blade = _NO_BLADE
-        if self.preview is not None and pv is not None:
-            blade = pv.blade
-            if not isinstance(blade, np.ndarray) or blade.dtype not in (np.float64, np.float32):
-                blade = np.asarray(blade, float)
-            if blade.ndim != 2 or blade.shape[0] < 1 or blade.shape[1] != 3:
-                raise ValueError(f"preview.blade has shape {blade.shape}; expected (n >= 1, 3) "
-                                 "per-blade winds")
-        elif self.preview == "lidar":
-            raise ValueError("this MPC was built with preview='lidar' but the harness gives no "
-                             "preview: pass simulate_closed_loop(..., preview=LidarPreview(...))")
-        if dprev is not None and blade.shape[0] == 0:          # the estimator's wind, held
-            if dprev.shape != (self._nd,):
-                raise ValueError(f"the estimated wind has shape {dprev.shape}; expected "
-                                 f"(n_d,) = ({self._nd},)")
-            z[self._nzd:].reshape(self.hp, self._nd)[:] = dprev
-        t_qp = time.perf_counter()
-        v, status = self._solve_z(dprev is not None or blade.shape[0] > 0, st,
-                                  self._up0 if self._u_prev is None else self._u_prev, blade)
-        qp_ms = 1e3 * (time.perf_counter() - t_qp)
-        budget = self.settings.time_budget_ms
-        if v is not None and budget is not None and qp_ms > budget:
-            v, status = None, f"took {qp_ms:.3g} ms, over its time budget of {budget:g} ms"
-        if v is None:
-            u, level = self._fallback(t, status)
-        else:
-            self._plan = v[:self._nvu].copy()
-            self._u_prev = self._dubuf          # read by the next step before it is rewritten
-            u, level = self._ubuf, 0.0
-        self.signals = {"qp_fallback": level,
-                        "pitch_ref_1": float(u[0]), "torque_ref": float(u[3]),
-                        "rotor_speed_slack": self._last_slack, "qp_solve_ms": qp_ms}
-        if self.estimator is not None:
-            self.signals.update(self.signals_est)
-        # within the actuators' limits: the QP holds them to its tolerance (a fine pitch of
-        # -1e-8 rad would count as a clipped command)
-        p_lo, p_hi, q_lo, q_hi = self._limits
-        return np.clip(u[:3], p_lo, p_hi), min(max(float(u[3]), q_lo), q_hi)
-
-    def _fallback(self, t: float, status: str) -> tuple[np.ndarray, float]:
-        """The command when the QP failed and the fallback's level: the rest of the last plan
-        (1) or the last command held (2, zero deviation at the start); logged."""
-        nu = self._nu
-        if self._plan is not None and len(self._plan) > nu:
-            v = np.concatenate([self._plan[nu:], self._plan[-nu:]])
-            level = 1.0
-        else:
-            v = np.zeros(self._nvu)
-            if self._u_prev is not None:
-                v[:self._nvu] = np.tile(self._u_prev / self._su[:nu], self.hu)
-            level = 2.0
-        self.fallbacks += 1
-        log.warning("MPC QP %s at t = %g s: fallback %d (%d so far)", status, t, int(level),
-                    self.fallbacks)
-        self._plan = v[:self._nvu]
-        du = v[:nu] * self._su[:nu]
-        self._u_prev = du
-        return self._u_abs(du), level
-
-    def hand_over(self, other: "MPC") -> None:
-        """Continue from another MPC's last command and estimate (gain scheduling): the
-        previous command and the estimator state are carried over in absolute units.
-
-        Parameters
-        ----------
-        other : MPC
-            The controller being replaced (its operating point may differ).
-        """
-        if other._u_prev is not None:
-            du = other._u_abs(other._u_prev) - self.model.u0
-            self._u_prev = np.array([du[0], du[3]]) if self.collective else du
-        self.applied_torque = other.applied_torque
-        if other.estimator is not None and self.estimator is not None:
-            offset = (np.concatenate([other.model.x0, other.model.d0])
-                      - np.concatenate([self.model.x0, self.model.d0]))
-            self.estimator.hand_over(other.estimator, offset)
-
-    @property
-    def plan(self) -> np.ndarray | None:
-        """The last applied plan: input deviations (H_u, n_u) from the operating point."""
-        if self._plan is None:
-            return None
-        return (self._plan * self._su[:self._nvu]).reshape(self.hu, self._nu)
-
 
 def drivetrain_frequency(turbine: linearize.Turbine, wind_mps: float | None = None) -> float:
     """The drivetrain's torsion mode of the turbine's full linearization (every degree of
@@ -1369,20 +1222,22 @@ def _gen_speed(model: linearize.LinearModel) -> float:
     return float(model.z0[model.outputs.index("gen_speed")])
 
 
-class ScheduledMPC(ControllerBase):
-    """MPC scheduled over a :class:`linearize.LinearModelFamily` on a measured mean wind.
+class ScheduledMPC(DesignBase):
+    """The design of an MPC scheduled over a :class:`linearize.LinearModelFamily` on a
+    measured mean wind, run by its shipped law (the ``mpc`` kind's C law;
+    :func:`mpc_wt.run.law_controller` runs a design made by hand).
 
-    One :class:`MPC` per grid wind of the family, all built with the design (``prebuild``: a
-    QP's setup takes some 70 ms, which a 10 Hz step must not spend on a switch) and kept, so
-    that the QP matrices, the OSQP factorization and the DAQP workspace of an operating point
-    are set up once and reused whenever the schedule returns to it. Which one acts is decided by a
-    :class:`~mpc_wt.controllers.scheduling.WindSchedule`: the grid wind nearest a low-passed
-    wind that the controller measures -- the rotor-effective wind of
+    One :class:`MPC` per grid wind of the family, all built with the design (``prebuild``),
+    their QPs' data the law's input. Which one acts the law decides as a
+    :class:`~mpc_wt.controllers.scheduling.WindSchedule` describes: the grid wind nearest a
+    low-passed wind that the controller measures -- the rotor-effective wind of
     :class:`~mpc_wt.controllers.wind_estimator.WindSpeedEstimator` (rotor speed, pitch,
     generator torque; ``wind_source="estimator"``) or the LIDAR's rotor-mean measurement
     (``wind_source="preview"``) -- with hysteresis against chattering. The first step starts at
     the grid wind nearest the first estimate. On a switch the previous command and the
-    estimator state are handed over in absolute units (bumpless).
+    estimator state are handed over in absolute units (bumpless). A QP that fails (or takes
+    longer than ``time_budget_ms``) takes the rest of the last plan, else the last command
+    held; the law logs the level (``qp_fallback``) and warns (``aviFAIL`` = 1).
 
     Parameters
     ----------
@@ -1509,7 +1364,28 @@ class ScheduledMPC(ControllerBase):
         if prebuild:
             for k in range(len(family.wind_mps)):
                 self.controller(k)
-        self.reset()
+
+    @classmethod
+    def of_one(cls, mpc: MPC) -> "ScheduledMPC":
+        """One design as a schedule of that one point (what its law runs): each design's own
+        operating point as the cost's target (Madsen's), no torque law, notch, power ceiling
+        or region floor.
+
+        Parameters
+        ----------
+        mpc : MPC
+            The design (its model, turbine and settings).
+
+        Returns
+        -------
+        ScheduledMPC
+            The schedule of ``mpc`` alone.
+        """
+        fam = linearize.LinearModelFamily(wind_mps=np.array([mpc.model.wind_mps]),
+                                          models=(mpc.model,))
+        one = cls(fam, mpc.turbine, mpc.settings, prebuild=False, target_time_constant=None)
+        one._ctl[0] = mpc
+        return one
 
     def controller(self, k: int) -> MPC:
         """The MPC of grid point ``k`` (built on first use).
@@ -1537,48 +1413,6 @@ class ScheduledMPC(ControllerBase):
         """The schedule's :class:`~mpc_wt.controllers.scheduling.RegionFloor` (None: none)."""
         return self.schedule.floor
 
-    @property
-    def switches(self) -> int:
-        """Switches between grid points since the last reset."""
-        return self.schedule.switches
-
-    @property
-    def fallbacks(self) -> int:
-        """Steps that took the QP fallback since the reset, over every design."""
-        return sum(c.fallbacks for c in self._ctl.values())
-
-    def reset(self) -> None:
-        """Forget the wind and every controller's state: the next step starts the schedule."""
-        self.schedule.reset()
-        for c in self._ctl.values():
-            c.reset()
-        self.target_wind: float | None = None
-        self.pitch_target_wind: float | None = None
-        if self._law is not None:
-            self._law.reset()
-        if self._notch is not None:
-            self._notch.reset()
-        self.signals: dict[str, float] = {}
-
-    def _target(self, meas: dict[str, Any]) -> tuple[np.ndarray, np.ndarray]:
-        """This step's target: the trim at the low-passed measured wind; with a torque law,
-        its torque at the measured generator speed, and no more power than that torque gives
-        there (so that a rotor slower than the trim is never asked to hold the trim's power,
-        which is how a power-tracking MPC stalls the rotor in a lull)."""
-        z, u = self.trim_at(self.target_wind)          # type: ignore[arg-type]
-        if self.pitch_target_wind != self.target_wind:
-            u = u.copy()
-            u[:3] = self.trim_at(self.pitch_target_wind)[1][:3]   # type: ignore[arg-type]
-        if self._law is None:
-            return z, u
-        w = float(meas["gen_speed"])
-        p = meas["pitch"]
-        q = self._law(w, (float(p[0]) + float(p[1]) + float(p[2])) / 3.0)
-        z, u = z.copy(), u.copy()
-        u[3] = q
-        z[self._ip] = min(z[self._ip], self._eff * q * w)
-        return z, u
-
     def trim_at(self, wind: float) -> tuple[np.ndarray, np.ndarray]:
         """The family's trim at ``wind``, linear between its grid winds (held beyond them).
 
@@ -1601,58 +1435,6 @@ class ScheduledMPC(ControllerBase):
         a = min(max((wind - g[i]) / (g[i + 1] - g[i]), 0.0), 1.0)
         return ((1.0 - a) * self._z_trim[i] + a * self._z_trim[i + 1],
                 (1.0 - a) * self._u_trim[i] + a * self._u_trim[i + 1])
-
-    def step(self, t: float, meas: dict[str, Any]) -> tuple[np.ndarray, float]:
-        """Update the schedule, switch (handing over) when it says so, step the active MPC.
-
-        Parameters
-        ----------
-        t : float
-            Time [s].
-        meas : dict
-            The harness's measurements.
-
-        Returns
-        -------
-        pitch_ref : (3,) ndarray
-            [rad]
-        gen_torque_ref : float
-            [N m]
-        """
-        k, ctl = self.schedule.acting(meas, self.controller)
-        if self.target_tau is not None:
-            w = float(self.schedule.floored)         # type: ignore[arg-type]
-            wp = float(self.schedule.measured)       # type: ignore[arg-type]
-            if self.target_wind is None:
-                self.target_wind, self.pitch_target_wind = w, wp
-            else:
-                a = 1.0 if self.target_tau == 0 else min(1.0, self.dt / self.target_tau)
-                self.target_wind += a * (w - self.target_wind)
-                self.pitch_target_wind += a * (wp - self.pitch_target_wind)  # type: ignore
-            ctl.set_target(*self._target(meas))
-        u = ctl.step(t, meas)
-        if self._notch is not None or self.power_limit is not None:
-            _, _, q_lo, q_hi = ctl._limits
-            q = float(u[1])
-            if self._notch is not None:
-                q = min(max(float(self._notch.step(q)[0]), q_lo), q_hi)
-            w = float(meas["gen_speed"])
-            if self.power_limit is not None and w > 0.0:
-                q = min(q, self.power_limit / (self._eff * w))
-            last = ctl.applied_torque           # handed over on a switch
-            if last is not None:                # the generator's rate stays hard
-                q = min(max(q, last - self._dq), last + self._dq)
-            ctl.applied_torque = q
-            u = (u[0], q)
-        self.signals = dict(ctl.signals, schedule_wind=float(self.schedule.wind or math.nan),
-                            schedule_grid_wind=float(self.family.wind_mps[k]),
-                            target_wind=float(self.target_wind or math.nan),
-                            schedule_floor=float(self.schedule.floored is not None
-                                                 and self.schedule.floored
-                                                 > self.schedule.measured),
-                            schedule_outside=float(self.schedule.outside),
-                            estimator_outside=float(self.schedule.estimator_outside))
-        return u
 
 
 key_caches_on_callees(__name__)

@@ -363,7 +363,7 @@ class TorqueLawGuard(ControllerBase):
         self.controller = controller
         self.law = BaselineController(turbine)
         self.fine = turbine.operation.fine_pitch_rad + band
-        self.reset()
+        self.signals: dict[str, float] = {"torque_law_active": 0.0}
 
     def reset(self) -> None:
         """Reset the guarded controller."""

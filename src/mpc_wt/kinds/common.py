@@ -21,9 +21,9 @@ log = logging.getLogger(__name__)
 def run_as_shipped(ctx: BuildContext, export: Any, built: Built) -> Built:
     """A design as it is shipped: its numbers written to its law's input file, its compiled
     library (:func:`mpc_wt.io.discon_export.shipped_library`) called through the host in this
-    process, so that every run of the kind calls the law users run in OpenFAST. A design with
-    options the law does not take (an MPC on OSQP, the sparse formulation, the true states)
-    keeps its Python step; the run's metadata says which law ran (``meta["law"]``).
+    process, so that every run of the kind calls the law users run in OpenFAST. A plugin's
+    design with a step of its own that its law does not take keeps that step (logged); the
+    run's metadata says which law ran (``meta["law"]``).
 
     Parameters
     ----------

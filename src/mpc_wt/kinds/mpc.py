@@ -15,7 +15,6 @@ import linearize
 from mpc_wt.registry.context import BuildContext, Built
 from mpc_wt.registry.options import Options, option
 from mpc_wt.registry.registry import register
-from mpc_wt.controllers.mpc import ESTIMATORS
 from mpc_wt.io import gain_tables as gt
 from mpc_wt.io.discon_export import LawExport, signal_codes
 from mpc_wt.kinds.common import (LidarOptions, baseline_entries, check_design_wind,
@@ -105,16 +104,7 @@ class MPCOptions(Options):
     grid design is an :class:`mpc_wt.MPC` whose :class:`mpc_wt.MPCSettings` these options
     make; a setting both take has the same name and default (the state estimated by default)."""
 
-    backend: Optional[str] = option(None, help="QP solver (default DAQP when installed, else "
-                                    "OSQP)", choices=(None, "osqp", "daqp"))
-    formulation: str = option("condensed", help="QP formulation (sparse: OSQP only)",
-                              choices=("condensed", "sparse"))
     horizon: int = option(15, help="H_p = H_u", lo=1, hi=200)
-    estimator: str = option("kalman", help="kalman: states and blade winds estimated from "
-                            "measured signals (rotor and generator speed, pitch, flap moments, "
-                            "tower-top acceleration); full-state: the plant's true states, an "
-                            "idealization no turbine has (labelled so in results)",
-                            choices=ESTIMATORS)
     design_wind_mps: Optional[float] = option(None, help="one design at this mean wind "
                                               "(Madsen's single-point design); default: "
                                               "designs from cut-in to cut-out scheduled on the "
@@ -256,21 +246,16 @@ def _mpc_settings(opts: MPCOptions, collective: bool, preview: bool) -> Any:
     defaults = None
     if opts.design_wind_mps is None:
         defaults = dict(ENVELOPE_WEIGHTS)
-        if not preview and not collective and opts.estimator == "kalman":
+        if not preview and not collective:
             defaults.update(NO_PREVIEW_WEIGHTS)
-    return MPCSettings(horizon=opts.horizon, backend=opts.backend,
-                       formulation=opts.formulation,
-                       estimator=opts.estimator,
+    return MPCSettings(horizon=opts.horizon, backend="daqp", formulation="condensed",
+                       estimator="kalman",
                        estimator_settings={
                            "wind_std_per_step": opts.kalman_wind_std,
                            "measurement_std": {f"flap_moment_{b}": opts.kalman_flap_std
                                                for b in (1, 2, 3)}},
                        collective=collective, weights=opts.weights.weights(defaults),
                        time_budget_ms=opts.time_budget_ms)
-
-
-#: The result label of a design that reads the plant's true states.
-FULL_STATE = "full-state information (idealization)"
 
 
 #: The default torque notch is left out when the drivetrain mode lies above this fraction of
@@ -372,15 +357,14 @@ def _mpc(collective: bool, with_lidar: bool) -> Any:
         else:
             v = check_design_wind(ctx.turbine, opts.design_wind_mps)
             model = linearize.linearize(ctx.turbine, v, config=linearize.PlantConfig.madsen())
-            ctl = MPC(model, ctx.turbine, settings)
+            ctl = ScheduledMPC.of_one(MPC(model, ctx.turbine, settings))   # nothing switches
             grid = [v, v]
         cdt = ctl.dt
         meta: dict[str, Any] = {"mpc": {
             "horizon": settings.horizon, "backend": settings.resolved_backend, "dt": cdt,
-            "formulation": settings.formulation, "estimator": opts.estimator,
+            "formulation": settings.formulation, "estimator": "kalman",
             "design_winds_mps": grid, "schedule_step_mps": opts.schedule_step,
-            "torque_notch_hz": getattr(ctl, "torque_notch_hz", None),
-            **({"idealization": FULL_STATE} if opts.estimator == "full-state" else {})}}
+            "torque_notch_hz": ctl.torque_notch_hz}}
         preview = None
         if with_lidar:
             from mpc_wt.simulation.preview import LidarPreview
@@ -487,10 +471,13 @@ def _preview_entries(preview: Any, horizon: int) -> list[tuple[str, Any, str]]:
 def _mpc_entries(ctl: Any, preview: Any = None) -> list[tuple[str, Any, str]]:
     """The numbers of a :class:`~mpc_wt.controllers.mpc.ScheduledMPC` (and its LIDAR preview)
     as input-file entries."""
-    from mpc_wt.controllers.mpc import ScheduledMPC
+    from mpc_wt.controllers.mpc import MPC, ScheduledMPC
 
+    if type(ctl) is MPC:                       # one design: a schedule of one point
+        ctl = ScheduledMPC.of_one(ctl)
     if type(ctl) is not ScheduledMPC:
-        raise ValueError(f"the MPC export takes a ScheduledMPC, got {type(ctl).__name__}")
+        raise ValueError(f"the MPC export takes a ScheduledMPC or an MPC, got "
+                         f"{type(ctl).__name__}")
     if ctl.wind_source != "estimator" and preview is None:
         raise ValueError("an MPC scheduled on its LIDAR's measurement exports with its LIDAR "
                          "preview (export the kind 'mpc-lidar' through mpc_wt.run."
@@ -558,11 +545,13 @@ def _mpc_entries(ctl: Any, preview: Any = None) -> list[tuple[str, Any, str]]:
 
 
 def _mpc_export(name: str, summary: str, lidar: bool = False) -> LawExport:
-    """An MPC kind's export: the MPC law with DAQP, from its published distribution; with the
-    LIDAR, the last sample's wind at each blade logged too."""
+    """An MPC kind's export: the MPC law with DAQP, from its published distribution; it logs
+    its fallback level, the QP's solve time, the schedule's winds, with the LIDAR the last
+    sample's wind at each blade, and the Kalman filter's blade winds."""
     log = ("qp_fallback", "qp_solve_ms", "schedule_wind", "schedule_grid_wind")
     if lidar:
         log += ("lidar_wind_1", "lidar_wind_2", "lidar_wind_3")
+    log += ("wind_est_1", "wind_est_2", "wind_est_3")
     return LawExport(name, summary, "mpc", _mpc_entries, sources=("mpc.c",), qp=True, log=log)
 
 

@@ -1,21 +1,22 @@
 """MPC solver comparison: the QPs of one closed-loop run, solved by several solvers.
 
 A closed loop of ``steps`` steps at 10 Hz of Madsen's individual-pitch MPC (8-state model at
-18 m/s, H_p = H_u = 15, 3 pitch + torque, pitch/torque/rate constraints) on our nonlinear plant in
-IEC class-A turbulence at 18 m/s mean. Every step's QP data (state, disturbance, previous command)
-is recorded, then the same sequence of QPs is solved by
+18 m/s, H_p = H_u = 15, 3 pitch + torque, pitch/torque/rate constraints), run by its shipped
+law, on our nonlinear plant in IEC class-A turbulence at 18 m/s mean. At every step the QP of
+the plant's state deviation and the law's previous command is recorded (the QP a design on
+the true states solves along that trajectory), then the same sequence of QPs is solved by
 
-- ``osqp-condensed`` and ``daqp-condensed``: our :class:`~mpc_wt.controllers.mpc.MPC`, scaled condensed QP,
-  warm-started, factorization kept (timed: the solver call alone, and the whole ``solve``
-  including the per-step vectors);
+- ``osqp-condensed``, ``osqp-sparse`` and ``daqp-condensed``: the design's QP
+  (:meth:`~mpc_wt.controllers.mpc.MPC.solve`), scaled, warm-started, factorization kept
+  (timed: the solver call alone, and the whole ``solve`` including the per-step vectors);
 - ``cvxpy-params (OSQP)``: cvxpy with parameters for q and the bounds, re-solved each step;
 - ``clarabel``: the condensed QP handed to Clarabel each step (interior point, no warm start);
 - ``qpoases-casadi``: qpOASES through CasADi's ``conic`` interface;
 
 against a reference solution (Clarabel, tolerances 1e-10). ``max_move_error`` is the largest
 error of the applied first move relative to the acceptance tolerance (0.01 deg pitch,
-0.1 % of rated torque): <= 1 passes. The whole closed-loop controller step (state extraction,
-vectors, solve, fallback logic) is timed in the closed loop itself.
+0.1 % of rated torque): <= 1 passes. The shipped law's whole step (the library's call:
+estimator, schedule, QP with DAQP, fallback logic) is timed in the closed loop itself.
 
 Used by ``benchmarks/bench_mpc.py`` and ``mpcwt bench mpc [--json]``.
 """
@@ -25,7 +26,7 @@ import contextlib
 import io
 import platform
 import time
-from typing import Any
+from typing import Any, Callable
 
 import numpy as np
 import scipy.sparse as sp
@@ -82,11 +83,15 @@ def _clarabel(qp: dict[str, np.ndarray], tol: float | None = None) -> tuple[np.n
     return np.asarray(sol.x), int(sol.iterations)
 
 
-def run_solver_benchmark(steps: int = 3000, progress: bool = True) -> dict[str, Any]:
+def run_solver_benchmark(law: Callable[..., Any], steps: int = 3000,
+                         progress: bool = True) -> dict[str, Any]:
     """Run the comparison on one closed loop at 18 m/s, class A.
 
     Parameters
     ----------
+    law : callable
+        ``law(design, kind, turbine)``: the design run by its shipped law
+        (:func:`mpc_wt.run.law_controller`).
     steps : int
         Controller steps of the closed loop (10 Hz), >= 10.
     progress : bool
@@ -116,7 +121,7 @@ def run_solver_benchmark(steps: int = 3000, progress: bool = True) -> dict[str, 
     if "daqp" not in backends:
         res["daqp"] = "not installed (pip install 'daqp>=0.11')"
     res["closed_loop_backend"] = default_backend()
-    rec = _record_closed_loop(t, model, steps, res, progress)
+    rec = _record_closed_loop(t, model, steps, res, progress, law)
     ctl = rec["controller"]
     qps = []
     for zz, has_preview in rec["z"]:
@@ -138,29 +143,36 @@ def run_solver_benchmark(steps: int = 3000, progress: bool = True) -> dict[str, 
 
 
 def _record_closed_loop(t: Any, model: Any, steps: int, res: dict[str, Any],
-                        progress: bool) -> dict[str, Any]:
-    """The closed loop on the default backend, recording each step's measurements and QP data
-    and timing the whole controller step in the loop."""
+                        progress: bool, law: Callable[..., Any]) -> dict[str, Any]:
+    """The closed loop of the design run by its shipped law, timing each call of the library;
+    at each step the QP data of the plant's state deviation and the law's previous command
+    (recorded from a design on the true states)."""
     dt = 0.1
+    host = law(MPC(model, t, MPCSettings(dt=dt)), "mpc", t)
     ctl = MPC(model, t, MPCSettings(estimator="full-state", dt=dt))
-    rec: dict[str, Any] = {"z": [], "meas": [], "controller": ctl}
+    rec: dict[str, Any] = {"z": [], "qp_in": [], "controller": ctl}
     step_times: list[float] = []
-    step0 = ctl.step
+    idx = [linearize.STATE_NAMES.index(n) for n in ctl.model.states]
+    last = np.zeros(4)
+    step0 = host.step
 
     def timed_step(tt: float, meas: dict[str, Any]) -> Any:
+        x = np.asarray(meas["state"])[idx] - ctl.model.x0
+        ctl.solve(x, None, last.copy())
+        rec["z"].append((ctl._z.copy(), False))
+        rec["qp_in"].append((x, last.copy()))
         t0 = time.perf_counter()
-        out = step0(tt, meas)
+        pitch, torque = step0(tt, meas)
         step_times.append(time.perf_counter() - t0)
-        rec["z"].append((ctl._z.copy(), ctl._has_preview))
-        rec["meas"].append((tt, {"state": np.array(meas["state"])}))
-        return out
-    ctl.step = timed_step  # type: ignore[method-assign]
+        last[:3], last[3] = np.asarray(pitch) - ctl.model.u0[:3], torque - ctl.model.u0[3]
+        return pitch, torque
+    host.step = timed_step  # type: ignore[method-assign]
     duration = steps * dt
     wind, _ = make_wind(t, Scenario(res["wind_mps"], "A", 1, duration, 0.2))
     op = linearize.trim(t, res["wind_mps"])
     t0 = time.perf_counter()
-    simulate_closed_loop(linearize.plant_params(t), ctl, wind, duration, x0=op.x, u0=op.u,
-                         controller_dt=dt, progress=progress)
+    simulate_closed_loop(linearize.plant_params(t), host, wind, duration, x0=op.x, u0=op.u,
+                         controller_dt=dt, progress=progress, compiled=False)
     res["closed_loop_s"] = time.perf_counter() - t0
     res["whole_step_closed_loop"] = _stats(step_times)
     return rec
@@ -194,9 +206,9 @@ class _MoveAccuracy:
 
 def _replay(model: Any, t: Any, backend: str, form: str, rec: dict[str, Any],
             su: np.ndarray, err: _MoveAccuracy) -> dict[str, Any]:
-    """Our backend: the whole controller step replayed on the recorded measurements (its own
-    warm starts and previous commands, as in the loop, without the plant between the steps);
-    then the recorded QPs solved in order for the move error."""
+    """Our backend: the design's whole ``solve`` on the recorded QP data in order (its own
+    warm starts), timed, with the solver call alone timed on a twin; the first moves for the
+    move error."""
     c = MPC(model, t, MPCSettings(estimator="full-state", backend=backend, formulation=form))
     be = c.qp_backend
     # DAQP through its C interface runs inside the compiled step: its solve alone is timed
@@ -208,15 +220,14 @@ def _replay(model: Any, t: Any, backend: str, form: str, rec: dict[str, Any],
     timer = _Timed(getattr(twin.qp_backend, attr), "solve")
     setattr(twin.qp_backend, attr, timer)
     whole, iters = [], []
-    for tt, meas in rec["meas"]:
+    for x, up in rec["qp_in"]:
         t0 = time.perf_counter()
-        c.step(tt, meas)
+        c.solve(x, None, up)
         whole.append(time.perf_counter() - t0)
         iters.append(be.iterations)
         if twin is not c:
-            twin.step(tt, meas)
+            twin.solve(x, None, up)
     solve_times = list(timer.times)
-    c.reset()
     nu = c._nu
     first = []
     for zz, has_preview in rec["z"]:

@@ -227,10 +227,8 @@ def test_assess_csv_from_another_tool(tmp_path: Path, capsys: pytest.CaptureFixt
      "--loop-gain/--keep-collective apply to the ibc controllers only"),
     (["design", "ibc", "--power-fraction", "1.5", "--out", "x"],
      "--power-fraction must be in (0, 1]"),
-    (["simulate", "--controller", "baseline", "--estimator", "kalman", "--wind", "18", "--out",
-      "x"], "apply to the MPC controllers only"),
-    (["simulate", "--controller", "mpc", "--formulation", "sparse", "--backend", "daqp",
-      "--wind", "18", "--duration", "1", "--out", "x"], "formulation='sparse' needs backend"),
+    (["simulate", "--controller", "baseline", "--horizon", "5", "--wind", "18", "--out", "x"],
+     "not to --controller baseline"),
     (["simulate", "--controller", "mpc", "--design-wind-mps", "30", "--wind", "8",
       "--duration", "1", "--out", "x"], "design_wind_mps = 30 m/s is outside the turbine's "
                                          "operating range 3..25 m/s"),
@@ -242,6 +240,14 @@ def test_assess_csv_from_another_tool(tmp_path: Path, capsys: pytest.CaptureFixt
 def test_simulate_assess_errors(argv, match: str, capsys: pytest.CaptureFixture[str]) -> None:
     assert main(argv) == 2
     assert match in capsys.readouterr().err
+
+
+def test_the_mpc_state_source_is_no_flag(capsys: pytest.CaptureFixture[str]) -> None:
+    """The MPC's law estimates its state: there is no flag for the plant's true states."""
+    with pytest.raises(SystemExit):
+        main(["simulate", "--controller", "mpc", "--estimator", "full-state", "--wind", "18",
+              "--out", "x"])
+    assert "--estimator" in capsys.readouterr().err
 
 
 def test_assess_unknown_channel(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
@@ -268,11 +274,9 @@ def test_simulate_mpc_controllers(controller: str, tmp_path: Path,
 
 
 @pytest.mark.parametrize("extra, meta", [
-    (["--formulation", "sparse", "--backend", "osqp"], {"formulation": "sparse",
-                                                         "backend": "osqp"}),
-    (["--estimator", "full-state", "--design-wind-mps", "17", "--horizon", "10"],
-     {"estimator": "full-state", "design_winds_mps": [17.0, 17.0], "horizon": 10,
-      "idealization": "full-state information (idealization)"}),
+    (["--design-wind-mps", "17", "--horizon", "10"],
+     {"estimator": "kalman", "design_winds_mps": [17.0, 17.0], "horizon": 10,
+      "backend": "daqp", "formulation": "condensed"}),
     (["--horizon", "10"], {"estimator": "kalman", "design_winds_mps": [3.0, 25.0],
                            "horizon": 10}),
 ])

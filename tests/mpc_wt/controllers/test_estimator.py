@@ -9,6 +9,7 @@ import pytest
 import linearize
 from mpc_wt.controllers.estimator import KalmanEstimator
 from mpc_wt.controllers.mpc import MPC, MPCSettings
+from mpc_wt.run import law_controller
 from mpc_wt.simulation.loop import simulate_closed_loop
 
 
@@ -20,15 +21,17 @@ def model(turbine: linearize.Turbine) -> linearize.LinearModel:
 def test_mpc_on_measured_signals_estimates_the_wind(turbine: linearize.Turbine,
                                                      params: linearize.PlantParams,
                                                      model) -> None:
-    # model at 18 m/s, plant in a steady 19 m/s without shear: the wind estimates must move
-    # from the operating point's 18 m/s to the true wind. Measured: mean of the three estimates
-    # 18.75 m/s over the last 10 s (the residual bias is the gravity/tilt 1P content of the flap
-    # moments, which the averaged linear model does not have); tolerance 0.5 m/s.
-    ctl = MPC(model, turbine, MPCSettings(estimator="kalman", backend="osqp"))
-    assert ctl.estimator.spectral_radius < 1
+    """One design at 18 m/s run by its shipped law, the plant in a steady 19 m/s without
+    shear: the Kalman filter's blade winds (logged by the law) move from the operating point's
+    18 m/s to the true wind: their mean over the last 10 s within 0.5 m/s of 19 (the residual
+    bias is the gravity/tilt 1P content of the flap moments, which the averaged linear model
+    does not have), no QP fallback, the power within 2 % of rated."""
+    design = MPC(model, turbine, MPCSettings(estimator="kalman", backend="daqp"))
+    assert design.estimator.spectral_radius < 1
     op = linearize.trim(turbine, 18.0)
-    r = simulate_closed_loop(params, ctl, linearize.SteadyWind(19.0, 0.0), 40.0, x0=op.x,
-                             u0=op.u, controller_dt=0.1)
+    r = simulate_closed_loop(params, law_controller(design, "mpc", turbine),
+                             linearize.SteadyWind(19.0, 0.0), 40.0, x0=op.x, u0=op.u,
+                             controller_dt=0.1)
     late = r.t > 30
     est = np.mean([r.controller[f"wind_est_{i}"][late].mean() for i in (1, 2, 3)])
     assert est == pytest.approx(19.0, abs=0.5)
@@ -75,23 +78,22 @@ def test_estimator_bad_input(model, turbine) -> None:
 
 def test_scheduled_mpc_switches_to_the_wind_it_meets(turbine: linearize.Turbine,
                                                      params: linearize.PlantParams) -> None:
+    """A schedule of four designs (16-22 m/s) run by its shipped law from the 18 m/s trim in a
+    steady 20 m/s: it switches once, to the 20 m/s design, with no QP fallback, and holds
+    rated power within 1 %."""
     from mpc_wt.controllers.mpc import ScheduledMPC
 
     fam = linearize.linearize_family(turbine, [16.0, 18.0, 20.0, 22.0],
                                      config=linearize.PlantConfig.madsen())
-    ctl = ScheduledMPC(fam, turbine, time_constant=5.0, prebuild=False)  # from its first estimate
+    ctl = law_controller(ScheduledMPC(fam, turbine, time_constant=5.0), "mpc", turbine)
     op = linearize.trim(turbine, 18.0)
     r = simulate_closed_loop(params, ctl, linearize.SteadyWind(20.0, 0.0), 40.0, x0=op.x,
                              u0=op.u, controller_dt=0.1)
     late = r.t > 30
-    assert ctl.switches == 1
-    assert r.controller["schedule_grid_wind"][-1] == 20.0
-    assert sorted(ctl._ctl) == [1, 2]                      # only the models it used were built
+    grid = r.controller["schedule_grid_wind"]
+    assert int(np.sum(np.diff(grid) != 0)) == 1 and grid[-1] == 20.0
     assert np.all(r.controller["qp_fallback"] == 0)
     assert r.channel("gen_power")[late].mean() == pytest.approx(5e6, rel=0.01)
-    # returning to a grid point reuses its controller (set up once per operating point)
-    c2 = ctl.controller(2)
-    assert ctl.controller(2) is c2
 
 
 def test_scheduled_mpc_bad_input(turbine: linearize.Turbine) -> None:
@@ -110,7 +112,7 @@ def test_the_kinds_options_and_the_mpcs_settings_agree_on_every_shared_default()
     """One configuration: a setting both the kind's options (``mpcwt run --controller mpc``,
     campaign specs) and the MPC on a linear model take has one default, and names its
     state source with the same words; the MPC estimates its state by default, as a turbine's
-    controller must (the true states are asked for by name)."""
+    controller must (the true states are asked for by name, for the design's QP alone)."""
     import dataclasses
 
     from mpc_wt.controllers.mpc import ESTIMATORS
@@ -120,9 +122,8 @@ def test_the_kinds_options_and_the_mpcs_settings_agree_on_every_shared_default()
     st = MPCSettings()
     shared = [n for n in opts if n in {f.name for f in dataclasses.fields(MPCSettings)}
               and n != "weights"]
-    assert set(shared) >= {"horizon", "backend", "formulation", "estimator", "time_budget_ms"}
+    assert set(shared) >= {"horizon", "time_budget_ms"}
     for name in shared:
         assert getattr(st, name) == opts[name], name
     assert st.estimator == "kalman" and ESTIMATORS == ("kalman", "full-state")
-    field = {f.name: f for f in dataclasses.fields(MPCOptions)}["estimator"]
-    assert tuple(field.metadata["choices"]) == ESTIMATORS
+    assert "estimator" not in opts          # the kinds run the law, which estimates its state

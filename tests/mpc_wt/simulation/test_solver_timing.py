@@ -31,4 +31,4 @@ def test_bench_mpc_json_and_move_errors(capsys: pytest.CaptureFixture[str],
 
 def test_bench_rejects_too_few_steps() -> None:
     with pytest.raises(ValueError, match="steps must be >= 10, got 3"):
-        run_solver_benchmark(3, progress=False)
+        run_solver_benchmark(None, 3, progress=False)

@@ -598,6 +598,14 @@ static int mpc_step(mw_ctrl *self, const mw_meas *m, mw_cmd *out, char *msg)
         out->nlog = 7;
         for (i = 0; i < 3; i++) out->log[4 + i] = c->pv.now[i];
     }
+    {                               /* wind_est_1..3: the Kalman filter's blade winds [m/s] */
+        const mw_point *p = &c->pt[k];
+        for (i = 0; i < 3; i++) {
+            int j = p->nd == 3 ? i : 0;
+            out->log[out->nlog + i] = p->kal.xa[p->nx + j] + p->x0d0[p->nx + j];
+        }
+        out->nlog += 3;
+    }
     return rc;
 }
 
