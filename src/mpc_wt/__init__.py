@@ -58,6 +58,7 @@ _WHERE = {
     "build_controller": "mpc_wt.run",
     "export_discon": "mpc_wt.run",
     "law_controller": "mpc_wt.run",
+    "estimate_wind": "mpc_wt.run",
     "run_controller": "mpc_wt.run",
     "simulate_closed_loop": "mpc_wt.simulation.loop",
     "LidarPreview": "mpc_wt.simulation.preview",
@@ -79,7 +80,7 @@ __all__ = ["__version__", "controllers", "registry", "DEFAULT_CHANNELS", "assess
            "simulate_closed_loop", "LQRPIOController", "design_lqr", "design_lqr_family",
            "design_pi_observer", "TSController", "build_ts_model", "design_ts_controller",
            "design_ts_observer", "WindSpeedEstimator", "tune", "export_discon",
-           "law_controller"]
+           "law_controller", "estimate_wind"]
 
 
 def __getattr__(name: str) -> Any:

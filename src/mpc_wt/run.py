@@ -572,6 +572,66 @@ def law_controller(controller: Any, kind: str, turbine: linearize.Turbine, *,
                         lidar=lidar if lidar is not None else getattr(controller, "sensor", None))
 
 
+def estimate_wind(turbine: linearize.Turbine, result: Any, estimator: Any = None,
+                  every: int = 8) -> tuple[np.ndarray, np.ndarray]:
+    """The rotor-effective wind the shipped laws' estimator (``windest.c``, an extended Kalman
+    filter on rotor speed, pitch and generator torque) finds in a run's measurements, replayed
+    through a library as OpenFAST calls it (its first call without a measured torque).
+
+    Parameters
+    ----------
+    turbine : Turbine
+        The run's turbine.
+    result : ClosedLoopResult
+        The run (any controller): its measured channels are the estimator's input.
+    estimator : WindSpeedEstimator, optional
+        The estimator's design (its tuning and C_P table; default
+        ``WindSpeedEstimator(turbine, 0.1)``); its ``dt`` is the replay's step.
+    every : int
+        Plant steps per estimator step (default 8: 10 Hz on the 80 Hz plant).
+
+    Returns
+    -------
+    t : ndarray
+        The estimator's times [s].
+    wind : ndarray
+        Its estimates [m/s].
+
+    Raises
+    ------
+    ValueError
+        ``every`` below 1.
+    """
+    from mpc_wt.controllers.mpc import MPC, MPCSettings, ScheduledMPC
+    from mpc_wt.controllers.wind_estimator import WindSpeedEstimator
+
+    if int(every) < 1:
+        raise ValueError(f"every must be >= 1 plant step, got {every!r}")
+    est = estimator or WindSpeedEstimator(turbine, 0.1)
+    # a one-point MPC whose schedule does not low-pass: its logged schedule wind is the
+    # estimator's (the MPC's own commands are not applied: the run is only read)
+    model = linearize.linearize(turbine, linearize.rated_wind_speed(turbine) + 1.0,
+                                config=linearize.PlantConfig.madsen())
+    design = ScheduledMPC.of_one(MPC(model, turbine, MPCSettings(dt=est.dt)),
+                                 time_constant=0.0, wind_estimator=est)
+    host = law_controller(design, "mpc", turbine)
+    out = []
+    idx = range(0, result.t.size, int(every))
+    blades = {n: np.array([result.channel(f"{n}_{b}") for b in (1, 2, 3)])
+              for n in ("pitch", "flap_moment", "edge_moment")}
+    scalars = {n: result.channel(n) for n in (
+        "gen_speed", "rotor_speed", "gen_torque", "gen_power", "azimuth",
+        "tower_fa_acceleration", "tower_ss_acceleration")}
+    try:
+        for i in idx:
+            host.step(float(result.t[i]), {**{n: v[:, i] for n, v in blades.items()},
+                                           **{n: float(v[i]) for n, v in scalars.items()}})
+            out.append(host.signals["schedule_wind"])
+    finally:
+        host.finalize()
+    return result.t[::int(every)], np.array(out)
+
+
 def export_saved_design(doc: Mapping[str, Any], turbine: linearize.Turbine, out: str | Path,
                         *, build: bool = True, compiler: str | None = None) -> Any:
     """Export a saved design (a gain-table document of ``mpcwt design``) as a library: a

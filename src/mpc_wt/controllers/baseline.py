@@ -543,9 +543,10 @@ class BaselineController(DesignBase):
 
 
 class LawTorque:
-    """The baseline's torque schedule as another controller's generator torque: the generator
-    speed low-passed at the law's filter corner, then :meth:`BaselineController.torque`,
-    within the generator's limits (the region-II law of the scheduled LQR-PIO, MPC and TS).
+    """The design of the baseline's torque schedule as another controller's generator torque
+    (the region-II law of the scheduled LQR-PIO, MPC and TS, which their shipped C laws run):
+    the generator speed low-passed at the law's filter corner (pole ``_a`` at the calling
+    controller's period), then :meth:`BaselineController.torque`, within the generator's limits.
 
     The schedule tells region 3 from a pitch 1 deg above fine (the NREL 5-MW controller's
     switch). A controller that tracks the trim holds a turbine with a minimum-pitch schedule
@@ -571,48 +572,6 @@ class LawTorque:
             law.below_rated_pitch = below_rated_pitch(law.turbine)
         self._offset = law.below_rated_pitch
         self._has_min_pitch = any(o > 0.0 for o in law.min_pitch_offsets)
-        self.reset()
-
-    def min_pitch(self) -> float | None:
-        """The law's minimum pitch at the last filtered speed
-        (:meth:`BaselineController.min_pitch`).
-
-        Returns
-        -------
-        float or None
-            [rad]; None where the law has no minimum-pitch schedule, or before the first
-            call.
-        """
-        if not self._has_min_pitch or self.w_filt is None:
-            return None
-        return self.law.min_pitch(self.w_filt)
-
-    def reset(self) -> None:
-        """Forget the filtered speed (the next call starts from its measurement)."""
-        self.w_filt: float | None = None
-
-    def __call__(self, gen_speed: float, pitch: float, power: float | None = None) -> float:
-        """Filter one generator speed sample and return the schedule's torque.
-
-        Parameters
-        ----------
-        gen_speed : float
-            Measured generator speed [rad/s].
-        pitch : float
-            Collective pitch [rad].
-        power : float, optional
-            Region-3 power [W] (default rated).
-
-        Returns
-        -------
-        float
-            Generator torque demand [N m].
-        """
-        w, a = float(gen_speed), self._a
-        self.w_filt = w if self.w_filt is None else a * self.w_filt + (1.0 - a) * w
-        if self.w_filt < self.law.w_rgn2:
-            pitch = pitch - self._offset
-        return min(max(self.law.torque(self.w_filt, pitch, power), self._lo), self._hi)
 
 
 def below_rated_pitch(turbine: linearize.Turbine, n: int = 6) -> float:

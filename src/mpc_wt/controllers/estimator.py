@@ -13,16 +13,13 @@ equation (scipy), once per operating point.
 """
 from __future__ import annotations
 
-from typing import Any
-
-import numba as nb
 import numpy as np
 import scipy.linalg
 
 import linearize
 from linearize.validate import check_number
 
-__all__ = ["KalmanEstimator", "MEASURED_SIGNALS", "read_signals", "SignalReader"]
+__all__ = ["KalmanEstimator", "MEASURED_SIGNALS"]
 
 #: Model outputs the estimator uses and their default measurement noise std [output units].
 MEASURED_SIGNALS: dict[str, float] = {
@@ -36,116 +33,10 @@ _STATE_NOISE = {"tower_fa_displacement": 1e-3, "tower_fa_velocity": 2e-3, "rotor
                 "pitch_3": 1e-5}
 
 
-def read_signals(meas: dict[str, Any], names: tuple[str, ...] | list[str]) -> np.ndarray:
-    """Named signals from a harness measurement dict: a key of ``meas`` itself, a blade signal
-    ``<key>_<1|2|3>`` of a per-blade array, or else a plant state from ``meas["state"]``.
-
-    Parameters
-    ----------
-    meas : dict
-        The harness's measurements.
-    names : sequence of str
-        Signal names.
-
-    Returns
-    -------
-    (n,) ndarray
-        The signals in that order.
-    """
-    return SignalReader(names)(meas)
-
-
-class SignalReader:
-    """:func:`read_signals` for one list of names, read the same way every step: where each
-    signal sits is found at the first call (and again if the measurements change shape), so
-    that a step costs a few item lookups.
-
-    Parameters
-    ----------
-    names : sequence of str
-        Signal names.
-    """
-
-    #: where the signals sit in the measurements is learnt from the run, not designed
-    __design__ = False
-
-    def __init__(self, names: tuple[str, ...] | list[str]) -> None:
-        self.names = tuple(names)
-        self._plan: list[tuple[str, int]] | None = None
-        self._y = np.empty(len(self.names))
-
-    def _resolve(self, meas: dict[str, Any]) -> list[tuple[str, int]]:
-        plan = []
-        for n in self.names:
-            if n in meas:
-                plan.append((n, -1))
-            elif n[-2:] in ("_1", "_2", "_3") and n[:-2] in meas:
-                plan.append((n[:-2], int(n[-1]) - 1))
-            elif n in linearize.STATE_NAMES and "state" in meas:
-                plan.append(("state", linearize.STATE_NAMES.index(n)))
-            else:
-                raise KeyError(f"signal {n!r} is neither in the measurements {sorted(meas)} "
-                               f"nor a plant state")
-        return plan
-
-    def __call__(self, meas: dict[str, Any]) -> np.ndarray:
-        """Read the signals: ``y[i]`` is ``names[i]`` of ``meas`` (a new array each call;
-        ``meas`` as :func:`read_signals` takes it)."""
-        if self._plan is None:
-            self._plan = self._resolve(meas)
-        try:
-            return self._read(meas)
-        except (KeyError, IndexError, TypeError):      # the measurements changed shape
-            self._plan = self._resolve(meas)
-            return self._read(meas)
-
-    def _read(self, meas: dict[str, Any]) -> np.ndarray:
-        y = self._y
-        for i, (key, j) in enumerate(self._plan):       # type: ignore[arg-type]
-            y[i] = meas[key] if j < 0 else meas[key][j]
-        return y.copy()
-
-
-@nb.njit(cache=True, nogil=True)
-def _kalman_step(a: np.ndarray, b: np.ndarray, c: np.ndarray, d: np.ndarray, gain: np.ndarray,
-                 y0: np.ndarray, xa: np.ndarray, y: np.ndarray, u: np.ndarray, predict: bool,
-                 work: np.ndarray) -> bool:  # pragma: no cover (compiled)
-    """One step of :meth:`KalmanEstimator.update` in place on ``xa``: predict (when
-    ``predict``) xa = a xa + b u, then correct xa += gain (y - y0 - c xa - d u). False, with
-    ``xa`` untouched, when a measurement is not finite."""
-    n, ny, nu = xa.shape[0], y.shape[0], u.shape[0]
-    for j in range(ny):
-        if not np.isfinite(y[j]):
-            return False
-    xp = work[:n]
-    for i in range(n):
-        acc = 0.0
-        if predict:
-            for k in range(n):
-                acc += a[i, k] * xa[k]
-            for k in range(nu):
-                acc += b[i, k] * u[k]
-        else:
-            acc = xa[i]
-        xp[i] = acc
-    innov = work[n:n + ny]
-    for j in range(ny):
-        acc = y[j] - y0[j]
-        for k in range(n):
-            acc -= c[j, k] * xp[k]
-        for k in range(nu):
-            acc -= d[j, k] * u[k]
-        innov[j] = acc
-    for i in range(n):
-        acc = xp[i]
-        for j in range(ny):
-            acc += gain[i, j] * innov[j]
-        xa[i] = acc
-    return True
-
-
 class KalmanEstimator:
-    """Steady-state Kalman filter for the states and the blade-effective winds.
+    """The design of the steady-state Kalman filter for the states and the blade-effective
+    winds: its augmented model and gain, which the MPC's shipped law runs (``mpc.c``: predict
+    with the input applied over the last step, correct with the measurements).
 
     Parameters
     ----------
@@ -158,9 +49,6 @@ class KalmanEstimator:
     measurement_std : dict, optional
         Overrides of the noise std per measured signal.
     """
-
-    #: a work buffer, not design data
-    __not_design__ = ("_work",)
 
     def __init__(self, model: linearize.LinearModel, *, wind_std_per_step: float = 0.2,
                  measurement_std: dict[str, float] | None = None) -> None:
@@ -203,84 +91,4 @@ class KalmanEstimator:
         if eig.max() >= 1.0:
             raise ValueError(f"the estimator is unstable (spectral radius {eig.max():.4f})")
         self.spectral_radius = float(eig.max())
-        self._read = SignalReader(self.signals)
-        self._work = np.empty(nx + nd + len(self.signals))
-        self.reset()
 
-    def reset(self, x_dev: np.ndarray | None = None, d_dev: np.ndarray | None = None) -> None:
-        """Start from deviations (default: the operating point).
-
-        Parameters
-        ----------
-        x_dev : (n_x,) ndarray, optional
-            State deviation to start from.
-        d_dev : (n_d,) ndarray, optional
-            Wind deviation to start from.
-        """
-        self.xa = np.concatenate([np.zeros(self.nx) if x_dev is None else x_dev,
-                                  np.zeros(self.nd) if d_dev is None else d_dev])
-        self._started = False
-
-    @property
-    def started(self) -> bool:
-        """Whether a measurement has been taken since the last reset."""
-        return self._started
-
-    def hand_over(self, other: "KalmanEstimator", offset: np.ndarray) -> None:
-        """Continue from another estimator's estimate (gain scheduling).
-
-        Parameters
-        ----------
-        other : KalmanEstimator
-            The estimator being replaced.
-        offset : (n_x + n_d,) ndarray
-            Its operating point minus ours ([x0; d0] of its model minus ours), so that the
-            estimate is carried over in absolute units.
-        """
-        self.xa = other.xa + offset
-        self._started = other.started
-
-    def measurement(self, meas: dict[str, Any]) -> np.ndarray:
-        """The measured-signal vector from a harness measurement dict.
-
-        Parameters
-        ----------
-        meas : dict
-            The harness's measurements.
-
-        Returns
-        -------
-        (n_y,) ndarray
-            The measured signals (:attr:`signals` order).
-        """
-        return self._read(meas)
-
-    def update(self, y: np.ndarray, u_dev: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """One step: predict with the input applied over the last step, correct with the
-        measurement ``y`` (absolute values, :attr:`signals` order). Returns the state and wind
-        deviations from the operating point.
-
-        Parameters
-        ----------
-        y : (n_y,) ndarray
-            Measured signals (absolute).
-        u_dev : (n_u,) ndarray
-            Input deviation applied over the last step.
-
-        Returns
-        -------
-        x_dev : (n_x,) ndarray
-            State deviation estimate.
-        d_dev : (n_d,) ndarray
-            Blade-effective wind deviation estimate [m/s].
-        """
-        y = np.asarray(y, float)
-        u = np.asarray(u_dev, float)
-        if y.shape != (len(self.signals),) or u.shape != (self.b.shape[1],) or not \
-                _kalman_step(self.a, self.b, self.c, self.d, self.gain, self.y0, self.xa, y, u,
-                             self._started, self._work):
-            raise ValueError(f"y must be {len(self.signals)} finite measurements "
-                             f"{self.signals} and u_dev {self.b.shape[1]} inputs, got y = "
-                             f"{y!r}, u_dev = {u!r}")
-        self._started = True
-        return self.xa[:self.nx].copy(), self.xa[self.nx:].copy()

@@ -1366,7 +1366,7 @@ class ScheduledMPC(DesignBase):
                 self.controller(k)
 
     @classmethod
-    def of_one(cls, mpc: MPC) -> "ScheduledMPC":
+    def of_one(cls, mpc: MPC, **schedule: Any) -> "ScheduledMPC":
         """One design as a schedule of that one point (what its law runs): each design's own
         operating point as the cost's target (Madsen's), no torque law, notch, power ceiling
         or region floor.
@@ -1375,6 +1375,9 @@ class ScheduledMPC(DesignBase):
         ----------
         mpc : MPC
             The design (its model, turbine and settings).
+        **schedule
+            The schedule's ``time_constant``, ``hysteresis``, ``wind_source`` or
+            ``wind_estimator`` (its logged wind; nothing switches).
 
         Returns
         -------
@@ -1383,7 +1386,8 @@ class ScheduledMPC(DesignBase):
         """
         fam = linearize.LinearModelFamily(wind_mps=np.array([mpc.model.wind_mps]),
                                           models=(mpc.model,))
-        one = cls(fam, mpc.turbine, mpc.settings, prebuild=False, target_time_constant=None)
+        one = cls(fam, mpc.turbine, mpc.settings, prebuild=False, target_time_constant=None,
+                  **schedule)
         one._ctl[0] = mpc
         return one
 

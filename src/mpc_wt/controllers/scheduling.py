@@ -21,7 +21,6 @@ baseline's gain schedule on the measured pitch (Jonkman et al. 2009, sec. 7.4).
 """
 from __future__ import annotations
 
-import bisect
 import math
 from typing import Any
 
@@ -231,7 +230,11 @@ class RegionFloor:
 
 
 class WindSchedule:
-    """The active grid point of a wind-scheduled controller.
+    """The schedule of a wind-scheduled controller's designs, as its shipped law runs it
+    (``mpc_wt/io/discon_c/windest.c``): the scheduling wind (the estimator's, or the LIDAR's
+    rotor-mean measurement) raised to the region floor, low-passed, the nearest grid wind
+    acting, a switch only beyond the hysteresis past the midpoint between grid winds; the
+    first step at the grid wind nearest the first wind.
 
     Parameters
     ----------
@@ -268,7 +271,6 @@ class WindSchedule:
         if source not in SCHEDULE_SOURCES:
             raise ValueError(f"source must be one of {SCHEDULE_SOURCES}, got {source!r}")
         self.grid, self.source = g, source
-        self._mid = (0.5 * (g[1:] + g[:-1])).tolist()     # the midpoints between grid winds
         self.dt = check_number("dt", dt, lo=0.0, lo_open=True, unit="s")
         self.tau = check_number("time_constant", time_constant, lo=0.0, unit="s")
         self.hyst = check_number("hysteresis", hysteresis, lo=0.0, unit="m/s")
@@ -280,112 +282,5 @@ class WindSchedule:
         else:
             self.estimator = WindSpeedEstimator(turbine, dt, estimator)
         self.floor = floor
-        self.reset()
 
-    def reset(self) -> None:
-        """Forget the wind: the next :meth:`update` starts the schedule again."""
-        self.estimator.reset()
-        self.wind: float | None = None
-        self.measured: float | None = None      # this step's wind before the low-pass
-        self.floored: float | None = None       # the same, raised to the region floor
-        self.active: int | None = None
-        self.switches = 0
-        self._from_estimator = False
 
-    #: how far beyond the grid's ends the scheduling wind may lie before :attr:`outside` [m/s]
-    OUTSIDE_MARGIN = 1.0
-
-    @property
-    def outside(self) -> bool:
-        """Whether the low-passed scheduling wind lies more than :attr:`OUTSIDE_MARGIN` beyond
-        the grid's ends: the acting design is then the nearest, used outside its range."""
-        return self.wind is not None and not (
-            self.grid[0] - self.OUTSIDE_MARGIN <= self.wind <= self.grid[-1] + self.OUTSIDE_MARGIN)
-
-    @property
-    def estimator_outside(self) -> bool:
-        """Whether this step's scheduling wind came from the wind estimator and the estimate
-        left its validity (:attr:`WindSpeedEstimator.outside`)."""
-        return self._from_estimator and self.estimator.outside
-
-    def measured_wind(self, meas: dict[str, Any]) -> float:
-        """This step's scheduling wind before the low-pass [m/s].
-
-        Parameters
-        ----------
-        meas : dict
-            The harness's measurements.
-
-        Returns
-        -------
-        float
-        """
-        self._from_estimator = not (self.source == "preview"
-                                    and meas.get("preview") is not None)
-        if not self._from_estimator:
-            return float(meas["preview"].rotor[0])
-        return self.estimator.step_measurements(meas)
-
-    def update(self, meas: dict[str, Any]) -> tuple[int, bool]:
-        """Take this step's measurements; the active grid index and whether it changed.
-
-        Parameters
-        ----------
-        meas : dict
-            The harness's measurements (``rotor_speed``, ``pitch``, ``gen_torque``; ``preview``
-            for the LIDAR source).
-
-        Returns
-        -------
-        k : int
-            The active grid index.
-        switched : bool
-            True when ``k`` differs from the last step's (never at the first step).
-        """
-        w = self.measured_wind(meas)
-        if not math.isfinite(w):
-            raise ValueError(f"scheduling wind is not finite ({w!r})")
-        self.measured = w
-        if self.floor is not None:
-            p = meas["pitch"]
-            w = max(w, self.floor.floor((float(p[0]) + float(p[1]) + float(p[2])) / 3.0,
-                                        float(meas["rotor_speed"])))
-        self.floored = w
-        if self.wind is None:
-            self.wind = w
-            self.active = bisect.bisect_left(self._mid, w)      # the nearest grid wind
-            return self.active, False
-        a = 1.0 if self.tau == 0 else min(1.0, self.dt / self.tau)
-        self.wind += a * (w - self.wind)
-        k, now = bisect.bisect_left(self._mid, self.wind), int(self.active or 0)
-        if k != now and abs(self.wind - 0.5 * (self.grid[k] + self.grid[now])) > self.hyst:
-            self.active = k
-            self.switches += 1
-            return k, True
-        return now, False
-
-    def acting(self, meas: dict[str, Any], design: Any) -> tuple[int, Any]:
-        """Update with this step's measurements and return the design that acts now; on a
-        switch it is reset and continues from the one before (``hand_over``: bumpless).
-
-        Parameters
-        ----------
-        meas : dict
-            The harness's measurements.
-        design : callable
-            Grid index -> its controller (with ``reset()`` and ``hand_over(other)``).
-
-        Returns
-        -------
-        k : int
-            The active grid index.
-        controller : object
-            ``design(k)``.
-        """
-        before = self.active
-        k, switched = self.update(meas)
-        ctl = design(k)
-        if switched:
-            ctl.reset()
-            ctl.hand_over(design(before))
-        return k, ctl

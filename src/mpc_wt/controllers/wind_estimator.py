@@ -1,4 +1,5 @@
-"""Rotor-effective wind speed from what a turbine controller measures.
+"""Rotor-effective wind speed from what a turbine controller measures: the design of the
+estimator the shipped laws run (``mpc_wt/io/discon_c/windest.c``).
 
 An extended Kalman filter on the drivetrain's one-degree-of-freedom model with the wind as a
 random walk, the estimator of ROSCO's ``WE_Mode = 2`` in its simplest form:
@@ -34,7 +35,6 @@ from typing import Any
 import numba as nb
 import numpy as np
 from scipy.interpolate import RectBivariateSpline
-from scipy.optimize import brentq
 
 import linearize
 from linearize.validate import check_positive, check_range
@@ -166,45 +166,10 @@ def _aero_torque(tx: np.ndarray, ty: np.ndarray, c: np.ndarray, kx: int, ky: int
     return q, dq_dv, dq_dw
 
 
-@nb.njit(cache=True, nogil=True)
-def _ekf_step(tx: np.ndarray, ty: np.ndarray, c: np.ndarray, kx: int, ky: int, k: np.ndarray,
-              x: np.ndarray, p: np.ndarray, u: np.ndarray,
-              rotor_speed: float) -> None:  # pragma: no cover (compiled)
-    """One predict-correct step of :meth:`WindSpeedEstimator.step` in place on the state x
-    (rotor speed, wind), its covariance p (2 x 2) with the last inputs u (pitch, torque)."""
-    w, v = x[0], x[1]
-    q, dq_dv, dq_dw = _aero_torque(tx, ty, c, kx, ky, k, v, w, u[0])
-    h = k[_DT] / k[_INERTIA]
-    x0 = w + h * (q - k[_GEAR] * u[1])
-    a, b = 1.0 + h * dq_dw, h * dq_dv
-    p00, p01, p10, p11 = p[0, 0], p[0, 1], p[1, 0], p[1, 1]
-    n00 = a * (a * p00 + b * p10) + b * (a * p01 + b * p11) + k[_Q0]
-    n01 = a * p01 + b * p11
-    n10 = a * p10 + b * p11
-    n11 = p11 + k[_Q1]
-    s = n00 + k[_R]
-    g0, g1 = n00 / s, n10 / s
-    e = rotor_speed - x0
-    x[0] = x0 + g0 * e
-    x[1] = min(max(v + g1 * e, k[_VMIN]), k[_VMAX])
-    p[0, 0], p[0, 1] = n00 - g0 * n00, n01 - g0 * n01
-    p[1, 0], p[1, 1] = n10 - g1 * n00, n11 - g1 * n01
-
-
-def _start_torque(gain: float, rated: float, rated_speed: float, rotor_speed: float) -> float:
-    """The torque schedule at a rotor speed: K omega^2 below 0.99 x rated speed, the rated
-    torque from rated speed on, a line in between (the module's docstring)."""
-    w1 = 0.99 * rated_speed
-    if rotor_speed >= rated_speed:
-        return rated
-    if rotor_speed <= w1:
-        return min(gain * rotor_speed**2, rated)
-    q1 = min(gain * w1**2, rated)
-    return q1 + (rated - q1) * (rotor_speed - w1) / (rated_speed - w1)
-
-
 class WindSpeedEstimator:
-    """Extended Kalman filter for the rotor-effective wind speed (module docstring).
+    """The design of the extended Kalman filter for the rotor-effective wind speed (module
+    docstring): its C_P table, constants and noise settings, which a law's input file carries
+    (the filter itself runs in the shipped C law, ``mpc_wt/io/discon_c/windest.c``).
 
     Parameters
     ----------
@@ -257,32 +222,6 @@ class WindSpeedEstimator:
         #: the first step's torque schedule where none is measured: K [N m s^2/rad^2] on the
         #: rotor speed, rated torque [N m], rated rotor speed [rad/s]
         self.start_torque = (gain, turbine.rated_generator_torque, op.rated_rotor_speed_rad_s)
-        self.reset()
-
-    def reset(self) -> None:
-        """Forget the estimate: the next step starts again from the measured torque balance."""
-        self.x: np.ndarray | None = None          # [rotor speed, wind]
-        self.p = np.diag([self.settings.speed_std**2, 1.0])
-        self._u = np.zeros(2)
-
-    @property
-    def estimate(self) -> float | None:
-        """The current rotor-effective wind estimate [m/s] (None before the first step)."""
-        return None if self.x is None else float(self.x[1])
-
-    @property
-    def outside(self) -> bool:
-        """Whether the estimate left the estimator's validity at the last step: held at an end
-        of its wind range (:attr:`wind_range`, half cut-in to 1.5 x cut-out), or at a
-        tip-speed ratio beyond its C_P table's (where the table is extrapolated)."""
-        if self.x is None:
-            return False
-        k = self._k
-        w, v = float(self.x[0]), float(self.x[1])
-        if v <= k[_VMIN] * (1 + 1e-9) or v >= k[_VMAX] * (1 - 1e-9):
-            return True
-        tsr = w * self.radius / v
-        return not k[_TSR0] <= tsr <= k[_TSR1]
 
     def aero_torque(self, wind: float, rotor_speed: float, pitch: float
                     ) -> tuple[float, float, float]:
@@ -309,71 +248,3 @@ class WindSpeedEstimator:
         # d/dv: lambda = w R / v, d lambda / dv = -lambda / v
         return _aero_torque(*self._spline, self._k, float(wind), float(rotor_speed),
                             float(pitch))
-
-    def _balance(self, rotor_speed: float, pitch: float, gen_torque: float) -> float:
-        """The wind at which the aerodynamic torque balances the generator's, or the nearest
-        end of the turbine's wind range."""
-        lo, hi = self.wind_range
-        f = (lambda v: self.aero_torque(v, rotor_speed, pitch)[0]
-             - self.torque_ratio * gen_torque)
-        a, b = f(lo), f(hi)
-        if a * b < 0.0:
-            return float(brentq(f, lo, hi, xtol=1e-6))
-        return lo if abs(a) < abs(b) else hi
-
-    def step(self, rotor_speed: float, pitch: float, gen_torque: float) -> float:
-        """Take one step's measurements and return the updated estimate.
-
-        Parameters
-        ----------
-        rotor_speed : float
-            Measured rotor speed [rad/s].
-        pitch : float
-            Collective (mean) pitch [rad].
-        gen_torque : float
-            Generator torque [N m] (high-speed shaft); at the first step, not positive: none
-            measured (:attr:`start_torque` instead).
-
-        Returns
-        -------
-        float
-            Rotor-effective wind speed estimate [m/s].
-
-        Raises
-        ------
-        ValueError
-            A non-finite measurement (naming it).
-        """
-        for name, val in (("rotor_speed", rotor_speed), ("pitch", pitch),
-                          ("gen_torque", gen_torque)):
-            if not math.isfinite(val):
-                raise ValueError(f"measurement {name} must be finite, got {val!r}")
-        if self.x is None:
-            if gen_torque <= 0.0:       # none measured yet: the torque schedule's
-                gen_torque = _start_torque(*self.start_torque, rotor_speed)
-            self.x = np.array([rotor_speed, self._balance(rotor_speed, pitch, gen_torque)])
-        else:
-            # predict with the previous step's inputs (held over the step), then correct with
-            # the measured rotor speed: x = f(x, u) + k (omega - f_omega), P = (I - k h) F P F' + Q
-            _ekf_step(*self._spline, self._k, self.x, self.p, self._u, float(rotor_speed))
-        self._u[0], self._u[1] = pitch, gen_torque
-        return float(self.x[1])
-
-    def step_measurements(self, meas: dict[str, Any]) -> float:
-        """:meth:`step` on a harness measurement dict (``rotor_speed``, ``pitch`` (3,),
-        ``gen_torque``).
-
-        Parameters
-        ----------
-        meas : dict
-            The closed loop's measurements.
-
-        Returns
-        -------
-        float
-            The estimate [m/s].
-        """
-        p = meas["pitch"]
-        pitch = (float(p[0]) + float(p[1]) + float(p[2])) / 3.0 if len(p) == 3 else \
-            float(np.mean(p))
-        return self.step(float(meas["rotor_speed"]), pitch, float(meas["gen_torque"]))

@@ -271,7 +271,8 @@ LQR_PIO_EXPORT = LawExport(
     "lqr-pio", "Do et al.'s LQR on PI-observer estimates, scheduled from cut-in to cut-out on "
     "the estimated wind, observing generator speed, tower-top acceleration and the blade root "
     "moments", "lqr", _lqr_entries, sources=("lqr.c",),
-    log=("region", "schedule_wind", "schedule_grid_wind"))
+    log=("region", "schedule_wind", "schedule_grid_wind", "schedule_outside",
+         "estimator_outside"))
 
 
 @register("lqr-pio", LQRPIOOptions, field_components="u", design=_design_lqr,

@@ -357,7 +357,11 @@ def _mpc(collective: bool, with_lidar: bool) -> Any:
         else:
             v = check_design_wind(ctx.turbine, opts.design_wind_mps)
             model = linearize.linearize(ctx.turbine, v, config=linearize.PlantConfig.madsen())
-            ctl = ScheduledMPC.of_one(MPC(model, ctx.turbine, settings))   # nothing switches
+            ctl = ScheduledMPC.of_one(                                  # nothing switches
+                MPC(model, ctx.turbine, settings),
+                wind_source="preview" if with_lidar else "estimator",
+                wind_estimator=wind_estimator(ctx, settings.dt),
+                time_constant=opts.schedule_time_constant)
             grid = [v, v]
         cdt = ctl.dt
         meta: dict[str, Any] = {"mpc": {
@@ -547,11 +551,12 @@ def _mpc_entries(ctl: Any, preview: Any = None) -> list[tuple[str, Any, str]]:
 def _mpc_export(name: str, summary: str, lidar: bool = False) -> LawExport:
     """An MPC kind's export: the MPC law with DAQP, from its published distribution; it logs
     its fallback level, the QP's solve time, the schedule's winds, with the LIDAR the last
-    sample's wind at each blade, and the Kalman filter's blade winds."""
+    sample's wind at each blade, the Kalman filter's blade winds, and whether the schedule's
+    wind lay beyond the grid or the estimator beyond its validity (0/1)."""
     log = ("qp_fallback", "qp_solve_ms", "schedule_wind", "schedule_grid_wind")
     if lidar:
         log += ("lidar_wind_1", "lidar_wind_2", "lidar_wind_3")
-    log += ("wind_est_1", "wind_est_2", "wind_est_3")
+    log += ("wind_est_1", "wind_est_2", "wind_est_3", "schedule_outside", "estimator_outside")
     return LawExport(name, summary, "mpc", _mpc_entries, sources=("mpc.c",), qp=True, log=log)
 
 

@@ -139,8 +139,11 @@ def test_the_torque_law_of_the_scheduled_kinds_holds_a_minimum_pitch_schedule() 
     assert math.degrees(pitch) > 2.0
     law = LawTorque(BaselineController(tb), 0.1)
     w_gen = op.x[linearize.STATE_NAMES.index("gen_speed")]
+    assert w_gen < law.law.w_rgn2            # below region 2: the law counts from the offset
+    assert law._offset >= pitch - tb.operation.fine_pitch_rad
     assert law.law.torque(w_gen, pitch) > 5.0 * op.u[3]
-    assert 0.0 <= law(w_gen, pitch) <= op.u[3], (law(w_gen, pitch), op.u[3])
+    q = law.law.torque(w_gen, pitch - law._offset)
+    assert 0.0 <= q <= op.u[3], (q, op.u[3])
 
 
 _WISDEM = Path(__file__).parents[2] / "data" / "iea15mw_steady_state_tabular.csv"

@@ -1,33 +1,9 @@
-"""The wind schedule of the scheduled controllers: which design acts, and when it acts
-outside its range."""
+"""The design side of the wind schedule: the region floor's curve, the grid of the scheduled
+designs and the first region-3 design (the schedule itself runs in the shipped C laws)."""
 from __future__ import annotations
 
 import pytest
 
-from mpc_wt.controllers.scheduling import WindSchedule
-
-
-@pytest.mark.parametrize("wind, outside", [
-    (None, False), (4.0, False), (3.0, False), (2.9, True), (25.9, False), (26.1, True),
-    (12.0, False)])
-def test_outside_is_more_than_a_metre_per_second_beyond_the_grid(turbine, wind,
-                                                                   outside) -> None:
-    """Grid 4-25 m/s and the 1 m/s margin, worked by hand: 3.0 and 25.9 m/s are within it,
-    2.9 and 26.1 m/s beyond; no wind yet is not outside."""
-    s = WindSchedule([4.0, 10.0, 25.0], turbine, 0.1)
-    s.wind = wind
-    assert s.outside is outside
-
-
-def test_the_nearest_grid_wind_acts_first_and_hysteresis_holds(turbine) -> None:
-    """The first estimate picks the nearest grid wind; a slow wind moving across a midpoint
-    switches only once it is more than the hysteresis beyond it."""
-    s = WindSchedule([4.0, 10.0, 25.0], turbine, 0.1, time_constant=0.0, hysteresis=0.5)
-    s.measured_wind = lambda meas: meas["w"]          # a scheduling wind given directly
-    assert s.update({"w": 6.5}) == (0, False)       # nearest to 6.5 is 4 (midpoint 7)
-    assert s.update({"w": 7.4}) == (0, False)       # 0.4 beyond the midpoint: held
-    assert s.update({"w": 7.6}) == (1, True)
-    assert s.switches == 1
 
 
 # ---- the region floor ------------------------------------------------------------------------
@@ -38,7 +14,6 @@ from hypothesis import given, settings, strategies as st  # noqa: E402
 
 import linearize  # noqa: E402
 from mpc_wt.controllers.scheduling import RegionFloor, envelope_winds, region3_wind  # noqa: E402
-from mpc_wt.controllers.wind_estimator import WindSpeedEstimator  # noqa: E402
 
 _D = math.radians
 
@@ -77,39 +52,6 @@ def test_a_floor_refuses_a_speed_margin_below_one() -> None:
         RegionFloor([12.0], [0.05], 0.005, 1.0, speed_margin=0.9)
 
 
-_ESTIMATORS: dict[int, WindSpeedEstimator] = {}
-
-
-def _estimator(turbine: linearize.Turbine) -> WindSpeedEstimator:
-    """One wind estimator per turbine object, made once: its C_P table takes seconds."""
-    if id(turbine) not in _ESTIMATORS:
-        _ESTIMATORS[id(turbine)] = WindSpeedEstimator(turbine, 0.1)
-    return _ESTIMATORS[id(turbine)]
-
-
-@settings(max_examples=200, deadline=None)
-@given(w=st.floats(2.0, 30.0), pitch=st.floats(-0.05, 0.5), speed=st.floats(0.5, 1.5))
-def test_the_floored_wind_is_never_below_the_measured_one(turbine, w, pitch, speed) -> None:
-    """Property: the schedule's floored wind is the larger of its wind and the floor, and its
-    measured wind stays the wind itself."""
-    s = WindSchedule([4.0, 12.0, 14.0, 25.0], turbine, 0.1, time_constant=0.0, floor=_floor(),
-                     estimator=_estimator(turbine))
-    s.measured_wind = lambda meas: w
-    s.update({"pitch": [pitch] * 3, "rotor_speed": speed})
-    assert s.measured == w
-    assert s.floored == max(w, _floor().floor((pitch + pitch + pitch) / 3.0, speed))
-
-
-def test_a_pitched_rotor_selects_a_region_3_design_whatever_the_wind_says(turbine) -> None:
-    """A wind estimate of 9 m/s (below rated) with the blades at 4 deg: the floor (13 m/s)
-    picks the 14 m/s design of the grid 4, 9, 14, 25 m/s; without the floor the 9 m/s one."""
-    meas = {"pitch": [_D(4.0)] * 3, "rotor_speed": 1.0}
-    for floor, k in ((_floor(), 2), (None, 1)):
-        s = WindSchedule([4.0, 9.0, 14.0, 25.0], turbine, 0.1, time_constant=0.0, floor=floor)
-        s.measured_wind = lambda meas: 9.0
-        assert s.update(meas)[0] == k
-
-
 def test_the_first_region_3_design_is_where_the_trim_has_left_fine_pitch(turbine) -> None:
     """With region3_pitch = 2 deg the rated point is replaced by the wind whose trim is 2 deg
     above fine pitch (within the bisection's 1 mm/s, the rounding's 5 mm/s and the trim's
@@ -136,3 +78,13 @@ def test_the_floor_of_a_family_below_rated_only_is_refused(turbine) -> None:
     fam = linearize.linearize_family(turbine, [6.0, 8.0], config=linearize.PlantConfig.madsen())
     with pytest.raises(ValueError, match="above rated"):
         RegionFloor.from_family(fam, turbine)
+
+
+@settings(max_examples=200, deadline=None)
+@given(p1=st.floats(-0.05, 0.5), p2=st.floats(-0.05, 0.5), speed=st.floats(0.5, 1.5))
+def test_the_floor_never_falls_as_the_pitch_rises(p1, p2, speed) -> None:
+    """Property: at one rotor speed, a larger pitch never gives a lower floor (the pitch curve
+    rises with the wind)."""
+    lo, hi = sorted((p1, p2))
+    f = _floor()
+    assert f.floor(hi, speed) >= f.floor(lo, speed)

@@ -1,7 +1,7 @@
 """The rotor-effective wind speed estimator: its aerodynamic torque against the BEM's, its
-derivatives against central differences, its estimates in steady sheared wind, and in
-turbulence against the true rotor-effective wind of the field (and against ROSCO's own
-estimator on the same runs)."""
+derivatives against central differences; the shipped law's estimates (its C estimator, run
+on a result's measurements) in steady sheared wind, and in turbulence against the true
+rotor-effective wind of the field (and against ROSCO's own estimator on the same runs)."""
 from __future__ import annotations
 
 import math
@@ -26,15 +26,12 @@ def estimator(turbine: linearize.Turbine) -> WindSpeedEstimator:
     return WindSpeedEstimator(turbine, 0.1)
 
 
-def _estimates(est: WindSpeedEstimator, res, every: int = 8) -> tuple[np.ndarray, np.ndarray]:
-    """The estimator run on a result's measurements at its own step (every 8th plant step:
-    10 Hz): rotor speed, mean pitch and generator torque only."""
-    est.reset()
-    k = slice(None, None, every)
-    pitch = (res.channel("pitch_1") + res.channel("pitch_2") + res.channel("pitch_3")) / 3.0
-    v = [est.step(w, p, q) for w, p, q in zip(res.channel("rotor_speed")[k], pitch[k],
-                                             res.channel("gen_torque")[k])]
-    return res.t[k], np.array(v)
+def _estimates(est: WindSpeedEstimator, res, turbine=None) -> tuple[np.ndarray, np.ndarray]:
+    """The shipped law's estimator (``windest.c``) of design ``est`` on a result's
+    measurements at 10 Hz, called as OpenFAST calls it (:func:`mpc_wt.run.estimate_wind`)."""
+    from mpc_wt.run import estimate_wind
+
+    return estimate_wind(turbine or linearize.load_turbine(), res, est)
 
 
 @pytest.mark.parametrize("v, lam, pitch_deg", [(8.0, 7.3, 0.3), (12.0, 6.1, 4.1),
@@ -69,12 +66,14 @@ def test_torque_derivatives_match_central_differences(estimator, v: float, omega
 
 @pytest.mark.parametrize("v", [6.0, 11.0, 20.0])
 def test_steady_sheared_wind_is_found(estimator, turbine, v: float) -> None:
-    # the baseline in steady wind with shear 0.2 (the table's): after 60 s the estimate is the
-    # hub wind to 0.2 % (measured 0.01-0.06 % in regions 2, 2.5 and 3), starting from the
-    # measured torque balance (within 1.5 % at the first step)
+    # the baseline in steady wind with shear 0.2 (the table's): after 60 s the law's estimate
+    # is the hub wind to 0.2 % (measured 0.01-0.05 % in regions 2, 2.5 and 3). Its first call
+    # has no measured torque (OpenFAST's first call leaves record 23 at 0), so it starts from
+    # its torque schedule at the measured speed: within 4 % at the first step (measured -1.4,
+    # +3.6, +0.5 %; the region-2.5 torque lies off the schedule's K omega^2)
     res = run_controller(turbine, "baseline", Scenario(v, "steady", 1, 60.0))
-    t, est = _estimates(estimator, res)
-    assert abs(est[0] - v) < 0.015 * v
+    t, est = _estimates(estimator, res, turbine=turbine)
+    assert abs(est[0] - v) < 0.04 * v
     assert_allclose(est[t >= 55.0].mean(), v, rtol=2e-3, atol=0)
 
 
@@ -143,7 +142,7 @@ def test_as_good_as_roscos_estimator_on_the_same_run(turbine, estimator, v: floa
     truth = lidar.rotor_effective_wind(field, turbine.geometry.tip_radius, method="cube")
     keep = dbg["Time"] >= 30.0
     e_rosco = dbg["WE_Vw"][keep] - np.interp(dbg["Time"][keep], field.t, truth)
-    t, est = _estimates(estimator, res)
+    t, est = _estimates(estimator, res, turbine=turbine)
     e_ours = est[t >= 30.0] - np.interp(t[t >= 30.0], field.t, truth)
     rms = [math.sqrt(float(np.mean(e**2))) for e in (e_ours, e_rosco)]
     assert rms[0] <= rms[1]
@@ -154,10 +153,6 @@ def test_bad_input_is_named(turbine, estimator) -> None:
         WindSpeedEstimator(turbine, 0.0)
     with pytest.raises(ValueError, match="wind_std_per_sqrt_s"):
         WindEstimatorSettings(wind_std_per_sqrt_s=-1.0)
-    estimator.reset()
-    with pytest.raises(ValueError, match="measurement rotor_speed must be finite, got nan"):
-        estimator.step(float("nan"), 0.0, 4e4)
-    assert estimator.estimate is None
 
 
 @settings(max_examples=200, deadline=None)
@@ -179,19 +174,35 @@ def test_compiled_spline_is_fitpacks(x: float, y: float, kx: int, ky: int) -> No
     assert d == pytest.approx(float(s.ev(x, y, dx=1)), abs=1e-11)
 
 
-def test_says_when_it_leaves_its_validity(turbine, estimator) -> None:
-    """At the trim at 12 m/s the estimate lies inside its range and table: not outside. A
-    generator torque no wind in half cut-in .. 1.5 x cut-out can balance at fine pitch and
-    rated speed (the generator's maximum torque with the rotor feathered to 90 deg: the
-    aerodynamic torque is then small at any wind) holds the estimate at an end of the range:
-    outside."""
+def _trim_meas(turbine, op, pitch=None, torque=None) -> dict:
+    p = float(op.u[0]) if pitch is None else pitch
+    return {"pitch": np.full(3, p), "flap_moment": np.zeros(3), "edge_moment": np.zeros(3),
+            "gen_speed": op.state("gen_speed"), "rotor_speed": op.state("rotor_speed"),
+            "gen_torque": float(op.u[3]) if torque is None else torque,
+            "gen_power": float(op.power)}
+
+
+def test_the_law_says_when_its_schedule_or_estimate_leaves_its_range(turbine) -> None:
+    """A one-point MPC (grid 13 m/s, no low-pass) fed by hand: at the 12 m/s trim neither flag
+    is set (within 1 m/s of the grid, the estimate inside its table); at the 20 m/s trim the
+    schedule's wind lies beyond 14 m/s (``schedule_outside``); the generator's largest torque
+    with the rotor feathered to 90 deg at rated speed is balanced by no wind in half cut-in ..
+    1.5 x cut-out: the estimate is held at an end of its range (``estimator_outside``)."""
+    from mpc_wt.controllers.mpc import MPC, MPCSettings, ScheduledMPC
+    from mpc_wt.run import law_controller
+
+    model = linearize.linearize(turbine, 13.0, config=linearize.PlantConfig.madsen())
+    host = law_controller(ScheduledMPC.of_one(MPC(model, turbine, MPCSettings()),
+                                              time_constant=0.0), "mpc", turbine)
+
+    def flags(meas):
+        host.reset()
+        for k in range(5):
+            host.step(0.1 * k, meas)
+        return host.signals["schedule_outside"], host.signals["estimator_outside"]
+    assert flags(_trim_meas(turbine, linearize.trim(turbine, 12.0))) == (0.0, 0.0)
+    assert flags(_trim_meas(turbine, linearize.trim(turbine, 20.0)))[0] == 1.0
     op = linearize.trim(turbine, 12.0)
-    estimator.reset()
-    assert not estimator.outside
-    for _ in range(5):
-        estimator.step(op.rotor_speed_rad_s, op.pitch_rad, op.gen_torque)
-    assert not estimator.outside
-    estimator.reset()
-    estimator.step(op.rotor_speed_rad_s, math.radians(90.0), turbine.generator.max_torque)
-    lo, hi = estimator.wind_range
-    assert estimator.estimate in (lo, hi) and estimator.outside
+    assert flags(_trim_meas(turbine, op, math.radians(90.0),
+                            turbine.generator.max_torque))[1] == 1.0
+    host.finalize()

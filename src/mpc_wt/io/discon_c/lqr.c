@@ -115,10 +115,13 @@ static int lqr_step(mw_ctrl *self, const mw_meas *m, mw_cmd *out, char *msg)
     p->udev[3] = torque - p->u0[3];
     for (b = 0; b < 3; b++) out->pitch[b] = pitch[b];
     out->torque = torque;
-    out->nlog = 3;                  /* region, schedule_wind, schedule_grid_wind */
+    /* region, schedule_wind, schedule_grid_wind, schedule_outside, estimator_outside */
+    out->nlog = 5;
     out->log[0] = p->region;
     out->log[1] = c->sched.wind;
     out->log[2] = c->sched.grid[k];
+    out->log[3] = mw_schedule_outside(&c->sched);
+    out->log[4] = mw_schedule_estimator_outside(&c->sched);
     return 0;
 }
 

@@ -606,6 +606,9 @@ static int mpc_step(mw_ctrl *self, const mw_meas *m, mw_cmd *out, char *msg)
         }
         out->nlog += 3;
     }
+    out->log[out->nlog] = mw_schedule_outside(&c->sched);   /* schedule_outside */
+    out->log[out->nlog + 1] = mw_schedule_estimator_outside(&c->sched); /* estimator_outside */
+    out->nlog += 2;
     return rc;
 }
 

@@ -222,6 +222,7 @@ int mw_windest_read(const mw_input *in, const char *prefix, mw_windest *e, char 
 void mw_windest_free(mw_windest *e);
 void mw_windest_reset(mw_windest *e);
 double mw_windest_step(mw_windest *e, double rotor_speed, double pitch, double gen_torque);
+int mw_windest_outside(const mw_windest *e);
 
 /* which design of a wind-scheduled controller acts */
 typedef struct {
@@ -230,6 +231,7 @@ typedef struct {
     double dt, tau, hyst;
     double wind, measured, floored;
     int active, started;
+    int from_estimator;    /* this step's scheduling wind came from the estimator */
     mw_windest est;
     /* the region floor: the trim's pitch curve above rated (winds, pitches), the pitch above
        which it counts [rad] while the rotor runs above floor_pitch_speed [rad/s], the rotor
@@ -240,6 +242,10 @@ typedef struct {
 int mw_schedule_read(const mw_input *in, const char *prefix, double dt, mw_schedule *s,
                      char *msg);
 void mw_schedule_free(mw_schedule *s);
+/* 1 when the low-passed wind lies more than 1 m/s beyond the grid's ends */
+int mw_schedule_outside(const mw_schedule *s);
+/* 1 when this step's wind came from the estimator and its estimate left its validity */
+int mw_schedule_estimator_outside(const mw_schedule *s);
 void mw_schedule_reset(mw_schedule *s);
 /* this step's active index; *switched = 1 on a switch */
 int mw_schedule_update(mw_schedule *s, const mw_meas *m, int *switched);

@@ -212,7 +212,7 @@ void mw_windest_reset(mw_windest *e)
 }
 
 /* the torque schedule at a rotor speed: K w^2 below 0.99 x rated speed, the rated torque from
- * rated speed on, a line in between (wind_estimator.py's _start_torque) */
+ * rated speed on, a line in between (mpc_wt.controllers.wind_estimator's docstring) */
 static double start_torque(const mw_windest *e, double w)
 {
     double w1 = 0.99 * e->start_speed, q1;
@@ -365,6 +365,7 @@ void mw_schedule_reset(mw_schedule *s)
     mw_windest_reset(&s->est);
     s->started = 0;
     s->active = 0;
+    s->from_estimator = 0;
 }
 
 /* the number of midpoints below x (Python's bisect_left) */
@@ -384,8 +385,30 @@ static int bisect_left(const double *a, int n, double x)
 int mw_schedule_update(mw_schedule *s, const mw_meas *m, int *switched)
 {
     double pitch = (m->pitch[0] + m->pitch[1] + m->pitch[2]) / 3.0;
-    return mw_schedule_update_wind(s, mw_windest_step(&s->est, m->rotor_speed, pitch,
-                                                      m->gen_torque), m, switched);
+    int k = mw_schedule_update_wind(s, mw_windest_step(&s->est, m->rotor_speed, pitch,
+                                                       m->gen_torque), m, switched);
+    s->from_estimator = 1;
+    return k;
+}
+
+int mw_windest_outside(const mw_windest *e)
+{
+    /* held at an end of its wind range, or at a tip-speed ratio beyond its C_P table's */
+    double tsr;
+    if (!e->started) return 0;
+    if (e->x[1] <= e->vmin * (1.0 + 1e-9) || e->x[1] >= e->vmax * (1.0 - 1e-9)) return 1;
+    tsr = e->x[0] * e->radius / e->x[1];
+    return !(e->tsr0 <= tsr && tsr <= e->tsr1);
+}
+
+int mw_schedule_outside(const mw_schedule *s)
+{
+    return s->started && (s->wind < s->grid[0] - 1.0 || s->wind > s->grid[s->n - 1] + 1.0);
+}
+
+int mw_schedule_estimator_outside(const mw_schedule *s)
+{
+    return s->from_estimator && mw_windest_outside(&s->est);
 }
 
 int mw_schedule_update_wind(mw_schedule *s, double w, const mw_meas *m, int *switched)
@@ -393,6 +416,7 @@ int mw_schedule_update_wind(mw_schedule *s, double w, const mw_meas *m, int *swi
     double a;
     int k, now;
     *switched = 0;
+    s->from_estimator = 0;
     s->measured = w;
     if (s->has_floor && m)
         w = dmax(w, schedule_floor(s, (m->pitch[0] + m->pitch[1] + m->pitch[2]) / 3.0,
