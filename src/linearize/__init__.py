@@ -46,13 +46,15 @@ from linearize.plant import PlantStepper, SimulationResult, plant_outputs, plant
 from linearize.steady import optimal_tsr, rotor_average, steady_coefficients
 from linearize.trim import (
     OperatingPoint,
+    aero_torque,
     max_torque_pitch,
     operating_point,
     operating_schedule,
     rated_wind_speed,
+    region2_pitch,
     trim,
 )
-from linearize.turbine import LoadReport, Turbine, available_turbines
+from linearize.turbine import LoadReport, MinPitchTable, Turbine, available_turbines
 from linearize.wind import GridWind, SteadyWind, element_wind
 
 __all__ = [
@@ -62,7 +64,7 @@ __all__ = [
     "element_wind",
     "plant_outputs", "plant_params", "plant_rhs", "rk4_simulate", "structural_frequencies", "check_plant_step",
     "optimal_tsr", "rotor_average", "steady_coefficients", "OperatingPoint", "TrimError",
-    "operating_point", "max_torque_pitch",
+    "operating_point", "max_torque_pitch", "region2_pitch", "MinPitchTable", "aero_torque",
     "operating_schedule", "rated_wind_speed", "trim", "Turbine", "TurbineFileError",
     "available_turbines",
     "load_turbine", "LinearizationError", "LinearModel", "LinearModelFamily",

@@ -49,6 +49,7 @@ from linearize.turbine import (
     Generator,
     Geometry,
     LoadReport,
+    MinPitchTable,
     ModeShapes,
     Nacelle,
     Operation,
@@ -640,6 +641,7 @@ def load_openfast(fst: str | Path | None = None, *, elastodyn: str | Path | None
                                            "kg m^2", ed, "NacYIner"))
     geometry = _with_nacelle_cm(geometry, ed, nac_mass, yaw_br)
     operation, generator, pitch = _control(ed, srv, dis, drive, rec)
+    min_pitch = _min_pitch_table(dis, rec) if dis is not None else None
     rigid = _rigid_dofs(ed, rec)
     if gravity_src[0].has(gravity_src[1]):
         g = rec.read("gravity", gravity_src[0].number(gravity_src[1], 0, 20), "m/s^2",
@@ -657,9 +659,38 @@ def load_openfast(fst: str | Path | None = None, *, elastodyn: str | Path | None
             blade=blade_aero, polars=polars, blade_structure=bstruct, tower_structure=tstruct,
             mode_shapes=ModeShapes(tower_fa1=tmodes[0], tower_ss1=tmodes[1],
                                    blade_flap1=bmodes[0], blade_edge1=bmodes[1]),
-            rigid_dofs=rigid, report=LoadReport(tuple(rec.entries), tuple(notes)))
+            rigid_dofs=rigid, min_pitch=min_pitch,
+            report=LoadReport(tuple(rec.entries), tuple(notes)))
     except ValueError as err:
         raise TurbineFileError(f"{source}: {err}") from err
+
+
+def _min_pitch_table(dis: OpenFASTFile, rec: _Recorder) -> MinPitchTable | None:
+    """ROSCO's minimum-pitch schedule (``PS_BldPitchMin`` over ``PS_WindSpeeds``) where
+    ``PS_Mode`` applies it (1; 0 or absent: none), with the keys' lines in the report."""
+    if not dis.has("PS_Mode") or dis.integer("PS_Mode", 0, 3) == 0:
+        return None
+    for key in ("PS_WindSpeeds", "PS_BldPitchMin"):
+        if not dis.has(key):
+            raise TurbineFileError(f"{dis.path}: {dis.where('PS_Mode')} applies a minimum-pitch "
+                                   f"schedule but the file has no {key}")
+    w, b = dis.numbers("PS_WindSpeeds"), dis.numbers("PS_BldPitchMin")
+    if dis.has("PS_BldPitchMin_N"):
+        n = dis.integer("PS_BldPitchMin_N", 2)
+        if not w.size == b.size == n:
+            raise TurbineFileError(f"{dis.path}: {dis.where('PS_BldPitchMin_N')} = {n}, but "
+                                   f"{dis.where('PS_WindSpeeds')} holds {w.size} values and "
+                                   f"{dis.where('PS_BldPitchMin')} {b.size}")
+    try:
+        table = MinPitchTable(tuple(w), tuple(b))
+    except ValueError as err:
+        raise TurbineFileError(f"{dis.path}: {dis.where('PS_BldPitchMin')}: {err}") from err
+    rec.entries.append(ReportEntry(
+        "minimum-pitch schedule", f"{math.degrees(min(b)):.3g}..{math.degrees(max(b)):.3g} deg "
+        f"over {w[0]:.3g}..{w[-1]:.3g} m/s ({w.size} points)",
+        f"{dis.where('PS_BldPitchMin')} over {dis.where('PS_WindSpeeds')} "
+        f"({dis.where('PS_Mode')} = 1: every operating point pitches at least this)"))
+    return table
 
 
 #: the plant's degrees of freedom and the ElastoDyn switch of each (its first mode)

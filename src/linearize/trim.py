@@ -7,12 +7,20 @@ limiting the power to the rated level"; Jonkman et al. 2009, sec. 7):
   minimum speed and fine pitch would brake (aerodynamic torque below the generator's minimum,
   e.g. the IEA-15-240-RWT at 3 m/s and 5 rpm, tip-speed ratio 21), the whole of region 1.5
   takes the pitch (>= fine) that maximizes the aerodynamic torque at that speed, as WISDEM's
-  schedule and ROSCO's minimum-pitch table do; deciding once per turbine keeps the schedule
-  continuous. The NREL 5-MW (6.9 rpm) stays at fine pitch, as Jonkman's baseline;
+  schedule and ROSCO's minimum-pitch table do (or the turbine's own minimum-pitch schedule where
+  that is higher); deciding once per turbine keeps the schedule continuous. The NREL 5-MW
+  (6.9 rpm) stays at fine pitch, as Jonkman's baseline;
 * region 2: maximum C_P tracking, omega = lambda_opt V / R, fine pitch;
 * region 2.5: rotor speed held at rated, fine pitch, power still below the cap;
 * region 3: power held at the cap (rated, or a power reference below rated) by pitching to
   feather at the scheduled rotor speed.
+
+A turbine with a minimum-pitch schedule over wind (:attr:`Turbine.min_pitch`, ROSCO's
+``PS_BldPitchMin``) pitches at least that schedule everywhere (:func:`region2_pitch`, never
+below fine pitch): in regions 1.5 to 2.5 at the schedule's pitch, tracking the tip-speed ratio
+of maximum C_P at that pitch (as the deck's controller tracks its optimal tip-speed ratio on the
+estimated wind), and in region 3 pitching up from it. The IEA-22-280-RWT, whose fine pitch of
+-4 deg reaches rated power below rated speed, trims only on its schedule.
 
 The structural equilibrium (tower deflections, shaft torsion, blade flap) follows exactly from
 the rotor loads, so that the trim point is an equilibrium of :func:`linearize.plant_rhs` (with
@@ -35,7 +43,7 @@ from linearize.turbine import Turbine
 from linearize.validate import check_finite_scalar
 
 __all__ = ["TrimError", "OperatingPoint", "trim", "operating_point", "operating_schedule",
-           "rated_wind_speed", "max_torque_pitch"]
+           "rated_wind_speed", "max_torque_pitch", "region2_pitch", "aero_torque"]
 
 
 @dataclass(frozen=True)
@@ -148,19 +156,58 @@ class OperatingPoint:
         }
 
 
-_TSR_CACHE: dict[tuple[int, PlantConfig, float], tuple[Turbine, float]] = {}
+_TSR_CACHE: dict[tuple[int, PlantConfig, float, float], tuple[Turbine, float]] = {}
 
 
-def _tsr_opt(params: PlantParams, shear: float) -> float:
+def _tsr_opt(params: PlantParams, shear: float, pitch: float | None = None) -> float:
+    """The tip-speed ratio of maximum C_P at a pitch [rad] (default: fine pitch)."""
     t = params.turbine
-    key = (id(t), params.config, shear)
+    b = t.operation.fine_pitch_rad if pitch is None else float(pitch)
+    key = (id(t), params.config, shear, b)
     hit = _TSR_CACHE.get(key)
     if hit is not None and hit[0] is t:
         return hit[1]
-    lam, _ = optimal_tsr(t, math.degrees(t.operation.fine_pitch_rad), params.config.aero,
+    lam, _ = optimal_tsr(t, math.degrees(b), params.config.aero,
                          shear_exponent=shear, integration=params.config.integration)
     _TSR_CACHE[key] = (t, lam)
     return lam
+
+
+def region2_pitch(turbine: Turbine, wind_mps: float) -> float:
+    """The least pitch [rad] the turbine operates at in a mean wind: its minimum-pitch schedule
+    there (:attr:`Turbine.min_pitch`), never below fine pitch; the fine pitch for a turbine
+    without a schedule. :func:`trim` holds it below rated and pitches up from it above.
+
+    Parameters
+    ----------
+    turbine : Turbine
+    wind_mps : float
+        Mean hub-height wind [m/s].
+
+    Returns
+    -------
+    float
+    """
+    fine = turbine.operation.fine_pitch_rad
+    table = turbine.min_pitch
+    return fine if table is None else max(fine, table.at(float(wind_mps)))
+
+
+def _region2(p: PlantParams, v: float, shear: float) -> tuple[float, float, float]:
+    """Rotor speed, pitch and unclamped maximum-C_P rotor speed [rad/s, rad, rad/s] of the
+    below-rated schedule at wind ``v``: the region-2 pitch and the optimal tip-speed ratio at
+    it, or at fine pitch where that is larger (a minimum-pitch schedule sheds thrust, it does
+    not slow the rotor: ROSCO keeps its ``VS_TSRopt`` whatever the pitch's floor), the speed
+    clamped to the operating range."""
+    t = p.turbine
+    op = t.operation
+    pitch = region2_pitch(t, v)
+    cone = t.geometry.precone_rad if p.config.aero.cone else 0.0
+    lam = _tsr_opt(p, shear)
+    if pitch != op.fine_pitch_rad:      # never slower than the fine pitch's optimum
+        lam = max(lam, _tsr_opt(p, shear, pitch))
+    w_opt = lam * v / (t.geometry.tip_radius * math.cos(cone))
+    return min(max(w_opt, op.min_rotor_speed_rad_s), op.rated_rotor_speed_rad_s), pitch, w_opt
 
 
 def _state(params: PlantParams, omega: float, pitch: float) -> FloatArray:
@@ -235,6 +282,16 @@ def _best_pitch(p: PlantParams, v: float, omega: float, fine: float, shear: floa
     return float(res.x)
 
 
+def _wind_and_speed(wind_mps: Any, rotor_speed_rad_s: Any) -> tuple[float, float]:
+    """A steady wind and rotor speed, both finite and > 0 (else ValueError naming them)."""
+    v = check_finite_scalar("wind_mps", wind_mps)
+    om = check_finite_scalar("rotor_speed_rad_s", rotor_speed_rad_s)
+    if not (v > 0 and om > 0):
+        raise ValueError(f"wind_mps and rotor_speed_rad_s must be > 0, got {v!r} m/s and "
+                         f"{om!r} rad/s")
+    return v, om
+
+
 def max_torque_pitch(turbine: Turbine, wind_mps: float, rotor_speed_rad_s: float, *,
                      config: PlantConfig | None = None, shear_exponent: float = 0.0,
                      params: PlantParams | None = None) -> tuple[float, float]:
@@ -258,15 +315,40 @@ def max_torque_pitch(turbine: Turbine, wind_mps: float, rotor_speed_rad_s: float
     pitch_rad, aero_torque : float
         [rad], [N m] (low-speed shaft).
     """
-    v = check_finite_scalar("wind_mps", wind_mps)
-    om = check_finite_scalar("rotor_speed_rad_s", rotor_speed_rad_s)
-    if not (v > 0 and om > 0):
-        raise ValueError(f"wind_mps and rotor_speed_rad_s must be > 0, got {v!r} m/s and "
-                         f"{om!r} rad/s")
+    v, om = _wind_and_speed(wind_mps, rotor_speed_rad_s)
     p = params if params is not None else plant_params(turbine, config)
     fine = turbine.operation.fine_pitch_rad
     b = _best_pitch(p, v, om, fine, float(shear_exponent))
     return b, _aero(p, v, om, b, float(shear_exponent))[0]
+
+
+def aero_torque(turbine: Turbine, wind_mps: float, rotor_speed_rad_s: float,
+                pitch_rad: float, *, config: PlantConfig | None = None,
+                shear_exponent: float = 0.0, params: PlantParams | None = None) -> float:
+    """The rotor's azimuth-averaged aerodynamic torque [N m] (low-speed shaft) at a steady
+    wind, rotor speed and collective pitch, the structure at its static deflection (as
+    :func:`trim` computes it), whatever torque the generator could hold.
+
+    Parameters
+    ----------
+    turbine : Turbine
+    wind_mps : float
+        Hub-height wind [m/s], > 0.
+    rotor_speed_rad_s : float
+        Rotor speed [rad/s], > 0.
+    pitch_rad : float
+        Collective pitch [rad].
+    config, shear_exponent, params
+        As :func:`trim`.
+
+    Returns
+    -------
+    float
+    """
+    v, om = _wind_and_speed(wind_mps, rotor_speed_rad_s)
+    b = check_finite_scalar("pitch_rad", pitch_rad)
+    p = params if params is not None else plant_params(turbine, config)
+    return _aero(p, v, om, b, float(shear_exponent))[0]
 
 
 def trim(turbine: Turbine, wind_mps: float, power_W: float | None = None, *,
@@ -324,22 +406,21 @@ def trim(turbine: Turbine, wind_mps: float, power_W: float | None = None, *,
     egb = dt.gearbox_efficiency
     cone = turbine.geometry.precone_rad if p.config.aero.cone else 0.0
     rproj = turbine.geometry.tip_radius * math.cos(cone)
-    fine = op.fine_pitch_rad
-    if fine < turbine.pitch_actuator.min_pitch_rad - 1e-12:
-        raise TrimError(f"the fine pitch {math.degrees(fine):.4g} deg"
+    if op.fine_pitch_rad < turbine.pitch_actuator.min_pitch_rad - 1e-12:
+        raise TrimError(f"the fine pitch {math.degrees(op.fine_pitch_rad):.4g} deg"
                         f"{_source(turbine, 'fine pitch')} is below the pitch actuator's "
                         f"minimum {math.degrees(turbine.pitch_actuator.min_pitch_rad):.4g} deg"
                         f"{_source(turbine, 'minimum pitch')}: the region-2 pitch must be one "
                         f"the actuator can reach")
 
-    lam = _tsr_opt(p, shear)
-    w_opt = lam * v / rproj
-    omega = min(max(w_opt, op.min_rotor_speed_rad_s), op.rated_rotor_speed_rad_s)
+    omega, fine, w_opt = _region2(p, v, shear)
     q_fine, _ = _aero(p, v, omega, fine, shear)
+    f0 = op.fine_pitch_rad
     if (omega <= op.min_rotor_speed_rad_s * (1 + 1e-12) and w_opt < omega
-            and _aero(p, op.cut_in_wind, op.min_rotor_speed_rad_s, fine, shear)[0] * egb / ngear
+            and _aero(p, op.cut_in_wind, op.min_rotor_speed_rad_s, f0, shear)[0] * egb / ngear
             < turbine.generator.min_torque):
-        fine = _best_pitch(p, v, omega, fine, shear)
+        # the torque-maximizing pitch, or the minimum-pitch schedule's where that is above it
+        fine = max(fine, _best_pitch(p, v, omega, f0, shear))
         q_fine, _ = _aero(p, v, omega, fine, shear)
         if egb * q_fine / ngear < turbine.generator.min_torque:
             raise TrimError(
@@ -348,6 +429,12 @@ def trim(turbine: Turbine, wind_mps: float, power_W: float | None = None, *,
                 f"{q_fine:.4g} N m (pitch {math.degrees(fine):.2f} deg), below the generator's "
                 f"minimum {turbine.generator.min_torque * ngear / egb:.4g} N m (low-speed shaft); "
                 f"raise cut-in above {v:g} m/s")
+    if egb * q_fine / ngear < turbine.generator.min_torque - 1e-9:
+        raise TrimError(
+            f"at {v:g} m/s the rotor at {omega * 30 / math.pi:.4g} rpm and the minimum-pitch "
+            f"schedule's {math.degrees(fine):.3g} deg{_source(turbine, 'minimum-pitch schedule')} "
+            f"makes an aerodynamic torque of {q_fine:.4g} N m, below the generator's minimum "
+            f"{turbine.generator.min_torque * ngear / egb:.4g} N m (low-speed shaft)")
     p_fine = eta * q_fine * omega
     if p_fine <= cap * (1 + 1e-12):
         if pref is not None and p_fine < pref * (1 - 1e-9):
@@ -581,7 +668,8 @@ def operating_schedule(turbine: Turbine, wind_mps: FloatArray, power_W: float | 
 
 def rated_wind_speed(turbine: Turbine, *, config: PlantConfig | None = None,
                      shear_exponent: float = 0.0) -> float:
-    """Lowest wind speed at which rated power is reached at fine pitch [m/s].
+    """Lowest wind speed at which rated power is reached at the region-2 pitch
+    (:func:`region2_pitch`) [m/s].
 
     Parameters
     ----------
@@ -606,13 +694,10 @@ def rated_wind_speed(turbine: Turbine, *, config: PlantConfig | None = None,
     op = turbine.operation
     dt = turbine.drivetrain
     eta = dt.generator_efficiency * dt.gearbox_efficiency
-    cone = turbine.geometry.precone_rad if p.config.aero.cone else 0.0
-    rproj = turbine.geometry.tip_radius * math.cos(cone)
-    lam = _tsr_opt(p, float(shear_exponent))
 
     def surplus(v: float) -> float:
-        w = min(max(lam * v / rproj, op.min_rotor_speed_rad_s), op.rated_rotor_speed_rad_s)
-        q, _ = _aero(p, v, w, op.fine_pitch_rad, float(shear_exponent))
+        w, pitch, _ = _region2(p, v, float(shear_exponent))
+        q, _ = _aero(p, v, w, pitch, float(shear_exponent))
         return eta * q * w - op.rated_power
 
     if surplus(op.cut_out_wind) < 0:

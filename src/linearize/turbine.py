@@ -25,7 +25,7 @@ from linearize.validate import frozen_array
 __all__ = [
     "TurbineFileError", "Geometry", "Operation", "Environment", "RotorMass", "Nacelle",
     "Drivetrain", "Generator", "PitchActuator", "Damping", "BladeAero", "Polar", "UAParams",
-    "BladeStructure", "TowerStructure", "ModeShapes", "Turbine",
+    "BladeStructure", "TowerStructure", "ModeShapes", "MinPitchTable", "Turbine",
     "available_turbines", "LoadReport", "ReportEntry", "content_digest",
 ]
 
@@ -677,6 +677,55 @@ class LoadReport:
 
 
 @dataclass(frozen=True)
+class MinPitchTable:
+    """A minimum-pitch schedule over mean wind: the least collective pitch the turbine's own
+    controller holds at each wind (ROSCO's ``PS_BldPitchMin`` over ``PS_WindSpeeds`` with
+    ``PS_Mode`` 1: the region-1.5 pitch at low wind and the peak shaving of thrust near rated),
+    linear between its points and held at its end values beyond them. Every operating point
+    of :func:`linearize.trim` pitches at least this, and at least the fine pitch.
+
+    Parameters
+    ----------
+    wind_mps : tuple of float
+        Mean winds [m/s], at least two, finite, strictly increasing.
+    pitch_rad : tuple of float
+        The minimum pitch at each wind [rad], finite.
+    """
+
+    wind_mps: tuple[float, ...]
+    pitch_rad: tuple[float, ...]
+
+    def __post_init__(self) -> None:
+        w = tuple(float(x) for x in np.ravel(self.wind_mps))
+        b = tuple(float(x) for x in np.ravel(self.pitch_rad))
+        if (len(w) < 2 or len(w) != len(b) or not all(map(math.isfinite, w + b))
+                or any(w1 <= w0 for w0, w1 in zip(w, w[1:])) or w[0] <= 0.0):
+            raise ValueError(f"MinPitchTable: wind_mps and pitch_rad must hold as many finite "
+                             f"values, at least 2, the winds > 0 and strictly increasing; got "
+                             f"{len(w)} winds {list(w)[:4]}... and {len(b)} pitches")
+        if not all(-math.pi / 2 <= x <= math.pi / 2 for x in b):
+            raise ValueError(f"MinPitchTable: pitch_rad must lie in [-pi/2, pi/2] rad, got "
+                             f"{min(b):g}..{max(b):g}")
+        object.__setattr__(self, "wind_mps", w)
+        object.__setattr__(self, "pitch_rad", b)
+
+    def at(self, wind_mps: float) -> float:
+        """The minimum pitch [rad] at a mean wind [m/s] (held at the end values beyond the
+        table).
+
+        Parameters
+        ----------
+        wind_mps : float
+            [m/s].
+
+        Returns
+        -------
+        float
+        """
+        return float(np.interp(wind_mps, self.wind_mps, self.pitch_rad))
+
+
+@dataclass(frozen=True)
 class Turbine:
     """A reference turbine as the BEM plant sees it. All quantities SI, angles in rad.
 
@@ -706,6 +755,9 @@ class Turbine:
         :data:`linearize.DOF_NAMES`; an OpenFAST deck's ElastoDyn switches, e.g.
         ``("drivetrain",)`` for ``DrTrDOF False``): :func:`linearize.plant_params` leaves them
         out of every configuration. Empty for a turbine whose every DOF is flexible.
+    min_pitch : MinPitchTable or None
+        The turbine's minimum-pitch schedule over mean wind (an OpenFAST deck's ROSCO
+        ``PS_BldPitchMin`` with ``PS_Mode`` 1); None: the fine pitch everywhere.
     report : LoadReport
         What was read from where.
     """
@@ -727,6 +779,7 @@ class Turbine:
     tower_structure: TowerStructure
     mode_shapes: ModeShapes
     rigid_dofs: tuple[str, ...] = field(default=(), metadata={"digest_at_default": False})
+    min_pitch: MinPitchTable | None = field(default=None, metadata={"digest_at_default": False})
     report: LoadReport = field(default_factory=LoadReport, compare=False)
 
     def __post_init__(self) -> None:

@@ -185,8 +185,9 @@ def test_operating_point_bad_input(turbine: linearize.Turbine, args, match: str)
 
 
 def test_a_trim_blocked_by_the_torque_limit_names_the_keys_and_what_would_work(tmp_path) -> None:
-    """The IEA-15 deck with its fine pitch lowered to -4 deg in a copy (as the IEA-22's
-    PC_FinePit is): rated power comes at 6.4 rpm, below rated speed, where the torque exceeds
+    """The IEA-15 deck with its fine pitch lowered to -4 deg and its minimum-pitch schedule off
+    (PS_Mode 0) in a copy (as the IEA-22's PC_FinePit is): rated power comes at 6.4 rpm, below
+    rated speed, where the torque exceeds
     VS_MaxTq. The error names the torque limit's and the fine pitch's file, line and key, the
     rotor speed against rated, and the torque limit that would trim it."""
     import shutil
@@ -197,6 +198,7 @@ def test_a_trim_blocked_by_the_torque_limit_names_the_keys_and_what_would_work(t
     text = dis.read_text().replace("0.000000000000      ! PC_FinePit",
                                    "-0.069813170080     ! PC_FinePit")
     text = text.replace("0.000000000000      ! PC_MinPit", "-0.069813170080     ! PC_MinPit")
+    text = text.replace("1                   ! PS_Mode", "0                   ! PS_Mode")
     dis.write_text(text)
     t = linearize.load_turbine(tmp_path / "iea15" / "turbine.yaml")
     with pytest.raises(linearize.TrimError) as err:

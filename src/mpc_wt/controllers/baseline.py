@@ -34,6 +34,7 @@ from dataclasses import dataclass, field
 from typing import Any, Callable, Sequence
 
 import numpy as np
+from scipy.optimize import brentq
 
 import linearize
 from mpc_wt.controllers.base import DesignBase
@@ -259,7 +260,8 @@ def tune_baseline(turbine: linearize.Turbine, *, omega_n_rad_s: float | None = N
         raise ValueError(f"omega_n_rad_s and zeta must be > 0, got {omega_n_rad_s!r}, {zeta!r}")
     if winds is None:
         v_rated = linearize.rated_wind_speed(turbine)
-        v = np.r_[v_rated + 1e-6, np.arange(12.0, 25.5, 1.0)]
+        grid = np.arange(12.0, 25.5, 1.0)
+        v = np.r_[v_rated + 1e-6, grid[grid > v_rated + 0.1]]    # rated may lie above 12 m/s
     else:
         v = np.asarray(winds, float)
     params = linearize.plant_params(turbine)
@@ -279,6 +281,8 @@ def tune_baseline(turbine: linearize.Turbine, *, omega_n_rad_s: float | None = N
     r = turbine.geometry.tip_radius * math.cos(turbine.geometry.precone_rad)
     rho = turbine.environment.air_density
     k_opt = 0.5 * rho * math.pi * r**5 * cp / lam**3 / n**3
+    if turbine.min_pitch is not None and _pitches_in_region2(turbine, params):
+        k_opt = region2_torque_gain(turbine, params=params)
     sp, off = min_pitch_schedule(turbine, k_opt, params=params, tsr_opt=lam)
     return BaselineGains(kp=kp, ki=ki, theta_k_rad=theta_k, k_opt=k_opt,
                          rated_gen_speed_rad_s=turbine.rated_generator_speed_rad_s,
@@ -335,8 +339,26 @@ def min_pitch_schedule(turbine: linearize.Turbine, k_opt: float, *,
     op = turbine.operation
     p = params if params is not None else linearize.plant_params(turbine)
     fine = op.fine_pitch_rad
+    n = turbine.drivetrain.gearbox_ratio
+    if turbine.min_pitch is not None:
+        brakes = (linearize.aero_torque(turbine, op.cut_in_wind, op.min_rotor_speed_rad_s, fine,
+                                        params=p) * turbine.drivetrain.gearbox_efficiency / n
+                  < turbine.generator.min_torque)
+        line = _max_torque_line(turbine, k_opt, int(n_points), p, tsr_opt) if brakes else None
+        return _table_schedule(turbine, k_opt, int(n_points), p, line)
     if not linearize.trim(turbine, op.cut_in_wind, params=p).pitch_rad > fine + 1e-9:
         return (), ()                               # the trim keeps fine pitch at cut-in
+    speeds, offsets = _max_torque_line(turbine, k_opt, int(n_points), p, tsr_opt)
+    return tuple(float(x) for x in speeds), tuple(offsets)
+
+
+def _max_torque_line(turbine: linearize.Turbine, k_opt: float, n_points: int,
+                     p: linearize.PlantParams, tsr_opt: float | None
+                     ) -> tuple[np.ndarray, list[float]]:
+    """The torque-maximizing pitch above fine pitch at ``n_points`` speeds on region 1.5's
+    torque line (:func:`min_pitch_schedule`), the last (region 2's start) at fine pitch."""
+    op = turbine.operation
+    fine = op.fine_pitch_rad
     n = turbine.drivetrain.gearbox_ratio
     w1 = op.min_rotor_speed_rad_s * n
     w2 = REGION15_SPAN * w1
@@ -354,14 +376,111 @@ def min_pitch_schedule(turbine: linearize.Turbine, k_opt: float, *,
     theta = np.array([b for b, _ in best])
     keep = np.r_[True, np.diff(g) < 0]                 # decreasing in lambda
     lam, g, theta = lam[keep], g[keep], theta[keep]
-    speeds = np.linspace(w1, w2, int(n_points))
+    speeds = np.linspace(w1, w2, n_points)
     offsets = []
     for w in speeds[:-1]:
         c = n * slope * (w - w1) / (q_ref * (w / n) ** 2)
         x = float(np.interp(c, g[::-1], lam[::-1]))     # clamped at the table's ends
         offsets.append(max(0.0, float(np.interp(x, lam, theta)) - fine))
     offsets.append(0.0)
-    return tuple(float(x) for x in speeds), tuple(offsets)
+    return speeds, offsets
+
+
+def _region2_trims(turbine: linearize.Turbine, params: linearize.PlantParams,
+                   n: int = 24) -> list[linearize.OperatingPoint]:
+    """The trims in region 2 (maximum-C_P tracking below rated speed) over ``n`` winds from
+    cut-in to rated wind."""
+    op = turbine.operation
+    winds = np.linspace(op.cut_in_wind, linearize.rated_wind_speed(turbine), n + 1)[:-1]
+    trims = [linearize.trim(turbine, float(v), params=params) for v in winds]
+    return [t for t in trims if t.region == "2"]
+
+
+def _pitches_in_region2(turbine: linearize.Turbine, params: linearize.PlantParams) -> bool:
+    """Whether the turbine's minimum-pitch schedule holds most of its region 2 off fine pitch
+    (the IEA-22-280-RWT's; the IEA-15-240-RWT's leaves fine pitch only at region 2's ends, and
+    its torque gain stays the fine pitch's optimum)."""
+    fine = turbine.operation.fine_pitch_rad
+    off = [abs(t.pitch_rad - fine) > 1e-9 for t in _region2_trims(turbine, params)]
+    return sum(off) > len(off) / 2
+
+
+def region2_torque_gain(turbine: linearize.Turbine, *,
+                        params: linearize.PlantParams | None = None) -> float:
+    """The region-2 torque gain K of T = K w_g^2 [N m/(rad/s)^2] that holds the trim's region-2
+    schedule in the least-squares sense: for a turbine whose minimum-pitch schedule
+    (:attr:`linearize.Turbine.min_pitch`) moves the region-2 pitch with the wind, no single
+    pitch's optimal C_P and tip-speed ratio (Jonkman et al. 2009, sec. 7.3, eq of K) describes
+    the schedule, so K is fitted to the trims' generator torques against their generator speeds,
+    K = sum T w^2 / sum w^4.
+
+    Parameters
+    ----------
+    turbine : Turbine
+    params : PlantParams, optional
+
+    Returns
+    -------
+    float
+
+    Raises
+    ------
+    ValueError
+        If no trim between cut-in and rated wind is in region 2.
+    """
+    p = params if params is not None else linearize.plant_params(turbine)
+    trims = _region2_trims(turbine, p)
+    if not trims:
+        raise ValueError(f"{turbine.name}: no trim between cut-in and rated wind is in region 2; "
+                         f"no region-2 torque gain to fit")
+    w = np.array([t.gen_speed_rad_s for t in trims])
+    tq = np.array([t.gen_torque for t in trims])
+    return float(np.sum(tq * w**2) / np.sum(w**4))
+
+
+def _table_schedule(turbine: linearize.Turbine, k_opt: float, n_points: int,
+                    p: linearize.PlantParams, line: tuple[np.ndarray, list[float]] | None
+                    ) -> tuple[tuple[float, ...], tuple[float, ...]]:
+    """The baseline's minimum pitch over its filtered generator speed from the turbine's
+    minimum-pitch table: on region 1.5's torque line (as :func:`min_pitch_schedule`) the
+    table's pitch at the wind where the rotor at that speed and pitch balances the line's torque;
+    above it the region-2 trims' pitch at their generator speeds, up to the last trim below
+    rated speed (at rated speed the pitch loop takes over). Where the rotor would brake at
+    fine pitch (``line``: :func:`_max_torque_line`), the line's pitch is the larger of the
+    table's and the torque-maximizing one, as the trim's."""
+    op, n = turbine.operation, turbine.drivetrain.gearbox_ratio
+    fine, egb = op.fine_pitch_rad, turbine.drivetrain.gearbox_efficiency
+    w1 = op.min_rotor_speed_rad_s * n
+    w2 = REGION15_SPAN * w1
+    slope = k_opt * w2**2 / (w2 - w1)
+    speeds, offsets = [], []
+    v_hi = linearize.rated_wind_speed(turbine)
+    for w in np.linspace(w1, w2, n_points)[1:]:
+        need = n * slope * (w - w1) / egb                       # low-speed shaft torque
+
+        def surplus(v: float, w: float = w, need: float = need) -> float:
+            b = linearize.region2_pitch(turbine, v)
+            return linearize.aero_torque(turbine, v, w / n, b, params=p) - need
+
+        v = brentq(surplus, 0.3 * op.cut_in_wind, v_hi, xtol=1e-6)
+        speeds.append(float(w))
+        offsets.append(max(0.0, linearize.region2_pitch(turbine, v) - fine))
+    for t in _region2_trims(turbine, p, n=48):
+        if t.gen_speed_rad_s > speeds[-1] * (1 + 1e-6) and len(speeds) < MIN_PITCH_TABLE_MAX:
+            speeds.append(t.gen_speed_rad_s)
+            offsets.append(max(0.0, t.pitch_rad - fine))
+    speeds.insert(0, float(w1))
+    offsets.insert(0, offsets[0])
+    if line is not None:
+        offsets[:n_points] = [max(a, b) for a, b in zip(offsets[:n_points], line[1])]
+    while len(speeds) > 2 and offsets[-1] == offsets[-2] == 0.0:   # fine pitch held beyond
+        speeds.pop()
+        offsets.pop()
+    return tuple(speeds), tuple(offsets)
+
+
+#: the most points the exported law's minimum-pitch schedule holds (``MW_MIN_PITCH_MAX``)
+MIN_PITCH_TABLE_MAX = 64
 
 
 def tune_baseline_schedule(turbine: linearize.Turbine,
@@ -553,7 +672,9 @@ class LawTorque:
     (the IEA-15: 3.8 deg at 3 m/s, 1.7 deg at 5.9 m/s) above that at its minimum rotor speed,
     where the schedule would then ask for rated power and stall the rotor; below region 2's
     speed the pitch is therefore counted from the largest below-rated trim pitch
-    (:func:`below_rated_pitch`; 0 for the NREL 5-MW, where nothing changes).
+    (:func:`below_rated_pitch`; 0 for the NREL 5-MW, where nothing changes), and above it from
+    the baseline's minimum-pitch schedule at the filtered speed (0 where that schedule is fine
+    pitch; the IEA-22-280-RWT's region 2 runs 3-5 deg above its fine pitch of -4 deg).
 
     Parameters
     ----------

@@ -39,7 +39,8 @@ SCHEDULE_SOURCES = ("estimator", "preview")
 def region3_wind(turbine: linearize.Turbine, pitch_rad: float, *,
                  config: linearize.PlantConfig | None = None) -> float:
     """The wind above rated at which the trim's collective pitch reaches ``pitch_rad`` above
-    fine pitch (bisection on :func:`linearize.trim`).
+    the region-2 pitch at rated wind (fine pitch, or a minimum-pitch schedule's there:
+    :func:`linearize.region2_pitch`; bisection on :func:`linearize.trim`).
 
     Parameters
     ----------
@@ -60,12 +61,12 @@ def region3_wind(turbine: linearize.Turbine, pitch_rad: float, *,
         If ``pitch_rad`` is not positive or the trim does not reach it by cut-out wind.
     """
     check_number("pitch_rad", pitch_rad, lo=0.0, lo_open=True, unit="rad")
-    fine = turbine.operation.fine_pitch_rad
+    lo, hi = linearize.rated_wind_speed(turbine, config=config), turbine.operation.cut_out_wind
+    fine = linearize.region2_pitch(turbine, lo)     # fine pitch, or the schedule's at rated
 
     def excess(v: float) -> float:
         return linearize.trim(turbine, v, config=config).pitch_rad - fine - pitch_rad
 
-    lo, hi = linearize.rated_wind_speed(turbine, config=config), turbine.operation.cut_out_wind
     if excess(hi) <= 0.0:
         raise ValueError(f"pitch_rad = {pitch_rad:g} rad: the trim's pitch at cut-out "
                          f"({hi:g} m/s) does not reach it")
@@ -177,7 +178,8 @@ class RegionFloor:
         ----------
         family : LinearModelFamily
         turbine : Turbine
-            Fine pitch, rated wind and rotor speed.
+            Fine pitch (or its minimum-pitch schedule's at rated wind: the threshold's base),
+            rated wind and rotor speed.
         pitch_margin : float, optional
             Above fine pitch [rad] (default :attr:`PITCH_MARGIN`).
         speed_margin : float
@@ -203,7 +205,7 @@ class RegionFloor:
         rising = np.cumprod(np.concatenate([[True], np.diff(p) > 0])).astype(bool)
         w, p = w[rising], p[rising]                     # the rising part of the curve
         margin = cls.PITCH_MARGIN if pitch_margin is None else pitch_margin
-        return cls(w, p, turbine.operation.fine_pitch_rad + margin,
+        return cls(w, p, linearize.region2_pitch(turbine, rated) + margin,
                    turbine.operation.rated_rotor_speed_rad_s, speed_margin)
 
     def floor(self, pitch: float, rotor_speed: float) -> float:

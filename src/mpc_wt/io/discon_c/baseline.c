@@ -577,7 +577,12 @@ double mw_torque_law_step(mw_torque_law *t, double gen_speed, double pitch, doub
     double q;
     t->w = t->started ? t->a * t->w + (1.0 - t->a) * gen_speed : gen_speed;
     t->started = 1;
-    if (t->w < t->law.w_rgn2) pitch -= t->offset;
+    /* the pitch counted from the minimum-pitch floor: below region 2 the largest below-rated
+     * trim pitch, above it the schedule's at the filtered speed (0 where it is fine pitch) */
+    if (t->w < t->law.w_rgn2)
+        pitch -= t->offset;
+    else
+        pitch -= mw_law_min_pitch_offset(&t->law, t->w);
     q = mw_law_torque(&t->law, t->w, pitch, power);
     return q < t->lo ? t->lo : (q > t->hi ? t->hi : q);
 }
