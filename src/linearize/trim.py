@@ -18,8 +18,9 @@ limiting the power to the rated level"; Jonkman et al. 2009, sec. 7):
 A turbine with a minimum-pitch schedule over wind (:attr:`Turbine.min_pitch`, ROSCO's
 ``PS_BldPitchMin``) pitches at least that schedule everywhere (:func:`region2_pitch`, never
 below fine pitch): in regions 1.5 to 2.5 at the schedule's pitch, tracking the tip-speed ratio
-of maximum C_P at that pitch (as the deck's controller tracks its optimal tip-speed ratio on the
-estimated wind), and in region 3 pitching up from it. The IEA-22-280-RWT, whose fine pitch of
+of maximum C_P at that pitch, or the fine pitch's where that is larger (as the deck's controller
+keeps its optimal tip-speed ratio on the estimated wind whatever the pitch's floor), and in
+region 3 pitching up from it. The IEA-22-280-RWT, whose fine pitch of
 -4 deg reaches rated power below rated speed, trims only on its schedule.
 
 The structural equilibrium (tower deflections, shaft torsion, blade flap) follows exactly from

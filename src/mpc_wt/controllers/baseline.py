@@ -281,8 +281,10 @@ def tune_baseline(turbine: linearize.Turbine, *, omega_n_rad_s: float | None = N
     r = turbine.geometry.tip_radius * math.cos(turbine.geometry.precone_rad)
     rho = turbine.environment.air_density
     k_opt = 0.5 * rho * math.pi * r**5 * cp / lam**3 / n**3
-    if turbine.min_pitch is not None and _pitches_in_region2(turbine, params):
-        k_opt = region2_torque_gain(turbine, params=params)
+    if turbine.min_pitch is not None:
+        trims2 = _region2_trims(turbine, params)
+        if _pitches_in_region2(turbine, trims2):
+            k_opt = region2_torque_gain(turbine, params=params, trims=trims2)
     sp, off = min_pitch_schedule(turbine, k_opt, params=params, tsr_opt=lam)
     return BaselineGains(kp=kp, ki=ki, theta_k_rad=theta_k, k_opt=k_opt,
                          rated_gen_speed_rad_s=turbine.rated_generator_speed_rad_s,
@@ -396,17 +398,19 @@ def _region2_trims(turbine: linearize.Turbine, params: linearize.PlantParams,
     return [t for t in trims if t.region == "2"]
 
 
-def _pitches_in_region2(turbine: linearize.Turbine, params: linearize.PlantParams) -> bool:
+def _pitches_in_region2(turbine: linearize.Turbine,
+                        trims: Sequence[linearize.OperatingPoint]) -> bool:
     """Whether the turbine's minimum-pitch schedule holds most of its region 2 off fine pitch
     (the IEA-22-280-RWT's; the IEA-15-240-RWT's leaves fine pitch only at region 2's ends, and
     its torque gain stays the fine pitch's optimum)."""
     fine = turbine.operation.fine_pitch_rad
-    off = [abs(t.pitch_rad - fine) > 1e-9 for t in _region2_trims(turbine, params)]
+    off = [abs(t.pitch_rad - fine) > 1e-9 for t in trims]
     return sum(off) > len(off) / 2
 
 
 def region2_torque_gain(turbine: linearize.Turbine, *,
-                        params: linearize.PlantParams | None = None) -> float:
+                        params: linearize.PlantParams | None = None,
+                        trims: Sequence[linearize.OperatingPoint] | None = None) -> float:
     """The region-2 torque gain K of T = K w_g^2 [N m/(rad/s)^2] that holds the trim's region-2
     schedule in the least-squares sense: for a turbine whose minimum-pitch schedule
     (:attr:`linearize.Turbine.min_pitch`) moves the region-2 pitch with the wind, no single
@@ -418,6 +422,8 @@ def region2_torque_gain(turbine: linearize.Turbine, *,
     ----------
     turbine : Turbine
     params : PlantParams, optional
+    trims : sequence of OperatingPoint, optional
+        The region-2 trims to fit (default: 24 winds from cut-in to rated wind).
 
     Returns
     -------
@@ -428,8 +434,9 @@ def region2_torque_gain(turbine: linearize.Turbine, *,
     ValueError
         If no trim between cut-in and rated wind is in region 2.
     """
-    p = params if params is not None else linearize.plant_params(turbine)
-    trims = _region2_trims(turbine, p)
+    if trims is None:
+        p = params if params is not None else linearize.plant_params(turbine)
+        trims = _region2_trims(turbine, p)
     if not trims:
         raise ValueError(f"{turbine.name}: no trim between cut-in and rated wind is in region 2; "
                          f"no region-2 torque gain to fit")

@@ -138,7 +138,8 @@ double mw_law_min_pitch_offset(const mw_law *law, double w);
 
 /* the baseline's torque schedule as another controller's generator torque: the generator
  * speed low-passed at the law's corner, the pitch counted from the below-rated offset under
- * region 2 and from the minimum-pitch schedule above, the torque within limits (input keys "law.*" and "law_torque") */
+ * region 2 and from the minimum-pitch schedule above, the torque within limits (input keys
+ * "law.*" and "law_torque") */
 typedef struct {
     mw_law law;
     double a, offset, lo, hi, w;
