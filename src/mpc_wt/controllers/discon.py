@@ -378,7 +378,10 @@ class DisconController(ControllerBase):
         (record 45 for all blades).
     workdir : str or Path, optional
         Where the library may write its own files (``.dbg``, ...); its ``OUTNAME`` is
-        ``workdir/root_name``. Default: a temporary folder removed by :meth:`finalize`.
+        ``workdir/root_name.SrvD``, as OpenFAST's ServoDyn names it (ROSCO strips the extension
+        and writes ``root_name.RO.dbg``, ``.RO.dbg2``, ...; without one the C string's NUL
+        stays in its root and every debug file opens the same path). Default: a temporary
+        folder removed by :meth:`finalize`.
     root_name : str
         The simulation root name given to the library.
     quiet : bool
@@ -586,7 +589,7 @@ class DisconController(ControllerBase):
         n = dr.gearbox_ratio
         assert self.workdir is not None
         self._infile = str(self.discon_in).encode()
-        self._outname = str(self.workdir / self.root_name).encode()
+        self._outname = str(self.workdir / (self.root_name + ".SrvD")).encode()
         fixed = {3: self.dt, 5: op.fine_pitch_rad, 6: pa.min_pitch_rad, 7: pa.max_pitch_rad,
                  8: -pa.max_rate_rad_s, 9: pa.max_rate_rad_s, 10: 0.0, 13: op.rated_power,
                  17: op.min_rotor_speed_rad_s * n, 18: op.rated_rotor_speed_rad_s * n,

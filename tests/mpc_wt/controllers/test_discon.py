@@ -19,7 +19,7 @@ from mpc_wt.controllers.discon import SWAP_SIZE, DisconController, rosco_discon,
 from mpc_wt.errors import ControllerLibraryError
 from mpc_wt.run import run_controller
 from mpc_wt.simulation.loop import simulate_closed_loop
-from mpc_wt.simulation.scenario import Scenario
+from mpc_wt.simulation.scenario import Scenario, make_wind
 
 PROBE_C = Path(__file__).resolve().parents[2] / "data" / "discon_probe.c"
 needs_cc = pytest.mark.skipif(shutil.which("gcc") is None and shutil.which("cc") is None,
@@ -37,7 +37,7 @@ def probe(tmp_path_factory) -> Path:
 
 
 def _records(workdir: Path) -> list[list[str]]:
-    with (workdir / "mpcwt_discon.swap.csv").open() as fh:
+    with (workdir / "mpcwt_discon.SrvD.swap.csv").open() as fh:
         return list(csv.reader(fh))
 
 
@@ -426,6 +426,36 @@ def test_roscos_shipped_file_starts_in_its_own_equilibrium(turbine) -> None:
         assert w.min() == pytest.approx(7.5 * 3.0 / 63.0, rel=0.01), kind
         assert w.max() == pytest.approx(7.5 * 3.0 / 63.0, rel=0.01), kind
         assert q.max() <= 1.1 * q[res.t >= 10.0].mean(), kind
+
+
+def test_rosco_logging_every_level_writes_its_files_side_by_side(turbine, tmp_path) -> None:
+    """ROSCO's shipped NREL-5MW DISCON.IN at ``LoggingLevel`` 3 (the IEA-22-280-RWT deck
+    ships level 2): ROSCO opens ``.RO.dbg``, ``.RO.dbg2`` and ``.RO.dbg3`` beside each other
+    under the run's OUTNAME, named ``root.SrvD`` as OpenFAST's ServoDyn names it. With a bare
+    root the C string's NUL stayed in ROSCO's root name, both files opened the same path and
+    ROSCO ended the process ("File already opened in another unit"). Two seconds at 12 m/s:
+    each file holds the header and a line per call (160 calls at 80 Hz)."""
+    lines = rosco_discon().read_text().splitlines()
+    for i, line in enumerate(lines):
+        words = line.split()
+        if len(words) >= 3 and words[2] == "LoggingLevel":
+            lines[i] = "3" + line[len(words[0]):]
+        elif len(words) >= 3 and words[2] == "PerfFileName":
+            perf = (rosco_discon().parent / words[0].strip('"')).resolve()
+            lines[i] = f'"{perf}"' + line[len(words[0]):]
+    infile = tmp_path / "DISCON.IN"
+    infile.write_text("\n".join(lines) + "\n")
+    run = tmp_path / "run"
+    ctl = DisconController(rosco_library(), infile, turbine, workdir=run)
+    op = linearize.trim(turbine, 12.0)
+    wind = make_wind(turbine, Scenario(12.0, "steady", 1, 2.0), "u")[0]
+    res = simulate_closed_loop(linearize.plant_params(turbine), ctl, wind, 2.0, x0=op.x, u0=op.u)
+    assert res.t[-1] == pytest.approx(2.0)
+    assert sorted(p.name for p in run.iterdir()) == [
+        "mpcwt_discon.RO.dbg", "mpcwt_discon.RO.dbg2", "mpcwt_discon.RO.dbg3"]
+    for name in ("mpcwt_discon.RO.dbg", "mpcwt_discon.RO.dbg2"):
+        rows = [ln for ln in (run / name).read_text().splitlines()[3:] if ln.strip()]
+        assert len(rows) == 160, name
 
 
 def test_roscos_runtime_exit_on_a_missing_table_fails_the_run_only(turbine, tmp_path) -> None:

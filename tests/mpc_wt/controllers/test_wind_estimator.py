@@ -138,7 +138,7 @@ def test_as_good_as_roscos_estimator_on_the_same_run(turbine, estimator, v: floa
         ctl = DisconController(rosco_library(), rosco_discon(), turbine, workdir=wd)
         res = simulate_closed_loop(linearize.plant_params(turbine), ctl, wind, 600.0, x0=op.x,
                                    u0=op.u)
-        dbg = _read_rosco_debug(pathlib.Path(wd) / ctl.root_name)
+        dbg = _read_rosco_debug(pathlib.Path(wd) / (ctl.root_name + ".RO.dbg"))
     truth = lidar.rotor_effective_wind(field, turbine.geometry.tip_radius, method="cube")
     keep = dbg["Time"] >= 30.0
     e_rosco = dbg["WE_Vw"][keep] - np.interp(dbg["Time"][keep], field.t, truth)

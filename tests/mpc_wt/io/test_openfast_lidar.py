@@ -160,7 +160,7 @@ def test_the_lidar_records_are_openfasts(tmp_path):
     case = read_openfast_case(deck, turbine=linearize.load_turbine("nrel5mw"))
     run_openfast_case(case, "discon", library=probe, discon_in=tmp_path / "PROBE.IN",
                       workdir=tmp_path / "ours")
-    ours = _lidar_rows(tmp_path / "ours" / "mpcwt_discon.lidar.csv")
+    ours = _lidar_rows(tmp_path / "ours" / "mpcwt_discon.SrvD.lidar.csv")
     n = min(len(of), len(ours)) - 1                   # OpenFAST's last call repeats its time
     np.testing.assert_allclose(ours[:n, 1], of[:n, 1], atol=1e-6)          # the calls' times
     np.testing.assert_array_equal(ours[:n, 2:6], of[:n, 2:6])
