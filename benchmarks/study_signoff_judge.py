@@ -35,10 +35,10 @@ TORQUE_ROUNDING = 1e-6
 def _torque_bound(campaign: Path) -> float:
     """The campaign's turbine's generator torque limit over its rated torque."""
     import linearize
-    import yaml
+    from mpc_wt.campaign import CampaignStore
 
-    spec = yaml.safe_load((campaign / "spec.yaml").read_text())
-    t = linearize.load_turbine(spec.get("turbine", "nrel5mw"))
+    with CampaignStore(campaign) as st:          # the spec with its paths resolved
+        t = linearize.load_turbine(st.meta()["spec_raw"].get("turbine", "nrel5mw"))
     return t.generator.max_torque / t.rated_generator_torque
 
 

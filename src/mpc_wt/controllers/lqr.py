@@ -464,7 +464,12 @@ class LQRPIOController(DesignBase):
     The torque by region: region III holds the operating point's torque (Do et al.'s constant
     torque), capped by the torque law where one is given (below rated speed at fine pitch the
     law asks less: a rotor slowed by a lull is not braked into a stall); region II follows the
-    law (or K_opt Omega_g^2 on the raw generator speed).
+    law (or K_opt Omega_g^2 on the raw generator speed). The pitch commands stay above the
+    turbine's region-2 pitch (a deck's minimum-pitch table, else the fine pitch): with a torque
+    law, the law's minimum-pitch schedule on its filtered generator speed (the baseline's and
+    the TS law's); without one, ``pitch_floor``, :func:`linearize.region2_pitch` at the
+    design's wind (never above the operating point's), which the schedule's nearest design
+    makes a minimum pitch scheduled on the estimated wind.
     """
 
     kind = "lqr-pio"
@@ -517,6 +522,11 @@ class LQRPIOController(DesignBase):
         self._iu_arr = np.asarray(self._iu, dtype=np.int64)
         pa = turbine.pitch_actuator
         self._pitch_lim = np.array([pa.min_pitch_rad, pa.max_pitch_rad])
+        # the lowest pitch command: the turbine's region-2 pitch at the design's wind (a deck's
+        # minimum-pitch table, else fine pitch), never above the operating point's
+        self.pitch_floor = float(min(max(pa.min_pitch_rad,
+                                         linearize.region2_pitch(turbine, model.wind_mps)),
+                                     np.min(np.asarray(model.u0)[:3])))
         # how far a command may lead the measured pitch: a first-order actuator (time
         # constant tau) then moves at most at its rate
         self._reach = pa.max_rate_rad_s * pa.time_constant if pa.time_constant > 0 else math.inf

@@ -216,6 +216,8 @@ def _lqr_point(c: Any, k: int) -> list[tuple[str, Any, str]]:
          "operating point states and unknown inputs"),
         (p + "k_opt", 0.0 if c.k_opt is None else float(c.k_opt),
          "region II torque gain without a torque law [N m s^2/rad^2]"),
+        (p + "pitch_floor", float(c.pitch_floor), "the design's lowest pitch command [rad]: "
+         "the turbine's region-2 pitch at its wind"),
     ]
 
 

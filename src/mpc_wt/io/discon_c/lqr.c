@@ -25,7 +25,7 @@ typedef struct {
     int nx, nf, ny, nu, ng, region, has_law;
     double *ad, *bd, *gain, *y0, *u0, *x0d0;
     int *gi;
-    double k_opt;
+    double k_opt, pitch_floor;
     /* state */
     double *xe, *udev;
 } mw_lqr_point;
@@ -63,7 +63,7 @@ static int lqr_step(mw_ctrl *self, const mw_meas *m, mw_cmd *out, char *msg)
     mw_lqr *c = (mw_lqr *)self;
     int switched, k, i, j, b, n, before = c->sched.active;
     mw_lqr_point *p;
-    double *xn = c->work, pitch[3], torque, reach = c->limits[4];
+    double *xn = c->work, pitch[3], torque, lo, reach = c->limits[4];
     if (!mw_finite(m->rotor_speed) || !mw_finite(m->gen_torque)
         || !mw_finite(m->pitch[0] + m->pitch[1] + m->pitch[2]) || !mw_finite(m->gen_speed)) {
         mw_msg(msg, "mpc-wt lqr-pio: measured rotor speed (record 21), generator speed (20), "
@@ -96,8 +96,15 @@ static int lqr_step(mw_ctrl *self, const mw_meas *m, mw_cmd *out, char *msg)
         for (j = 0; j < n; j++) acc += p->gain[(size_t)i * n + j] * p->xe[j];
         c->u[p->gi[i]] -= acc;
     }
+    /* the lowest pitch: the baseline's minimum-pitch schedule on the law's filtered speed
+     * (continuous, as the baseline's and the TS law's), else the design's floor */
+    lo = dmax(c->limits[0], p->pitch_floor);
+    if (p->has_law && c->law.started) {
+        double off = mw_law_min_pitch_offset(&c->law.law, c->law.w);
+        lo = off > 0.0 ? dmax(c->limits[0], c->law.law.p_min + off) : c->limits[0];
+    }
     for (b = 0; b < 3; b++) {
-        pitch[b] = dmin(dmax(c->u[b], c->limits[0]), c->limits[1]);
+        pitch[b] = dmin(dmax(c->u[b], lo), c->limits[1]);
         if (reach >= 0.0)
             pitch[b] = dmin(dmax(pitch[b], m->pitch[b] - reach), m->pitch[b] + reach);
     }
@@ -189,6 +196,7 @@ static int point_read(const mw_input *in, int k, int n_signals, mw_lqr_point *p,
         || !(p->u0 = mw_getp_alloc_n(in, pre, "u0", p->nu, msg))
         || !(p->x0d0 = mw_getp_alloc_n(in, pre, "x0d0", n, msg))
         || mw_getp(in, pre, "k_opt", &p->k_opt, msg)
+        || mw_getp(in, pre, "pitch_floor", &p->pitch_floor, msg)
         || !(gi = mw_getp_alloc_n(in, pre, "gain_inputs", p->ng, msg)))
         return -1;
     p->gi = (int *)malloc((size_t)p->ng * sizeof(int));
