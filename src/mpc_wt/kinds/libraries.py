@@ -198,10 +198,38 @@ def _rosco_keys(path: Path) -> list[str]:
     return keys
 
 
+#: ROSCO's modes that need what mpc-wt's plant and host do not give, and what that is: ROSCO
+#: reads records no host fills or drives actuators the plant lacks (BAR_10's own file,
+#: ``Flp_Mode`` 2, ended the library's process with a segmentation fault at the first call)
+ROSCO_MODES_REFUSED = {"Flp_Mode": "trailing-edge flap control; the plant has no flaps",
+                       "CC_Mode": "cable control; the plant has no mooring",
+                       "StC_Mode": "structural control; the plant has no tuned dampers",
+                       "Ext_Mode": "an external controller library called by ROSCO",
+                       "ZMQ_Mode": "a ZeroMQ connection to another process"}
+
+
+def _refused_modes(path: Path) -> None:
+    """Raise ValueError naming the first of :data:`ROSCO_MODES_REFUSED` that ``path`` sets."""
+    for no, line in enumerate(path.read_text(errors="replace").splitlines(), 1):
+        head, bang, tail = line.partition("!")
+        words = tail.split()
+        if not bang or not words or words[0] not in ROSCO_MODES_REFUSED:
+            continue
+        try:
+            value = int(float(head.split()[0]))
+        except (IndexError, ValueError):
+            continue
+        if value != 0:
+            raise ValueError(f"discon_in: {path.name}:{no} {words[0]} is {value} "
+                             f"({ROSCO_MODES_REFUSED[words[0]]}); allowed here: 0; set it to 0 "
+                             f"in a copy of {path}")
+
+
 def rosco_file_check(path: Path) -> list[str]:
     """The keys the installed ROSCO's own NREL 5-MW input file has and ``path`` lacks, logged
     as a warning with the installed version: a file written for another ROSCO release (ROSCO
     stops on the ones it requires: "Missing or default values are not allowed for ...").
+    A file that sets a mode of :data:`ROSCO_MODES_REFUSED` is refused.
 
     Parameters
     ----------
@@ -217,6 +245,8 @@ def rosco_file_check(path: Path) -> list[str]:
     ------
     FileNotFoundError
         If ``path`` does not exist.
+    ValueError
+        Naming the file, line, key and value of a refused mode.
     """
     from importlib.metadata import PackageNotFoundError, version
 
@@ -224,6 +254,7 @@ def rosco_file_check(path: Path) -> list[str]:
 
     if not path.is_file():
         raise FileNotFoundError(f"discon_in: {path} does not exist")
+    _refused_modes(path)
     ref = rosco_discon("NREL-5MW")
     have = set(_rosco_keys(path))
     missing = [k for k in _rosco_keys(ref) if k not in have]

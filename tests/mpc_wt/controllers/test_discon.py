@@ -504,3 +504,23 @@ def test_a_discon_in_of_another_rosco_release_is_named_with_its_missing_keys(tur
     with pytest.raises(ControllerLibraryError, match="F_VSRefSpdCornerFreq"):
         run_controller(turbine, "rosco", Scenario(12.0, "steady", 1, 2.0),
                        options={"discon_in": str(old)})
+
+
+def test_a_rosco_file_with_flap_control_is_refused_naming_its_line(tmp_path) -> None:
+    """The rosco wheel's BAR_10 ``DISCON.IN`` sets ``Flp_Mode`` 2 (trailing-edge flaps, which
+    the plant does not have): ROSCO ended its process with a segmentation fault at the first
+    call. The check refuses it before a run, naming the file, line 27 and the key; a copy with
+    the mode 0 passes."""
+    import rosco
+
+    from mpc_wt.kinds.libraries import rosco_file_check
+
+    path = (Path(rosco.__file__).parents[1] / "Examples" / "Test_Cases" / "BAR_10"
+            / "BAR_10_DISCON.IN")
+    with pytest.raises(ValueError, match=r"BAR_10_DISCON.IN:27 Flp_Mode is 2 \(trailing-edge "
+                                         r"flap control.*allowed here: 0"):
+        rosco_file_check(path)
+    copy = tmp_path / "BAR_10_DISCON.IN"
+    copy.write_text(path.read_text().replace("2                   ! Flp_Mode",
+                                             "0                   ! Flp_Mode"))
+    rosco_file_check(copy)
