@@ -95,6 +95,9 @@ def _judge(name: str, d: dict[str, Any], base: dict[str, Any], turbine: lineariz
     winds = sorted({c[0] for c in cases})
     row: dict[str, Any] = {"controller": name, "failed": len(d["failed"]),
                            "stops": sum(1 for c in cases if c[2].get("supervisor_state"))}
+    if not cases:                              # every case failed: nothing to measure
+        return {**row, **dict.fromkeys(("power_r3", "speed_over", "power_max", "travel",
+                                        "region2_pitch"), math.nan)}
     p3 = [np.mean([c[2]["power_mean_W"] for c in cases if c[0] == w]) / rated_p
           for w in winds if w >= rated_wind + margin]
     row["power_r3"] = max(p3, key=lambda p: abs(p - 1.0)) if p3 else math.nan

@@ -301,3 +301,31 @@ def test_lqr_pio_on_the_iea22_pitches_no_lower_than_its_minimum_pitch_table() ->
     pitch = np.column_stack([res.channel(f"pitch_{i}") for i in (1, 2, 3)])
     assert pitch.min() >= _iea22_table_floor() - math.radians(0.01)
     assert res.channel("rotor_speed").max() <= 1.1 * t.operation.rated_rotor_speed_rad_s
+
+
+def _deck_value(path: Path, key: str) -> float:
+    """A ``value ! key`` line's value, read from the file as published."""
+    for line in path.read_text().splitlines():
+        head, bang, tail = line.partition("!")
+        if bang and tail.split()[:1] == [key]:
+            return float(head.split()[0])
+    raise AssertionError(f"no {key} in {path}")
+
+
+@pytest.mark.parametrize("kind", ["ts", "lqr-pio"])
+def test_the_model_based_kinds_pitch_no_lower_than_fine_on_a_deck_whose_actuator_goes_lower(
+        kind: str) -> None:
+    """The rosco wheel's NREL-2.8-127: fine pitch 0 deg (its ``PC_FinePit``), the actuator's
+    limit -10 deg (``PC_MinPit``), so a law's lowest pitch must be the fine pitch, not the
+    actuator's. 90 s at 8 m/s (region 2, class A, seed 1): TS's and LQR-PIO's blades never
+    below the file's fine pitch. The laws took the actuator's limit where the baseline's
+    minimum-pitch schedule has no offset: TS's region-2 pitch stood 10 deg below fine in the
+    table of every kind on this deck."""
+    fst = CASES / "NREL_2p8_127" / "NREL-2p8-127.fst"
+    dis = fst.parent / "NREL-2p8-127_DISCON.IN"
+    fine, lowest = _deck_value(dis, "PC_FinePit"), _deck_value(dis, "PC_MinPit")
+    assert lowest < fine - math.radians(5.0)
+    t = linearize.load_turbine(fst)
+    res = run_controller(t, kind, Scenario(8.0, "A", 1, 90.0))
+    pitch = np.column_stack([res.channel(f"pitch_{i}") for i in (1, 2, 3)])
+    assert pitch.min() >= fine - math.radians(0.01)
