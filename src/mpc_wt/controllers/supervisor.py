@@ -337,7 +337,12 @@ class TorqueLawGuard(ControllerBase):
     fine, only the torque left; holding power with it is the unstable constant-power law below
     rated: the torque rises as the rotor slows, and the rotor stalls (the sign-off campaign:
     13 of 65 MPC cases, from 9 to 17 m/s). With the guard, while the measured collective pitch
-    is within ``fine_band`` of fine and the generator speed below the law's rated speed, the
+    is within ``fine_band`` of the law's minimum pitch at the measured generator speed (fine
+    pitch plus the baseline's minimum-pitch schedule,
+    :meth:`~mpc_wt.controllers.baseline.BaselineController.min_pitch`: a deck's ROSCO table
+    where it has one; from the fine pitch alone the guard never acted on the
+    IEA-22-280-RWT, whose region 2 lies 3-5 deg above its fine pitch) and the generator speed
+    below the law's rated speed, the
     torque is at most the baseline's law at that speed (K omega^2 in region 2, the region 2.5
     line up to rated torque: :meth:`mpc_wt.controllers.baseline.BaselineController.torque`); otherwise the
     guarded controller's torque passes unchanged.
@@ -362,7 +367,7 @@ class TorqueLawGuard(ControllerBase):
             raise ValueError(f"fine_band must be a finite pitch >= 0 rad, got {fine_band!r}")
         self.controller = controller
         self.law = BaselineController(turbine)
-        self.fine = turbine.operation.fine_pitch_rad + band
+        self.band = band
         self.signals: dict[str, float] = {"torque_law_active": 0.0}
 
     def reset(self) -> None:
@@ -376,8 +381,9 @@ class TorqueLawGuard(ControllerBase):
         pitch, tq = self.controller.step(t, meas)
         w, p = float(meas["gen_speed"]), meas["pitch"]
         active = 0.0
-        if w < self.law.w_rated and float(p[0] + p[1] + p[2]) / 3.0 <= self.fine:
-            cap = self.law.torque(w, 0.0)
+        floor = self.law.min_pitch(w)         # the law's region-2 pitch at this speed
+        if w < self.law.w_rated and float(p[0] + p[1] + p[2]) / 3.0 <= floor + self.band:
+            cap = self.law.torque(w, self.law.pitch_min)   # the law's region-2 torque
             if tq > cap:
                 tq, active = cap, 1.0
         self.signals = {**getattr(self.controller, "signals", {}), "torque_law_active": active}

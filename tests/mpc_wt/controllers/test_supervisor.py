@@ -205,3 +205,26 @@ def test_torque_law_guard_caps_only_in_a_lull() -> None:
     assert tq == pytest.approx(k * w2**2, rel=1e-12)
     with pytest.raises(ValueError, match=r"fine_band must be a finite pitch >= 0 rad, got -1"):
         TorqueLawGuard(_MaxTorque(tb), tb, fine_band=-1)
+
+
+def test_torque_law_guard_measures_its_band_from_the_minimum_pitch_table() -> None:
+    """The IEA-22-280-RWT deck as published: fine pitch -4.01 deg, its ROSCO table holds region
+    2 at -1.3 to +0.6 deg. At the trim of 9 m/s (5.10 rpm, pitch -1.15 deg on the table, read
+    back from the turbine's trim) the guard caps the torque at the law's; 2 deg above the table
+    it lets it pass. Measured from the fine pitch, its band ended at -3.01 deg and it never
+    acted on this turbine."""
+    from pathlib import Path
+
+    from mpc_wt.controllers.supervisor import TorqueLawGuard
+
+    deck = (Path(__file__).parents[2] / "data" / "iea22" / "OpenFAST" / "IEA-22-280-RWT-Monopile"
+            / "IEA-22-280-RWT-Monopile.fst")
+    tb = linearize.load_turbine(deck)
+    op = linearize.trim(tb, 9.0)
+    assert math.degrees(op.pitch_rad) > math.degrees(tb.operation.fine_pitch_rad) + 2.5
+    g = TorqueLawGuard(_MaxTorque(tb), tb)
+    w = op.rotor_speed_rad_s * tb.drivetrain.gearbox_ratio
+    _, tq = g.step(0.0, {"gen_speed": w, "pitch": np.full(3, op.pitch_rad)})
+    assert g.signals["torque_law_active"] == 1.0 and tq < tb.generator.max_torque
+    _, tq = g.step(0.1, {"gen_speed": w, "pitch": np.full(3, op.pitch_rad + math.radians(2.0))})
+    assert g.signals["torque_law_active"] == 0.0 and tq == tb.generator.max_torque
