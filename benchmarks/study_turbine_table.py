@@ -47,17 +47,31 @@ REGION2_PITCH_TOL = 0.5
 WIND_AVERAGE_S = 30.0
 
 
+#: the low-passed rotor-effective wind of each scenario's field: every controller of a case
+#: meets the same field, made once here
+_WIND: dict[Scenario, tuple[np.ndarray, np.ndarray]] = {}
+
+
+def _filtered_wind(turbine: linearize.Turbine, scenario: Scenario
+                   ) -> tuple[np.ndarray, np.ndarray]:
+    """Times [s] and the rotor-effective wind of the case's field low-passed over
+    :data:`WIND_AVERAGE_S` [m/s]."""
+    if scenario not in _WIND:
+        _, field = make_wind(turbine, scenario, "u")
+        v = lidar.rotor_effective_wind(field, turbine.geometry.tip_radius, method="cube")
+        n = max(1, int(round(WIND_AVERAGE_S / float(np.median(np.diff(field.t))))))
+        _WIND[scenario] = (field.t, np.convolve(v, np.ones(n) / n, mode="same"))
+    return _WIND[scenario]
+
+
 def _region2_deviation(turbine: linearize.Turbine, res: ClosedLoopResult, scenario: Scenario,
-                       rated_wind: float) -> float:
+                       rated_wind: float, transient: float) -> float:
     """The median region-2 deviation of the mean pitch from the schedule [deg] (module
     docstring), NaN where the case holds no region-2 sample."""
-    _, field = make_wind(turbine, scenario, "u")
-    v = lidar.rotor_effective_wind(field, turbine.geometry.tip_radius, method="cube")
-    n = max(1, int(round(WIND_AVERAGE_S / float(np.median(np.diff(field.t))))))
-    vf = np.convolve(v, np.ones(n) / n, mode="same")
+    tf, vf = _filtered_wind(turbine, scenario)
     t = res.t
-    keep = t >= t[0] + 60.0
-    vw = np.interp(t[keep], field.t, vf)
+    keep = t >= t[0] + transient
+    vw = np.interp(t[keep], tf, vf)
     pitch = np.mean([res.channel(f"pitch_{i}")[keep] for i in (1, 2, 3)], axis=0)
     power = res.channel("gen_power")[keep]
     sel = (vw <= rated_wind - 1.0) & (power < 0.95 * turbine.operation.rated_power)
@@ -68,19 +82,20 @@ def _region2_deviation(turbine: linearize.Turbine, res: ClosedLoopResult, scenar
 
 
 def _collect(root: Path) -> tuple[dict[str, Any], linearize.Turbine, float]:
-    """Per controller its done cases (wind, seed, metrics, file, scenario) and failures."""
+    """Per controller its done cases (wind, seed, metrics, file, the spec's case) and
+    failures."""
     out: dict[str, Any] = {}
     with CampaignStore(root) as st:
         raw = st.meta()["spec_raw"]          # the spec with its paths resolved
         spec = spec_from_dict(raw, import_plugins=False)
-        scen = {c.case_id: c.scenario for c in spec.cases()}
+        cases = {c.case_id: c for c in spec.cases()}
         turbine = linearize.load_turbine(spec.turbine)
         rated_wind = linearize.rated_wind_speed(turbine)
         for r in st.rows():
             d = out.setdefault(r.controller, {"cases": [], "failed": []})
             if r.status == "done" and r.metrics:
                 d["cases"].append((r.wind_mps, r.seed, r.metrics, root / str(r.file),
-                                   scen.get(r.case_id)))
+                                   cases.get(r.case_id)))
             elif r.status == "failed":
                 d["failed"].append(f"{r.wind_mps:g} m/s seed {r.seed}: {r.error}")
     return out, turbine, rated_wind
@@ -111,7 +126,8 @@ def _judge(name: str, d: dict[str, Any], base: dict[str, Any], turbine: lineariz
     row["power_max"] = max(c[2]["extremes"]["gen_power"]["max"] for c in cases) / rated_p
     travel = sum(c[2]["pitch_travel_deg"] for c in cases)
     row["travel"] = travel / sum(c[2]["pitch_travel_deg"] for c in base["cases"])
-    dev = [_region2_deviation(turbine, ClosedLoopResult.load(c[3]), c[4], rated_wind)
+    dev = [_region2_deviation(turbine, ClosedLoopResult.load(c[3]), c[4].scenario, rated_wind,
+                              c[4].transient)
            for c in cases if c[0] < rated_wind and c[4] is not None]
     dev = [x for x in dev if math.isfinite(x)]
     row["region2_pitch"] = max(dev, key=abs) if dev else math.nan

@@ -188,14 +188,15 @@ def _build_rosco(ctx: BuildContext, opts: RoscoOptions) -> Built:
                          **source)
 
 
-def _rosco_keys(path: Path) -> list[str]:
-    """The keys of a ROSCO input file's ``value ! key - description`` lines."""
-    keys = []
-    for line in path.read_text(errors="replace").splitlines():
+def _rosco_entries(path: Path) -> list[tuple[int, str, str]]:
+    """The ``value ! key - description`` lines of a ROSCO input file: (line number, key,
+    value text)."""
+    out = []
+    for no, line in enumerate(path.read_text(errors="replace").splitlines(), 1):
         head, bang, tail = line.partition("!")
         if bang and head.strip() and tail.split():
-            keys.append(tail.split()[0])
-    return keys
+            out.append((no, tail.split()[0], head.strip()))
+    return out
 
 
 #: ROSCO's modes that need what mpc-wt's plant and host do not give, and what that is: ROSCO
@@ -208,20 +209,19 @@ ROSCO_MODES_REFUSED = {"Flp_Mode": "trailing-edge flap control; the plant has no
                        "ZMQ_Mode": "a ZeroMQ connection to another process"}
 
 
-def _refused_modes(path: Path) -> None:
-    """Raise ValueError naming the first of :data:`ROSCO_MODES_REFUSED` that ``path`` sets."""
-    for no, line in enumerate(path.read_text(errors="replace").splitlines(), 1):
-        head, bang, tail = line.partition("!")
-        words = tail.split()
-        if not bang or not words or words[0] not in ROSCO_MODES_REFUSED:
+def _refused_modes(path: Path, entries: list[tuple[int, str, str]]) -> None:
+    """Raise ValueError naming the first of :data:`ROSCO_MODES_REFUSED` that ``path`` (its
+    :func:`_rosco_entries`) sets."""
+    for no, key, head in entries:
+        if key not in ROSCO_MODES_REFUSED:
             continue
         try:
             value = int(float(head.split()[0]))
-        except (IndexError, ValueError):
+        except ValueError:
             continue
         if value != 0:
-            raise ValueError(f"discon_in: {path.name}:{no} {words[0]} is {value} "
-                             f"({ROSCO_MODES_REFUSED[words[0]]}); allowed here: 0; set it to 0 "
+            raise ValueError(f"discon_in: {path.name}:{no} {key} is {value} "
+                             f"({ROSCO_MODES_REFUSED[key]}); allowed here: 0; set it to 0 "
                              f"in a copy of {path}")
 
 
@@ -254,10 +254,11 @@ def rosco_file_check(path: Path) -> list[str]:
 
     if not path.is_file():
         raise FileNotFoundError(f"discon_in: {path} does not exist")
-    _refused_modes(path)
+    entries = _rosco_entries(path)
+    _refused_modes(path, entries)
+    have = {k for _, k, _ in entries}
     ref = rosco_discon("NREL-5MW")
-    have = set(_rosco_keys(path))
-    missing = [k for k in _rosco_keys(ref) if k not in have]
+    missing = [k for _, k, _ in _rosco_entries(ref) if k not in have]
     if missing:
         try:
             installed = version("rosco")

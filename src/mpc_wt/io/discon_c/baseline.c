@@ -587,6 +587,12 @@ double mw_torque_law_step(mw_torque_law *t, double gen_speed, double pitch, doub
     return q < t->lo ? t->lo : (q > t->hi ? t->hi : q);
 }
 
+double mw_torque_law_min_pitch(const mw_torque_law *t)
+{
+    if (!t->started) return -HUGE_VAL;
+    return t->law.p_min + mw_law_min_pitch_offset(&t->law, t->w);
+}
+
 mw_ctrl *mw_ctrl_new(size_t size, const char *who,
                      int (*step)(mw_ctrl *, const mw_meas *, mw_cmd *, char *),
                      void (*destroy)(mw_ctrl *),

@@ -98,10 +98,8 @@ static int lqr_step(mw_ctrl *self, const mw_meas *m, mw_cmd *out, char *msg)
     }
     /* the lowest pitch: the baseline's minimum-pitch schedule on the law's filtered speed
      * (continuous, as the baseline's and the TS law's), else the design's floor */
-    lo = dmax(c->limits[0], p->pitch_floor);
-    if (p->has_law && c->law.started)
-        lo = dmax(c->limits[0], c->law.law.p_min + mw_law_min_pitch_offset(&c->law.law,
-                                                                            c->law.w));
+    lo = dmax(c->limits[0], p->has_law && c->law.started ? mw_torque_law_min_pitch(&c->law)
+                                                          : p->pitch_floor);
     for (b = 0; b < 3; b++) {
         pitch[b] = dmin(dmax(c->u[b], lo), c->limits[1]);
         if (reach >= 0.0)

@@ -147,6 +147,9 @@ typedef struct {
 } mw_torque_law;
 int mw_torque_law_read(const mw_input *in, mw_torque_law *t, char *msg);
 double mw_torque_law_step(mw_torque_law *t, double gen_speed, double pitch, double power);
+/* the law's minimum pitch at its filtered speed: fine pitch plus the minimum-pitch schedule's
+ * offset [rad] (a law that has not stepped yet: -inf, no floor) */
+double mw_torque_law_min_pitch(const mw_torque_law *t);
 
 /* second-order sections in transposed direct form II on nch signals, started at the steady
  * state of their first input (scipy's sosfilt_zi) (ibc.c) */

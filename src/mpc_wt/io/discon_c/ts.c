@@ -182,8 +182,8 @@ static int ts_step(mw_ctrl *self, const mw_meas *m, mw_cmd *out, char *msg)
         lo = dmax(lo, pmin - c->limits[4]);
         hi = dmin(hi, pmax + c->limits[4]);
     }
-    if (c->has_law && c->law.started)       /* the baseline's minimum-pitch schedule */
-        lo = dmax(lo, c->law.law.p_min + mw_law_min_pitch_offset(&c->law.law, c->law.w));
+    if (c->has_law)                         /* the baseline's minimum-pitch schedule */
+        lo = dmax(lo, mw_torque_law_min_pitch(&c->law));
     pitch = dmin(dmax(raw[0], lo), hi);
     torque = dmin(dmax(raw[1], c->limits[2]), c->limits[3]);
     if (pitch != raw[0] || (c->own_torque && torque != raw[1])) q = c->q;   /* anti-windup */
