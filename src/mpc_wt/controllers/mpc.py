@@ -1267,6 +1267,15 @@ class ScheduledMPC(DesignBase):
         baseline's, :class:`~mpc_wt.controllers.baseline.BaselineController`): the target
         torque at the measured generator speed, and the power target capped at what that
         torque gives there.
+    law_region3_speed : float
+        Below this fraction of the law's rated generator speed [-] (default 0.95, as
+        :class:`~mpc_wt.controllers.scheduling.RegionFloor`'s ``pitch_min_speed``) the target
+        torque is the law's region-2 torque whatever the measured pitch: the law tells region
+        3 from a pitch above its minimum-pitch schedule, which the MPC's own pitch reaches in
+        a lull far below rated speed; the law's region 3 then asked for rated power, the
+        torque rose as the rotor slowed, and the rotor stalled (``mpc-lidar`` on the
+        IEA-22-280-RWT at 9 m/s, class IA, seed 2: 4 deg of pitch at 0.45 x rated speed,
+        the rotor reversed at 228 s).
     below_rated : MPCSettings, optional
         Settings of the designs at grid winds below rated (default: ``settings``).
     torque_notch_hz : float or None
@@ -1314,7 +1323,7 @@ class ScheduledMPC(DesignBase):
                  below_rated: MPCSettings | None = None, torque_notch_hz: float | None = None,
                  torque_notch_q: float = 2.0, region_floor: Any = None,
                  tower_notch_hz: float | None = None,
-                 power_limit: float | None = None) -> None:
+                 power_limit: float | None = None, law_region3_speed: float = 0.95) -> None:
         from mpc_wt.controllers.scheduling import SCHEDULE_SOURCES, RegionFloor, WindSchedule
 
         if wind_source not in SCHEDULE_SOURCES:
@@ -1347,6 +1356,8 @@ class ScheduledMPC(DesignBase):
         self._rated_wind = linearize.rated_wind_speed(turbine)
         self.torque_law = torque_law
         self._law = LawTorque(torque_law, st.dt) if torque_law is not None else None
+        self.law_region3_speed = check_number("law_region3_speed", law_region3_speed, lo=0.0,
+                                              hi=2.0)
         self._ip = linearize.MADSEN_OUTPUTS.index("gen_power")
         m0 = family.models[0]
         self._eff = float(m0.z0[m0.outputs.index("gen_power")] / (m0.u0[3] * _gen_speed(m0)))

@@ -523,6 +523,9 @@ def _mpc_entries(ctl: Any, preview: Any = None) -> list[tuple[str, Any, str]]:
         rows.append(("law_torque", np.array([lt._a, lt._offset, lt._lo, lt._hi], float),
                      "speed filter pole, below-rated pitch offset [rad], torque min, max "
                      "[N m]"))
+        rows.append(("law_region3_speed",
+                     ctl.law_region3_speed * lt.law.gains.rated_gen_speed_rad_s,
+                     "the law's pitch tells region 3 above this generator speed [rad/s]"))
     notch = ctl._notch
     rows.append(("torque_notch", float(notch is not None),
                  "1: a notch on the torque command (the estimator is given the filtered torque)"))

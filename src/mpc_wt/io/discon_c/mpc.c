@@ -78,6 +78,7 @@ typedef struct {
     mw_point *pt;
     mw_schedule sched;
     mw_torque_law law;
+    double law_region3_speed;     /* the law's pitch counts above this generator speed [rad/s] */
     double target_wind, pitch_target_wind;
     int target_started;
     int has_notch;                /* the notch on the torque command, its largest rate */
@@ -563,7 +564,11 @@ static int mpc_step(mw_ctrl *self, const mw_meas *m, mw_cmd *out, char *msg)
         }
         if (c->has_law) {
             double w_g = m->gen_speed, pitch = (m->pitch[0] + m->pitch[1] + m->pitch[2]) / 3.0;
-            double q = mw_torque_law_step(&c->law, w_g, pitch, c->law.law.p_rated);
+            double q;
+            /* a pitched rotor well below rated speed is in a lull, not in region 3: the
+             * target is the law's region-2 torque there, not rated power's */
+            if (w_g < c->law_region3_speed) pitch = c->law.law.p_min;
+            q = mw_torque_law_step(&c->law, w_g, pitch, c->law.law.p_rated);
             c->ut[3] = q;
             c->zt[c->ip] = dmin(c->zt[c->ip], c->eff * q * w_g);
         }
@@ -687,7 +692,16 @@ static int mpc_read(const mw_input *in, mw_ctrl *self, char *msg)
         mw_msg(msg, "mpc-wt mpc: out of memory");
         return -1;
     }
-    if (c->has_law && mw_torque_law_read(in, &c->law, msg)) return -1;
+    if (c->has_law) {
+        if (mw_torque_law_read(in, &c->law, msg)
+            || mw_get(in, "law_region3_speed", &c->law_region3_speed, msg))
+            return -1;
+        if (!(c->law_region3_speed >= 0.0) || !mw_finite(c->law_region3_speed)) {
+            mw_msg(msg, "mpc-wt mpc: input file '%s': key 'law_region3_speed' must be a finite "
+                   "generator speed >= 0 rad/s, got %g", in->path, c->law_region3_speed);
+            return -1;
+        }
+    }
     if (mw_get_int(in, "torque_notch", 0, 1, &c->has_notch, msg)
         || mw_get(in, "power_limit", &c->power_limit, msg))
         return -1;
