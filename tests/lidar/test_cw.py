@@ -223,3 +223,17 @@ def test_rotor_effective_wind(turbulent: WindField) -> None:
     # the disc average has less variance than a point (spatial filtering)
     assert rews.std() < turbulent.u[:, 12, 12].std()
     assert lidar.rotor_effective_wind(turbulent, 63.0, "cube").mean() >= rews.mean()
+
+
+@pytest.mark.parametrize("radius", [63.0, 89.2, 120.0, 142.0])
+def test_the_default_focus_grows_with_the_rotor(radius: float) -> None:
+    """Madsen et al. (2012, sec. II-E) focus 54 m ahead of the NREL 5-MW's 63 m rotor; by
+    default any rotor's LIDAR keeps their beam half-cone angle at 75 % span, atan(47.25 / 54)
+    = 41.19 deg, under the 45 deg their reference recommends, and a preview that grows with
+    the rotor."""
+    lid = CWLidar(radius)
+    assert math.degrees(lid.cone_angle_rad) == pytest.approx(41.186, abs=1e-3)
+    assert lid.focus_distance == pytest.approx(54.0 * radius / 63.0, rel=1e-12)
+    if radius == 63.0:
+        assert lid.focus_distance == 54.0
+    assert CWLidar(radius, focus_distance=30.0).focus_distance == 30.0

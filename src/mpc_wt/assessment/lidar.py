@@ -13,7 +13,7 @@ __all__ = ["lidar_evaluation"]
 
 
 def lidar_evaluation(field: lidar.WindField, turbine: linearize.Turbine, *,
-                   focus_distance: float = 54.0, sample_rate: float = 10.0, horizon: int = 15,
+                   focus_distance: float | None = None, sample_rate: float = 10.0, horizon: int = 15,
                    dt_ctrl: float = 0.1, evolution: bool = False, evolution_seed: int = 0,
                    **lidar_options: Any) -> tuple[dict[str, Any], dict[str, Any]]:
     """Run the LIDAR over the field with the rotor at its trimmed speed and judge the preview.
@@ -30,8 +30,9 @@ def lidar_evaluation(field: lidar.WindField, turbine: linearize.Turbine, *,
         The wind field.
     turbine : Turbine
         The turbine (rotor radius, trimmed speed).
-    focus_distance : float
-        Axial focus distance [m].
+    focus_distance : float, optional
+        Axial focus distance [m] (default :class:`lidar.CWLidar`'s for the rotor: 54 m on the
+        NREL 5-MW).
     sample_rate : float
         LIDAR samples per second [Hz].
     horizon : int
@@ -71,6 +72,7 @@ def lidar_evaluation(field: lidar.WindField, turbine: linearize.Turbine, *,
                          f"{tp:.2f} s plus a {horizon * dt_ctrl:g} s horizon")
     t = np.arange(field.t[0], t_end, 1.0 / sample_rate)
     psi = omega * t
+    focus_distance = lid.focus_distance
     seen = lidar.evolve_field(field, focus_distance, seed=evolution_seed) if evolution else field
     meas = lid.measure(seen, t, psi, omega)
     later = lidar.blade_effective_wind(field, t + tp, psi + omega * tp, lid.radius)

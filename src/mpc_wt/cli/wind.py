@@ -58,7 +58,9 @@ def add_parsers(sub: Any) -> None:
     q = lid.add_parser("evaluate", help="coherence bandwidth and preview error on a field")
     q.add_argument("--field", required=True, help=".bts or .npz wind field")
     add_turbine(q)
-    q.add_argument("--focus", type=float, default=54.0, help="axial focus distance [m]")
+    q.add_argument("--focus", type=float, default=None,
+                   help="axial focus distance [m] (default 6/7 of the rotor radius: 54 m on "
+                        "the NREL 5-MW)")
     q.add_argument("--point", action="store_true", help="point measurement (no range weighting)")
     q.add_argument("--no-los-error", action="store_true", help="measure u directly")
     q.add_argument("--noise", type=float, default=0.0, help="LOS noise std [m/s]")

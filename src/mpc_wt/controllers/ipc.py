@@ -460,7 +460,9 @@ class IBCController(_PitchAddOn):
     ``collective`` is the baseline (or derated baseline) that regulates rotor speed and power;
     the law adds the per-blade pitch w(P) BS(K(theta_mean) HP(M_i)) (less its mean over the
     blades, see below; each blade's within ``max_amplitude_rad``) to its collective command
-    and enforces the pitch limits and rate on the sum. The filters start at the steady state of
+    and enforces the pitch limits and rate on the sum, the collective's part first (the
+    blades' own moves within the rate it leaves, as Coleman IPC's: a collective at its rate in
+    a gust is never slowed by the blades' loops). The filters start at the steady state of
     their first input. Signals: ``ibc_weight``, ``ibc_gain`` and ``ibc_pitch_1..3`` [rad].
 
     ``remove_collective=True`` (default) subtracts the blades' mean IBC pitch: the loops act on

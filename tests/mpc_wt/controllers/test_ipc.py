@@ -161,6 +161,29 @@ def test_coleman_ipc_gives_the_collective_the_rate_first(turbine) -> None:
         assert_allclose(cmd, np.radians(expect), atol=1e-6)
 
 
+def test_ibc_gives_the_collective_the_rate_first(turbine, ibc_gains) -> None:
+    """The same hand-worked case on IBC's shipped law (0.1 deg a step; at ServoDyn's first call
+    no power, so the blades' loops ask for nothing): blades at 12 / 9 / 9 deg, a collective of
+    10 deg. At the set point the collective stays and the rate step returns the blades toward
+    it: 11.9 / 9.1 / 9.1 deg. With the generator 60 rad/s above it the collective takes the
+    whole step (10.1 deg) and the blades' own parts stay: 12.1 / 9.1 / 9.1 deg. (Clipped blade
+    by blade the collective moved a third of its step, 11.9 / 9.1 / 9.1, and in a gust on the
+    IEA-22-280-RWT's 2 deg/s drives it fell behind the baseline's.)"""
+    from mpc_wt.controllers.ipc import IBCController
+
+    base = BaselineController(turbine, tune_baseline(turbine))
+    ctl = law_controller(IBCController(base, ibc_gains), "ibc", turbine)
+    w_set = base.gains.rated_gen_speed_rad_s
+    for speed, expect in ((w_set, [11.9, 9.1, 9.1]), (w_set + 60.0, [12.1, 9.1, 9.1])):
+        ctl.reset()
+        meas = {"pitch": np.radians([12.0, 9.0, 9.0]), "gen_speed": speed,
+                "rotor_speed": speed / turbine.drivetrain.gearbox_ratio,
+                "flap_moment": np.zeros(3), "edge_moment": np.zeros(3), "azimuth": 0.0,
+                "gen_power": 5e6}
+        cmd, _ = ctl.step(0.0, meas)
+        assert_allclose(cmd, np.radians(expect), atol=1e-6)
+
+
 def test_the_cyclic_amplitude_follows_the_pitch_drives(turbine) -> None:
     """Hand-worked from published data: a cyclic pitch of amplitude A at 1P moves at A Omega.
     The NREL 5-MW's drives reach 8 deg/s and its rotor turns at 12.1 rpm (1.267 rad/s): half

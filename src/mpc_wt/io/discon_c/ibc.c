@@ -133,10 +133,20 @@ int mw_ibc_step(mw_ibc *b, const mw_meas *m, double dt, const double *pc, double
     for (i = 0; i < 3; i++) u[i] = b->u[i] = dmin(dmax(u[i], -b->amp), b->amp);
     b->weight = w;
     b->gain = k;
-    for (i = 0; i < 3; i++) {
-        double prev = b->has_last ? b->last[i] : m->pitch[i], d = b->a.rate * dt;
-        double v = dmin(dmax(pc[i] + u[i], b->a.pmin), b->a.pmax);
-        out[i] = b->last[i] = dmin(dmax(v, prev - d), prev + d);
+    {
+        /* the collective's part moves first within the rate, the blades' own within what is
+         * left (clipped blade by blade, a collective at the rate fell behind the baseline's) */
+        double prev[3], c_last, c_mean, c_new, budget, d = b->a.rate * dt;
+        for (i = 0; i < 3; i++) prev[i] = b->has_last ? b->last[i] : m->pitch[i];
+        c_last = (prev[0] + prev[1] + prev[2]) / 3.0;
+        c_mean = (pc[0] + pc[1] + pc[2]) / 3.0;
+        c_new = dmin(dmax(c_mean, c_last - d), c_last + d);
+        budget = d - fabs(c_new - c_last);
+        for (i = 0; i < 3; i++) {
+            double a_last = prev[i] - c_last;
+            double a = dmin(dmax(pc[i] - c_mean + u[i], a_last - budget), a_last + budget);
+            out[i] = b->last[i] = dmin(dmax(c_new + a, b->a.pmin), b->a.pmax);
+        }
     }
     b->has_last = 1;
     return 0;
