@@ -134,45 +134,28 @@ def test_coleman_ipc_gains(turbine) -> None:
     assert np.all(np.abs(np.abs(np.degrees(g.azimuth_offset_rad)) - 180.0) < 45.0)
 
 
-def test_coleman_ipc_gives_the_collective_the_rate_first(turbine) -> None:
-    """Hand-worked, on the shipped law: the NREL 5-MW's 8 deg/s at 80 Hz is 0.1 deg a step.
-    At the first call (ServoDyn's: no power yet, so the IPC's weight is 0 and it asks for no
-    cyclic) the blades stand at 12 / 9 / 9 deg, a collective of 10 deg with a cyclic of
+@pytest.mark.parametrize("kind", ["coleman-ipc", "ibc"])
+def test_the_collective_gets_the_rate_first(turbine, ibc_gains, kind) -> None:
+    """Hand-worked, on each shipped law: the NREL 5-MW's 8 deg/s at 80 Hz is 0.1 deg a step.
+    At the first call (ServoDyn's: no power yet, so the blades' loops have weight 0 and ask for
+    nothing) the blades stand at 12 / 9 / 9 deg, a collective of 10 deg with blade parts of
     +2 / -1 / -1 deg. With the generator at its set point the baseline's collective stays at
-    10 deg (its bumpless start), and the whole rate step returns the cyclic toward 0:
+    10 deg (its bumpless start), and the whole rate step returns the blades toward it:
     11.9 / 9.1 / 9.1 deg. With the generator 60 rad/s above it the collective asks for more
     than the rate step (the PI's integral step kI GK e dt = 0.22 deg): it takes the whole step
-    (10.1 deg) and the cyclic stays where it was: 12.1 / 9.1 / 9.1 deg. Float32 records:
-    1e-6 rad."""
-    from mpc_wt.controllers.ipc import ColemanIPCController
+    (10.1 deg) and the blades' parts stay where they were: 12.1 / 9.1 / 9.1 deg. Float32
+    records: 1e-6 rad. (IBC's law clipped blade by blade: its collective moved a third of its
+    step, 11.9 / 9.1 / 9.1, and in a gust on the IEA-22-280-RWT's 2 deg/s drives it fell
+    behind the baseline's.)"""
+    from mpc_wt.controllers.ipc import ColemanIPCController, IBCController
 
     base = BaselineController(turbine, tune_baseline(turbine))
-    design = ColemanIPCController(base, tune_coleman_ipc(turbine, winds=[14.0, 20.0]))
-    assert math.degrees(design.step_max) == pytest.approx(0.1, rel=1e-9)
-    ctl = law_controller(design, "coleman-ipc", turbine)
-    w_set = base.gains.rated_gen_speed_rad_s
-    for speed, expect in ((w_set, [11.9, 9.1, 9.1]), (w_set + 60.0, [12.1, 9.1, 9.1])):
-        ctl.reset()
-        meas = {"pitch": np.radians([12.0, 9.0, 9.0]), "gen_speed": speed,
-                "rotor_speed": speed / turbine.drivetrain.gearbox_ratio,
-                "flap_moment": np.zeros(3), "edge_moment": np.zeros(3), "azimuth": 0.0,
-                "gen_power": 5e6}
-        cmd, _ = ctl.step(0.0, meas)
-        assert_allclose(cmd, np.radians(expect), atol=1e-6)
-
-
-def test_ibc_gives_the_collective_the_rate_first(turbine, ibc_gains) -> None:
-    """The same hand-worked case on IBC's shipped law (0.1 deg a step; at ServoDyn's first call
-    no power, so the blades' loops ask for nothing): blades at 12 / 9 / 9 deg, a collective of
-    10 deg. At the set point the collective stays and the rate step returns the blades toward
-    it: 11.9 / 9.1 / 9.1 deg. With the generator 60 rad/s above it the collective takes the
-    whole step (10.1 deg) and the blades' own parts stay: 12.1 / 9.1 / 9.1 deg. (Clipped blade
-    by blade the collective moved a third of its step, 11.9 / 9.1 / 9.1, and in a gust on the
-    IEA-22-280-RWT's 2 deg/s drives it fell behind the baseline's.)"""
-    from mpc_wt.controllers.ipc import IBCController
-
-    base = BaselineController(turbine, tune_baseline(turbine))
-    ctl = law_controller(IBCController(base, ibc_gains), "ibc", turbine)
+    if kind == "ibc":
+        design = IBCController(base, ibc_gains)
+    else:
+        design = ColemanIPCController(base, tune_coleman_ipc(turbine, winds=[14.0, 20.0]))
+        assert math.degrees(design.step_max) == pytest.approx(0.1, rel=1e-9)
+    ctl = law_controller(design, kind, turbine)
     w_set = base.gains.rated_gen_speed_rad_s
     for speed, expect in ((w_set, [11.9, 9.1, 9.1]), (w_set + 60.0, [12.1, 9.1, 9.1])):
         ctl.reset()
