@@ -53,7 +53,8 @@ def _condition(raw: Mapping[str, Any] | None) -> dict[str, Any]:
 def design_controller(turbine: linearize.Turbine, controller: str,
                       options: Mapping[str, Any] | None = None, *,
                       cache: DesignCache = DEFAULT_CACHE, naming: Naming = API_NAMING,
-                      params: linearize.PlantParams | None = None) -> tuple[Built, bool]:
+                      params: linearize.PlantParams | None = None,
+                      shipped: bool = False) -> tuple[Built, bool]:
     """The design of a controller for a turbine: made once and kept in ``cache`` (keyed on the
     turbine's content, the name and the options), so that every case after the first runs the
     same design. The build sees the turbine, its options and the harness's step only
@@ -81,6 +82,10 @@ def design_controller(turbine: linearize.Turbine, controller: str,
         How error messages name options.
     params : PlantParams, optional
         The turbine's plant parameters, if already derived.
+    shipped : bool
+        The design as its runs run it (default False): a kind that exports as the host of its
+        compiled law, ``meta["design"]["law"]`` that law's build key
+        (:func:`mpc_wt.io.discon_export.shipped_law_key`).
 
     Returns
     -------
@@ -91,7 +96,7 @@ def design_controller(turbine: linearize.Turbine, controller: str,
         True when it was made now, False when it came from the cache.
     """
     sel = resolve(controller)
-    return _design(turbine, sel, sel.options(options, naming), cache, params)
+    return _design(turbine, sel, sel.options(options, naming), cache, params, shipped=shipped)
 
 
 def _design(turbine: linearize.Turbine, sel: Selection, opts: Sequence[Options],

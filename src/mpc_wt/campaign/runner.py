@@ -172,12 +172,23 @@ def run_campaign(spec: CampaignSpec, out: str | Path, *, workers: int | None = N
         return summary
 
 
-def _recorded_design(path: Path) -> str | None:
-    """The design digest a result file records (None if it records none or cannot be read)."""
+def _recorded_design(path: Path) -> dict[str, Any] | None:
+    """The design a result file records: its digest and, for a shipped law, the law's build
+    key (None if it records none or cannot be read)."""
     from mpc_wt.simulation.results import ClosedLoopResult
 
     design = (ClosedLoopResult.read_meta(path) or {}).get("design")
-    return design.get("digest") if isinstance(design, dict) else None
+    return design if isinstance(design, dict) and design.get("digest") else None
+
+
+def _differs(recorded: dict[str, Any] | None, now: dict[str, Any]) -> bool:
+    """Whether a finished case's recorded design is not the one made now: another digest, or
+    another law where both name theirs (a file of a version that recorded no law keeps)."""
+    if recorded is None:
+        return False
+    if recorded["digest"] != now.get("digest"):
+        return True
+    return bool(recorded.get("law") and now.get("law") and recorded["law"] != now["law"])
 
 
 def check_designs(spec: CampaignSpec, store: CampaignStore) -> int:
@@ -188,7 +199,10 @@ def check_designs(spec: CampaignSpec, store: CampaignStore) -> int:
     check): a new version that changes one would keep the old results. Each controller with
     finished cases is designed once here (as its workers will) and the design's digest
     (:func:`~mpc_wt.registry.context.design_digest`) compared with the one each finished case's
-    file records; a case whose design differs is computed again, its file kept as
+    file records, and a shipped law's build key
+    (:func:`~mpc_wt.io.discon_export.shipped_law_key`: its C sources, compiler and flags) with
+    the one the file records (a fixed law, the same numbers); a case whose design differs is
+    computed again, its file kept as
     ``cases/ID.redesigned.nc`` (logged). A controller that cannot be designed here keeps its
     cases (logged).
 
@@ -224,13 +238,13 @@ def check_designs(spec: CampaignSpec, store: CampaignStore) -> int:
         try:
             load_plugins(first.plugins, first.plugin_folder)
             built, _ = design_controller(load_case_turbine(first.turbine), first.run_name,
-                                         first.options)
-            now = built.meta["design"]["digest"]
+                                         first.options, shipped=True)
+            now = built.meta["design"]
         except Exception as err:       # a design that fails here fails in its cases too
             log.warning("controller %s could not be designed to check the design of its %d "
                         "finished cases (%s); they are kept", name, len(cases), err)
             continue
-        stale = [cid for cid, d in recorded.items() if d is not None and d != now]
+        stale = [cid for cid, d in recorded.items() if _differs(d, now)]
         if stale:
             log.warning("controller %s: %d finished cases were computed with another design "
                         "than this version makes from the same options (a default of the kind "

@@ -531,9 +531,7 @@ def shipped_library(export: LawExport, *, compiler: str | None = None) -> Path:
     name = library_name(export.law)
     with tempfile.TemporaryDirectory(prefix="mpcwt_shipped_") as tmp:
         folder = Path(tmp)
-        _copy_sources(folder, export)
-        flags = _CFLAGS.split() + _defines(folder)
-        key = _digest("\0".join(_build_key(folder, cc, flags)).encode())[:24]
+        key = _law_key(folder, export, cc)
         target = cache_dir() / "libraries" / key / name
         if not target.is_file():
             lib = build_library(folder, export.law, compiler=cc, name=name)
@@ -544,6 +542,48 @@ def shipped_library(export: LawExport, *, compiler: str | None = None) -> Path:
             log.info("the %s law's library built and cached at %s", export.law, target)
     _SHIPPED[memo] = target
     return target
+
+
+def _law_key(folder: Path, export: LawExport, cc: str) -> str:
+    """The sources of ``export``'s law copied into ``folder``; their build key (sources,
+    compiler, flags), 24 hex digits."""
+    _copy_sources(folder, export)
+    flags = _CFLAGS.split() + _defines(folder)
+    key = _digest("\0".join(_build_key(folder, cc, flags)).encode())[:24]
+    _LAW_KEYS[(export.law, export.sources, export.qp, cc)] = key
+    return key
+
+
+_LAW_KEYS: dict[tuple[Any, ...], str] = {}
+
+
+def shipped_law_key(export: LawExport, *, compiler: str | None = None) -> str | None:
+    """What the library :func:`shipped_library` builds for ``export`` is made of: a digest of
+    its C sources (the solver's too), the compiler and the flags. Two runs whose keys are equal
+    ran the same law; a campaign computes again the finished cases of a law whose key changed
+    (:func:`mpc_wt.campaign.runner.check_designs`).
+
+    Parameters
+    ----------
+    export : LawExport
+    compiler : str, optional
+        The C compiler (default :func:`find_compiler`).
+
+    Returns
+    -------
+    str or None
+        24 hex digits; None without a C compiler (nothing can be built, nothing compared).
+    """
+    import tempfile
+
+    cc = compiler or find_compiler()
+    if cc is None:
+        return None
+    memo = (export.law, export.sources, export.qp, cc)
+    if memo not in _LAW_KEYS:
+        with tempfile.TemporaryDirectory(prefix="mpcwt_lawkey_") as tmp:
+            _law_key(Path(tmp), export, cc)
+    return _LAW_KEYS[memo]
 
 
 def shipped_input(controller: Any, export: LawExport, turbine: linearize.Turbine,

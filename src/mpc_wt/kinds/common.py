@@ -23,7 +23,8 @@ def run_as_shipped(ctx: BuildContext, export: Any, built: Built) -> Built:
     library (:func:`mpc_wt.io.discon_export.shipped_library`) called through the host in this
     process, so that every run of the kind calls the law users run in OpenFAST. A plugin's
     design with a step of its own that its law does not take keeps that step (logged); the
-    run's metadata says which law ran (``meta["law"]``).
+    run's metadata says which law ran (``meta["law"]``; ``meta["design"]["law"]`` the build
+    key of its library, :func:`mpc_wt.io.discon_export.shipped_law_key`).
 
     Parameters
     ----------
@@ -56,10 +57,13 @@ def run_as_shipped(ctx: BuildContext, export: Any, built: Built) -> Built:
             raise
         log.info("%s: the design does not export (%s); its Python step runs", export.name, err)
         return dataclasses.replace(built, meta={**built.meta, "law": "python"})
+    from mpc_wt.io.discon_export import shipped_law_key
+
+    design = {**built.meta.get("design", {}), "law": shipped_law_key(export)}
     return dataclasses.replace(built, controller=ctl, controller_dt=ctl.dt, preview=None,
                                design=built.controller,
                                meta={**built.meta, "law": "shipped",
-                                     "library": ctl.library.name})
+                                     "library": ctl.library.name, "design": design})
 
 
 def shipped_host(design: Any, export: Any, turbine: linearize.Turbine, preview: Any = None, *,

@@ -870,3 +870,40 @@ def test_a_default_changed_in_code_computes_the_cases_again(tmp_path, monkeypatc
         registry._PLUGINS_LOADED.discard("code_default_kind")
         sys.modules.pop("code_default_kind", None)
         DEFAULT_CACHE.clear()
+
+
+def test_a_law_built_otherwise_computes_the_cases_again(tmp_path, monkeypatch) -> None:
+    """The same design run by another build of its law (here another compiler flag, as a fixed
+    C source would be): the files record the law's build key, a resume finds it changed and
+    computes the cases again; with the law as it was a resume computes nothing. A file that
+    records no law (an older version's) keeps."""
+    from mpc_wt.io import discon_export
+    from mpc_wt.registry.context import DEFAULT_CACHE
+
+    spec = spec_from_dict({"name": "law-build", "duration": 10, "transient": 0,
+                           "winds": [18], "seeds": [1, 2], "turbulence": "A",
+                           "controllers": [{"name": "b", "controller": "baseline"}],
+                           "channels": {"tower_base_fa_moment": 4}})
+    out = tmp_path / "c"
+    s = run_campaign(spec, out, engine="serial", progress=False)
+    assert (s.done, s.failed) == (2, 0)
+    first = ClosedLoopResult.read_meta(next((out / "cases").glob("*.nc")))
+    assert len(first["design"]["law"]) == 24
+    s = run_campaign(spec, out, engine="serial", progress=False)
+    assert (s.submitted, s.sync["redesigned"]) == (0, 0)
+    monkeypatch.setattr(discon_export, "_CFLAGS", discon_export._CFLAGS + " -DMPCWT_REBUILT=1")
+    monkeypatch.setattr(discon_export, "_SHIPPED", {})
+    monkeypatch.setattr(discon_export, "_LAW_KEYS", {})
+    DEFAULT_CACHE.clear()
+    try:
+        s = run_campaign(spec, out, engine="serial", progress=False)
+        assert (s.submitted, s.done, s.sync["redesigned"]) == (2, 2, 2)
+        again = ClosedLoopResult.read_meta(next((out / "cases").glob("*s1.nc")))
+        assert again["design"]["law"] != first["design"]["law"]
+        assert again["design"]["digest"] == first["design"]["digest"]
+    finally:
+        DEFAULT_CACHE.clear()
+    from mpc_wt.campaign.runner import _differs
+
+    assert not _differs({"digest": "d"}, {"digest": "d", "law": "k"})      # no law recorded
+    assert _differs({"digest": "d", "law": "j"}, {"digest": "d", "law": "k"})
