@@ -523,9 +523,10 @@ def _mpc_entries(ctl: Any, preview: Any = None) -> list[tuple[str, Any, str]]:
         rows.append(("law_torque", np.array([lt._a, lt._offset, lt._lo, lt._hi], float),
                      "speed filter pole, below-rated pitch offset [rad], torque min, max "
                      "[N m]"))
-        rows.append(("law_region3_speed",
-                     ctl.law_region3_speed * lt.law.gains.rated_gen_speed_rad_s,
-                     "the law's pitch tells region 3 above this generator speed [rad/s]"))
+        rows.append(("law_lull_speeds", np.asarray(ctl.law_lull_speeds, float)
+                     * lt.law.gains.rated_gen_speed_rad_s,
+                     "the target is the law's region-2 torque below the first generator speed, "
+                     "the law's own above the second, blended between [rad/s]"))
     notch = ctl._notch
     rows.append(("torque_notch", float(notch is not None),
                  "1: a notch on the torque command (the estimator is given the filtered torque)"))

@@ -78,7 +78,8 @@ typedef struct {
     mw_point *pt;
     mw_schedule sched;
     mw_torque_law law;
-    double law_region3_speed;     /* the law's pitch counts above this generator speed [rad/s] */
+    double law_lull[2];           /* the law's pitch counts in full above law_lull[1], not at
+                                     all below law_lull[0] (generator speeds [rad/s]) */
     double target_wind, pitch_target_wind;
     int target_started;
     int has_notch;                /* the notch on the torque command, its largest rate */
@@ -564,11 +565,18 @@ static int mpc_step(mw_ctrl *self, const mw_meas *m, mw_cmd *out, char *msg)
         }
         if (c->has_law) {
             double w_g = m->gen_speed, pitch = (m->pitch[0] + m->pitch[1] + m->pitch[2]) / 3.0;
-            double q;
+            double q = mw_torque_law_step(&c->law, w_g, pitch, c->law.law.p_rated);
             /* a pitched rotor well below rated speed is in a lull, not in region 3: the
-             * target is the law's region-2 torque there, not rated power's */
-            if (w_g < c->law_region3_speed) pitch = c->law.law.p_min;
-            q = mw_torque_law_step(&c->law, w_g, pitch, c->law.law.p_rated);
+             * target there is the law's region-2 torque, not rated power's, reached linearly
+             * in the filtered speed between the two lull speeds (no step in the target) */
+            double a = (c->law.w - c->law_lull[0]) / (c->law_lull[1] - c->law_lull[0]);
+            if (a < 1.0) {
+                double q2 = mw_law_torque(&c->law.law, c->law.w, c->law.law.p_min,
+                                          c->law.law.p_rated);
+                q2 = dmin(dmax(q2, c->law.lo), c->law.hi);
+                a = dmax(a, 0.0);
+                q = a * q + (1.0 - a) * q2;
+            }
             c->ut[3] = q;
             c->zt[c->ip] = dmin(c->zt[c->ip], c->eff * q * w_g);
         }
@@ -694,11 +702,13 @@ static int mpc_read(const mw_input *in, mw_ctrl *self, char *msg)
     }
     if (c->has_law) {
         if (mw_torque_law_read(in, &c->law, msg)
-            || mw_get(in, "law_region3_speed", &c->law_region3_speed, msg))
+            || mw_getp_vec(in, "", "law_lull_speeds", c->law_lull, 2, msg))
             return -1;
-        if (!(c->law_region3_speed >= 0.0) || !mw_finite(c->law_region3_speed)) {
-            mw_msg(msg, "mpc-wt mpc: input file '%s': key 'law_region3_speed' must be a finite "
-                   "generator speed >= 0 rad/s, got %g", in->path, c->law_region3_speed);
+        if (!mw_finite(c->law_lull[0]) || !mw_finite(c->law_lull[1]) || !(c->law_lull[0] >= 0.0)
+            || !(c->law_lull[1] > c->law_lull[0])) {
+            mw_msg(msg, "mpc-wt mpc: input file '%s': key 'law_lull_speeds' must be two finite "
+                   "generator speeds, 0 <= first < second [rad/s], got %g %g", in->path,
+                   c->law_lull[0], c->law_lull[1]);
             return -1;
         }
     }
