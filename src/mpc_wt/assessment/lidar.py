@@ -72,8 +72,7 @@ def lidar_evaluation(field: lidar.WindField, turbine: linearize.Turbine, *,
                          f"{tp:.2f} s plus a {horizon * dt_ctrl:g} s horizon")
     t = np.arange(field.t[0], t_end, 1.0 / sample_rate)
     psi = omega * t
-    focus_distance = lid.focus_distance
-    seen = lidar.evolve_field(field, focus_distance, seed=evolution_seed) if evolution else field
+    seen = lidar.evolve_field(field, lid.focus_distance, seed=evolution_seed) if evolution else field
     meas = lid.measure(seen, t, psi, omega)
     later = lidar.blade_effective_wind(field, t + tp, psi + omega * tp, lid.radius)
     fs = sample_rate
@@ -81,7 +80,7 @@ def lidar_evaluation(field: lidar.WindField, turbine: linearize.Turbine, *,
     gamma2 = np.column_stack([lidar.coherence(meas.u_hat[:, i], later[:, i], fs,
                                               nperseg=256)[1] for i in range(3)])
     bw = lidar.coherence_bandwidth(f, gamma2.mean(axis=1))
-    res = {"focus_m": focus_distance, "preview_time_s": tp,
+    res = {"focus_m": lid.focus_distance, "preview_time_s": tp,
            "lead_angle_deg": math.degrees(omega * tp) % 360.0,
            "rotor_speed_rpm": omega * 30 / math.pi, "coherence_bandwidth_Hz": bw,
            "coherence_bandwidth_rad_per_m": 2 * math.pi * bw / field.mean_speed,
