@@ -506,7 +506,8 @@ def shipped_library(export: LawExport, *, compiler: str | None = None) -> Path:
     Returns
     -------
     Path
-        The library; a new build where the sources, compiler or flags changed.
+        The library, in a folder named by the build key of its sources, compiler and flags
+        (:func:`shipped_law_key`); a new build where any of them changed.
 
     Raises
     ------
@@ -531,7 +532,9 @@ def shipped_library(export: LawExport, *, compiler: str | None = None) -> Path:
     name = library_name(export.law)
     with tempfile.TemporaryDirectory(prefix="mpcwt_shipped_") as tmp:
         folder = Path(tmp)
-        key = _law_key(folder, export, cc)
+        _copy_sources(folder, export)
+        flags = _CFLAGS.split() + _defines(folder)
+        key = _digest("\0".join(_build_key(folder, cc, flags)).encode())[:24]
         target = cache_dir() / "libraries" / key / name
         if not target.is_file():
             lib = build_library(folder, export.law, compiler=cc, name=name)
@@ -544,24 +547,11 @@ def shipped_library(export: LawExport, *, compiler: str | None = None) -> Path:
     return target
 
 
-def _law_key(folder: Path, export: LawExport, cc: str) -> str:
-    """The sources of ``export``'s law copied into ``folder``; their build key (sources,
-    compiler, flags), 24 hex digits."""
-    _copy_sources(folder, export)
-    flags = _CFLAGS.split() + _defines(folder)
-    key = _digest("\0".join(_build_key(folder, cc, flags)).encode())[:24]
-    _LAW_KEYS[(export.law, export.sources, export.qp, cc)] = key
-    return key
-
-
-_LAW_KEYS: dict[tuple[Any, ...], str] = {}
-
-
-def shipped_law_key(export: LawExport, *, compiler: str | None = None) -> str | None:
-    """What the library :func:`shipped_library` builds for ``export`` is made of: a digest of
-    its C sources (the solver's too), the compiler and the flags. Two runs whose keys are equal
-    ran the same law; a campaign computes again the finished cases of a law whose key changed
-    (:func:`mpc_wt.campaign.runner.check_designs`).
+def shipped_law_key(export: LawExport, *, compiler: str | None = None) -> str:
+    """What the library :func:`shipped_library` builds for ``export`` is made of: the digest of
+    its C sources (the solver's too), the compiler and the flags that names its folder in the
+    cache. Two runs whose keys are equal ran the same law; a campaign computes again the
+    finished cases of a law whose key changed (:func:`mpc_wt.campaign.runner.check_designs`).
 
     Parameters
     ----------
@@ -571,19 +561,15 @@ def shipped_law_key(export: LawExport, *, compiler: str | None = None) -> str | 
 
     Returns
     -------
-    str or None
-        24 hex digits; None without a C compiler (nothing can be built, nothing compared).
-    """
-    import tempfile
+    str
+        24 hex digits.
 
-    cc = compiler or find_compiler()
-    if cc is None:
-        return None
-    memo = (export.law, export.sources, export.qp, cc)
-    if memo not in _LAW_KEYS:
-        with tempfile.TemporaryDirectory(prefix="mpcwt_lawkey_") as tmp:
-            _law_key(Path(tmp), export, cc)
-    return _LAW_KEYS[memo]
+    Raises
+    ------
+    ControllerLibraryError, SolverSourceError
+        As :func:`shipped_library` (the library is built if it is not there).
+    """
+    return shipped_library(export, compiler=compiler).parent.name
 
 
 def shipped_input(controller: Any, export: LawExport, turbine: linearize.Turbine,

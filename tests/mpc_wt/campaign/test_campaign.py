@@ -893,7 +893,6 @@ def test_a_law_built_otherwise_computes_the_cases_again(tmp_path, monkeypatch) -
     assert (s.submitted, s.sync["redesigned"]) == (0, 0)
     monkeypatch.setattr(discon_export, "_CFLAGS", discon_export._CFLAGS + " -DMPCWT_REBUILT=1")
     monkeypatch.setattr(discon_export, "_SHIPPED", {})
-    monkeypatch.setattr(discon_export, "_LAW_KEYS", {})
     DEFAULT_CACHE.clear()
     try:
         s = run_campaign(spec, out, engine="serial", progress=False)

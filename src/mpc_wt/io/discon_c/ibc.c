@@ -110,6 +110,23 @@ void mw_sos_free(mw_sos *f)
     free(f->zi);
 }
 
+/* the pitch rate the collective's first: the collective moves from c_last toward c_target
+ * by at most d, and each blade's own part (parts[i]) from a_last[i] within what that leaves;
+ * the blades' demands within the pitch limits into out; the new collective returned */
+static double collective_first(double c_last, const double *a_last, double c_target,
+                               const double *parts, double d, double pmin, double pmax,
+                               double *out)
+{
+    double c_new = dmin(dmax(c_target, c_last - d), c_last + d);
+    double budget = d - fabs(c_new - c_last);
+    int i;
+    for (i = 0; i < 3; i++) {
+        double a = dmin(dmax(parts[i], a_last[i] - budget), a_last[i] + budget);
+        out[i] = dmin(dmax(c_new + a, pmin), pmax);
+    }
+    return c_new;
+}
+
 int mw_ibc_step(mw_ibc *b, const mw_meas *m, double dt, const double *pc, double *out,
                 char *msg)
 {
@@ -134,19 +151,18 @@ int mw_ibc_step(mw_ibc *b, const mw_meas *m, double dt, const double *pc, double
     b->weight = w;
     b->gain = k;
     {
-        /* the collective's part moves first within the rate, the blades' own within what is
-         * left (clipped blade by blade, a collective at the rate fell behind the baseline's) */
-        double prev[3], c_last, c_mean, c_new, budget, d = b->a.rate * dt;
+        /* clipped blade by blade, a collective at the rate fell behind the baseline's */
+        double prev[3], a_last[3], parts[3], c_last, c_mean;
         for (i = 0; i < 3; i++) prev[i] = b->has_last ? b->last[i] : m->pitch[i];
         c_last = (prev[0] + prev[1] + prev[2]) / 3.0;
         c_mean = (pc[0] + pc[1] + pc[2]) / 3.0;
-        c_new = dmin(dmax(c_mean, c_last - d), c_last + d);
-        budget = d - fabs(c_new - c_last);
         for (i = 0; i < 3; i++) {
-            double a_last = prev[i] - c_last;
-            double a = dmin(dmax(pc[i] - c_mean + u[i], a_last - budget), a_last + budget);
-            out[i] = b->last[i] = dmin(dmax(c_new + a, b->a.pmin), b->a.pmax);
+            a_last[i] = prev[i] - c_last;
+            parts[i] = pc[i] - c_mean + u[i];
         }
+        collective_first(c_last, a_last, c_mean, parts, b->a.rate * dt, b->a.pmin, b->a.pmax,
+                         out);
+        for (i = 0; i < 3; i++) b->last[i] = out[i];
     }
     b->has_last = 1;
     return 0;
@@ -188,7 +204,7 @@ void mw_ibc_free(mw_ibc *b)
 int mw_cipc_step(mw_cipc *b, const mw_meas *m, double dt, const double *pc, double *out,
                  char *msg)
 {
-    double psi = m->azimuth, c[3], s[3], w, k, phi, cp, sp, amp, c_mean, c_new, budget;
+    double psi = m->azimuth, c[3], s[3], w, k, phi, cp, sp, amp, c_mean, c_new, parts[3];
     double d = b->a.rate * dt;
     int i;
     if (!mw_finite(m->flap[0] + m->flap[1] + m->flap[2]) || !mw_finite(psi)
@@ -226,13 +242,8 @@ int mw_cipc_step(mw_cipc *b, const mw_meas *m, double dt, const double *pc, doub
         b->has_last = 1;
     }
     /* the collective's part moves first within the rate, the cyclic within what is left */
-    c_new = dmin(dmax(c_mean, b->c_last - d), b->c_last + d);
-    budget = d - fabs(c_new - b->c_last);
-    for (i = 0; i < 3; i++) {
-        double du = b->cyc_c * c[i] + b->cyc_s * s[i];
-        double a = dmin(dmax(pc[i] - c_mean + du, b->a_last[i] - budget), b->a_last[i] + budget);
-        out[i] = dmin(dmax(c_new + a, b->a.pmin), b->a.pmax);
-    }
+    for (i = 0; i < 3; i++) parts[i] = pc[i] - c_mean + (b->cyc_c * c[i] + b->cyc_s * s[i]);
+    c_new = collective_first(b->c_last, b->a_last, c_mean, parts, d, b->a.pmin, b->a.pmax, out);
     b->c_last = c_new;
     for (i = 0; i < 3; i++) b->a_last[i] = out[i] - c_new;
     return 0;
