@@ -177,12 +177,34 @@ def turbine_scale_ratios(turbine: linearize.Turbine) -> dict[str, float]:
     return out
 
 
+def scaling_pitch_rate(turbine: linearize.Turbine) -> float:
+    """The pitch drives' largest rate that the designs' scales go with [rad/s]: the turbine's,
+    at most the NREL 5-MW's (8 deg/s). A faster drive does not make a blade's motion cheaper
+    (its bearings and its duty are the same), and a deck's rate limit can be a placeholder:
+    BAR_10's ``PC_MaxRat`` is 2 rad/s (115 deg/s), which weighed the scheduled LQR's pitch
+    rates 200x less than on the NREL 5-MW (its pitch swung until the rotor overspeeded at
+    18 m/s, 14x the baseline's travel) and let the MPC without preview's soft speed limit
+    rise to 1.22 x rated.
+
+    Parameters
+    ----------
+    turbine : Turbine
+
+    Returns
+    -------
+    float
+        [rad/s], > 0.
+    """
+    return min(turbine.pitch_actuator.max_rate_rad_s, dict(_nrel5mw_magnitudes())["pitch_rate"])
+
+
 def pitch_drive_scale_ratio(turbine: linearize.Turbine,
                             exponent: float = PITCH_RATE_SCALE_EXPONENT) -> float:
-    """The ratio of ``turbine``'s pitch drives' largest rate to the NREL 5-MW's (8 deg/s), to
-    the power ``exponent``: the factor on the MPC's pitch-rate scale (0.71 on the
-    IEA-15-240-RWT with the default exponent) and, with its own exponent, on the scheduled
-    LQR's pitch scale. 1 on the NREL 5-MW.
+    """The ratio of ``turbine``'s pitch drives' largest rate (:func:`scaling_pitch_rate`: at
+    most the NREL 5-MW's) to the NREL 5-MW's (8 deg/s), to the power ``exponent``: the factor
+    on the MPC's pitch-rate scale (0.71 on the IEA-15-240-RWT with the default exponent) and,
+    with its own exponent, on the scheduled LQR's pitch scale. 1 on the NREL 5-MW and on any
+    faster drive.
 
     Parameters
     ----------
@@ -196,7 +218,7 @@ def pitch_drive_scale_ratio(turbine: linearize.Turbine,
     """
     check_number("exponent", exponent, lo=0.0)
     ref = dict(_nrel5mw_magnitudes())["pitch_rate"]
-    return (turbine.pitch_actuator.max_rate_rad_s / ref) ** exponent
+    return (scaling_pitch_rate(turbine) / ref) ** exponent
 
 
 #: The MPC's state sources: its Kalman estimator on measured signals, or the plant's true states.

@@ -60,7 +60,8 @@ LQR_REGION3_ROTOR_SPEED_WEIGHT = 10.0
 
 
 #: The scheduled LQR's weight on each blade's pitch rate, on the scale of the pitch drives'
-#: largest rate (0.1 on (rate / 1 deg/s)^2 on the IEA-15-240-RWT's 2 deg/s drives, 0.006 on
+#: largest rate (at most the NREL 5-MW's: :func:`mpc_wt.controllers.mpc.scaling_pitch_rate`;
+#: 0.1 on (rate / 1 deg/s)^2 on the IEA-15-240-RWT's 2 deg/s drives, 0.006 on
 #: the NREL 5-MW's 8 deg/s). On the IEA-15, class B, seeds 11-12 (not the sign-off's), 5-25
 #: m/s, 600 s, against the baseline: the pitch travel 3.29x -> 2.83x, the shaft's lifetime
 #: bending DEL +1.4 -> +3.2 % (the rate weight at 0.5 and 2 on the 1 deg/s scale: 2.42x and
@@ -349,14 +350,14 @@ def _lqr_pio_at(turbine: linearize.Turbine, model: linearize.LinearModel, wind: 
         turbine_scales,
     )
 
-    from mpc_wt.controllers.mpc import pitch_drive_scale_ratio
+    from mpc_wt.controllers.mpc import pitch_drive_scale_ratio, scaling_pitch_rate
 
     region = "II" if wind < linearize.rated_wind_speed(turbine) else "III"
     w, iw = opts.lqr_weights(region, turbine)
     scales = {**REGION2_SCALES, **REGION3_SCALES}
     r = pitch_drive_scale_ratio(turbine, LQR_PITCH_SCALE_EXPONENT)   # slower drives: dearer
     scales.update({k: v * r for k, v in scales.items() if k.startswith("pitch_ref_")})
-    scales.update({f"pitch_rate_{i}": turbine.pitch_actuator.max_rate_rad_s for i in (1, 2, 3)})
+    scales.update({f"pitch_rate_{i}": scaling_pitch_rate(turbine) for i in (1, 2, 3)})
     lq = design_lqr(model, state_weights=w, output_weights=opts.output_weights(),
                     input_weights=iw, scales=scales)
     sy = {k: v * (opts.moment_scale if k.startswith("flap_moment") else 1.0)

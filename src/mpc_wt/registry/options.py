@@ -111,6 +111,12 @@ def _convert(key: str, val: Any, tp: Any, meta: Mapping[str, Any]) -> Any:
 
 
 def _number(key: str, val: Any, base: Any, meta: Mapping[str, Any]) -> float | int:
+    if isinstance(val, str):
+        # YAML 1.1 (PyYAML) reads 4.2e5, without a dot in the mantissa, as a string
+        try:
+            val = int(val.strip()) if base is int else float(val.strip())
+        except ValueError:
+            raise OptionsError(f"{key} must be a number, got {val!r}", key) from None
     try:
         v = check_number(key, val, lo=meta.get("lo"), hi=meta.get("hi"),
                          lo_open=bool(meta.get("lo_open")), unit=meta.get("unit") or "",

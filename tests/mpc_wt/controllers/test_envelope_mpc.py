@@ -203,6 +203,29 @@ def test_cost_scales_follow_the_turbine() -> None:
     assert w0.for_turbine(five) == w0
 
 
+def test_a_pitch_drive_faster_than_the_nrel5mw_does_not_cheapen_the_pitch() -> None:
+    """BAR_10's deck gives its pitch drives 2 rad/s (ROSCO's ``PC_MaxRat``, 115 deg/s): the
+    scales go with the NREL 5-MW's 8 deg/s, so the designs weigh a blade's motion as on the
+    NREL 5-MW (ratio 1), the scheduled LQR's pitch-rate scale is 8 deg/s, and the MPC without
+    preview keeps the NREL 5-MW's soft speed limit (1.1 x rated; 1.22 with the deck's rate)."""
+    import dataclasses
+    import math
+
+    from mpc_wt.controllers.mpc import (pitch_drive_scale_ratio, scaling_pitch_rate,
+                                        turbine_scale_ratios)
+    from mpc_wt.kinds.mpc import ENVELOPE_SPEED_LIMIT, MPCOptions, _mpc_settings, \
+        _no_preview_drives
+
+    five = linearize.load_turbine("nrel5mw")
+    fast = dataclasses.replace(five, pitch_actuator=dataclasses.replace(
+        five.pitch_actuator, max_rate_rad_s=2.0))
+    assert scaling_pitch_rate(fast) == pytest.approx(math.radians(8.0))
+    assert pitch_drive_scale_ratio(fast, 0.5) == 1.0
+    assert turbine_scale_ratios(fast)["pitch_rate"] == 1.0
+    _, limit = _no_preview_drives(fast, _mpc_settings(MPCOptions(), False, False))
+    assert limit == pytest.approx(ENVELOPE_SPEED_LIMIT) == pytest.approx(1.1)
+
+
 def test_the_torque_bound_and_the_torque_rate_weight_act(turbine, tmp_path) -> None:
     """The 10-14 m/s step of the test above, three designs without the power ceiling
     (``power_limit: null``, ``speed_limit: 1.065``). With ``torque_limit: 1.0`` no

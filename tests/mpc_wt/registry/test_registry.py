@@ -204,6 +204,21 @@ def test_option_class_for_users_validates_its_fields() -> None:
         Mine.from_dict({"gain": float("nan")})
 
 
+def test_a_number_yaml_reads_as_a_string_is_taken_as_the_number() -> None:
+    """PyYAML (YAML 1.1) reads ``4.49e6`` (no dot in the mantissa) as a string: the option is
+    that number, as ``4.49e+6`` would be; a string that is no number is named as such."""
+    import yaml
+
+    raw = yaml.safe_load("{kalman_flap_std: 4.49e6, horizon: '12'}")
+    assert raw["kalman_flap_std"] == "4.49e6"              # what the spec file hands over
+    opts = resolve("mpc").options(raw)[0]
+    assert (opts.kalman_flap_std, opts.horizon) == (4.49e6, 12)
+    with pytest.raises(OptionsError, match="kalman_flap_std must be a number, got 'big'"):
+        resolve("mpc").options({"kalman_flap_std": "big"})
+    with pytest.raises(OptionsError, match="horizon must be a number, got '2.5'"):
+        resolve("mpc").options({"horizon": "2.5"})
+
+
 @pytest.mark.parametrize("argv, match", [
     (["linearize", "--wind", "12", "--out", "models.lin"], "--out must end in .mat, .npz, .json"),
     (["design", "ts", "--decay-rate=-1"], "--decay-rate must be > 0, got -1.0"),
