@@ -415,3 +415,24 @@ def test_without_a_preview_the_mpc_adds_no_shaft_bending(turbine) -> None:
     print(f"shaft bending {sb_m / sb_b - 1:+.1%}, pitch travel {tr_m / tr_b:.2f}x")
     assert sb_m <= 1.05 * sb_b
     assert tr_m < 2.0 * tr_b
+
+
+def test_the_below_rated_pitch_weight_rises_only_where_the_pitch_can_move_both_ways() -> None:
+    """The NREL 5-MW's region-2 pitch is its fine pitch, 0 deg, the drives' lowest (its
+    published report): the below-rated designs keep the pitch weight above rated. With the
+    drives allowed 2 deg below fine pitch (as the NREL-2.8-127's deck allows 10), or with a
+    minimum-pitch schedule above the lowest pitch (the IEA-15's 3.8 deg at cut-in, WISDEM's
+    schedule), the pitch can move both ways around a flat power coefficient and the designs
+    below rated weigh it :data:`BELOW_RATED_FREE_PITCH_WEIGHT`."""
+    import dataclasses
+    import math
+
+    from mpc_wt.kinds.mpc import (BELOW_RATED_FREE_PITCH_WEIGHT, _pitch_free_below_rated)
+
+    five = linearize.load_turbine("nrel5mw")
+    assert not _pitch_free_below_rated(five)
+    lower = dataclasses.replace(five, pitch_actuator=dataclasses.replace(
+        five.pitch_actuator, min_pitch_rad=math.radians(-2.0)))
+    assert _pitch_free_below_rated(lower)
+    assert _pitch_free_below_rated(linearize.load_turbine("iea15mw"))
+    assert BELOW_RATED_FREE_PITCH_WEIGHT > 0.01
