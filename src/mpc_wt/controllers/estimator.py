@@ -19,10 +19,11 @@ import scipy.linalg
 import linearize
 from linearize.validate import check_number
 
-__all__ = ["KalmanEstimator", "MEASURED_SIGNALS", "STATE_NOISE", "turbine_noise"]
+__all__ = ["KalmanEstimator", "MEASURED_SIGNALS", "STATE_NOISE"]
 
 #: Model outputs the estimator uses and their default measurement noise std [output units]
-#: (the NREL 5-MW's: :func:`turbine_noise` carries them to another turbine).
+#: (the NREL 5-MW's: :func:`mpc_wt.controllers.mpc.turbine_noise` carries them to another
+#: turbine).
 MEASURED_SIGNALS: dict[str, float] = {
     "rotor_speed": 1e-3, "gen_speed": 0.1, "pitch_1": 1e-4, "pitch_2": 1e-4, "pitch_3": 1e-4,
     "flap_moment_1": 2e4, "flap_moment_2": 2e4, "flap_moment_3": 2e4,
@@ -32,47 +33,6 @@ MEASURED_SIGNALS: dict[str, float] = {
 STATE_NOISE = {"tower_fa_displacement": 1e-3, "tower_fa_velocity": 2e-3, "rotor_speed": 1e-4,
                 "gen_speed": 1e-2, "shaft_torsion": 1e-5, "pitch_1": 1e-5, "pitch_2": 1e-5,
                 "pitch_3": 1e-5}
-
-
-def turbine_noise(turbine: linearize.Turbine, flap_std: float = MEASURED_SIGNALS["flap_moment_1"]
-                  ) -> dict[str, dict[str, float]]:
-    """The noise of the measured signals and of the states carried from the NREL 5-MW (whose
-    are :data:`MEASURED_SIGNALS`, :data:`STATE_NOISE` and ``flap_std``) to ``turbine``: rotor
-    and generator speed, flap moments and shaft torsion in proportion to the turbine's own at
-    rated wind (:func:`mpc_wt.controllers.mpc.turbine_scale_ratios`; the generator speed is the
-    rotor's times the gearbox ratio); angles and the tower's acceleration keep theirs.
-
-    The filter weighs each residual by its noise: with the NREL 5-MW's numbers on the
-    IEA-22-280-RWT (flap moments 10.7x, rotor speed 0.58x the NREL 5-MW's) the flap moments
-    counted 18x as much against the rotor speed as intended, the blade winds took the model's
-    flap moment error, and the rotor-speed estimate sat 0.7 % below the measured speed in
-    steady 18 m/s wind; the MPC on it then held the rotor 1.3 % above rated speed.
-
-    Parameters
-    ----------
-    turbine : Turbine
-    flap_std : float
-        The flap moments' noise at the NREL 5-MW's scale [N m].
-
-    Returns
-    -------
-    dict
-        ``{"measurement_std": {...}, "state_std": {...}}``, keyword arguments of
-        :class:`KalmanEstimator`; the NREL 5-MW's exactly the defaults (and ``flap_std``).
-    """
-    from mpc_wt.controllers.mpc import turbine_scale_ratios
-
-    check_number("flap_std", flap_std, lo=0.0, lo_open=True, unit="N m")
-    r = turbine_scale_ratios(turbine)
-    speed = r["rotor_speed"]
-    gen = speed * turbine.drivetrain.gearbox_ratio / 97.0   # the NREL 5-MW's gearbox: 97
-    meas = {"rotor_speed": MEASURED_SIGNALS["rotor_speed"] * speed,
-            "gen_speed": MEASURED_SIGNALS["gen_speed"] * gen}
-    meas.update({f"flap_moment_{b}": flap_std * r["flap_moment"] for b in (1, 2, 3)})
-    state = {"rotor_speed": STATE_NOISE["rotor_speed"] * speed,
-             "gen_speed": STATE_NOISE["gen_speed"] * gen,
-             "shaft_torsion": STATE_NOISE["shaft_torsion"] * r["shaft_torsion"]}
-    return {"measurement_std": meas, "state_std": state}
 
 
 class KalmanEstimator:

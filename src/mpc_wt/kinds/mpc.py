@@ -346,7 +346,7 @@ def _mpc(collective: bool, with_lidar: bool) -> Any:
     def build(ctx: BuildContext, opts: MPCOptions) -> Built:
         from mpc_wt.controllers.mpc import MPC, ScheduledMPC
 
-        from mpc_wt.controllers.estimator import turbine_noise
+        from mpc_wt.controllers.mpc import turbine_noise
 
         settings = _mpc_settings(opts, collective, with_lidar)
         settings = settings.replace(

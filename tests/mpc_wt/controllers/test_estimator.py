@@ -7,9 +7,8 @@ import numpy as np
 import pytest
 
 import linearize
-from mpc_wt.controllers.estimator import (MEASURED_SIGNALS, STATE_NOISE, KalmanEstimator,
-                                          turbine_noise)
-from mpc_wt.controllers.mpc import MPC, MPCSettings
+from mpc_wt.controllers.estimator import MEASURED_SIGNALS, STATE_NOISE, KalmanEstimator
+from mpc_wt.controllers.mpc import MPC, MPCSettings, turbine_noise
 from mpc_wt.run import law_controller
 from mpc_wt.simulation.loop import simulate_closed_loop
 
