@@ -595,7 +595,7 @@ class BaselineController(DesignBase):
         self.rate = turbine.pitch_actuator.max_rate_rad_s
         self.tq_rate = turbine.generator.max_torque_rate
         self.tq_max = turbine.generator.max_torque
-        #: the largest below-rated trim pitch [rad], set by the first LawTorque on this law
+        #: the largest below-rated trim pitch [rad], set by :meth:`largest_region2_pitch`
         self.below_rated_pitch: float | None = None
         self._breakpoints(slip_pct)
         self._par = law_parameters(self)
@@ -643,6 +643,18 @@ class BaselineController(DesignBase):
             [rad]
         """
         return self.pitch_min + float(min_pitch_offset(float(w_filt), self._par))
+
+    def largest_region2_pitch(self) -> float:
+        """:func:`below_rated_pitch` of this law's turbine [rad], one trim sweep per law.
+
+        Returns
+        -------
+        float
+            [rad] above fine pitch, >= 0.
+        """
+        if self.below_rated_pitch is None:
+            self.below_rated_pitch = below_rated_pitch(self.turbine)
+        return self.below_rated_pitch
 
     def torque(self, w: float, pitch: float, power: float | None = None) -> float:
         """The torque law: generator torque demand for a filtered generator speed and the
@@ -696,9 +708,7 @@ class LawTorque:
         self._a = math.exp(-law.wc * float(dt))
         g = law.turbine.generator
         self._lo, self._hi = g.min_torque, g.max_torque
-        if law.below_rated_pitch is None:                      # one trim sweep per law
-            law.below_rated_pitch = below_rated_pitch(law.turbine)
-        self._offset = law.below_rated_pitch
+        self._offset = law.largest_region2_pitch()
         self._has_min_pitch = any(o > 0.0 for o in law.min_pitch_offsets)
 
 

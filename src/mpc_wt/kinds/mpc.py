@@ -315,24 +315,25 @@ def _tower_notch(ctx: BuildContext, opts: MPCOptions, dt: float) -> Optional[flo
     return f
 
 
-def _pitch_free_below_rated(turbine: linearize.Turbine) -> bool:
+def _pitch_free_below_rated(law: Any) -> bool:
     """Whether the trim's region-2 pitch lies above the pitch actuator's lowest pitch anywhere
     from cut-in to rated (a minimum-pitch schedule, or a fine pitch above that limit): there the
-    designs may move the pitch both ways (:data:`BELOW_RATED_FREE_PITCH_WEIGHT`)."""
-    from mpc_wt.controllers.baseline import below_rated_pitch
+    designs may move the pitch both ways (:data:`BELOW_RATED_FREE_PITCH_WEIGHT`). ``law`` is the
+    designs' torque law (a :class:`~mpc_wt.controllers.baseline.BaselineController`), which
+    keeps the trim sweep's largest pitch."""
+    t = law.turbine
+    above_lowest = (law.largest_region2_pitch() + t.operation.fine_pitch_rad
+                    - t.pitch_actuator.min_pitch_rad)
+    return above_lowest > math.radians(0.01)
 
-    above_fine = below_rated_pitch(turbine)
-    lowest = turbine.pitch_actuator.min_pitch_rad
-    return above_fine + turbine.operation.fine_pitch_rad - lowest > math.radians(0.01)
 
-
-def _below_rated(ctx: BuildContext, opts: MPCOptions, settings: Any) -> Any:
+def _below_rated(ctx: BuildContext, opts: MPCOptions, settings: Any, law: Any) -> Any:
     """The scheduled designs' settings below rated wind: their weights
     (:data:`BELOW_RATED_WEIGHTS`, the pitch's :data:`BELOW_RATED_FREE_PITCH_WEIGHT` where
     :func:`_pitch_free_below_rated`, and the options' ``below_rated_weights`` over the others)
     and soft speed limit (``below_rated_speed_limit``, default :data:`BELOW_RATED_SPEED_LIMIT`)."""
     base = dict(BELOW_RATED_WEIGHTS)
-    if _pitch_free_below_rated(ctx.turbine):
+    if _pitch_free_below_rated(law):
         base["pitch_ref"] = BELOW_RATED_FREE_PITCH_WEIGHT
     weights = opts.below_rated_weights.over(MPCWeightOptions(**base).over(settings.weights))
     limit = opts.below_rated_speed_limit
@@ -344,9 +345,7 @@ def _below_rated(ctx: BuildContext, opts: MPCOptions, settings: Any) -> Any:
 
 def _mpc(collective: bool, with_lidar: bool) -> Any:
     def build(ctx: BuildContext, opts: MPCOptions) -> Built:
-        from mpc_wt.controllers.mpc import MPC, ScheduledMPC
-
-        from mpc_wt.controllers.mpc import turbine_noise
+        from mpc_wt.controllers.mpc import MPC, ScheduledMPC, turbine_noise
 
         settings = _mpc_settings(opts, collective, with_lidar)
         settings = settings.replace(
@@ -375,7 +374,7 @@ def _mpc(collective: bool, with_lidar: bool) -> Any:
                                wind_source="preview" if with_lidar else "estimator",
                                wind_estimator=wind_estimator(ctx, settings.dt),
                                time_constant=opts.schedule_time_constant,
-                               torque_law=law, below_rated=_below_rated(ctx, opts, settings),
+                               torque_law=law, below_rated=_below_rated(ctx, opts, settings, law),
                                torque_notch_hz=_torque_notch(ctx, opts, settings.dt),
                                torque_notch_q=opts.torque_notch_q,
                                tower_notch_hz=_tower_notch(ctx, opts, settings.dt),

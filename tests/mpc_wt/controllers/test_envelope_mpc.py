@@ -427,12 +427,16 @@ def test_the_below_rated_pitch_weight_rises_only_where_the_pitch_can_move_both_w
     import dataclasses
     import math
 
+    from mpc_wt.controllers.baseline import BaselineController, tune_baseline
     from mpc_wt.kinds.mpc import (BELOW_RATED_FREE_PITCH_WEIGHT, _pitch_free_below_rated)
 
+    def law(t: linearize.Turbine) -> BaselineController:
+        return BaselineController(t, tune_baseline(t))
+
     five = linearize.load_turbine("nrel5mw")
-    assert not _pitch_free_below_rated(five)
+    assert not _pitch_free_below_rated(law(five))
     lower = dataclasses.replace(five, pitch_actuator=dataclasses.replace(
         five.pitch_actuator, min_pitch_rad=math.radians(-2.0)))
-    assert _pitch_free_below_rated(lower)
-    assert _pitch_free_below_rated(linearize.load_turbine("iea15mw"))
+    assert _pitch_free_below_rated(law(lower))
+    assert _pitch_free_below_rated(law(linearize.load_turbine("iea15mw")))
     assert BELOW_RATED_FREE_PITCH_WEIGHT > 0.01
